@@ -1,0 +1,1 @@
+"""The scene library and loader, metrics, the runner and the CLI."""

@@ -1,0 +1,63 @@
+"""The engines simparity knows, by name, imported only when asked for."""
+
+from __future__ import annotations
+
+import importlib
+
+from core.engine import Engine, KinematicsModel, Simulation, Support
+from core.errors import UnknownEngineError
+
+_ENGINES = {
+    "core": ("core.inhouse", "InHouseEngine"),
+    "analytic": ("references.analytic", "AnalyticEngine"),
+    "mujoco": ("references.mujoco_adapter", "MujocoEngine"),
+    "pybullet": ("references.pybullet_adapter", "PybulletEngine"),
+    "pinocchio": ("references.pinocchio_adapter", "PinocchioEngine"),
+}
+ENGINE_NAMES = tuple(_ENGINES)
+
+
+class UnavailableEngine(Engine):
+    """An engine whose library failed to import: every scene gets n/a with the import error."""
+
+    def __init__(self, name: str, error: str) -> None:
+        self.name = name
+        self._reason = f"{name} is not importable here: {error}"
+
+    def version(self) -> str:
+        return "unavailable"
+
+    def integrators(self) -> tuple[str, ...]:
+        return ("-",)
+
+    def supports_dynamics(self, scene, integrator: str) -> Support:
+        return Support.no(self._reason)
+
+    def build_dynamics(self, scene, integrator: str, dt: float) -> Simulation:
+        raise RuntimeError(self._reason)
+
+    def supports_kinematics(self, chain) -> Support:
+        return Support.no(self._reason)
+
+    def build_kinematics(self, chain) -> KinematicsModel:
+        raise RuntimeError(self._reason)
+
+
+def check_engine_names(names) -> tuple[str, ...]:
+    """The names, checked against :data:`ENGINE_NAMES`; raises UnknownEngineError."""
+    unknown = [n for n in names if n not in _ENGINES]
+    if unknown:
+        raise UnknownEngineError(
+            f"unknown engine(s): {', '.join(unknown)} (known: {', '.join(ENGINE_NAMES)})"
+        )
+    return tuple(names)
+
+
+def make_engine(name: str) -> Engine:
+    """The engine called ``name``, or an :class:`UnavailableEngine` if its library won't import."""
+    check_engine_names([name])
+    module, cls = _ENGINES[name]
+    try:
+        return getattr(importlib.import_module(module), cls)()
+    except ImportError as err:
+        return UnavailableEngine(name, str(err))

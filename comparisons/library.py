@@ -1,0 +1,34 @@
+"""The built-in scene library (``comparisons/scenes/*.toml``) and scene lookup by name or path."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from comparisons.scene_loader import load_scene
+from core.errors import UnknownSceneError
+
+SCENES_DIR = Path(__file__).parent / "scenes"
+
+
+def builtin_paths() -> dict[str, Path]:
+    """Built-in scene name -> file, sorted by name."""
+    return {p.stem: p for p in sorted(SCENES_DIR.glob("*.toml"))}
+
+
+def resolve(name_or_path: str) -> Path:
+    """The file of a built-in scene name, or an existing scene file path."""
+    builtin = builtin_paths()
+    if name_or_path in builtin:
+        return builtin[name_or_path]
+    path = Path(name_or_path)
+    if path.is_file():
+        return path
+    raise UnknownSceneError(
+        f"'{name_or_path}' is neither a built-in scene nor a file "
+        f"(built-in: {', '.join(builtin)}; see 'simparity list')"
+    )
+
+
+def load(names_or_paths) -> list:
+    """Every named scene, all checked before any is returned (so a run never starts on a bad file)."""
+    return [load_scene(resolve(n)) for n in names_or_paths]

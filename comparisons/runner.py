@@ -1,0 +1,141 @@
+"""Runs scenes on engines and measures them against each scene's reference.
+
+Every scene x engine x integrator x dt gets one row per metric: ``ok`` with a value, or
+``n/a`` / ``failed`` / ``diverged`` with the reason in ``detail``. An engine that raises
+becomes ``failed`` rows; the run goes on.
+"""
+
+from __future__ import annotations
+
+import math
+import traceback
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from comparisons.metrics import DYNAMICS_METRICS, KINEMATICS_METRICS, kinematics_errors, trajectory_errors
+from comparisons.timing import best_of
+from core.engine import Engine
+from core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
+from core.scene import DynamicsScene, KinematicsScene
+
+DEFAULT_REPEATS = 3
+"""Timed repeats per measurement (the minimum is kept), after one warm-up run."""
+
+
+@dataclass(frozen=True)
+class _Case:
+    scene: str
+    engine: str
+    integrator: str
+    dt: float
+    reference: str
+
+    def rows(self, metrics: dict[str, str], status: str, detail: str, values: dict | None = None) -> list[ResultRow]:
+        values = values or {}
+        return [
+            ResultRow(self.scene, self.engine, self.integrator, self.dt, metric,
+                      values.get(metric, (math.nan, unit))[0], unit, self.reference, status, detail)
+            for metric, unit in metrics.items()
+        ]
+
+
+def _error_text(err: BaseException) -> str:
+    where = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None
+    at = f" at {where.filename.rsplit('/', 1)[-1]}:{where.lineno}" if where else ""
+    return f"{type(err).__name__}: {err}{at}".replace("\n", " ")
+
+
+def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, repeats: int) -> list[ResultRow]:
+    rows: list[ResultRow] = []
+    ref_integrator = reference.integrators()[0]
+    ref_label = f"{reference.name}:{ref_integrator}"
+    ref_support = reference.supports_dynamics(scene, ref_integrator)
+    for dt in scene.dts:
+        n = scene.n_steps(dt)
+        ref_traj, ref_problem = None, ""
+        if not ref_support.ok:
+            ref_problem = f"reference {ref_label} cannot do this scene: {ref_support.reason}"
+        else:
+            try:
+                ref_traj = reference.build_dynamics(scene, ref_integrator, dt).run(n)
+            except Exception as err:  # noqa: BLE001 - reported in the rows
+                ref_problem = f"reference {ref_label} failed: {_error_text(err)}"
+        for engine in engines:
+            for integrator in engine.integrators():
+                case = _Case(scene.name, engine.name, integrator, dt, ref_label)
+                is_reference = engine.name == reference.name and integrator == ref_integrator
+                rows += _dynamics_case(scene, engine, case, n, ref_traj, ref_problem, repeats, is_reference)
+    return rows
+
+
+def _dynamics_case(scene, engine: Engine, case: _Case, n: int, ref_traj, ref_problem: str, repeats: int,
+                   is_reference: bool) -> list[ResultRow]:
+    support = engine.supports_dynamics(scene, case.integrator)
+    if not support.ok:
+        return case.rows(DYNAMICS_METRICS, NOT_AVAILABLE, support.reason)
+    try:
+        sim = engine.build_dynamics(scene, case.integrator, case.dt)
+        seconds, traj = best_of(lambda: sim.run(n), repeats)
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        return case.rows(DYNAMICS_METRICS, FAILED, _error_text(err))
+    values = {"time_per_step": (seconds / n, "s")}
+    if not traj.is_finite():
+        return case.rows(DYNAMICS_METRICS, DIVERGED, "non-finite state; " + sim.detail, values)
+    if ref_traj is None:
+        rows = case.rows({"time_per_step": "s"}, OK, sim.detail, values)
+        errors = {k: v for k, v in DYNAMICS_METRICS.items() if k != "time_per_step"}
+        return rows + case.rows(errors, NOT_AVAILABLE, ref_problem)
+    values.update(trajectory_errors(traj, ref_traj))
+    detail = ("this is the reference; " if is_reference else "") + sim.detail
+    return case.rows(DYNAMICS_METRICS, OK, detail, values)
+
+
+def _kinematics(scene: KinematicsScene, engines: list[Engine], reference: Engine, repeats: int) -> list[ResultRow]:
+    q = scene.configurations()
+    ref_label = f"{reference.name}:fk"
+    ref, ref_problem = None, ""
+    ref_support = reference.supports_kinematics(scene.chain)
+    if not ref_support.ok:
+        ref_problem = f"reference {ref_label} cannot do this chain: {ref_support.reason}"
+    else:
+        model = reference.build_kinematics(scene.chain)
+        ref = (model.forward_kinematics(q), model.jacobian_world(q))
+    rows: list[ResultRow] = []
+    for engine in engines:
+        case = _Case(scene.name, engine.name, "", math.nan, ref_label)
+        support = engine.supports_kinematics(scene.chain)
+        if not support.ok:
+            rows += case.rows(KINEMATICS_METRICS, NOT_AVAILABLE, support.reason)
+            continue
+        try:
+            model = engine.build_kinematics(scene.chain)
+            fk_seconds, poses = best_of(lambda: model.forward_kinematics(q), repeats)
+            jac_seconds, jac = best_of(lambda: model.jacobian_world(q), repeats)
+        except Exception as err:  # noqa: BLE001 - reported in the rows
+            rows += case.rows(KINEMATICS_METRICS, FAILED, _error_text(err))
+            continue
+        values = {"time_per_fk": (fk_seconds / len(q), "s"), "time_per_jacobian": (jac_seconds / len(q), "s")}
+        if not (np.all(np.isfinite(poses.position_world)) and np.all(np.isfinite(jac))):
+            rows += case.rows(KINEMATICS_METRICS, DIVERGED, "non-finite FK or Jacobian", values)
+            continue
+        if ref is None:
+            rows += case.rows({k: KINEMATICS_METRICS[k] for k in values}, OK, model.detail, values)
+            rows += case.rows({k: u for k, u in KINEMATICS_METRICS.items() if k not in values},
+                              NOT_AVAILABLE, ref_problem)
+            continue
+        values.update(kinematics_errors(poses, jac, *ref))
+        detail = ("this is the reference; " if engine.name == reference.name else "") + model.detail
+        rows += case.rows(KINEMATICS_METRICS, OK, detail, values)
+    return rows
+
+
+def run_scene(
+    scene, engines: list[Engine], make_reference: Callable[[str], Engine], repeats: int = DEFAULT_REPEATS
+) -> list[ResultRow]:
+    """All rows of one scene on ``engines``, measured against ``make_reference(scene.reference)``."""
+    reference = make_reference(scene.reference)
+    if isinstance(scene, DynamicsScene):
+        return _dynamics(scene, engines, reference, repeats)
+    return _kinematics(scene, engines, reference, repeats)

@@ -1,0 +1,139 @@
+"""The one engine interface shared by the in-house core and every reference.
+
+An engine answers three questions about a scene: can you do it (:class:`Support`, with
+the reason when not), build it (untimed), and run it (timed by the runner). Building and
+running are split so the runner can time the stepping alone.
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass
+
+import numpy as np
+
+from core.errors import SimparityError
+from core.scene import Chain, DynamicsScene, KinematicsScene
+from core.trajectory import FramePoses, Trajectory
+
+
+@dataclass(frozen=True)
+class Support:
+    """Whether an engine can do what a scene asks, and why not when it cannot."""
+
+    ok: bool
+    reason: str = ""
+
+    @classmethod
+    def yes(cls) -> "Support":
+        return cls(True)
+
+    @classmethod
+    def no(cls, reason: str) -> "Support":
+        return cls(False, reason)
+
+
+class Simulation(abc.ABC):
+    """A dynamics scene built for one engine, integrator and time step.
+
+    Attributes
+    ----------
+    detail : str
+        What the engine was configured with beyond the scene (defaults switched off,
+        harness-side stepping, ...); shown in the results' ``detail`` column.
+    """
+
+    detail: str = ""
+
+    @abc.abstractmethod
+    def run(self, n_steps: int) -> Trajectory:
+        """Simulate ``n_steps`` steps from the scene's initial state.
+
+        Every call starts again from the initial state. Returns a :class:`Trajectory` with
+        ``n_steps + 1`` samples.
+        """
+
+
+class KinematicsModel(abc.ABC):
+    """A chain built for one engine."""
+
+    detail: str = ""
+
+    @abc.abstractmethod
+    def forward_kinematics(self, q: np.ndarray) -> FramePoses:
+        """Poses of every joint's child-link frame and of the end effector.
+
+        Parameters
+        ----------
+        q : (B, n) ndarray
+            Joint values [rad or m].
+
+        Returns
+        -------
+        FramePoses
+            F = n + 1 frames in the order of :meth:`Chain.frame_names`.
+        """
+
+    @abc.abstractmethod
+    def jacobian_world(self, q: np.ndarray) -> np.ndarray:
+        """Geometric Jacobian of the end-effector frame.
+
+        Rows 0-2 map joint velocities to the linear velocity of the end-effector origin,
+        rows 3-5 to the angular velocity, both in world axes (Pinocchio's
+        LOCAL_WORLD_ALIGNED). (B, n) -> (B, 6, n).
+        """
+
+
+class Engine(abc.ABC):
+    """One engine: the in-house core, an analytic truth, or an adapter to a library."""
+
+    name: str = ""
+
+    @abc.abstractmethod
+    def version(self) -> str:
+        """Version string of the library behind the engine."""
+
+    @abc.abstractmethod
+    def integrators(self) -> tuple[str, ...]:
+        """Names of the dynamics integrators the engine offers (empty if none)."""
+
+    @abc.abstractmethod
+    def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
+        """Whether :meth:`build_dynamics` can simulate ``scene`` with ``integrator``."""
+
+    @abc.abstractmethod
+    def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
+        """Build the model for ``scene`` (not timed). Call only when supported."""
+
+    @abc.abstractmethod
+    def supports_kinematics(self, chain: Chain) -> Support:
+        """Whether :meth:`build_kinematics` can evaluate ``chain``."""
+
+    @abc.abstractmethod
+    def build_kinematics(self, chain: Chain) -> KinematicsModel:
+        """Build the model for ``chain`` (not timed). Call only when supported."""
+
+    def check_integrator(self, integrator: str) -> Support:
+        """Support for an integrator name alone."""
+        if integrator in self.integrators():
+            return Support.yes()
+        offered = ", ".join(self.integrators()) or "none"
+        return Support.no(f"{self.name} has no integrator '{integrator}' (offers: {offered})")
+
+    def export(self, scene: DynamicsScene | KinematicsScene, integrator: str | None, dt: float | None) -> str:
+        """Text of the model this engine is given for ``scene`` (MJCF, URDF, ...).
+
+        ``integrator`` and ``dt`` apply to dynamics scenes; ``None`` picks the engine's
+        first integrator and the scene's first time step.
+        """
+        raise SimparityError(f"engine '{self.name}' builds no model to export")
+
+    def _export_settings(self, scene: DynamicsScene, integrator: str | None, dt: float | None) -> tuple[str, float]:
+        integrator = integrator or self.integrators()[0]
+        support = self.check_integrator(integrator)
+        if not support.ok:
+            raise SimparityError(support.reason)
+        dt = scene.dts[0] if dt is None else dt
+        if not dt > 0:
+            raise SimparityError(f"--dt {dt}: must be a positive time step in seconds")
+        return integrator, dt

@@ -1,0 +1,133 @@
+"""The in-house engine: the lecture's methods in ``core`` behind the shared interface."""
+
+from __future__ import annotations
+
+import platform
+
+import numpy as np
+
+from core import point_mass
+from core.engine import Engine, KinematicsModel, Simulation, Support
+from core.forces import has_torque, make_wrench
+from core.integrators import ORIENTATION_UPDATES, SCHEMES, make_step
+from core.kinematics import forward_kinematics, jacobian_world
+from core.rigid_body import MassProperties, initial_state, velocities
+from core.rotations import matrix_to_quat_wxyz
+from core.scene import Chain, DynamicsScene
+from core.trajectory import FramePoses, Trajectory
+
+_DEFAULT_ORIENTATION = "quaternion"
+
+
+def integrator_names() -> tuple[str, ...]:
+    """``scheme`` (quaternion orientation), ``scheme+matrix``, ``scheme+expmap``, particle rules."""
+    names = []
+    for scheme in SCHEMES:
+        if scheme == "engine_euler":
+            names.append(scheme)
+            continue
+        names.append(scheme)
+        names.extend(f"{scheme}+{o}" for o in ORIENTATION_UPDATES if o != _DEFAULT_ORIENTATION)
+    return tuple(names) + tuple(point_mass.RULES)
+
+
+def parse_integrator(name: str) -> tuple[str, str]:
+    """``"rk4+expmap"`` -> ``("rk4", "expmap")``; no suffix means quaternion."""
+    scheme, _, orientation = name.partition("+")
+    return scheme, orientation or _DEFAULT_ORIENTATION
+
+
+class _RigidBodySimulation(Simulation):
+    def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
+        scheme, orientation = parse_integrator(integrator)
+        self._props = MassProperties.of(scene.bodies)
+        self._state0 = initial_state(scene.bodies, self._props, quaternion=orientation == "quaternion")
+        self._step = make_step(scheme, orientation, self._props, make_wrench(scene.forces, self._props))
+        self._dt = dt
+        self.detail = f"in-house {scheme}, orientation update: {orientation}"
+
+    def run(self, n_steps: int) -> Trajectory:
+        state, dt = self._state0, self._dt
+        b = len(self._props.mass)
+        pos, quat, vel, omg = (np.empty((n_steps + 1, b, k)) for k in (3, 4, 3, 3))
+        for i in range(n_steps + 1):
+            if i:
+                state = self._step((i - 1) * dt, state, dt)
+            v, omega = velocities(state, self._props)
+            pos[i], vel[i], omg[i] = state.position_world, v, omega
+            o = state.orientation
+            quat[i] = o if o.shape[-1] == 4 else matrix_to_quat_wxyz(o)
+        return Trajectory(np.arange(n_steps + 1) * dt, pos, quat, vel, omg)
+
+
+class _ParticleSimulation(Simulation):
+    """The lecture's point-mass rules; orientation and angular velocity stay at their initial values."""
+
+    def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
+        self._rule = point_mass.RULES[integrator]
+        props = MassProperties.of(scene.bodies)
+        self._wrench = make_wrench(scene.forces, props)
+        self._mass = props.mass[:, None]
+        self._x0 = np.stack([b.position_world for b in scene.bodies])
+        self._v0 = np.stack([b.velocity_world for b in scene.bodies])
+        self._q0 = np.stack([b.quat_wxyz for b in scene.bodies])
+        self._r0 = np.stack([b.rotation_world for b in scene.bodies])
+        self._dt = dt
+        self.detail = f"in-house particle rule {integrator} (lecture, Bodies in Free Fall)"
+
+    def run(self, n_steps: int) -> Trajectory:
+        x, v, dt = self._x0, self._v0, self._dt
+        pos, vel = np.empty((n_steps + 1,) + x.shape), np.empty((n_steps + 1,) + x.shape)
+        pos[0], vel[0] = x, v
+        zero = np.zeros_like(x)
+        for i in range(1, n_steps + 1):
+            force, _ = self._wrench((i - 1) * dt, x, self._r0, v, zero)
+            x, v = self._rule(x, v, force / self._mass, dt)
+            pos[i], vel[i] = x, v
+        quat = np.broadcast_to(self._q0, (n_steps + 1,) + self._q0.shape)
+        omg = np.zeros((n_steps + 1,) + x.shape)
+        return Trajectory(np.arange(n_steps + 1) * dt, pos, quat, vel, omg)
+
+
+class _Kinematics(KinematicsModel):
+    def __init__(self, chain: Chain) -> None:
+        self._chain = chain
+        self.detail = "in-house FK; Jacobian columns a_i x (E - P_i) (lecture)"
+
+    def forward_kinematics(self, q: np.ndarray) -> FramePoses:
+        return forward_kinematics(self._chain, q)
+
+    def jacobian_world(self, q: np.ndarray) -> np.ndarray:
+        return jacobian_world(self._chain, q)
+
+
+class InHouseEngine(Engine):
+    """The lecture's methods as implemented in ``core``."""
+
+    name = "core"
+
+    def version(self) -> str:
+        return f"numpy {np.__version__}, python {platform.python_version()}"
+
+    def integrators(self) -> tuple[str, ...]:
+        return integrator_names()
+
+    def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
+        named = self.check_integrator(integrator)
+        if not named.ok or integrator not in point_mass.RULES:
+            return named
+        rotating = any(np.any(b.angular_velocity_world != 0) for b in scene.bodies)
+        if rotating or has_torque(scene.forces):
+            return Support.no(f"{integrator} is a point-mass rule; the scene's bodies rotate")
+        return Support.yes()
+
+    def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
+        if integrator in point_mass.RULES:
+            return _ParticleSimulation(scene, integrator, dt)
+        return _RigidBodySimulation(scene, integrator, dt)
+
+    def supports_kinematics(self, chain: Chain) -> Support:
+        return Support.yes()
+
+    def build_kinematics(self, chain: Chain) -> KinematicsModel:
+        return _Kinematics(chain)

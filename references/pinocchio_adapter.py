@@ -1,0 +1,157 @@
+"""Pinocchio behind the shared engine interface.
+
+Pinocchio computes dynamics but has no time stepper: the harness steps the accelerations
+of ``pin.aba`` itself, and the results say so ("harness-stepped").
+
+Conversions (each pinned by a test in ``tests/test_pinocchio_adapter.py``)
+------------------------------------------------------------------------
+- Free-flyer ``q[3:7]`` is (x, y, z, w): reordered here.
+- Free-flyer ``v[0:3]`` and ``v[3:6]`` are in the LOCAL (body) frame: v_world = R v[0:3],
+  omega_world = R v[3:6]. The joint frame is the COM (lever 0), so v[0:3] is the COM's.
+- ``aba`` returns the SPATIAL acceleration; the classical acceleration of the origin is
+  a[0:3] + omega x v[0:3] (both local).
+- ``euler``: the engines' first-order scheme (as MuJoCo Euler): v_world += dt R a_classical,
+  omega_local += dt a[3:6], then p += dt v_world and R = R exp(dt omega_local).
+  Stepping ``pin.integrate`` on the local twist instead would follow an SE(3) screw and
+  drift from the others (0.25 m after 2 s of free fall).
+- Chains: built from the adapter's URDF with ``buildModelFromXML`` (fixed base). A
+  ``continuous`` joint has nq = 2 (cos, sin). Jacobians are LOCAL_WORLD_ALIGNED.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from core.engine import Engine, KinematicsModel, Simulation, Support
+from core.rotations import quat_wxyz_to_matrix, so3_exp, matrix_to_quat_wxyz
+from core.scene import Chain, DynamicsScene, KinematicsScene
+from core.trajectory import FramePoses, Trajectory
+from references.conventions import xyzw_from_wxyz
+from references.urdf_export import chain_urdf
+
+
+def free_bodies_model(scene: DynamicsScene) -> pin.Model:
+    """One free-flyer joint per body, attached to the universe, with the scene's inertia."""
+    model = pin.Model()
+    for body in scene.bodies:
+        jid = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), f"{body.name}_free")
+        model.appendBodyToJoint(jid, pin.Inertia(body.mass, np.zeros(3), body.inertia_body), pin.SE3.Identity())
+    gravity = scene.forces.gravity_world
+    model.gravity = pin.Motion(np.zeros(3) if gravity is None else gravity, np.zeros(3))
+    return model
+
+
+class _Simulation(Simulation):
+    def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
+        self._model = free_bodies_model(scene)
+        self._data = self._model.createData()
+        self._position0 = np.stack([b.position_world for b in scene.bodies])
+        self._rotation0 = np.stack([b.rotation_world for b in scene.bodies])
+        self._velocity0 = np.stack([b.velocity_world for b in scene.bodies])
+        self._omega_local0 = np.einsum(
+            "bji,bj->bi", self._rotation0, np.stack([b.angular_velocity_world for b in scene.bodies])
+        )
+        self._tau = np.zeros(self._model.nv)
+        self._dt = dt
+        self.detail = "harness-stepped: pin.aba accelerations, engines' semi-implicit Euler on SO(3)"
+
+    def run(self, n_steps: int) -> Trajectory:
+        dt, b = self._dt, len(self._position0)
+        p, r, v, w = self._position0, self._rotation0, self._velocity0, self._omega_local0
+        pos, rot, vel, omg = (np.empty((n_steps + 1, b) + s) for s in ((3,), (3, 3), (3,), (3,)))
+        q, qd = np.empty((b, 7)), np.empty((b, 6))
+        for i in range(n_steps + 1):
+            if i:
+                q[:, :3], q[:, 3:] = p, xyzw_from_wxyz(matrix_to_quat_wxyz(r))
+                v_local = np.einsum("bji,bj->bi", r, v)
+                qd[:, :3], qd[:, 3:] = v_local, w
+                a = pin.aba(self._model, self._data, q.ravel(), qd.ravel(), self._tau).reshape(b, 6)
+                a_classical = a[:, :3] + np.cross(w, v_local)
+                v = v + dt * np.einsum("bij,bj->bi", r, a_classical)
+                w = w + dt * a[:, 3:]
+                p = p + dt * v
+                r = r @ so3_exp(dt * w)
+            pos[i], rot[i], vel[i], omg[i] = p, r, v, np.einsum("bij,bj->bi", r, w)
+        times = np.arange(n_steps + 1) * dt
+        return Trajectory(times, pos, matrix_to_quat_wxyz(rot), vel, omg)
+
+
+class _Kinematics(KinematicsModel):
+    def __init__(self, chain: Chain) -> None:
+        self._model = pin.buildModelFromXML(chain_urdf(chain))
+        self._data = self._model.createData()
+        joints = [self._model.joints[self._model.getJointId(j.name)] for j in chain.joints]
+        self._idx_q = [j.idx_q for j in joints]
+        self._idx_v = [j.idx_v for j in joints]
+        self._continuous = [j.nq == 2 for j in joints]
+        self._frames = [self._model.getFrameId(name, pin.BODY) for name in chain.frame_names()]
+        self.detail = "forwardKinematics + updateFramePlacements; computeFrameJacobian LOCAL_WORLD_ALIGNED"
+
+    def _configuration(self, q_row: np.ndarray) -> np.ndarray:
+        q = pin.neutral(self._model)
+        for value, at, continuous in zip(q_row, self._idx_q, self._continuous):
+            if continuous:
+                q[at], q[at + 1] = np.cos(value), np.sin(value)
+            else:
+                q[at] = value
+        return q
+
+    def forward_kinematics(self, q: np.ndarray) -> FramePoses:
+        q = np.atleast_2d(q)
+        n = len(self._frames)
+        pos, rot = np.empty((len(q), n, 3)), np.empty((len(q), n, 3, 3))
+        for k, row in enumerate(q):
+            pin.framesForwardKinematics(self._model, self._data, self._configuration(row))
+            for f, fid in enumerate(self._frames):
+                pos[k, f] = self._data.oMf[fid].translation
+                rot[k, f] = self._data.oMf[fid].rotation
+        return FramePoses(pos, rot)
+
+    def jacobian_world(self, q: np.ndarray) -> np.ndarray:
+        q = np.atleast_2d(q)
+        out = np.empty((len(q), 6, len(self._idx_v)))
+        for k, row in enumerate(q):
+            jac = pin.computeFrameJacobian(
+                self._model, self._data, self._configuration(row), self._frames[-1], pin.LOCAL_WORLD_ALIGNED
+            )
+            out[k] = jac[:, self._idx_v]
+        return out
+
+
+class PinocchioEngine(Engine):
+    """Pinocchio: kinematics from the adapter's URDF; dynamics from aba, stepped by the harness."""
+
+    name = "pinocchio"
+
+    def version(self) -> str:
+        return pin.__version__
+
+    def integrators(self) -> tuple[str, ...]:
+        return ("euler",)
+
+    def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
+        return self.check_integrator(integrator)
+
+    def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
+        return _Simulation(scene, integrator, dt)
+
+    def supports_kinematics(self, chain: Chain) -> Support:
+        return Support.yes()
+
+    def build_kinematics(self, chain: Chain) -> KinematicsModel:
+        return _Kinematics(chain)
+
+    def export(self, scene, integrator, dt) -> str:
+        if isinstance(scene, KinematicsScene):
+            return chain_urdf(scene.chain)
+        integrator, dt = self._export_settings(scene, integrator, dt)
+        model = free_bodies_model(scene)
+        inertias = "".join(
+            f"{model.names[j]}: {model.inertias[j]}\n" for j in range(1, model.njoints)
+        )
+        return (
+            f"# Pinocchio model built in code (no file): one free-flyer per body.\n"
+            f"# gravity: {model.gravity.linear}; stepped by the harness ({integrator}, dt = {dt!r} s)\n"
+            f"{model}\n{inertias}"
+        )

@@ -1,0 +1,194 @@
+"""PyBullet behind the shared engine interface.
+
+Conversions and overridden defaults (each pinned by a test in ``tests/test_pybullet_adapter.py``)
+-----------------------------------------------------------------------------------------------
+- Quaternions are (x, y, z, w) in PyBullet: reordered here.
+- ``getBasePositionAndOrientation`` / ``resetBasePositionAndOrientation`` speak of the
+  base's INERTIAL frame (COM, principal axes). The URDF puts the principal axes at
+  ``Q`` in the body frame, so R_inertial = R_body Q and R_body = R_inertial Q^T.
+- ``getBaseVelocity`` is the COM velocity and the angular velocity, both world frame.
+- Inertia is taken from the URDF (``URDF_USE_INERTIA_FROM_FILE``): by default PyBullet
+  recomputes it from collision shapes.
+- Linear and angular damping default to 0.04 on every link: set to 0.
+- Gravity defaults to 0: always set explicitly (to the scene's, or zero).
+- Sleeping (deactivation of slow bodies) is disabled.
+- ``maxJointVelocity`` (Bullet clamps velocities at 100 rad/s by default) is raised far
+  above any scene's.
+- ``getLinkState`` positions and orientations are FLOAT32 (errors ~1e-7); the Jacobian
+  from ``calculateJacobian`` is double.
+- PyBullet has one integrator (semi-implicit Euler, velocity then position); time step = dt,
+  no sub-steps.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import os
+import tempfile
+
+import numpy as np
+import pybullet
+
+from core.engine import Engine, KinematicsModel, Simulation, Support
+from core.rotations import quat_wxyz_to_matrix, matrix_to_quat_wxyz
+from core.scene import Chain, DynamicsScene, KinematicsScene
+from core.trajectory import FramePoses, Trajectory
+from references.conventions import fmt, principal_axes, wxyz_from_xyzw, xyzw_from_wxyz
+from references.urdf_export import body_urdf, chain_urdf
+
+_MAX_VELOCITY = 1e9  # [rad/s or m/s]: effectively no clamping
+
+
+def _load_urdf(client: int, text: str, **kwargs) -> int:
+    """loadURDF needs a file: write the text to a temporary one."""
+    with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
+        f.write(text)
+        path = f.name
+    try:
+        return pybullet.loadURDF(
+            path, flags=pybullet.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client, **kwargs
+        )
+    finally:
+        os.unlink(path)
+
+
+class _Client:
+    """A private DIRECT-mode PyBullet world, disconnected when garbage-collected."""
+
+    def __init__(self) -> None:
+        self.id = pybullet.connect(pybullet.DIRECT)
+
+    def __del__(self) -> None:
+        try:
+            pybullet.disconnect(physicsClientId=self.id)
+        except Exception:  # noqa: BLE001 - interpreter shutdown may have unloaded pybullet
+            pass
+
+
+class _Simulation(Simulation):
+    def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
+        self._client = _Client()
+        c = self._client.id
+        gravity = scene.forces.gravity_world
+        pybullet.setGravity(*(gravity if gravity is not None else (0.0, 0.0, 0.0)), physicsClientId=c)
+        pybullet.setTimeStep(dt, physicsClientId=c)
+        pybullet.setPhysicsEngineParameter(numSubSteps=0, physicsClientId=c)
+        self._bodies, self._axes, self._initial = [], [], []
+        for body in scene.bodies:
+            uid = _load_urdf(c, body_urdf(body))
+            pybullet.changeDynamics(
+                uid, -1, linearDamping=0.0, angularDamping=0.0, maxJointVelocity=_MAX_VELOCITY,
+                activationState=pybullet.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=c,
+            )
+            _, axes = principal_axes(body.inertia_body)
+            quat_inertial = matrix_to_quat_wxyz(body.rotation_world @ axes)
+            self._bodies.append(uid)
+            self._axes.append(axes)
+            self._initial.append((body.position_world, xyzw_from_wxyz(quat_inertial),
+                                  body.velocity_world, body.angular_velocity_world))
+        self._axes = np.stack(self._axes)
+        self._dt = dt
+        self.detail = (
+            "PyBullet multibody; inertia from file; damping 0; sleeping off; gravity set explicitly"
+        )
+
+    def run(self, n_steps: int) -> Trajectory:
+        c = self._client.id
+        for uid, (pos, quat, vel, omega) in zip(self._bodies, self._initial):
+            pybullet.resetBasePositionAndOrientation(uid, pos, quat, physicsClientId=c)
+            pybullet.resetBaseVelocity(uid, vel, omega, physicsClientId=c)
+        b = len(self._bodies)
+        raw = np.empty((n_steps + 1, b, 13))  # position 3, quat xyzw 4, velocity 3, omega 3
+        for i in range(n_steps + 1):
+            if i:
+                pybullet.stepSimulation(physicsClientId=c)
+            for k, uid in enumerate(self._bodies):
+                pos, quat = pybullet.getBasePositionAndOrientation(uid, physicsClientId=c)
+                vel, omega = pybullet.getBaseVelocity(uid, physicsClientId=c)
+                raw[i, k] = (*pos, *quat, *vel, *omega)
+        rotation_inertial = quat_wxyz_to_matrix(wxyz_from_xyzw(raw[..., 3:7]))
+        quat_body = matrix_to_quat_wxyz(rotation_inertial @ np.swapaxes(self._axes, -1, -2))
+        times = np.arange(n_steps + 1) * self._dt
+        return Trajectory(times, raw[..., :3], quat_body, raw[..., 7:10], raw[..., 10:13])
+
+
+class _Kinematics(KinematicsModel):
+    def __init__(self, chain: Chain) -> None:
+        self._client = _Client()
+        c = self._client.id
+        self._uid = _load_urdf(c, chain_urdf(chain), useFixedBase=True)
+        index = {
+            pybullet.getJointInfo(self._uid, j, physicsClientId=c)[1].decode(): j
+            for j in range(pybullet.getNumJoints(self._uid, physicsClientId=c))
+        }
+        self._joints = [index[j.name] for j in chain.joints]
+        self._links = self._joints + [index[f"{chain.end_effector_name}_fixed"]]
+        self.detail = "getLinkState (float32 link frames); calculateJacobian (double) at the end-effector link"
+
+    def _set(self, q_row: np.ndarray) -> None:
+        for j, value in zip(self._joints, q_row):
+            pybullet.resetJointState(self._uid, j, float(value), physicsClientId=self._client.id)
+
+    def forward_kinematics(self, q: np.ndarray) -> FramePoses:
+        q = np.atleast_2d(q)
+        pos = np.empty((len(q), len(self._links), 3))
+        quat = np.empty((len(q), len(self._links), 4))
+        for k, row in enumerate(q):
+            self._set(row)
+            states = pybullet.getLinkStates(
+                self._uid, self._links, computeForwardKinematics=True, physicsClientId=self._client.id
+            )
+            for f, state in enumerate(states):
+                pos[k, f], quat[k, f] = state[4], state[5]
+        return FramePoses(pos, quat_wxyz_to_matrix(wxyz_from_xyzw(quat)))
+
+    def jacobian_world(self, q: np.ndarray) -> np.ndarray:
+        q = np.atleast_2d(q)
+        zeros = [0.0] * len(self._joints)
+        out = np.empty((len(q), 6, len(self._joints)))
+        for k, row in enumerate(q):
+            self._set(row)
+            linear, angular = pybullet.calculateJacobian(
+                self._uid, self._links[-1], [0.0, 0.0, 0.0], [float(v) for v in row], zeros, zeros,
+                physicsClientId=self._client.id,
+            )
+            out[k, :3], out[k, 3:] = np.array(linear), np.array(angular)
+        return out
+
+
+class PybulletEngine(Engine):
+    """PyBullet (Bullet multibody), built from URDF the adapter writes."""
+
+    name = "pybullet"
+
+    def version(self) -> str:
+        return importlib.metadata.version("pybullet")
+
+    def integrators(self) -> tuple[str, ...]:
+        return ("euler",)
+
+    def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
+        return self.check_integrator(integrator)
+
+    def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
+        return _Simulation(scene, integrator, dt)
+
+    def supports_kinematics(self, chain: Chain) -> Support:
+        return Support.yes()
+
+    def build_kinematics(self, chain: Chain) -> KinematicsModel:
+        return _Kinematics(chain)
+
+    def export(self, scene, integrator, dt) -> str:
+        if isinstance(scene, KinematicsScene):
+            return chain_urdf(scene.chain)
+        integrator, dt = self._export_settings(scene, integrator, dt)
+        gravity = scene.forces.gravity_world
+        api = (
+            f"<!-- Set through the API: setGravity({fmt(gravity if gravity is not None else [0, 0, 0])}), "
+            f"setTimeStep({fmt([dt])}), numSubSteps=0; each body: loadURDF(flags=URDF_USE_INERTIA_FROM_FILE), "
+            f"changeDynamics(linearDamping=0, angularDamping=0, maxJointVelocity={_MAX_VELOCITY:g}, "
+            "activationState=ACTIVATION_STATE_DISABLE_SLEEPING), resetBasePositionAndOrientation and "
+            "resetBaseVelocity to the scene's initial state (inertial frame). -->\n"
+        )
+        return api + "".join(body_urdf(b) for b in scene.bodies)

@@ -1,0 +1,100 @@
+"""``report.md``: per scene, error against the reference and time per step for every engine."""
+
+from __future__ import annotations
+
+import math
+
+import pandas as pd
+
+from core.results import NOT_AVAILABLE, OK, STATUSES
+
+_DYNAMICS_COLUMNS = [
+    ("position_error_max", "position error max [m]"),
+    ("orientation_error_max", "orientation error max [rad]"),
+    ("velocity_error_max", "velocity error max [m/s]"),
+    ("angular_velocity_error_max", "angular velocity error max [rad/s]"),
+    ("time_per_step", "time per step [s]"),
+]
+_KINEMATICS_COLUMNS = [
+    ("position_error_max", "frame position error max [m]"),
+    ("orientation_error_max", "frame orientation error max [rad]"),
+    ("jacobian_error_max", "Jacobian error max"),
+    ("time_per_fk", "time per FK [s]"),
+    ("time_per_jacobian", "time per Jacobian [s]"),
+]
+
+
+def _number(value: float) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "—"
+    return "0" if value == 0 else f"{value:.3g}"
+
+
+def _status(group: pd.DataFrame) -> str:
+    """'ok', or the first non-ok status with its reason."""
+    bad = group[group["status"] != OK]
+    if bad.empty:
+        return OK
+    first = bad.iloc[0]
+    return f"{first['status']}: {first['detail']}" if first["detail"] else first["status"]
+
+
+def _table(scene_rows: pd.DataFrame, columns, keys: list[str]) -> list[str]:
+    head = keys + [label for _, label in columns] + ["status"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for key, group in scene_rows.groupby(keys, sort=False, dropna=False):
+        key = key if isinstance(key, tuple) else (key,)
+        values = dict(zip(group["metric"], group["value"]))
+        cells = [_key_cell(name, v) for name, v in zip(keys, key)]
+        cells += [_number(values.get(metric, math.nan)) for metric, _ in columns]
+        lines.append("| " + " | ".join(cells + [_status(group).replace("|", "/")]) + " |")
+    return lines
+
+
+def _key_cell(name: str, value) -> str:
+    if name == "dt":
+        return _number(float(value))
+    return str(value)
+
+
+def _notes(scene_rows: pd.DataFrame) -> list[str]:
+    ok = scene_rows[scene_rows["status"] == OK].drop_duplicates(["engine", "integrator"])
+    lines = ["", "What each engine was given:", ""]
+    for _, row in ok.iterrows():
+        label = f"{row['engine']} {row['integrator']}".strip()
+        lines.append(f"- **{label}**: {row['detail']}")
+    return lines if len(lines) > 3 else []
+
+
+def render(table: pd.DataFrame, info: dict) -> str:
+    """Markdown text of a stored run."""
+    versions = ", ".join(f"{k} {v}" for k, v in info.get("engine_versions", {}).items())
+    m = info.get("machine", {})
+    counts = table.drop_duplicates(["scene", "engine", "integrator", "dt"])["status"].value_counts()
+    lines = [
+        "# simparity report",
+        "",
+        f"Run {info.get('created_utc', '?')} · commit {info.get('git_commit', '?')} · "
+        f"{m.get('platform', '?')} · {m.get('cpu_count', '?')} CPUs · Python {m.get('python', '?')}",
+        "",
+        f"Engines: {versions}",
+        "",
+        "Cases: " + ", ".join(f"{s} {int(counts.get(s, 0))}" for s in STATUSES)
+        + f". `{NOT_AVAILABLE}` means the engine cannot do what the scene asks; the reason is given.",
+        "Errors are maxima over every body and sample against the reference named per scene; "
+        "times are the best of several repeats of the stepping alone (model building excluded).",
+    ]
+    for scene, rows in table.groupby("scene", sort=False):
+        dynamics = rows["dt"].notna().any()
+        reference = rows["reference"].iloc[0]
+        about = info.get("scenes", {}).get(scene, {})
+        lines += ["", f"## {scene} ({'dynamics' if dynamics else 'kinematics'})", ""]
+        if about.get("description"):
+            lines += [about["description"], ""]
+        lines += [f"Reference: `{reference}`." + (f" Scene file: `{about['source']}`." if about.get("source") else ""), ""]
+        if dynamics:
+            lines += _table(rows, _DYNAMICS_COLUMNS, ["engine", "integrator", "dt"])
+        else:
+            lines += _table(rows, _KINEMATICS_COLUMNS, ["engine"])
+        lines += _notes(rows)
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,33 @@
+"""Reading a stored run."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pandas as pd
+
+from core.errors import ResultsError
+from core.results import COLUMNS, RESULTS_FILE, RUN_INFO_FILE, SCHEMA_VERSION
+
+
+def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
+    """(results table, run information) of a stored run; raises ResultsError if unusable."""
+    run_dir = Path(run_dir)
+    results, info = run_dir / RESULTS_FILE, run_dir / RUN_INFO_FILE
+    for path in (results, info):
+        if not path.is_file():
+            raise ResultsError(f"{path}: missing (is {run_dir} the output folder of 'simparity run'?)")
+    try:
+        meta = json.loads(info.read_text(encoding="utf-8"))
+        table = pd.read_csv(results, keep_default_na=False, na_values={"value": ["", "nan", "NaN"], "dt": ["", "nan", "NaN"]})
+    except (json.JSONDecodeError, pd.errors.ParserError, UnicodeDecodeError) as err:
+        raise ResultsError(f"{run_dir}: unreadable stored run: {err}") from None
+    if meta.get("schema_version") != SCHEMA_VERSION:
+        raise ResultsError(
+            f"{info}: schema_version {meta.get('schema_version')!r}, this simparity reads {SCHEMA_VERSION}"
+        )
+    missing = [c for c in COLUMNS if c not in table.columns]
+    if missing:
+        raise ResultsError(f"{results}: missing columns {missing}")
+    return table, meta

@@ -1,0 +1,107 @@
+"""The simparity command: list, run, export, report, and clean errors for user mistakes."""
+
+import io
+import subprocess
+import sys
+
+import pandas as pd
+import pytest
+
+from comparisons.cli import EXIT_OK, EXIT_USAGE, main
+from comparisons.engines import ENGINE_NAMES
+from comparisons.library import builtin_paths
+from core.results import COLUMNS, NOT_AVAILABLE, OK, STATUSES
+from tests.test_scene_loader import BROKEN
+
+
+def _run(argv):
+    out = io.StringIO()
+    code = main(argv, out=out)
+    return code, out.getvalue()
+
+
+def test_list_names_every_builtin_scene():
+    """'simparity list' prints one line per built-in scene, starting with its name."""
+    code, text = _run(["list"])
+    lines = text.strip().splitlines()
+    assert code == EXIT_OK
+    assert [line.split()[0] for line in lines] == sorted(builtin_paths())
+
+
+def test_default_run_covers_every_engine_on_every_builtin_scene(tmp_path):
+    """'simparity run' writes results.csv and report.md with a row for every engine on both scenes."""
+    code, text = _run(["run", "--out", str(tmp_path), "--repeats", "1"])
+    assert code == EXIT_OK, text
+    table = pd.read_csv(tmp_path / "results.csv")
+    assert tuple(table.columns) == COLUMNS
+    assert set(table["status"]) <= set(STATUSES)
+    for scene in ("lecture-projectile", "lecture-planar-arm"):
+        rows = table[table["scene"] == scene]
+        assert set(rows["engine"]) == set(ENGINE_NAMES), scene
+        assert set(rows["status"]) <= {OK, NOT_AVAILABLE}, rows[~rows["status"].isin([OK, NOT_AVAILABLE])]
+        assert (rows[rows["status"] == NOT_AVAILABLE]["detail"].str.len() > 0).all()
+    report = (tmp_path / "report.md").read_text()
+    assert "## lecture-projectile (dynamics)" in report and "## lecture-planar-arm (kinematics)" in report
+    assert (tmp_path / "run.json").is_file()
+
+
+@pytest.mark.parametrize("name, base, old, new, key, words", BROKEN[:6], ids=[b[0] for b in BROKEN[:6]])
+def test_broken_scene_exits_2_with_one_line(tmp_path, capsys, name, base, old, new, key, words):
+    """A broken scene file gives exit code 2 and one line naming file and key, no traceback, no results."""
+    path = tmp_path / "bad.toml"
+    path.write_text(base.replace(old, new, 1))
+    code = main(["run", str(path), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == EXIT_USAGE
+    assert err.count("\n") == 1 and err.startswith("simparity: error: ")
+    assert str(path) in err and key in err and words in err
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["run", "no-such-scene"], "neither a built-in scene nor a file"),
+        (["run", "lecture-projectile", "--engines", "core,havok"], "unknown engine(s): havok"),
+        (["run", "lecture-projectile", "--repeats", "0"], "--repeats 0"),
+        (["report", "/nonexistent/run"], "missing"),
+        (["export", "lecture-projectile", "--engine", "mujoco", "--integrator", "verlet"], "no integrator 'verlet'"),
+        (["export", "lecture-projectile", "--engine", "mujoco", "--dt", "-1"], "--dt -1"),
+    ],
+)
+def test_user_mistakes_exit_2(capsys, argv, words):
+    """Unknown scenes, engines, integrators, bad numbers and missing runs are one-line errors with exit 2."""
+    assert main(argv) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert words in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("engine, marker", [("mujoco", "<mujoco"), ("pybullet", "<robot"), ("pinocchio", "<robot")])
+def test_export_prints_the_model_for_kinematics(engine, marker):
+    """export prints the MJCF or URDF each adapter builds for the chain."""
+    code, text = _run(["export", "lecture-planar-arm", "--engine", engine])
+    assert code == EXIT_OK and marker in text and "elbow" in text
+
+
+@pytest.mark.parametrize("engine, marker", [("mujoco", "<freejoint"), ("pybullet", "URDF_USE_INERTIA_FROM_FILE"),
+                                            ("pinocchio", "free-flyer")])
+def test_export_prints_the_model_for_dynamics(engine, marker):
+    """For a dynamics scene export shows the model and the settings given through the API."""
+    code, text = _run(["export", "lecture-projectile", "--engine", engine])
+    assert code == EXIT_OK and marker in text
+
+
+def test_report_rerenders_a_stored_run(tmp_path):
+    """'simparity report DIR' rebuilds report.md from results.csv alone."""
+    assert _run(["run", "lecture-planar-arm", "--engines", "core,analytic", "--out", str(tmp_path), "--repeats", "1"])[0] == 0
+    (tmp_path / "report.md").unlink()
+    code, _ = _run(["report", str(tmp_path)])
+    assert code == EXIT_OK and "lecture-planar-arm" in (tmp_path / "report.md").read_text()
+
+
+def test_console_script_help():
+    """The installed entry point answers --help for every command."""
+    for argv in ([], ["run"], ["list"], ["export"], ["report"]):
+        done = subprocess.run([sys.executable, "-m", "comparisons.cli", *argv, "--help"],
+                              capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0 and "usage: simparity" in done.stdout

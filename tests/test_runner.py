@@ -1,0 +1,94 @@
+"""The runner: one row per metric and case; failures, divergence and n/a are rows, never lost."""
+
+import math
+
+import numpy as np
+
+from comparisons.engines import make_engine
+from comparisons.metrics import DYNAMICS_METRICS, KINEMATICS_METRICS
+from comparisons.runner import run_scene
+from core.engine import Support
+from core.inhouse import InHouseEngine
+from core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK
+from tests.helpers import builtin
+
+
+class _Crashing(InHouseEngine):
+    name = "crashing"
+
+    def build_dynamics(self, scene, integrator, dt):
+        raise RuntimeError("boom")
+
+    def build_kinematics(self, chain):
+        raise RuntimeError("boom")
+
+
+class _Diverging(InHouseEngine):
+    name = "diverging"
+
+    def integrators(self):
+        return ("rk4",)
+
+    def build_dynamics(self, scene, integrator, dt):
+        sim = super().build_dynamics(scene, integrator, dt)
+
+        class _Sim:
+            detail = "test"
+
+            def run(self, n):
+                traj = sim.run(n)
+                pos = traj.position_world.copy()
+                pos[-1] = np.nan
+                return type(traj)(traj.times, pos, traj.quat_wxyz, traj.velocity_world, traj.angular_velocity_world)
+
+        return _Sim()
+
+
+class _Refusing(InHouseEngine):
+    name = "refusing"
+
+    def supports_dynamics(self, scene, integrator):
+        return Support.no("cannot, for a reason")
+
+
+def _cases(rows):
+    return {(r.engine, r.integrator, r.dt): r.status for r in rows}
+
+
+def test_each_case_has_every_metric_and_crashes_do_not_stop_the_run():
+    """A crashing engine gets failed rows with the error; the engines after it still run."""
+    scene = builtin("lecture-projectile")
+    rows = run_scene(scene, [_Crashing(), _Diverging(), _Refusing(), make_engine("mujoco")], make_engine, repeats=1)
+    per_case = {}
+    for r in rows:
+        per_case.setdefault((r.engine, r.integrator, r.dt), []).append(r.metric)
+    assert all(sorted(m) == sorted(DYNAMICS_METRICS) for m in per_case.values())
+    statuses = _cases(rows)
+    assert {s for (e, _, _), s in statuses.items() if e == "crashing"} == {FAILED}
+    assert {s for (e, _, _), s in statuses.items() if e == "diverging"} == {DIVERGED}
+    assert {s for (e, _, _), s in statuses.items() if e == "refusing"} == {NOT_AVAILABLE}
+    assert {s for (e, _, _), s in statuses.items() if e == "mujoco"} == {OK}
+    crash = next(r for r in rows if r.engine == "crashing")
+    assert "RuntimeError: boom" in crash.detail
+    assert all(math.isnan(r.value) for r in rows if r.status in (FAILED, NOT_AVAILABLE))
+    assert any(r.metric == "time_per_step" and r.value > 0 for r in rows if r.status == DIVERGED)
+
+
+def test_missing_reference_keeps_timings_and_says_why():
+    """If the reference cannot do the scene, errors are n/a with the reason and timings are still measured."""
+    scene = builtin("lecture-projectile")
+    rows = run_scene(scene, [make_engine("mujoco")], lambda name: _Refusing(), repeats=1)
+    timing = [r for r in rows if r.metric == "time_per_step"]
+    errors = [r for r in rows if r.metric != "time_per_step"]
+    assert all(r.status == OK and r.value > 0 for r in timing)
+    assert all(r.status == NOT_AVAILABLE and "cannot, for a reason" in r.detail for r in errors)
+
+
+def test_kinematics_rows_and_reference_marking():
+    """Kinematics cases give every kinematics metric; the reference engine's rows say it is the reference."""
+    scene = builtin("lecture-planar-arm")
+    rows = run_scene(scene, [make_engine("analytic"), make_engine("core"), _Crashing()], make_engine, repeats=1)
+    assert {r.metric for r in rows if r.engine == "core"} == set(KINEMATICS_METRICS)
+    assert all(r.detail.startswith("this is the reference") for r in rows if r.engine == "analytic")
+    assert {r.status for r in rows if r.engine == "crashing"} == {FAILED}
+    assert all(math.isnan(r.dt) and r.integrator == "" for r in rows)

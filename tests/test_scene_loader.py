@@ -1,0 +1,149 @@
+"""Scene files: every built-in scene loads; every kind of bad input is rejected with file, key and reason."""
+
+import numpy as np
+import pytest
+
+from comparisons.library import builtin_paths
+from comparisons.scene_loader import LENGTH_UNITS, load_scene, parse_scene, tomllib
+from core.errors import SceneError
+
+VALID_DYNAMICS = """
+[scene]
+name = "drop"
+kind = "dynamics"
+reference = "analytic"
+
+[world]
+gravity_world = [0.0, 0.0, -9.81]
+
+[[body]]
+name = "ball"
+mass = 1.5
+inertia_body_diagonal = [0.1, 0.1, 0.1]
+velocity_world = [1.0, 0.0, 0.0]
+
+[simulation]
+duration = 1.0
+dt = [0.01]
+"""
+
+VALID_KINEMATICS = """
+[scene]
+name = "arm"
+kind = "kinematics"
+reference = "core"
+
+[chain]
+[[chain.joint]]
+name = "j1"
+type = "revolute"
+axis = [0.0, 0.0, 1.0]
+lower = -1.0
+upper = 1.0
+"""
+
+# (name, base text, old fragment, new fragment, key named in the error, words in the error)
+BROKEN = [
+    ("unknown key", VALID_DYNAMICS, 'name = "ball"', 'name = "ball"\ncolour = "red"', "body[0].colour", "unknown key"),
+    ("unknown table", VALID_DYNAMICS, "[world]", "[weather]\n[world]", "weather", "unknown key"),
+    ("short vector", VALID_DYNAMICS, "velocity_world = [1.0, 0.0, 0.0]", "velocity_world = [1.0, 0.0]",
+     "body[0].velocity_world", "expected a list of 3 numbers, got 2 values"),
+    ("nan mass", VALID_DYNAMICS, "mass = 1.5", "mass = nan", "body[0].mass", "not finite"),
+    ("inf gravity", VALID_DYNAMICS, "[0.0, 0.0, -9.81]", "[0.0, inf, -9.81]", "world.gravity_world[1]", "not finite"),
+    ("zero mass", VALID_DYNAMICS, "mass = 1.5", "mass = 0", "body[0].mass", "is not positive"),
+    ("negative mass", VALID_DYNAMICS, "mass = 1.5", "mass = -2.0", "body[0].mass", "is not positive"),
+    ("text mass", VALID_DYNAMICS, "mass = 1.5", 'mass = "heavy"', "body[0].mass", "expected a number"),
+    ("zero quaternion", VALID_DYNAMICS, 'name = "ball"', 'name = "ball"\nquat_wxyz = [0, 0, 0, 0]',
+     "body[0].quat_wxyz", "all zeros"),
+    ("missing mass", VALID_DYNAMICS, "mass = 1.5\n", "", "body[0].mass", "missing required key"),
+    ("missing simulation", VALID_DYNAMICS, "[simulation]\nduration = 1.0\ndt = [0.01]\n", "", "simulation",
+     "missing required table"),
+    ("bad kind", VALID_DYNAMICS, 'kind = "dynamics"', 'kind = "fluid"', "scene.kind", "allowed: dynamics, kinematics"),
+    ("bad reference", VALID_DYNAMICS, 'reference = "analytic"', 'reference = "havok"', "scene.reference",
+     "allowed: core, analytic, mujoco, pybullet, pinocchio"),
+    ("bad unit", VALID_DYNAMICS, 'reference = "analytic"', 'reference = "analytic"\nlength_unit = "furlong"',
+     "scene.length_unit", "allowed: m, cm, mm, ft, in"),
+    ("dt not dividing", VALID_DYNAMICS, "dt = [0.01]", "dt = [0.3]", "simulation.dt", "not a whole number of steps"),
+    ("dt and rate", VALID_DYNAMICS, "dt = [0.01]", "dt = [0.01]\nrate_hz = [100]", "simulation.dt", "exactly one"),
+    ("negative dt", VALID_DYNAMICS, "dt = [0.01]", "dt = [-0.01]", "simulation.dt[0]", "is not positive"),
+    ("non-positive inertia", VALID_DYNAMICS, "[0.1, 0.1, 0.1]", "[0.1, -0.1, 0.1]",
+     "body[0].inertia_body_diagonal[1]", "is not positive"),
+    ("triangle inequality", VALID_DYNAMICS, "[0.1, 0.1, 0.1]", "[0.1, 0.1, 0.3]", "body[0].inertia_body_diagonal",
+     "triangle inequality"),
+    ("non-symmetric inertia", VALID_DYNAMICS, "inertia_body_diagonal = [0.1, 0.1, 0.1]",
+     "inertia_body = [[0.1, 0.01, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]]", "body[0].inertia_body", "symmetric"),
+    ("indefinite inertia", VALID_DYNAMICS, "inertia_body_diagonal = [0.1, 0.1, 0.1]",
+     "inertia_body = [[0.1, 0.2, 0.0], [0.2, 0.1, 0.0], [0.0, 0.0, 0.1]]", "body[0].inertia_body",
+     "positive definite"),
+    ("two inertias", VALID_DYNAMICS, "inertia_body_diagonal = [0.1, 0.1, 0.1]",
+     "inertia_body_diagonal = [0.1, 0.1, 0.1]\ninertia_body = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]",
+     "body[0].inertia_body_diagonal", "exactly one"),
+    ("chain in dynamics", VALID_DYNAMICS, "[world]", "[chain]\n[world]", "chain", "not part of a dynamics scene"),
+    ("bad joint type", VALID_KINEMATICS, 'type = "revolute"', 'type = "spherical"', "chain.joint[0].type",
+     "allowed: revolute, prismatic"),
+    ("lower without upper", VALID_KINEMATICS, "upper = 1.0\n", "", "chain.joint[0].upper", "need both"),
+    ("inverted limits", VALID_KINEMATICS, "upper = 1.0", "upper = -2.0", "chain.joint[0].upper", "not above lower"),
+    ("zero axis", VALID_KINEMATICS, "axis = [0.0, 0.0, 1.0]", "axis = [0.0, 0.0, 0.0]", "chain.joint[0].axis",
+     "all zeros"),
+    ("no joints", VALID_KINEMATICS, '[[chain.joint]]\nname = "j1"\ntype = "revolute"\naxis = [0.0, 0.0, 1.0]\n'
+     "lower = -1.0\nupper = 1.0\n", "", "chain.joint", "missing required key"),
+    ("zero configurations", VALID_KINEMATICS, "[chain]", "[sampling]\nconfigurations = 0\n[chain]",
+     "sampling.configurations", ">= 1"),
+]
+
+
+def _write(tmp_path, text, name="scene.toml"):
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+@pytest.mark.parametrize("name, base, old, new, key, words", BROKEN, ids=[b[0] for b in BROKEN])
+def test_broken_scene_is_rejected_with_file_key_and_reason(tmp_path, name, base, old, new, key, words):
+    """Each broken file raises SceneError naming the file, the key path and what was wrong."""
+    assert old in base, f"test table out of date: {old!r}"
+    path = _write(tmp_path, base.replace(old, new, 1))
+    with pytest.raises(SceneError) as caught:
+        load_scene(path)
+    assert caught.value.source == str(path)
+    assert caught.value.key == key
+    assert words in str(caught.value)
+
+
+def test_unreadable_and_invalid_toml_files(tmp_path):
+    """A missing file and a file that is not TOML are SceneErrors too."""
+    with pytest.raises(SceneError, match="cannot read the file"):
+        load_scene(tmp_path / "missing.toml")
+    with pytest.raises(SceneError, match="not valid TOML"):
+        load_scene(_write(tmp_path, "[scene\nname = 1"))
+
+
+def test_valid_scenes_load_with_defaults_and_units(tmp_path):
+    """Defaults fill in (identity orientation, zero velocities, 100 configurations); lengths are scaled to metres."""
+    scene = load_scene(_write(tmp_path, VALID_DYNAMICS))
+    body = scene.bodies[0]
+    np.testing.assert_array_equal(body.quat_wxyz, [1, 0, 0, 0])
+    np.testing.assert_array_equal(body.angular_velocity_world, [0, 0, 0])
+    assert scene.n_steps(scene.dts[0]) == 100
+    feet = load_scene(_write(tmp_path, VALID_DYNAMICS.replace(
+        'reference = "analytic"', 'reference = "analytic"\nlength_unit = "ft"'), "ft.toml"))
+    np.testing.assert_allclose(feet.forces.gravity_world, [0, 0, -9.81 * LENGTH_UNITS["ft"]], rtol=1e-15)
+    np.testing.assert_allclose(feet.bodies[0].inertia_body, 0.1 * LENGTH_UNITS["ft"] ** 2 * np.eye(3), rtol=1e-15)
+    assert feet.bodies[0].mass == 1.5
+    arm = load_scene(_write(tmp_path, VALID_KINEMATICS, "arm.toml"))
+    assert arm.n_configurations == 100 and arm.chain.n_joints == 1
+    assert arm.configurations().shape == (100, 1) and np.all(np.abs(arm.configurations()) <= 1.0)
+
+
+def test_absent_forces_stay_absent():
+    """A scene without [world] has no gravity at all (None), not zero gravity."""
+    scene = parse_scene(tomllib.loads(VALID_DYNAMICS.replace("[world]\ngravity_world = [0.0, 0.0, -9.81]\n", "")))
+    assert scene.forces.gravity_world is None
+    assert scene.forces.names() == ()
+
+
+@pytest.mark.parametrize("name", sorted(builtin_paths()))
+def test_every_builtin_scene_loads(name):
+    """The built-in library is valid: every file loads and names itself after its file."""
+    scene = load_scene(builtin_paths()[name])
+    assert scene.name == name
