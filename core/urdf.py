@@ -1,0 +1,255 @@
+"""Serial chains from URDF files (kinematics only), read with the standard library.
+
+Only what fixes the kinematics is read: each ``<link name>`` and each ``<joint>``'s type,
+``<parent>``, ``<child>``, ``<origin xyz rpy>``, ``<axis xyz>`` and ``<limit lower upper>``.
+Visual, collision, inertial, dynamics, transmission and other elements are ignored.
+Values follow the URDF specification: a missing ``<origin>`` is the identity, a missing
+``<axis>`` is (1, 0, 0), a missing ``lower`` / ``upper`` attribute of ``<limit>`` is 0,
+``rpy`` is roll-pitch-yaw Rz(yaw) Ry(pitch) Rx(roll) (:func:`core.rotations.rpy_to_matrix`).
+
+The whole file must be a well-formed tree (unique names, every referenced link present,
+one parent per link, one root, finite numbers). The chain is the path from ``base_link``
+to ``tip_link``; joints on that path must be revolute, continuous (an unlimited revolute
+joint) or prismatic, or fixed (merged into the next movable joint's origin, or into the
+end-effector transform after the last movable joint). Joints off the path may be of any
+URDF type, mimic ones included, since they do not move the chain. Anything else is
+rejected with a :class:`~core.errors.SceneError` naming the element; nothing is guessed.
+"""
+
+from __future__ import annotations
+
+import os
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+from core.errors import SceneError
+from core.rotations import rpy_to_matrix
+from core.scene import Chain, Joint
+
+URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+_CHAIN_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed")
+_ALLOWED_ON_PATH = "revolute, continuous, prismatic or fixed joints without <mimic>"
+
+
+def chain_from_urdf(
+    path_or_text: str | os.PathLike,
+    base_link: str | None = None,
+    tip_link: str | None = None,
+    source: str | None = None,
+) -> Chain:
+    """Build the serial :class:`~core.scene.Chain` from ``base_link`` to ``tip_link``.
+
+    Parameters
+    ----------
+    path_or_text : str or path-like
+        A URDF file, or the URDF text itself (a string whose first non-blank character
+        is ``<``).
+    base_link : str, optional
+        The link whose frame is the world frame; default the tree's root link.
+    tip_link : str, optional
+        The link whose frame is the end effector; default the unique leaf below
+        ``base_link`` (an error when there are several).
+    source : str, optional
+        Name reported in errors; default the file path, or ``"<urdf text>"``.
+
+    Returns
+    -------
+    Chain
+        Named after ``<robot name>``; one joint per movable joint on the path, the
+        end-effector frame named after ``tip_link``.
+
+    Raises
+    ------
+    SceneError
+        For malformed XML or numbers, missing links, a link with two parents, several
+        roots, an unknown or missing base/tip link, several leaves without ``tip_link``,
+        or a mimic, floating or planar joint on the path. ``key`` names the element,
+        e.g. ``robot/joint[@name='j3']/mimic``.
+    """
+    root, source = _parse(path_or_text, source)
+    links = _links(root, source)
+    joints = _joints(root, source, links)
+    parent_joint = _parent_joints(joints, source)
+    roots = [name for name in links if name not in parent_joint]
+    if len(roots) != 1:
+        raise SceneError(source, "robot/link", f"the tree has {len(roots)} root links {roots}",
+                         "exactly one link that is no joint's child")
+    base = _pick_base(base_link, roots[0], links, source)
+    tip = _pick_tip(tip_link, base, links, joints, source)
+    path = _path(base, tip, parent_joint, source)
+    return _assemble(root.get("name", ""), path, tip, source)
+
+
+def _parse(path_or_text: str | os.PathLike, source: str | None) -> tuple[ET.Element, str]:
+    text = os.fspath(path_or_text)
+    is_text = text.lstrip().startswith("<")
+    source = source or ("<urdf text>" if is_text else text)
+    try:
+        root = ET.fromstring(text) if is_text else ET.parse(text).getroot()
+    except ET.ParseError as err:
+        raise SceneError(source, "robot", f"not well-formed XML ({err})", "a URDF document") from None
+    except OSError as err:
+        raise SceneError(source, "robot", f"cannot read the file ({err.strerror})", "a readable URDF file") from None
+    if root.tag != "robot":
+        raise SceneError(source, root.tag, "the root element is not <robot>", "<robot>")
+    return root, source
+
+
+def _links(root: ET.Element, source: str) -> list[str]:
+    names: list[str] = []
+    for i, link in enumerate(root.findall("link")):
+        name = link.get("name")
+        if not name:
+            raise SceneError(source, f"robot/link[{i + 1}]/@name", "missing", "a non-empty link name")
+        if name in names:
+            raise SceneError(source, f"robot/link[@name='{name}']", "the link name is used twice", "unique names")
+        names.append(name)
+    return names
+
+
+def _joints(root: ET.Element, source: str, links: list[str]) -> list[dict]:
+    joints: list[dict] = []
+    for i, element in enumerate(root.findall("joint")):
+        name = element.get("name")
+        if not name:
+            raise SceneError(source, f"robot/joint[{i + 1}]/@name", "missing", "a non-empty joint name")
+        key = f"robot/joint[@name='{name}']"
+        if any(j["name"] == name for j in joints):
+            raise SceneError(source, key, "the joint name is used twice", "unique names")
+        kind = element.get("type")
+        if kind not in URDF_JOINT_TYPES:
+            raise SceneError(source, f"{key}/@type", f"unknown joint type {kind!r}", ", ".join(URDF_JOINT_TYPES))
+        joint = {"name": name, "key": key, "type": kind, "element": element}
+        for end in ("parent", "child"):
+            link = element.find(end)
+            if link is None or not link.get("link"):
+                raise SceneError(source, f"{key}/{end}", "missing", f"<{end} link='...'/>")
+            if link.get("link") not in links:
+                raise SceneError(source, f"{key}/{end}/@link", f"link {link.get('link')!r} is not defined",
+                                 "the name of a <link> in the file")
+            joint[end] = link.get("link")
+        origin = element.find("origin")
+        joint["xyz"] = _numbers(origin, "xyz", (0.0, 0.0, 0.0), f"{key}/origin", source)
+        joint["rpy"] = _numbers(origin, "rpy", (0.0, 0.0, 0.0), f"{key}/origin", source)
+        joint["axis"] = _numbers(element.find("axis"), "xyz", (1.0, 0.0, 0.0), f"{key}/axis", source)
+        if kind in ("revolute", "continuous", "prismatic") and not np.any(joint["axis"]):
+            raise SceneError(source, f"{key}/axis/@xyz", "the axis is zero", "a non-zero vector")
+        joint["limits"] = _limits(element, kind, key, source)
+        joints.append(joint)
+    return joints
+
+
+def _numbers(element: ET.Element | None, attribute: str, default: tuple[float, ...], key: str,
+             source: str) -> np.ndarray:
+    if element is None or element.get(attribute) is None:
+        return np.array(default)
+    text = element.get(attribute)
+    try:
+        values = np.array([float(word) for word in text.split()])
+    except ValueError:
+        values = np.array([np.nan])
+    if values.shape != (len(default),) or not np.all(np.isfinite(values)):
+        raise SceneError(source, f"{key}/@{attribute}", f"malformed number list {text!r}",
+                         f"{len(default)} finite numbers separated by spaces")
+    return values
+
+
+def _limits(element: ET.Element, kind: str, key: str, source: str) -> tuple[float, float]:
+    if kind in ("continuous", "fixed", "floating", "planar"):
+        return -np.inf, np.inf
+    limit = element.find("limit")
+    if limit is None:
+        raise SceneError(source, f"{key}/limit", f"a {kind} joint has no <limit>",
+                         "<limit lower='...' upper='...'/> (use type='continuous' for an unlimited joint)")
+    lower, upper = (_numbers(limit, bound, (0.0,), f"{key}/limit", source)[0] for bound in ("lower", "upper"))
+    if lower > upper:
+        raise SceneError(source, f"{key}/limit", f"lower {lower} is above upper {upper}", "lower <= upper")
+    return lower, upper
+
+
+def _parent_joints(joints: list[dict], source: str) -> dict[str, dict]:
+    parent_joint: dict[str, dict] = {}
+    for joint in joints:
+        child = joint["child"]
+        if child in parent_joint:
+            raise SceneError(source, f"robot/link[@name='{child}']",
+                             f"the link is the child of two joints, '{parent_joint[child]['name']}' and "
+                             f"'{joint['name']}' (a closed loop)", "a tree: one parent joint per link")
+        parent_joint[child] = joint
+    return parent_joint
+
+
+def _pick_base(base_link: str | None, root_link: str, links: list[str], source: str) -> str:
+    if base_link is None:
+        return root_link
+    if base_link not in links:
+        raise SceneError(source, "base_link", f"no link named {base_link!r}", ", ".join(links))
+    return base_link
+
+
+def _pick_tip(tip_link: str | None, base: str, links: list[str], joints: list[dict], source: str) -> str:
+    if tip_link is not None:
+        if tip_link not in links:
+            raise SceneError(source, "tip_link", f"no link named {tip_link!r}", ", ".join(links))
+        return tip_link
+    children: dict[str, list[str]] = {}
+    for joint in joints:
+        children.setdefault(joint["parent"], []).append(joint["child"])
+    leaves, stack = [], [base]
+    while stack:
+        link = stack.pop()
+        stack.extend(children.get(link, []))
+        if link not in children:
+            leaves.append(link)
+    if len(leaves) != 1:
+        raise SceneError(source, "tip_link", f"link {base!r} has {len(leaves)} leaf links below it "
+                         f"{sorted(leaves)} and no tip_link was given", "one of the leaf link names")
+    return leaves[0]
+
+
+def _path(base: str, tip: str, parent_joint: dict[str, dict], source: str) -> list[dict]:
+    path, link = [], tip
+    while link != base:
+        if link not in parent_joint:
+            raise SceneError(source, "tip_link", f"link {tip!r} is not below base link {base!r}",
+                             f"a link in the subtree of {base!r}")
+        if any(joint["child"] == link for joint in path):
+            raise SceneError(source, f"robot/link[@name='{link}']", "the link is its own ancestor (a closed loop)",
+                             "a tree")
+        path.append(parent_joint[link])
+        link = parent_joint[link]["parent"]
+    return path[::-1]
+
+
+def _assemble(robot_name: str, path: list[dict], tip: str, source: str) -> Chain:
+    # (position, rotation) of the frame reached so far, in the last movable joint's
+    # child-link frame (or the base frame before the first movable joint).
+    position, rotation = np.zeros(3), np.eye(3)
+    chain_joints: list[Joint] = []
+    for joint in path:
+        key = joint["key"]
+        if joint["type"] not in _CHAIN_JOINT_TYPES:
+            raise SceneError(source, f"{key}/@type", f"a {joint['type']} joint on the chain", _ALLOWED_ON_PATH)
+        if joint["element"].find("mimic") is not None:
+            raise SceneError(source, f"{key}/mimic", "a mimic joint on the chain", _ALLOWED_ON_PATH)
+        position = position + rotation @ joint["xyz"]
+        rotation = rotation @ rpy_to_matrix(joint["rpy"])
+        if joint["type"] == "fixed":
+            continue
+        lower, upper = joint["limits"]
+        chain_joints.append(Joint(
+            name=joint["name"],
+            type="prismatic" if joint["type"] == "prismatic" else "revolute",
+            axis=joint["axis"],
+            origin_xyz=position,
+            origin_rotation=rotation,
+            lower=lower,
+            upper=upper,
+        ))
+        position, rotation = np.zeros(3), np.eye(3)
+    if not chain_joints:
+        raise SceneError(source, "tip_link", f"no movable joint between the base and {tip!r}",
+                         "a path with at least one revolute, continuous or prismatic joint")
+    return Chain(robot_name, tuple(chain_joints), end_effector_name=tip,
+                 end_effector_xyz=position, end_effector_rotation=rotation)
