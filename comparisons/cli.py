@@ -13,7 +13,7 @@ import sys
 from pathlib import Path
 
 from comparisons import library
-from comparisons.engines import ENGINE_NAMES, check_engine_names, make_engine
+from comparisons.engines import DEFAULT_ENGINES, ENGINE_NAMES, check_engine_names, make_engine
 from comparisons.runner import DEFAULT_REPEATS, run_scene
 from comparisons.store import DEFAULT_OUT_ROOT, RunWriter, default_out_dir
 from core.errors import SimparityError
@@ -45,8 +45,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     run.add_argument("scenes", nargs="*", metavar="SCENE|FILE",
                      help="built-in scene names or scene files (default: the whole built-in suite)")
-    run.add_argument("--engines", type=_engine_list, default=ENGINE_NAMES, metavar="A,B,...",
-                     help=f"comma-separated engines to run (default: all: {','.join(ENGINE_NAMES)})")
+    run.add_argument("--engines", type=_engine_list, default=DEFAULT_ENGINES, metavar="A,B,...",
+                     help=f"comma-separated engines to run (default: {','.join(DEFAULT_ENGINES)}; "
+                     f"known: {','.join(ENGINE_NAMES)})")
     run.add_argument("--out", type=Path, default=None, metavar="DIR",
                      help=f"output folder (default: {DEFAULT_OUT_ROOT}/<UTC date-time>/)")
     run.add_argument("--repeats", type=int, default=DEFAULT_REPEATS, metavar="N",

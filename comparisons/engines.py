@@ -13,8 +13,11 @@ _ENGINES = {
     "mujoco": ("references.mujoco_adapter", "MujocoEngine"),
     "pybullet": ("references.pybullet_adapter", "PybulletEngine"),
     "pinocchio": ("references.pinocchio_adapter", "PinocchioEngine"),
+    "tight": ("references.tight", "TightSolveEngine"),
 }
 ENGINE_NAMES = tuple(_ENGINES)
+DEFAULT_ENGINES = ("core", "analytic", "mujoco", "pybullet", "pinocchio")
+"""What ``simparity run`` runs unless told otherwise; ``tight`` serves as a reference only."""
 
 
 class UnavailableEngine(Engine):

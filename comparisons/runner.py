@@ -14,9 +14,18 @@ from typing import Callable
 
 import numpy as np
 
-from comparisons.metrics import DYNAMICS_METRICS, KINEMATICS_METRICS, kinematics_errors, trajectory_errors
+from comparisons.metrics import (
+    KINEMATICS_METRICS,
+    ORDER_METRICS,
+    drifts,
+    dynamics_metrics,
+    kinematics_errors,
+    observed_order,
+    trajectory_errors,
+)
 from comparisons.timing import best_of
 from core.engine import Engine
+from core.errors import DivergedError
 from core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
 from core.scene import DynamicsScene, KinematicsScene
 
@@ -47,11 +56,22 @@ def _error_text(err: BaseException) -> str:
     return f"{type(err).__name__}: {err}{at}".replace("\n", " ")
 
 
+def _integrators(scene: DynamicsScene, engine: Engine) -> tuple[list[str], str]:
+    """(the engine's integrators the scene runs, reason when none)."""
+    offered = list(engine.integrators())
+    chosen = [i for i in offered if not scene.integrators or i in scene.integrators]
+    reason = "" if chosen else (
+        f"the scene runs only {', '.join(scene.integrators)}; {engine.name} offers {', '.join(offered)}")
+    return chosen, reason
+
+
 def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, repeats: int) -> list[ResultRow]:
     rows: list[ResultRow] = []
+    metrics = dynamics_metrics(scene)
     ref_integrator = reference.integrators()[0]
     ref_label = f"{reference.name}:{ref_integrator}"
     ref_support = reference.supports_dynamics(scene, ref_integrator)
+    errors: dict[tuple[str, str], list[tuple[float, dict]]] = {}
     for dt in scene.dts:
         n = scene.n_steps(dt)
         ref_traj, ref_problem = None, ""
@@ -63,33 +83,59 @@ def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, re
             except Exception as err:  # noqa: BLE001 - reported in the rows
                 ref_problem = f"reference {ref_label} failed: {_error_text(err)}"
         for engine in engines:
-            for integrator in engine.integrators():
+            chosen, reason = _integrators(scene, engine)
+            if not chosen:
+                rows += _Case(scene.name, engine.name, "-", dt, ref_label).rows(metrics, NOT_AVAILABLE, reason)
+            for integrator in chosen:
                 case = _Case(scene.name, engine.name, integrator, dt, ref_label)
                 is_reference = engine.name == reference.name and integrator == ref_integrator
-                rows += _dynamics_case(scene, engine, case, n, ref_traj, ref_problem, repeats, is_reference)
+                case_rows = _dynamics_case(scene, engine, case, metrics, n, ref_traj, ref_problem, repeats,
+                                           is_reference)
+                rows += case_rows
+                errors.setdefault((engine.name, integrator), []).append(
+                    (dt, {r.metric: r.value for r in case_rows if r.status == OK}))
+    if len(scene.dts) > 1:
+        rows += _orders(scene, errors, ref_label)
     return rows
 
 
-def _dynamics_case(scene, engine: Engine, case: _Case, n: int, ref_traj, ref_problem: str, repeats: int,
-                   is_reference: bool) -> list[ResultRow]:
+def _orders(scene: DynamicsScene, errors: dict, ref_label: str) -> list[ResultRow]:
+    """Observed order of convergence per engine and integrator over the scene's time steps."""
+    rows = []
+    for (engine, integrator), per_dt in errors.items():
+        dts = [dt for dt, _ in per_dt]
+        for metric, source in (("order_position", "position_error_max"), ("order_orientation", "orientation_error_max")):
+            slope, detail = observed_order(dts, [values.get(source, math.nan) for _, values in per_dt])
+            status = NOT_AVAILABLE if math.isnan(slope) else OK
+            rows.append(ResultRow(scene.name, engine, integrator, math.nan, metric, slope, ORDER_METRICS[metric],
+                                  ref_label, status, detail))
+    return rows
+
+
+def _dynamics_case(scene, engine: Engine, case: _Case, metrics: dict, n: int, ref_traj, ref_problem: str,
+                   repeats: int, is_reference: bool) -> list[ResultRow]:
     support = engine.supports_dynamics(scene, case.integrator)
     if not support.ok:
-        return case.rows(DYNAMICS_METRICS, NOT_AVAILABLE, support.reason)
+        return case.rows(metrics, NOT_AVAILABLE, support.reason)
     try:
         sim = engine.build_dynamics(scene, case.integrator, case.dt)
-        seconds, traj = best_of(lambda: sim.run(n), repeats)
+        with np.errstate(all="ignore"):  # a diverging run overflows; it is reported as diverged
+            seconds, traj = best_of(lambda: sim.run(n), repeats)
+    except DivergedError as err:
+        return case.rows(metrics, DIVERGED, str(err))
     except Exception as err:  # noqa: BLE001 - reported in the rows
-        return case.rows(DYNAMICS_METRICS, FAILED, _error_text(err))
+        return case.rows(metrics, FAILED, _error_text(err))
     values = {"time_per_step": (seconds / n, "s")}
     if not traj.is_finite():
-        return case.rows(DYNAMICS_METRICS, DIVERGED, "non-finite state; " + sim.detail, values)
+        return case.rows(metrics, DIVERGED, "non-finite state; " + sim.detail, values)
+    values.update(drifts(scene, traj))
+    measured = {k: metrics[k] for k in values}
     if ref_traj is None:
-        rows = case.rows({"time_per_step": "s"}, OK, sim.detail, values)
-        errors = {k: v for k, v in DYNAMICS_METRICS.items() if k != "time_per_step"}
-        return rows + case.rows(errors, NOT_AVAILABLE, ref_problem)
+        rows = case.rows(measured, OK, sim.detail, values)
+        return rows + case.rows({k: u for k, u in metrics.items() if k not in values}, NOT_AVAILABLE, ref_problem)
     values.update(trajectory_errors(traj, ref_traj))
     detail = ("this is the reference; " if is_reference else "") + sim.detail
-    return case.rows(DYNAMICS_METRICS, OK, detail, values)
+    return case.rows(metrics, OK, detail, values)
 
 
 def _kinematics(scene: KinematicsScene, engines: list[Engine], reference: Engine, repeats: int) -> list[ResultRow]:

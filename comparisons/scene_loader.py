@@ -17,7 +17,9 @@ from comparisons.engines import ENGINE_NAMES
 from core.errors import SceneError
 from core.inertia import inertia_problem
 from core.rotations import rpy_to_matrix
-from core.scene import Chain, DynamicsScene, Forces, Joint, KinematicsScene, RigidBody
+from core.dh import chain_from_dh
+from core.scene import HARD_TARGETS, AppliedForce, Chain, DynamicsScene, Forces, IKScene, Joint, KinematicsScene, RigidBody
+from core.urdf import chain_from_urdf
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -27,7 +29,7 @@ else:  # pragma: no cover - exercised on Python 3.10 only
 LENGTH_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "ft": 0.3048, "in": 0.0254}
 """Units a scene may declare for lengths, and their size in metres."""
 
-KINDS = ("dynamics", "kinematics")
+KINDS = ("dynamics", "kinematics", "ik")
 JOINT_TYPES = ("revolute", "prismatic")
 
 _REQUIRED = object()  # marks a key without a default
@@ -115,6 +117,13 @@ class _Reader:
             raise self.fail(key, f"expected a non-empty list of numbers, got {value!r}")
         return tuple(self._checked(f"{key}[{i}]", v, True) for i, v in enumerate(value))
 
+    def strings(self, key: str) -> tuple[str, ...]:
+        """A non-empty list of non-empty strings."""
+        value = self._get(key, _REQUIRED)
+        if not isinstance(value, list) or not value or not all(isinstance(v, str) and v for v in value):
+            raise self.fail(key, f"expected a non-empty list of names, got {value!r}")
+        return tuple(value)
+
     def subtable(self, key: str, allowed: tuple[str, ...], required: bool = True) -> "_Reader | None":
         if key not in self.table:
             if required:
@@ -133,15 +142,39 @@ class _Reader:
 
 
 
-_TOP = ("scene", "world", "body", "simulation", "chain", "sampling")
+_TOP = ("scene", "world", "body", "simulation", "chain", "sampling", "targets")
+_PARTS = {"dynamics": ("world", "body", "simulation"), "kinematics": ("chain", "sampling"), "ik": ("chain", "targets")}
 _SCENE = ("name", "description", "kind", "reference", "length_unit")
+# Drag coefficients and the power of length in their units (for length_unit scaling).
+DRAG_KEYS = {"linear_drag": 0, "quadratic_drag": -1, "angular_linear_drag": 2, "angular_quadratic_drag": 2}
 _BODY = ("name", "mass", "inertia_body_diagonal", "inertia_body", "position_world", "quat_wxyz",
-         "velocity_world", "angular_velocity_world")
-_CHAIN = ("name", "joint", "end_effector", "end_effector_xyz", "end_effector_rpy")
+         "velocity_world", "angular_velocity_world", "force") + tuple(DRAG_KEYS)
+_FORCE = ("force_world", "point_body")
+_CHAIN = ("name", "joint", "end_effector", "end_effector_xyz", "end_effector_rpy", "urdf", "base_link", "tip_link",
+          "dh")
+_DH = ("convention", "a", "alpha", "d", "theta_offset", "lower", "upper")
+_TARGETS = ("count", "seed", "kind", "start", "position_tolerance", "orientation_tolerance", "max_iterations",
+            "hard")
+PYBULLET_DATA_PREFIX = "pybullet_data:"
+"""A ``urdf`` path starting with this is inside the installed pybullet_data package."""
 _JOINT = ("name", "type", "axis", "origin_xyz", "origin_rpy", "lower", "upper")
 
 # duration / dt may differ from a whole number by this much (rounding of a decimal dt).
 _STEP_COUNT_RTOL = 1e-9
+
+
+def _body_forces(r: _Reader, index: int) -> tuple[dict, list[AppliedForce]]:
+    """Drag coefficients (key -> value, only those set) and applied forces of one body."""
+    drags = {key: r.number(key, length=power) for key, power in DRAG_KEYS.items() if r.has(key)}
+    for key, value in drags.items():
+        if value < 0:
+            raise r.fail(key, f"{value} is negative", "numbers >= 0")
+    applied = []
+    if r.has("force"):
+        for f in r.array_of_tables("force", _FORCE):
+            applied.append(AppliedForce(index, f.vector("force_world", 3, length=1),
+                                        f.vector("point_body", 3, [0.0] * 3, length=1)))
+    return drags, applied
 
 
 def _body(r: _Reader) -> RigidBody:
@@ -167,13 +200,24 @@ def _body(r: _Reader) -> RigidBody:
 
 
 def _dynamics(top: _Reader, head: dict) -> DynamicsScene:
-    world = top.subtable("world", ("gravity_world",), required=False)
+    world = top.subtable("world", ("gravity_world", "air_velocity_world"), required=False)
     gravity = world.vector("gravity_world", 3, length=1) if world and world.has("gravity_world") else None
-    bodies = tuple(_body(r) for r in top.array_of_tables("body", _BODY))
+    air = world.vector("air_velocity_world", 3, length=1) if world and world.has("air_velocity_world") else None
+    readers = top.array_of_tables("body", _BODY)
+    bodies = tuple(_body(r) for r in readers)
+    per_body = [_body_forces(r, i) for i, r in enumerate(readers)]
+    drag = {
+        key: np.array([d.get(key, 0.0) for d, _ in per_body]) if any(key in d for d, _ in per_body) else None
+        for key in DRAG_KEYS
+    }
+    if air is not None and drag["linear_drag"] is None and drag["quadratic_drag"] is None:
+        raise world.fail("air_velocity_world", "wind needs a body with linear_drag or quadratic_drag to act on")
+    forces = Forces(gravity_world=gravity, air_velocity_world=air,
+                    applied=tuple(a for _, applied in per_body for a in applied), **drag)
     names = [b.name for b in bodies]
     if len(set(names)) != len(names):
         raise top.fail("body", f"body names repeat: {names}", "distinct names")
-    sim = top.subtable("simulation", ("duration", "dt", "rate_hz"))
+    sim = top.subtable("simulation", ("duration", "dt", "rate_hz", "integrators"))
     duration = sim.number("duration", positive=True)
     if sim.has("dt") == sim.has("rate_hz"):
         raise sim.fail("dt", "give exactly one of dt and rate_hz")
@@ -184,7 +228,8 @@ def _dynamics(top: _Reader, head: dict) -> DynamicsScene:
             raise sim.fail("dt" if sim.has("dt") else "rate_hz",
                            f"duration {duration} s is not a whole number of steps of {dt} s",
                            "time steps that divide the duration")
-    return DynamicsScene(bodies=bodies, forces=Forces(gravity_world=gravity), duration=duration, dts=dts, **head)
+    integrators = sim.strings("integrators") if sim.has("integrators") else ()
+    return DynamicsScene(bodies=bodies, forces=forces, duration=duration, dts=dts, integrators=integrators, **head)
 
 
 def _joint(r: _Reader) -> Joint:
@@ -204,22 +249,96 @@ def _joint(r: _Reader) -> Joint:
     )
 
 
-def _kinematics(top: _Reader, head: dict) -> KinematicsScene:
+def _urdf_path(c: _Reader) -> Path:
+    text = c.string("urdf")
+    if text.startswith(PYBULLET_DATA_PREFIX):
+        import pybullet_data  # data files only; ships with pybullet
+
+        path = Path(pybullet_data.getDataPath()) / text[len(PYBULLET_DATA_PREFIX):]
+    else:
+        path = Path(text) if Path(text).is_absolute() else Path(c.source).parent / text
+    if not path.is_file():
+        raise c.fail("urdf", f"no such file: {path}", f"a path relative to the scene file, or {PYBULLET_DATA_PREFIX}...")
+    return path
+
+
+def _dh_chain(c: _Reader, name: str) -> Chain:
+    dh = c.subtable("dh", _DH)
+    convention = dh.string("convention", "standard", choices=("standard", "modified"))
+    columns = {key: dh.table.get(key) for key in ("a", "alpha", "d", "theta_offset")}
+    size = len(columns["a"]) if isinstance(columns["a"], list) else 0
+    if size < 1:
+        raise dh.fail("a", "expected a non-empty list of numbers")
+    values = {key: dh.vector(key, size, [0.0] * size if key == "theta_offset" else None,
+                             length=1 if key in ("a", "d") else 0) for key in columns}
+    limits = None
+    if dh.has("lower") or dh.has("upper"):
+        limits = np.stack([dh.vector("lower", size), dh.vector("upper", size)], axis=1)
+        bad = np.flatnonzero(limits[:, 0] >= limits[:, 1])
+        if bad.size:
+            raise dh.fail("upper", f"upper limit of joint {bad[0]} is not above its lower limit")
+    return chain_from_dh(name, convention=convention, limits=limits, **values)
+
+
+def _chain(top: _Reader, name: str) -> Chain:
     c = top.subtable("chain", _CHAIN)
+    sources = [key for key in ("joint", "urdf", "dh") if c.has(key)]
+    if len(sources) != 1:
+        raise c.fail("joint", f"give exactly one chain source, got {sources or 'none'}", "joint, urdf, dh")
+    if sources == ["urdf"]:
+        return chain_from_urdf(_urdf_path(c), base_link=c.table.get("base_link"), tip_link=c.table.get("tip_link"))
+    if sources == ["dh"]:
+        return _dh_chain(c, c.string("name", name))
     joints = tuple(_joint(r) for r in c.array_of_tables("joint", _JOINT))
     names = [j.name for j in joints]
     end_effector = c.string("end_effector", "end_effector")
     if len(set(names + [end_effector])) != len(names) + 1:
         raise c.fail("joint", f"joint and end-effector names repeat: {names + [end_effector]}", "distinct names")
-    chain = Chain(
-        name=c.string("name", head["name"]), joints=joints, end_effector_name=end_effector,
+    return Chain(
+        name=c.string("name", name), joints=joints, end_effector_name=end_effector,
         end_effector_xyz=c.vector("end_effector_xyz", 3, [0.0] * 3, length=1),
         end_effector_rotation=rpy_to_matrix(c.vector("end_effector_rpy", 3, [0.0] * 3)),
     )
+
+
+def _kinematics(top: _Reader, head: dict) -> KinematicsScene:
+    chain = _chain(top, head["name"])
     sampling = top.subtable("sampling", ("configurations", "seed"), required=False)
     n = sampling.integer("configurations", 100, minimum=1) if sampling else 100
     seed = sampling.integer("seed", 0) if sampling else 0
     return KinematicsScene(chain=chain, n_configurations=n, seed=seed, **head)
+
+
+def _start(t: _Reader, chain: Chain) -> np.ndarray:
+    """The start pose: "zeros", "mid-range" (limits' middle, 0 where unlimited) or a list."""
+    value = t.table.get("start", "zeros")
+    if isinstance(value, list):
+        q = t.vector("start", chain.n_joints)
+    elif value in ("zeros", "mid-range"):
+        middle = (chain.lower + chain.upper) / 2
+        q = np.zeros(chain.n_joints) if value == "zeros" else np.where(np.isfinite(middle), middle, 0.0)
+    else:
+        raise t.fail("start", f"{value!r} is not allowed", f'"zeros", "mid-range" or a list of {chain.n_joints} numbers')
+    outside = np.flatnonzero((q < chain.lower) | (q > chain.upper))
+    if outside.size:
+        raise t.fail("start", f"joint {chain.joints[outside[0]].name} starts outside its limits")
+    return q
+
+
+def _ik(top: _Reader, head: dict) -> IKScene:
+    chain = _chain(top, head["name"])
+    t = top.subtable("targets", _TARGETS)
+    hard = t.strings("hard") if t.has("hard") else ()
+    unknown = [h for h in hard if h not in HARD_TARGETS]
+    if unknown:
+        raise t.fail("hard", f"unknown hard target {unknown[0]!r}", ", ".join(HARD_TARGETS))
+    return IKScene(
+        chain=chain, n_targets=t.integer("count", 100, minimum=1), seed=t.integer("seed", 0),
+        target_kind=t.string("kind", "pose", choices=("pose", "position")), q_start=_start(t, chain),
+        position_tolerance=t.number("position_tolerance", 1e-6, positive=True),
+        orientation_tolerance=t.number("orientation_tolerance", 1e-6, positive=True),
+        max_iterations=t.integer("max_iterations", 200, minimum=1), hard_targets=hard, **head,
+    )
 
 
 def parse_scene(data: dict, source: str = "<scene>"):
@@ -233,13 +352,12 @@ def parse_scene(data: dict, source: str = "<scene>"):
         reference=s.string("reference", choices=ENGINE_NAMES), source=source,
     )
     top.scale = LENGTH_UNITS[unit]
-    misplaced = ("chain", "sampling") if kind == "dynamics" else ("world", "body", "simulation")
-    for key in misplaced:
-        if top.has(key):
-            raise top.fail(key, f"not part of a {kind} scene", ", ".join(k for k in _TOP if k not in misplaced))
+    for key in _TOP[1:]:
+        if top.has(key) and key not in _PARTS[kind]:
+            raise top.fail(key, f"not part of a {kind} scene", ", ".join(("scene",) + _PARTS[kind]))
     if kind == "dynamics":
         return _dynamics(top, dict(head, length_unit=unit))
-    return _kinematics(top, head)
+    return _kinematics(top, head) if kind == "kinematics" else _ik(top, head)
 
 
 def load_scene(path: str | Path):

@@ -1,4 +1,4 @@
-"""Timing: best of several repeats, after one untimed warm-up call."""
+"""Timing: best of several repeats, after one warm-up call."""
 
 from __future__ import annotations
 
@@ -8,12 +8,27 @@ from typing import Callable, TypeVar
 T = TypeVar("T")
 
 
+LONG_CALL_SECONDS = 1.0
+"""A call at least this long is timed once: its warm-up is its measurement (caches matter
+little at that length, and repeating it would only slow the run)."""
+
+REPEAT_BUDGET_SECONDS = 1.0
+"""Timed repeats stop early once they have used this much time (at least one is made)."""
+
+
 def best_of(fn: Callable[[], T], repeats: int) -> tuple[float, T]:
-    """(minimum wall time [s] over ``repeats`` timed calls, the last call's result)."""
+    """(minimum wall time [s] over up to ``repeats`` timed calls, the last call's result)."""
+    start = time.perf_counter()
     result = fn()  # warm-up: caches, lazy allocations
-    best = float("inf")
+    best = time.perf_counter() - start
+    if best >= LONG_CALL_SECONDS:
+        return best, result
+    best, spent = float("inf"), 0.0
     for _ in range(repeats):
         start = time.perf_counter()
         result = fn()
-        best = min(best, time.perf_counter() - start)
+        elapsed = time.perf_counter() - start
+        best, spent = min(best, elapsed), spent + elapsed
+        if spent >= REPEAT_BUDGET_SECONDS:
+            break
     return best, result

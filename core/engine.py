@@ -13,6 +13,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from core.errors import SimparityError
+from core.ik.jacobian_solvers import IKOptions
+from core.ik.result import IKResult
 from core.scene import Chain, DynamicsScene, KinematicsScene
 from core.trajectory import FramePoses, Trajectory
 
@@ -84,6 +86,40 @@ class KinematicsModel(abc.ABC):
         """
 
 
+class IKModel(abc.ABC):
+    """An inverse-kinematics solver built for one chain.
+
+    Attributes
+    ----------
+    detail : str
+        What the solver is and how it was configured (library call, iterations, damping).
+    """
+
+    detail: str = ""
+
+    @abc.abstractmethod
+    def solve(self, target_position_world: np.ndarray, target_rotation_world: np.ndarray | None,
+              q_start: np.ndarray) -> IKResult:
+        """Solve a batch of end-effector targets, every one from the same start.
+
+        Parameters
+        ----------
+        target_position_world : (B, 3) ndarray
+            [m].
+        target_rotation_world : (B, 3, 3) ndarray or None
+            End-effector to world rotation; ``None`` for position-only targets.
+        q_start : (n,) ndarray
+            Start configuration [rad or m].
+
+        Returns
+        -------
+        IKResult
+            Never raises for an unreachable or singular target; residuals are measured with
+            the engine's own forward kinematics. ``iterations`` is -1 where the engine does
+            not report it.
+        """
+
+
 class Engine(abc.ABC):
     """One engine: the in-house core, an analytic truth, or an adapter to a library."""
 
@@ -112,6 +148,21 @@ class Engine(abc.ABC):
     @abc.abstractmethod
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
         """Build the model for ``chain`` (not timed). Call only when supported."""
+
+    def ik_solvers(self) -> tuple[str, ...]:
+        """Names of the IK solvers the engine offers (empty if none)."""
+        return ()
+
+    def supports_ik(self, chain: Chain, solver: str) -> Support:
+        """Whether :meth:`build_ik` can build ``solver`` for ``chain``."""
+        if solver in self.ik_solvers():
+            return Support.yes()
+        offered = ", ".join(self.ik_solvers()) or "none"
+        return Support.no(f"{self.name} has no IK solver '{solver}' (offers: {offered})")
+
+    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
+        """Build ``solver`` for ``chain`` with the scene's tolerances and iteration cap (not timed)."""
+        raise SimparityError(f"engine '{self.name}' has no IK solvers")
 
     def check_integrator(self, integrator: str) -> Support:
         """Support for an integrator name alone."""

@@ -45,5 +45,9 @@ class UnknownEngineError(SimparityError):
     """An engine name is not one simparity knows."""
 
 
+class DivergedError(SimparityError):
+    """A simulation became unstable (an engine reported it, or its state left the finite numbers)."""
+
+
 class ResultsError(SimparityError):
     """A stored run is missing or unreadable."""

@@ -8,10 +8,10 @@ import numpy as np
 
 from core import point_mass
 from core.engine import Engine, KinematicsModel, Simulation, Support
-from core.forces import has_torque, make_wrench
+from core.forces import make_wrench
 from core.integrators import ORIENTATION_UPDATES, SCHEMES, make_step
 from core.kinematics import forward_kinematics, jacobian_world
-from core.rigid_body import MassProperties, initial_state, velocities
+from core.rigid_body import MassProperties, State, initial_state, velocities
 from core.rotations import matrix_to_quat_wxyz
 from core.scene import Chain, DynamicsScene
 from core.trajectory import FramePoses, Trajectory
@@ -48,16 +48,23 @@ class _RigidBodySimulation(Simulation):
 
     def run(self, n_steps: int) -> Trajectory:
         state, dt = self._state0, self._dt
-        b = len(self._props.mass)
-        pos, quat, vel, omg = (np.empty((n_steps + 1, b, k)) for k in (3, 4, 3, 3))
+        o = state.orientation
+        pos, mom, ang = (np.empty((n_steps + 1,) + state.position_world.shape) for _ in range(3))
+        ori = np.empty((n_steps + 1,) + o.shape)
         for i in range(n_steps + 1):
             if i:
                 state = self._step((i - 1) * dt, state, dt)
-            v, omega = velocities(state, self._props)
-            pos[i], vel[i], omg[i] = state.position_world, v, omega
-            o = state.orientation
-            quat[i] = o if o.shape[-1] == 4 else matrix_to_quat_wxyz(o)
-        return Trajectory(np.arange(n_steps + 1) * dt, pos, quat, vel, omg)
+            pos[i], ori[i], mom[i], ang[i] = (state.position_world, state.orientation, state.momentum_world,
+                                              state.angular_momentum_world)
+        # Velocities and quaternions of all samples at once (T * B bodies in one batch).
+        b = len(self._props.mass)
+        flat = State(pos.reshape(-1, 3), ori.reshape((-1,) + o.shape[1:]), mom.reshape(-1, 3), ang.reshape(-1, 3))
+        tiled = MassProperties(np.tile(self._props.mass, n_steps + 1), np.tile(self._props.inertia_body, (n_steps + 1, 1, 1)),
+                               np.tile(self._props.inertia_body_inv, (n_steps + 1, 1, 1)))
+        vel, omg = velocities(flat, tiled)
+        quat = ori if o.shape[-1] == 4 else matrix_to_quat_wxyz(ori)
+        shape = (n_steps + 1, b, 3)
+        return Trajectory(np.arange(n_steps + 1) * dt, pos, quat, vel.reshape(shape), omg.reshape(shape))
 
 
 class _ParticleSimulation(Simulation):
@@ -117,7 +124,7 @@ class InHouseEngine(Engine):
         if not named.ok or integrator not in point_mass.RULES:
             return named
         rotating = any(np.any(b.angular_velocity_world != 0) for b in scene.bodies)
-        if rotating or has_torque(scene.forces):
+        if rotating or scene.forces.exerts_torque:
             return Support.no(f"{integrator} is a point-mass rule; the scene's bodies rotate")
         return Support.yes()
 

@@ -33,6 +33,7 @@ import numpy as np
 
 from core.rigid_body import MassProperties, State, Wrench, velocities
 from core.rotations import (
+    cross,
     matrix_to_quat_wxyz,
     orthonormalize,
     quat_wxyz_from_rotvec,
@@ -80,8 +81,8 @@ def _dexpinv(u: np.ndarray, omega: np.ndarray) -> np.ndarray:
     small = angle < _DEXPINV_SERIES_ANGLE
     a = np.where(small, 1.0, angle)
     coef = np.where(small, 1 / 12 + angle**2 / 720, (1 - (a / 2) / np.tan(a / 2)) / (a * a))
-    ux_w = np.cross(u, omega)
-    return omega - 0.5 * ux_w + coef[:, None] * np.cross(u, ux_w)
+    ux_w = cross(u, omega)
+    return omega - 0.5 * ux_w + coef[:, None] * cross(u, ux_w)
 
 
 def _project(state: State) -> State:
@@ -115,8 +116,9 @@ class _Derivative:
 
 
 def _derivative(t: float, state: State, props: MassProperties, wrench: Wrench) -> _Derivative:
-    v, omega = velocities(state, props)
-    force, torque = wrench(t, state.position_world, state.rotation_world, v, omega)
+    rotation = state.rotation_world
+    v, omega = velocities(state, props, rotation)
+    force, torque = wrench(t, state.position_world, rotation, v, omega)
     return _Derivative(v, omega, force, torque)
 
 
@@ -192,11 +194,11 @@ def engine_euler_step(props: MassProperties, wrench: Wrench) -> Step:
     def step(t: float, s: State, dt: float) -> State:
         rotation = s.rotation_world
         rt = np.swapaxes(rotation, -1, -2)
-        v, omega = velocities(s, props)
+        v, omega = velocities(s, props, rotation)
         force, torque = wrench(t, s.position_world, rotation, v, omega)
         omega_body = np.einsum("bij,bj->bi", rt, omega)
         torque_body = np.einsum("bij,bj->bi", rt, torque)
-        gyro = np.cross(omega_body, np.einsum("bij,bj->bi", props.inertia_body, omega_body))
+        gyro = cross(omega_body, np.einsum("bij,bj->bi", props.inertia_body, omega_body))
         omega_body = omega_body + dt * np.einsum("bij,bj->bi", props.inertia_body_inv, torque_body - gyro)
         v = v + dt * force / props.mass[:, None]
         new_rotation = rotation @ so3_exp(dt * omega_body)

@@ -89,8 +89,11 @@ def initial_state(bodies: tuple[RigidBody, ...], props: MassProperties, quaterni
     )
 
 
-def velocities(state: State, props: MassProperties) -> tuple[np.ndarray, np.ndarray]:
-    """(v = P / M, omega = I(t)^-1 L), each (B, 3), in world axes."""
-    rotation = state.rotation_world
-    omega = np.einsum("bij,bj->bi", props.inertia_world_inv(rotation), state.angular_momentum_world)
+def velocities(state: State, props: MassProperties, rotation: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(v = P / M, omega = I(t)^-1 L), each (B, 3), in world axes.
+
+    ``rotation`` (B, 3, 3) is the state's rotation matrix when the caller already has it.
+    """
+    rotation = state.rotation_world if rotation is None else rotation
+    omega = (props.inertia_world_inv(rotation) @ state.angular_momentum_world[..., None])[..., 0]
     return state.momentum_world / props.mass[:, None], omega

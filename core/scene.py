@@ -15,13 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from core.arrays import readonly
 from core.rotations import quat_wxyz_to_matrix
-
-
-def _frozen(a, shape: tuple[int, ...]) -> np.ndarray:
-    out = np.array(a, dtype=float).reshape(shape)
-    out.setflags(write=False)
-    return out
 
 
 @dataclass(frozen=True)
@@ -55,13 +50,13 @@ class RigidBody:
     angular_velocity_world: np.ndarray
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "inertia_body", _frozen(self.inertia_body, (3, 3)))
-        object.__setattr__(self, "position_world", _frozen(self.position_world, (3,)))
+        object.__setattr__(self, "inertia_body", readonly(self.inertia_body, shape=(3, 3)))
+        object.__setattr__(self, "position_world", readonly(self.position_world, shape=(3,)))
         q = np.asarray(self.quat_wxyz, dtype=float).reshape(4)
-        object.__setattr__(self, "quat_wxyz", _frozen(q / np.linalg.norm(q), (4,)))
-        object.__setattr__(self, "velocity_world", _frozen(self.velocity_world, (3,)))
+        object.__setattr__(self, "quat_wxyz", readonly(q / np.linalg.norm(q), shape=(4,)))
+        object.__setattr__(self, "velocity_world", readonly(self.velocity_world, shape=(3,)))
         object.__setattr__(
-            self, "angular_velocity_world", _frozen(self.angular_velocity_world, (3,))
+            self, "angular_velocity_world", readonly(self.angular_velocity_world, shape=(3,))
         )
 
     @property
@@ -71,24 +66,97 @@ class RigidBody:
 
 
 @dataclass(frozen=True)
+class AppliedForce:
+    """A constant world-frame force applied at a point fixed in a body (lecture: "Forces").
+
+    Attributes
+    ----------
+    body : int
+        Index of the body in the scene.
+    force_world : (3,) ndarray
+        [N].
+    point_body : (3,) ndarray
+        Point of application relative to the COM, in body axes [m]; its torque about the
+        COM is (R point_body) x force_world.
+    """
+
+    body: int
+    force_world: np.ndarray
+    point_body: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "force_world", readonly(self.force_world, shape=(3,)))
+        object.__setattr__(self, "point_body", readonly(self.point_body, shape=(3,)))
+
+
+def _per_body(values) -> np.ndarray | None:
+    return None if values is None else readonly(values, shape=(-1,))
+
+
+@dataclass(frozen=True)
 class Forces:
-    """External forces a dynamics scene asks for; absent ones are ``None``.
+    """External forces a dynamics scene asks for; absent ones are ``None`` (or empty).
+
+    Drag acts on the velocity relative to the air, v - air_velocity_world (wind).
 
     Attributes
     ----------
     gravity_world : (3,) ndarray or None
         Gravitational acceleration [m/s^2].
+    air_velocity_world : (3,) ndarray or None
+        Wind [m/s]; None means still air.
+    linear_drag : (B,) ndarray or None
+        F = -b (v - w) [N s/m].
+    quadratic_drag : (B,) ndarray or None
+        F = -c |v - w| (v - w) [N s^2/m^2].
+    angular_linear_drag : (B,) ndarray or None
+        tau = -k omega [N m s].
+    angular_quadratic_drag : (B,) ndarray or None
+        tau = -k |omega| omega [N m s^2].
+    applied : tuple of AppliedForce
     """
 
     gravity_world: np.ndarray | None = None
+    air_velocity_world: np.ndarray | None = None
+    linear_drag: np.ndarray | None = None
+    quadratic_drag: np.ndarray | None = None
+    angular_linear_drag: np.ndarray | None = None
+    angular_quadratic_drag: np.ndarray | None = None
+    applied: tuple[AppliedForce, ...] = ()
 
     def __post_init__(self) -> None:
-        if self.gravity_world is not None:
-            object.__setattr__(self, "gravity_world", _frozen(self.gravity_world, (3,)))
+        for name in ("gravity_world", "air_velocity_world"):
+            if getattr(self, name) is not None:
+                object.__setattr__(self, name, readonly(getattr(self, name), shape=(3,)))
+        for name in ("linear_drag", "quadratic_drag", "angular_linear_drag", "angular_quadratic_drag"):
+            object.__setattr__(self, name, _per_body(getattr(self, name)))
+        object.__setattr__(self, "applied", tuple(self.applied))
 
     def names(self) -> tuple[str, ...]:
-        """Names of the forces present, e.g. ``("gravity",)``."""
-        return tuple(n for n, v in (("gravity", self.gravity_world),) if v is not None)
+        """Names of the forces present, e.g. ``("gravity", "linear_drag")``."""
+        present = [
+            ("gravity", self.gravity_world), ("wind", self.air_velocity_world),
+            ("linear_drag", self.linear_drag), ("quadratic_drag", self.quadratic_drag),
+            ("angular_linear_drag", self.angular_linear_drag),
+            ("angular_quadratic_drag", self.angular_quadratic_drag),
+            ("applied_force", self.applied or None),
+        ]
+        return tuple(name for name, value in present if value is not None)
+
+    @property
+    def exerts_torque(self) -> bool:
+        """True when some force has a torque about a body's COM (angular drag, applied forces)."""
+        return bool({"angular_linear_drag", "angular_quadratic_drag", "applied_force"} & set(self.names()))
+
+    @property
+    def conserves_energy(self) -> bool:
+        """True when kinetic plus gravitational potential energy is conserved (no drag, no applied force)."""
+        return set(self.names()) <= {"gravity"}
+
+    @property
+    def conserves_angular_momentum(self) -> bool:
+        """True when each body's angular momentum about its COM is conserved (no torque)."""
+        return not self.exerts_torque
 
 
 @dataclass(frozen=True)
@@ -107,6 +175,8 @@ class DynamicsScene:
         [s].
     dts : tuple of float
         Time steps [s] to run; each divides ``duration`` into a whole number of steps.
+    integrators : tuple of str
+        Integrator names to run (every engine runs those it has); empty means all.
     length_unit : str
         The unit the scene file was written in (values here are already in metres).
     source : str
@@ -120,6 +190,7 @@ class DynamicsScene:
     forces: Forces
     duration: float
     dts: tuple[float, ...]
+    integrators: tuple[str, ...] = ()
     length_unit: str = "m"
     source: str = "<code>"
     kind: str = field(default="dynamics", init=False)
@@ -162,9 +233,9 @@ class Joint:
 
     def __post_init__(self) -> None:
         axis = np.asarray(self.axis, dtype=float).reshape(3)
-        object.__setattr__(self, "axis", _frozen(axis / np.linalg.norm(axis), (3,)))
-        object.__setattr__(self, "origin_xyz", _frozen(self.origin_xyz, (3,)))
-        object.__setattr__(self, "origin_rotation", _frozen(self.origin_rotation, (3, 3)))
+        object.__setattr__(self, "axis", readonly(axis / np.linalg.norm(axis), shape=(3,)))
+        object.__setattr__(self, "origin_xyz", readonly(self.origin_xyz, shape=(3,)))
+        object.__setattr__(self, "origin_rotation", readonly(self.origin_rotation, shape=(3, 3)))
 
     @property
     def limited(self) -> bool:
@@ -194,9 +265,9 @@ class Chain:
     end_effector_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "end_effector_xyz", _frozen(self.end_effector_xyz, (3,)))
+        object.__setattr__(self, "end_effector_xyz", readonly(self.end_effector_xyz, shape=(3,)))
         object.__setattr__(
-            self, "end_effector_rotation", _frozen(self.end_effector_rotation, (3, 3))
+            self, "end_effector_rotation", readonly(self.end_effector_rotation, shape=(3, 3))
         )
 
     @property
@@ -244,11 +315,70 @@ class KinematicsScene:
 
     def configurations(self) -> np.ndarray:
         """(n_configurations, n_joints) seeded random joint values within the limits."""
-        rng = np.random.default_rng(self.seed)
-        default = np.array([np.pi if j.type == "revolute" else 1.0 for j in self.chain.joints])
-        lo = np.where(np.isfinite(self.chain.lower), self.chain.lower, -default)
-        hi = np.where(np.isfinite(self.chain.upper), self.chain.upper, default)
-        return rng.uniform(lo, hi, size=(self.n_configurations, self.chain.n_joints))
+        return sample_configurations(self.chain, self.n_configurations, self.seed)
 
 
-Scene = DynamicsScene | KinematicsScene
+HARD_TARGETS = ("stretched", "beyond_reach", "at_base", "near_limits", "orientation_in_place", "wrist_flip")
+"""Hard IK targets a scene may ask for (see ``comparisons.ik_targets``)."""
+
+
+@dataclass(frozen=True)
+class IKScene:
+    """A chain, seeded random reachable targets and hard targets for every IK solver.
+
+    Attributes
+    ----------
+    name, description : str
+    reference : str
+        Engine whose forward kinematics generates the targets and judges cross-evaluation.
+    chain : Chain
+    n_targets : int
+        Random reachable targets: the end-effector poses of seeded random configurations.
+    seed : int
+    target_kind : str
+        ``"pose"`` (position and orientation) or ``"position"``.
+    q_start : (n,) ndarray
+        The one start configuration of every solve [rad or m] (also the rest pose).
+    position_tolerance : float
+        [m].
+    orientation_tolerance : float
+        [rad].
+    max_iterations : int
+    hard_targets : tuple of str
+        Names from :data:`HARD_TARGETS`.
+    source : str
+    """
+
+    name: str
+    description: str
+    reference: str
+    chain: Chain
+    n_targets: int
+    seed: int
+    target_kind: str
+    q_start: np.ndarray
+    position_tolerance: float
+    orientation_tolerance: float
+    max_iterations: int
+    hard_targets: tuple[str, ...] = ()
+    source: str = "<code>"
+    kind: str = field(default="ik", init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "q_start", readonly(self.q_start, shape=(self.chain.n_joints,)))
+
+    def configurations(self) -> np.ndarray:
+        """(n_targets, n) seeded random configurations within the limits (as KinematicsScene)."""
+        return sample_configurations(self.chain, self.n_targets, self.seed)
+
+
+def sample_configurations(chain: Chain, count: int, seed: int) -> np.ndarray:
+    """(count, n) uniform joint values within the limits; [-pi, pi] rad or [-1, 1] m where unlimited."""
+    rng = np.random.default_rng(seed)
+    default = np.array([np.pi if j.type == "revolute" else 1.0 for j in chain.joints])
+    lo = np.where(np.isfinite(chain.lower), chain.lower, -default)
+    hi = np.where(np.isfinite(chain.upper), chain.upper, default)
+    return rng.uniform(lo, hi, size=(count, chain.n_joints))
+
+
+Scene = DynamicsScene | KinematicsScene | IKScene

@@ -6,11 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a = np.ascontiguousarray(a, dtype=float)
-    a.setflags(write=False)
-    return a
+from core.arrays import readonly
 
 
 @dataclass(frozen=True)
@@ -48,8 +44,8 @@ class Trajectory:
             value = np.asarray(getattr(self, name))
             if value.ndim != 3 or value.shape[0] != n or value.shape[2] != last:
                 raise ValueError(f"Trajectory.{name} has shape {value.shape}, expected ({n}, B, {last})")
-            object.__setattr__(self, name, _readonly(value))
-        object.__setattr__(self, "times", _readonly(self.times))
+            object.__setattr__(self, name, readonly(value))
+        object.__setattr__(self, "times", readonly(self.times))
 
     @property
     def n_bodies(self) -> int:
@@ -79,5 +75,5 @@ class FramePoses:
     rotation_world: np.ndarray
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "position_world", _readonly(self.position_world))
-        object.__setattr__(self, "rotation_world", _readonly(self.rotation_world))
+        object.__setattr__(self, "position_world", readonly(self.position_world))
+        object.__setattr__(self, "rotation_world", readonly(self.rotation_world))

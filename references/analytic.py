@@ -1,13 +1,19 @@
 """Analytic ground truth behind the shared engine interface.
 
 Dynamics: closed forms from :mod:`references.analytic_solutions`, evaluated at the sample
-times of the step being compared (the "integrator" is ``exact``). Supported: bodies under
-gravity or no force, whose rotation is steady (angular velocity zero, or along a principal
-axis, or any with an isotropic inertia). Anything else gets ``n/a`` with the reason.
+times of the step being compared (the "integrator" is ``exact``). Translation and rotation
+decouple (no force here couples them), and each is solved per body:
 
-Kinematics: planar chains (revolute joints about z, origins in the xy plane): the
-end effector is a sum of rotated link vectors, sum_k Rz(phi_k) o_k with phi_k the
-cumulative angle, and the Jacobian is its closed-form derivative.
+- translation: the projectile; linear drag with or without wind; quadratic drag along the
+  line of gravity (still air only);
+- rotation, in the body's principal axes: steady spin, torque-free axisymmetric (steady
+  precession), torque-free asymmetric (Jacobi elliptic functions + quadrature), linear
+  angular drag on an isotropic body.
+
+Anything else (applied forces, both drags at once, quadratic angular drag, ...) gets
+``n/a`` with the reason. Kinematics: planar chains (revolute joints about z, origins in
+the xy plane): the end effector is a sum of rotated link vectors, sum_k Rz(phi_k) o_k with
+phi_k the cumulative angle, and the Jacobian is its closed-form derivative.
 """
 
 from __future__ import annotations
@@ -15,44 +21,108 @@ from __future__ import annotations
 import numpy as np
 
 from core.engine import Engine, KinematicsModel, Simulation, Support
-from core.rotations import matrix_to_quat_wxyz, so3_exp
-from core.scene import Chain, DynamicsScene, RigidBody
+from core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix, so3_exp
+from core.scene import Chain, DynamicsScene
 from core.trajectory import FramePoses, Trajectory
-from references.analytic_solutions import projectile
+from references import analytic_solutions as closed
+from references.conventions import principal_axes
 
-# Relative tolerance deciding that an inertia is isotropic or that omega lies on a
-# principal axis: such scenes are built exactly so, 1e-12 only absorbs rounding.
-_STEADY_RTOL = 1e-12
+# Relative tolerance deciding that principal moments are equal, or omega lies on a
+# principal axis: such scenes are built exactly so; 1e-12 only absorbs rounding.
+_EQUAL_RTOL = 1e-12
 
 
-def _steady_rotation(body: RigidBody) -> bool:
-    """True when the torque-free body spins at constant angular velocity."""
+def _rotation_kind(scene: DynamicsScene, k: int) -> tuple[str, str]:
+    """(kind, reason-if-unsupported) of body k's rotation."""
+    forces, body = scene.forces, scene.bodies[k]
+    moments, _ = principal_axes(body.inertia_body)
+    isotropic = np.ptp(moments) <= _EQUAL_RTOL * moments.max()
+    if any(a.body == k for a in forces.applied):
+        return "", f"no closed form for the torque of an applied force on body '{body.name}'"
+    if forces.angular_quadratic_drag is not None and forces.angular_quadratic_drag[k] > 0:
+        return "", f"no closed form for quadratic angular drag on body '{body.name}'"
+    if forces.angular_linear_drag is not None and forces.angular_linear_drag[k] > 0:
+        if not isotropic:
+            return "", f"closed-form angular drag needs an isotropic inertia; body '{body.name}' is not"
+        return "angular_drag", ""
     omega = body.angular_velocity_world
-    if not np.any(omega):
-        return True
-    inertia = body.rotation_world @ body.inertia_body @ body.rotation_world.T
-    l_world = inertia @ omega
-    return bool(np.linalg.norm(np.cross(l_world, omega)) <= _STEADY_RTOL * np.linalg.norm(l_world) * np.linalg.norm(omega))
+    l_world = body.rotation_world @ body.inertia_body @ body.rotation_world.T @ omega
+    cross = np.linalg.norm(np.cross(l_world, omega))
+    if not np.any(omega) or cross <= _EQUAL_RTOL * np.linalg.norm(l_world) * np.linalg.norm(omega):
+        return "steady", ""
+    gaps = np.diff(moments)
+    if np.any(gaps <= _EQUAL_RTOL * moments.max()):
+        return "axisymmetric", ""
+    return "asymmetric", ""
+
+
+def _translation_kind(scene: DynamicsScene, k: int) -> tuple[str, str]:
+    forces, name = scene.forces, scene.bodies[k].name
+    linear = forces.linear_drag is not None and forces.linear_drag[k] > 0
+    quadratic = forces.quadratic_drag is not None and forces.quadratic_drag[k] > 0
+    if linear and quadratic:
+        return "", f"no closed form for linear and quadratic drag together on body '{name}'"
+    if quadratic:
+        if forces.air_velocity_world is not None and np.any(forces.air_velocity_world):
+            return "", f"no closed form for quadratic drag in wind on body '{name}'"
+        body = scene.bodies[k]
+        g = forces.gravity_world if forces.gravity_world is not None else np.zeros(3)
+        if np.any(g) and np.any(body.velocity_world) and np.linalg.norm(np.cross(g, body.velocity_world)) > (
+            _EQUAL_RTOL * np.linalg.norm(g) * np.linalg.norm(body.velocity_world)
+        ):
+            return "", f"quadratic drag has a closed form only along the line of gravity; body '{name}' leaves it"
+        return "quadratic_drag", ""
+    return ("linear_drag" if linear else "projectile"), ""
+
+
+def _translation(scene: DynamicsScene, k: int, kind: str, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    forces, body = scene.forces, scene.bodies[k]
+    g = forces.gravity_world if forces.gravity_world is not None else np.zeros(3)
+    if kind == "linear_drag":
+        air = forces.air_velocity_world if forces.air_velocity_world is not None else np.zeros(3)
+        return closed.linear_drag(body.position_world, body.velocity_world, g,
+                                  forces.linear_drag[k] / body.mass, times, air_velocity=air)
+    if kind == "quadratic_drag":
+        return closed.quadratic_drag_along_line(body.position_world, body.velocity_world, g,
+                                                forces.quadratic_drag[k] / body.mass, times)
+    return closed.projectile(body.position_world, body.velocity_world, g, times)
+
+
+def _rotation(scene: DynamicsScene, k: int, kind: str, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(quat_wxyz (T, 4), angular_velocity_world (T, 3)) of body k."""
+    body = scene.bodies[k]
+    omega = body.angular_velocity_world
+    if kind == "steady":
+        rotation = so3_exp(times[:, None] * omega) @ body.rotation_world
+        return matrix_to_quat_wxyz(rotation), np.broadcast_to(omega, (len(times), 3))
+    moments, axes = principal_axes(body.inertia_body)
+    if kind == "angular_drag":
+        quat, omega_world, _ = closed.linear_angular_drag_isotropic(
+            moments[0], scene.forces.angular_linear_drag[k], omega, body.quat_wxyz, times)
+        return quat, omega_world
+    solve = closed.torque_free_axisymmetric if kind == "axisymmetric" else closed.torque_free_asymmetric
+    if kind == "axisymmetric" and moments[1] - moments[0] > moments[2] - moments[1]:
+        # The closed form wants the equal pair first (I1 == I2): cycle the axes (still proper).
+        moments, axes = moments[[1, 2, 0]], axes[:, [1, 2, 0]]
+    # Torque-free: solve in the principal frame R_p = R Q, then return to the body frame.
+    rotation_principal = body.rotation_world @ axes
+    omega_principal = rotation_principal.T @ omega
+    quat_p, omega_world, _ = solve(moments, omega_principal, matrix_to_quat_wxyz(rotation_principal), times)
+    return matrix_to_quat_wxyz(quat_wxyz_to_matrix(quat_p) @ axes.T), omega_world
 
 
 class _Simulation(Simulation):
-    def __init__(self, scene: DynamicsScene, dt: float) -> None:
-        self._scene = scene
-        self._dt = dt
-        self.detail = "closed form: projectile, steady rotation"
+    def __init__(self, scene: DynamicsScene, dt: float, kinds: list[tuple[str, str]]) -> None:
+        self._scene, self._dt, self._kinds = scene, dt, kinds
+        self.detail = "closed form: " + ", ".join(sorted({f"{t}/{r}" for t, r in kinds}))
 
     def run(self, n_steps: int) -> Trajectory:
         times = np.arange(n_steps + 1) * self._dt
-        gravity = self._scene.forces.gravity_world
-        gravity = np.zeros(3) if gravity is None else gravity
         pos, vel, quat, omg = [], [], [], []
-        for body in self._scene.bodies:
-            p, v = projectile(body.position_world, body.velocity_world, gravity, times)
-            rotation = so3_exp(times[:, None] * body.angular_velocity_world) @ body.rotation_world
-            pos.append(p)
-            vel.append(v)
-            quat.append(matrix_to_quat_wxyz(rotation))
-            omg.append(np.broadcast_to(body.angular_velocity_world, (len(times), 3)))
+        for k, (translation, rotation) in enumerate(self._kinds):
+            p, v = _translation(self._scene, k, translation, times)
+            q, w = _rotation(self._scene, k, rotation, times)
+            pos.append(p), vel.append(v), quat.append(q), omg.append(w)
         return Trajectory(times, *(np.stack(a, axis=1) for a in (pos, quat, vel, omg)))
 
 
@@ -124,13 +194,15 @@ class AnalyticEngine(Engine):
         named = self.check_integrator(integrator)
         if not named.ok:
             return named
-        for body in scene.bodies:
-            if not _steady_rotation(body):
-                return Support.no(f"no closed form here for the unsteady rotation of body '{body.name}'")
+        for k in range(len(scene.bodies)):
+            for kind, reason in (_translation_kind(scene, k), _rotation_kind(scene, k)):
+                if not kind:
+                    return Support.no(reason)
         return Support.yes()
 
     def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
-        return _Simulation(scene, dt)
+        kinds = [(_translation_kind(scene, k)[0], _rotation_kind(scene, k)[0]) for k in range(len(scene.bodies))]
+        return _Simulation(scene, dt, kinds)
 
     def supports_kinematics(self, chain: Chain) -> Support:
         return _planar(chain)

@@ -7,8 +7,7 @@ body to world; angular velocities in the world frame unless the name ends in ``_
 Translation: :func:`projectile`, :func:`linear_drag`, :func:`quadratic_drag_along_line`.
 Rotation: :func:`linear_angular_drag_isotropic`, :func:`torque_free_axisymmetric`,
 :func:`torque_free_asymmetric` (Jacobi elliptic functions + quadrature) and
-:func:`intermediate_axis_flip_period`. Invariants: :func:`kinetic_energy`,
-:func:`angular_momentum_world`.
+:func:`intermediate_axis_flip_period`. Invariants are in :mod:`core.invariants`.
 """
 
 from __future__ import annotations
@@ -312,7 +311,8 @@ def torque_free_axisymmetric(
     angle = rate * t[:, 0]
     c, s = np.cos(angle), np.sin(angle)
     omega_body = np.stack(
-        [c * omega0[0] - s * omega0[1], s * omega0[0] + c * omega0[1], np.full_like(angle, omega0[2])], axis=-1
+        [c * omega0[0] - s * omega0[1], s * omega0[0] + c * omega0[1], np.full_like(angle, omega0[2])],
+        axis=-1,
     )
     l_world = quat_wxyz_to_matrix(q0) @ (inertia * omega0)
     spin = quat_wxyz_from_rotvec(-rate * t * np.array([0.0, 0.0, 1.0]))
@@ -495,13 +495,15 @@ def _precession_integral(sol: _Elliptic, u: np.ndarray) -> np.ndarray:
 def _quat_zxz(psi: np.ndarray, theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
     """Quaternion of Rz(psi) Rx(theta) Rz(phi). (T,) x 3 -> (T, 4)."""
     ex, ez = np.eye(3)[0], np.eye(3)[2]
-    return quat_wxyz_multiply(
-        quat_wxyz_from_rotvec(psi[:, None] * ez),
-        quat_wxyz_multiply(quat_wxyz_from_rotvec(theta[:, None] * ex), quat_wxyz_from_rotvec(phi[:, None] * ez)),
+    nutation_spin = quat_wxyz_multiply(
+        quat_wxyz_from_rotvec(theta[:, None] * ex), quat_wxyz_from_rotvec(phi[:, None] * ez)
     )
+    return quat_wxyz_multiply(quat_wxyz_from_rotvec(psi[:, None] * ez), nutation_spin)
 
 
-def _nutation_and_spin(sol: _Elliptic, omega_primed: np.ndarray, am: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _nutation_and_spin(
+    sol: _Elliptic, omega_primed: np.ndarray, am: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Euler angles theta, phi of L in primed body axes: L' / |L| = (s_th s_ph, s_th c_ph, c_th).
 
     tan phi = I1 w1 / (I2 w2) = cos(am) / (k sin(am)), k = sqrt(I2 (I3 - I1) / (I1 (I3 - I2)));
@@ -525,8 +527,10 @@ def torque_free_asymmetric(
     relabelled (1, 2, 3) = (c, b, a) by a proper signed permutation, with b the
     intermediate axis, a the major axis when L^2 > 2 E I_b (rotation near the major axis)
     and the minor axis when L^2 < 2 E I_b (near the minor axis),
-    omega' = (A1 cn u, A2 sn u, A3 dn u), u = rate t + u0, u0 = F(atan2(w2/A2, w1/A1) | m)
-    so that the initial condition is reproduced for any signs. On the separatrix
+    omega' = (A1 cn u, A2 sn u, A3 dn u), u = rate t + u0, with the phase u0 inverted from
+    (cn, sn) = (w1/A1, w2/A2) so that the initial condition is reproduced for any signs.
+    sn, cn, dn are evaluated by an AGM started from 1 - m itself (not SciPy's ellipj, which
+    fails near m = 1). On the separatrix
     (L^2 = 2 E I_b exactly) m = 1 and the same formulas give the homoclinic solution
     (sn = tanh, cn = dn = sech): omega approaches the unstable intermediate axis without
     flipping. A spin about one principal axis (or rest) is returned as a steady rotation.
@@ -537,8 +541,8 @@ def torque_free_asymmetric(
     dpsi/dt = |L| (I1 w1^2 + I2 w2^2) / (I1^2 w1^2 + I2^2 w2^2) > 0 (primed axes),
     integrated by panelled Gauss-Legendre quadrature of its elliptic-function form.
 
-    Accuracy degrades like 1e-16 / m1 (m1 = 1 - m) very close to the separatrix, where
-    float64 cannot hold m precisely enough.
+    Near the separatrix the motion itself is ill-conditioned (rounding omega0 by 1e-16
+    moves the flips by ~1e-16 / (1 - m) of a period); the evaluation adds no more than that.
 
     Parameters
     ----------
@@ -573,12 +577,15 @@ def torque_free_asymmetric(
     u = np.concatenate([[sol.phase0], sol.rate * t + sol.phase0])
     sn, cn, dn, am = _jacobi(sol, u)
     omega_primed = sol.amplitude * np.stack([cn, sn, dn], axis=-1)
-    psi = (_precession_integral(sol, u) - _precession_integral(sol, u[:1])) / sol.rate
+    precession = _precession_integral(sol, u)
+    psi = (precession - precession[0]) / sol.rate
     theta, phi = _nutation_and_spin(sol, omega_primed, am)
     q_primed = matrix_to_quat_wxyz(sol.to_primed)
     # B = R0 Q^T (Rx(theta0) Rz(phi0))^T, so that R(0) = B Rx(theta0) Rz(phi0) Q = R0.
     start = _quat_zxz(np.zeros(1), theta[:1], phi[:1])[0]
-    frame = quat_wxyz_multiply(quat_wxyz_multiply(q0, quat_wxyz_conjugate(q_primed)), quat_wxyz_conjugate(start))
+    frame = quat_wxyz_multiply(
+        quat_wxyz_multiply(q0, quat_wxyz_conjugate(q_primed)), quat_wxyz_conjugate(start)
+    )
     quat = quat_wxyz_multiply(quat_wxyz_multiply(frame, _quat_zxz(psi[1:], theta[1:], phi[1:])), q_primed)
     omega_body = omega_primed[1:] @ sol.to_primed
     return quat, _world_from_body(quat, omega_body), omega_body
@@ -610,50 +617,3 @@ def intermediate_axis_flip_period(inertia_principal, angular_velocity_body0) -> 
     """
     sol = _elliptic(_distinct(inertia_principal), _vector(angular_velocity_body0))
     return np.inf if sol is None else float(4 * sol.quarter / abs(sol.rate))
-
-
-def kinetic_energy(mass, inertia_body, velocity_world, angular_velocity_world, rotation_world) -> np.ndarray:
-    """E = m |v|^2 / 2 + omega_b . I_body omega_b / 2, omega_b = R^T omega. Batched.
-
-    Parameters
-    ----------
-    mass : (...) array_like
-        [kg].
-    inertia_body : (..., 3, 3) array_like
-        [kg m^2] about the COM, body axes.
-    velocity_world, angular_velocity_world : (..., 3) array_like
-        [m/s], [rad/s].
-    rotation_world : (..., 3, 3) array_like
-        Body to world.
-
-    Returns
-    -------
-    (...) ndarray
-        [J].
-    """
-    v = np.asarray(velocity_world, dtype=float)
-    omega_body = np.einsum("...ji,...j->...i", np.asarray(rotation_world, dtype=float), angular_velocity_world)
-    spin = np.einsum("...i,...ij,...j->...", omega_body, np.asarray(inertia_body, dtype=float), omega_body)
-    return 0.5 * np.asarray(mass, dtype=float) * np.sum(v * v, axis=-1) + 0.5 * spin
-
-
-def angular_momentum_world(inertia_body, angular_velocity_world, rotation_world) -> np.ndarray:
-    """L = R I_body R^T omega about the COM, world axes. Batched.
-
-    Parameters
-    ----------
-    inertia_body : (..., 3, 3) array_like
-        [kg m^2].
-    angular_velocity_world : (..., 3) array_like
-        [rad/s].
-    rotation_world : (..., 3, 3) array_like
-        Body to world.
-
-    Returns
-    -------
-    (..., 3) ndarray
-        [kg m^2 / s].
-    """
-    rotation = np.asarray(rotation_world, dtype=float)
-    omega_body = np.einsum("...ji,...j->...i", rotation, angular_velocity_world)
-    return np.einsum("...ij,...jk,...k->...i", rotation, np.asarray(inertia_body, dtype=float), omega_body)

@@ -6,6 +6,8 @@ What MuJoCo is given, and why
 - Every free body gets an explicit ``<inertial>`` with ``fullinertia`` from the scene (no
   inertia from geoms); it has no geom, so nothing can collide, and contact is disabled.
 - Gravity is set only when the scene has gravity; otherwise it is zero AND disabled.
+- With drag (given as ``dof_damping`` by the adapter) ``eulerdamp`` is disabled, so the
+  Euler integrator applies damping explicitly like every other engine.
 - Defaults already zero in MuJoCo (dof damping, armature, frictionloss, wind, density,
   viscosity) are left at zero; tests pin each one.
 - Quaternions in MJCF are (w, x, y, z), the project's order: no conversion.
@@ -34,6 +36,8 @@ def dynamics_mjcf(scene: DynamicsScene, integrator: str, dt: float) -> str:
     flags = ['contact="disable"']
     if gravity is None:
         flags.append('gravity="disable"')
+    if scene.forces.linear_drag is not None or scene.forces.angular_linear_drag is not None:
+        flags.append('eulerdamp="disable"')  # the drag is dof_damping: keep Euler explicit
     gravity_attr = fmt(gravity) if gravity is not None else "0 0 0"
     bodies = []
     for body in scene.bodies:

@@ -8,6 +8,19 @@ Conversions (each pinned by a test in ``tests/test_mujoco_adapter.py``)
 - Free-joint ``qvel[3:6]`` is the angular velocity in the BODY frame: world = R qvel[3:6].
 - Stepping uses ``mujoco.rollout`` (bit-identical to an ``mj_step`` loop), whose state
   rows are the state AFTER each step; the initial state is prepended.
+- Forces: linear drag and linear angular drag are MuJoCo's own ``dof_damping`` on the free
+  joint (translational damping acts on the world-frame origin velocity = COM velocity,
+  rotational on the local angular velocity; isotropic, so both equal the scene's drag), with
+  ``eulerdamp`` disabled so that Euler treats damping explicitly, as every other engine does
+  (the implicit integrators keep it implicit, by design). Wind adds the constant force b w,
+  passed to rollout as ``xfrc_applied``. Forces MuJoCo has no model for (quadratic drag,
+  forces at body points) are computed from the state at the start of each step and held
+  over the step in ``xfrc_applied`` by an ``mj_step`` loop; its RK4 then sees them as
+  constant within a step.
+- Instability: MuJoCo does not return NaN; it warns ("Nan, Inf or huge value in QACC") and
+  RESETS the state to the model's initial one, so the trajectory stays finite and wrong.
+  The adapter counts ``mjWARN_BADQACC`` over the run and raises ``DivergedError`` with
+  MuJoCo's message instead (the message is captured, not printed).
 - Kinematics: ``mj_kinematics`` then ``mj_comPos`` before ``mj_jacSite`` (the Jacobian is
   silently zero without ``mj_comPos``).
 """
@@ -19,8 +32,11 @@ import numpy as np
 from mujoco import rollout
 
 from core.engine import Engine, KinematicsModel, Simulation, Support
+from core.errors import DivergedError
 from core.rotations import quat_wxyz_to_matrix
-from core.scene import Chain, DynamicsScene, KinematicsScene
+from core.forces import make_wrench
+from core.rigid_body import MassProperties
+from core.scene import Chain, DynamicsScene, Forces, KinematicsScene
 from core.trajectory import FramePoses, Trajectory
 from references.conventions import fmt
 from references.mjcf import INTEGRATORS, chain_mjcf, dynamics_mjcf
@@ -28,11 +44,36 @@ from references.mjcf import INTEGRATORS, chain_mjcf, dynamics_mjcf
 _STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
 
 
+def _native_damping(forces: Forces, n_bodies: int) -> np.ndarray:
+    """(n_bodies, 6) dof_damping: linear drag on the 3 translational dofs, angular on the rotational."""
+    damping = np.zeros((n_bodies, 6))
+    if forces.linear_drag is not None:
+        damping[:, :3] = forces.linear_drag[:, None]
+    if forces.angular_linear_drag is not None:
+        damping[:, 3:] = forces.angular_linear_drag[:, None]
+    return damping
+
+
+def _stepwise_forces(forces: Forces) -> Forces | None:
+    """The forces MuJoCo cannot model natively, or None when there are none."""
+    rest = Forces(air_velocity_world=forces.air_velocity_world, quadratic_drag=forces.quadratic_drag,
+                  angular_quadratic_drag=forces.angular_quadratic_drag, applied=forces.applied)
+    return rest if {"quadratic_drag", "angular_quadratic_drag", "applied_force"} & set(rest.names()) else None
+
+
 class _Simulation(Simulation):
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
         self.model = mujoco.MjModel.from_xml_string(dynamics_mjcf(scene, integrator, dt))
-        self._data = mujoco.MjData(self.model)
         self._n_bodies = len(scene.bodies)
+        forces = scene.forces
+        self.model.dof_damping[:] = _native_damping(forces, self._n_bodies).ravel()
+        self._data = mujoco.MjData(self.model)
+        self._xfrc = np.zeros((self.model.nbody, 6))  # world body first
+        if forces.air_velocity_world is not None and forces.linear_drag is not None:
+            self._xfrc[1:, :3] = forces.linear_drag[:, None] * forces.air_velocity_world
+        stepwise = _stepwise_forces(forces)
+        self._props = MassProperties.of(scene.bodies)
+        self._wrench = make_wrench(stepwise, self._props) if stepwise is not None else None
         qvel = self._data.qvel.reshape(self._n_bodies, 6)
         for k, body in enumerate(scene.bodies):
             qvel[k, :3] = body.velocity_world
@@ -41,15 +82,52 @@ class _Simulation(Simulation):
         mujoco.mj_getState(self.model, self._data, self._state0, _STATE)
         self._qpos_at = mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_TIME)
         self._dt = dt
+        native = [n for n in ("linear_drag", "angular_linear_drag") if n in forces.names()]
         self.detail = (
             f"MuJoCo integrator {INTEGRATORS[integrator]}; explicit inertia; contact disabled"
-            + ("" if scene.forces.gravity_world is not None else "; gravity disabled")
-            + "; stepped by mujoco.rollout"
+            + ("" if forces.gravity_world is not None else "; gravity disabled")
+            + (f"; {' and '.join(native)} as dof_damping, eulerdamp disabled" if native else "")
+            + ("; wind as constant xfrc_applied" if np.any(self._xfrc) else "")
+            + ("; stepped by mujoco.rollout" if self._wrench is None else
+               "; other forces as xfrc_applied from the state at each step start, mj_step loop")
         )
 
+    def _rollout(self, n_steps: int) -> np.ndarray:
+        if not np.any(self._xfrc):
+            states, _ = rollout.rollout(self.model, self._data, self._state0[None], nstep=n_steps)
+        else:
+            states, _ = rollout.rollout(self.model, self._data, self._state0[None], self._xfrc.ravel()[None, None],
+                                        control_spec=mujoco.mjtState.mjSTATE_XFRC_APPLIED, nstep=n_steps)
+        return states[0]
+
+    def _loop(self, n_steps: int) -> np.ndarray:
+        m, d = self.model, self._data
+        mujoco.mj_setState(m, d, self._state0, _STATE)
+        states = np.empty((n_steps, len(self._state0)))
+        b = self._n_bodies
+        for i in range(n_steps):
+            qpos, qvel = d.qpos.reshape(b, 7), d.qvel.reshape(b, 6)
+            rotation = quat_wxyz_to_matrix(qpos[:, 3:])
+            omega = np.einsum("bij,bj->bi", rotation, qvel[:, 3:])
+            force, torque = self._wrench(i * m.opt.timestep, qpos[:, :3], rotation, qvel[:, :3], omega)
+            d.xfrc_applied[1:, :3] = self._xfrc[1:, :3] + force
+            d.xfrc_applied[1:, 3:] = torque
+            mujoco.mj_step(m, d)
+            mujoco.mj_getState(m, d, states[i], _STATE)
+        return states
+
     def run(self, n_steps: int) -> Trajectory:
-        states, _ = rollout.rollout(self.model, self._data, self._state0[None], nstep=n_steps)
-        states = np.concatenate([self._state0[None], states[0]], axis=0)
+        warning = self._data.warning[mujoco.mjtWarning.mjWARN_BADQACC]
+        warning.number = 0
+        messages: list[str] = []
+        mujoco.set_mju_user_warning(messages.append)
+        try:
+            stepped = self._rollout(n_steps) if self._wrench is None else self._loop(n_steps)
+        finally:
+            mujoco.set_mju_user_warning(None)
+        if warning.number:
+            raise DivergedError(f"MuJoCo reset the unstable simulation: {messages[0] if messages else 'bad qacc'}")
+        states = np.concatenate([self._state0[None], stepped], axis=0)
         nq, b = self.model.nq, self._n_bodies
         qpos = states[:, self._qpos_at : self._qpos_at + nq].reshape(-1, b, 7)
         qvel = states[:, self._qpos_at + nq : self._qpos_at + nq + self.model.nv].reshape(-1, b, 6)
@@ -130,4 +208,7 @@ class MujocoEngine(Engine):
             f"angular (body) {fmt(b.rotation_world.T @ b.angular_velocity_world)} -->\n"
             for b in scene.bodies
         )
-        return dynamics_mjcf(scene, integrator, dt) + velocities
+        damping = _native_damping(scene.forces, len(scene.bodies))
+        extra = (f"<!-- set after compiling: dof_damping = {fmt(damping)} (per body: 3 translational, "
+                 "3 rotational) -->\n" if np.any(damping) else "")
+        return dynamics_mjcf(scene, integrator, dt) + velocities + extra

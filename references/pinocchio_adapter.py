@@ -14,6 +14,8 @@ Conversions (each pinned by a test in ``tests/test_pinocchio_adapter.py``)
   omega_local += dt a[3:6], then p += dt v_world and R = R exp(dt omega_local).
   Stepping ``pin.integrate`` on the local twist instead would follow an SE(3) screw and
   drift from the others (0.25 m after 2 s of free fall).
+- Forces other than gravity (``model.gravity``) enter ``aba`` as ``fext``: per joint, a
+  force and a torque about the joint origin (the COM) in the LOCAL frame: (R^T F, R^T tau).
 - Chains: built from the adapter's URDF with ``buildModelFromXML`` (fixed base). A
   ``continuous`` joint has nq = 2 (cos, sin). Jacobians are LOCAL_WORLD_ALIGNED.
 """
@@ -24,7 +26,9 @@ import numpy as np
 import pinocchio as pin
 
 from core.engine import Engine, KinematicsModel, Simulation, Support
-from core.rotations import quat_wxyz_to_matrix, so3_exp, matrix_to_quat_wxyz
+from core.rotations import matrix_to_quat_wxyz, so3_exp
+from core.forces import make_wrench, without_gravity
+from core.rigid_body import MassProperties
 from core.scene import Chain, DynamicsScene, KinematicsScene
 from core.trajectory import FramePoses, Trajectory
 from references.conventions import xyzw_from_wxyz
@@ -53,6 +57,9 @@ class _Simulation(Simulation):
             "bji,bj->bi", self._rotation0, np.stack([b.angular_velocity_world for b in scene.bodies])
         )
         self._tau = np.zeros(self._model.nv)
+        extra = without_gravity(scene.forces)
+        self._props = MassProperties.of(scene.bodies)
+        self._wrench = make_wrench(extra, self._props) if extra.names() else None
         self._dt = dt
         self.detail = "harness-stepped: pin.aba accelerations, engines' semi-implicit Euler on SO(3)"
 
@@ -66,7 +73,7 @@ class _Simulation(Simulation):
                 q[:, :3], q[:, 3:] = p, xyzw_from_wxyz(matrix_to_quat_wxyz(r))
                 v_local = np.einsum("bji,bj->bi", r, v)
                 qd[:, :3], qd[:, 3:] = v_local, w
-                a = pin.aba(self._model, self._data, q.ravel(), qd.ravel(), self._tau).reshape(b, 6)
+                a = self._aba(i - 1, q, qd, p, r, v, w)
                 a_classical = a[:, :3] + np.cross(w, v_local)
                 v = v + dt * np.einsum("bij,bj->bi", r, a_classical)
                 w = w + dt * a[:, 3:]
@@ -75,6 +82,18 @@ class _Simulation(Simulation):
             pos[i], rot[i], vel[i], omg[i] = p, r, v, np.einsum("bij,bj->bi", r, w)
         times = np.arange(n_steps + 1) * dt
         return Trajectory(times, pos, matrix_to_quat_wxyz(rot), vel, omg)
+
+    def _aba(self, step, q, qd, p, r, v, w_local) -> np.ndarray:
+        """(B, 6) spatial accelerations (local), with the scene's non-gravity forces as fext."""
+        if self._wrench is None:
+            return pin.aba(self._model, self._data, q.ravel(), qd.ravel(), self._tau).reshape(-1, 6)
+        omega = np.einsum("bij,bj->bi", r, w_local)
+        force, torque = self._wrench(step * self._dt, p, r, v, omega)
+        fext = pin.StdVec_Force()
+        fext.append(pin.Force.Zero())
+        for k in range(len(p)):
+            fext.append(pin.Force(r[k].T @ force[k], r[k].T @ torque[k]))
+        return pin.aba(self._model, self._data, q.ravel(), qd.ravel(), self._tau, fext).reshape(-1, 6)
 
 
 class _Kinematics(KinematicsModel):

@@ -18,6 +18,11 @@ Conversions and overridden defaults (each pinned by a test in ``tests/test_pybul
   from ``calculateJacobian`` is double.
 - PyBullet has one integrator (semi-implicit Euler, velocity then position); time step = dt,
   no sub-steps.
+- Forces other than gravity (drag, wind, forces at body points) are computed from the state
+  at the start of each step (``core.forces``) and applied as a world-frame force at the COM
+  plus a world-frame torque (``applyExternalForce`` / ``applyExternalTorque`` with
+  WORLD_FRAME; in 3.2.7 both honour the flag, which bullet3 #1949 once had swapped for the
+  base); PyBullet clears them after every step.
 """
 
 from __future__ import annotations
@@ -31,6 +36,8 @@ import pybullet
 
 from core.engine import Engine, KinematicsModel, Simulation, Support
 from core.rotations import quat_wxyz_to_matrix, matrix_to_quat_wxyz
+from core.forces import make_wrench, without_gravity
+from core.rigid_body import MassProperties
 from core.scene import Chain, DynamicsScene, KinematicsScene
 from core.trajectory import FramePoses, Trajectory
 from references.conventions import fmt, principal_axes, wxyz_from_xyzw, xyzw_from_wxyz
@@ -87,9 +94,12 @@ class _Simulation(Simulation):
             self._initial.append((body.position_world, xyzw_from_wxyz(quat_inertial),
                                   body.velocity_world, body.angular_velocity_world))
         self._axes = np.stack(self._axes)
+        extra = without_gravity(scene.forces)
+        self._wrench = make_wrench(extra, MassProperties.of(scene.bodies)) if extra.names() else None
         self._dt = dt
         self.detail = (
             "PyBullet multibody; inertia from file; damping 0; sleeping off; gravity set explicitly"
+            + ("; other forces applied each step from the state at its start" if self._wrench else "")
         )
 
     def run(self, n_steps: int) -> Trajectory:
@@ -101,15 +111,30 @@ class _Simulation(Simulation):
         raw = np.empty((n_steps + 1, b, 13))  # position 3, quat xyzw 4, velocity 3, omega 3
         for i in range(n_steps + 1):
             if i:
+                if self._wrench is not None:
+                    self._apply(i - 1, raw[i - 1])
                 pybullet.stepSimulation(physicsClientId=c)
             for k, uid in enumerate(self._bodies):
                 pos, quat = pybullet.getBasePositionAndOrientation(uid, physicsClientId=c)
                 vel, omega = pybullet.getBaseVelocity(uid, physicsClientId=c)
                 raw[i, k] = (*pos, *quat, *vel, *omega)
-        rotation_inertial = quat_wxyz_to_matrix(wxyz_from_xyzw(raw[..., 3:7]))
-        quat_body = matrix_to_quat_wxyz(rotation_inertial @ np.swapaxes(self._axes, -1, -2))
+        quat_body = self._body_quat(raw[..., 3:7])
         times = np.arange(n_steps + 1) * self._dt
         return Trajectory(times, raw[..., :3], quat_body, raw[..., 7:10], raw[..., 10:13])
+
+    def _body_quat(self, quat_xyzw_inertial: np.ndarray) -> np.ndarray:
+        """Body-frame quaternions from PyBullet's inertial-frame ones: R_body = R_inertial Q^T."""
+        rotation_inertial = quat_wxyz_to_matrix(wxyz_from_xyzw(quat_xyzw_inertial))
+        return matrix_to_quat_wxyz(rotation_inertial @ np.swapaxes(self._axes, -1, -2))
+
+    def _apply(self, step: int, raw: np.ndarray) -> None:
+        """Apply the scene's non-gravity forces, evaluated at the state ``raw`` (B, 13)."""
+        c = self._client.id
+        rotation = quat_wxyz_to_matrix(self._body_quat(raw[:, 3:7]))
+        force, torque = self._wrench(step * self._dt, raw[:, :3], rotation, raw[:, 7:10], raw[:, 10:13])
+        for k, uid in enumerate(self._bodies):
+            pybullet.applyExternalForce(uid, -1, force[k], raw[k, :3], pybullet.WORLD_FRAME, physicsClientId=c)
+            pybullet.applyExternalTorque(uid, -1, torque[k], pybullet.WORLD_FRAME, physicsClientId=c)
 
 
 class _Kinematics(KinematicsModel):

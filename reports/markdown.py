@@ -13,7 +13,13 @@ _DYNAMICS_COLUMNS = [
     ("orientation_error_max", "orientation error max [rad]"),
     ("velocity_error_max", "velocity error max [m/s]"),
     ("angular_velocity_error_max", "angular velocity error max [rad/s]"),
+    ("energy_drift_max", "energy drift max (rel.)"),
+    ("angular_momentum_drift_max", "angular momentum drift max (rel.)"),
     ("time_per_step", "time per step [s]"),
+]
+_ORDER_COLUMNS = [
+    ("order_position", "observed order (position)"),
+    ("order_orientation", "observed order (orientation)"),
 ]
 _KINEMATICS_COLUMNS = [
     ("position_error_max", "frame position error max [m]"),
@@ -40,6 +46,8 @@ def _status(group: pd.DataFrame) -> str:
 
 
 def _table(scene_rows: pd.DataFrame, columns, keys: list[str]) -> list[str]:
+    present = set(scene_rows["metric"])
+    columns = [(metric, label) for metric, label in columns if metric in present]
     head = keys + [label for _, label in columns] + ["status"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for key, group in scene_rows.groupby(keys, sort=False, dropna=False):
@@ -93,7 +101,13 @@ def render(table: pd.DataFrame, info: dict) -> str:
             lines += [about["description"], ""]
         lines += [f"Reference: `{reference}`." + (f" Scene file: `{about['source']}`." if about.get("source") else ""), ""]
         if dynamics:
-            lines += _table(rows, _DYNAMICS_COLUMNS, ["engine", "integrator", "dt"])
+            per_dt = rows[rows["dt"].notna()]
+            lines += _table(per_dt, _DYNAMICS_COLUMNS, ["engine", "integrator", "dt"])
+            orders = rows[rows["dt"].isna()]
+            if not orders.empty:
+                lines += ["", "Observed order of convergence: slope of log(error max) against log(dt) over the "
+                          "time steps above (errors at rounding level left out).", ""]
+                lines += _table(orders, _ORDER_COLUMNS, ["engine", "integrator"])
         else:
             lines += _table(rows, _KINEMATICS_COLUMNS, ["engine"])
         lines += _notes(rows)

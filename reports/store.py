@@ -11,6 +11,10 @@ from core.errors import ResultsError
 from core.results import COLUMNS, RESULTS_FILE, RUN_INFO_FILE, SCHEMA_VERSION
 
 
+# pandas < 3 parses floats inexactly unless asked; pandas 3 is exact and deprecates the option.
+_EXACT_FLOATS = {"float_precision": "round_trip"} if int(pd.__version__.split(".")[0]) < 3 else {}
+
+
 def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
     """(results table, run information) of a stored run; raises ResultsError if unusable."""
     run_dir = Path(run_dir)
@@ -20,7 +24,9 @@ def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
             raise ResultsError(f"{path}: missing (is {run_dir} the output folder of 'simparity run'?)")
     try:
         meta = json.loads(info.read_text(encoding="utf-8"))
-        table = pd.read_csv(results, keep_default_na=False, na_values={"value": ["", "nan", "NaN"], "dt": ["", "nan", "NaN"]})
+        # keep_default_na=False: pandas would read the status "n/a" as missing.
+        table = pd.read_csv(results, keep_default_na=False, **_EXACT_FLOATS,
+                            na_values={"value": ["", "nan", "NaN"], "dt": ["", "nan", "NaN"]})
     except (json.JSONDecodeError, pd.errors.ParserError, UnicodeDecodeError) as err:
         raise ResultsError(f"{run_dir}: unreadable stored run: {err}") from None
     if meta.get("schema_version") != SCHEMA_VERSION:

@@ -4,13 +4,13 @@ import io
 import subprocess
 import sys
 
-import pandas as pd
 import pytest
 
 from comparisons.cli import EXIT_OK, EXIT_USAGE, main
-from comparisons.engines import ENGINE_NAMES
+from comparisons.engines import DEFAULT_ENGINES
 from comparisons.library import builtin_paths
 from core.results import COLUMNS, NOT_AVAILABLE, OK, STATUSES
+from reports.store import read_run
 from tests.test_scene_loader import BROKEN
 
 
@@ -28,16 +28,27 @@ def test_list_names_every_builtin_scene():
     assert [line.split()[0] for line in lines] == sorted(builtin_paths())
 
 
-def test_default_run_covers_every_engine_on_every_builtin_scene(tmp_path):
-    """'simparity run' writes results.csv and report.md with a row for every engine on both scenes."""
-    code, text = _run(["run", "--out", str(tmp_path), "--repeats", "1"])
+def test_run_without_scenes_runs_the_whole_builtin_suite(tmp_path, monkeypatch):
+    """No scene argument means every built-in scene, each once, on the default engines."""
+    seen = []
+    monkeypatch.setattr("comparisons.cli.run_scene", lambda scene, engines, *a, **k: seen.append(
+        (scene.name, tuple(e.name for e in engines))) or [])
+    code, _ = _run(["run", "--out", str(tmp_path)])
+    assert code == EXIT_OK
+    assert [name for name, _ in seen] == sorted(builtin_paths())
+    assert all(engines == DEFAULT_ENGINES for _, engines in seen)
+
+
+def test_lecture_scenes_end_to_end(tmp_path):
+    """'simparity run' on the two lecture scenes writes results.csv and report.md with every engine's rows."""
+    code, text = _run(["run", "lecture-projectile", "lecture-planar-arm", "--out", str(tmp_path), "--repeats", "1"])
     assert code == EXIT_OK, text
-    table = pd.read_csv(tmp_path / "results.csv")
+    table, _ = read_run(tmp_path)
     assert tuple(table.columns) == COLUMNS
     assert set(table["status"]) <= set(STATUSES)
     for scene in ("lecture-projectile", "lecture-planar-arm"):
         rows = table[table["scene"] == scene]
-        assert set(rows["engine"]) == set(ENGINE_NAMES), scene
+        assert set(rows["engine"]) == set(DEFAULT_ENGINES), scene
         assert set(rows["status"]) <= {OK, NOT_AVAILABLE}, rows[~rows["status"].isin([OK, NOT_AVAILABLE])]
         assert (rows[rows["status"] == NOT_AVAILABLE]["detail"].str.len() > 0).all()
     report = (tmp_path / "report.md").read_text()

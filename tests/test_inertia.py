@@ -18,6 +18,7 @@ from core.inertia import (
     mass_and_center_of_mass,
 )
 from core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix
+from references.conventions import fmt
 
 # Sums of a few dozen float64 products of O(1) numbers: rounding is ~1e-15 relative to
 # the largest entry; 1e-13 leaves margin without hiding any modelling difference.
@@ -183,8 +184,7 @@ def test_point_masses_match_pinocchio():
 def _mujoco_body(masses: np.ndarray, points: np.ndarray) -> mujoco.MjModel:
     """A free body with one small sphere geom per point mass."""
     geoms = "".join(
-        f'<geom type="sphere" size="{MUJOCO_SPHERE_RADIUS!r}" mass="{m:.17g}" '
-        f'pos="{p[0]:.17g} {p[1]:.17g} {p[2]:.17g}"/>'
+        f'<geom type="sphere" size="{fmt(MUJOCO_SPHERE_RADIUS)}" mass="{fmt(m)}" pos="{fmt(p)}"/>'
         for m, p in zip(masses, points)
     )
     xml = f'<mujoco><worldbody><body name="cloud"><freejoint/>{geoms}</body></worldbody></mujoco>'
@@ -193,7 +193,7 @@ def _mujoco_body(masses: np.ndarray, points: np.ndarray) -> mujoco.MjModel:
 
 @pytest.mark.parametrize("seed", [5, 6, 7])
 def test_point_masses_match_mujoco(seed):
-    """MuJoCo's body_ipos, principal moments and iquat-rebuilt tensor equal ours plus the spheres' 2/5 m r^2."""
+    """MuJoCo's body_ipos, principal moments and iquat tensor equal ours plus the spheres' 2/5 m r^2."""
     rng = np.random.default_rng(seed)
     masses, points = _random_cloud(rng, 10)
     model = _mujoco_body(masses, points)

@@ -4,16 +4,13 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from core.inhouse import InHouseEngine
 from core.kinematics import forward_kinematics, jacobian_world
-from core.rotations import geodesic_angle_quat_wxyz
 from core.scene import Chain
 from references.pinocchio_adapter import PinocchioEngine, free_bodies_model
 from tests.helpers import builtin, exact_projectile, random_chain, tumbling_box
 
 KINEMATICS_TOL = 1e-12  # see tests/test_mujoco_adapter.py
 ACCUMULATED_ROUNDING_TOL = 1e-9
-SAME_SCHEME_TOL = 1e-12
 # Pinocchio keeps the inertia as a packed symmetric matrix; reading it back rounds by 1 ulp.
 STORED_INERTIA_RTOL = 1e-15
 
@@ -49,16 +46,6 @@ def test_projectile_error_is_semi_implicit_eulers():
     offset = scene.forces.gravity_world * traj.times[:, None, None] * dt / 2
     np.testing.assert_allclose(traj.position_world - position, offset, atol=ACCUMULATED_ROUNDING_TOL)
     np.testing.assert_allclose(traj.velocity_world, velocity, atol=ACCUMULATED_ROUNDING_TOL)
-
-
-def test_same_scheme_gives_the_same_numbers_as_core():
-    """Pinocchio (aba, harness Euler) equals core's engine_euler on the tumbling box over 600 steps."""
-    scene = tumbling_box(duration=2.5)
-    n = scene.n_steps(scene.dts[0])
-    ours = InHouseEngine().build_dynamics(scene, "engine_euler", scene.dts[0]).run(n)
-    theirs = PinocchioEngine().build_dynamics(scene, "euler", scene.dts[0]).run(n)
-    np.testing.assert_allclose(theirs.position_world, ours.position_world, atol=SAME_SCHEME_TOL)
-    assert geodesic_angle_quat_wxyz(theirs.quat_wxyz, ours.quat_wxyz).max() <= SAME_SCHEME_TOL
 
 
 def test_free_flyer_conventions():

@@ -4,9 +4,8 @@ import numpy as np
 import pybullet
 import pytest
 
-from core.inhouse import InHouseEngine
 from core.kinematics import forward_kinematics, jacobian_world
-from core.rotations import geodesic_angle_matrix, geodesic_angle_quat_wxyz, so3_exp
+from core.rotations import geodesic_angle_matrix
 from references.conventions import wxyz_from_xyzw, xyzw_from_wxyz
 from references.pybullet_adapter import PybulletEngine
 from references.urdf_export import body_urdf
@@ -19,7 +18,6 @@ LINK_STATE_ORIENTATION_TOL = 2e-6  # [rad]
 # calculateJacobian is computed in double from the joint values we pass.
 JACOBIAN_TOL = 1e-12
 ACCUMULATED_ROUNDING_TOL = 1e-9
-SAME_SCHEME_TOL = 1e-12  # see tests/test_mujoco_adapter.py
 
 
 @pytest.mark.parametrize("which", ["planar-arm", "random-7"])
@@ -73,17 +71,6 @@ def test_default_damping_exists_so_the_override_matters():
     finally:
         pybullet.disconnect(client)
     assert speed < 9.0  # 10 m/s decays to ~6.9 m/s in 1 s with the default damping
-
-
-def test_full_inertia_uses_principal_axes_and_same_scheme_as_core():
-    """A non-diagonal inertia (principal axes rotated) tumbles exactly as core's engine_euler."""
-    r = so3_exp(np.array([0.3, -0.5, 0.7]))
-    scene = tumbling_box(inertia_body=r @ np.diag([0.1, 0.2, 0.3]) @ r.T)
-    n = scene.n_steps(scene.dts[0])
-    ours = InHouseEngine().build_dynamics(scene, "engine_euler", scene.dts[0]).run(n)
-    theirs = PybulletEngine().build_dynamics(scene, "euler", scene.dts[0]).run(n)
-    np.testing.assert_allclose(theirs.position_world, ours.position_world, atol=SAME_SCHEME_TOL)
-    assert geodesic_angle_quat_wxyz(theirs.quat_wxyz, ours.quat_wxyz).max() <= SAME_SCHEME_TOL
 
 
 def test_quaternion_order_conversion():

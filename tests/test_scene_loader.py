@@ -60,7 +60,7 @@ BROKEN = [
      "missing required table"),
     ("bad kind", VALID_DYNAMICS, 'kind = "dynamics"', 'kind = "fluid"', "scene.kind", "allowed: dynamics, kinematics"),
     ("bad reference", VALID_DYNAMICS, 'reference = "analytic"', 'reference = "havok"', "scene.reference",
-     "allowed: core, analytic, mujoco, pybullet, pinocchio"),
+     "allowed: core, analytic, mujoco, pybullet, pinocchio, tight"),
     ("bad unit", VALID_DYNAMICS, 'reference = "analytic"', 'reference = "analytic"\nlength_unit = "furlong"',
      "scene.length_unit", "allowed: m, cm, mm, ft, in"),
     ("dt not dividing", VALID_DYNAMICS, "dt = [0.01]", "dt = [0.3]", "simulation.dt", "not a whole number of steps"),
@@ -78,6 +78,18 @@ BROKEN = [
     ("two inertias", VALID_DYNAMICS, "inertia_body_diagonal = [0.1, 0.1, 0.1]",
      "inertia_body_diagonal = [0.1, 0.1, 0.1]\ninertia_body = [[1, 0, 0], [0, 1, 0], [0, 0, 1]]",
      "body[0].inertia_body_diagonal", "exactly one"),
+    ("negative drag", VALID_DYNAMICS, "mass = 1.5", "mass = 1.5\nlinear_drag = -0.1", "body[0].linear_drag",
+     "is negative"),
+    ("wind without drag", VALID_DYNAMICS, "[world]", "[world]\nair_velocity_world = [1.0, 0.0, 0.0]",
+     "world.air_velocity_world", "wind needs a body with linear_drag or quadratic_drag"),
+    ("force without vector", VALID_DYNAMICS, "velocity_world = [1.0, 0.0, 0.0]",
+     "velocity_world = [1.0, 0.0, 0.0]\n[[body.force]]\npoint_body = [0, 0, 0]",
+     "body[0].force[0].force_world", "missing required key"),
+    ("unknown force key", VALID_DYNAMICS, "velocity_world = [1.0, 0.0, 0.0]",
+     "velocity_world = [1.0, 0.0, 0.0]\n[[body.force]]\nforce_world = [0, 0, 1]\ntorque = 1",
+     "body[0].force[0].torque", "unknown key"),
+    ("unknown integrator list", VALID_DYNAMICS, "dt = [0.01]", "dt = [0.01]\nintegrators = []",
+     "simulation.integrators", "non-empty list"),
     ("chain in dynamics", VALID_DYNAMICS, "[world]", "[chain]\n[world]", "chain", "not part of a dynamics scene"),
     ("bad joint type", VALID_KINEMATICS, 'type = "revolute"', 'type = "spherical"', "chain.joint[0].type",
      "allowed: revolute, prismatic"),
@@ -86,7 +98,15 @@ BROKEN = [
     ("zero axis", VALID_KINEMATICS, "axis = [0.0, 0.0, 1.0]", "axis = [0.0, 0.0, 0.0]", "chain.joint[0].axis",
      "all zeros"),
     ("no joints", VALID_KINEMATICS, '[[chain.joint]]\nname = "j1"\ntype = "revolute"\naxis = [0.0, 0.0, 1.0]\n'
-     "lower = -1.0\nupper = 1.0\n", "", "chain.joint", "missing required key"),
+     "lower = -1.0\nupper = 1.0\n", "", "chain.joint", "exactly one chain source"),
+    ("two chain sources", VALID_KINEMATICS, "[chain]", '[chain]\nurdf = "robot.urdf"', "chain.joint",
+     "exactly one chain source"),
+    ("missing urdf", VALID_KINEMATICS, '[[chain.joint]]\nname = "j1"\ntype = "revolute"\naxis = [0.0, 0.0, 1.0]\n'
+     "lower = -1.0\nupper = 1.0\n", 'urdf = "no-such.urdf"\n', "chain.urdf", "no such file"),
+    ("ik start outside limits", VALID_KINEMATICS.replace('kind = "kinematics"', 'kind = "ik"'), "[chain]",
+     "[targets]\nstart = [2.0]\n[chain]", "targets.start", "outside its limits"),
+    ("ik unknown hard target", VALID_KINEMATICS.replace('kind = "kinematics"', 'kind = "ik"'), "[chain]",
+     '[targets]\nhard = ["inside_out"]\n[chain]', "targets.hard", "unknown hard target"),
     ("zero configurations", VALID_KINEMATICS, "[chain]", "[sampling]\nconfigurations = 0\n[chain]",
      "sampling.configurations", ">= 1"),
 ]
@@ -133,6 +153,22 @@ def test_valid_scenes_load_with_defaults_and_units(tmp_path):
     arm = load_scene(_write(tmp_path, VALID_KINEMATICS, "arm.toml"))
     assert arm.n_configurations == 100 and arm.chain.n_joints == 1
     assert arm.configurations().shape == (100, 1) and np.all(np.abs(arm.configurations()) <= 1.0)
+
+
+def test_forces_load_per_body_with_units(tmp_path):
+    """Drag and applied forces become per-body arrays; bodies without a drag get 0; lengths scale."""
+    text = VALID_DYNAMICS.replace('velocity_world = [1.0, 0.0, 0.0]', 'velocity_world = [1.0, 0.0, 0.0]\n'
+                                  'quadratic_drag = 0.2\n[[body.force]]\n'
+                                  'force_world = [0.0, 0.0, 1.0]\npoint_body = [1.0, 0.0, 0.0]') + (
+        '\n[[body]]\nname = "other"\nmass = 1.0\ninertia_body_diagonal = [1.0, 1.0, 1.0]\n')
+    text = text.replace('reference = "analytic"', 'reference = "analytic"\nlength_unit = "cm"')
+    scene = load_scene(_write(tmp_path, text))
+    np.testing.assert_allclose(scene.forces.quadratic_drag, [0.2 / 0.01, 0.0])  # kg/m: per length
+    assert scene.forces.linear_drag is None
+    (applied,) = scene.forces.applied
+    assert applied.body == 0
+    np.testing.assert_allclose(applied.point_body, [0.01, 0, 0])
+    np.testing.assert_allclose(applied.force_world, [0, 0, 0.01])  # N = kg m/s^2: per length
 
 
 def test_absent_forces_stay_absent():
