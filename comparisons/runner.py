@@ -23,11 +23,12 @@ from comparisons.metrics import (
     observed_order,
     trajectory_errors,
 )
+from comparisons.ik_runner import run_ik_scene
 from comparisons.timing import best_of
 from core.engine import Engine
 from core.errors import DivergedError
 from core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
-from core.scene import DynamicsScene, KinematicsScene
+from core.scene import DynamicsScene, IKScene, KinematicsScene
 
 DEFAULT_REPEATS = 3
 """Timed repeats per measurement (the minimum is kept), after one warm-up run."""
@@ -181,6 +182,8 @@ def run_scene(
     scene, engines: list[Engine], make_reference: Callable[[str], Engine], repeats: int = DEFAULT_REPEATS
 ) -> list[ResultRow]:
     """All rows of one scene on ``engines``, measured against ``make_reference(scene.reference)``."""
+    if isinstance(scene, IKScene):
+        return run_ik_scene(scene, engines, repeats)
     reference = make_reference(scene.reference)
     if isinstance(scene, DynamicsScene):
         return _dynamics(scene, engines, reference, repeats)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -286,7 +287,10 @@ def _chain(top: _Reader, name: str) -> Chain:
     if len(sources) != 1:
         raise c.fail("joint", f"give exactly one chain source, got {sources or 'none'}", "joint, urdf, dh")
     if sources == ["urdf"]:
-        return chain_from_urdf(_urdf_path(c), base_link=c.table.get("base_link"), tip_link=c.table.get("tip_link"))
+        path, base = _urdf_path(c), c.table.get("base_link")
+        chain = chain_from_urdf(path, base_link=base, tip_link=c.table.get("tip_link"))
+        # Engines load the file themselves when the chain starts at its root link.
+        return chain if base is not None else replace(chain, urdf_path=str(path))
     if sources == ["dh"]:
         return _dh_chain(c, c.string("name", name))
     joints = tuple(_joint(r) for r in c.array_of_tables("joint", _JOINT))

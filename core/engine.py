@@ -153,8 +153,8 @@ class Engine(abc.ABC):
         """Names of the IK solvers the engine offers (empty if none)."""
         return ()
 
-    def supports_ik(self, chain: Chain, solver: str) -> Support:
-        """Whether :meth:`build_ik` can build ``solver`` for ``chain``."""
+    def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
+        """Whether :meth:`build_ik` can build ``solver`` for ``chain`` and this kind of target."""
         if solver in self.ik_solvers():
             return Support.yes()
         offered = ", ".join(self.ik_solvers()) or "none"

@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import platform
+from dataclasses import replace
 
 import numpy as np
 
 from core import point_mass
-from core.engine import Engine, KinematicsModel, Simulation, Support
+from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
 from core.forces import make_wrench
+from core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik
+from core.ik.result import IKResult
 from core.integrators import ORIENTATION_UPDATES, SCHEMES, make_step
 from core.kinematics import forward_kinematics, jacobian_world
 from core.rigid_body import MassProperties, State, initial_state, velocities
@@ -108,6 +111,23 @@ class _Kinematics(KinematicsModel):
         return jacobian_world(self._chain, q)
 
 
+NULLSPACE = "damped_least_squares+nullspace"
+"""Damped least squares plus the lecture's control expression pulling toward the start pose."""
+
+
+class _InHouseIK(IKModel):
+    def __init__(self, chain: Chain, solver: str, options: IKOptions) -> None:
+        self._chain, self._options = chain, options
+        self._method = solver.partition("+")[0]
+        self._nullspace = solver == NULLSPACE
+        self.detail = (f"in-house {self._method} (batched), max step {options.max_step:g} rad, hard joint limits"
+                       + ("; null-space term H = sum a (q - q_start)^2 toward the start pose" if self._nullspace else ""))
+
+    def solve(self, target_position_world, target_rotation_world, q_start) -> IKResult:
+        options = replace(self._options, rest_pose=np.asarray(q_start, dtype=float)) if self._nullspace else self._options
+        return solve_ik(self._chain, target_position_world, target_rotation_world, q_start, self._method, options)
+
+
 class InHouseEngine(Engine):
     """The lecture's methods as implemented in ``core``."""
 
@@ -138,3 +158,16 @@ class InHouseEngine(Engine):
 
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
         return _Kinematics(chain)
+
+    def ik_solvers(self) -> tuple[str, ...]:
+        return METHODS + (NULLSPACE,)
+
+    def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
+        named = super().supports_ik(chain, solver, position_only)
+        task = 3 if position_only else 6
+        if named.ok and solver == "jacobian_inverse" and chain.n_joints != task:
+            return Support.no(f"the Jacobian inverse needs a square Jacobian; this one is {task} x {chain.n_joints}")
+        return named
+
+    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
+        return _InHouseIK(chain, solver, options)

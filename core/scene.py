@@ -256,6 +256,10 @@ class Chain:
         End-effector frame origin in the last link's frame [m].
     end_effector_rotation : (3, 3) ndarray
         Last link frame to end-effector frame.
+    urdf_path : str or None
+        The URDF file the chain was read from, rooted at the file's root link; engines
+        then load that file themselves (the end effector is its link of the same name).
+        None for chains defined otherwise, which engines receive as the adapters' export.
     """
 
     name: str
@@ -263,6 +267,7 @@ class Chain:
     end_effector_name: str = "end_effector"
     end_effector_xyz: np.ndarray = field(default_factory=lambda: np.zeros(3))
     end_effector_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    urdf_path: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "end_effector_xyz", readonly(self.end_effector_xyz, shape=(3,)))

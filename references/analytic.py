@@ -11,7 +11,7 @@ decouple (no force here couples them), and each is solved per body:
   angular drag on an isotropic body.
 
 Anything else (applied forces, both drags at once, quadratic angular drag, ...) gets
-``n/a`` with the reason. Kinematics: planar chains (revolute joints about z, origins in
+``n/a`` with the reason. IK: the lecture's analytic solution of the planar 2-link arm. Kinematics: planar chains (revolute joints about z, origins in
 the xy plane): the end effector is a sum of rotated link vectors, sum_k Rz(phi_k) o_k with
 phi_k the cumulative angle, and the Jacobian is its closed-form derivative.
 """
@@ -20,7 +20,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from core.engine import Engine, KinematicsModel, Simulation, Support
+from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from core.ik.analytic_2link import two_link_fk, two_link_ik
+from core.ik.jacobian_solvers import IKOptions, check_inputs
+from core.ik.result import IKResult
 from core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix, so3_exp
 from core.scene import Chain, DynamicsScene
 from core.trajectory import FramePoses, Trajectory
@@ -179,6 +182,45 @@ class _PlanarKinematics(KinematicsModel):
         return jac
 
 
+def _two_link(chain: Chain) -> Support:
+    planar = _planar(chain)
+    if not planar.ok:
+        return planar
+    if chain.n_joints != 2 or np.any(chain.joints[0].origin_xyz) or np.any(chain.joints[1].origin_xyz[1:]) or np.any(
+            chain.end_effector_xyz[1:]):
+        return Support.no("the analytic IK is the lecture's 2-link arm: two z joints, links along x from the origin")
+    return Support.yes()
+
+
+class _TwoLinkIK(IKModel):
+    """The lecture's analytic 2-link solution; of the two elbow branches, the one within the
+    limits that is nearest to the start pose (wrapped angle distance)."""
+
+    def __init__(self, chain: Chain, options: IKOptions) -> None:
+        self._chain, self._options = chain, options
+        self._l1, self._l2 = chain.joints[1].origin_xyz[0], chain.end_effector_xyz[0]
+        self.detail = "the lecture's closed form (both branches; the nearest one within the limits)"
+
+    def solve(self, target_position_world, target_rotation_world, q_start) -> IKResult:
+        p, _, q0 = check_inputs(self._chain, target_position_world, None, q_start)
+        solution = two_link_ik(self._l1, self._l2, p[:, :2])
+        lower, upper = self._chain.lower, self._chain.upper
+        inside = np.all((solution.q >= lower) & (solution.q <= upper), axis=2)  # (B, branch)
+        distance = np.linalg.norm(np.angle(np.exp(1j * (solution.q - q0[:, None, :]))), axis=2)
+        distance = np.where(inside, distance, np.inf)
+        branch = np.argmin(distance, axis=1)
+        q = solution.q[np.arange(len(p)), branch]
+        blocked = ~np.any(inside, axis=1)
+        q = np.where(blocked[:, None], np.clip(q, lower, upper), q)
+        reached = np.concatenate([two_link_fk(self._l1, self._l2, q), np.zeros((len(p), 1))], axis=1)
+        residual = np.linalg.norm(reached - p, axis=1)
+        success = solution.reachable & ~blocked & (residual <= self._options.position_tolerance)
+        reason = np.where(success, "", np.where(~solution.reachable, "unreachable",
+                                                np.where(blocked, "limit_blocked", "singular")))
+        violation = np.max(np.maximum(np.maximum(lower - q, q - upper), 0.0), axis=1)
+        return IKResult(q, success, np.zeros(len(p), int), residual, np.zeros(len(p)), violation, reason)
+
+
 class AnalyticEngine(Engine):
     """Closed-form ground truths; ``n/a`` wherever no closed form is implemented."""
 
@@ -209,3 +251,17 @@ class AnalyticEngine(Engine):
 
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
         return _PlanarKinematics(chain)
+
+    def ik_solvers(self) -> tuple[str, ...]:
+        return ("two_link",)
+
+    def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
+        named = super().supports_ik(chain, solver, position_only)
+        if not named.ok:
+            return named
+        if not position_only:
+            return Support.no("the analytic 2-link IK solves position targets in the plane")
+        return _two_link(chain)
+
+    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
+        return _TwoLinkIK(chain, options)

@@ -22,7 +22,10 @@ Conversions (each pinned by a test in ``tests/test_mujoco_adapter.py``)
   The adapter counts ``mjWARN_BADQACC`` over the run and raises ``DivergedError`` with
   MuJoCo's message instead (the message is captured, not printed).
 - Kinematics: ``mj_kinematics`` then ``mj_comPos`` before ``mj_jacSite`` (the Jacobian is
-  silently zero without ``mj_comPos``).
+  silently zero without ``mj_comPos``). A chain read from a URDF file is loaded from that
+  file by MuJoCo's own URDF importer, with ``fusestatic`` off (by default MuJoCo merges
+  fixed-joint links away, and the end effector may be one) and a site added at the tip
+  link; other chains come from the adapter's MJCF.
 """
 
 from __future__ import annotations
@@ -31,14 +34,16 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from core.engine import Engine, KinematicsModel, Simulation, Support
+from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
 from core.errors import DivergedError
 from core.rotations import quat_wxyz_to_matrix
 from core.forces import make_wrench
+from core.ik.jacobian_solvers import IKOptions
 from core.rigid_body import MassProperties
 from core.scene import Chain, DynamicsScene, Forces, KinematicsScene
 from core.trajectory import FramePoses, Trajectory
 from references.conventions import fmt
+from references import mujoco_ik
 from references.mjcf import INTEGRATORS, chain_mjcf, dynamics_mjcf
 
 _STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
@@ -137,42 +142,67 @@ class _Simulation(Simulation):
         return Trajectory(times, qpos[..., :3], quat, qvel[..., :3], omega_world)
 
 
-class _Kinematics(KinematicsModel):
-    def __init__(self, chain: Chain) -> None:
-        self.model = mujoco.MjModel.from_xml_string(chain_mjcf(chain))
-        self._data = mujoco.MjData(self.model)
-        self._bodies = [mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, j.name) for j in chain.joints]
-        joints = [mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, j.name) for j in chain.joints]
-        self._qadr = self.model.jnt_qposadr[joints]
-        self._dofadr = self.model.jnt_dofadr[joints]
-        self._site = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, chain.end_effector_name)
-        self.detail = "mj_kinematics + mj_comPos; mj_jacSite at the end-effector site"
+def _chain_model(chain: Chain) -> mujoco.MjModel:
+    """The chain's MuJoCo model: its original URDF (fixed links kept, a site at the tip link), or the MJCF export."""
+    if chain.urdf_path is None:
+        return mujoco.MjModel.from_xml_string(chain_mjcf(chain))
+    spec = mujoco.MjSpec.from_file(chain.urdf_path)
+    spec.compiler.fusestatic = False  # keep fixed-joint links: the end effector may be one
+    spec.body(chain.end_effector_name).add_site(name=chain.end_effector_name)
+    return spec.compile()
 
-    def _set(self, q_row: np.ndarray) -> None:
-        self._data.qpos[self._qadr] = q_row
-        mujoco.mj_kinematics(self.model, self._data)
-        mujoco.mj_comPos(self.model, self._data)
+
+class MujocoChain(KinematicsModel):
+    """A chain in MuJoCo: the model, its data and the chain's joint and site indices.
+
+    Attributes
+    ----------
+    model, data : mujoco.MjModel, mujoco.MjData
+    qpos_adr, dof_adr : (n,) int ndarray
+        qpos and dof addresses of the chain's joints.
+    bodies : (n,) int ndarray
+        Body of each joint (its child link).
+    site : int
+        The end-effector site.
+    """
+
+    def __init__(self, chain: Chain) -> None:
+        self.model = _chain_model(chain)
+        self.data = mujoco.MjData(self.model)
+        joints = [mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, j.name) for j in chain.joints]
+        self.qpos_adr = self.model.jnt_qposadr[joints]
+        self.dof_adr = self.model.jnt_dofadr[joints]
+        self.bodies = self.model.jnt_bodyid[joints]
+        self.site = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, chain.end_effector_name)
+        origin = f"MjSpec from {chain.urdf_path} (fusestatic off)" if chain.urdf_path else "the adapter's MJCF"
+        self.detail = f"{origin}; mj_kinematics + mj_comPos; mj_jacSite at the end-effector site"
+
+    def set(self, q_row: np.ndarray) -> None:
+        """Put the joints at ``q_row`` (n,) and update kinematics and COM positions."""
+        self.data.qpos[self.qpos_adr] = q_row
+        mujoco.mj_kinematics(self.model, self.data)
+        mujoco.mj_comPos(self.model, self.data)
 
     def forward_kinematics(self, q: np.ndarray) -> FramePoses:
         q = np.atleast_2d(q)
-        n = len(self._bodies)
+        n = len(self.bodies)
         pos, rot = np.empty((len(q), n + 1, 3)), np.empty((len(q), n + 1, 3, 3))
         for k, row in enumerate(q):
-            self._set(row)
-            pos[k, :n] = self._data.xpos[self._bodies]
-            rot[k, :n] = self._data.xmat[self._bodies].reshape(n, 3, 3)
-            pos[k, n] = self._data.site_xpos[self._site]
-            rot[k, n] = self._data.site_xmat[self._site].reshape(3, 3)
+            self.set(row)
+            pos[k, :n] = self.data.xpos[self.bodies]
+            rot[k, :n] = self.data.xmat[self.bodies].reshape(n, 3, 3)
+            pos[k, n] = self.data.site_xpos[self.site]
+            rot[k, n] = self.data.site_xmat[self.site].reshape(3, 3)
         return FramePoses(pos, rot)
 
     def jacobian_world(self, q: np.ndarray) -> np.ndarray:
         q = np.atleast_2d(q)
         jacp, jacr = np.empty((3, self.model.nv)), np.empty((3, self.model.nv))
-        out = np.empty((len(q), 6, len(self._bodies)))
+        out = np.empty((len(q), 6, len(self.bodies)))
         for k, row in enumerate(q):
-            self._set(row)
-            mujoco.mj_jacSite(self.model, self._data, jacp, jacr, self._site)
-            out[k, :3], out[k, 3:] = jacp[:, self._dofadr], jacr[:, self._dofadr]
+            self.set(row)
+            mujoco.mj_jacSite(self.model, self.data, jacp, jacr, self.site)
+            out[k, :3], out[k, 3:] = jacp[:, self.dof_adr], jacr[:, self.dof_adr]
         return out
 
 
@@ -197,7 +227,13 @@ class MujocoEngine(Engine):
         return Support.yes()
 
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
-        return _Kinematics(chain)
+        return MujocoChain(chain)
+
+    def ik_solvers(self) -> tuple[str, ...]:
+        return mujoco_ik.SOLVERS
+
+    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
+        return mujoco_ik.MujocoIK(MujocoChain(chain), chain, solver, options)
 
     def export(self, scene, integrator, dt) -> str:
         if isinstance(scene, KinematicsScene):

@@ -16,8 +16,10 @@ Conversions (each pinned by a test in ``tests/test_pinocchio_adapter.py``)
   drift from the others (0.25 m after 2 s of free fall).
 - Forces other than gravity (``model.gravity``) enter ``aba`` as ``fext``: per joint, a
   force and a torque about the joint origin (the COM) in the LOCAL frame: (R^T F, R^T tau).
-- Chains: built from the adapter's URDF with ``buildModelFromXML`` (fixed base). A
-  ``continuous`` joint has nq = 2 (cos, sin). Jacobians are LOCAL_WORLD_ALIGNED.
+- Chains: a chain read from a URDF file is built from that file (``buildModelFromUrdf``),
+  others from the adapter's URDF (``buildModelFromXML``); fixed base. A ``continuous``
+  joint has nq = 2 (cos, sin). Joint frames are the child links' frames; Jacobians are
+  LOCAL_WORLD_ALIGNED.
 """
 
 from __future__ import annotations
@@ -25,14 +27,16 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from core.engine import Engine, KinematicsModel, Simulation, Support
+from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
 from core.rotations import matrix_to_quat_wxyz, so3_exp
 from core.forces import make_wrench, without_gravity
+from core.ik.jacobian_solvers import IKOptions
 from core.rigid_body import MassProperties
 from core.scene import Chain, DynamicsScene, KinematicsScene
 from core.trajectory import FramePoses, Trajectory
+from references import pinocchio_ik
 from references.conventions import xyzw_from_wxyz
-from references.urdf_export import chain_urdf
+from references.urdf_export import chain_urdf, urdf_support
 
 
 def free_bodies_model(scene: DynamicsScene) -> pin.Model:
@@ -96,19 +100,37 @@ class _Simulation(Simulation):
         return pin.aba(self._model, self._data, q.ravel(), qd.ravel(), self._tau, fext).reshape(-1, 6)
 
 
-class _Kinematics(KinematicsModel):
+class PinocchioChain(KinematicsModel):
+    """A fixed-base chain in Pinocchio: its original URDF when it has one, else the adapter's export.
+
+    Attributes
+    ----------
+    model, data : pinocchio.Model, pinocchio.Data
+    end_frame : int
+        Frame id of the end effector (the BODY frame of the link of that name).
+    """
+
     def __init__(self, chain: Chain) -> None:
-        self._model = pin.buildModelFromXML(chain_urdf(chain))
-        self._data = self._model.createData()
-        joints = [self._model.joints[self._model.getJointId(j.name)] for j in chain.joints]
+        if chain.urdf_path is None:
+            self.model = pin.buildModelFromXML(chain_urdf(chain))
+        else:
+            self.model = pin.buildModelFromUrdf(chain.urdf_path)
+        self.data = self.model.createData()
+        joints = [self.model.joints[self.model.getJointId(j.name)] for j in chain.joints]
         self._idx_q = [j.idx_q for j in joints]
         self._idx_v = [j.idx_v for j in joints]
         self._continuous = [j.nq == 2 for j in joints]
-        self._frames = [self._model.getFrameId(name, pin.BODY) for name in chain.frame_names()]
-        self.detail = "forwardKinematics + updateFramePlacements; computeFrameJacobian LOCAL_WORLD_ALIGNED"
+        # A joint's frame is its child link's frame (URDF); the end effector is a link.
+        self._frames = [self.model.getFrameId(j.name, pin.JOINT) for j in chain.joints]
+        self.end_frame = self.model.getFrameId(chain.end_effector_name, pin.BODY)
+        self._frames.append(self.end_frame)
+        origin = f"buildModelFromUrdf({chain.urdf_path})" if chain.urdf_path else "the adapter's URDF"
+        self.detail = (f"{origin}; forwardKinematics + updateFramePlacements; "
+                       "computeFrameJacobian LOCAL_WORLD_ALIGNED")
 
-    def _configuration(self, q_row: np.ndarray) -> np.ndarray:
-        q = pin.neutral(self._model)
+    def configuration(self, q_row: np.ndarray) -> np.ndarray:
+        """Pinocchio configuration (nq,) of joint values (n,): (cos, sin) for continuous joints."""
+        q = pin.neutral(self.model)
         for value, at, continuous in zip(q_row, self._idx_q, self._continuous):
             if continuous:
                 q[at], q[at + 1] = np.cos(value), np.sin(value)
@@ -116,24 +138,28 @@ class _Kinematics(KinematicsModel):
                 q[at] = value
         return q
 
+    def joint_values(self, configuration: np.ndarray) -> np.ndarray:
+        """Joint values (n,) of a configuration; atan2(sin, cos) in (-pi, pi] for continuous joints."""
+        return np.array([np.arctan2(configuration[at + 1], configuration[at]) if continuous else configuration[at]
+                         for at, continuous in zip(self._idx_q, self._continuous)])
+
     def forward_kinematics(self, q: np.ndarray) -> FramePoses:
         q = np.atleast_2d(q)
         n = len(self._frames)
         pos, rot = np.empty((len(q), n, 3)), np.empty((len(q), n, 3, 3))
         for k, row in enumerate(q):
-            pin.framesForwardKinematics(self._model, self._data, self._configuration(row))
+            pin.framesForwardKinematics(self.model, self.data, self.configuration(row))
             for f, fid in enumerate(self._frames):
-                pos[k, f] = self._data.oMf[fid].translation
-                rot[k, f] = self._data.oMf[fid].rotation
+                pos[k, f] = self.data.oMf[fid].translation
+                rot[k, f] = self.data.oMf[fid].rotation
         return FramePoses(pos, rot)
 
     def jacobian_world(self, q: np.ndarray) -> np.ndarray:
         q = np.atleast_2d(q)
         out = np.empty((len(q), 6, len(self._idx_v)))
         for k, row in enumerate(q):
-            jac = pin.computeFrameJacobian(
-                self._model, self._data, self._configuration(row), self._frames[-1], pin.LOCAL_WORLD_ALIGNED
-            )
+            jac = pin.computeFrameJacobian(self.model, self.data, self.configuration(row), self.end_frame,
+                                           pin.LOCAL_WORLD_ALIGNED)
             out[k] = jac[:, self._idx_v]
         return out
 
@@ -156,10 +182,20 @@ class PinocchioEngine(Engine):
         return _Simulation(scene, integrator, dt)
 
     def supports_kinematics(self, chain: Chain) -> Support:
-        return Support.yes()
+        return urdf_support(chain) if chain.urdf_path is None else Support.yes()
+
+    def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
+        named = super().supports_ik(chain, solver, position_only)
+        return named if not named.ok else self.supports_kinematics(chain)
 
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
-        return _Kinematics(chain)
+        return PinocchioChain(chain)
+
+    def ik_solvers(self) -> tuple[str, ...]:
+        return pinocchio_ik.SOLVERS
+
+    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
+        return pinocchio_ik.PinocchioIK(PinocchioChain(chain), chain, solver, options)
 
     def export(self, scene, integrator, dt) -> str:
         if isinstance(scene, KinematicsScene):

@@ -14,6 +14,8 @@ Conversions and overridden defaults (each pinned by a test in ``tests/test_pybul
 - Sleeping (deactivation of slow bodies) is disabled.
 - ``maxJointVelocity`` (Bullet clamps velocities at 100 rad/s by default) is raised far
   above any scene's.
+- A chain read from a URDF file is loaded from that file (``useFixedBase``); other chains
+  from the adapter's URDF.
 - ``getLinkState`` positions and orientations are FLOAT32 (errors ~1e-7); the Jacobian
   from ``calculateJacobian`` is double.
 - PyBullet has one integrator (semi-implicit Euler, velocity then position); time step = dt,
@@ -34,14 +36,16 @@ import tempfile
 import numpy as np
 import pybullet
 
-from core.engine import Engine, KinematicsModel, Simulation, Support
+from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
 from core.rotations import quat_wxyz_to_matrix, matrix_to_quat_wxyz
 from core.forces import make_wrench, without_gravity
+from core.ik.jacobian_solvers import IKOptions
 from core.rigid_body import MassProperties
 from core.scene import Chain, DynamicsScene, KinematicsScene
 from core.trajectory import FramePoses, Trajectory
+from references import pybullet_ik
 from references.conventions import fmt, principal_axes, wxyz_from_xyzw, xyzw_from_wxyz
-from references.urdf_export import body_urdf, chain_urdf
+from references.urdf_export import body_urdf, chain_urdf, urdf_support
 
 _MAX_VELOCITY = 1e9  # [rad/s or m/s]: effectively no clamping
 
@@ -137,45 +141,73 @@ class _Simulation(Simulation):
             pybullet.applyExternalTorque(uid, -1, torque[k], pybullet.WORLD_FRAME, physicsClientId=c)
 
 
-class _Kinematics(KinematicsModel):
+class PybulletChain(KinematicsModel):
+    """A fixed-base chain in a private PyBullet world.
+
+    Loads the chain's original URDF when it has one, else the adapter's export.
+
+    Attributes
+    ----------
+    client : int
+        The PyBullet client id.
+    body : int
+        The multibody's unique id.
+    joints : list of int
+        PyBullet joint index of each chain joint (= the index of its child link).
+    end_link : int
+        Link index of the end effector.
+    """
+
     def __init__(self, chain: Chain) -> None:
         self._client = _Client()
-        c = self._client.id
-        self._uid = _load_urdf(c, chain_urdf(chain), useFixedBase=True)
-        index = {
-            pybullet.getJointInfo(self._uid, j, physicsClientId=c)[1].decode(): j
-            for j in range(pybullet.getNumJoints(self._uid, physicsClientId=c))
-        }
-        self._joints = [index[j.name] for j in chain.joints]
-        self._links = self._joints + [index[f"{chain.end_effector_name}_fixed"]]
-        self.detail = "getLinkState (float32 link frames); calculateJacobian (double) at the end-effector link"
+        self.client = self._client.id
+        if chain.urdf_path is None:
+            self.body = _load_urdf(self.client, chain_urdf(chain), useFixedBase=True)
+        else:
+            self.body = pybullet.loadURDF(chain.urdf_path, useFixedBase=True,
+                                          flags=pybullet.URDF_USE_INERTIA_FROM_FILE, physicsClientId=self.client)
+        info = [pybullet.getJointInfo(self.body, j, physicsClientId=self.client)
+                for j in range(pybullet.getNumJoints(self.body, physicsClientId=self.client))]
+        joint_index = {i[1].decode(): i[0] for i in info}
+        link_index = {i[12].decode(): i[0] for i in info}
+        self.joints = [joint_index[j.name] for j in chain.joints]
+        self.end_link = link_index[chain.end_effector_name]
+        origin = f"loadURDF({chain.urdf_path})" if chain.urdf_path else "the adapter's URDF"
+        self.detail = (f"{origin}; getLinkState (float32 link frames); calculateJacobian (double) "
+                       "at the end-effector link")
 
-    def _set(self, q_row: np.ndarray) -> None:
-        for j, value in zip(self._joints, q_row):
-            pybullet.resetJointState(self._uid, j, float(value), physicsClientId=self._client.id)
+    def set(self, q_row: np.ndarray) -> None:
+        """Put the joints at ``q_row`` (n,) [rad or m]."""
+        for j, value in zip(self.joints, q_row):
+            pybullet.resetJointState(self.body, j, float(value), physicsClientId=self.client)
 
     def forward_kinematics(self, q: np.ndarray) -> FramePoses:
         q = np.atleast_2d(q)
-        pos = np.empty((len(q), len(self._links), 3))
-        quat = np.empty((len(q), len(self._links), 4))
+        links = self.joints + [self.end_link]
+        pos = np.empty((len(q), len(links), 3))
+        quat = np.empty((len(q), len(links), 4))
         for k, row in enumerate(q):
-            self._set(row)
-            states = pybullet.getLinkStates(
-                self._uid, self._links, computeForwardKinematics=True, physicsClientId=self._client.id
-            )
+            self.set(row)
+            states = pybullet.getLinkStates(self.body, links, computeForwardKinematics=True,
+                                            physicsClientId=self.client)
             for f, state in enumerate(states):
                 pos[k, f], quat[k, f] = state[4], state[5]
         return FramePoses(pos, quat_wxyz_to_matrix(wxyz_from_xyzw(quat)))
 
+    def end_effector_frames(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """End-effector positions (B, 3) [m] and rotations (B, 3, 3), float32 from getLinkState."""
+        poses = self.forward_kinematics(q)
+        return poses.position_world[:, -1], poses.rotation_world[:, -1]
+
     def jacobian_world(self, q: np.ndarray) -> np.ndarray:
         q = np.atleast_2d(q)
-        zeros = [0.0] * len(self._joints)
-        out = np.empty((len(q), 6, len(self._joints)))
+        zeros = [0.0] * len(self.joints)
+        out = np.empty((len(q), 6, len(self.joints)))
         for k, row in enumerate(q):
-            self._set(row)
+            self.set(row)
             linear, angular = pybullet.calculateJacobian(
-                self._uid, self._links[-1], [0.0, 0.0, 0.0], [float(v) for v in row], zeros, zeros,
-                physicsClientId=self._client.id,
+                self.body, self.end_link, [0.0, 0.0, 0.0], [float(v) for v in row], zeros, zeros,
+                physicsClientId=self.client,
             )
             out[k, :3], out[k, 3:] = np.array(linear), np.array(angular)
         return out
@@ -199,10 +231,20 @@ class PybulletEngine(Engine):
         return _Simulation(scene, integrator, dt)
 
     def supports_kinematics(self, chain: Chain) -> Support:
-        return Support.yes()
+        return urdf_support(chain) if chain.urdf_path is None else Support.yes()
+
+    def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
+        named = super().supports_ik(chain, solver, position_only)
+        return named if not named.ok else self.supports_kinematics(chain)
 
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
-        return _Kinematics(chain)
+        return PybulletChain(chain)
+
+    def ik_solvers(self) -> tuple[str, ...]:
+        return pybullet_ik.SOLVERS
+
+    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
+        return pybullet_ik.PybulletIK(PybulletChain(chain), chain, solver, options)
 
     def export(self, scene, integrator, dt) -> str:
         if isinstance(scene, KinematicsScene):

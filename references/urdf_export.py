@@ -15,6 +15,7 @@ What the URDF says, and why
 
 from __future__ import annotations
 
+from core.engine import Support
 from core.rotations import matrix_to_rpy
 from core.scene import Chain, RigidBody
 from references.conventions import fmt, principal_axes
@@ -41,6 +42,14 @@ def body_urdf(body: RigidBody) -> str:
         + _inertial(body.mass, moments, matrix_to_rpy(axes))
         + "  </link>\n</robot>\n"
     )
+
+
+def urdf_support(chain: Chain) -> Support:
+    """Whether the chain can be written as URDF: a prismatic joint needs limits there."""
+    for joint in chain.joints:
+        if joint.type == "prismatic" and not joint.limited:
+            return Support.no(f"URDF cannot express the unlimited prismatic joint '{joint.name}'")
+    return Support.yes()
 
 
 def chain_urdf(chain: Chain) -> str:

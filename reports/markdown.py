@@ -17,6 +17,25 @@ _DYNAMICS_COLUMNS = [
     ("angular_momentum_drift_max", "angular momentum drift max (rel.)"),
     ("time_per_step", "time per step [s]"),
 ]
+_IK_COLUMNS = [
+    ("solve_rate", "solve rate"),
+    ("position_residual_median", "position residual median [m]"),
+    ("position_residual_max", "position residual max [m]"),
+    ("orientation_residual_max", "orientation residual max [rad]"),
+    ("iterations_median", "iterations median"),
+    ("time_per_solve", "time per solve [s]"),
+    ("limit_violations", "solutions outside limits"),
+    ("rest_distance_median", "distance to start median"),
+    ("cross_eval_solve_rate_min", "solve rate, worst engine's FK"),
+    ("cross_eval_disagreement_max", "FK disagreement max [m]"),
+]
+_IK_PROTOCOL = (
+    "Protocol (TRAC-IK): seeded random reachable targets (end-effector poses of seeded random configurations "
+    "within the limits), every solve from the scene's one start pose, success when the residuals are within "
+    "the scene's tolerances, time per solve = batch time / batch size with failed solves included. Each "
+    "solution is also put through every engine's forward kinematics (worst solve rate and largest "
+    "disagreement shown), so no solver passes on its own kinematics alone."
+)
 _ORDER_COLUMNS = [
     ("order_position", "observed order (position)"),
     ("order_orientation", "observed order (orientation)"),
@@ -74,6 +93,37 @@ def _notes(scene_rows: pd.DataFrame) -> list[str]:
     return lines if len(lines) > 3 else []
 
 
+def _hard_cell(row) -> str:
+    if row["status"] != OK:
+        return row["status"]
+    verdict = row["detail"].split(";")[0]
+    return f"{'✓' if verdict == 'solved' else '✗ ' + verdict.removeprefix('failed: ')} {_number(row['value'])} m"
+
+
+def _hard_table(rows: pd.DataFrame) -> list[str]:
+    """Engine x solver against each hard target: solved or the reason, with the position residual."""
+    hard = rows[rows["metric"].str.startswith("hard_")]
+    if hard.empty:
+        return []
+    names = list(dict.fromkeys(hard["metric"]))
+    head = ["engine", "solver"] + [n.removeprefix("hard_") for n in names]
+    lines = ["", "Hard targets (✓ solved, ✗ the reason; position residual):", "",
+             "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for (engine, solver), group in hard.groupby(["engine", "integrator"], sort=False):
+        cells = {r["metric"]: _hard_cell(r) for _, r in group.iterrows()}
+        lines.append("| " + " | ".join([engine, solver] + [cells.get(n, "—") for n in names]) + " |")
+    notes = hard[hard["status"] == OK].drop_duplicates("metric")
+    lines += [""] + [f"- `{r['metric'].removeprefix('hard_')}`: {r['detail'].split('; ')[-1]}"
+                     for _, r in notes.iterrows()]
+    return lines
+
+
+def _kind(rows: pd.DataFrame) -> str:
+    if (rows["metric"] == "solve_rate").any():
+        return "ik"
+    return "dynamics" if rows["dt"].notna().any() else "kinematics"
+
+
 def render(table: pd.DataFrame, info: dict) -> str:
     """Markdown text of a stored run."""
     versions = ", ".join(f"{k} {v}" for k, v in info.get("engine_versions", {}).items())
@@ -93,14 +143,19 @@ def render(table: pd.DataFrame, info: dict) -> str:
         "times are the best of several repeats of the stepping alone (model building excluded).",
     ]
     for scene, rows in table.groupby("scene", sort=False):
-        dynamics = rows["dt"].notna().any()
+        kind = _kind(rows)
         reference = rows["reference"].iloc[0]
         about = info.get("scenes", {}).get(scene, {})
-        lines += ["", f"## {scene} ({'dynamics' if dynamics else 'kinematics'})", ""]
+        lines += ["", f"## {scene} ({kind})", ""]
         if about.get("description"):
             lines += [about["description"], ""]
         lines += [f"Reference: `{reference}`." + (f" Scene file: `{about['source']}`." if about.get("source") else ""), ""]
-        if dynamics:
+        if kind == "ik":
+            lines += [_IK_PROTOCOL, ""]
+            solved = rows[~rows["metric"].str.startswith("hard_")].rename(columns={"integrator": "solver"})
+            lines += _table(solved, _IK_COLUMNS, ["engine", "solver"])
+            lines += _hard_table(rows)
+        elif kind == "dynamics":
             per_dt = rows[rows["dt"].notna()]
             lines += _table(per_dt, _DYNAMICS_COLUMNS, ["engine", "integrator", "dt"])
             orders = rows[rows["dt"].isna()]

@@ -4,10 +4,20 @@ from __future__ import annotations
 
 import numpy as np
 
+import dataclasses
+import os
+
+import pybullet_data
+
+from comparisons.engines import make_engine
 from comparisons.library import builtin_paths
 from comparisons.scene_loader import load_scene
-from core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix, rpy_to_matrix
+from core.ik.jacobian_solvers import IKOptions
+from core.ik.reach import reach_upper_bound
+from core.kinematics import forward_kinematics
+from core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix, rpy_to_matrix, so3_exp
 from core.scene import Chain, DynamicsScene, Forces, Joint, RigidBody
+from core.urdf import chain_from_urdf
 
 
 def builtin(name: str):
@@ -47,3 +57,42 @@ def exact_projectile(scene: DynamicsScene, times: np.ndarray) -> tuple[np.ndarra
     v0 = np.stack([b.velocity_world for b in scene.bodies])
     t = times[:, None, None]
     return x0 + v0 * t + 0.5 * g * t * t, v0 + g * t
+
+
+def unlimited(chain: Chain) -> Chain:
+    """The same chain with every joint unlimited (URDF continuous joints)."""
+    return dataclasses.replace(chain, joints=tuple(
+        dataclasses.replace(j, lower=-np.inf, upper=np.inf) for j in chain.joints))
+
+
+IIWA = chain_from_urdf(os.path.join(pybullet_data.getDataPath(), "kuka_iiwa/model.urdf"))
+"""The KUKA iiwa of pybullet_data, read by core's URDF loader (engines get the adapters' export)."""
+REVOLUTE7 = random_chain(np.random.default_rng(5), 7, prismatic_every=0)
+"""A spatial 7R chain (no prismatic joint: engine IK ignores limits, so a prismatic joint
+would reach targets beyond the reach bound)."""
+MIXED6 = random_chain(np.random.default_rng(31), 6)
+"""Every third joint prismatic, to pin conventions on both joint types."""
+CONTINUOUS7 = unlimited(REVOLUTE7)
+"""The 7R chain with every joint unlimited: URDF continuous, nq = 2 in Pinocchio."""
+
+
+def reachable_targets(chain: Chain, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """End-effector positions (n, 3) and rotations (n, 3, 3) of seeded configurations within the limits."""
+    lower = np.where(np.isfinite(chain.lower), chain.lower, -np.pi)
+    upper = np.where(np.isfinite(chain.upper), chain.upper, np.pi)
+    frames = forward_kinematics(chain, np.random.default_rng(seed).uniform(lower, upper, (n, chain.n_joints)))
+    return frames.position_world[:, -1], frames.rotation_world[:, -1]
+
+
+def far_targets(chain: Chain, n: int, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """Targets at three times the reach bound from the first joint, random orientations."""
+    rng = np.random.default_rng(seed)
+    center, radius = reach_upper_bound(chain)
+    direction = rng.normal(size=(n, 3))
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+    return center + 3 * radius * direction, so3_exp(rng.normal(size=(n, 3)))
+
+
+def build_ik(engine: str, chain: Chain, solver: str, options: IKOptions):
+    """An engine's IK solver, built the way the runner builds it."""
+    return make_engine(engine).build_ik(chain, solver, options)

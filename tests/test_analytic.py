@@ -63,3 +63,19 @@ def test_tumbling_closed_forms_in_any_body_frame(moments, rotated):
     fine = InHouseEngine().build_dynamics(scene, "rk4", 1e-3).run(n)
     assert geodesic_angle_quat_wxyz(exact.quat_wxyz, fine.quat_wxyz).max() <= TUMBLING_TOL
     np.testing.assert_allclose(exact.angular_velocity_world, fine.angular_velocity_world, atol=TUMBLING_TOL)
+
+
+def test_two_link_ik_picks_the_branch_nearest_the_start_and_reports_unreachable():
+    """The closed form solves reachable targets to 1e-12 near the start branch; far targets are unreachable."""
+    from core.ik.jacobian_solvers import IKOptions
+
+    scene = builtin("lecture-2link-ik")
+    model = AnalyticEngine().build_ik(scene.chain, "two_link", IKOptions())
+    q_true = np.array([[0.4, 0.9], [-1.0, 0.5]])  # elbow on the start's side (q2 > 0)
+    target = forward_kinematics(scene.chain, q_true).position_world[:, -1]
+    result = model.solve(target, None, scene.q_start)
+    np.testing.assert_allclose(result.q, q_true, atol=1e-12)
+    assert result.success.all() and result.position_residual.max() < 1e-12
+    far = model.solve(np.array([[3.0, 0.0, 0.0]]), None, scene.q_start)
+    assert not far.success[0] and far.reason[0] == "unreachable"
+    np.testing.assert_allclose(far.position_residual, [3.0 - 1.8], atol=1e-12)  # nearest reachable point

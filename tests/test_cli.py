@@ -116,3 +116,18 @@ def test_console_script_help():
         done = subprocess.run([sys.executable, "-m", "comparisons.cli", *argv, "--help"],
                               capture_output=True, text=True, timeout=60)
         assert done.returncode == 0 and "usage: simparity" in done.stdout
+
+
+def test_urdf_with_an_unsupported_element_exits_2_naming_it(tmp_path, capsys):
+    """A scene whose URDF has a mimic joint on the chain is a one-line error naming the element."""
+    (tmp_path / "robot.urdf").write_text(
+        '<robot name="r"><link name="a"/><link name="b"/><link name="c"/>'
+        '<joint name="j1" type="revolute"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1"/></joint>'
+        '<joint name="j2" type="revolute"><parent link="b"/><child link="c"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1" upper="1"/><mimic joint="j1"/></joint></robot>')
+    (tmp_path / "scene.toml").write_text(
+        '[scene]\nname = "m"\nkind = "kinematics"\nreference = "core"\n[chain]\nurdf = "robot.urdf"\n')
+    assert main(["run", str(tmp_path / "scene.toml"), "--out", str(tmp_path / "out")]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "mimic" in err and "j2" in err

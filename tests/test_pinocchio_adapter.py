@@ -2,12 +2,9 @@
 
 import numpy as np
 import pinocchio as pin
-import pytest
 
-from core.kinematics import forward_kinematics, jacobian_world
-from core.scene import Chain
 from references.pinocchio_adapter import PinocchioEngine, free_bodies_model
-from tests.helpers import builtin, exact_projectile, random_chain, tumbling_box
+from tests.helpers import builtin, exact_projectile, tumbling_box
 
 KINEMATICS_TOL = 1e-12  # see tests/test_mujoco_adapter.py
 ACCUMULATED_ROUNDING_TOL = 1e-9
@@ -15,26 +12,6 @@ ACCUMULATED_ROUNDING_TOL = 1e-9
 STORED_INERTIA_RTOL = 1e-15
 
 
-@pytest.mark.parametrize("which", ["planar-arm", "random-7", "unlimited"])
-def test_fk_and_jacobian_agree_with_core(which):
-    """Frames and Jacobian equal core's to 1e-12, continuous (nq = 2) joints included."""
-    rng = np.random.default_rng(41)
-    if which == "planar-arm":
-        scene = builtin("lecture-planar-arm")
-        chain, q = scene.chain, scene.configurations()
-    else:
-        chain = random_chain(rng, 7)
-        if which == "unlimited":
-            joints = tuple(j.__class__(j.name, j.type, j.axis, j.origin_xyz, j.origin_rotation)
-                           if j.type == "revolute" else j for j in chain.joints)
-            chain = Chain(chain.name, joints, chain.end_effector_name, chain.end_effector_xyz,
-                          chain.end_effector_rotation)
-        q = rng.uniform(-np.pi, np.pi, size=(100, chain.n_joints))
-    model = PinocchioEngine().build_kinematics(chain)
-    poses, ref = model.forward_kinematics(q), forward_kinematics(chain, q)
-    np.testing.assert_allclose(poses.position_world, ref.position_world, atol=KINEMATICS_TOL)
-    np.testing.assert_allclose(poses.rotation_world, ref.rotation_world, atol=KINEMATICS_TOL)
-    np.testing.assert_allclose(model.jacobian_world(q), jacobian_world(chain, q), atol=KINEMATICS_TOL)
 
 
 def test_projectile_error_is_semi_implicit_eulers():

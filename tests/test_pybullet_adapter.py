@@ -2,14 +2,11 @@
 
 import numpy as np
 import pybullet
-import pytest
 
-from core.kinematics import forward_kinematics, jacobian_world
-from core.rotations import geodesic_angle_matrix
 from references.conventions import wxyz_from_xyzw, xyzw_from_wxyz
 from references.pybullet_adapter import PybulletEngine
 from references.urdf_export import body_urdf
-from tests.helpers import builtin, exact_projectile, random_chain, tumbling_box
+from tests.helpers import builtin, exact_projectile, tumbling_box
 
 # getLinkState returns float32: relative error ~6e-8 of coordinates up to ~3 m, and
 # ~3e-7 rad in orientation; these bounds leave a factor ~3-8 of margin.
@@ -20,21 +17,6 @@ JACOBIAN_TOL = 1e-12
 ACCUMULATED_ROUNDING_TOL = 1e-9
 
 
-@pytest.mark.parametrize("which", ["planar-arm", "random-7"])
-def test_fk_within_float32_and_jacobian_within_double_of_core(which):
-    """Link frames agree to float32 precision, the Jacobian to double precision."""
-    rng = np.random.default_rng(31)
-    if which == "planar-arm":
-        scene = builtin("lecture-planar-arm")
-        chain, q = scene.chain, scene.configurations()
-    else:
-        chain = random_chain(rng, 7)
-        q = rng.uniform(chain.lower, chain.upper, size=(100, chain.n_joints))
-    model = PybulletEngine().build_kinematics(chain)
-    poses, ref = model.forward_kinematics(q), forward_kinematics(chain, q)
-    np.testing.assert_allclose(poses.position_world, ref.position_world, atol=LINK_STATE_POSITION_TOL)
-    assert geodesic_angle_matrix(poses.rotation_world, ref.rotation_world).max() < LINK_STATE_ORIENTATION_TOL
-    np.testing.assert_allclose(model.jacobian_world(q), jacobian_world(chain, q), atol=JACOBIAN_TOL)
 
 
 def test_projectile_error_is_semi_implicit_eulers():

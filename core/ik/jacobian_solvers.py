@@ -177,7 +177,7 @@ def solve_ik(
         On malformed inputs, an unknown method, or a non-square Jacobian for
         ``"jacobian_inverse"``.
     """
-    target_position, target_rotation, q = _check_inputs(chain, target_position, target_rotation, q_start)
+    target_position, target_rotation, q = check_inputs(chain, target_position, target_rotation, q_start)
     if method not in METHODS:
         raise ValueError(f"unknown IK method {method!r}, expected one of {METHODS}")
     rows = 3 if target_rotation is None else 6
@@ -241,7 +241,11 @@ def solve_ik(
                     orientation_residual=rot_res, limit_violation=violation, reason=reason.astype(str))
 
 
-def _check_inputs(chain, target_position, target_rotation, q_start):
+def check_inputs(chain, target_position, target_rotation, q_start):
+    """Checked IK inputs: (p (B, 3), R (B, 3, 3) or None, q_start broadcast to (B, n)).
+
+    Used by every solver, in-house or engine; raises ValueError naming the bad argument.
+    """
     p = np.asarray(target_position, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3 or not np.all(np.isfinite(p)):
         raise ValueError(f"target_position must be a finite (B, 3) array, got shape {p.shape}")

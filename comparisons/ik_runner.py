@@ -1,0 +1,146 @@
+"""Runs an IK scene: every engine's solvers on the random and hard targets, cross-evaluated.
+
+Per engine x solver (the ``integrator`` column holds the solver; ``dt`` is NaN):
+
+- on the random targets, the metrics of :data:`IK_METRICS`; the time per solve is the
+  batch's wall time over its size, failed solves included (TRAC-IK protocol);
+- cross-evaluation: each solution is put through every engine's forward kinematics, so
+  a solver cannot pass on its own engine's kinematics alone: ``cross_eval_solve_rate_min``
+  is the lowest solve rate any engine's FK grants, ``cross_eval_disagreement_max`` the
+  largest distance between two engines' end-effector positions for the same solution;
+- each hard target: one row ``hard_<name>`` whose value is the position residual and
+  whose detail says solved or the reason, with the orientation residual.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from comparisons.ik_targets import ORIENTATION_ONLY, Targets, hard_target, random_targets
+from comparisons.timing import best_of
+from core.engine import Engine, KinematicsModel
+from core.ik.jacobian_solvers import IKOptions
+from core.ik.result import IKResult
+from core.results import FAILED, NOT_AVAILABLE, OK, ResultRow
+from core.rotations import geodesic_angle_matrix
+from core.scene import IKScene
+
+IK_METRICS = {
+    "solve_rate": "1",
+    "position_residual_median": "m",
+    "position_residual_max": "m",
+    "orientation_residual_median": "rad",
+    "orientation_residual_max": "rad",
+    "iterations_median": "1",
+    "time_per_solve": "s",
+    "limit_violations": "1",
+    "rest_distance_median": "rad or m",
+    "cross_eval_solve_rate_min": "1",
+    "cross_eval_disagreement_max": "m",
+}
+
+
+def _summary(result: IKResult, q_start: np.ndarray, seconds: float) -> dict[str, float]:
+    iterations = result.iterations[result.iterations >= 0]
+    return {
+        "solve_rate": result.solve_rate,
+        "position_residual_median": float(np.median(result.position_residual)),
+        "position_residual_max": float(result.position_residual.max()),
+        "orientation_residual_median": float(np.median(result.orientation_residual)),
+        "orientation_residual_max": float(result.orientation_residual.max()),
+        "iterations_median": float(np.median(iterations)) if iterations.size else math.nan,
+        "time_per_solve": seconds / len(result.q),
+        "limit_violations": float(np.count_nonzero(result.limit_violation > 0)),
+        "rest_distance_median": float(np.median(np.linalg.norm(result.q - q_start, axis=1))),
+    }
+
+
+def _cross_evaluation(scene: IKScene, targets: Targets, q: np.ndarray,
+                      judges: dict[str, KinematicsModel]) -> dict[str, float]:
+    """Solve rate by each judge's FK (lowest kept) and the spread of their end-effector positions."""
+    rates, ends = [], []
+    for model in judges.values():
+        frames = model.forward_kinematics(q)
+        end, rotation = frames.position_world[:, -1], frames.rotation_world[:, -1]
+        solved = np.linalg.norm(end - targets.position_world, axis=1) <= scene.position_tolerance
+        if targets.rotation_world is not None:
+            solved &= geodesic_angle_matrix(rotation, targets.rotation_world) <= scene.orientation_tolerance
+        rates.append(float(np.mean(solved)))
+        ends.append(end)
+    ends = np.stack(ends)
+    spread = np.linalg.norm(ends[:, None] - ends[None, :], axis=-1).max() if len(ends) > 1 else 0.0
+    return {"cross_eval_solve_rate_min": min(rates), "cross_eval_disagreement_max": float(spread)}
+
+
+def _judges(scene: IKScene, engines: list[Engine]) -> dict[str, KinematicsModel]:
+    judges = {}
+    for engine in engines:
+        if engine.supports_kinematics(scene.chain).ok:
+            try:
+                judges[engine.name] = engine.build_kinematics(scene.chain)
+            except Exception:  # noqa: BLE001 - an engine that cannot build the chain judges nothing
+                continue
+    return judges
+
+
+def _hard_row(scene: IKScene, case: dict, targets: Targets, result: IKResult | None, problem: str) -> ResultRow:
+    metric = f"hard_{targets.name}"
+    if result is None:
+        return ResultRow(value=math.nan, metric=metric, unit="m", status=NOT_AVAILABLE if problem.startswith("n/a")
+                         else FAILED, detail=problem.removeprefix("n/a: "), **case)
+    verdict = "solved" if result.success[0] else f"failed: {result.reason[0]}"
+    detail = (f"{verdict}; orientation residual {result.orientation_residual[0]:.3g} rad; "
+              f"limit violation {result.limit_violation[0]:.3g}; {targets.note}")
+    return ResultRow(value=float(result.position_residual[0]), metric=metric, unit="m", status=OK, detail=detail,
+                     **case)
+
+
+def _solve(model, targets: Targets, q_start: np.ndarray) -> IKResult:
+    return model.solve(targets.position_world, targets.rotation_world, q_start)
+
+
+def run_ik_scene(scene: IKScene, engines: list[Engine], repeats: int) -> list[ResultRow]:
+    """All rows of an IK scene."""
+    options = IKOptions(position_tolerance=scene.position_tolerance, orientation_tolerance=scene.orientation_tolerance,
+                        max_iterations=scene.max_iterations)
+    position_only = scene.target_kind == "position"
+    random = random_targets(scene)
+    hard = [hard_target(scene, name) for name in scene.hard_targets
+            if not (position_only and name in ORIENTATION_ONLY)]
+    skipped = [name for name in scene.hard_targets if position_only and name in ORIENTATION_ONLY]
+    judges = _judges(scene, engines)
+    reference = f"{scene.reference}:fk (targets); cross-evaluated by {', '.join(judges)}"
+    rows: list[ResultRow] = []
+    for engine in engines:
+        for solver in engine.ik_solvers() or ("-",):
+            case = dict(scene=scene.name, engine=engine.name, integrator=solver, dt=math.nan, reference=reference)
+
+            def rows_for(metrics, status, detail, values=None):
+                values = values or {}
+                return [ResultRow(value=values.get(m, math.nan), metric=m, unit=u, status=status, detail=detail, **case)
+                        for m, u in metrics.items()]
+
+            support = engine.supports_ik(scene.chain, solver, position_only)
+            if not support.ok:
+                rows += rows_for(IK_METRICS, NOT_AVAILABLE, support.reason)
+                rows += [_hard_row(scene, case, t, None, f"n/a: {support.reason}") for t in hard]
+                continue
+            try:
+                model = engine.build_ik(scene.chain, solver, options)
+                seconds, result = best_of(lambda: _solve(model, random, scene.q_start), repeats)
+            except Exception as err:  # noqa: BLE001 - reported in the rows
+                rows += rows_for(IK_METRICS, FAILED, f"{type(err).__name__}: {err}".replace("\n", " "))
+                continue
+            values = _summary(result, scene.q_start, seconds)
+            values.update(_cross_evaluation(scene, random, result.q, judges))
+            rows += rows_for(IK_METRICS, OK, f"{model.detail}; {random.note}", values)
+            for targets in hard:
+                try:
+                    rows.append(_hard_row(scene, case, targets, _solve(model, targets, scene.q_start), ""))
+                except Exception as err:  # noqa: BLE001 - reported in the row
+                    rows.append(_hard_row(scene, case, targets, None, f"{type(err).__name__}: {err}"))
+            rows += [ResultRow(value=math.nan, metric=f"hard_{name}", unit="m", status=NOT_AVAILABLE,
+                               detail="position-only scene: no orientation to target", **case) for name in skipped]
+    return rows

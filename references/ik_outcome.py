@@ -1,0 +1,57 @@
+"""The IK adapters' shared verdict: success, reason and limit violation from residuals.
+
+Every library IK adapter (:mod:`references.pybullet_ik`, :mod:`references.pinocchio_ik`,
+:mod:`references.mujoco_ik`) judges its solutions the same way, whatever the library's
+own stopping rule was:
+
+- success: position residual <= ``options.position_tolerance`` [m] AND orientation
+  residual <= ``options.orientation_tolerance`` [rad] (0 for position-only targets);
+- reason of a failure: ``"unreachable"`` when the target is farther from the first joint
+  than :func:`core.ik.reach.reach_upper_bound` (plus the position tolerance), else
+  ``"iteration_cap"``: the libraries report no cause (a stop at their own looser
+  threshold, a stall and the cap all look alike), and :data:`core.ik.result.REASONS` has
+  no "stopped early";
+- limit violation: measured on the returned joint values, which are never clamped.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from core.ik.jacobian_solvers import IKOptions
+from core.ik.reach import reach_upper_bound
+from core.ik.result import IKResult
+from core.scene import Chain
+
+
+def ik_outcome(chain: Chain, q: np.ndarray, iterations: np.ndarray, position_residual: np.ndarray,
+               orientation_residual: np.ndarray, target_position_world: np.ndarray,
+               options: IKOptions) -> IKResult:
+    """Judge a batch of library IK solutions.
+
+    Parameters
+    ----------
+    chain : Chain
+    q : (B, n) ndarray
+        Joint values the library returned [rad or m].
+    iterations : (B,) int ndarray
+        Joint updates applied, -1 where the library does not report them.
+    position_residual, orientation_residual : (B,) ndarray
+        Measured with the library's forward kinematics at ``q`` [m], [rad].
+    target_position_world : (B, 3) ndarray
+        [m].
+    options : IKOptions
+        Only the two tolerances are read.
+
+    Returns
+    -------
+    IKResult
+    """
+    success = ((position_residual <= options.position_tolerance)
+               & (orientation_residual <= options.orientation_tolerance))
+    center, radius = reach_upper_bound(chain)
+    beyond = np.linalg.norm(target_position_world - center, axis=1) > radius + options.position_tolerance
+    reason = np.where(success, "", np.where(beyond, "unreachable", "iteration_cap"))
+    violation = np.max(np.maximum(np.maximum(chain.lower - q, q - chain.upper), 0.0), axis=1, initial=0.0)
+    return IKResult(q=q, success=success, iterations=iterations, position_residual=position_residual,
+                    orientation_residual=orientation_residual, limit_violation=violation, reason=reason)
