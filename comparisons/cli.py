@@ -17,7 +17,7 @@ from comparisons.engines import DEFAULT_ENGINES, ENGINE_NAMES, check_engine_name
 from comparisons.runner import DEFAULT_REPEATS, run_scene
 from comparisons.store import DEFAULT_OUT_ROOT, RunWriter, default_out_dir
 from core.errors import SimparityError
-from core.results import FAILED, REPORT_FILE
+from core.results import FAILED, REPORT_FILE, case_counts
 from reports.markdown import render
 from reports.store import read_run
 
@@ -82,21 +82,29 @@ def cmd_run(args, out) -> int:
     scenes = library.load(args.scenes or list(library.builtin_paths()))
     engines = [make_engine(n) for n in names]
     out_dir = args.out or default_out_dir()
+    if out_dir.exists() and not out_dir.is_dir():
+        raise SimparityError(f"--out {out_dir}: exists and is not a folder")
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise SimparityError(f"--out {out_dir}: cannot create the folder: {err.strerror}") from None
     writer = RunWriter(out_dir, {e.name: e.version() for e in engines}, " ".join(["simparity"] + sys.argv[1:]), scenes)
     failed = 0
     try:
         for scene in scenes:
             rows = run_scene(scene, engines, make_engine, repeats=args.repeats)
             writer.append(rows)
-            cases = {(r.engine, r.integrator, r.dt): r.status for r in rows}
-            counts = {s: list(cases.values()).count(s) for s in sorted(set(cases.values()))}
-            failed += counts.get(FAILED, 0)
-            print(f"{scene.name}: {len(cases)} cases (" + ", ".join(f"{s} {c}" for s, c in counts.items()) + ")",
-                  file=out)
+            counts = case_counts(rows)
+            failed += counts[FAILED]
+            print(f"{scene.name}: {sum(counts.values())} cases ("
+                  + ", ".join(f"{s} {c}" for s, c in counts.items() if c) + ")", file=out)
     except KeyboardInterrupt:
         print(f"interrupted; results so far are in {writer.results_path}", file=out)
         _write_report(out_dir, out)
         return EXIT_INTERRUPTED
+    except SimparityError:
+        _write_report(out_dir, out)  # keep what was computed, then report the error
+        raise
     _write_report(out_dir, out)
     return EXIT_FAILED_CASES if failed else EXIT_OK
 

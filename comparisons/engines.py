@@ -45,15 +45,20 @@ class UnavailableEngine(Engine):
     def build_kinematics(self, chain) -> KinematicsModel:
         raise RuntimeError(self._reason)
 
+    def supports_ik(self, chain, solver: str, position_only: bool) -> Support:
+        return Support.no(self._reason)
+
 
 def check_engine_names(names) -> tuple[str, ...]:
-    """The names, checked against :data:`ENGINE_NAMES`; raises UnknownEngineError."""
+    """The names, checked against :data:`ENGINE_NAMES`, duplicates dropped; raises UnknownEngineError."""
     unknown = [n for n in names if n not in _ENGINES]
     if unknown:
         raise UnknownEngineError(
             f"unknown engine(s): {', '.join(unknown)} (known: {', '.join(ENGINE_NAMES)})"
         )
-    return tuple(names)
+    if not names:
+        raise UnknownEngineError(f"no engine named (known: {', '.join(ENGINE_NAMES)})")
+    return tuple(dict.fromkeys(names))
 
 
 def make_engine(name: str) -> Engine:
@@ -64,3 +69,12 @@ def make_engine(name: str) -> Engine:
         return getattr(importlib.import_module(module), cls)()
     except ImportError as err:
         return UnavailableEngine(name, str(err))
+
+
+def known_integrators() -> tuple[str, ...]:
+    """Every integrator name some engine offers (for checking scene files)."""
+    names = {}
+    for engine in ENGINE_NAMES:
+        names.update(dict.fromkeys(make_engine(engine).integrators()))
+    names.pop("-", None)
+    return tuple(names)

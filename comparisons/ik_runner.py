@@ -6,7 +6,8 @@ Per engine x solver (the ``integrator`` column holds the solver; ``dt`` is NaN):
   batch's wall time over its size, failed solves included (TRAC-IK protocol);
 - cross-evaluation: each solution is put through every engine's forward kinematics, so
   a solver cannot pass on its own engine's kinematics alone: ``cross_eval_solve_rate_min``
-  is the lowest solve rate any engine's FK grants, ``cross_eval_disagreement_max`` the
+  is the lowest solve rate any engine's FK grants (each judge allows its own resolution on
+  top of the tolerance: PyBullet's float32 link states cannot tell 1e-6 m apart), ``cross_eval_disagreement_max`` the
   largest distance between two engines' end-effector positions for the same solution;
 - each hard target: one row ``hard_<name>`` whose value is the position residual and
   whose detail says solved or the reason, with the orientation residual.
@@ -15,12 +16,14 @@ Per engine x solver (the ``integrator`` column holds the solver; ``dt`` is NaN):
 from __future__ import annotations
 
 import math
+from typing import Callable
 
 import numpy as np
 
 from comparisons.ik_targets import ORIENTATION_ONLY, Targets, hard_target, random_targets
+from comparisons.rows import Case, error_text
 from comparisons.timing import best_of
-from core.engine import Engine, KinematicsModel
+from core.engine import Engine, KinematicsModel, Support
 from core.ik.jacobian_solvers import IKOptions
 from core.ik.result import IKResult
 from core.results import FAILED, NOT_AVAILABLE, OK, ResultRow
@@ -64,9 +67,12 @@ def _cross_evaluation(scene: IKScene, targets: Targets, q: np.ndarray,
     for model in judges.values():
         frames = model.forward_kinematics(q)
         end, rotation = frames.position_world[:, -1], frames.rotation_world[:, -1]
-        solved = np.linalg.norm(end - targets.position_world, axis=1) <= scene.position_tolerance
+        position_resolution, orientation_resolution = model.resolution
+        solved = (np.linalg.norm(end - targets.position_world, axis=1)
+                  <= scene.position_tolerance + position_resolution)
         if targets.rotation_world is not None:
-            solved &= geodesic_angle_matrix(rotation, targets.rotation_world) <= scene.orientation_tolerance
+            solved &= (geodesic_angle_matrix(rotation, targets.rotation_world)
+                       <= scene.orientation_tolerance + orientation_resolution)
         rates.append(float(np.mean(solved)))
         ends.append(end)
     ends = np.stack(ends)
@@ -85,62 +91,73 @@ def _judges(scene: IKScene, engines: list[Engine]) -> dict[str, KinematicsModel]
     return judges
 
 
-def _hard_row(scene: IKScene, case: dict, targets: Targets, result: IKResult | None, problem: str) -> ResultRow:
-    metric = f"hard_{targets.name}"
-    if result is None:
-        return ResultRow(value=math.nan, metric=metric, unit="m", status=NOT_AVAILABLE if problem.startswith("n/a")
-                         else FAILED, detail=problem.removeprefix("n/a: "), **case)
-    verdict = "solved" if result.success[0] else f"failed: {result.reason[0]}"
-    detail = (f"{verdict}; orientation residual {result.orientation_residual[0]:.3g} rad; "
-              f"limit violation {result.limit_violation[0]:.3g}; {targets.note}")
-    return ResultRow(value=float(result.position_residual[0]), metric=metric, unit="m", status=OK, detail=detail,
-                     **case)
+def _hard_rows(case: Case, hard: list[Targets], results: list[IKResult | None], status: str,
+               problem: str) -> list[ResultRow]:
+    """One row per hard target: the position residual, and solved or the reason (or why there is none)."""
+    rows = []
+    for targets, result in zip(hard, results):
+        metric = {f"hard_{targets.name}": "m"}
+        if result is None:
+            rows += case.rows(metric, status, problem)
+            continue
+        verdict = "solved" if result.success[0] else f"failed: {result.reason[0]}"
+        detail = (f"{verdict}; orientation residual {result.orientation_residual[0]:.3g} rad; "
+                  f"limit violation {result.limit_violation[0]:.3g}; {targets.note}")
+        rows += case.rows(metric, OK, detail, {f"hard_{targets.name}": (float(result.position_residual[0]), "m")})
+    return rows
 
 
 def _solve(model, targets: Targets, q_start: np.ndarray) -> IKResult:
     return model.solve(targets.position_world, targets.rotation_world, q_start)
 
 
-def run_ik_scene(scene: IKScene, engines: list[Engine], repeats: int) -> list[ResultRow]:
-    """All rows of an IK scene."""
+def _case_rows(scene: IKScene, engine: Engine, case: Case, options: IKOptions, random: Targets,
+               hard: list[Targets], judges: dict[str, KinematicsModel], repeats: int) -> list[ResultRow]:
+    support = engine.supports_ik(scene.chain, case.integrator, scene.target_kind == "position")
+    if not support.ok:
+        return (case.rows(IK_METRICS, NOT_AVAILABLE, support.reason)
+                + _hard_rows(case, hard, [None] * len(hard), NOT_AVAILABLE, support.reason))
+    try:
+        model = engine.build_ik(scene.chain, case.integrator, options)
+        seconds, result = best_of(lambda: _solve(model, random, scene.q_start), repeats)
+        hard_results = [_solve(model, targets, scene.q_start) for targets in hard]
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        problem = error_text(err)
+        return case.rows(IK_METRICS, FAILED, problem) + _hard_rows(case, hard, [None] * len(hard), FAILED, problem)
+    values = _summary(result, scene.q_start, seconds)
+    values.update(_cross_evaluation(scene, random, result.q, judges))
+    return (case.rows(IK_METRICS, OK, f"{model.detail}; {random.note}", {m: (v, IK_METRICS[m]) for m, v in values.items()})
+            + _hard_rows(case, hard, hard_results, OK, ""))
+
+
+def run_ik_scene(scene: IKScene, engines: list[Engine], make_reference: Callable[[str], Engine],
+                 repeats: int) -> list[ResultRow]:
+    """All rows of an IK scene; the reference engine's FK generates the targets."""
     options = IKOptions(position_tolerance=scene.position_tolerance, orientation_tolerance=scene.orientation_tolerance,
                         max_iterations=scene.max_iterations)
+    reference = make_reference(scene.reference)
+    support = reference.supports_kinematics(scene.chain)
+    try:
+        fk = reference.build_kinematics(scene.chain) if support.ok else None
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        fk, support = None, Support.no(f"failed: {error_text(err)}")
+    if fk is None:
+        status = NOT_AVAILABLE if support.reason and not support.reason.startswith("failed: ") else FAILED
+        problem = f"reference {scene.reference} cannot make the targets: {support.reason}"
+        return [row for engine in engines for solver in engine.ik_solvers() or ("-",)
+                for row in Case(scene.name, engine.name, solver, math.nan, f"{scene.reference}:fk").rows(
+                    IK_METRICS, status, problem)]
     position_only = scene.target_kind == "position"
-    random = random_targets(scene)
-    hard = [hard_target(scene, name) for name in scene.hard_targets
+    random = random_targets(scene, fk)
+    hard = [hard_target(scene, name, fk) for name in scene.hard_targets
             if not (position_only and name in ORIENTATION_ONLY)]
-    skipped = [name for name in scene.hard_targets if position_only and name in ORIENTATION_ONLY]
+    skipped = {f"hard_{name}": "m" for name in scene.hard_targets if position_only and name in ORIENTATION_ONLY}
     judges = _judges(scene, engines)
-    reference = f"{scene.reference}:fk (targets); cross-evaluated by {', '.join(judges)}"
+    label = f"{scene.reference}:fk (targets); cross-evaluated by {', '.join(judges)}"
     rows: list[ResultRow] = []
     for engine in engines:
         for solver in engine.ik_solvers() or ("-",):
-            case = dict(scene=scene.name, engine=engine.name, integrator=solver, dt=math.nan, reference=reference)
-
-            def rows_for(metrics, status, detail, values=None):
-                values = values or {}
-                return [ResultRow(value=values.get(m, math.nan), metric=m, unit=u, status=status, detail=detail, **case)
-                        for m, u in metrics.items()]
-
-            support = engine.supports_ik(scene.chain, solver, position_only)
-            if not support.ok:
-                rows += rows_for(IK_METRICS, NOT_AVAILABLE, support.reason)
-                rows += [_hard_row(scene, case, t, None, f"n/a: {support.reason}") for t in hard]
-                continue
-            try:
-                model = engine.build_ik(scene.chain, solver, options)
-                seconds, result = best_of(lambda: _solve(model, random, scene.q_start), repeats)
-            except Exception as err:  # noqa: BLE001 - reported in the rows
-                rows += rows_for(IK_METRICS, FAILED, f"{type(err).__name__}: {err}".replace("\n", " "))
-                continue
-            values = _summary(result, scene.q_start, seconds)
-            values.update(_cross_evaluation(scene, random, result.q, judges))
-            rows += rows_for(IK_METRICS, OK, f"{model.detail}; {random.note}", values)
-            for targets in hard:
-                try:
-                    rows.append(_hard_row(scene, case, targets, _solve(model, targets, scene.q_start), ""))
-                except Exception as err:  # noqa: BLE001 - reported in the row
-                    rows.append(_hard_row(scene, case, targets, None, f"{type(err).__name__}: {err}"))
-            rows += [ResultRow(value=math.nan, metric=f"hard_{name}", unit="m", status=NOT_AVAILABLE,
-                               detail="position-only scene: no orientation to target", **case) for name in skipped]
+            case = Case(scene.name, engine.name, solver, math.nan, label)
+            rows += _case_rows(scene, engine, case, options, random, hard, judges, repeats)
+            rows += case.rows(skipped, NOT_AVAILABLE, "position-only scene: no orientation to target")
     return rows

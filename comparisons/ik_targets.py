@@ -1,8 +1,8 @@
 """IK targets of a scene: seeded random reachable ones and the hard cases.
 
-Random targets follow the TRAC-IK protocol: the end-effector poses (by core's forward
-kinematics) of seeded random configurations within the joint limits, every one solved
-from the scene's single start pose.
+Random targets follow the TRAC-IK protocol: the end-effector poses (by the scene's reference
+engine's forward kinematics) of seeded random configurations within the joint limits, every
+one solved from the scene's single start pose.
 
 Hard targets (one each; poses for pose scenes, positions for position scenes):
 
@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from core.engine import KinematicsModel
 from core.ik.reach import reach_upper_bound
-from core.kinematics import forward_kinematics
 from core.rotations import so3_exp
 from core.scene import IKScene
 
@@ -54,15 +54,15 @@ class Targets:
     note: str
 
 
-def _poses(scene: IKScene, q: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-    frames = forward_kinematics(scene.chain, q)
+def _poses(scene: IKScene, q: np.ndarray, fk: KinematicsModel) -> tuple[np.ndarray, np.ndarray | None]:
+    frames = fk.forward_kinematics(q)
     rotation = frames.rotation_world[:, -1] if scene.target_kind == "pose" else None
     return frames.position_world[:, -1], rotation
 
 
-def random_targets(scene: IKScene) -> Targets:
-    """End-effector targets of the scene's seeded random configurations within the limits."""
-    position, rotation = _poses(scene, scene.configurations())
+def random_targets(scene: IKScene, fk: KinematicsModel) -> Targets:
+    """End-effector targets (by ``fk``) of the scene's seeded random configurations within the limits."""
+    position, rotation = _poses(scene, scene.configurations(), fk)
     return Targets("random", position, rotation,
                    f"{scene.n_targets} seeded random reachable {scene.target_kind} targets (seed {scene.seed})")
 
@@ -71,14 +71,14 @@ def _clip(scene: IKScene, q: np.ndarray) -> np.ndarray:
     return np.clip(q, scene.chain.lower, scene.chain.upper)
 
 
-def hard_target(scene: IKScene, name: str) -> Targets:
-    """The hard target ``name`` of the scene (see the module docstring)."""
+def hard_target(scene: IKScene, name: str, fk: KinematicsModel) -> Targets:
+    """The hard target ``name`` of the scene (see the module docstring), poses by ``fk``."""
     chain, q0 = scene.chain, scene.q_start
     center, radius = reach_upper_bound(chain)
     if name == "stretched":
         q = np.zeros(chain.n_joints)
         q[0] = 0.5
-        position, rotation = _poses(scene, _clip(scene, q)[None])
+        position, rotation = _poses(scene, _clip(scene, q)[None], fk)
         note = "the zero (stretched) configuration with joint 1 at 0.5 rad: boundary, singular"
     elif name in ("beyond_reach", "at_base"):
         direction = np.ones(3) / np.sqrt(3)
@@ -92,16 +92,16 @@ def hard_target(scene: IKScene, name: str) -> Targets:
         at_upper = rng.random(chain.n_joints) < 0.5
         q = np.where(at_upper, chain.upper - _NEAR_LIMIT_FRACTION * span, chain.lower + _NEAR_LIMIT_FRACTION * span)
         q = np.where(np.isfinite(q), q, np.pi - _NEAR_LIMIT_FRACTION * span)
-        position, rotation = _poses(scene, q[None])
+        position, rotation = _poses(scene, q[None], fk)
         note = f"every joint {_NEAR_LIMIT_FRACTION:g} of its range inside a limit: reachable"
     elif name == "orientation_in_place":
-        position, rotation = _poses(scene, q0[None])
+        position, rotation = _poses(scene, q0[None], fk)
         rotation = rotation @ so3_exp(np.array([0.0, 0.0, np.pi / 2]))
         note = "the start pose turned 90 deg about the tool z axis, same position"
     elif name == "wrist_flip":
         q = q0.copy()
         q[-3:] += np.pi
-        position, rotation = _poses(scene, _clip(scene, q)[None])
+        position, rotation = _poses(scene, _clip(scene, q)[None], fk)
         note = "the start configuration with its last three joints turned half a turn (clipped to limits)"
     else:
         raise ValueError(f"unknown hard target {name!r}")

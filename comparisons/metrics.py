@@ -28,8 +28,8 @@ ORDER_METRICS = {"order_position": "1", "order_orientation": "1"}
 """Observed order p of convergence, from a least-squares fit of log(error) = p log(dt) + c."""
 
 ROUNDING_FLOOR = 1e-11
-"""Errors below this (relative to the reference's scale) are rounding, not truncation: they are
-left out of order fits. [m] for positions of ~1 m, [rad] for orientations."""
+"""Errors below this absolute value ([m] for positions, [rad] for orientations, both of order
+1 in the library's scenes) are rounding, not truncation: they are left out of order fits."""
 
 KINEMATICS_METRICS = {
     "position_error_max": "m",
@@ -82,7 +82,9 @@ def dynamics_metrics(scene: DynamicsScene) -> dict[str, str]:
 
 
 def drifts(scene: DynamicsScene, traj: Trajectory) -> dict[str, tuple[float, str]]:
-    """Relative drift max_t |E(t) - E(0)| / |E(0)| and max_t |L(t) - L(0)| / |L(0)| (per body, worst)."""
+    """Relative drifts, per body (the worst is kept): max_t |E(t) - E(0)| / max(|E(0)|, max_t kinetic
+    energy) and max_t |L(t) - L(0)| / |L(0)|; NaN when no body has anything to compare against.
+    """
     wanted = dynamics_metrics(scene)
     mass = np.array([b.mass for b in scene.bodies])
     inertia = np.stack([b.inertia_body for b in scene.bodies])
@@ -92,7 +94,13 @@ def drifts(scene: DynamicsScene, traj: Trajectory) -> dict[str, tuple[float, str
         energy = kinetic_energy(mass, inertia, traj.velocity_world, traj.angular_velocity_world, rotation)
         if scene.forces.gravity_world is not None:
             energy = energy + potential_energy(mass, scene.forces.gravity_world, traj.position_world)
-        out["energy_drift_max"] = (float(np.max(np.abs(energy - energy[0]) / np.abs(energy[0]))), "1")
+        # Relative to |E(0)|, or to the largest kinetic energy when E(0) is near 0 (a body
+        # dropped from rest at the potential's zero): a drift relative to nothing is n/a.
+        kinetic = kinetic_energy(mass, inertia, traj.velocity_world, traj.angular_velocity_world, rotation)
+        scale = np.maximum(np.abs(energy[0]), kinetic.max(axis=0))  # per body
+        moving = scale > 0
+        drift = np.max(np.abs(energy - energy[0])[:, moving] / scale[moving]) if moving.any() else math.nan
+        out["energy_drift_max"] = (float(drift), "1")
     if "angular_momentum_drift_max" in wanted:
         momentum = angular_momentum_world(inertia, traj.angular_velocity_world, rotation)
         size = np.linalg.norm(momentum[0], axis=-1)

@@ -8,8 +8,6 @@ becomes ``failed`` rows; the run goes on.
 from __future__ import annotations
 
 import math
-import traceback
-from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -24,6 +22,7 @@ from comparisons.metrics import (
     trajectory_errors,
 )
 from comparisons.ik_runner import run_ik_scene
+from comparisons.rows import Case, error_text
 from comparisons.timing import best_of
 from core.engine import Engine
 from core.errors import DivergedError
@@ -31,30 +30,11 @@ from core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
 from core.scene import DynamicsScene, IKScene, KinematicsScene
 
 DEFAULT_REPEATS = 3
+
+BLOW_UP_FACTOR = 1e6
+"""A run whose speed or spin exceeds this many times what the scene could plausibly reach
+(initial speed plus what gravity adds over the duration, plus 1) has blown up: diverged."""
 """Timed repeats per measurement (the minimum is kept), after one warm-up run."""
-
-
-@dataclass(frozen=True)
-class _Case:
-    scene: str
-    engine: str
-    integrator: str
-    dt: float
-    reference: str
-
-    def rows(self, metrics: dict[str, str], status: str, detail: str, values: dict | None = None) -> list[ResultRow]:
-        values = values or {}
-        return [
-            ResultRow(self.scene, self.engine, self.integrator, self.dt, metric,
-                      values.get(metric, (math.nan, unit))[0], unit, self.reference, status, detail)
-            for metric, unit in metrics.items()
-        ]
-
-
-def _error_text(err: BaseException) -> str:
-    where = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None
-    at = f" at {where.filename.rsplit('/', 1)[-1]}:{where.lineno}" if where else ""
-    return f"{type(err).__name__}: {err}{at}".replace("\n", " ")
 
 
 def _integrators(scene: DynamicsScene, engine: Engine) -> tuple[list[str], str]:
@@ -75,29 +55,46 @@ def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, re
     errors: dict[tuple[str, str], list[tuple[float, dict]]] = {}
     for dt in scene.dts:
         n = scene.n_steps(dt)
-        ref_traj, ref_problem = None, ""
+        ref_traj, ref_problem, ref_status = None, "", NOT_AVAILABLE
         if not ref_support.ok:
             ref_problem = f"reference {ref_label} cannot do this scene: {ref_support.reason}"
         else:
             try:
-                ref_traj = reference.build_dynamics(scene, ref_integrator, dt).run(n)
+                with np.errstate(all="ignore"):
+                    ref_traj = reference.build_dynamics(scene, ref_integrator, dt).run(n)
+                if not ref_traj.is_finite():
+                    ref_traj, ref_problem = None, f"reference {ref_label} diverged (non-finite state)"
             except Exception as err:  # noqa: BLE001 - reported in the rows
-                ref_problem = f"reference {ref_label} failed: {_error_text(err)}"
+                ref_problem, ref_status = f"reference {ref_label} failed: {error_text(err)}", FAILED
         for engine in engines:
             chosen, reason = _integrators(scene, engine)
             if not chosen:
-                rows += _Case(scene.name, engine.name, "-", dt, ref_label).rows(metrics, NOT_AVAILABLE, reason)
+                rows += Case(scene.name, engine.name, "-", dt, ref_label).rows(metrics, NOT_AVAILABLE, reason)
             for integrator in chosen:
-                case = _Case(scene.name, engine.name, integrator, dt, ref_label)
+                case = Case(scene.name, engine.name, integrator, dt, ref_label)
                 is_reference = engine.name == reference.name and integrator == ref_integrator
-                case_rows = _dynamics_case(scene, engine, case, metrics, n, ref_traj, ref_problem, repeats,
-                                           is_reference)
+                case_rows = _dynamics_case(scene, engine, case, metrics, n, ref_traj, (ref_problem, ref_status),
+                                           repeats, is_reference)
                 rows += case_rows
                 errors.setdefault((engine.name, integrator), []).append(
                     (dt, {r.metric: r.value for r in case_rows if r.status == OK}))
     if len(scene.dts) > 1:
         rows += _orders(scene, errors, ref_label)
     return rows
+
+
+def _blown_up(scene: DynamicsScene, traj) -> str:
+    """Why the trajectory counts as blown up (see BLOW_UP_FACTOR), or "" when it does not."""
+    g = 0.0 if scene.forces.gravity_world is None else float(np.linalg.norm(scene.forces.gravity_world))
+    for name, values, start in (
+        ("speed", traj.velocity_world, [b.velocity_world for b in scene.bodies]),
+        ("angular speed", traj.angular_velocity_world, [b.angular_velocity_world for b in scene.bodies]),
+    ):
+        bound = BLOW_UP_FACTOR * (np.linalg.norm(start, axis=-1).max() + g * scene.duration + 1.0)
+        peak = float(np.linalg.norm(values, axis=-1).max())
+        if peak > bound:
+            return f"{name} reached {peak:.3g} (bound {bound:.3g})"
+    return ""
 
 
 def _orders(scene: DynamicsScene, errors: dict, ref_label: str) -> list[ResultRow]:
@@ -113,8 +110,9 @@ def _orders(scene: DynamicsScene, errors: dict, ref_label: str) -> list[ResultRo
     return rows
 
 
-def _dynamics_case(scene, engine: Engine, case: _Case, metrics: dict, n: int, ref_traj, ref_problem: str,
+def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref_traj, ref_problem: tuple[str, str],
                    repeats: int, is_reference: bool) -> list[ResultRow]:
+    """Rows of one case; ``ref_problem`` is (why there is no reference trajectory, the status that gives)."""
     support = engine.supports_dynamics(scene, case.integrator)
     if not support.ok:
         return case.rows(metrics, NOT_AVAILABLE, support.reason)
@@ -125,15 +123,20 @@ def _dynamics_case(scene, engine: Engine, case: _Case, metrics: dict, n: int, re
     except DivergedError as err:
         return case.rows(metrics, DIVERGED, str(err))
     except Exception as err:  # noqa: BLE001 - reported in the rows
-        return case.rows(metrics, FAILED, _error_text(err))
+        return case.rows(metrics, FAILED, error_text(err))
     values = {"time_per_step": (seconds / n, "s")}
     if not traj.is_finite():
         return case.rows(metrics, DIVERGED, "non-finite state; " + sim.detail, values)
-    values.update(drifts(scene, traj))
+    blown = _blown_up(scene, traj)
+    if blown:
+        return case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values)
+    with np.errstate(all="ignore"):
+        values.update(drifts(scene, traj))
     measured = {k: metrics[k] for k in values}
     if ref_traj is None:
         rows = case.rows(measured, OK, sim.detail, values)
-        return rows + case.rows({k: u for k, u in metrics.items() if k not in values}, NOT_AVAILABLE, ref_problem)
+        problem, status = ref_problem
+        return rows + case.rows({k: u for k, u in metrics.items() if k not in values}, status, problem)
     values.update(trajectory_errors(traj, ref_traj))
     detail = ("this is the reference; " if is_reference else "") + sim.detail
     return case.rows(metrics, OK, detail, values)
@@ -142,16 +145,19 @@ def _dynamics_case(scene, engine: Engine, case: _Case, metrics: dict, n: int, re
 def _kinematics(scene: KinematicsScene, engines: list[Engine], reference: Engine, repeats: int) -> list[ResultRow]:
     q = scene.configurations()
     ref_label = f"{reference.name}:fk"
-    ref, ref_problem = None, ""
+    ref, ref_problem, ref_status = None, "", NOT_AVAILABLE
     ref_support = reference.supports_kinematics(scene.chain)
     if not ref_support.ok:
         ref_problem = f"reference {ref_label} cannot do this chain: {ref_support.reason}"
     else:
-        model = reference.build_kinematics(scene.chain)
-        ref = (model.forward_kinematics(q), model.jacobian_world(q))
+        try:
+            model = reference.build_kinematics(scene.chain)
+            ref = (model.forward_kinematics(q), model.jacobian_world(q))
+        except Exception as err:  # noqa: BLE001 - reported in the rows
+            ref_problem, ref_status = f"reference {ref_label} failed: {error_text(err)}", FAILED
     rows: list[ResultRow] = []
     for engine in engines:
-        case = _Case(scene.name, engine.name, "", math.nan, ref_label)
+        case = Case(scene.name, engine.name, "", math.nan, ref_label)
         support = engine.supports_kinematics(scene.chain)
         if not support.ok:
             rows += case.rows(KINEMATICS_METRICS, NOT_AVAILABLE, support.reason)
@@ -161,7 +167,7 @@ def _kinematics(scene: KinematicsScene, engines: list[Engine], reference: Engine
             fk_seconds, poses = best_of(lambda: model.forward_kinematics(q), repeats)
             jac_seconds, jac = best_of(lambda: model.jacobian_world(q), repeats)
         except Exception as err:  # noqa: BLE001 - reported in the rows
-            rows += case.rows(KINEMATICS_METRICS, FAILED, _error_text(err))
+            rows += case.rows(KINEMATICS_METRICS, FAILED, error_text(err))
             continue
         values = {"time_per_fk": (fk_seconds / len(q), "s"), "time_per_jacobian": (jac_seconds / len(q), "s")}
         if not (np.all(np.isfinite(poses.position_world)) and np.all(np.isfinite(jac))):
@@ -170,7 +176,7 @@ def _kinematics(scene: KinematicsScene, engines: list[Engine], reference: Engine
         if ref is None:
             rows += case.rows({k: KINEMATICS_METRICS[k] for k in values}, OK, model.detail, values)
             rows += case.rows({k: u for k, u in KINEMATICS_METRICS.items() if k not in values},
-                              NOT_AVAILABLE, ref_problem)
+                              ref_status, ref_problem)
             continue
         values.update(kinematics_errors(poses, jac, *ref))
         detail = ("this is the reference; " if engine.name == reference.name else "") + model.detail
@@ -183,7 +189,7 @@ def run_scene(
 ) -> list[ResultRow]:
     """All rows of one scene on ``engines``, measured against ``make_reference(scene.reference)``."""
     if isinstance(scene, IKScene):
-        return run_ik_scene(scene, engines, repeats)
+        return run_ik_scene(scene, engines, make_reference, repeats)
     reference = make_reference(scene.reference)
     if isinstance(scene, DynamicsScene):
         return _dynamics(scene, engines, reference, repeats)

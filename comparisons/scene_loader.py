@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from comparisons.engines import ENGINE_NAMES
+from comparisons.engines import ENGINE_NAMES, known_integrators
 from core.errors import SceneError
 from core.inertia import inertia_problem
 from core.rotations import rpy_to_matrix
@@ -72,8 +72,12 @@ class _Reader:
     def _checked(self, key: str, value, positive: bool) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.fail(key, f"expected a number, got {value!r}")
-        if not math.isfinite(value):
-            raise self.fail(key, f"{value} is not finite", "finite numbers")
+        try:
+            finite = math.isfinite(value)
+        except OverflowError:
+            finite = False
+        if not finite:
+            raise self.fail(key, f"{value!s:.30} is not finite", "finite numbers")
         if positive and value <= 0:
             raise self.fail(key, f"{value} is not positive", "numbers > 0")
         return float(value)
@@ -156,6 +160,7 @@ _CHAIN = ("name", "joint", "end_effector", "end_effector_xyz", "end_effector_rpy
 _DH = ("convention", "a", "alpha", "d", "theta_offset", "lower", "upper")
 _TARGETS = ("count", "seed", "kind", "start", "position_tolerance", "orientation_tolerance", "max_iterations",
             "hard")
+DEFAULT_POSITION_TOLERANCE = 1e-6  # [m], in any length unit the scene declares
 PYBULLET_DATA_PREFIX = "pybullet_data:"
 """A ``urdf`` path starting with this is inside the installed pybullet_data package."""
 _JOINT = ("name", "type", "axis", "origin_xyz", "origin_rpy", "lower", "upper")
@@ -230,6 +235,10 @@ def _dynamics(top: _Reader, head: dict) -> DynamicsScene:
                            f"duration {duration} s is not a whole number of steps of {dt} s",
                            "time steps that divide the duration")
     integrators = sim.strings("integrators") if sim.has("integrators") else ()
+    known = known_integrators() if integrators else ()
+    for i, name in enumerate(integrators):
+        if name not in known:
+            raise sim.fail(f"integrators[{i}]", f"no engine has an integrator '{name}'", ", ".join(known))
     return DynamicsScene(bodies=bodies, forces=forces, duration=duration, dts=dts, integrators=integrators, **head)
 
 
@@ -317,7 +326,8 @@ def _start(t: _Reader, chain: Chain) -> np.ndarray:
     """The start pose: "zeros", "mid-range" (limits' middle, 0 where unlimited) or a list."""
     value = t.table.get("start", "zeros")
     if isinstance(value, list):
-        q = t.vector("start", chain.n_joints)
+        prismatic = np.array([j.type == "prismatic" for j in chain.joints])
+        q = t.vector("start", chain.n_joints) * np.where(prismatic, t.scale, 1.0)  # lengths in the scene's unit
     elif value in ("zeros", "mid-range"):
         middle = (chain.lower + chain.upper) / 2
         q = np.zeros(chain.n_joints) if value == "zeros" else np.where(np.isfinite(middle), middle, 0.0)
@@ -339,7 +349,8 @@ def _ik(top: _Reader, head: dict) -> IKScene:
     return IKScene(
         chain=chain, n_targets=t.integer("count", 100, minimum=1), seed=t.integer("seed", 0),
         target_kind=t.string("kind", "pose", choices=("pose", "position")), q_start=_start(t, chain),
-        position_tolerance=t.number("position_tolerance", 1e-6, positive=True),
+        position_tolerance=(t.number("position_tolerance", positive=True, length=1)
+                            if t.has("position_tolerance") else DEFAULT_POSITION_TOLERANCE),
         orientation_tolerance=t.number("orientation_tolerance", 1e-6, positive=True),
         max_iterations=t.integer("max_iterations", 200, minimum=1), hard_targets=hard, **head,
     )
@@ -371,6 +382,8 @@ def load_scene(path: str | Path):
         text = path.read_text(encoding="utf-8")
     except OSError as err:
         raise SceneError(str(path), "-", f"cannot read the file: {err.strerror}") from None
+    except UnicodeDecodeError as err:
+        raise SceneError(str(path), "-", f"not UTF-8 text: {err.reason} at byte {err.start}") from None
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:

@@ -57,9 +57,18 @@ class Simulation(abc.ABC):
 
 
 class KinematicsModel(abc.ABC):
-    """A chain built for one engine."""
+    """A chain built for one engine.
+
+    Attributes
+    ----------
+    detail : str
+    resolution : tuple of float
+        (position [m], orientation [rad]) below which this engine's FK cannot tell two
+        poses apart (0 for double precision); a judge of IK solutions grants that much.
+    """
 
     detail: str = ""
+    resolution: tuple[float, float] = (0.0, 0.0)
 
     @abc.abstractmethod
     def forward_kinematics(self, q: np.ndarray) -> FramePoses:

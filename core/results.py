@@ -43,3 +43,29 @@ class ResultRow:
 
     def as_dict(self) -> dict:
         return asdict(self)
+
+
+_SEVERITY = {OK: 0, NOT_AVAILABLE: 1, DIVERGED: 2, FAILED: 3}
+
+
+def case_status(statuses) -> str:
+    """The status of a case (scene x engine x integrator x dt) from its rows' statuses: the worst,
+    in the order failed > diverged > n/a > ok."""
+    return max(statuses, key=_SEVERITY.__getitem__, default=OK)
+
+
+def case_counts(rows) -> dict[str, int]:
+    """Number of cases per status, from rows with scene, engine, integrator, dt and status.
+
+    ``rows`` is an iterable of mappings (or ResultRow); dt NaN is one case key like any other.
+    """
+    cases: dict[tuple, list[str]] = {}
+    for row in rows:
+        get = row.get if isinstance(row, dict) else row.__getattribute__
+        dt = get("dt")
+        key = (get("scene"), get("engine"), get("integrator"), "nan" if dt != dt else dt)
+        cases.setdefault(key, []).append(get("status"))
+    counts = {s: 0 for s in STATUSES}
+    for statuses in cases.values():
+        counts[case_status(statuses)] += 1
+    return counts

@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
+PLACEHOLDER_MASS = 1.0  # [kg]
+PLACEHOLDER_INERTIA = 1e-3  # [kg m^2]
+"""Inertia given to the links of kinematics-only models: MuJoCo rejects massless moving bodies and
+PyBullet would invent mass 1, inertia 1. It does not affect kinematics."""
+
 
 def fmt(values) -> str:
     """Space-separated shortest round-trip decimal forms of the values (float64-exact)."""

@@ -21,13 +21,11 @@ from __future__ import annotations
 
 from core.rotations import matrix_to_quat_wxyz
 from core.scene import Chain, DynamicsScene
-from references.conventions import fmt
+from references.conventions import PLACEHOLDER_INERTIA, PLACEHOLDER_MASS, fmt
 
 INTEGRATORS = {"euler": "Euler", "rk4": "RK4", "implicit": "implicit", "implicitfast": "implicitfast"}
 """simparity integrator name -> MJCF ``option/@integrator``."""
 
-PLACEHOLDER_MASS = 1.0
-PLACEHOLDER_INERTIA = 1e-3
 
 
 def dynamics_mjcf(scene: DynamicsScene, integrator: str, dt: float) -> str:

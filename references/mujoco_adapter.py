@@ -19,8 +19,8 @@ Conversions (each pinned by a test in ``tests/test_mujoco_adapter.py``)
   constant within a step.
 - Instability: MuJoCo does not return NaN; it warns ("Nan, Inf or huge value in QACC") and
   RESETS the state to the model's initial one, so the trajectory stays finite and wrong.
-  The adapter counts ``mjWARN_BADQACC`` over the run and raises ``DivergedError`` with
-  MuJoCo's message instead (the message is captured, not printed).
+  The adapter counts ``mjWARN_BADQACC``, ``mjWARN_BADQPOS`` and ``mjWARN_BADQVEL`` over the
+  run and raises ``DivergedError`` with MuJoCo's message instead (captured, not printed).
 - Kinematics: ``mj_kinematics`` then ``mj_comPos`` before ``mj_jacSite`` (the Jacobian is
   silently zero without ``mj_comPos``). A chain read from a URDF file is loaded from that
   file by MuJoCo's own URDF importer, with ``fusestatic`` off (by default MuJoCo merges
@@ -40,13 +40,16 @@ from core.rotations import quat_wxyz_to_matrix
 from core.forces import make_wrench
 from core.ik.jacobian_solvers import IKOptions
 from core.rigid_body import MassProperties
-from core.scene import Chain, DynamicsScene, Forces, KinematicsScene
+from core.scene import Chain, DynamicsScene, Forces
 from core.trajectory import FramePoses, Trajectory
 from references.conventions import fmt
 from references import mujoco_ik
 from references.mjcf import INTEGRATORS, chain_mjcf, dynamics_mjcf
+from references.urdf_export import original_urdf
 
 _STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
+_RESET_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL)
+"""Warnings on which MuJoCo resets the simulation to its initial state (and carries on)."""
 
 
 def _native_damping(forces: Forces, n_bodies: int) -> np.ndarray:
@@ -122,16 +125,17 @@ class _Simulation(Simulation):
         return states
 
     def run(self, n_steps: int) -> Trajectory:
-        warning = self._data.warning[mujoco.mjtWarning.mjWARN_BADQACC]
-        warning.number = 0
+        warnings = [self._data.warning[w] for w in _RESET_WARNINGS]
+        for warning in warnings:
+            warning.number = 0
         messages: list[str] = []
         mujoco.set_mju_user_warning(messages.append)
         try:
             stepped = self._rollout(n_steps) if self._wrench is None else self._loop(n_steps)
         finally:
             mujoco.set_mju_user_warning(None)
-        if warning.number:
-            raise DivergedError(f"MuJoCo reset the unstable simulation: {messages[0] if messages else 'bad qacc'}")
+        if any(warning.number for warning in warnings):
+            raise DivergedError(f"MuJoCo reset the unstable simulation: {messages[0] if messages else 'bad state'}")
         states = np.concatenate([self._state0[None], stepped], axis=0)
         nq, b = self.model.nq, self._n_bodies
         qpos = states[:, self._qpos_at : self._qpos_at + nq].reshape(-1, b, 7)
@@ -236,7 +240,9 @@ class MujocoEngine(Engine):
         return mujoco_ik.MujocoIK(MujocoChain(chain), chain, solver, options)
 
     def export(self, scene, integrator, dt) -> str:
-        if isinstance(scene, KinematicsScene):
+        if not isinstance(scene, DynamicsScene):
+            if scene.chain.urdf_path:
+                return original_urdf(scene.chain, "MjSpec.from_file, fusestatic off, a site added at the tip link")
             return chain_mjcf(scene.chain)
         integrator, dt = self._export_settings(scene, integrator, dt)
         velocities = "".join(
@@ -247,4 +253,11 @@ class MujocoEngine(Engine):
         damping = _native_damping(scene.forces, len(scene.bodies))
         extra = (f"<!-- set after compiling: dof_damping = {fmt(damping)} (per body: 3 translational, "
                  "3 rotational) -->\n" if np.any(damping) else "")
+        if scene.forces.air_velocity_world is not None and scene.forces.linear_drag is not None:
+            wind = scene.forces.linear_drag[:, None] * scene.forces.air_velocity_world
+            extra += f"<!-- constant xfrc_applied force (wind, b w) per body: {fmt(wind)} N -->\n"
+        stepwise = _stepwise_forces(scene.forces)
+        if stepwise is not None:
+            extra += (f"<!-- each step, xfrc_applied from the state at its start: "
+                      f"{', '.join(n for n in stepwise.names() if n != 'wind')} -->\n")
         return dynamics_mjcf(scene, integrator, dt) + velocities + extra

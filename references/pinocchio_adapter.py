@@ -32,11 +32,11 @@ from core.rotations import matrix_to_quat_wxyz, so3_exp
 from core.forces import make_wrench, without_gravity
 from core.ik.jacobian_solvers import IKOptions
 from core.rigid_body import MassProperties
-from core.scene import Chain, DynamicsScene, KinematicsScene
+from core.scene import Chain, DynamicsScene
 from core.trajectory import FramePoses, Trajectory
 from references import pinocchio_ik
 from references.conventions import xyzw_from_wxyz
-from references.urdf_export import chain_urdf, urdf_support
+from references.urdf_export import chain_urdf, original_urdf, UrdfChains
 
 
 def free_bodies_model(scene: DynamicsScene) -> pin.Model:
@@ -164,7 +164,7 @@ class PinocchioChain(KinematicsModel):
         return out
 
 
-class PinocchioEngine(Engine):
+class PinocchioEngine(UrdfChains, Engine):
     """Pinocchio: kinematics from the adapter's URDF; dynamics from aba, stepped by the harness."""
 
     name = "pinocchio"
@@ -181,13 +181,6 @@ class PinocchioEngine(Engine):
     def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
         return _Simulation(scene, integrator, dt)
 
-    def supports_kinematics(self, chain: Chain) -> Support:
-        return urdf_support(chain) if chain.urdf_path is None else Support.yes()
-
-    def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
-        named = super().supports_ik(chain, solver, position_only)
-        return named if not named.ok else self.supports_kinematics(chain)
-
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
         return PinocchioChain(chain)
 
@@ -198,7 +191,9 @@ class PinocchioEngine(Engine):
         return pinocchio_ik.PinocchioIK(PinocchioChain(chain), chain, solver, options)
 
     def export(self, scene, integrator, dt) -> str:
-        if isinstance(scene, KinematicsScene):
+        if not isinstance(scene, DynamicsScene):
+            if scene.chain.urdf_path:
+                return original_urdf(scene.chain, "pinocchio.buildModelFromUrdf (fixed base)")
             return chain_urdf(scene.chain)
         integrator, dt = self._export_settings(scene, integrator, dt)
         model = free_bodies_model(scene)
@@ -208,5 +203,8 @@ class PinocchioEngine(Engine):
         return (
             f"# Pinocchio model built in code (no file): one free-flyer per body.\n"
             f"# gravity: {model.gravity.linear}; stepped by the harness ({integrator}, dt = {dt!r} s)\n"
-            f"{model}\n{inertias}"
+            + (f"# each step, aba's fext (local frame, about the COM): "
+               f"{', '.join(without_gravity(scene.forces).names())}\n" if without_gravity(scene.forces).names() else "")
+            + 
+f"{model}\n{inertias}"
         )

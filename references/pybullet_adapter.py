@@ -12,8 +12,8 @@ Conversions and overridden defaults (each pinned by a test in ``tests/test_pybul
 - Linear and angular damping default to 0.04 on every link: set to 0.
 - Gravity defaults to 0: always set explicitly (to the scene's, or zero).
 - Sleeping (deactivation of slow bodies) is disabled.
-- ``maxJointVelocity`` (Bullet clamps velocities at 100 rad/s by default) is raised far
-  above any scene's.
+- ``maxJointVelocity`` (Bullet clamps velocities at 100 rad/s by default) is raised to 1e9,
+  far above any scene's; a run that still reaches it has blown up and raises DivergedError.
 - A chain read from a URDF file is loaded from that file (``useFixedBase``); other chains
   from the adapter's URDF.
 - ``getLinkState`` positions and orientations are FLOAT32 (errors ~1e-7); the Jacobian
@@ -34,20 +34,22 @@ import os
 import tempfile
 
 import numpy as np
-import pybullet
+from references.pybullet_quiet import pybullet
 
 from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from core.errors import DivergedError
 from core.rotations import quat_wxyz_to_matrix, matrix_to_quat_wxyz
 from core.forces import make_wrench, without_gravity
 from core.ik.jacobian_solvers import IKOptions
 from core.rigid_body import MassProperties
-from core.scene import Chain, DynamicsScene, KinematicsScene
+from core.scene import Chain, DynamicsScene
 from core.trajectory import FramePoses, Trajectory
 from references import pybullet_ik
 from references.conventions import fmt, principal_axes, wxyz_from_xyzw, xyzw_from_wxyz
-from references.urdf_export import body_urdf, chain_urdf, urdf_support
+from references.urdf_export import body_urdf, chain_urdf, original_urdf, UrdfChains
 
 _MAX_VELOCITY = 1e9  # [rad/s or m/s]: effectively no clamping
+_CLAMPED = 0.999 * _MAX_VELOCITY  # a velocity this large has hit the cap: the run blew up
 
 
 def _load_urdf(client: int, text: str, **kwargs) -> int:
@@ -122,6 +124,9 @@ class _Simulation(Simulation):
                 pos, quat = pybullet.getBasePositionAndOrientation(uid, physicsClientId=c)
                 vel, omega = pybullet.getBaseVelocity(uid, physicsClientId=c)
                 raw[i, k] = (*pos, *quat, *vel, *omega)
+        speeds = np.abs(raw[..., 7:13]).max()
+        if speeds >= _CLAMPED:
+            raise DivergedError(f"PyBullet clamped a velocity at {speeds:.3g} (its cap): the run blew up")
         quat_body = self._body_quat(raw[..., 3:7])
         times = np.arange(n_steps + 1) * self._dt
         return Trajectory(times, raw[..., :3], quat_body, raw[..., 7:10], raw[..., 10:13])
@@ -141,6 +146,11 @@ class _Simulation(Simulation):
             pybullet.applyExternalTorque(uid, -1, torque[k], pybullet.WORLD_FRAME, physicsClientId=c)
 
 
+LINK_STATE_RESOLUTION = (1e-6, 2e-6)
+"""getLinkState is FLOAT32: ~6e-8 relative on coordinates of a few metres and ~3e-7 rad,
+bounded with margin by 1e-6 m and 2e-6 rad (the tests' tolerances)."""
+
+
 class PybulletChain(KinematicsModel):
     """A fixed-base chain in a private PyBullet world.
 
@@ -156,6 +166,11 @@ class PybulletChain(KinematicsModel):
         PyBullet joint index of each chain joint (= the index of its child link).
     end_link : int
         Link index of the end effector.
+    dof_index : list of int
+        Position of each chain joint among the body's movable joints (the order of the
+        lists PyBullet's IK and Jacobian calls take and return).
+    n_dof : int
+        Movable joints of the whole body (a URDF file may have some off the chain).
     """
 
     def __init__(self, chain: Chain) -> None:
@@ -172,6 +187,10 @@ class PybulletChain(KinematicsModel):
         link_index = {i[12].decode(): i[0] for i in info}
         self.joints = [joint_index[j.name] for j in chain.joints]
         self.end_link = link_index[chain.end_effector_name]
+        movable = [i[0] for i in info if i[2] != pybullet.JOINT_FIXED]
+        self.dof_index = [movable.index(j) for j in self.joints]
+        self.n_dof = len(movable)
+        self.resolution = LINK_STATE_RESOLUTION
         origin = f"loadURDF({chain.urdf_path})" if chain.urdf_path else "the adapter's URDF"
         self.detail = (f"{origin}; getLinkState (float32 link frames); calculateJacobian (double) "
                        "at the end-effector link")
@@ -201,19 +220,22 @@ class PybulletChain(KinematicsModel):
 
     def jacobian_world(self, q: np.ndarray) -> np.ndarray:
         q = np.atleast_2d(q)
-        zeros = [0.0] * len(self.joints)
+        zeros = [0.0] * self.n_dof
+        positions = np.zeros(self.n_dof)  # joints off the chain stay at 0, as set() leaves them
         out = np.empty((len(q), 6, len(self.joints)))
         for k, row in enumerate(q):
             self.set(row)
+            positions[self.dof_index] = row
             linear, angular = pybullet.calculateJacobian(
-                self.body, self.end_link, [0.0, 0.0, 0.0], [float(v) for v in row], zeros, zeros,
+                self.body, self.end_link, [0.0, 0.0, 0.0], positions.tolist(), zeros, zeros,
                 physicsClientId=self.client,
             )
-            out[k, :3], out[k, 3:] = np.array(linear), np.array(angular)
+            out[k, :3] = np.array(linear)[:, self.dof_index]
+            out[k, 3:] = np.array(angular)[:, self.dof_index]
         return out
 
 
-class PybulletEngine(Engine):
+class PybulletEngine(UrdfChains, Engine):
     """PyBullet (Bullet multibody), built from URDF the adapter writes."""
 
     name = "pybullet"
@@ -230,13 +252,6 @@ class PybulletEngine(Engine):
     def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
         return _Simulation(scene, integrator, dt)
 
-    def supports_kinematics(self, chain: Chain) -> Support:
-        return urdf_support(chain) if chain.urdf_path is None else Support.yes()
-
-    def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
-        named = super().supports_ik(chain, solver, position_only)
-        return named if not named.ok else self.supports_kinematics(chain)
-
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
         return PybulletChain(chain)
 
@@ -247,7 +262,9 @@ class PybulletEngine(Engine):
         return pybullet_ik.PybulletIK(PybulletChain(chain), chain, solver, options)
 
     def export(self, scene, integrator, dt) -> str:
-        if isinstance(scene, KinematicsScene):
+        if not isinstance(scene, DynamicsScene):
+            if scene.chain.urdf_path:
+                return original_urdf(scene.chain, "loadURDF(useFixedBase=True, URDF_USE_INERTIA_FROM_FILE)")
             return chain_urdf(scene.chain)
         integrator, dt = self._export_settings(scene, integrator, dt)
         gravity = scene.forces.gravity_world
@@ -258,4 +275,8 @@ class PybulletEngine(Engine):
             "activationState=ACTIVATION_STATE_DISABLE_SLEEPING), resetBasePositionAndOrientation and "
             "resetBaseVelocity to the scene's initial state (inertial frame). -->\n"
         )
+        extra = without_gravity(scene.forces).names()
+        if extra:
+            api += (f"<!-- each step: applyExternalForce / applyExternalTorque (WORLD_FRAME) of "
+                    f"{', '.join(extra)}, from the state at the step's start -->\n")
         return api + "".join(body_urdf(b) for b in scene.bodies)

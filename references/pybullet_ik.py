@@ -33,7 +33,7 @@ Conventions and what the adapter does (pinned in ``tests/test_pybullet_ik.py``)
 from __future__ import annotations
 
 import numpy as np
-import pybullet
+from references.pybullet_quiet import pybullet
 
 from core.engine import IKModel
 from core.ik.jacobian_solvers import IKOptions, check_inputs
@@ -96,17 +96,24 @@ class PybulletIK(IKModel):
         if solver != "calculateInverseKinematics":
             self._settings = dict(maxNumIterations=options.max_iterations,
                                   residualThreshold=options.position_tolerance,
-                                  jointDamping=[TUNED_JOINT_DAMPING] * chain.n_joints)
+                                  jointDamping=[TUNED_JOINT_DAMPING] * kinematics.n_dof)
             configured = (f"maxNumIterations {options.max_iterations}, residualThreshold "
                           f"{options.position_tolerance:g} m, jointDamping {TUNED_JOINT_DAMPING:g}")
         if solver.endswith("-nullspace"):
             lower = np.where(np.isfinite(chain.lower), chain.lower, -_UNLIMITED)
             upper = np.where(np.isfinite(chain.upper), chain.upper, _UNLIMITED)
-            self._settings.update(lowerLimits=lower.tolist(), upperLimits=upper.tolist(),
-                                  jointRanges=(upper - lower).tolist())
+            self._settings.update(lowerLimits=self._per_dof(lower, -_UNLIMITED),
+                                  upperLimits=self._per_dof(upper, _UNLIMITED),
+                                  jointRanges=self._per_dof(upper - lower, 2 * _UNLIMITED))
             configured += "; joint limits and restPoses = q_start (null-space variant, soft limits)"
         self.detail = (f"pybullet.calculateInverseKinematics (IK_DLS), {configured}; "
                        "residuals from getLinkState (float32); iterations not reported")
+
+    def _per_dof(self, chain_values: np.ndarray, other: float) -> list[float]:
+        """A list over the body's movable joints: the chain's values, ``other`` for joints off the chain."""
+        out = np.full(self._kinematics.n_dof, other)
+        out[self._kinematics.dof_index] = chain_values
+        return out.tolist()
 
     def solve(self, target_position_world: np.ndarray, target_rotation_world: np.ndarray | None,
               q_start: np.ndarray) -> IKResult:
@@ -118,11 +125,11 @@ class PybulletIK(IKModel):
         for k in range(len(p)):
             kin.set(q0[k])
             if self._solver.endswith("-nullspace"):
-                settings["restPoses"] = q0[k].tolist()
+                settings["restPoses"] = self._per_dof(q0[k], 0.0)
             if quat_xyzw is not None:
                 settings["targetOrientation"] = quat_xyzw[k].tolist()
-            q[k] = pybullet.calculateInverseKinematics(kin.body, kin.end_link, p[k].tolist(),
-                                                       physicsClientId=kin.client, **settings)
+            q[k] = np.asarray(pybullet.calculateInverseKinematics(
+                kin.body, kin.end_link, p[k].tolist(), physicsClientId=kin.client, **settings))[kin.dof_index]
         position, rotation = kin.end_effector_frames(q)
         position_residual = np.linalg.norm(p - position, axis=1)
         orientation_residual = np.zeros(len(p)) if r is None else geodesic_angle_matrix(rotation, r)

@@ -18,10 +18,8 @@ from __future__ import annotations
 from core.engine import Support
 from core.rotations import matrix_to_rpy
 from core.scene import Chain, RigidBody
-from references.conventions import fmt, principal_axes
+from references.conventions import PLACEHOLDER_INERTIA, PLACEHOLDER_MASS, fmt, principal_axes
 
-PLACEHOLDER_MASS = 1.0
-PLACEHOLDER_INERTIA = 1e-3
 
 
 def _inertial(mass: float, moments, rpy) -> str:
@@ -50,6 +48,17 @@ def urdf_support(chain: Chain) -> Support:
         if joint.type == "prismatic" and not joint.limited:
             return Support.no(f"URDF cannot express the unlimited prismatic joint '{joint.name}'")
     return Support.yes()
+
+
+class UrdfChains:
+    """Support rules of an engine that receives chains as URDF (a mixin for Engine subclasses)."""
+
+    def supports_kinematics(self, chain: Chain) -> Support:
+        return urdf_support(chain) if chain.urdf_path is None else Support.yes()
+
+    def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
+        named = super().supports_ik(chain, solver, position_only)
+        return named if not named.ok else self.supports_kinematics(chain)
 
 
 def chain_urdf(chain: Chain) -> str:
@@ -82,3 +91,10 @@ def chain_urdf(chain: Chain) -> str:
         "",
     ]
     return "\n".join(parts)
+
+
+def original_urdf(chain: Chain, how: str) -> str:
+    """The URDF file a chain was read from, headed by how the engine loads it (for ``simparity export``)."""
+    with open(chain.urdf_path, encoding="utf-8") as f:
+        text = f.read()
+    return f"<!-- {chain.urdf_path}, loaded by {how} -->\n{text}"

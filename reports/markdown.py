@@ -6,7 +6,7 @@ import math
 
 import pandas as pd
 
-from core.results import NOT_AVAILABLE, OK, STATUSES
+from core.results import NOT_AVAILABLE, OK, STATUSES, case_counts
 
 _DYNAMICS_COLUMNS = [
     ("position_error_max", "position error max [m]"),
@@ -128,7 +128,7 @@ def render(table: pd.DataFrame, info: dict) -> str:
     """Markdown text of a stored run."""
     versions = ", ".join(f"{k} {v}" for k, v in info.get("engine_versions", {}).items())
     m = info.get("machine", {})
-    counts = table.drop_duplicates(["scene", "engine", "integrator", "dt"])["status"].value_counts()
+    counts = case_counts(table.to_dict("records"))
     lines = [
         "# simparity report",
         "",
@@ -137,7 +137,7 @@ def render(table: pd.DataFrame, info: dict) -> str:
         "",
         f"Engines: {versions}",
         "",
-        "Cases: " + ", ".join(f"{s} {int(counts.get(s, 0))}" for s in STATUSES)
+        "Cases (a case is as bad as its worst row): " + ", ".join(f"{s} {counts[s]}" for s in STATUSES)
         + f". `{NOT_AVAILABLE}` means the engine cannot do what the scene asks; the reason is given.",
         "Errors are maxima over every body and sample against the reference named per scene; "
         "times are the best of several repeats of the stepping alone (model building excluded).",

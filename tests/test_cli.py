@@ -75,6 +75,8 @@ def test_broken_scene_exits_2_with_one_line(tmp_path, capsys, name, base, old, n
         (["run", "no-such-scene"], "neither a built-in scene nor a file"),
         (["run", "lecture-projectile", "--engines", "core,havok"], "unknown engine(s): havok"),
         (["run", "lecture-projectile", "--repeats", "0"], "--repeats 0"),
+        (["run", "lecture-projectile", "--engines", ","], "no engine named"),
+        (["run", "lecture-projectile", "--out", "/dev/null"], "exists and is not a folder"),
         (["report", "/nonexistent/run"], "missing"),
         (["export", "lecture-projectile", "--engine", "mujoco", "--integrator", "verlet"], "no integrator 'verlet'"),
         (["export", "lecture-projectile", "--engine", "mujoco", "--dt", "-1"], "--dt -1"),
@@ -131,3 +133,11 @@ def test_urdf_with_an_unsupported_element_exits_2_naming_it(tmp_path, capsys):
     assert main(["run", str(tmp_path / "scene.toml"), "--out", str(tmp_path / "out")]) == EXIT_USAGE
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "mimic" in err and "j2" in err
+
+
+def test_repeated_engine_names_run_once(tmp_path):
+    """--engines core,core runs core once."""
+    code, _ = _run(["run", "lecture-planar-arm", "--engines", "core,core", "--out", str(tmp_path), "--repeats", "1"])
+    table, _ = read_run(tmp_path)
+    assert code == EXIT_OK and len(table[table["engine"] == "core"]) == len(table)
+    assert table.duplicated(["engine", "metric"]).sum() == 0

@@ -68,3 +68,21 @@ def test_unlimited_prismatic_joint_is_not_available_in_urdf_engines(engine):
     chain = unlimited(random_chain(np.random.default_rng(3), 3))
     support = make_engine(engine).supports_kinematics(chain)
     assert not support.ok and "prismatic joint 'j2'" in support.reason
+
+
+@pytest.mark.parametrize("engine", sorted(FRAME_TOLERANCES))
+def test_sub_chain_of_a_urdf_file_with_joints_beyond_the_tip(engine):
+    """The iiwa file cut at link 5 (two movable joints past the tip): engines map the chain's joints by name."""
+    import dataclasses
+
+    scene = builtin("iiwa-kinematics")
+    from core.urdf import chain_from_urdf
+
+    chain = dataclasses.replace(chain_from_urdf(scene.chain.urdf_path, tip_link="lbr_iiwa_link_5"),
+                                urdf_path=scene.chain.urdf_path)
+    q = np.random.default_rng(8).uniform(chain.lower, chain.upper, size=(50, chain.n_joints))
+    model = make_engine(engine).build_kinematics(chain)
+    position_tol, _ = FRAME_TOLERANCES[engine]
+    np.testing.assert_allclose(model.forward_kinematics(q).position_world, forward_kinematics(chain, q).position_world,
+                               atol=position_tol)
+    np.testing.assert_allclose(model.jacobian_world(q), jacobian_world(chain, q), atol=DOUBLE_TOL)

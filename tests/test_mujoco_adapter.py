@@ -91,3 +91,33 @@ def test_instability_is_reported_not_reset_silently():
         sim.run(scene.n_steps(0.02))
     stable = MujocoEngine().build_dynamics(scene, "rk4", 0.005).run(10)  # the warning counter was reset
     assert stable.is_finite()
+
+
+def test_jacobian_needs_com_pos_which_the_adapter_calls():
+    """mj_jacSite is silently zero after mj_kinematics alone; the adapter's model is not."""
+    scene = builtin("lecture-planar-arm")
+    model = MujocoEngine().build_kinematics(scene.chain)
+    q = scene.configurations()[:1]
+    model.data.qpos[model.qpos_adr] = q[0]
+    mujoco.mj_kinematics(model.model, model.data)
+    jacp, jacr = np.zeros((3, model.model.nv)), np.zeros((3, model.model.nv))
+    mujoco.mj_jacSite(model.model, model.data, jacp, jacr, model.site)
+    assert not jacp.any()  # the engine fact the adapter works around
+    assert np.abs(model.jacobian_world(q)[0, :3]).max() > 0.1
+
+
+def test_euler_damping_is_implicit_unless_eulerdamp_is_disabled():
+    """With drag as dof_damping, default Euler damps implicitly (v / (1 + dt b / m)); the adapter's is explicit."""
+    from dataclasses import replace
+
+    from core.scene import Forces
+
+    scene = replace(tumbling_box(inertia_body=0.2 * np.eye(3), gravity=None), forces=Forces(linear_drag=np.array([4.0])))
+    dt, b, m = 0.01, 4.0, scene.bodies[0].mass
+    v0 = scene.bodies[0].velocity_world
+    explicit = MujocoEngine().build_dynamics(scene, "euler", dt).run(1).velocity_world[1, 0]
+    np.testing.assert_allclose(explicit, v0 * (1 - dt * b / m), rtol=1e-14)
+    sim = MujocoEngine().build_dynamics(scene, "euler", dt)
+    sim.model.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)  # back to MuJoCo's default
+    implicit = sim.run(1).velocity_world[1, 0]
+    np.testing.assert_allclose(implicit, v0 / (1 + dt * b / m), rtol=1e-14)

@@ -23,25 +23,31 @@ class _Crashing(InHouseEngine):
         raise RuntimeError("boom")
 
 
-class _Diverging(InHouseEngine):
-    name = "diverging"
+def _tampered(name: str, field: str, value: float):
+    """An in-house engine (rk4 only) whose trajectories get ``field`` at the last sample set to ``value``."""
 
-    def integrators(self):
-        return ("rk4",)
+    class _Engine(InHouseEngine):
+        def integrators(self):
+            return ("rk4",)
 
-    def build_dynamics(self, scene, integrator, dt):
-        sim = super().build_dynamics(scene, integrator, dt)
+        def build_dynamics(self, scene, integrator, dt):
+            sim = super().build_dynamics(scene, integrator, dt)
 
-        class _Sim:
-            detail = "test"
+            class _Sim:
+                detail = "test"
 
-            def run(self, n):
-                traj = sim.run(n)
-                pos = traj.position_world.copy()
-                pos[-1] = np.nan
-                return type(traj)(traj.times, pos, traj.quat_wxyz, traj.velocity_world, traj.angular_velocity_world)
+                def run(self, n):
+                    traj = sim.run(n)
+                    values = {f: getattr(traj, f) for f in ("position_world", "quat_wxyz", "velocity_world",
+                                                           "angular_velocity_world")}
+                    values[field] = values[field].copy()
+                    values[field][-1] = value
+                    return type(traj)(traj.times, **values)
 
-        return _Sim()
+            return _Sim()
+
+    _Engine.name = name
+    return _Engine()
 
 
 class _Refusing(InHouseEngine):
@@ -58,7 +64,7 @@ def _cases(rows):
 def test_each_case_has_every_metric_and_crashes_do_not_stop_the_run():
     """A crashing engine gets failed rows with the error; the engines after it still run."""
     scene = builtin("lecture-projectile")
-    rows = run_scene(scene, [_Crashing(), _Diverging(), _Refusing(), make_engine("mujoco")], make_engine, repeats=1)
+    rows = run_scene(scene, [_Crashing(), _tampered("diverging", "position_world", np.nan), _Refusing(), make_engine("mujoco")], make_engine, repeats=1)
     per_case = {}
     for r in rows:
         if not math.isnan(r.dt):
@@ -106,3 +112,38 @@ def test_order_rows_fit_the_time_step_ladder():
     assert euler.status == OK and abs(euler.value - 1.0) < 1e-6  # error g t dt / 2 is exactly linear in dt
     exact = orders[("rk4", "order_position")]
     assert exact.status == NOT_AVAILABLE and "rounding floor" in exact.detail  # RK4 is exact here
+
+
+def test_blown_up_but_finite_run_is_diverged():
+    """A spin that explodes while staying finite (PyBullet caps it at 1e9 rad/s) is diverged; RK4 is not."""
+    scene = builtin("fast-spinner")
+    rows = run_scene(scene, [make_engine("pybullet"), make_engine("mujoco")], make_engine, repeats=1)
+    spin = {(r.engine, r.integrator, r.dt): r for r in rows if r.metric == "angular_velocity_error_max"}
+    for dt in scene.dts:
+        assert spin[("pybullet", "euler", dt)].status == DIVERGED
+        assert "clamped a velocity" in spin[("pybullet", "euler", dt)].detail  # PyBullet's cap, 1e9 rad/s
+    assert spin[("mujoco", "rk4", 0.005)].status == OK
+
+
+def test_finite_blow_up_is_diverged_by_the_runner_bound():
+    """A trajectory whose speed passes BLOW_UP_FACTOR x the plausible scale is diverged, even if finite."""
+    scene = builtin("lecture-projectile")
+
+    rows = run_scene(scene, [_tampered("exploding", "velocity_world", 1e12)], make_engine, repeats=1)
+    assert {r.status for r in rows if not math.isnan(r.dt)} == {DIVERGED}
+    assert "speed reached" in rows[0].detail
+
+
+def test_energy_drift_without_energy_is_not_available():
+    """A body dropped from rest at the potential's zero has E(0) = 0: drift is measured against its kinetic energy."""
+    from dataclasses import replace
+
+    scene = builtin("lecture-projectile")
+    body = replace(scene.bodies[0], velocity_world=np.zeros(3))
+    rows = run_scene(replace(scene, bodies=(body,)), [make_engine("mujoco")], make_engine, repeats=1)
+    drift = [r for r in rows if r.metric == "energy_drift_max"]
+    assert all(r.status == OK and math.isfinite(r.value) for r in drift)
+    still = replace(scene, bodies=(body,), forces=replace(scene.forces, gravity_world=None))
+    rows = run_scene(still, [make_engine("mujoco")], make_engine, repeats=1)
+    drift = [r for r in rows if r.metric == "energy_drift_max"]
+    assert all(r.status == NOT_AVAILABLE and "nothing to measure" in r.detail for r in drift)

@@ -90,6 +90,9 @@ BROKEN = [
      "body[0].force[0].torque", "unknown key"),
     ("unknown integrator list", VALID_DYNAMICS, "dt = [0.01]", "dt = [0.01]\nintegrators = []",
      "simulation.integrators", "non-empty list"),
+    ("unknown integrator", VALID_DYNAMICS, "dt = [0.01]", 'dt = [0.01]\nintegrators = ["rk4", "rk5"]',
+     "simulation.integrators[1]", "no engine has an integrator 'rk5'"),
+    ("overflowing number", VALID_DYNAMICS, "mass = 1.5", "mass = 1" + "0" * 400, "body[0].mass", "is not finite"),
     ("chain in dynamics", VALID_DYNAMICS, "[world]", "[chain]\n[world]", "chain", "not part of a dynamics scene"),
     ("bad joint type", VALID_KINEMATICS, 'type = "revolute"', 'type = "spherical"', "chain.joint[0].type",
      "allowed: revolute, prismatic"),
@@ -131,7 +134,10 @@ def test_broken_scene_is_rejected_with_file_key_and_reason(tmp_path, name, base,
 
 
 def test_unreadable_and_invalid_toml_files(tmp_path):
-    """A missing file and a file that is not TOML are SceneErrors too."""
+    """A missing file, a file that is not TOML and one that is not UTF-8 are SceneErrors too."""
+    (tmp_path / "latin1.toml").write_bytes("[scene]\nname = \"caf\xe9\"\n".encode("latin-1"))
+    with pytest.raises(SceneError, match="not UTF-8"):
+        load_scene(tmp_path / "latin1.toml")
     with pytest.raises(SceneError, match="cannot read the file"):
         load_scene(tmp_path / "missing.toml")
     with pytest.raises(SceneError, match="not valid TOML"):
@@ -153,6 +159,17 @@ def test_valid_scenes_load_with_defaults_and_units(tmp_path):
     arm = load_scene(_write(tmp_path, VALID_KINEMATICS, "arm.toml"))
     assert arm.n_configurations == 100 and arm.chain.n_joints == 1
     assert arm.configurations().shape == (100, 1) and np.all(np.abs(arm.configurations()) <= 1.0)
+
+
+def test_ik_lengths_follow_the_length_unit(tmp_path):
+    """In a millimetre IK scene the position tolerance and prismatic start values are converted to metres."""
+    text = VALID_KINEMATICS.replace('kind = "kinematics"', 'kind = "ik"\nlength_unit = "mm"').replace(
+        "[chain]", "[targets]\nposition_tolerance = 0.01\nstart = [0.0, 250.0]\n[chain]") + (
+        '\n[[chain.joint]]\nname = "slide"\ntype = "prismatic"\naxis = [1.0, 0.0, 0.0]\nlower = 0.0\nupper = 500.0\n')
+    scene = load_scene(_write(tmp_path, text))
+    assert scene.position_tolerance == pytest.approx(1e-5)
+    np.testing.assert_allclose(scene.q_start, [0.0, 0.25])
+    assert scene.chain.upper[1] == pytest.approx(0.5)
 
 
 def test_forces_load_per_body_with_units(tmp_path):
