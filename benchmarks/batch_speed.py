@@ -29,7 +29,7 @@ from core.scene import DynamicsScene, Forces, RigidBody  # noqa: E402
 
 # (engine, integrator) pairs on the same first-order scheme, then the fourth-order ones.
 DYNAMICS = [("core", "engine_euler"), ("mujoco", "euler"), ("pybullet", "euler"), ("pinocchio", "euler"),
-            ("core", "rk4"), ("mujoco", "rk4")]
+            ("core", "rk4"), ("mujoco", "rk4"), ("pinocchio", "rk4")]
 IK = [("core", "damped_least_squares"), ("mujoco", "dls"), ("pybullet", "calculateInverseKinematics-tuned"),
       ("pinocchio", "clik")]
 

@@ -71,8 +71,11 @@ _DEXPINV_SERIES_ANGLE = 1e-3
 Step = Callable[[float, State, float], State]
 
 
-def _dexpinv(u: np.ndarray, omega: np.ndarray) -> np.ndarray:
+def dexpinv_so3(u: np.ndarray, omega: np.ndarray) -> np.ndarray:
     """Inverse of the derivative of exp on so(3), applied to omega: du/dt for R = exp(u) R0.
+
+    For a body-frame (right) increment R = R0 exp(u) with body angular velocity omega, du/dt is
+    ``dexpinv_so3(-u, omega)``.
 
     dexp_u^-1(w) = w - u x w / 2 + (1 - (a/2) cot(a/2)) / a^2  u x (u x w), a = |u|.
     (B, 3) x (B, 3) -> (B, 3).
@@ -150,7 +153,7 @@ def runge_kutta_step(
             k = _derivative(t + c[i] * dt, stage, props, wrench)
             ks.append(k)
             rot_incs.append(
-                _dexpinv(u, k.omega_world) if lie else _orientation_rate(stage.orientation, k.omega_world)
+                dexpinv_so3(u, k.omega_world) if lie else _orientation_rate(stage.orientation, k.omega_world)
             )
 
         def total(field: str) -> np.ndarray:

@@ -12,6 +12,7 @@ Conversions (each pinned by a test in ``tests/test_pinocchio_adapter.py``)
   a[0:3] + omega x v[0:3] (both local).
 - ``euler``: the engines' first-order scheme (as MuJoCo Euler): v_world += dt R a_classical,
   omega_local += dt a[3:6], then p += dt v_world and R = R exp(dt omega_local).
+- ``rk4``: RK4 on the same accelerations, the rotation by RKMK in the body frame.
   Stepping ``pin.integrate`` on the local twist instead would follow an SE(3) screw and
   drift from the others (0.25 m after 2 s of free fall).
 - Forces other than gravity (``model.gravity``) enter ``aba`` as ``fext``: per joint, a
@@ -28,6 +29,7 @@ import numpy as np
 import pinocchio as pin
 
 from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from core.integrators import dexpinv_so3
 from core.rotations import matrix_to_quat_wxyz, so3_exp
 from core.forces import make_wrench, without_gravity
 from core.ik.jacobian_solvers import IKOptions
@@ -50,7 +52,24 @@ def free_bodies_model(scene: DynamicsScene) -> pin.Model:
     return model
 
 
+INTEGRATORS = ("euler", "rk4")
+"""Harness-side steppers of aba's accelerations: the engines' first-order scheme, and RK4 (RKMK on SO(3))."""
+
+# Classical RK4 tableau.
+_RK4_A = ((), (0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
+_RK4_B = (1 / 6, 1 / 3, 1 / 3, 1 / 6)
+_RK4_C = (0.0, 0.5, 0.5, 1.0)
+
+
 class _Simulation(Simulation):
+    """Free bodies stepped by the harness on aba's accelerations.
+
+    State per body: COM position p and velocity v (world), rotation R, angular velocity w
+    in the LOCAL frame (Pinocchio's). ``euler``: the engines' scheme (velocities first, then
+    p += dt v, R = R exp(dt w)). ``rk4``: classical RK4 on (p, v, w) with the rotation by
+    Runge-Kutta-Munthe-Kaas in the body frame, R = R0 exp(u), du/dt = dexp^-1_{-u}(w).
+    """
+
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
         self._model = free_bodies_model(scene)
         self._data = self._model.createData()
@@ -62,42 +81,59 @@ class _Simulation(Simulation):
         )
         self._tau = np.zeros(self._model.nv)
         extra = without_gravity(scene.forces)
-        self._props = MassProperties.of(scene.bodies)
-        self._wrench = make_wrench(extra, self._props) if extra.names() else None
+        self._wrench = make_wrench(extra, MassProperties.of(scene.bodies)) if extra.names() else None
+        self._step = self._rk4 if integrator == "rk4" else self._euler
         self._dt = dt
-        self.detail = "harness-stepped: pin.aba accelerations, engines' semi-implicit Euler on SO(3)"
+        self.detail = ("harness-stepped: pin.aba accelerations, "
+                       + ("RK4 with RKMK on SO(3)" if integrator == "rk4" else "engines' semi-implicit Euler on SO(3)"))
 
     def run(self, n_steps: int) -> Trajectory:
         dt, b = self._dt, len(self._position0)
-        p, r, v, w = self._position0, self._rotation0, self._velocity0, self._omega_local0
+        state = (self._position0, self._rotation0, self._velocity0, self._omega_local0)
         pos, rot, vel, omg = (np.empty((n_steps + 1, b) + s) for s in ((3,), (3, 3), (3,), (3,)))
-        q, qd = np.empty((b, 7)), np.empty((b, 6))
         for i in range(n_steps + 1):
             if i:
-                q[:, :3], q[:, 3:] = p, xyzw_from_wxyz(matrix_to_quat_wxyz(r))
-                v_local = np.einsum("bji,bj->bi", r, v)
-                qd[:, :3], qd[:, 3:] = v_local, w
-                a = self._aba(i - 1, q, qd, p, r, v, w)
-                a_classical = a[:, :3] + np.cross(w, v_local)
-                v = v + dt * np.einsum("bij,bj->bi", r, a_classical)
-                w = w + dt * a[:, 3:]
-                p = p + dt * v
-                r = r @ so3_exp(dt * w)
+                state = self._step((i - 1) * dt, state, dt)
+            p, r, v, w = state
             pos[i], rot[i], vel[i], omg[i] = p, r, v, np.einsum("bij,bj->bi", r, w)
         times = np.arange(n_steps + 1) * dt
         return Trajectory(times, pos, matrix_to_quat_wxyz(rot), vel, omg)
 
-    def _aba(self, step, q, qd, p, r, v, w_local) -> np.ndarray:
-        """(B, 6) spatial accelerations (local), with the scene's non-gravity forces as fext."""
+    def _accelerations(self, t, p, r, v, w_local) -> tuple[np.ndarray, np.ndarray]:
+        """(dv/dt world (B, 3), dw/dt local (B, 3)) from aba, the scene's non-gravity forces as fext."""
+        b = len(p)
+        q = np.concatenate([p, xyzw_from_wxyz(matrix_to_quat_wxyz(r))], axis=1)
+        v_local = np.einsum("bji,bj->bi", r, v)
+        qd = np.concatenate([v_local, w_local], axis=1)
         if self._wrench is None:
-            return pin.aba(self._model, self._data, q.ravel(), qd.ravel(), self._tau).reshape(-1, 6)
-        omega = np.einsum("bij,bj->bi", r, w_local)
-        force, torque = self._wrench(step * self._dt, p, r, v, omega)
-        fext = pin.StdVec_Force()
-        fext.append(pin.Force.Zero())
-        for k in range(len(p)):
-            fext.append(pin.Force(r[k].T @ force[k], r[k].T @ torque[k]))
-        return pin.aba(self._model, self._data, q.ravel(), qd.ravel(), self._tau, fext).reshape(-1, 6)
+            a = pin.aba(self._model, self._data, q.ravel(), qd.ravel(), self._tau).reshape(b, 6)
+        else:
+            force, torque = self._wrench(t, p, r, v, np.einsum("bij,bj->bi", r, w_local))
+            fext = pin.StdVec_Force()
+            fext.append(pin.Force.Zero())
+            for k in range(b):
+                fext.append(pin.Force(r[k].T @ force[k], r[k].T @ torque[k]))
+            a = pin.aba(self._model, self._data, q.ravel(), qd.ravel(), self._tau, fext).reshape(b, 6)
+        # aba's linear part is the spatial acceleration; the COM's classical one adds w x v.
+        return np.einsum("bij,bj->bi", r, a[:, :3] + np.cross(w_local, v_local)), a[:, 3:]
+
+    def _euler(self, t, state, dt):
+        p, r, v, w = state
+        dv, dw = self._accelerations(t, p, r, v, w)
+        v, w = v + dt * dv, w + dt * dw
+        return p + dt * v, r @ so3_exp(dt * w), v, w
+
+    def _rk4(self, t, state, dt):
+        p, r, v, w = state
+        ks = []  # (dp, du, dv, dw) per stage
+        for a_row, c in zip(_RK4_A, _RK4_C):
+            inc = [sum((dt * a * k[j] for a, k in zip(a_row, ks)), start=np.zeros_like(p)) for j in range(4)]
+            u = inc[1]
+            stage_v, stage_w = v + inc[2], w + inc[3]
+            dv, dw = self._accelerations(t + c * dt, p + inc[0], r @ so3_exp(u), stage_v, stage_w)
+            ks.append((stage_v, dexpinv_so3(-u, stage_w), dv, dw))
+        total = [sum(dt * bi * k[j] for bi, k in zip(_RK4_B, ks)) for j in range(4)]
+        return p + total[0], r @ so3_exp(total[1]), v + total[2], w + total[3]
 
 
 class PinocchioChain(KinematicsModel):
@@ -173,7 +209,7 @@ class PinocchioEngine(UrdfChains, Engine):
         return pin.__version__
 
     def integrators(self) -> tuple[str, ...]:
-        return ("euler",)
+        return INTEGRATORS
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         return self.check_integrator(integrator)

@@ -1,11 +1,14 @@
 """PyBullet, imported without its "pybullet build time" banner.
 
-The banner is printed by the C extension straight to file descriptor 1, so it lands in the
-output of ``simparity export ... > model.urdf``; it is silenced for the import only.
+The banner is printed by the C extension to C's stdout, so it lands in the output of
+``simparity export ... > model.urdf``. File descriptor 1 points at /dev/null for the import,
+and C's buffered output is flushed there before it is restored (else the banner would be
+flushed at exit, into the real stdout).
 """
 
 from __future__ import annotations
 
+import ctypes
 import os
 import sys
 
@@ -17,6 +20,7 @@ def _import_quietly():
     try:
         import pybullet as module
     finally:
+        ctypes.CDLL(None).fflush(None)
         os.dup2(saved, 1)
         os.close(saved)
         os.close(devnull)
