@@ -45,13 +45,14 @@ class ResultRow:
         return asdict(self)
 
 
-_SEVERITY = {OK: 0, NOT_AVAILABLE: 1, DIVERGED: 2, FAILED: 3}
+_PRECEDENCE = (FAILED, DIVERGED, OK, NOT_AVAILABLE)
 
 
 def case_status(statuses) -> str:
-    """The status of a case (scene x engine x integrator x dt) from its rows' statuses: the worst,
-    in the order failed > diverged > n/a > ok."""
-    return max(statuses, key=_SEVERITY.__getitem__, default=OK)
+    """The status of a case (scene x engine x integrator x dt) from its rows' statuses: failed if
+    any row failed, else diverged if any diverged, else ok if anything was measured, else n/a."""
+    present = set(statuses)
+    return next((s for s in _PRECEDENCE if s in present), NOT_AVAILABLE)
 
 
 def case_counts(rows) -> dict[str, int]:
