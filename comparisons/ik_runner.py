@@ -23,7 +23,7 @@ import numpy as np
 from comparisons.ik_targets import ORIENTATION_ONLY, Targets, hard_target, random_targets
 from comparisons.rows import Case, error_text
 from comparisons.timing import best_of
-from core.engine import Engine, KinematicsModel, Support
+from core.engine import Engine, KinematicsModel
 from core.ik.jacobian_solvers import IKOptions
 from core.ik.result import IKResult
 from core.results import FAILED, NOT_AVAILABLE, OK, ResultRow
@@ -137,13 +137,14 @@ def run_ik_scene(scene: IKScene, engines: list[Engine], make_reference: Callable
                         max_iterations=scene.max_iterations)
     reference = make_reference(scene.reference)
     support = reference.supports_kinematics(scene.chain)
-    try:
-        fk = reference.build_kinematics(scene.chain) if support.ok else None
-    except Exception as err:  # noqa: BLE001 - reported in the rows
-        fk, support = None, Support.no(f"failed: {error_text(err)}")
+    fk, status, reason = None, NOT_AVAILABLE, support.reason
+    if support.ok:
+        try:
+            fk = reference.build_kinematics(scene.chain)
+        except Exception as err:  # noqa: BLE001 - reported in the rows
+            status, reason = FAILED, f"failed: {error_text(err)}"
     if fk is None:
-        status = NOT_AVAILABLE if support.reason and not support.reason.startswith("failed: ") else FAILED
-        problem = f"reference {scene.reference} cannot make the targets: {support.reason}"
+        problem = f"reference {scene.reference} cannot make the targets: {reason}"
         return [row for engine in engines for solver in engine.ik_solvers() or ("-",)
                 for row in Case(scene.name, engine.name, solver, math.nan, f"{scene.reference}:fk").rows(
                     IK_METRICS, status, problem)]

@@ -37,6 +37,14 @@ class Case:
         return rows
 
 
+    def partial_rows(self, metrics: dict[str, str], values: dict, detail: str, missing_status: str,
+                     missing_detail: str) -> list[ResultRow]:
+        """Rows of the metrics measured (ok), then of the others with why they are missing."""
+        measured = {m: u for m, u in metrics.items() if m in values}
+        missing = {m: u for m, u in metrics.items() if m not in values}
+        return self.rows(measured, OK, detail, values) + self.rows(missing, missing_status, missing_detail)
+
+
 def error_text(err: BaseException) -> str:
     """``Type: message at file:line`` of an exception, on one line."""
     where = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None

@@ -30,11 +30,11 @@ from core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
 from core.scene import DynamicsScene, IKScene, KinematicsScene
 
 DEFAULT_REPEATS = 3
+"""Timed repeats per measurement (the minimum is kept), after one warm-up run."""
 
 BLOW_UP_FACTOR = 1e6
 """A run whose speed or spin exceeds this many times what the scene could plausibly reach
 (initial speed plus what gravity adds over the duration, plus 1) has blown up: diverged."""
-"""Timed repeats per measurement (the minimum is kept), after one warm-up run."""
 
 
 def _integrators(scene: DynamicsScene, engine: Engine) -> tuple[list[str], str]:
@@ -132,11 +132,9 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
         return case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values)
     with np.errstate(all="ignore"):
         values.update(drifts(scene, traj))
-    measured = {k: metrics[k] for k in values}
     if ref_traj is None:
-        rows = case.rows(measured, OK, sim.detail, values)
         problem, status = ref_problem
-        return rows + case.rows({k: u for k, u in metrics.items() if k not in values}, status, problem)
+        return case.partial_rows(metrics, values, sim.detail, status, problem)
     values.update(trajectory_errors(traj, ref_traj))
     detail = ("this is the reference; " if is_reference else "") + sim.detail
     return case.rows(metrics, OK, detail, values)
@@ -174,9 +172,7 @@ def _kinematics(scene: KinematicsScene, engines: list[Engine], reference: Engine
             rows += case.rows(KINEMATICS_METRICS, DIVERGED, "non-finite FK or Jacobian", values)
             continue
         if ref is None:
-            rows += case.rows({k: KINEMATICS_METRICS[k] for k in values}, OK, model.detail, values)
-            rows += case.rows({k: u for k, u in KINEMATICS_METRICS.items() if k not in values},
-                              ref_status, ref_problem)
+            rows += case.partial_rows(KINEMATICS_METRICS, values, model.detail, ref_status, ref_problem)
             continue
         values.update(kinematics_errors(poses, jac, *ref))
         detail = ("this is the reference; " if engine.name == reference.name else "") + model.detail

@@ -26,11 +26,9 @@ def integrator_names() -> tuple[str, ...]:
     """``scheme`` (quaternion orientation), ``scheme+matrix``, ``scheme+expmap``, particle rules."""
     names = []
     for scheme in SCHEMES:
-        if scheme == "engine_euler":
-            names.append(scheme)
-            continue
         names.append(scheme)
-        names.extend(f"{scheme}+{o}" for o in ORIENTATION_UPDATES if o != _DEFAULT_ORIENTATION)
+        if scheme != "engine_euler":  # always the exponential map: no variants
+            names.extend(f"{scheme}+{o}" for o in ORIENTATION_UPDATES if o != _DEFAULT_ORIENTATION)
     return tuple(names) + tuple(point_mass.RULES)
 
 
@@ -59,15 +57,10 @@ class _RigidBodySimulation(Simulation):
                 state = self._step((i - 1) * dt, state, dt)
             pos[i], ori[i], mom[i], ang[i] = (state.position_world, state.orientation, state.momentum_world,
                                               state.angular_momentum_world)
-        # Velocities and quaternions of all samples at once (T * B bodies in one batch).
-        b = len(self._props.mass)
-        flat = State(pos.reshape(-1, 3), ori.reshape((-1,) + o.shape[1:]), mom.reshape(-1, 3), ang.reshape(-1, 3))
-        tiled = MassProperties(np.tile(self._props.mass, n_steps + 1), np.tile(self._props.inertia_body, (n_steps + 1, 1, 1)),
-                               np.tile(self._props.inertia_body_inv, (n_steps + 1, 1, 1)))
-        vel, omg = velocities(flat, tiled)
+        # Velocities and quaternions of all samples at once, broadcast over (T, B).
+        vel, omg = velocities(State(pos, ori, mom, ang), self._props)
         quat = ori if o.shape[-1] == 4 else matrix_to_quat_wxyz(ori)
-        shape = (n_steps + 1, b, 3)
-        return Trajectory(np.arange(n_steps + 1) * dt, pos, quat, vel.reshape(shape), omg.reshape(shape))
+        return Trajectory(np.arange(n_steps + 1) * dt, pos, quat, vel, omg)
 
 
 class _ParticleSimulation(Simulation):

@@ -90,9 +90,10 @@ def initial_state(bodies: tuple[RigidBody, ...], props: MassProperties, quaterni
 
 
 def velocities(state: State, props: MassProperties, rotation: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """(v = P / M, omega = I(t)^-1 L), each (B, 3), in world axes.
+    """(v = P / M, omega = I(t)^-1 L), each (..., B, 3), in world axes.
 
-    ``rotation`` (B, 3, 3) is the state's rotation matrix when the caller already has it.
+    The state may have leading axes before the B bodies (e.g. samples in time); ``rotation``
+    (..., B, 3, 3) is the state's rotation matrix when the caller already has it.
     """
     rotation = state.rotation_world if rotation is None else rotation
     omega = (props.inertia_world_inv(rotation) @ state.angular_momentum_world[..., None])[..., 0]
