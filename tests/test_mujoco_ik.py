@@ -12,9 +12,6 @@ from tests.helpers import IIWA, REVOLUTE7, build_ik, reachable_targets
 
 OPTIONS = IKOptions()  # 1e-6 m, 1e-6 rad, 200 iterations
 N_TARGETS = 100
-# MuJoCo's and core's FK are both double: ~1e-15 on joint values of a few rad, growing
-# with them (measured worst 1.3e-13 m where a prismatic joint ran out to 267 m).
-DOUBLE_TOL = 1e-12
 
 
 # Measured solve rates (100 targets, start q = 0): iiwa pose 1.00, iiwa position 0.98

@@ -12,11 +12,6 @@ from tests.helpers import CONTINUOUS7, IIWA, REVOLUTE7, build_ik, reachable_targ
 
 OPTIONS = IKOptions()  # 1e-6 m, 1e-6 rad, 200 iterations
 N_TARGETS = 60
-# Pinocchio's and core's FK are both double, but DT = 0.1 with damp = 1e-12 takes huge
-# steps near singularities: joint values reach ~1e2 rad on the iiwa and ~1e5 m on
-# prismatic joints, and FK rounding grows with them. Residuals must agree to this much
-# per unit of 1 + max |q| (measured worst 1.7e-15).
-DOUBLE_TOL = 1e-12
 
 
 # Measured solve rates (60 targets, start q = 0): iiwa pose 1.00, iiwa position 1.00,

@@ -1,5 +1,8 @@
 """PyBullet adapter: overridden defaults and conventions pinned; kinematics and dynamics checked."""
 
+import dataclasses
+import tempfile
+
 import numpy as np
 import pybullet
 
@@ -38,21 +41,49 @@ def test_default_damping_is_overridden():
     np.testing.assert_allclose(traj.angular_velocity_world[-1, 0], scene.bodies[0].angular_velocity_world, rtol=1e-13)
 
 
-def test_default_damping_exists_so_the_override_matters():
-    """Control: a body loaded the plain way (defaults) loses speed, so the adapter's override is needed."""
+def _plain_pybullet_velocity(velocity, omega, steps, damping=None):
+    """(linear, angular) velocity of the test box after ``steps`` steps in PyBullet loaded the plain
+    way (no gravity, every default kept except, if given, the damping)."""
     client = pybullet.connect(pybullet.DIRECT)
     try:
-        import tempfile
         with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as f:
-            f.write(body_urdf(tumbling_box().bodies[0]))
+            f.write(body_urdf(tumbling_box(inertia_body=0.2 * np.eye(3)).bodies[0]))
         uid = pybullet.loadURDF(f.name, flags=pybullet.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client)
-        pybullet.resetBaseVelocity(uid, [10.0, 0, 0], [0, 0, 0], physicsClientId=client)
-        for _ in range(240):
+        if damping is not None:
+            pybullet.changeDynamics(uid, -1, linearDamping=damping, angularDamping=damping, physicsClientId=client)
+        pybullet.resetBaseVelocity(uid, velocity, omega, physicsClientId=client)
+        for _ in range(steps):
             pybullet.stepSimulation(physicsClientId=client)
-        speed = np.linalg.norm(pybullet.getBaseVelocity(uid, physicsClientId=client)[0])
+        linear, angular = pybullet.getBaseVelocity(uid, physicsClientId=client)
     finally:
         pybullet.disconnect(client)
-    assert speed < 9.0  # 10 m/s decays to ~6.9 m/s in 1 s with the default damping
+    return np.array(linear), np.array(angular)
+
+
+def test_default_damping_exists_so_the_override_matters():
+    """Control: a body loaded the plain way (defaults) loses speed, so the adapter's override is needed."""
+    linear, _ = _plain_pybullet_velocity([10.0, 0, 0], [0, 0, 0], 240)
+    assert np.linalg.norm(linear) < 9.0  # 10 m/s decays to ~6.9 m/s in 1 s with the default damping
+
+
+def test_default_velocity_cap_is_raised():
+    """PyBullet clips a 300 rad/s spin to 100 rad/s by default; the adapter keeps it (isotropic, torque-free)."""
+    _, angular = _plain_pybullet_velocity([0, 0, 0], [0, 0, 300.0], 10, damping=0.0)
+    np.testing.assert_allclose(angular, [0, 0, 100.0])  # the default cap, measured
+    scene = tumbling_box(inertia_body=0.2 * np.eye(3), gravity=None, duration=10 / 240)
+    body = dataclasses.replace(scene.bodies[0], angular_velocity_world=np.array([0.0, 0.0, 300.0]))
+    traj = PybulletEngine().build_dynamics(dataclasses.replace(scene, bodies=(body,)), "euler", 1 / 240).run(10)
+    np.testing.assert_allclose(traj.angular_velocity_world[-1, 0], [0, 0, 300.0], atol=1e-12)
+
+
+def test_slow_body_keeps_moving():
+    """A body drifting at 1 mm/s for 5 s keeps its velocity (sleeping is off; 3.2.7's defaults did not sleep either)."""
+    scene = tumbling_box(inertia_body=0.2 * np.eye(3), gravity=None, duration=5.0)
+    body = dataclasses.replace(scene.bodies[0], velocity_world=np.array([1e-3, 0.0, 0.0]),
+                               angular_velocity_world=np.zeros(3))
+    traj = PybulletEngine().build_dynamics(dataclasses.replace(scene, bodies=(body,)), "euler", 1 / 240).run(1200)
+    np.testing.assert_allclose(traj.velocity_world[-1, 0], [1e-3, 0, 0], rtol=1e-12)
+    np.testing.assert_allclose(traj.position_world[-1, 0] - traj.position_world[0, 0], [5e-3, 0, 0], rtol=1e-9)
 
 
 def test_quaternion_order_conversion():

@@ -11,10 +11,6 @@ from tests.helpers import IIWA, REVOLUTE7, build_ik, reachable_targets
 OPTIONS = IKOptions()  # 1e-6 m, 1e-6 rad, 200 iterations
 N_TARGETS = 100
 TUNED = "calculateInverseKinematics-tuned"
-# getLinkState is float32: ~6e-8 relative on coordinates up to ~1.3 m and ~3e-7 rad on
-# orientations (tests/test_pybullet_adapter.py); factor ~3-8 of margin.
-FLOAT32_POSITION_TOL = 1e-6  # [m]
-FLOAT32_ORIENTATION_TOL = 2e-6  # [rad]
 
 
 # Measured solve rates (100 targets, start q = 0): iiwa pose 0.99, iiwa position 1.00,
