@@ -1,9 +1,10 @@
 """PyBullet, imported without its "pybullet build time" banner.
 
-The banner is printed by the C extension to C's stdout, so it lands in the output of
-``simparity export ... > model.urdf``. File descriptor 1 points at /dev/null for the import,
-and C's buffered output is flushed there before it is restored (else the banner would be
-flushed at exit, into the real stdout).
+The C extension prints the banner through C's stdio (seen on stdout and on stderr depending
+on how the streams are attached), so it would land in ``simparity export ... > model.urdf``
+and in every log. File descriptors 1 and 2 point at /dev/null for the import, and C's
+buffered output is flushed there before they are restored (else it would reappear at exit).
+A failing import still raises as usual.
 """
 
 from __future__ import annotations
@@ -15,14 +16,18 @@ import sys
 
 def _import_quietly():
     sys.stdout.flush()
-    saved, devnull = os.dup(1), os.open(os.devnull, os.O_WRONLY)
-    os.dup2(devnull, 1)
+    sys.stderr.flush()
+    saved = {fd: os.dup(fd) for fd in (1, 2)}
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    for fd in saved:
+        os.dup2(devnull, fd)
     try:
         import pybullet as module
     finally:
         ctypes.CDLL(None).fflush(None)
-        os.dup2(saved, 1)
-        os.close(saved)
+        for fd, copy in saved.items():
+            os.dup2(copy, fd)
+            os.close(copy)
         os.close(devnull)
     return module
 

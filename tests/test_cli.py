@@ -144,8 +144,9 @@ def test_repeated_engine_names_run_once(tmp_path):
 
 
 def test_export_output_is_only_the_model():
-    """Piped to a file, 'export --engine pybullet' is pure URDF: PyBullet's import banner stays out."""
+    """Piped, 'export --engine pybullet' is pure URDF and says nothing on stderr: PyBullet's banner stays out."""
     done = subprocess.run([sys.executable, "-m", "comparisons.cli", "export", "lecture-planar-arm", "--engine",
                            "pybullet"], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0
     assert done.stdout.startswith("<robot") and "build time" not in done.stdout
+    assert "build time" not in done.stderr
