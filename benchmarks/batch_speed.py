@@ -19,13 +19,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from comparisons.engines import make_engine  # noqa: E402
-from comparisons.ik_targets import random_targets  # noqa: E402
-from comparisons.library import load  # noqa: E402
-from comparisons.timing import best_of  # noqa: E402
-from core.ik.jacobian_solvers import IKOptions  # noqa: E402
-from core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix  # noqa: E402
-from core.scene import DynamicsScene, Forces, RigidBody  # noqa: E402
+from simparity.comparisons.engines import make_engine  # noqa: E402
+from simparity.comparisons.ik_targets import random_targets  # noqa: E402
+from simparity.comparisons.library import load  # noqa: E402
+from simparity.comparisons.timing import best_of  # noqa: E402
+from simparity.core.ik.problem import IKTolerances  # noqa: E402
+from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix  # noqa: E402
+from simparity.core.scene import DynamicsScene, Forces, RigidBody  # noqa: E402
 
 # (engine, integrator) pairs on the same first-order scheme, then the fourth-order ones.
 DYNAMICS = [("core", "engine_euler"), ("mujoco", "euler"), ("pybullet", "euler"), ("pinocchio", "euler"),
@@ -74,7 +74,7 @@ def ik_table(n_targets: int) -> None:
     scene = load(["iiwa-ik"])[0]
     scene = replace(scene, n_targets=n_targets)
     targets = random_targets(scene, make_engine(scene.reference).build_kinematics(scene.chain))
-    options = IKOptions(scene.position_tolerance, scene.orientation_tolerance, scene.max_iterations)
+    options = IKTolerances(scene.position_tolerance, scene.orientation_tolerance, scene.max_iterations)
     print(f"\nIK on the iiwa: {n_targets} pose targets from one start (failures inside the timing)")
     print(f"{'engine':<10} {'solver':<36}{'solve rate':>12}{'ms per solve':>14}{'core / engine':>15}")
     core_ms = None

@@ -12,14 +12,14 @@ import argparse
 import sys
 from pathlib import Path
 
-from comparisons import library
-from comparisons.engines import DEFAULT_ENGINES, ENGINE_NAMES, check_engine_names, make_engine
-from comparisons.runner import DEFAULT_REPEATS, run_scene
-from comparisons.store import DEFAULT_OUT_ROOT, RunWriter, default_out_dir
-from core.errors import SimparityError
-from core.results import FAILED, REPORT_FILE, case_counts
-from reports.markdown import render
-from reports.store import read_run
+from simparity.comparisons import library
+from simparity.comparisons.engines import DEFAULT_ENGINES, ENGINE_NAMES, check_engine_names, make_engine
+from simparity.comparisons.runner import DEFAULT_REPEATS, run_scene
+from simparity.comparisons.store import DEFAULT_OUT_ROOT, RunWriter, default_out_dir
+from simparity.core.errors import SimparityError
+from simparity.core.results import FAILED, REPORT_FILE, case_counts
+from simparity.reports.markdown import render
+from simparity.reports.store import read_run
 
 EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 EXPORTABLE = ("mujoco", "pybullet", "pinocchio")

@@ -4,16 +4,16 @@ from __future__ import annotations
 
 import importlib
 
-from core.engine import Engine, KinematicsModel, Simulation, Support
-from core.errors import UnknownEngineError
+from simparity.core.engine import Engine, KinematicsModel, Simulation, Support
+from simparity.core.errors import UnknownEngineError
 
 _ENGINES = {
-    "core": ("core.inhouse", "InHouseEngine"),
-    "analytic": ("references.analytic", "AnalyticEngine"),
-    "mujoco": ("references.mujoco_adapter", "MujocoEngine"),
-    "pybullet": ("references.pybullet_adapter", "PybulletEngine"),
-    "pinocchio": ("references.pinocchio_adapter", "PinocchioEngine"),
-    "tight": ("references.tight", "TightSolveEngine"),
+    "core": ("simparity.core.inhouse", "InHouseEngine"),
+    "analytic": ("simparity.references.analytic", "AnalyticEngine"),
+    "mujoco": ("simparity.references.mujoco_adapter", "MujocoEngine"),
+    "pybullet": ("simparity.references.pybullet_adapter", "PybulletEngine"),
+    "pinocchio": ("simparity.references.pinocchio_adapter", "PinocchioEngine"),
+    "tight": ("simparity.references.tight", "TightSolveEngine"),
 }
 ENGINE_NAMES = tuple(_ENGINES)
 DEFAULT_ENGINES = ("core", "analytic", "mujoco", "pybullet", "pinocchio")

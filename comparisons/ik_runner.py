@@ -20,15 +20,15 @@ from typing import Callable
 
 import numpy as np
 
-from comparisons.ik_targets import ORIENTATION_ONLY, Targets, hard_target, random_targets
-from comparisons.rows import Case, error_text
-from comparisons.timing import best_of
-from core.engine import Engine, KinematicsModel
-from core.ik.jacobian_solvers import IKOptions
-from core.ik.result import IKResult
-from core.results import FAILED, NOT_AVAILABLE, OK, ResultRow
-from core.rotations import geodesic_angle_matrix
-from core.scene import IKScene
+from simparity.comparisons.ik_targets import ORIENTATION_ONLY, Targets, hard_target, random_targets
+from simparity.comparisons.rows import Case, error_text
+from simparity.comparisons.timing import best_of
+from simparity.core.engine import Engine, KinematicsModel
+from simparity.core.ik.problem import IKTolerances
+from simparity.core.ik.result import IKResult
+from simparity.core.results import FAILED, NOT_AVAILABLE, OK, ResultRow
+from simparity.core.rotations import geodesic_angle_matrix
+from simparity.core.scene import IKScene
 
 IK_METRICS = {
     "solve_rate": "1",
@@ -111,7 +111,7 @@ def _solve(model, targets: Targets, q_start: np.ndarray) -> IKResult:
     return model.solve(targets.position_world, targets.rotation_world, q_start)
 
 
-def _case_rows(scene: IKScene, engine: Engine, case: Case, options: IKOptions, random: Targets,
+def _case_rows(scene: IKScene, engine: Engine, case: Case, options: IKTolerances, random: Targets,
                hard: list[Targets], judges: dict[str, KinematicsModel], repeats: int) -> list[ResultRow]:
     support = engine.supports_ik(scene.chain, case.integrator, scene.target_kind == "position")
     if not support.ok:
@@ -133,7 +133,7 @@ def _case_rows(scene: IKScene, engine: Engine, case: Case, options: IKOptions, r
 def run_ik_scene(scene: IKScene, engines: list[Engine], make_reference: Callable[[str], Engine],
                  repeats: int) -> list[ResultRow]:
     """All rows of an IK scene; the reference engine's FK generates the targets."""
-    options = IKOptions(position_tolerance=scene.position_tolerance, orientation_tolerance=scene.orientation_tolerance,
+    options = IKTolerances(position_tolerance=scene.position_tolerance, orientation_tolerance=scene.orientation_tolerance,
                         max_iterations=scene.max_iterations)
     reference = make_reference(scene.reference)
     support = reference.supports_kinematics(scene.chain)

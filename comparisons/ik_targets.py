@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.engine import KinematicsModel
-from core.ik.reach import reach_upper_bound
-from core.rotations import so3_exp
-from core.scene import IKScene
+from simparity.core.engine import KinematicsModel
+from simparity.core.ik.reach import reach_upper_bound
+from simparity.core.rotations import so3_exp
+from simparity.core.scene import IKScene
 
 ORIENTATION_ONLY = ("orientation_in_place", "wrist_flip")
 """Hard targets that only make sense for pose targets."""

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from comparisons.scene_loader import load_scene
-from core.errors import UnknownSceneError
+from simparity.comparisons.scene_loader import load_scene
+from simparity.core.errors import UnknownSceneError
 
 SCENES_DIR = Path(__file__).parent / "scenes"
 

@@ -10,10 +10,10 @@ import math
 
 import numpy as np
 
-from core.invariants import angular_momentum_world, kinetic_energy, potential_energy
-from core.rotations import geodesic_angle_matrix, geodesic_angle_quat_wxyz, quat_wxyz_to_matrix
-from core.scene import DynamicsScene
-from core.trajectory import FramePoses, Trajectory
+from simparity.comparisons.invariants import angular_momentum_world, kinetic_energy, potential_energy
+from simparity.core.rotations import geodesic_angle_matrix, geodesic_angle_quat_wxyz, quat_wxyz_to_matrix
+from simparity.core.scene import DynamicsScene
+from simparity.core.trajectory import FramePoses, Trajectory
 
 DYNAMICS_METRICS = {
     "position_error_max": "m",

@@ -6,7 +6,7 @@ import math
 import traceback
 from dataclasses import dataclass
 
-from core.results import NOT_AVAILABLE, OK, ResultRow
+from simparity.core.results import NOT_AVAILABLE, OK, ResultRow
 
 
 @dataclass(frozen=True)

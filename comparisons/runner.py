@@ -12,7 +12,7 @@ from typing import Callable
 
 import numpy as np
 
-from comparisons.metrics import (
+from simparity.comparisons.metrics import (
     KINEMATICS_METRICS,
     ORDER_METRICS,
     drifts,
@@ -21,13 +21,13 @@ from comparisons.metrics import (
     observed_order,
     trajectory_errors,
 )
-from comparisons.ik_runner import run_ik_scene
-from comparisons.rows import Case, error_text
-from comparisons.timing import best_of
-from core.engine import Engine
-from core.errors import DivergedError
-from core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
-from core.scene import DynamicsScene, IKScene, KinematicsScene
+from simparity.comparisons.ik_runner import run_ik_scene
+from simparity.comparisons.rows import Case, error_text
+from simparity.comparisons.timing import best_of
+from simparity.core.engine import Engine
+from simparity.core.errors import DivergedError
+from simparity.core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
+from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
 
 DEFAULT_REPEATS = 3
 """Timed repeats per measurement (the minimum is kept), after one warm-up run."""

@@ -9,18 +9,17 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from comparisons.engines import ENGINE_NAMES, known_integrators
-from core.errors import SceneError
-from core.inertia import inertia_problem
-from core.rotations import rpy_to_matrix
-from core.dh import chain_from_dh
-from core.scene import HARD_TARGETS, AppliedForce, Chain, DynamicsScene, Forces, IKScene, Joint, KinematicsScene, RigidBody
-from core.urdf import chain_from_urdf
+from simparity.comparisons.engines import ENGINE_NAMES, known_integrators
+from simparity.core.errors import SceneError
+from simparity.core.inertia import inertia_problem
+from simparity.core.rotations import rpy_to_matrix
+from simparity.core.dh import chain_from_dh
+from simparity.core.scene import HARD_TARGETS, AppliedForce, Chain, DynamicsScene, Forces, IKScene, Joint, KinematicsScene, RigidBody
+from simparity.core.urdf import chain_from_urdf
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -296,10 +295,8 @@ def _chain(top: _Reader, name: str) -> Chain:
     if len(sources) != 1:
         raise c.fail("joint", f"give exactly one chain source, got {sources or 'none'}", "joint, urdf, dh")
     if sources == ["urdf"]:
-        path, base = _urdf_path(c), c.table.get("base_link")
-        chain = chain_from_urdf(path, base_link=base, tip_link=c.table.get("tip_link"))
-        # Engines load the file themselves when the chain starts at its root link.
-        return chain if base is not None else replace(chain, urdf_path=str(path))
+        return chain_from_urdf(str(_urdf_path(c)), base_link=c.table.get("base_link"),
+                               tip_link=c.table.get("tip_link"))
     if sources == ["dh"]:
         return _dh_chain(c, c.string("name", name))
     joints = tuple(_joint(r) for r in c.array_of_tables("joint", _JOINT))

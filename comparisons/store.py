@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from core.results import COLUMNS, RESULTS_FILE, RUN_INFO_FILE, SCHEMA_VERSION, ResultRow
+from simparity.core.results import COLUMNS, RESULTS_FILE, RUN_INFO_FILE, SCHEMA_VERSION, ResultRow
 
 DEFAULT_OUT_ROOT = Path("simparity-results")
 """Default parent folder of runs: each run goes to ``simparity-results/<UTC time>/``."""

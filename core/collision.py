@@ -18,8 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.arrays import readonly
-from core.point_mass import average_velocity_step
+from simparity.core.arrays import readonly
+from simparity.core.point_mass import average_velocity_step
 
 METHODS = ("backup", "detect_and_reflect")
 """Collision handling offered by :func:`step_particles`."""

@@ -27,8 +27,8 @@ from types import MappingProxyType
 
 import numpy as np
 
-from core.errors import SceneError
-from core.scene import Chain, Joint
+from simparity.core.errors import SceneError
+from simparity.core.scene import Chain, Joint
 
 CONVENTIONS = ("standard", "modified")
 JOINT_TYPES = ("revolute", "prismatic")

@@ -12,11 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.errors import SimparityError
-from core.ik.jacobian_solvers import IKOptions
-from core.ik.result import IKResult
-from core.scene import Chain, DynamicsScene, KinematicsScene
-from core.trajectory import FramePoses, Trajectory
+from simparity.core.errors import SimparityError
+from simparity.core.ik.problem import IKTolerances
+from simparity.core.ik.result import IKResult
+from simparity.core.scene import Chain, DynamicsScene, KinematicsScene
+from simparity.core.trajectory import FramePoses, Trajectory
 
 
 @dataclass(frozen=True)
@@ -169,7 +169,7 @@ class Engine(abc.ABC):
         offered = ", ".join(self.ik_solvers()) or "none"
         return Support.no(f"{self.name} has no IK solver '{solver}' (offers: {offered})")
 
-    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
+    def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
         """Build ``solver`` for ``chain`` with the scene's tolerances and iteration cap (not timed)."""
         raise SimparityError(f"engine '{self.name}' has no IK solvers")
 

@@ -13,8 +13,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from core.rigid_body import MassProperties, Wrench
-from core.scene import Forces
+from simparity.core.rigid_body import MassProperties, Wrench
+from simparity.core.scene import Forces
 
 
 def make_wrench(forces: Forces, props: MassProperties) -> Wrench:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from core.errors import SceneError
+from simparity.core.errors import SceneError
 
 # Relative tolerance of inertia_problem's symmetry and triangle-inequality checks, as a
 # fraction of the largest principal moment. Scene files quote inertias to ~6 significant

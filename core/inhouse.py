@@ -3,21 +3,22 @@
 from __future__ import annotations
 
 import platform
-from dataclasses import replace
+from dataclasses import asdict, replace
 
 import numpy as np
 
-from core import point_mass
-from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
-from core.forces import make_wrench
-from core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik
-from core.ik.result import IKResult
-from core.integrators import ORIENTATION_UPDATES, SCHEMES, make_step
-from core.kinematics import forward_kinematics, jacobian_world
-from core.rigid_body import MassProperties, State, initial_state, velocities
-from core.rotations import matrix_to_quat_wxyz
-from core.scene import Chain, DynamicsScene
-from core.trajectory import FramePoses, Trajectory
+from simparity.core import point_mass
+from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.forces import make_wrench
+from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik
+from simparity.core.ik.problem import IKTolerances
+from simparity.core.ik.result import IKResult
+from simparity.core.integrators import ORIENTATION_UPDATES, SCHEMES, make_step
+from simparity.core.kinematics import forward_kinematics, jacobian_world
+from simparity.core.rigid_body import MassProperties, State, initial_state, velocities
+from simparity.core.rotations import matrix_to_quat_wxyz
+from simparity.core.scene import Chain, DynamicsScene
+from simparity.core.trajectory import FramePoses, Trajectory
 
 _DEFAULT_ORIENTATION = "quaternion"
 
@@ -162,5 +163,6 @@ class InHouseEngine(Engine):
             return Support.no(f"the Jacobian inverse needs a square Jacobian; this one is {task} x {chain.n_joints}")
         return named
 
-    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
-        return _InHouseIK(chain, solver, options)
+    def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
+        # The scene's tolerances and cap; the in-house settings keep their defaults unless given.
+        return _InHouseIK(chain, solver, options if isinstance(options, IKOptions) else IKOptions(**asdict(options)))

@@ -31,8 +31,8 @@ from typing import Callable
 
 import numpy as np
 
-from core.rigid_body import MassProperties, State, Wrench, velocities
-from core.rotations import (
+from simparity.core.rigid_body import MassProperties, State, Wrench, velocities
+from simparity.core.rotations import (
     cross,
     matrix_to_quat_wxyz,
     orthonormalize,

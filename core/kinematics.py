@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from core.rotations import so3_exp, so3_log
-from core.scene import Chain
-from core.trajectory import FramePoses
+from simparity.core.rotations import so3_exp, so3_log
+from simparity.core.scene import Chain
+from simparity.core.trajectory import FramePoses
 
 
 def _as_batch(chain: Chain, q: np.ndarray) -> np.ndarray:

@@ -15,8 +15,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from core.arrays import readonly
-from core.rotations import quat_wxyz_to_matrix
+from simparity.core.arrays import readonly
+from simparity.core.rotations import quat_wxyz_to_matrix
 
 
 @dataclass(frozen=True)
@@ -257,9 +257,13 @@ class Chain:
     end_effector_rotation : (3, 3) ndarray
         Last link frame to end-effector frame.
     urdf_path : str or None
-        The URDF file the chain was read from, rooted at the file's root link; engines
-        then load that file themselves (the end effector is its link of the same name).
-        None for chains defined otherwise, which engines receive as the adapters' export.
+        The URDF file the chain was read from; engines then load that file themselves (the
+        end effector is its link of the same name). None for chains defined otherwise,
+        which engines receive as the adapters' export.
+    base_link : str or None
+        For a chain read from a URDF file: the link whose frame is the world frame (the
+        file's root link unless the scene chose another); engines express every pose in
+        it. None otherwise.
     """
 
     name: str
@@ -268,6 +272,7 @@ class Chain:
     end_effector_xyz: np.ndarray = field(default_factory=lambda: np.zeros(3))
     end_effector_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
     urdf_path: str | None = None
+    base_link: str | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "end_effector_xyz", readonly(self.end_effector_xyz, shape=(3,)))

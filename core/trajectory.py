@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.arrays import readonly
+from simparity.core.arrays import readonly
 
 
 @dataclass(frozen=True)

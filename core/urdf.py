@@ -20,12 +20,13 @@ from __future__ import annotations
 
 import os
 import xml.etree.ElementTree as ET
+from dataclasses import replace
 
 import numpy as np
 
-from core.errors import SceneError
-from core.rotations import rpy_to_matrix
-from core.scene import Chain, Joint
+from simparity.core.errors import SceneError
+from simparity.core.rotations import rpy_to_matrix
+from simparity.core.scene import Chain, Joint
 
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 _CHAIN_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed")
@@ -57,7 +58,8 @@ def chain_from_urdf(
     -------
     Chain
         Named after ``<robot name>``; one joint per movable joint on the path, the
-        end-effector frame named after ``tip_link``.
+        end-effector frame named after ``tip_link``; ``urdf_path`` is the file (None for
+        text) and ``base_link`` the base link's name.
 
     Raises
     ------
@@ -78,7 +80,9 @@ def chain_from_urdf(
     base = _pick_base(base_link, roots[0], links, source)
     tip = _pick_tip(tip_link, base, links, joints, source)
     path = _path(base, tip, parent_joint, source)
-    return _assemble(root.get("name", ""), path, tip, source)
+    chain = _assemble(root.get("name", ""), path, tip, source)
+    is_file = not os.fspath(path_or_text).lstrip().startswith("<")
+    return replace(chain, urdf_path=os.fspath(path_or_text) if is_file else None, base_link=base)
 
 
 def _parse(path_or_text: str | os.PathLike, source: str | None) -> tuple[ET.Element, str]:

@@ -20,15 +20,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
-from core.ik.analytic_2link import two_link_fk, two_link_ik
-from core.ik.jacobian_solvers import IKOptions, check_inputs
-from core.ik.result import IKResult
-from core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix, so3_exp
-from core.scene import Chain, DynamicsScene
-from core.trajectory import FramePoses, Trajectory
-from references import analytic_solutions as closed
-from references.conventions import principal_axes
+from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.ik.analytic_2link import two_link_fk, two_link_ik
+from simparity.core.ik.problem import IKTolerances, check_inputs
+from simparity.core.ik.result import IKResult
+from simparity.core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix, so3_exp
+from simparity.core.scene import Chain, DynamicsScene
+from simparity.core.trajectory import FramePoses, Trajectory
+from simparity.references import analytic_solutions as closed
+from simparity.references.conventions import principal_axes
 
 # Relative tolerance deciding that principal moments are equal, or omega lies on a
 # principal axis: such scenes are built exactly so; 1e-12 only absorbs rounding.
@@ -196,7 +196,7 @@ class _TwoLinkIK(IKModel):
     """The lecture's analytic 2-link solution; of the two elbow branches, the one within the
     limits that is nearest to the start pose (wrapped angle distance)."""
 
-    def __init__(self, chain: Chain, options: IKOptions) -> None:
+    def __init__(self, chain: Chain, options: IKTolerances) -> None:
         self._chain, self._options = chain, options
         self._l1, self._l2 = chain.joints[1].origin_xyz[0], chain.end_effector_xyz[0]
         self.detail = "the lecture's closed form (both branches; the nearest one within the limits)"
@@ -263,5 +263,5 @@ class AnalyticEngine(Engine):
             return Support.no("the analytic 2-link IK solves position targets in the plane")
         return _two_link(chain)
 
-    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
+    def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
         return _TwoLinkIK(chain, options)

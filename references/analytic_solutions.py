@@ -17,7 +17,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.special import ellipkinc, exprel
 
-from core.rotations import (
+from simparity.core.rotations import (
     matrix_to_quat_wxyz,
     quat_wxyz_conjugate,
     quat_wxyz_from_rotvec,

@@ -18,15 +18,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from core.ik.jacobian_solvers import IKOptions
-from core.ik.reach import reach_upper_bound
-from core.ik.result import IKResult
-from core.scene import Chain
+from simparity.core.ik.problem import IKTolerances
+from simparity.core.ik.reach import reach_upper_bound
+from simparity.core.ik.result import IKResult
+from simparity.core.scene import Chain
 
 
 def ik_outcome(chain: Chain, q: np.ndarray, iterations: np.ndarray, position_residual: np.ndarray,
                orientation_residual: np.ndarray, target_position_world: np.ndarray,
-               options: IKOptions) -> IKResult:
+               options: IKTolerances) -> IKResult:
     """Judge a batch of library IK solutions.
 
     Parameters
@@ -40,7 +40,7 @@ def ik_outcome(chain: Chain, q: np.ndarray, iterations: np.ndarray, position_res
         Measured with the library's forward kinematics at ``q`` [m], [rad].
     target_position_world : (B, 3) ndarray
         [m].
-    options : IKOptions
+    options : IKTolerances
         Only the two tolerances are read.
 
     Returns

@@ -19,9 +19,9 @@ What MuJoCo is given, and why
 
 from __future__ import annotations
 
-from core.rotations import matrix_to_quat_wxyz
-from core.scene import Chain, DynamicsScene
-from references.conventions import PLACEHOLDER_INERTIA, PLACEHOLDER_MASS, fmt
+from simparity.core.rotations import matrix_to_quat_wxyz
+from simparity.core.scene import Chain, DynamicsScene
+from simparity.references.conventions import PLACEHOLDER_INERTIA, PLACEHOLDER_MASS, fmt
 
 INTEGRATORS = {"euler": "Euler", "rk4": "RK4", "implicit": "implicit", "implicitfast": "implicitfast"}
 """simparity integrator name -> MJCF ``option/@integrator``."""

@@ -34,18 +34,18 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
-from core.errors import DivergedError
-from core.rotations import quat_wxyz_to_matrix
-from core.forces import make_wrench
-from core.ik.jacobian_solvers import IKOptions
-from core.rigid_body import MassProperties
-from core.scene import Chain, DynamicsScene, Forces
-from core.trajectory import FramePoses, Trajectory
-from references.conventions import fmt
-from references import mujoco_ik
-from references.mjcf import INTEGRATORS, chain_mjcf, dynamics_mjcf
-from references.urdf_export import original_urdf
+from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.errors import DivergedError
+from simparity.core.rotations import quat_wxyz_to_matrix
+from simparity.core.forces import make_wrench
+from simparity.core.ik.problem import IKTolerances
+from simparity.core.rigid_body import MassProperties
+from simparity.core.scene import Chain, DynamicsScene, Forces
+from simparity.core.trajectory import FramePoses, Trajectory
+from simparity.references.conventions import fmt
+from simparity.references import mujoco_ik
+from simparity.references.mjcf import INTEGRATORS, chain_mjcf, dynamics_mjcf
+from simparity.references.urdf_export import original_urdf
 
 _STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
 _RESET_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL)
@@ -236,7 +236,7 @@ class MujocoEngine(Engine):
     def ik_solvers(self) -> tuple[str, ...]:
         return mujoco_ik.SOLVERS
 
-    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
+    def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
         return mujoco_ik.MujocoIK(MujocoChain(chain), chain, solver, options)
 
     def export(self, scene, integrator, dt) -> str:

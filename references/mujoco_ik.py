@@ -35,12 +35,12 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from core.engine import IKModel
-from core.ik.jacobian_solvers import IKOptions, check_inputs
-from core.ik.result import IKResult
-from core.rotations import matrix_to_quat_wxyz
-from core.scene import Chain
-from references.ik_outcome import ik_outcome
+from simparity.core.engine import IKModel
+from simparity.core.ik.problem import IKTolerances, check_inputs
+from simparity.core.ik.result import IKResult
+from simparity.core.rotations import matrix_to_quat_wxyz
+from simparity.core.scene import Chain
+from simparity.references.ik_outcome import ik_outcome
 
 SOLVERS = ("dls",)
 """dm_control's damped least squares."""
@@ -67,10 +67,10 @@ class MujocoIK(IKModel):
     chain : Chain
     solver : str
         ``"dls"``.
-    options : IKOptions
+    options : IKTolerances
     """
 
-    def __init__(self, kinematics, chain: Chain, solver: str, options: IKOptions) -> None:
+    def __init__(self, kinematics, chain: Chain, solver: str, options: IKTolerances) -> None:
         if solver not in SOLVERS:
             raise ValueError(f"unknown MuJoCo IK solver {solver!r}, expected one of {SOLVERS}")
         self._chain, self._options = chain, options

@@ -28,17 +28,17 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
-from core.integrators import dexpinv_so3
-from core.rotations import matrix_to_quat_wxyz, so3_exp
-from core.forces import make_wrench, without_gravity
-from core.ik.jacobian_solvers import IKOptions
-from core.rigid_body import MassProperties
-from core.scene import Chain, DynamicsScene
-from core.trajectory import FramePoses, Trajectory
-from references import pinocchio_ik
-from references.conventions import xyzw_from_wxyz
-from references.urdf_export import chain_urdf, original_urdf, UrdfChains
+from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.integrators import dexpinv_so3
+from simparity.core.rotations import matrix_to_quat_wxyz, so3_exp
+from simparity.core.forces import make_wrench, without_gravity
+from simparity.core.ik.problem import IKTolerances
+from simparity.core.rigid_body import MassProperties
+from simparity.core.scene import Chain, DynamicsScene
+from simparity.core.trajectory import FramePoses, Trajectory
+from simparity.references import pinocchio_ik
+from simparity.references.conventions import xyzw_from_wxyz
+from simparity.references.urdf_export import chain_urdf, original_urdf, UrdfChains
 
 
 def free_bodies_model(scene: DynamicsScene) -> pin.Model:
@@ -223,7 +223,7 @@ class PinocchioEngine(UrdfChains, Engine):
     def ik_solvers(self) -> tuple[str, ...]:
         return pinocchio_ik.SOLVERS
 
-    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
+    def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
         return pinocchio_ik.PinocchioIK(PinocchioChain(chain), chain, solver, options)
 
     def export(self, scene, integrator, dt) -> str:

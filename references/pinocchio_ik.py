@@ -33,11 +33,11 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from core.engine import IKModel
-from core.ik.jacobian_solvers import IKOptions, check_inputs
-from core.ik.result import IKResult
-from core.scene import Chain
-from references.ik_outcome import ik_outcome
+from simparity.core.engine import IKModel
+from simparity.core.ik.problem import IKTolerances, check_inputs
+from simparity.core.ik.result import IKResult
+from simparity.core.scene import Chain
+from simparity.references.ik_outcome import ik_outcome
 
 SOLVERS = ("clik", "clik-documented")
 """The documented iteration stopped by the scene's tolerances; the documentation's own constants."""
@@ -67,10 +67,10 @@ class PinocchioIK(IKModel):
     chain : Chain
     solver : str
         One of :data:`SOLVERS`.
-    options : IKOptions
+    options : IKTolerances
     """
 
-    def __init__(self, kinematics, chain: Chain, solver: str, options: IKOptions) -> None:
+    def __init__(self, kinematics, chain: Chain, solver: str, options: IKTolerances) -> None:
         if solver not in SOLVERS:
             raise ValueError(f"unknown Pinocchio IK solver {solver!r}, expected one of {SOLVERS}")
         self._chain, self._options = chain, options

@@ -34,19 +34,19 @@ import os
 import tempfile
 
 import numpy as np
-from references.pybullet_quiet import pybullet
+from simparity.references.pybullet_quiet import pybullet
 
-from core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
-from core.errors import DivergedError
-from core.rotations import quat_wxyz_to_matrix, matrix_to_quat_wxyz
-from core.forces import make_wrench, without_gravity
-from core.ik.jacobian_solvers import IKOptions
-from core.rigid_body import MassProperties
-from core.scene import Chain, DynamicsScene
-from core.trajectory import FramePoses, Trajectory
-from references import pybullet_ik
-from references.conventions import fmt, principal_axes, wxyz_from_xyzw, xyzw_from_wxyz
-from references.urdf_export import body_urdf, chain_urdf, original_urdf, UrdfChains
+from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.errors import DivergedError
+from simparity.core.rotations import quat_wxyz_to_matrix, matrix_to_quat_wxyz
+from simparity.core.forces import make_wrench, without_gravity
+from simparity.core.ik.problem import IKTolerances
+from simparity.core.rigid_body import MassProperties
+from simparity.core.scene import Chain, DynamicsScene
+from simparity.core.trajectory import FramePoses, Trajectory
+from simparity.references import pybullet_ik
+from simparity.references.conventions import fmt, principal_axes, wxyz_from_xyzw, xyzw_from_wxyz
+from simparity.references.urdf_export import body_urdf, chain_urdf, original_urdf, UrdfChains
 
 _MAX_VELOCITY = 1e9  # [rad/s or m/s]: effectively no clamping
 _CLAMPED = 0.999 * _MAX_VELOCITY  # a velocity this large has hit the cap: the run blew up
@@ -258,7 +258,7 @@ class PybulletEngine(UrdfChains, Engine):
     def ik_solvers(self) -> tuple[str, ...]:
         return pybullet_ik.SOLVERS
 
-    def build_ik(self, chain: Chain, solver: str, options: IKOptions) -> IKModel:
+    def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
         return pybullet_ik.PybulletIK(PybulletChain(chain), chain, solver, options)
 
     def export(self, scene, integrator, dt) -> str:

@@ -33,15 +33,15 @@ Conventions and what the adapter does (pinned in ``tests/test_pybullet_ik.py``)
 from __future__ import annotations
 
 import numpy as np
-from references.pybullet_quiet import pybullet
+from simparity.references.pybullet_quiet import pybullet
 
-from core.engine import IKModel
-from core.ik.jacobian_solvers import IKOptions, check_inputs
-from core.ik.result import IKResult
-from core.rotations import geodesic_angle_matrix, matrix_to_quat_wxyz
-from core.scene import Chain
-from references.conventions import xyzw_from_wxyz
-from references.ik_outcome import ik_outcome
+from simparity.core.engine import IKModel
+from simparity.core.ik.problem import IKTolerances, check_inputs
+from simparity.core.ik.result import IKResult
+from simparity.core.rotations import geodesic_angle_matrix, matrix_to_quat_wxyz
+from simparity.core.scene import Chain
+from simparity.references.conventions import xyzw_from_wxyz
+from simparity.references.ik_outcome import ik_outcome
 
 SOLVERS = ("calculateInverseKinematics", "calculateInverseKinematics-tuned",
            "calculateInverseKinematics-tuned-nullspace")
@@ -82,11 +82,11 @@ class PybulletIK(IKModel):
     chain : Chain
     solver : str
         One of :data:`SOLVERS`.
-    options : IKOptions
+    options : IKTolerances
         The scene's tolerances and iteration cap.
     """
 
-    def __init__(self, kinematics, chain: Chain, solver: str, options: IKOptions) -> None:
+    def __init__(self, kinematics, chain: Chain, solver: str, options: IKTolerances) -> None:
         if solver not in SOLVERS:
             raise ValueError(f"unknown PyBullet IK solver {solver!r}, expected one of {SOLVERS}")
         self._chain, self._options, self._solver = chain, options, solver

@@ -12,12 +12,12 @@ import numpy as np
 import scipy
 from scipy.integrate import solve_ivp
 
-from core.engine import Engine, KinematicsModel, Simulation, Support
-from core.forces import make_wrench
-from core.rigid_body import MassProperties, State, initial_state, velocities
-from core.rotations import quat_wxyz_multiply, quat_wxyz_normalize
-from core.scene import Chain, DynamicsScene
-from core.trajectory import Trajectory
+from simparity.core.engine import Engine, KinematicsModel, Simulation, Support
+from simparity.core.forces import make_wrench
+from simparity.core.rigid_body import MassProperties, State, initial_state, velocities
+from simparity.core.rotations import quat_wxyz_multiply, quat_wxyz_normalize
+from simparity.core.scene import Chain, DynamicsScene
+from simparity.core.trajectory import Trajectory
 
 TOLERANCE = 1e-13
 """rtol = atol of the solve. Against the elliptic-function solution of a tumbling box it measured

@@ -15,10 +15,10 @@ What the URDF says, and why
 
 from __future__ import annotations
 
-from core.engine import Support
-from core.rotations import matrix_to_rpy
-from core.scene import Chain, RigidBody
-from references.conventions import PLACEHOLDER_INERTIA, PLACEHOLDER_MASS, fmt, principal_axes
+from simparity.core.engine import Support
+from simparity.core.rotations import matrix_to_rpy
+from simparity.core.scene import Chain, RigidBody
+from simparity.references.conventions import PLACEHOLDER_INERTIA, PLACEHOLDER_MASS, fmt, principal_axes
 
 
 

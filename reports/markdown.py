@@ -6,7 +6,7 @@ import math
 
 import pandas as pd
 
-from core.results import NOT_AVAILABLE, OK, STATUSES, case_counts
+from simparity.core.results import NOT_AVAILABLE, OK, STATUSES, case_counts
 
 _DYNAMICS_COLUMNS = [
     ("position_error_max", "position error max [m]"),

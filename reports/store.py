@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from core.errors import ResultsError
-from core.results import COLUMNS, RESULTS_FILE, RUN_INFO_FILE, SCHEMA_VERSION
+from simparity.core.errors import ResultsError
+from simparity.core.results import COLUMNS, RESULTS_FILE, RUN_INFO_FILE, SCHEMA_VERSION
 
 
 # pandas < 3 parses floats inexactly unless asked; pandas 3 is exact and deprecates the option.

@@ -9,15 +9,15 @@ import os
 
 import pybullet_data
 
-from comparisons.engines import make_engine
-from comparisons.library import builtin_paths
-from comparisons.scene_loader import load_scene
-from core.ik.jacobian_solvers import IKOptions
-from core.ik.reach import reach_upper_bound
-from core.kinematics import forward_kinematics
-from core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix, rpy_to_matrix, so3_exp
-from core.scene import Chain, DynamicsScene, Forces, Joint, RigidBody
-from core.urdf import chain_from_urdf
+from simparity.comparisons.engines import make_engine
+from simparity.comparisons.library import builtin_paths
+from simparity.comparisons.scene_loader import load_scene
+from simparity.core.ik.jacobian_solvers import IKOptions
+from simparity.core.ik.reach import reach_upper_bound
+from simparity.core.kinematics import forward_kinematics
+from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix, rpy_to_matrix, so3_exp
+from simparity.core.scene import Chain, DynamicsScene, Forces, Joint, RigidBody
+from simparity.core.urdf import chain_from_urdf
 
 
 def builtin(name: str):

@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from core.inhouse import InHouseEngine
-from core.rotations import geodesic_angle_quat_wxyz, so3_exp
+from simparity.core.inhouse import InHouseEngine
+from simparity.core.rotations import geodesic_angle_quat_wxyz, so3_exp
 
-from core.kinematics import forward_kinematics, jacobian_world
-from references.analytic import AnalyticEngine
+from simparity.core.kinematics import forward_kinematics, jacobian_world
+from simparity.references.analytic import AnalyticEngine
 from tests.helpers import builtin, exact_projectile, random_chain, tumbling_box
 
 # Two float64 evaluations of equivalent closed forms on a ~2.4 m arm.
@@ -67,7 +67,7 @@ def test_tumbling_closed_forms_in_any_body_frame(moments, rotated):
 
 def test_two_link_ik_picks_the_branch_nearest_the_start_and_reports_unreachable():
     """The closed form solves reachable targets to 1e-12 near the start branch; far targets are unreachable."""
-    from core.ik.jacobian_solvers import IKOptions
+    from simparity.core.ik.jacobian_solvers import IKOptions
 
     scene = builtin("lecture-2link-ik")
     model = AnalyticEngine().build_ik(scene.chain, "two_link", IKOptions())

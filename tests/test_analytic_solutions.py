@@ -6,15 +6,15 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from core.inertia import inertia_solid_box
-from core.rotations import (
+from simparity.core.inertia import inertia_solid_box
+from simparity.core.rotations import (
     geodesic_angle_quat_wxyz,
     quat_wxyz_multiply,
     quat_wxyz_normalize,
     quat_wxyz_to_matrix,
 )
-from core.invariants import angular_momentum_world, kinetic_energy
-from references.analytic_solutions import (
+from simparity.comparisons.invariants import angular_momentum_world, kinetic_energy
+from simparity.references.analytic_solutions import (
     intermediate_axis_flip_period,
     linear_angular_drag_isotropic,
     linear_drag,

@@ -6,11 +6,11 @@ import sys
 
 import pytest
 
-from comparisons.cli import EXIT_OK, EXIT_USAGE, main
-from comparisons.engines import DEFAULT_ENGINES
-from comparisons.library import builtin_paths
-from core.results import COLUMNS, NOT_AVAILABLE, OK, STATUSES
-from reports.store import read_run
+from simparity.comparisons.cli import EXIT_OK, EXIT_USAGE, main
+from simparity.comparisons.engines import DEFAULT_ENGINES
+from simparity.comparisons.library import builtin_paths
+from simparity.core.results import COLUMNS, NOT_AVAILABLE, OK, STATUSES
+from simparity.reports.store import read_run
 from tests.test_scene_loader import BROKEN
 
 
@@ -31,7 +31,7 @@ def test_list_names_every_builtin_scene():
 def test_run_without_scenes_runs_the_whole_builtin_suite(tmp_path, monkeypatch):
     """No scene argument means every built-in scene, each once, on the default engines."""
     seen = []
-    monkeypatch.setattr("comparisons.cli.run_scene", lambda scene, engines, *a, **k: seen.append(
+    monkeypatch.setattr("simparity.comparisons.cli.run_scene", lambda scene, engines, *a, **k: seen.append(
         (scene.name, tuple(e.name for e in engines))) or [])
     code, _ = _run(["run", "--out", str(tmp_path)])
     assert code == EXIT_OK

@@ -5,7 +5,7 @@ import re
 import numpy as np
 import pytest
 
-from core.collision import (
+from simparity.core.collision import (
     BAD_RESTITUTION,
     UNKNOWN_METHOD,
     ZERO_NORMAL,

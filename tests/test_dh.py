@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from core.dh import CONVENTIONS, UR5_DH, chain_from_dh, dh_forward
-from core.errors import SceneError
-from core.kinematics import joint_frames
+from simparity.core.dh import CONVENTIONS, UR5_DH, chain_from_dh, dh_forward
+from simparity.core.errors import SceneError
+from simparity.core.kinematics import joint_frames
 
 # The chain and the direct product multiply the same elementary matrices grouped
 # differently; they differ by float64 rounding only (~1e-15 on a 1 m arm).

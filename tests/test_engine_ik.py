@@ -3,11 +3,11 @@
 import numpy as np
 import pytest
 
-from comparisons.engines import make_engine
-from core.ik.jacobian_solvers import IKOptions
-from core.ik.reach import reach_upper_bound
-from core.kinematics import forward_kinematics
-from core.rotations import geodesic_angle_matrix
+from simparity.comparisons.engines import make_engine
+from simparity.core.ik.jacobian_solvers import IKOptions
+from simparity.core.ik.reach import reach_upper_bound
+from simparity.core.kinematics import forward_kinematics
+from simparity.core.rotations import geodesic_angle_matrix
 from tests.helpers import CONTINUOUS7, IIWA, MIXED6, REVOLUTE7, build_ik, far_targets, reachable_targets
 
 OPTIONS = IKOptions()  # 1e-6 m, 1e-6 rad, 200 iterations

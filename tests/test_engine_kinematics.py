@@ -7,9 +7,9 @@ own importer (core reads it with its own URDF reader).
 import numpy as np
 import pytest
 
-from comparisons.engines import make_engine
-from core.kinematics import forward_kinematics, jacobian_world
-from core.rotations import geodesic_angle_matrix
+from simparity.comparisons.engines import make_engine
+from simparity.core.kinematics import forward_kinematics, jacobian_world
+from simparity.core.rotations import geodesic_angle_matrix
 from tests.helpers import builtin, random_chain, unlimited
 
 # Double-precision kinematics of ~1 m chains agree to ~1e-15; 1e-12 is the project's bound.
@@ -76,7 +76,7 @@ def test_sub_chain_of_a_urdf_file_with_joints_beyond_the_tip(engine):
     import dataclasses
 
     scene = builtin("iiwa-kinematics")
-    from core.urdf import chain_from_urdf
+    from simparity.core.urdf import chain_from_urdf
 
     chain = dataclasses.replace(chain_from_urdf(scene.chain.urdf_path, tip_link="lbr_iiwa_link_5"),
                                 urdf_path=scene.chain.urdf_path)

@@ -2,10 +2,10 @@
 
 import numpy as np
 
-from core.forces import make_wrench, without_gravity
-from core.rigid_body import MassProperties
-from core.rotations import so3_exp
-from core.scene import AppliedForce, Forces
+from simparity.core.forces import make_wrench, without_gravity
+from simparity.core.rigid_body import MassProperties
+from simparity.core.rotations import so3_exp
+from simparity.core.scene import AppliedForce, Forces
 from tests.helpers import tumbling_box
 
 EXACT_TOL = 1e-15  # the same few float64 operations on both sides

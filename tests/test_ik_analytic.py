@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from core.ik import two_link_fk, two_link_ik
+from simparity.core.ik.analytic_2link import two_link_fk, two_link_ik
 
 # Both elbow branches must put the end point on the target to float64 rounding:
 # |x| <= L1 + L2 ~ 1 m, a few operations each ~1e-16.

@@ -6,11 +6,11 @@ import math
 import numpy as np
 import pytest
 
-from comparisons.engines import DEFAULT_ENGINES, make_engine
-from comparisons.ik_runner import IK_METRICS, run_ik_scene
-from comparisons.ik_targets import random_targets
-from core.ik.jacobian_solvers import IKOptions
-from core.results import FAILED, NOT_AVAILABLE, OK
+from simparity.comparisons.engines import DEFAULT_ENGINES, make_engine
+from simparity.comparisons.ik_runner import IK_METRICS, run_ik_scene
+from simparity.comparisons.ik_targets import random_targets
+from simparity.core.ik.jacobian_solvers import IKOptions
+from simparity.core.results import FAILED, NOT_AVAILABLE, OK
 from tests.helpers import builtin
 
 # Issue #4: core's best solver solves >= 99.5 % of 1000 seeded iiwa pose targets.
@@ -80,7 +80,7 @@ def test_analytic_two_link_beside_the_iterative_solvers():
 
 def test_a_failing_solver_still_reports_every_hard_target():
     """A solver that raises gets failed rows for every metric and every hard target, with the error."""
-    from core.inhouse import InHouseEngine
+    from simparity.core.inhouse import InHouseEngine
 
     class _Broken(InHouseEngine):
         name = "broken"
@@ -107,7 +107,7 @@ def test_float32_judge_does_not_fail_double_precision_solutions():
 
 def test_unavailable_engine_says_why_in_ik_scenes():
     """An engine whose library fails to import gets n/a IK rows naming the import error."""
-    from comparisons.engines import UnavailableEngine
+    from simparity.comparisons.engines import UnavailableEngine
 
     scene = dataclasses.replace(builtin("lecture-2link-ik"), n_targets=5)
     rows = run_ik_scene(scene, [UnavailableEngine("mujoco", "No module named 'mujoco'")], make_engine, repeats=1)

@@ -8,14 +8,16 @@ import numpy as np
 import pybullet_data
 import pytest
 
-from core.dh import UR5_DH, chain_from_dh
-from core.ik import METHODS, REASONS, IKOptions, IKResult, reach_upper_bound, solve_ik
-from core.ik import steps
-from core.ik.limits import cross_gap, crossable_gap, wrap_into_limits
-from core.kinematics import joint_frames
-from core.rotations import so3_exp
-from core.scene import Chain, Joint
-from core.urdf import chain_from_urdf
+from simparity.core.dh import UR5_DH, chain_from_dh
+from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik
+from simparity.core.ik.reach import reach_upper_bound
+from simparity.core.ik.result import REASONS, IKResult
+from simparity.core.ik import steps
+from simparity.core.ik.limits import cross_gap, crossable_gap, wrap_into_limits
+from simparity.core.kinematics import joint_frames
+from simparity.core.rotations import so3_exp
+from simparity.core.scene import Chain, Joint
+from simparity.core.urdf import chain_from_urdf
 
 IIWA = chain_from_urdf(os.path.join(pybullet_data.getDataPath(), "kuka_iiwa/model.urdf"))
 

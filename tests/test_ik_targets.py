@@ -4,11 +4,11 @@ import dataclasses
 
 import numpy as np
 
-from comparisons.engines import make_engine
-from comparisons.ik_targets import ORIENTATION_ONLY, hard_target, random_targets
-from core.ik.reach import reach_upper_bound
-from core.kinematics import forward_kinematics
-from core.rotations import geodesic_angle_matrix
+from simparity.comparisons.engines import make_engine
+from simparity.comparisons.ik_targets import ORIENTATION_ONLY, hard_target, random_targets
+from simparity.core.ik.reach import reach_upper_bound
+from simparity.core.kinematics import forward_kinematics
+from simparity.core.rotations import geodesic_angle_matrix
 from tests.helpers import builtin
 
 EXACT_TOL = 1e-12  # FK evaluated twice in float64

@@ -7,8 +7,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from core.errors import SceneError
-from core.inertia import (
+from simparity.core.errors import SceneError
+from simparity.core.inertia import (
     inertia_from_point_masses,
     inertia_problem,
     inertia_solid_box,
@@ -17,8 +17,8 @@ from core.inertia import (
     inertia_world,
     mass_and_center_of_mass,
 )
-from core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix
-from references.conventions import fmt
+from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix
+from simparity.references.conventions import fmt
 
 # Sums of a few dozen float64 products of O(1) numbers: rounding is ~1e-15 relative to
 # the largest entry; 1e-13 leaves margin without hiding any modelling difference.

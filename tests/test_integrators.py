@@ -5,13 +5,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from comparisons.metrics import observed_order
-from core.inhouse import InHouseEngine
-from core.integrators import ORDER, ORIENTATION_UPDATES, SCHEMES
-from core.invariants import angular_momentum_world, kinetic_energy
-from core.rotations import geodesic_angle_quat_wxyz, quat_wxyz_to_matrix
-from core.scene import Forces
-from references.analytic import AnalyticEngine
+from simparity.comparisons.metrics import observed_order
+from simparity.core.inhouse import InHouseEngine
+from simparity.core.integrators import ORDER, ORIENTATION_UPDATES, SCHEMES
+from simparity.comparisons.invariants import angular_momentum_world, kinetic_energy
+from simparity.core.rotations import geodesic_angle_quat_wxyz, quat_wxyz_to_matrix
+from simparity.core.scene import Forces
+from simparity.references.analytic import AnalyticEngine
 from tests.helpers import builtin, tumbling_box
 
 # The bound on a measured order: within 0.2 of the theoretical one.

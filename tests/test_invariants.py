@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from core.invariants import angular_momentum_world, kinetic_energy, potential_energy
-from core.rotations import so3_exp
+from simparity.comparisons.invariants import angular_momentum_world, kinetic_energy, potential_energy
+from simparity.core.rotations import so3_exp
 
 EXACT_TOL = 1e-14
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from core.kinematics import finite_difference_jacobian_world, forward_kinematics, jacobian_world
+from simparity.core.kinematics import finite_difference_jacobian_world, forward_kinematics, jacobian_world
 from tests.helpers import builtin, random_chain
 
 # Central differences with h = 1e-6 on ~1 m chains: truncation ~h^2 = 1e-12, rounding

@@ -4,8 +4,8 @@ import math
 
 import pandas as pd
 
-from core.results import ResultRow
-from reports.markdown import render
+from simparity.core.results import ResultRow
+from simparity.reports.markdown import render
 
 
 def _rows():

@@ -4,9 +4,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from core.rotations import quat_wxyz_to_matrix, so3_exp
-from references.mjcf import dynamics_mjcf
-from references.mujoco_adapter import MujocoEngine
+from simparity.core.rotations import quat_wxyz_to_matrix, so3_exp
+from simparity.references.mjcf import dynamics_mjcf
+from simparity.references.mujoco_adapter import MujocoEngine
 from tests.helpers import builtin, exact_projectile, tumbling_box
 
 # Both sides evaluate float64 kinematics of ~1 m chains: agreement is ~1e-15; 1e-12 is
@@ -83,7 +83,7 @@ def test_export_is_the_model_that_runs():
 
 def test_instability_is_reported_not_reset_silently():
     """MuJoCo resets an unstable run to its initial state; the adapter raises DivergedError instead."""
-    from core.errors import DivergedError
+    from simparity.core.errors import DivergedError
 
     scene = builtin("fast-spinner")
     sim = MujocoEngine().build_dynamics(scene, "euler", 0.02)
@@ -110,7 +110,7 @@ def test_euler_damping_is_implicit_unless_eulerdamp_is_disabled():
     """With drag as dof_damping, default Euler damps implicitly (v / (1 + dt b / m)); the adapter's is explicit."""
     from dataclasses import replace
 
-    from core.scene import Forces
+    from simparity.core.scene import Forces
 
     scene = replace(tumbling_box(inertia_body=0.2 * np.eye(3), gravity=None), forces=Forces(linear_drag=np.array([4.0])))
     dt, b, m = 0.01, 4.0, scene.bodies[0].mass

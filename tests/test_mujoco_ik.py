@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from core.ik.jacobian_solvers import IKOptions
-from core.kinematics import forward_kinematics
+from simparity.core.ik.jacobian_solvers import IKOptions
+from simparity.core.kinematics import forward_kinematics
 
 from tests.helpers import IIWA, REVOLUTE7, build_ik, reachable_targets
 

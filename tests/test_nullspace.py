@@ -8,10 +8,11 @@ import numpy as np
 import pybullet_data
 import pytest
 
-from core.ik import IKOptions, limit_penalty_gradient, nullspace_term, penalty, penalty_gradient, solve_ik
-from core.kinematics import jacobian_world, joint_frames
-from core.rotations import so3_log
-from core.urdf import chain_from_urdf
+from simparity.core.ik.jacobian_solvers import IKOptions, solve_ik
+from simparity.core.ik.nullspace import limit_penalty_gradient, nullspace_term, penalty, penalty_gradient
+from simparity.core.kinematics import jacobian_world, joint_frames
+from simparity.core.rotations import so3_log
+from simparity.core.urdf import chain_from_urdf
 
 IIWA = chain_from_urdf(os.path.join(pybullet_data.getDataPath(), "kuka_iiwa/model.urdf"))
 

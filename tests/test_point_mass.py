@@ -5,10 +5,10 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from comparisons.library import builtin_paths
-from comparisons.scene_loader import LENGTH_UNITS, load_scene
-from core import point_mass
-from core.inhouse import InHouseEngine
+from simparity.comparisons.library import builtin_paths
+from simparity.comparisons.scene_loader import LENGTH_UNITS, load_scene
+from simparity.core import point_mass
+from simparity.core.inhouse import InHouseEngine
 
 # The lecture's worked example, in feet and seconds, exactly as printed on the slide.
 LECTURE_POSITIONS_FT = {

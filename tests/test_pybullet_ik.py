@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from core.ik.jacobian_solvers import IKOptions
+from simparity.core.ik.jacobian_solvers import IKOptions
 from tests.helpers import IIWA, REVOLUTE7, build_ik, reachable_targets
 
 OPTIONS = IKOptions()  # 1e-6 m, 1e-6 rad, 200 iterations

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from core import rotations as rot
+from simparity.core import rotations as rot
 
 # Round trips through float64 formulas: a few ulps of values of size 1.
 ROUND_TRIP_TOL = 1e-14

@@ -4,12 +4,12 @@ import math
 
 import numpy as np
 
-from comparisons.engines import make_engine
-from comparisons.metrics import DYNAMICS_METRICS, KINEMATICS_METRICS, ORDER_METRICS, dynamics_metrics
-from comparisons.runner import run_scene
-from core.engine import Support
-from core.inhouse import InHouseEngine
-from core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK
+from simparity.comparisons.engines import make_engine
+from simparity.comparisons.metrics import DYNAMICS_METRICS, KINEMATICS_METRICS, ORDER_METRICS, dynamics_metrics
+from simparity.comparisons.runner import run_scene
+from simparity.core.engine import Support
+from simparity.core.inhouse import InHouseEngine
+from simparity.core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK
 from tests.helpers import builtin
 
 

@@ -10,9 +10,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from comparisons.engines import make_engine
-from core.rotations import geodesic_angle_quat_wxyz, so3_exp
-from core.scene import AppliedForce, Forces
+from simparity.comparisons.engines import make_engine
+from simparity.core.rotations import geodesic_angle_quat_wxyz, so3_exp
+from simparity.core.scene import AppliedForce, Forces
 from tests.helpers import tumbling_box
 
 # Each step rounds differently on each side (~1e-16) and the tumbling amplifies it:

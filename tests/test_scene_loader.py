@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from comparisons.library import builtin_paths
-from comparisons.scene_loader import LENGTH_UNITS, load_scene, parse_scene, tomllib
-from core.errors import SceneError
+from simparity.comparisons.library import builtin_paths
+from simparity.comparisons.scene_loader import LENGTH_UNITS, load_scene, parse_scene, tomllib
+from simparity.core.errors import SceneError
 
 VALID_DYNAMICS = """
 [scene]

@@ -5,10 +5,10 @@ import math
 
 import pytest
 
-from comparisons.store import RunWriter
-from core.errors import ResultsError
-from core.results import ResultRow
-from reports.store import read_run
+from simparity.comparisons.store import RunWriter
+from simparity.core.errors import ResultsError
+from simparity.core.results import ResultRow
+from simparity.reports.store import read_run
 from tests.helpers import builtin
 
 

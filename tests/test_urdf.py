@@ -9,9 +9,9 @@ import pinocchio as pin
 import pybullet_data
 import pytest
 
-from core.errors import SceneError
-from core.kinematics import joint_frames
-from core.urdf import chain_from_urdf
+from simparity.core.errors import SceneError
+from simparity.core.kinematics import joint_frames
+from simparity.core.urdf import chain_from_urdf
 
 IIWA_PATH = os.path.join(pybullet_data.getDataPath(), "kuka_iiwa/model.urdf")
 

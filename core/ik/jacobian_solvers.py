@@ -37,6 +37,9 @@ reach bound is ``"unreachable"`` also when the iteration cap stops it):
 - ``"iteration_cap"``: the cap came while the target was still making progress, or it
   had stalled without any of these causes (such a target keeps going until the cap).
 
+A stalled target is judged at its current iterate, and where that names no cause, at its
+best configuration (an iterate can oscillate about a singular best one).
+
 A failed target returns the best configuration met (smallest |e|).
 """
 
@@ -46,34 +49,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.ik import steps
-from core.ik.limits import cross_gap, crossable_gap, inside, wrap_into_limits
-from core.ik.nullspace import limit_penalty_gradient, nullspace_term, penalty_gradient
-from core.ik.reach import reach_upper_bound
-from core.ik.result import IKResult
-from core.kinematics import jacobian_world, joint_frames
-from core.rotations import so3_log
-from core.scene import Chain
+from simparity.core.ik import steps
+from simparity.core.ik.limits import cross_gap, crossable_gap, inside, wrap_into_limits
+from simparity.core.ik.problem import IKTolerances, check_inputs
+from simparity.core.ik.nullspace import limit_penalty_gradient, nullspace_term, penalty_gradient
+from simparity.core.ik.reach import reach_upper_bound
+from simparity.core.ik.result import IKResult
+from simparity.core.kinematics import jacobian_world, joint_frames
+from simparity.core.rotations import so3_log
+from simparity.core.scene import Chain
 
 METHODS = ("jacobian_inverse", "pseudo_inverse", "transpose", "damped_least_squares")
 
-# Largest |R^T R - I| accepted for a target rotation: rotations built in float64 are
-# orthonormal to ~1e-15; 1e-9 still rejects anything that is not a rotation.
-_ROTATION_TOLERANCE = 1e-9
-
 
 @dataclass(frozen=True)
-class IKOptions:
-    """Settings shared by the iterative solvers.
+class IKOptions(IKTolerances):
+    """Settings of the in-house iterative solvers: the problem's tolerances and iteration
+    cap (:class:`~simparity.core.ik.problem.IKTolerances`) plus their own.
 
     Attributes
     ----------
-    position_tolerance : float
-        Success needs |p_target - p| <= this [m].
-    orientation_tolerance : float
-        ... and, for pose targets, the angle of R_target R^T <= this [rad].
-    max_iterations : int
-        Joint updates per target at most.
     max_step : float
         Largest change of any joint in one update [rad or m]; a longer update is scaled
         down as a whole, its direction kept.
@@ -109,9 +104,6 @@ class IKOptions:
     # damping_max = 1e-2 lowered the solve rate from 99.7 % to 99.1 % because damping
     # slows the approach to near-singular solutions (linear rate lambda^2 / (sigma^2 +
     # lambda^2)). max_step = 0.75 rad lets a step cross the iiwa's 0.17-0.35 rad limit gaps.
-    position_tolerance: float = 1e-6
-    orientation_tolerance: float = 1e-6
-    max_iterations: int = 200
     max_step: float = 0.75
     rank_rcond: float = 1e-6
     singular_threshold: float = 1e-2
@@ -125,14 +117,13 @@ class IKOptions:
     limit_gain: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("position_tolerance", "orientation_tolerance", "max_step", "rank_rcond",
-                     "singular_threshold", "damping_max", "stall_ratio"):
+        super().__post_init__()
+        for name in ("max_step", "rank_rcond", "singular_threshold", "damping_max", "stall_ratio"):
             value = getattr(self, name)
             if not (np.isfinite(value) and value > 0):
                 raise ValueError(f"IKOptions.{name} must be finite and > 0, got {value}")
-        for name in ("max_iterations", "stall_window"):
-            if getattr(self, name) < 1:
-                raise ValueError(f"IKOptions.{name} must be >= 1, got {getattr(self, name)}")
+        if self.stall_window < 1:
+            raise ValueError(f"IKOptions.stall_window must be >= 1, got {self.stall_window}")
         if self.gap_crossings < 0:
             raise ValueError(f"IKOptions.gap_crossings must be >= 0, got {self.gap_crossings}")
         if self.rest_exponent < 1:
@@ -217,6 +208,14 @@ def solve_ik(
         jac = jacobian_world(chain, qa)[:, :rows]
         dq, locked = _update(method, jac, err, qa, lower, upper, revolute, options)
         cause = _classify(jac, locked, end_world, target_position[idx], center, beyond_reach[idx], options)
+        # A stalled iterate that oscillates about a singular best configuration (the
+        # pseudo-inverse at a stretched arm) is judged at that configuration, which it returns.
+        waiting = (since_best[idx] >= options.stall_window) & (cause == "iteration_cap") & ~solved
+        if np.any(waiting):
+            w = idx[waiting]
+            best_positions = joint_frames(chain, best_q[w])[0]
+            cause[waiting] = _classify(jacobian_world(chain, best_q[w])[:, :rows], locked[waiting],
+                                       best_positions[:, -1], target_position[w], center, beyond_reach[w], options)
         stalled = (since_best[idx] >= options.stall_window) & (cause != "iteration_cap") & ~solved
         escape = stalled & (cause == "limit_blocked") & np.any(locked & crossable, axis=1) & (crossings_left[idx] > 0)
         stalled &= ~escape
@@ -239,30 +238,6 @@ def solve_ik(
     violation = np.max(np.maximum(np.maximum(lower - best_q, best_q - upper), 0.0), axis=1, initial=0.0)
     return IKResult(q=best_q, success=reason == "", iterations=iterations, position_residual=pos_res,
                     orientation_residual=rot_res, limit_violation=violation, reason=reason.astype(str))
-
-
-def check_inputs(chain, target_position, target_rotation, q_start):
-    """Checked IK inputs: (p (B, 3), R (B, 3, 3) or None, q_start broadcast to (B, n)).
-
-    Used by every solver, in-house or engine; raises ValueError naming the bad argument.
-    """
-    p = np.asarray(target_position, dtype=float)
-    if p.ndim != 2 or p.shape[1] != 3 or not np.all(np.isfinite(p)):
-        raise ValueError(f"target_position must be a finite (B, 3) array, got shape {p.shape}")
-    batch = p.shape[0]
-    r = None
-    if target_rotation is not None:
-        r = np.asarray(target_rotation, dtype=float)
-        if r.shape != (batch, 3, 3) or not np.all(np.isfinite(r)):
-            raise ValueError(f"target_rotation must be a finite ({batch}, 3, 3) array, got shape {r.shape}")
-        off = np.abs(np.swapaxes(r, 1, 2) @ r - np.eye(3)).max(initial=0.0)
-        if off > _ROTATION_TOLERANCE or np.any(np.linalg.det(r) <= 0):
-            raise ValueError(f"target_rotation must hold rotation matrices (max |R^T R - I| = {off:.1e})")
-    n = chain.n_joints
-    q = np.zeros(n) if q_start is None else np.asarray(q_start, dtype=float)
-    if q.shape not in ((n,), (batch, n)) or not np.all(np.isfinite(q)):
-        raise ValueError(f"q_start must be a finite ({n},) or ({batch}, {n}) array, got shape {q.shape}")
-    return p, r, np.array(np.broadcast_to(q, (batch, n)))
 
 
 def _error(chain, q, target_position, target_rotation):

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from core.arrays import readonly
+from simparity.core.arrays import readonly
 
 REASONS = ("", "unreachable", "singular", "limit_blocked", "iteration_cap")
 """Failure vocabulary: ``""`` for a success, otherwise why the target was not reached."""

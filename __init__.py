@@ -1,0 +1,32 @@
+"""simparity: textbook IK and rigid-body methods beside MuJoCo, PyBullet and Pinocchio.
+
+The project's top-level folders install as this package's subpackages
+(``simparity.core``, ``simparity.references``, ``simparity.comparisons``,
+``simparity.reports``). The public API, importable from ``simparity``:
+
+- :func:`load_scene` ``(name_or_path) -> Scene``: a built-in scene by name, or a scene file;
+- :func:`run_scene` ``(scene, engines=..., repeats=...) -> pandas.DataFrame``: one tidy row
+  per scene x engine x integrator x dt x metric;
+- :func:`read_run` ``(run_dir) -> (pandas.DataFrame, dict)``: a run stored by ``simparity run``.
+
+They are imported on first use, so ``import simparity.core`` stays free of pandas and the
+engines.
+"""
+
+from __future__ import annotations
+
+_PUBLIC = {
+    "load_scene": "simparity.comparisons.api",
+    "run_scene": "simparity.comparisons.api",
+    "read_run": "simparity.reports.store",
+}
+
+__all__ = sorted(_PUBLIC)
+
+
+def __getattr__(name: str):
+    if name in _PUBLIC:
+        import importlib
+
+        return getattr(importlib.import_module(_PUBLIC[name]), name)
+    raise AttributeError(f"module 'simparity' has no attribute {name!r}")
