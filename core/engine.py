@@ -43,9 +43,14 @@ class Simulation(abc.ABC):
     detail : str
         What the engine was configured with beyond the scene (defaults switched off,
         harness-side stepping, ...); shown in the results' ``detail`` column.
+    integrates_rotation : bool
+        False when the scheme moves only the centre of mass (the lecture's point-mass
+        rules): orientation and angular velocity stay at their initial values, so their
+        errors and orders of convergence measure nothing.
     """
 
     detail: str = ""
+    integrates_rotation: bool = True
 
     @abc.abstractmethod
     def run(self, n_steps: int) -> Trajectory:

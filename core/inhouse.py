@@ -67,6 +67,8 @@ class _RigidBodySimulation(Simulation):
 class _ParticleSimulation(Simulation):
     """The lecture's point-mass rules; orientation and angular velocity stay at their initial values."""
 
+    integrates_rotation = False
+
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
         self._rule = point_mass.RULES[integrator]
         props = MassProperties.of(scene.bodies)
