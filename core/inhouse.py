@@ -16,7 +16,7 @@ from simparity.core.ik.result import IKResult
 from simparity.core.integrators import ORIENTATION_UPDATES, SCHEMES, make_step
 from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.rigid_body import MassProperties, State, initial_state, velocities
-from simparity.core.rotations import matrix_to_quat_wxyz
+from simparity.core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from simparity.core.scene import Chain, DynamicsScene
 from simparity.core.trajectory import FramePoses, Trajectory
 
@@ -77,7 +77,7 @@ class _ParticleSimulation(Simulation):
         self._x0 = np.stack([b.position_world for b in scene.bodies])
         self._v0 = np.stack([b.velocity_world for b in scene.bodies])
         self._q0 = np.stack([b.quat_wxyz for b in scene.bodies])
-        self._r0 = np.stack([b.rotation_world for b in scene.bodies])
+        self._r0 = quat_wxyz_to_matrix(np.stack([b.quat_wxyz for b in scene.bodies]))
         self._dt = dt
         self.detail = f"in-house particle rule {integrator} (lecture, Bodies in Free Fall)"
 

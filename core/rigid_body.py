@@ -78,7 +78,7 @@ class State:
 
 def initial_state(bodies: tuple[RigidBody, ...], props: MassProperties, quaternion: bool) -> State:
     """State at t = 0 of scene bodies, orientation as quaternion or matrix."""
-    rotation = np.stack([b.rotation_world for b in bodies])
+    rotation = quat_wxyz_to_matrix(np.stack([b.quat_wxyz for b in bodies]))
     omega = np.stack([b.angular_velocity_world for b in bodies])
     orientation = np.stack([b.quat_wxyz for b in bodies]) if quaternion else rotation
     return State(

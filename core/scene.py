@@ -16,7 +16,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from simparity.core.arrays import readonly
-from simparity.core.rotations import quat_wxyz_to_matrix
 
 
 @dataclass(frozen=True)
@@ -58,11 +57,6 @@ class RigidBody:
         object.__setattr__(
             self, "angular_velocity_world", readonly(self.angular_velocity_world, shape=(3,))
         )
-
-    @property
-    def rotation_world(self) -> np.ndarray:
-        """(3, 3) initial rotation matrix, body to world."""
-        return quat_wxyz_to_matrix(self.quat_wxyz)
 
 
 @dataclass(frozen=True)

@@ -11,9 +11,13 @@ decouple (no force here couples them), and each is solved per body:
   angular drag on an isotropic body.
 
 Anything else (applied forces, both drags at once, quadratic angular drag, ...) gets
-``n/a`` with the reason. IK: the lecture's analytic solution of the planar 2-link arm. Kinematics: planar chains (revolute joints about z, origins in
+``n/a`` with the reason. Kinematics: planar chains (revolute joints about z, origins in
 the xy plane): the end effector is a sum of rotated link vectors, sum_k Rz(phi_k) o_k with
-phi_k the cumulative angle, and the Jacobian is its closed-form derivative.
+phi_k the cumulative angle, and the Jacobian is its closed-form derivative. IK: the planar
+2-link arm solved geometrically (the elbow is where the circle |e| = l1 about the base
+meets the circle |p - e| = l2 about the target), a formulation of its own, independent of
+core's law-of-cosines solver that it checks. Rotations are SciPy's
+(:mod:`simparity.references.conventions`).
 """
 
 from __future__ import annotations
@@ -21,14 +25,12 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
-from simparity.core.ik.analytic_2link import two_link_fk, two_link_ik
 from simparity.core.ik.problem import IKTolerances, check_inputs
 from simparity.core.ik.result import IKResult
-from simparity.core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix, so3_exp
 from simparity.core.scene import Chain, DynamicsScene
 from simparity.core.trajectory import FramePoses, Trajectory
 from simparity.references import analytic_solutions as closed
-from simparity.references.conventions import principal_axes
+from simparity.references.conventions import matrix_to_quat_wxyz, principal_axes, quat_wxyz_to_matrix, rotvec_to_matrix
 
 # Relative tolerance deciding that principal moments are equal, or omega lies on a
 # principal axis: such scenes are built exactly so; 1e-12 only absorbs rounding.
@@ -49,7 +51,8 @@ def _rotation_kind(scene: DynamicsScene, k: int) -> tuple[str, str]:
             return "", f"closed-form angular drag needs an isotropic inertia; body '{body.name}' is not"
         return "angular_drag", ""
     omega = body.angular_velocity_world
-    l_world = body.rotation_world @ body.inertia_body @ body.rotation_world.T @ omega
+    rotation = quat_wxyz_to_matrix(body.quat_wxyz)
+    l_world = rotation @ body.inertia_body @ rotation.T @ omega
     cross = np.linalg.norm(np.cross(l_world, omega))
     if not np.any(omega) or cross <= _EQUAL_RTOL * np.linalg.norm(l_world) * np.linalg.norm(omega):
         return "steady", ""
@@ -95,8 +98,9 @@ def _rotation(scene: DynamicsScene, k: int, kind: str, times: np.ndarray) -> tup
     """(quat_wxyz (T, 4), angular_velocity_world (T, 3)) of body k."""
     body = scene.bodies[k]
     omega = body.angular_velocity_world
+    rotation0 = quat_wxyz_to_matrix(body.quat_wxyz)
     if kind == "steady":
-        rotation = so3_exp(times[:, None] * omega) @ body.rotation_world
+        rotation = rotvec_to_matrix(times[:, None] * omega) @ rotation0
         return matrix_to_quat_wxyz(rotation), np.broadcast_to(omega, (len(times), 3))
     moments, axes = principal_axes(body.inertia_body)
     if kind == "angular_drag":
@@ -108,7 +112,7 @@ def _rotation(scene: DynamicsScene, k: int, kind: str, times: np.ndarray) -> tup
         # The closed form wants the equal pair first (I1 == I2): cycle the axes (still proper).
         moments, axes = moments[[1, 2, 0]], axes[:, [1, 2, 0]]
     # Torque-free: solve in the principal frame R_p = R Q, then return to the body frame.
-    rotation_principal = body.rotation_world @ axes
+    rotation_principal = rotation0 @ axes
     omega_principal = rotation_principal.T @ omega
     quat_p, omega_world, _ = solve(moments, omega_principal, matrix_to_quat_wxyz(rotation_principal), times)
     return matrix_to_quat_wxyz(quat_wxyz_to_matrix(quat_p) @ axes.T), omega_world
@@ -192,30 +196,71 @@ def _two_link(chain: Chain) -> Support:
     return Support.yes()
 
 
+def elbow_solutions(l1: float, l2: float, target_xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Both joint solutions of the planar 2-link arm, from the elbow's position.
+
+    The elbow e lies on the circle |e| = l1 about the base and on |p - e| = l2 about the
+    target p: at distance a = (l1^2 - l2^2 + r^2) / (2 r) along p / r and h = +-sqrt(l1^2 -
+    a^2) across it (r = |p|). Then q1 = angle(e) and q2 = angle(p - e) - q1. A target out
+    of reach (h^2 < 0) gets the elbow on the line through p (h = 0, a clipped to +-l1):
+    the arm stretched toward it or folded. At r = 0 the line is taken along +x.
+
+    Parameters
+    ----------
+    l1, l2 : float
+        Link lengths [m].
+    target_xy : (B, 2) ndarray
+        [m].
+
+    Returns
+    -------
+    q : (B, 2, 2) ndarray
+        [target, branch, joint] angles [rad] (branch 0 has the elbow to the left of the
+        line from the base to the target).
+    reachable : (B,) bool ndarray
+        |l1 - l2| <= r <= l1 + l2.
+    """
+    p = np.asarray(target_xy, dtype=float)
+    r = np.hypot(p[:, 0], p[:, 1])
+    along = np.where(r[:, None] > 0, p / np.where(r > 0, r, 1.0)[:, None], [1.0, 0.0])
+    across = np.stack([-along[:, 1], along[:, 0]], axis=1)
+    a = np.clip((l1 * l1 - l2 * l2 + r * r) / (2 * np.where(r > 0, r, 1.0)), -l1, l1)
+    h = np.sqrt(np.maximum(l1 * l1 - a * a, 0.0))
+    reachable = (r <= l1 + l2) & (r >= abs(l1 - l2))
+    q = np.empty((len(p), 2, 2))
+    for branch, side in enumerate((1.0, -1.0)):
+        elbow = a[:, None] * along + side * h[:, None] * across
+        q1 = np.arctan2(elbow[:, 1], elbow[:, 0])
+        forearm = p - elbow
+        q2 = np.arctan2(forearm[:, 1], forearm[:, 0]) - q1
+        q[:, branch] = np.stack([q1, np.angle(np.exp(1j * q2))], axis=1)
+    return q, reachable
+
+
 class _TwoLinkIK(IKModel):
-    """The lecture's analytic 2-link solution; of the two elbow branches, the one within the
-    limits that is nearest to the start pose (wrapped angle distance)."""
+    """The planar 2-link arm solved geometrically (:func:`elbow_solutions`); of the two elbow
+    branches, the one within the limits that is nearest to the start pose (wrapped angle distance)."""
 
     def __init__(self, chain: Chain, options: IKTolerances) -> None:
         self._chain, self._options = chain, options
         self._l1, self._l2 = chain.joints[1].origin_xyz[0], chain.end_effector_xyz[0]
-        self.detail = "the lecture's closed form (both branches; the nearest one within the limits)"
+        self._fk = _PlanarKinematics(chain)
+        self.detail = "closed form: the elbow where two circles meet (both branches; the nearest within the limits)"
 
     def solve(self, target_position_world, target_rotation_world, q_start) -> IKResult:
         p, _, q0 = check_inputs(self._chain, target_position_world, None, q_start)
-        solution = two_link_ik(self._l1, self._l2, p[:, :2])
+        solutions, reachable = elbow_solutions(self._l1, self._l2, p[:, :2])
         lower, upper = self._chain.lower, self._chain.upper
-        inside = np.all((solution.q >= lower) & (solution.q <= upper), axis=2)  # (B, branch)
-        distance = np.linalg.norm(np.angle(np.exp(1j * (solution.q - q0[:, None, :]))), axis=2)
-        distance = np.where(inside, distance, np.inf)
-        branch = np.argmin(distance, axis=1)
-        q = solution.q[np.arange(len(p)), branch]
+        inside = np.all((solutions >= lower) & (solutions <= upper), axis=2)  # (B, branch)
+        distance = np.linalg.norm(np.angle(np.exp(1j * (solutions - q0[:, None, :]))), axis=2)
+        branch = np.argmin(np.where(inside, distance, np.inf), axis=1)
+        q = solutions[np.arange(len(p)), branch]
         blocked = ~np.any(inside, axis=1)
         q = np.where(blocked[:, None], np.clip(q, lower, upper), q)
-        reached = np.concatenate([two_link_fk(self._l1, self._l2, q), np.zeros((len(p), 1))], axis=1)
+        reached = self._fk.forward_kinematics(q).position_world[:, -1]
         residual = np.linalg.norm(reached - p, axis=1)
-        success = solution.reachable & ~blocked & (residual <= self._options.position_tolerance)
-        reason = np.where(success, "", np.where(~solution.reachable, "unreachable",
+        success = reachable & ~blocked & (residual <= self._options.position_tolerance)
+        reason = np.where(success, "", np.where(~reachable, "unreachable",
                                                 np.where(blocked, "limit_blocked", "singular")))
         violation = np.max(np.maximum(np.maximum(lower - q, q - upper), 0.0), axis=1)
         return IKResult(q, success, np.zeros(len(p), int), residual, np.zeros(len(p)), violation, reason)

@@ -7,7 +7,7 @@ body to world; angular velocities in the world frame unless the name ends in ``_
 Translation: :func:`projectile`, :func:`linear_drag`, :func:`quadratic_drag_along_line`.
 Rotation: :func:`linear_angular_drag_isotropic`, :func:`torque_free_axisymmetric`,
 :func:`torque_free_asymmetric` (Jacobi elliptic functions + quadrature) and
-:func:`intermediate_axis_flip_period`. Invariants are in :mod:`core.invariants`.
+:func:`intermediate_axis_flip_period`. Rotations are SciPy's (:mod:`simparity.references.conventions`), not core's.
 """
 
 from __future__ import annotations
@@ -17,12 +17,11 @@ from typing import NamedTuple
 import numpy as np
 from scipy.special import ellipkinc, exprel
 
-from simparity.core.rotations import (
+from simparity.references.conventions import (
     matrix_to_quat_wxyz,
     quat_wxyz_conjugate,
     quat_wxyz_from_rotvec,
     quat_wxyz_multiply,
-    quat_wxyz_normalize,
     quat_wxyz_to_matrix,
 )
 
@@ -55,6 +54,12 @@ def _vector(a, n: int = 3) -> np.ndarray:
 def _column(times) -> np.ndarray:
     """(T,) times -> (T, 1)."""
     return np.asarray(times, dtype=float).reshape(-1)[:, None]
+
+
+def _unit(q) -> np.ndarray:
+    """(4,) quaternion scaled to unit norm."""
+    q = _vector(q, 4)
+    return q / np.linalg.norm(q)
 
 
 def _nonnegative(value: float, name: str) -> float:
@@ -258,7 +263,7 @@ def linear_angular_drag_isotropic(
     k = _nonnegative(angular_drag, "angular_drag") / float(moment_of_inertia)
     t = _column(times)
     omega0 = _vector(angular_velocity_world0)
-    q0 = quat_wxyz_normalize(_vector(quat_wxyz0, 4))
+    q0 = _unit(quat_wxyz0)
     omega = omega0 * np.exp(-k * t)
     quat = quat_wxyz_multiply(quat_wxyz_from_rotvec(omega0 * t * exprel(-k * t)), q0)
     return quat, omega, _body_from_world(quat, omega)
@@ -306,7 +311,7 @@ def torque_free_axisymmetric(
         raise ValueError(f"torque_free_axisymmetric needs I1 == I2, got {inertia.tolist()}")
     t = _column(times)
     omega0 = _vector(angular_velocity_body0)
-    q0 = quat_wxyz_normalize(_vector(quat_wxyz0, 4))
+    q0 = _unit(quat_wxyz0)
     rate = (inertia[2] - inertia[0]) / inertia[0] * omega0[2]
     angle = rate * t[:, 0]
     c, s = np.cos(angle), np.sin(angle)
@@ -568,7 +573,7 @@ def torque_free_asymmetric(
     inertia = _distinct(inertia_principal)
     t = _column(times)[:, 0]
     omega0 = _vector(angular_velocity_body0)
-    q0 = quat_wxyz_normalize(_vector(quat_wxyz0, 4))
+    q0 = _unit(quat_wxyz0)
     sol = _elliptic(inertia, omega0)
     if sol is None:
         quat = quat_wxyz_multiply(q0, quat_wxyz_from_rotvec(t[:, None] * omega0))

@@ -7,7 +7,7 @@ own stopping rule was:
 - success: position residual <= ``options.position_tolerance`` [m] AND orientation
   residual <= ``options.orientation_tolerance`` [rad] (0 for position-only targets);
 - reason of a failure: ``"unreachable"`` when the target is farther from the first joint
-  than :func:`core.ik.reach.reach_upper_bound` (plus the position tolerance), else
+  than the chain could possibly reach (:func:`reach_bound`, plus the position tolerance), else
   ``"iteration_cap"``: the libraries report no cause (a stop at their own looser
   threshold, a stall and the cap all look alike), and :data:`core.ik.result.REASONS` has
   no "stopped early";
@@ -19,9 +19,22 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.core.ik.problem import IKTolerances
-from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.ik.result import IKResult
 from simparity.core.scene import Chain
+
+
+def reach_bound(chain: Chain) -> tuple[np.ndarray, float]:
+    """(first joint's origin (3,) [m], the farthest the end effector can be from it [m]).
+
+    Every later joint origin and the end effector sit at fixed offsets along the chain, and
+    a prismatic joint adds at most its largest |limit|: by the triangle inequality the end
+    effector is never farther than the sum of their lengths (inf with an unlimited
+    prismatic joint).
+    """
+    lengths = [np.linalg.norm(joint.origin_xyz) for joint in chain.joints[1:]]
+    lengths.append(np.linalg.norm(chain.end_effector_xyz))
+    lengths += [max(-joint.lower, joint.upper) for joint in chain.joints if joint.type == "prismatic"]
+    return np.asarray(chain.joints[0].origin_xyz, dtype=float), float(np.sum(lengths))
 
 
 def ik_outcome(chain: Chain, q: np.ndarray, iterations: np.ndarray, position_residual: np.ndarray,
@@ -49,7 +62,7 @@ def ik_outcome(chain: Chain, q: np.ndarray, iterations: np.ndarray, position_res
     """
     success = ((position_residual <= options.position_tolerance)
                & (orientation_residual <= options.orientation_tolerance))
-    center, radius = reach_upper_bound(chain)
+    center, radius = reach_bound(chain)
     beyond = np.linalg.norm(target_position_world - center, axis=1) > radius + options.position_tolerance
     reason = np.where(success, "", np.where(beyond, "unreachable", "iteration_cap"))
     violation = np.max(np.maximum(np.maximum(chain.lower - q, q - chain.upper), 0.0), axis=1, initial=0.0)

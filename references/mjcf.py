@@ -1,4 +1,7 @@
-"""MJCF (MuJoCo's model format) for simparity scenes and chains.
+"""MJCF (MuJoCo's model format) for simparity scenes and chains, built with an XML library.
+
+Every element is built with :mod:`xml.etree.ElementTree`, which escapes attribute values:
+no name can close an element or open another (no string templates).
 
 What MuJoCo is given, and why
 -----------------------------
@@ -19,66 +22,58 @@ What MuJoCo is given, and why
 
 from __future__ import annotations
 
-from simparity.core.rotations import matrix_to_quat_wxyz
+import xml.etree.ElementTree as ET
+
 from simparity.core.scene import Chain, DynamicsScene
-from simparity.references.conventions import PLACEHOLDER_INERTIA, PLACEHOLDER_MASS, fmt
+from simparity.references.conventions import PLACEHOLDER_INERTIA, PLACEHOLDER_MASS, fmt, matrix_to_quat_wxyz
 
 INTEGRATORS = {"euler": "Euler", "rk4": "RK4", "implicit": "implicit", "implicitfast": "implicitfast"}
 """simparity integrator name -> MJCF ``option/@integrator``."""
 
 
+def _text(root: ET.Element) -> str:
+    ET.indent(root, space="  ")
+    return ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _model(name: str, flags: dict[str, str], **option: str) -> tuple[ET.Element, ET.Element]:
+    """(``<mujoco>``, its ``<worldbody>``) with radians, the options and the disabled flags."""
+    root = ET.Element("mujoco", model=name)
+    ET.SubElement(root, "compiler", angle="radian")
+    ET.SubElement(ET.SubElement(root, "option", **option), "flag", **flags)
+    return root, ET.SubElement(root, "worldbody")
+
 
 def dynamics_mjcf(scene: DynamicsScene, integrator: str, dt: float) -> str:
     """MJCF text of a dynamics scene for one integrator and time step."""
     gravity = scene.forces.gravity_world
-    flags = ['contact="disable"']
+    flags = {"contact": "disable"}
     if gravity is None:
-        flags.append('gravity="disable"')
+        flags["gravity"] = "disable"
     if scene.forces.linear_drag is not None or scene.forces.angular_linear_drag is not None:
-        flags.append('eulerdamp="disable"')  # the drag is dof_damping: keep Euler explicit
-    gravity_attr = fmt(gravity) if gravity is not None else "0 0 0"
-    bodies = []
+        flags["eulerdamp"] = "disable"  # the drag is dof_damping: keep Euler explicit
+    root, world = _model(scene.name, flags, timestep=fmt([dt]), integrator=INTEGRATORS[integrator],
+                         gravity=fmt(gravity) if gravity is not None else "0 0 0")
     for body in scene.bodies:
         i = body.inertia_body
-        bodies.append(
-            f'    <body name="{body.name}" pos="{fmt(body.position_world)}" quat="{fmt(body.quat_wxyz)}">\n'
-            f'      <freejoint name="{body.name}_free"/>\n'
-            f'      <inertial pos="0 0 0" mass="{fmt([body.mass])}" '
-            f'fullinertia="{fmt([i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2]])}"/>\n'
-            f"    </body>"
-        )
-    return (
-        f'<mujoco model="{scene.name}">\n'
-        f'  <compiler angle="radian"/>\n'
-        f'  <option timestep="{fmt([dt])}" integrator="{INTEGRATORS[integrator]}" gravity="{gravity_attr}">\n'
-        f"    <flag {' '.join(flags)}/>\n"
-        f"  </option>\n"
-        f"  <worldbody>\n" + "\n".join(bodies) + "\n  </worldbody>\n</mujoco>\n"
-    )
+        element = ET.SubElement(world, "body", name=body.name, pos=fmt(body.position_world), quat=fmt(body.quat_wxyz))
+        ET.SubElement(element, "freejoint", name=f"{body.name}_free")
+        ET.SubElement(element, "inertial", pos="0 0 0", mass=fmt([body.mass]),
+                      fullinertia=fmt([i[0, 0], i[1, 1], i[2, 2], i[0, 1], i[0, 2], i[1, 2]]))
+    return _text(root)
 
 
 def chain_mjcf(chain: Chain) -> str:
     """MJCF text of a fixed-base chain (kinematics only)."""
-    lines = [f'<mujoco model="{chain.name}">', '  <compiler angle="radian"/>', "  <option>",
-             '    <flag contact="disable" gravity="disable"/>', "  </option>", "  <worldbody>"]
-    indent = "    "
+    root, parent = _model(chain.name, {"contact": "disable", "gravity": "disable"})
     for joint in chain.joints:
-        kind = "hinge" if joint.type == "revolute" else "slide"
-        limit = f' range="{fmt([joint.lower, joint.upper])}"' if joint.limited else ' limited="false"'
-        lines += [
-            f'{indent}<body name="{joint.name}" pos="{fmt(joint.origin_xyz)}" '
-            f'quat="{fmt(matrix_to_quat_wxyz(joint.origin_rotation))}">',
-            f'{indent}  <joint name="{joint.name}" type="{kind}" axis="{fmt(joint.axis)}"{limit}/>',
-            f'{indent}  <inertial pos="0 0 0" mass="{PLACEHOLDER_MASS}" '
-            f'diaginertia="{fmt([PLACEHOLDER_INERTIA] * 3)}"/>',
-        ]
-        indent += "  "
-    lines.append(
-        f'{indent}<site name="{chain.end_effector_name}" pos="{fmt(chain.end_effector_xyz)}" '
-        f'quat="{fmt(matrix_to_quat_wxyz(chain.end_effector_rotation))}"/>'
-    )
-    for _ in chain.joints:
-        indent = indent[:-2]
-        lines.append(f"{indent}</body>")
-    lines += ["  </worldbody>", "</mujoco>", ""]
-    return "\n".join(lines)
+        parent = ET.SubElement(parent, "body", name=joint.name, pos=fmt(joint.origin_xyz),
+                               quat=fmt(matrix_to_quat_wxyz(joint.origin_rotation)))
+        limits = {"range": fmt([joint.lower, joint.upper])} if joint.limited else {"limited": "false"}
+        ET.SubElement(parent, "joint", name=joint.name, type="hinge" if joint.type == "revolute" else "slide",
+                      axis=fmt(joint.axis), **limits)
+        ET.SubElement(parent, "inertial", pos="0 0 0", mass=fmt([PLACEHOLDER_MASS]),
+                      diaginertia=fmt([PLACEHOLDER_INERTIA] * 3))
+    ET.SubElement(parent, "site", name=chain.end_effector_name, pos=fmt(chain.end_effector_xyz),
+                  quat=fmt(matrix_to_quat_wxyz(chain.end_effector_rotation)))
+    return _text(root)

@@ -8,24 +8,30 @@ Conversions (each pinned by a test in ``tests/test_mujoco_adapter.py``)
 - Free-joint ``qvel[3:6]`` is the angular velocity in the BODY frame: world = R qvel[3:6].
 - Stepping uses ``mujoco.rollout`` (bit-identical to an ``mj_step`` loop), whose state
   rows are the state AFTER each step; the initial state is prepended.
-- Forces: linear drag and linear angular drag are MuJoCo's own ``dof_damping`` on the free
-  joint (translational damping acts on the world-frame origin velocity = COM velocity,
-  rotational on the local angular velocity; isotropic, so both equal the scene's drag), with
-  ``eulerdamp`` disabled so that Euler treats damping explicitly, as every other engine does
-  (the implicit integrators keep it implicit, by design). Wind adds the constant force b w,
-  passed to rollout as ``xfrc_applied``. Forces MuJoCo has no model for (quadratic drag,
-  forces at body points) are computed from the state at the start of each step and held
-  over the step in ``xfrc_applied`` by an ``mj_step`` loop; its RK4 then sees them as
-  constant within a step.
+- Forces, the way MuJoCo users apply them: linear drag and linear angular drag are
+  MuJoCo's own ``dof_damping`` on the free joint (translational damping acts on the
+  world-frame origin velocity = COM velocity, rotational on the local angular velocity;
+  isotropic, so both equal the scene's drag), with ``eulerdamp`` disabled so that Euler
+  treats damping explicitly, as every other engine does (the implicit integrators keep it
+  implicit, by design). Wind adds the constant force b w, passed to rollout as
+  ``xfrc_applied``. A force at a body point is applied at the point's WORLD position with
+  ``mj_applyFT`` (MuJoCo computes its torque). Quadratic drags, which MuJoCo does not
+  model, come from :mod:`references.external_forces` (independent of core) as
+  ``xfrc_applied``. Both are set from the state at the start of each step (positions
+  updated by ``mj_kinematics`` and ``mj_comPos`` first) and held over the step by an
+  ``mj_step`` loop; its RK4 then sees them as constant within a step.
 - Instability: MuJoCo does not return NaN; it warns ("Nan, Inf or huge value in QACC") and
   RESETS the state to the model's initial one, so the trajectory stays finite and wrong.
   The adapter counts ``mjWARN_BADQACC``, ``mjWARN_BADQPOS`` and ``mjWARN_BADQVEL`` over the
   run and raises ``DivergedError`` with MuJoCo's message instead (captured, not printed).
 - Kinematics: ``mj_kinematics`` then ``mj_comPos`` before ``mj_jacSite`` (the Jacobian is
-  silently zero without ``mj_comPos``). A chain read from a URDF file is loaded from that
-  file by MuJoCo's own URDF importer, with ``fusestatic`` off (by default MuJoCo merges
-  fixed-joint links away, and the end effector may be one) and a site added at the tip
-  link; other chains come from the adapter's MJCF.
+  silently zero without ``mj_comPos``). A chain read from a URDF file is that file without
+  its visual and collision geometry (:func:`references.urdf_export.chain_urdf`), compiled by
+  MuJoCo's own URDF importer with ``fusestatic`` off (by default MuJoCo merges fixed-joint
+  links away, and the end effector may be one), ``boundmass`` / ``boundinertia`` so that a
+  kinematics-only file without ``<inertial>`` compiles (masses play no part in
+  kinematics), and a site added at the tip link; poses are re-expressed in the chain's base
+  link (:mod:`references.base_frame`). Other chains come from the adapter's MJCF.
 """
 
 from __future__ import annotations
@@ -36,20 +42,23 @@ from mujoco import rollout
 
 from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
 from simparity.core.errors import DivergedError
-from simparity.core.rotations import quat_wxyz_to_matrix
-from simparity.core.forces import make_wrench
 from simparity.core.ik.problem import IKTolerances
-from simparity.core.rigid_body import MassProperties
 from simparity.core.scene import Chain, DynamicsScene, Forces
 from simparity.core.trajectory import FramePoses, Trajectory
-from simparity.references.conventions import fmt
-from simparity.references import mujoco_ik
+from simparity.references import external_forces, mujoco_ik
+from simparity.references.base_frame import BaseFrame
+from simparity.references.conventions import fmt, quat_wxyz_to_matrix
 from simparity.references.mjcf import INTEGRATORS, chain_mjcf, dynamics_mjcf
-from simparity.references.urdf_export import original_urdf
+from simparity.references.quiet import captured_output
+from simparity.references.urdf_export import chain_export, chain_source, chain_urdf
 
 _STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
 _RESET_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL)
 """Warnings on which MuJoCo resets the simulation to its initial state (and carries on)."""
+
+MIN_MASS, MIN_INERTIA = 1e-3, 1e-6  # [kg], [kg m^2]
+"""``boundmass`` / ``boundinertia`` of chains read from URDF: a link without ``<inertial>``
+gets these instead of MuJoCo's refusal; kinematics does not depend on them."""
 
 
 def _native_damping(forces: Forces, n_bodies: int) -> np.ndarray:
@@ -62,11 +71,19 @@ def _native_damping(forces: Forces, n_bodies: int) -> np.ndarray:
     return damping
 
 
-def _stepwise_forces(forces: Forces) -> Forces | None:
-    """The forces MuJoCo cannot model natively, or None when there are none."""
-    rest = Forces(air_velocity_world=forces.air_velocity_world, quadratic_drag=forces.quadratic_drag,
-                  angular_quadratic_drag=forces.angular_quadratic_drag, applied=forces.applied)
-    return rest if {"quadratic_drag", "angular_quadratic_drag", "applied_force"} & set(rest.names()) else None
+def _quadratic_drags(forces: Forces) -> Forces | None:
+    """The drags MuJoCo has no model for (quadratic, relative to the wind), or None."""
+    if forces.quadratic_drag is None and forces.angular_quadratic_drag is None:
+        return None
+    return Forces(air_velocity_world=forces.air_velocity_world, quadratic_drag=forces.quadratic_drag,
+                  angular_quadratic_drag=forces.angular_quadratic_drag)
+
+
+def _wind_force(forces: Forces) -> np.ndarray | None:
+    """(B, 3) constant force b w [N] completing the native damping -b v to -b (v - w), or None."""
+    if forces.air_velocity_world is None or forces.linear_drag is None:
+        return None
+    return forces.linear_drag[:, None] * forces.air_velocity_world
 
 
 class _Simulation(Simulation):
@@ -77,28 +94,34 @@ class _Simulation(Simulation):
         self.model.dof_damping[:] = _native_damping(forces, self._n_bodies).ravel()
         self._data = mujoco.MjData(self.model)
         self._xfrc = np.zeros((self.model.nbody, 6))  # world body first
-        if forces.air_velocity_world is not None and forces.linear_drag is not None:
-            self._xfrc[1:, :3] = forces.linear_drag[:, None] * forces.air_velocity_world
-        stepwise = _stepwise_forces(forces)
-        self._props = MassProperties.of(scene.bodies)
-        self._wrench = make_wrench(stepwise, self._props) if stepwise is not None else None
+        wind = _wind_force(forces)
+        if wind is not None:
+            self._xfrc[1:, :3] = wind
+        self._drags = _quadratic_drags(forces)
+        self._applied = forces.applied
         qvel = self._data.qvel.reshape(self._n_bodies, 6)
         for k, body in enumerate(scene.bodies):
             qvel[k, :3] = body.velocity_world
-            qvel[k, 3:] = body.rotation_world.T @ body.angular_velocity_world
+            qvel[k, 3:] = quat_wxyz_to_matrix(body.quat_wxyz).T @ body.angular_velocity_world
         self._state0 = np.empty(mujoco.mj_stateSize(self.model, _STATE))
         mujoco.mj_getState(self.model, self._data, self._state0, _STATE)
         self._qpos_at = mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_TIME)
         self._dt = dt
         native = [n for n in ("linear_drag", "angular_linear_drag") if n in forces.names()]
+        stepwise = (["mj_applyFT at each applied force's world point"] if self._applied else []) + (
+            [f"quadratic drag as xfrc_applied ({external_forces.DETAIL})"] if self._drags else [])
         self.detail = (
             f"MuJoCo integrator {INTEGRATORS[integrator]}; explicit inertia; contact disabled"
             + ("" if forces.gravity_world is not None else "; gravity disabled")
             + (f"; {' and '.join(native)} as dof_damping, eulerdamp disabled" if native else "")
-            + ("; wind as constant xfrc_applied" if np.any(self._xfrc) else "")
-            + ("; stepped by mujoco.rollout" if self._wrench is None else
-               "; other forces as xfrc_applied from the state at each step start, mj_step loop")
+            + ("; wind as constant xfrc_applied b w" if wind is not None else "")
+            + ("; stepped by mujoco.rollout" if not self._stepwise else
+               "; " + "; ".join(stepwise) + ", from the state at each step start, mj_step loop")
         )
+
+    @property
+    def _stepwise(self) -> bool:
+        return bool(self._applied) or self._drags is not None
 
     def _rollout(self, n_steps: int) -> np.ndarray:
         if not np.any(self._xfrc):
@@ -108,18 +131,29 @@ class _Simulation(Simulation):
                                         control_spec=mujoco.mjtState.mjSTATE_XFRC_APPLIED, nstep=n_steps)
         return states[0]
 
+    def _apply_forces(self) -> None:
+        """Set xfrc_applied and qfrc_applied from the current state (positions updated first)."""
+        m, d, b = self.model, self._data, self._n_bodies
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        d.xfrc_applied[:] = self._xfrc
+        if self._drags is not None:
+            qvel = d.qvel.reshape(b, 6)
+            omega = np.array([d.xmat[k + 1].reshape(3, 3) @ qvel[k, 3:] for k in range(b)])
+            d.xfrc_applied[1:, :3] += external_forces.drag_force_world(self._drags, qvel[:, :3])
+            d.xfrc_applied[1:, 3:] += external_forces.drag_torque_world(self._drags, omega)
+        d.qfrc_applied[:] = 0.0
+        for applied in self._applied:
+            body = applied.body + 1
+            point = d.xpos[body] + d.xmat[body].reshape(3, 3) @ applied.point_body
+            mujoco.mj_applyFT(m, d, applied.force_world, np.zeros(3), point, body, d.qfrc_applied)
+
     def _loop(self, n_steps: int) -> np.ndarray:
         m, d = self.model, self._data
         mujoco.mj_setState(m, d, self._state0, _STATE)
         states = np.empty((n_steps, len(self._state0)))
-        b = self._n_bodies
         for i in range(n_steps):
-            qpos, qvel = d.qpos.reshape(b, 7), d.qvel.reshape(b, 6)
-            rotation = quat_wxyz_to_matrix(qpos[:, 3:])
-            omega = np.einsum("bij,bj->bi", rotation, qvel[:, 3:])
-            force, torque = self._wrench(i * m.opt.timestep, qpos[:, :3], rotation, qvel[:, :3], omega)
-            d.xfrc_applied[1:, :3] = self._xfrc[1:, :3] + force
-            d.xfrc_applied[1:, 3:] = torque
+            self._apply_forces()
             mujoco.mj_step(m, d)
             mujoco.mj_getState(m, d, states[i], _STATE)
         return states
@@ -131,7 +165,7 @@ class _Simulation(Simulation):
         messages: list[str] = []
         mujoco.set_mju_user_warning(messages.append)
         try:
-            stepped = self._rollout(n_steps) if self._wrench is None else self._loop(n_steps)
+            stepped = self._loop(n_steps) if self._stepwise else self._rollout(n_steps)
         finally:
             mujoco.set_mju_user_warning(None)
         if any(warning.number for warning in warnings):
@@ -147,13 +181,16 @@ class _Simulation(Simulation):
 
 
 def _chain_model(chain: Chain) -> mujoco.MjModel:
-    """The chain's MuJoCo model: its original URDF (fixed links kept, a site at the tip link), or the MJCF export."""
-    if chain.urdf_path is None:
-        return mujoco.MjModel.from_xml_string(chain_mjcf(chain))
-    spec = mujoco.MjSpec.from_file(chain.urdf_path)
-    spec.compiler.fusestatic = False  # keep fixed-joint links: the end effector may be one
-    spec.body(chain.end_effector_name).add_site(name=chain.end_effector_name)
-    return spec.compile()
+    """The chain's MuJoCo model: its URDF file without geometry (fixed links kept, a site at the
+    tip link, masses bounded), or the MJCF export."""
+    with captured_output():
+        if chain.urdf_path is None:
+            return mujoco.MjModel.from_xml_string(chain_mjcf(chain))
+        spec = mujoco.MjSpec.from_string(chain_urdf(chain))
+        spec.compiler.fusestatic = False  # keep fixed-joint links: the end effector may be one
+        spec.compiler.boundmass, spec.compiler.boundinertia = MIN_MASS, MIN_INERTIA
+        spec.body(chain.end_effector_name).add_site(name=chain.end_effector_name)
+        return spec.compile()
 
 
 class MujocoChain(KinematicsModel):
@@ -168,6 +205,9 @@ class MujocoChain(KinematicsModel):
         Body of each joint (its child link).
     site : int
         The end-effector site.
+    base : BaseFrame
+        The chain's base link in MuJoCo's world (identity unless a URDF chain starts below
+        the file's root link).
     """
 
     def __init__(self, chain: Chain) -> None:
@@ -178,8 +218,19 @@ class MujocoChain(KinematicsModel):
         self.dof_adr = self.model.jnt_dofadr[joints]
         self.bodies = self.model.jnt_bodyid[joints]
         self.site = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_SITE, chain.end_effector_name)
-        origin = f"MjSpec from {chain.urdf_path} (fusestatic off)" if chain.urdf_path else "the adapter's MJCF"
+        self.base = self._base_frame(chain)
+        origin = (f"MuJoCo's URDF importer on {chain_source(chain)}, fusestatic off" if chain.urdf_path
+                  else "the adapter's MJCF")
         self.detail = f"{origin}; mj_kinematics + mj_comPos; mj_jacSite at the end-effector site"
+
+    def _base_frame(self, chain: Chain) -> BaseFrame:
+        """The base link body's pose at qpos0 (MuJoCo's world body, the identity, if it merged into it)."""
+        body = -1 if chain.base_link is None else mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY,
+                                                                      chain.base_link)
+        if body <= 0:
+            return BaseFrame()
+        mujoco.mj_kinematics(self.model, self.data)
+        return BaseFrame(self.data.xpos[body].copy(), self.data.xmat[body].reshape(3, 3).copy())
 
     def set(self, q_row: np.ndarray) -> None:
         """Put the joints at ``q_row`` (n,) and update kinematics and COM positions."""
@@ -197,7 +248,7 @@ class MujocoChain(KinematicsModel):
             rot[k, :n] = self.data.xmat[self.bodies].reshape(n, 3, 3)
             pos[k, n] = self.data.site_xpos[self.site]
             rot[k, n] = self.data.site_xmat[self.site].reshape(3, 3)
-        return FramePoses(pos, rot)
+        return FramePoses(*self.base.frames(pos, rot))
 
     def jacobian_world(self, q: np.ndarray) -> np.ndarray:
         q = np.atleast_2d(q)
@@ -207,11 +258,11 @@ class MujocoChain(KinematicsModel):
             self.set(row)
             mujoco.mj_jacSite(self.model, self.data, jacp, jacr, self.site)
             out[k, :3], out[k, 3:] = jacp[:, self.dof_adr], jacr[:, self.dof_adr]
-        return out
+        return self.base.jacobian(out)
 
 
 class MujocoEngine(Engine):
-    """MuJoCo, built from MJCF the adapter writes (see :mod:`references.mjcf`)."""
+    """MuJoCo, built from MJCF the adapter writes (see :mod:`references.mjcf`) or from a chain's URDF file."""
 
     name = "mujoco"
 
@@ -242,22 +293,27 @@ class MujocoEngine(Engine):
     def export(self, scene, integrator, dt) -> str:
         if not isinstance(scene, DynamicsScene):
             if scene.chain.urdf_path:
-                return original_urdf(scene.chain, "MjSpec.from_file, fusestatic off, a site added at the tip link")
+                return chain_export(scene.chain, f"MjSpec.from_string (MuJoCo's URDF importer), fusestatic off, "
+                                    f"boundmass {MIN_MASS:g}, boundinertia {MIN_INERTIA:g}, a site at the tip link")
             return chain_mjcf(scene.chain)
         integrator, dt = self._export_settings(scene, integrator, dt)
         velocities = "".join(
             f"<!-- initial qvel of {b.name}: linear (world) {fmt(b.velocity_world)}, "
-            f"angular (body) {fmt(b.rotation_world.T @ b.angular_velocity_world)} -->\n"
+            f"angular (body) {fmt(quat_wxyz_to_matrix(b.quat_wxyz).T @ b.angular_velocity_world)} -->\n"
             for b in scene.bodies
         )
         damping = _native_damping(scene.forces, len(scene.bodies))
         extra = (f"<!-- set after compiling: dof_damping = {fmt(damping)} (per body: 3 translational, "
                  "3 rotational) -->\n" if np.any(damping) else "")
-        if scene.forces.air_velocity_world is not None and scene.forces.linear_drag is not None:
-            wind = scene.forces.linear_drag[:, None] * scene.forces.air_velocity_world
+        wind = _wind_force(scene.forces)
+        if wind is not None:
             extra += f"<!-- constant xfrc_applied force (wind, b w) per body: {fmt(wind)} N -->\n"
-        stepwise = _stepwise_forces(scene.forces)
-        if stepwise is not None:
+        drags = _quadratic_drags(scene.forces)
+        if drags is not None:
             extra += (f"<!-- each step, xfrc_applied from the state at its start: "
-                      f"{', '.join(n for n in stepwise.names() if n != 'wind')} -->\n")
+                      f"{', '.join(n for n in drags.names() if n != 'wind')} -->\n")
+        for applied in scene.forces.applied:
+            extra += (f"<!-- each step, mj_applyFT of {fmt(applied.force_world)} N at body point "
+                      f"{fmt(applied.point_body)} m (world position from the state at the step's start), "
+                      f"body {applied.body + 1} -->\n")
         return dynamics_mjcf(scene, integrator, dt) + velocities + extra

@@ -18,7 +18,10 @@ scene's (position residual <= ``options.position_tolerance`` and angle <=
 
 Conventions and what the adapter does (pinned in ``tests/test_mujoco_ik.py``)
 ---------------------------------------------------------------------------
-- The model is :func:`references.mjcf.chain_mjcf`; the end effector is its site.
+- The model is the chain's (:class:`references.mujoco_adapter.MujocoChain`: its URDF file
+  without geometry, or the MJCF export); the end effector is its site. Targets are given
+  in the chain's base frame and moved into MuJoCo's world (:mod:`references.base_frame`);
+  residuals are distances, the same in either frame.
 - ``mj_kinematics`` then ``mj_comPos`` before ``mj_jacSite`` (the Jacobian is silently
   zero without ``mj_comPos``); dm_control calls ``mj_fwdPosition``, which does both.
 - MuJoCo quaternions are (w, x, y, z), the project's order: no reordering. The rotation
@@ -38,7 +41,6 @@ import numpy as np
 from simparity.core.engine import IKModel
 from simparity.core.ik.problem import IKTolerances, check_inputs
 from simparity.core.ik.result import IKResult
-from simparity.core.rotations import matrix_to_quat_wxyz
 from simparity.core.scene import Chain
 from simparity.references.ik_outcome import ik_outcome
 
@@ -76,6 +78,7 @@ class MujocoIK(IKModel):
         self._chain, self._options = chain, options
         self._model, self._data = kinematics.model, kinematics.data
         self._qadr, self._dofadr, self._site = kinematics.qpos_adr, kinematics.dof_adr, kinematics.site
+        self._base = kinematics.base
         self.detail = (f"dm_control qpos_from_site_pose on mj_jacSite: lambda {REGULARIZATION_STRENGTH:g} while "
                        f"err > {REGULARIZATION_THRESHOLD:g}, |dq| <= {MAX_UPDATE_NORM:g}, progress halt "
                        f"{PROGRESS_THRESH:g}; max_steps {options.max_iterations}; stops at the scene's "
@@ -84,14 +87,15 @@ class MujocoIK(IKModel):
     def solve(self, target_position_world: np.ndarray, target_rotation_world: np.ndarray | None,
               q_start: np.ndarray) -> IKResult:
         p, r, q0 = check_inputs(self._chain, target_position_world, target_rotation_world, q_start)
-        quat = None if r is None else matrix_to_quat_wxyz(r)
+        world_p, world_r = self._base.targets_to_world(p, r)
+        quat = None if world_r is None else np.array([_mat2quat(m) for m in world_r])
         batch = len(p)
         q = np.empty_like(q0)
         iterations = np.empty(batch, int)
         position_residual, orientation_residual = np.empty(batch), np.zeros(batch)
         for k in range(batch):
             q[k], iterations[k], position_residual[k], orientation_residual[k] = self._dls(
-                p[k], None if quat is None else quat[k], q0[k])
+                world_p[k], None if quat is None else quat[k], q0[k])
         return ik_outcome(self._chain, q, iterations, position_residual, orientation_residual, p, self._options)
 
     def _dls(self, target_pos: np.ndarray, target_quat: np.ndarray | None,
@@ -131,6 +135,13 @@ class MujocoIK(IKModel):
             mujoco.mj_integratePos(model, data.qpos, update, 1.0)
             steps += 1
         return data.qpos[self._qadr].copy(), steps, position, angle
+
+
+def _mat2quat(rotation: np.ndarray) -> np.ndarray:
+    """MuJoCo's quaternion (w, x, y, z) of a rotation matrix (3, 3)."""
+    quat = np.empty(4)
+    mujoco.mju_mat2Quat(quat, np.ascontiguousarray(rotation).ravel())
+    return quat
 
 
 def _nullspace_method(jac: np.ndarray, err: np.ndarray, regularization: float) -> np.ndarray:

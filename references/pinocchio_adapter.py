@@ -12,15 +12,20 @@ Conversions (each pinned by a test in ``tests/test_pinocchio_adapter.py``)
   a[0:3] + omega x v[0:3] (both local).
 - ``euler``: the engines' first-order scheme (as MuJoCo Euler): v_world += dt R a_classical,
   omega_local += dt a[3:6], then p += dt v_world and R = R exp(dt omega_local).
-- ``rk4``: RK4 on the same accelerations, the rotation by RKMK in the body frame.
-  Stepping ``pin.integrate`` on the local twist instead would follow an SE(3) screw and
-  drift from the others (0.25 m after 2 s of free fall).
-- Forces other than gravity (``model.gravity``) enter ``aba`` as ``fext``: per joint, a
-  force and a torque about the joint origin (the COM) in the LOCAL frame: (R^T F, R^T tau).
-- Chains: a chain read from a URDF file is built from that file (``buildModelFromUrdf``),
-  others from the adapter's URDF (``buildModelFromXML``); fixed base. A ``continuous``
-  joint has nq = 2 (cos, sin). Joint frames are the child links' frames; Jacobians are
-  LOCAL_WORLD_ALIGNED.
+- ``rk4``: RK4 on the same accelerations, the rotation by RKMK in the body frame with
+  Pinocchio's own Lie-group functions: R = R0 exp3(u), du/dt = Jlog3(exp3(u)) w (the inverse
+  of the right Jacobian of exp). Stepping ``pin.integrate`` on the local twist instead
+  would follow an SE(3) screw and drift from the others (0.25 m after 2 s of free fall).
+- Forces other than gravity (``model.gravity``) enter ``aba`` as ``fext``, as Pinocchio
+  users give them: per joint a spatial force about the joint origin (the COM) in the LOCAL
+  frame. A force f at a body point p is ``SE3(I, p).act(Force(R^T f, 0))`` (Pinocchio
+  computes its moment); drag and wind (:mod:`references.external_forces`, independent of
+  core) are (R^T F, R^T tau) at the COM.
+- Chains: the chain's URDF text (:func:`references.urdf_export.chain_urdf`: a URDF file
+  without its visual and collision geometry, or the adapter's export) read by
+  ``buildModelFromXML``; fixed base. A ``continuous`` joint has nq = 2 (cos, sin). Joint
+  frames are the child links' frames; Jacobians are LOCAL_WORLD_ALIGNED; poses are
+  re-expressed in the chain's base link (:mod:`references.base_frame`).
 """
 
 from __future__ import annotations
@@ -29,16 +34,14 @@ import numpy as np
 import pinocchio as pin
 
 from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
-from simparity.core.integrators import dexpinv_so3
-from simparity.core.rotations import matrix_to_quat_wxyz, so3_exp
-from simparity.core.forces import make_wrench, without_gravity
 from simparity.core.ik.problem import IKTolerances
-from simparity.core.rigid_body import MassProperties
 from simparity.core.scene import Chain, DynamicsScene
 from simparity.core.trajectory import FramePoses, Trajectory
-from simparity.references import pinocchio_ik
-from simparity.references.conventions import xyzw_from_wxyz
-from simparity.references.urdf_export import chain_urdf, original_urdf, UrdfChains
+from simparity.references import external_forces, pinocchio_ik
+from simparity.references.base_frame import BaseFrame
+from simparity.references.conventions import matrix_to_quat_wxyz, quat_wxyz_to_matrix
+from simparity.references.quiet import captured_output
+from simparity.references.urdf_export import UrdfChains, chain_export, chain_source, chain_urdf
 
 
 def free_bodies_model(scene: DynamicsScene) -> pin.Model:
@@ -74,18 +77,21 @@ class _Simulation(Simulation):
         self._model = free_bodies_model(scene)
         self._data = self._model.createData()
         self._position0 = np.stack([b.position_world for b in scene.bodies])
-        self._rotation0 = np.stack([b.rotation_world for b in scene.bodies])
+        self._rotation0 = quat_wxyz_to_matrix(np.stack([b.quat_wxyz for b in scene.bodies]))
         self._velocity0 = np.stack([b.velocity_world for b in scene.bodies])
         self._omega_local0 = np.einsum(
             "bji,bj->bi", self._rotation0, np.stack([b.angular_velocity_world for b in scene.bodies])
         )
         self._tau = np.zeros(self._model.nv)
-        extra = without_gravity(scene.forces)
-        self._wrench = make_wrench(extra, MassProperties.of(scene.bodies)) if extra.names() else None
+        self._forces = scene.forces
+        self._drag = external_forces.has_drag(scene.forces) or external_forces.has_angular_drag(scene.forces)
+        self._external = self._drag or bool(scene.forces.applied)
         self._step = self._rk4 if integrator == "rk4" else self._euler
         self._dt = dt
         self.detail = ("harness-stepped: pin.aba accelerations, "
-                       + ("RK4 with RKMK on SO(3)" if integrator == "rk4" else "engines' semi-implicit Euler on SO(3)"))
+                       + ("RK4 with RKMK on SO(3)" if integrator == "rk4" else "engines' semi-implicit Euler on SO(3)")
+                       + ("; applied forces as aba fext at their body points (SE3.act)" if scene.forces.applied else "")
+                       + (f"; {external_forces.DETAIL}, as aba fext" if self._drag else ""))
 
     def run(self, n_steps: int) -> Trajectory:
         dt, b = self._dt, len(self._position0)
@@ -99,21 +105,33 @@ class _Simulation(Simulation):
         times = np.arange(n_steps + 1) * dt
         return Trajectory(times, pos, matrix_to_quat_wxyz(rot), vel, omg)
 
+    def _fext(self, r: np.ndarray, v: np.ndarray, w_local: np.ndarray) -> pin.StdVec_Force:
+        """aba's external forces per joint (universe first), LOCAL frame, about each COM."""
+        b = len(r)
+        force, torque = np.zeros((b, 3)), np.zeros((b, 3))
+        if self._drag:
+            force = external_forces.drag_force_world(self._forces, v)
+            torque = external_forces.drag_torque_world(self._forces, np.einsum("bij,bj->bi", r, w_local))
+        per_joint = [pin.Force.Zero()] + [pin.Force(r[k].T @ force[k], r[k].T @ torque[k]) for k in range(b)]
+        for applied in self._forces.applied:
+            k = applied.body
+            at_point = pin.SE3(np.eye(3), applied.point_body)
+            per_joint[k + 1] = per_joint[k + 1] + at_point.act(pin.Force(r[k].T @ applied.force_world, np.zeros(3)))
+        fext = pin.StdVec_Force()
+        for spatial in per_joint:
+            fext.append(spatial)
+        return fext
+
     def _accelerations(self, t, p, r, v, w_local) -> tuple[np.ndarray, np.ndarray]:
         """(dv/dt world (B, 3), dw/dt local (B, 3)) from aba, the scene's non-gravity forces as fext."""
         b = len(p)
-        q = np.concatenate([p, xyzw_from_wxyz(matrix_to_quat_wxyz(r))], axis=1)
+        q = np.concatenate([pin.SE3ToXYZQUAT(pin.SE3(r[k], p[k])) for k in range(b)])
         v_local = np.einsum("bji,bj->bi", r, v)
-        qd = np.concatenate([v_local, w_local], axis=1)
-        if self._wrench is None:
-            a = pin.aba(self._model, self._data, q.ravel(), qd.ravel(), self._tau).reshape(b, 6)
+        qd = np.concatenate([v_local, w_local], axis=1).ravel()
+        if self._external:
+            a = pin.aba(self._model, self._data, q, qd, self._tau, self._fext(r, v, w_local)).reshape(b, 6)
         else:
-            force, torque = self._wrench(t, p, r, v, np.einsum("bij,bj->bi", r, w_local))
-            fext = pin.StdVec_Force()
-            fext.append(pin.Force.Zero())
-            for k in range(b):
-                fext.append(pin.Force(r[k].T @ force[k], r[k].T @ torque[k]))
-            a = pin.aba(self._model, self._data, q.ravel(), qd.ravel(), self._tau, fext).reshape(b, 6)
+            a = pin.aba(self._model, self._data, q, qd, self._tau).reshape(b, 6)
         # aba's linear part is the spatial acceleration; the COM's classical one adds w x v.
         return np.einsum("bij,bj->bi", r, a[:, :3] + np.cross(w_local, v_local)), a[:, 3:]
 
@@ -121,7 +139,7 @@ class _Simulation(Simulation):
         p, r, v, w = state
         dv, dw = self._accelerations(t, p, r, v, w)
         v, w = v + dt * dv, w + dt * dw
-        return p + dt * v, r @ so3_exp(dt * w), v, w
+        return p + dt * v, r @ _exp3(dt * w), v, w
 
     def _rk4(self, t, state, dt):
         p, r, v, w = state
@@ -130,38 +148,54 @@ class _Simulation(Simulation):
             inc = [sum((dt * a * k[j] for a, k in zip(a_row, ks)), start=np.zeros_like(p)) for j in range(4)]
             u = inc[1]
             stage_v, stage_w = v + inc[2], w + inc[3]
-            dv, dw = self._accelerations(t + c * dt, p + inc[0], r @ so3_exp(u), stage_v, stage_w)
-            ks.append((stage_v, dexpinv_so3(-u, stage_w), dv, dw))
+            dv, dw = self._accelerations(t + c * dt, p + inc[0], r @ _exp3(u), stage_v, stage_w)
+            ks.append((stage_v, _dexp_inverse(u, stage_w), dv, dw))
         total = [sum(dt * bi * k[j] for bi, k in zip(_RK4_B, ks)) for j in range(4)]
-        return p + total[0], r @ so3_exp(total[1]), v + total[2], w + total[3]
+        return p + total[0], r @ _exp3(total[1]), v + total[2], w + total[3]
+
+
+def _exp3(rotvec: np.ndarray) -> np.ndarray:
+    """Pinocchio's exp3 per body: (B, 3) rotation vectors -> (B, 3, 3)."""
+    return np.array([pin.exp3(u) for u in rotvec])
+
+
+def _dexp_inverse(u: np.ndarray, w_local: np.ndarray) -> np.ndarray:
+    """du/dt of R = R0 exp3(u) with body angular velocity w: Jlog3(exp3(u)) w. (B, 3) x (B, 3) -> (B, 3)."""
+    return np.array([pin.Jlog3(pin.exp3(uk)) @ wk for uk, wk in zip(u, w_local)])
 
 
 class PinocchioChain(KinematicsModel):
-    """A fixed-base chain in Pinocchio: its original URDF when it has one, else the adapter's export.
+    """A fixed-base chain in Pinocchio: its URDF file without geometry when it has one, else the adapter's export.
 
     Attributes
     ----------
     model, data : pinocchio.Model, pinocchio.Data
     end_frame : int
         Frame id of the end effector (the BODY frame of the link of that name).
+    idx_v : list of int
+        Velocity index of each chain joint (a URDF file may have joints off the chain).
+    base : BaseFrame
+        The chain's base link in Pinocchio's world.
     """
 
     def __init__(self, chain: Chain) -> None:
-        if chain.urdf_path is None:
+        with captured_output():
             self.model = pin.buildModelFromXML(chain_urdf(chain))
-        else:
-            self.model = pin.buildModelFromUrdf(chain.urdf_path)
         self.data = self.model.createData()
         joints = [self.model.joints[self.model.getJointId(j.name)] for j in chain.joints]
         self._idx_q = [j.idx_q for j in joints]
-        self._idx_v = [j.idx_v for j in joints]
+        self.idx_v = [j.idx_v for j in joints]
         self._continuous = [j.nq == 2 for j in joints]
         # A joint's frame is its child link's frame (URDF); the end effector is a link.
         self._frames = [self.model.getFrameId(j.name, pin.JOINT) for j in chain.joints]
         self.end_frame = self.model.getFrameId(chain.end_effector_name, pin.BODY)
         self._frames.append(self.end_frame)
-        origin = f"buildModelFromUrdf({chain.urdf_path})" if chain.urdf_path else "the adapter's URDF"
-        self.detail = (f"{origin}; forwardKinematics + updateFramePlacements; "
+        self.base = BaseFrame()
+        if chain.base_link is not None:
+            pin.framesForwardKinematics(self.model, self.data, pin.neutral(self.model))
+            placement = self.data.oMf[self.model.getFrameId(chain.base_link, pin.BODY)]
+            self.base = BaseFrame(placement.translation.copy(), placement.rotation.copy())
+        self.detail = (f"buildModelFromXML of {chain_source(chain)}; forwardKinematics + updateFramePlacements; "
                        "computeFrameJacobian LOCAL_WORLD_ALIGNED")
 
     def configuration(self, q_row: np.ndarray) -> np.ndarray:
@@ -188,20 +222,20 @@ class PinocchioChain(KinematicsModel):
             for f, fid in enumerate(self._frames):
                 pos[k, f] = self.data.oMf[fid].translation
                 rot[k, f] = self.data.oMf[fid].rotation
-        return FramePoses(pos, rot)
+        return FramePoses(*self.base.frames(pos, rot))
 
     def jacobian_world(self, q: np.ndarray) -> np.ndarray:
         q = np.atleast_2d(q)
-        out = np.empty((len(q), 6, len(self._idx_v)))
+        out = np.empty((len(q), 6, len(self.idx_v)))
         for k, row in enumerate(q):
             jac = pin.computeFrameJacobian(self.model, self.data, self.configuration(row), self.end_frame,
                                            pin.LOCAL_WORLD_ALIGNED)
-            out[k] = jac[:, self._idx_v]
-        return out
+            out[k] = jac[:, self.idx_v]
+        return self.base.jacobian(out)
 
 
 class PinocchioEngine(UrdfChains, Engine):
-    """Pinocchio: kinematics from the adapter's URDF; dynamics from aba, stepped by the harness."""
+    """Pinocchio: kinematics from a chain's URDF; dynamics from aba, stepped by the harness."""
 
     name = "pinocchio"
 
@@ -228,19 +262,16 @@ class PinocchioEngine(UrdfChains, Engine):
 
     def export(self, scene, integrator, dt) -> str:
         if not isinstance(scene, DynamicsScene):
-            if scene.chain.urdf_path:
-                return original_urdf(scene.chain, "pinocchio.buildModelFromUrdf (fixed base)")
-            return chain_urdf(scene.chain)
+            return chain_export(scene.chain, "pinocchio.buildModelFromXML (fixed base)")
         integrator, dt = self._export_settings(scene, integrator, dt)
         model = free_bodies_model(scene)
         inertias = "".join(
             f"{model.names[j]}: {model.inertias[j]}\n" for j in range(1, model.njoints)
         )
+        external = [n for n in scene.forces.names() if n != "gravity"]
         return (
             f"# Pinocchio model built in code (no file): one free-flyer per body.\n"
             f"# gravity: {model.gravity.linear}; stepped by the harness ({integrator}, dt = {dt!r} s)\n"
-            + (f"# each step, aba's fext (local frame, about the COM): "
-               f"{', '.join(without_gravity(scene.forces).names())}\n" if without_gravity(scene.forces).names() else "")
-            + 
-f"{model}\n{inertias}"
+            + (f"# each step, aba's fext (local frame, about the COM): {', '.join(external)}\n" if external else "")
+            + f"{model}\n{inertias}"
         )

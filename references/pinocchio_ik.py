@@ -15,11 +15,15 @@ I)^-1 err.
 
 Conventions and what the adapter does (pinned in ``tests/test_pinocchio_ik.py``)
 -------------------------------------------------------------------------------
-- The model is :func:`references.urdf_export.chain_urdf` read by ``buildModelFromXML``
-  (fixed base); the end effector is the BODY frame named after it.
+- The model is the chain's (:class:`references.pinocchio_adapter.PinocchioChain`: its
+  URDF file without geometry, or the export, read by ``buildModelFromXML``; fixed base);
+  the end effector is the BODY frame named after it. Targets are given in the chain's
+  base frame and moved into Pinocchio's world (:mod:`references.base_frame`).
 - A ``continuous`` (unlimited revolute) joint has nq = 2, (cos, sin): the start angle is
   converted in, the result converted back with atan2 (in (-pi, pi]). ``integrate``
   keeps (cos, sin) on the unit circle; nothing else is normalised.
+- Only the chain's joints move: the Jacobian's columns of joints off the chain (above its
+  base link, or on other branches of the file) are left out and their velocity is 0.
 - No joint limits (the documentation has none): revolute angles can leave their limits
   and are returned as they are; ``limit_violation`` says by how much.
 - Residuals come from Pinocchio's forward kinematics at the returned q (double):
@@ -78,6 +82,7 @@ class PinocchioIK(IKModel):
         self._max_updates = DOCUMENTED_IT_MAX if self._documented else options.max_iterations
         self._kinematics = kinematics
         self._model, self._data, self._frame = kinematics.model, kinematics.data, kinematics.end_frame
+        self._idx_v = kinematics.idx_v
         stop = (f"|log6 err| < {DOCUMENTED_EPS:g}, IT_MAX {DOCUMENTED_IT_MAX}" if self._documented else
                 f"position <= {options.position_tolerance:g} m and angle <= {options.orientation_tolerance:g} rad, "
                 f"IT_MAX {options.max_iterations}")
@@ -87,16 +92,18 @@ class PinocchioIK(IKModel):
     def solve(self, target_position_world: np.ndarray, target_rotation_world: np.ndarray | None,
               q_start: np.ndarray) -> IKResult:
         p, r, q0 = check_inputs(self._chain, target_position_world, target_rotation_world, q_start)
+        p_world, r_world = self._kinematics.base.targets_to_world(p, r)
         batch = len(p)
         q = np.empty_like(q0)
         iterations = np.empty(batch, int)
         position_residual, orientation_residual = np.empty(batch), np.zeros(batch)
         for k in range(batch):
             if r is None:
-                config, iterations[k], position_residual[k] = self._position_clik(p[k], self._kinematics.configuration(q0[k]))
+                config, iterations[k], position_residual[k] = self._position_clik(
+                    p_world[k], self._kinematics.configuration(q0[k]))
             else:
                 config, iterations[k], position_residual[k], orientation_residual[k] = self._pose_clik(
-                    pin.SE3(r[k], p[k]), self._kinematics.configuration(q0[k]))
+                    pin.SE3(r_world[k], p_world[k]), self._kinematics.configuration(q0[k]))
             q[k] = self._kinematics.joint_values(config)
         return ik_outcome(self._chain, q, iterations, position_residual, orientation_residual, p, self._options)
 
@@ -111,10 +118,10 @@ class PinocchioIK(IKModel):
             position, angle = np.linalg.norm(i_m_d.translation), np.linalg.norm(err[3:])
             if self._converged(np.linalg.norm(err), position, angle) or i >= self._max_updates:
                 return q, i, position, angle
-            jac = pin.computeFrameJacobian(model, data, q, self._frame, pin.LOCAL)
+            jac = pin.computeFrameJacobian(model, data, q, self._frame, pin.LOCAL)[:, self._idx_v]
             jac = -pin.Jlog6(i_m_d.inverse()) @ jac
             v = -jac.T @ np.linalg.solve(jac @ jac.T + DAMP * np.eye(6), err)
-            q = pin.integrate(model, q, v * DT)
+            q = pin.integrate(model, q, self._on_chain(v) * DT)
             i += 1
 
     def _position_clik(self, p_des: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, int, float]:
@@ -127,10 +134,16 @@ class PinocchioIK(IKModel):
             position = np.linalg.norm(err)
             if self._converged(position, position, 0.0) or i >= self._max_updates:
                 return q, i, position
-            jac = pin.computeFrameJacobian(model, data, q, self._frame, pin.LOCAL_WORLD_ALIGNED)[:3]
+            jac = pin.computeFrameJacobian(model, data, q, self._frame, pin.LOCAL_WORLD_ALIGNED)[:3, self._idx_v]
             v = jac.T @ np.linalg.solve(jac @ jac.T + DAMP * np.eye(3), err)
-            q = pin.integrate(model, q, v * DT)
+            q = pin.integrate(model, q, self._on_chain(v) * DT)
             i += 1
+
+    def _on_chain(self, v_chain: np.ndarray) -> np.ndarray:
+        """The model's velocity (nv,): the chain joints' (n,) in place, 0 for every other joint."""
+        v = np.zeros(self._model.nv)
+        v[self._idx_v] = v_chain
+        return v
 
     def _converged(self, err_norm: float, position: float, angle: float) -> bool:
         if self._documented:

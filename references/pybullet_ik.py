@@ -14,8 +14,13 @@ and the limits stay soft: the result can still lie outside them.
 Conventions and what the adapter does (pinned in ``tests/test_pybullet_ik.py``)
 -----------------------------------------------------------------------------
 - The chain is the URDF of :func:`references.urdf_export.chain_urdf`, loaded with a fixed
-  base; PyBullet targets the URDF link frame of the end-effector link (link index of
-  the fixed joint ``<ee>_fixed``), which is the chain's end-effector frame.
+  base (:class:`references.pybullet_adapter.PybulletChain`). Targets are given in the
+  chain's base frame and moved into PyBullet's world (:mod:`references.base_frame`).
+- PyBullet's target POSITION is the URDF link frame's origin of the end-effector link, but
+  its target ORIENTATION is that of the link's INERTIAL frame, which PyBullet rotates to
+  principal axes when the URDF inertia has products of inertia (measured on the Panda's
+  ``panda_link7``: a 0.24 rad miss). The adapter passes R_target R_inertial, with
+  R_inertial the inertial frame's orientation in the link frame (``getDynamicsInfo``).
 - ``targetOrientation`` is a quaternion (x, y, z, w): reordered from the project's
   (w, x, y, z). Position-only targets are called without it.
 - The solver starts from the body's current joint state: every target starts with the
@@ -38,9 +43,8 @@ from simparity.references.pybullet_quiet import pybullet
 from simparity.core.engine import IKModel
 from simparity.core.ik.problem import IKTolerances, check_inputs
 from simparity.core.ik.result import IKResult
-from simparity.core.rotations import geodesic_angle_matrix, matrix_to_quat_wxyz
 from simparity.core.scene import Chain
-from simparity.references.conventions import xyzw_from_wxyz
+from simparity.references.conventions import matrix_to_quat_wxyz, rotation_angle, xyzw_from_wxyz
 from simparity.references.ik_outcome import ik_outcome
 
 SOLVERS = ("calculateInverseKinematics", "calculateInverseKinematics-tuned",
@@ -120,7 +124,8 @@ class PybulletIK(IKModel):
         p, r, q0 = check_inputs(self._chain, target_position_world, target_rotation_world, q_start)
         kin = self._kinematics
         settings = dict(self._settings)
-        quat_xyzw = None if r is None else xyzw_from_wxyz(matrix_to_quat_wxyz(r))
+        world_p, world_r = kin.base.targets_to_world(p, r)
+        quat_xyzw = None if r is None else xyzw_from_wxyz(matrix_to_quat_wxyz(world_r @ kin.end_inertial_rotation))
         q = np.empty_like(q0)
         for k in range(len(p)):
             kin.set(q0[k])
@@ -129,9 +134,9 @@ class PybulletIK(IKModel):
             if quat_xyzw is not None:
                 settings["targetOrientation"] = quat_xyzw[k].tolist()
             q[k] = np.asarray(pybullet.calculateInverseKinematics(
-                kin.body, kin.end_link, p[k].tolist(), physicsClientId=kin.client, **settings))[kin.dof_index]
+                kin.body, kin.end_link, world_p[k].tolist(), physicsClientId=kin.client, **settings))[kin.dof_index]
         position, rotation = kin.end_effector_frames(q)
         position_residual = np.linalg.norm(p - position, axis=1)
-        orientation_residual = np.zeros(len(p)) if r is None else geodesic_angle_matrix(rotation, r)
+        orientation_residual = np.zeros(len(p)) if r is None else rotation_angle(rotation, r)
         return ik_outcome(self._chain, q, np.full(len(p), -1), position_residual, orientation_residual,
                           p, self._options)

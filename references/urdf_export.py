@@ -1,45 +1,62 @@
-"""URDF for simparity scenes and chains (given to PyBullet and Pinocchio).
+"""URDF for simparity scenes and chains, built with an XML library.
 
-What the URDF says, and why
----------------------------
+Every element is built (or rewritten) with :mod:`xml.etree.ElementTree`, which escapes
+attribute values: no name can close an element or open another (no string templates).
+
+What the engines are given, and why
+-----------------------------------
 - A free body is one link whose ``<inertial>`` carries the scene's mass and inertia in
   PRINCIPAL axes (``origin rpy`` = the principal frame, off-diagonal terms zero): PyBullet
   keeps only a diagonal inertia and reports the base pose in this inertial frame, so the
   adapters convert with the same rotation (:func:`references.conventions.principal_axes`).
-- No ``<collision>`` or ``<visual>``: nothing collides.
-- Chains: ``base`` link, then one link per joint named after the joint, and a fixed joint
-  to a link named after the end effector. Revolute joints without limits become
-  ``continuous``. Links (the fixed base too) get a placeholder inertial (mass 1, inertia 1e-3; PyBullet would
-  otherwise invent mass 1, inertia 1), which does not affect kinematics.
+  No ``<collision>`` or ``<visual>``: nothing collides.
+- A chain read from a URDF file: the ORIGINAL file, parsed (its XML declaration's encoding
+  honoured) with every link's ``<visual>`` and ``<collision>`` removed. Kinematics and IK
+  need no geometry ("model only what a scene needs"), so no engine opens a mesh: not one
+  named by ``package://``, not one missing, and not one anywhere else on disk.
+- Other chains: ``base`` link, then one link per joint named after the joint, and a fixed
+  joint to a link named after the end effector. Revolute joints without limits become
+  ``continuous``. Links (the fixed base too) get a placeholder inertial (mass 1, inertia
+  1e-3; PyBullet would otherwise invent mass 1, inertia 1), which does not affect kinematics.
 """
 
 from __future__ import annotations
 
+import xml.etree.ElementTree as ET
+
 from simparity.core.engine import Support
-from simparity.core.rotations import matrix_to_rpy
 from simparity.core.scene import Chain, RigidBody
-from simparity.references.conventions import PLACEHOLDER_INERTIA, PLACEHOLDER_MASS, fmt, principal_axes
+from simparity.references.conventions import (
+    PLACEHOLDER_INERTIA,
+    PLACEHOLDER_MASS,
+    fmt,
+    matrix_to_rpy,
+    principal_axes,
+)
+
+GEOMETRY = ("visual", "collision")
+"""Link elements left out of a chain's URDF: kinematics and IK need no geometry."""
 
 
+def _text(root: ET.Element) -> str:
+    ET.indent(root, space="  ")
+    return ET.tostring(root, encoding="unicode") + "\n"
 
-def _inertial(mass: float, moments, rpy) -> str:
+
+def _inertial(link: ET.Element, mass: float, moments, rpy) -> None:
+    inertial = ET.SubElement(link, "inertial")
+    ET.SubElement(inertial, "origin", xyz="0 0 0", rpy=fmt(rpy))
+    ET.SubElement(inertial, "mass", value=fmt([mass]))
     ixx, iyy, izz = moments
-    return (
-        f'    <inertial>\n      <origin xyz="0 0 0" rpy="{fmt(rpy)}"/>\n'
-        f'      <mass value="{fmt([mass])}"/>\n'
-        f'      <inertia ixx="{fmt([ixx])}" ixy="0" ixz="0" iyy="{fmt([iyy])}" iyz="0" izz="{fmt([izz])}"/>\n'
-        f"    </inertial>\n"
-    )
+    ET.SubElement(inertial, "inertia", ixx=fmt([ixx]), ixy="0", ixz="0", iyy=fmt([iyy]), iyz="0", izz=fmt([izz]))
 
 
 def body_urdf(body: RigidBody) -> str:
     """URDF text of one free rigid body (a single link, inertia in principal axes)."""
     moments, axes = principal_axes(body.inertia_body)
-    return (
-        f'<robot name="{body.name}">\n  <link name="{body.name}">\n'
-        + _inertial(body.mass, moments, matrix_to_rpy(axes))
-        + "  </link>\n</robot>\n"
-    )
+    root = ET.Element("robot", name=body.name)
+    _inertial(ET.SubElement(root, "link", name=body.name), body.mass, moments, matrix_to_rpy(axes))
+    return _text(root)
 
 
 def urdf_support(chain: Chain) -> Support:
@@ -61,40 +78,74 @@ class UrdfChains:
         return named if not named.ok else self.supports_kinematics(chain)
 
 
-def chain_urdf(chain: Chain) -> str:
-    """URDF text of a fixed-base chain."""
-    placeholder = _inertial(PLACEHOLDER_MASS, [PLACEHOLDER_INERTIA] * 3, [0, 0, 0])
-    parts = [f'<robot name="{chain.name}">', f'  <link name="base">\n{placeholder}  </link>']
+def _placeholder_link(root: ET.Element, name: str) -> None:
+    _inertial(ET.SubElement(root, "link", name=name), PLACEHOLDER_MASS, [PLACEHOLDER_INERTIA] * 3, [0, 0, 0])
+
+
+def _joint(root: ET.Element, name: str, kind: str, parent: str, child: str, xyz, rotation) -> ET.Element:
+    joint = ET.SubElement(root, "joint", name=name, type=kind)
+    ET.SubElement(joint, "parent", link=parent)
+    ET.SubElement(joint, "child", link=child)
+    ET.SubElement(joint, "origin", xyz=fmt(xyz), rpy=fmt(matrix_to_rpy(rotation)))
+    return joint
+
+
+def exported_chain_urdf(chain: Chain) -> str:
+    """URDF text written for a chain that has no URDF file (joints inline or from DH)."""
+    root = ET.Element("robot", name=chain.name)
+    _placeholder_link(root, "base")
     parent = "base"
     for joint in chain.joints:
         kind = joint.type if joint.limited or joint.type == "prismatic" else "continuous"
-        limit = (
-            f'\n    <limit lower="{fmt([joint.lower])}" upper="{fmt([joint.upper])}" effort="0" velocity="0"/>'
-            if joint.limited
-            else ""
-        )
-        parts += [
-            f'  <link name="{joint.name}">\n{placeholder}  </link>',
-            f'  <joint name="{joint.name}" type="{kind}">\n'
-            f'    <parent link="{parent}"/>\n    <child link="{joint.name}"/>\n'
-            f'    <origin xyz="{fmt(joint.origin_xyz)}" rpy="{fmt(matrix_to_rpy(joint.origin_rotation))}"/>\n'
-            f'    <axis xyz="{fmt(joint.axis)}"/>{limit}\n  </joint>',
-        ]
+        _placeholder_link(root, joint.name)
+        element = _joint(root, joint.name, kind, parent, joint.name, joint.origin_xyz, joint.origin_rotation)
+        ET.SubElement(element, "axis", xyz=fmt(joint.axis))
+        if joint.limited:
+            ET.SubElement(element, "limit", lower=fmt([joint.lower]), upper=fmt([joint.upper]), effort="0", velocity="0")
         parent = joint.name
-    ee = chain.end_effector_name
-    parts += [
-        f'  <link name="{ee}">\n{placeholder}  </link>',
-        f'  <joint name="{ee}_fixed" type="fixed">\n    <parent link="{parent}"/>\n    <child link="{ee}"/>\n'
-        f'    <origin xyz="{fmt(chain.end_effector_xyz)}" rpy="{fmt(matrix_to_rpy(chain.end_effector_rotation))}"/>\n'
-        f"  </joint>",
-        "</robot>",
-        "",
-    ]
-    return "\n".join(parts)
+    _placeholder_link(root, chain.end_effector_name)
+    _joint(root, f"{chain.end_effector_name}_fixed", "fixed", parent, chain.end_effector_name,
+           chain.end_effector_xyz, chain.end_effector_rotation)
+    return _text(root)
 
 
-def original_urdf(chain: Chain, how: str) -> str:
-    """The URDF file a chain was read from, headed by how the engine loads it (for ``simparity export``)."""
-    with open(chain.urdf_path, encoding="utf-8") as f:
-        text = f.read()
-    return f"<!-- {chain.urdf_path}, loaded by {how} -->\n{text}"
+def original_without_geometry(urdf_path: str) -> str:
+    """The URDF file's text with every link's visual and collision elements removed."""
+    root = ET.parse(urdf_path).getroot()
+    for link in root.findall("link"):
+        for tag in GEOMETRY:
+            for element in link.findall(tag):
+                link.remove(element)
+    return _text(root)
+
+
+def movable_joints_above_base(chain: Chain) -> list[str]:
+    """Names of the URDF file's non-fixed joints between its root link and the chain's base link."""
+    if chain.urdf_path is None:
+        return []
+    parent_joint = {j.find("child").get("link"): j for j in ET.parse(chain.urdf_path).getroot().findall("joint")}
+    names, link = [], chain.base_link
+    while link in parent_joint:
+        joint = parent_joint[link]
+        if joint.get("type") != "fixed":
+            names.append(joint.get("name"))
+        link = joint.find("parent").get("link")
+    return names[::-1]
+
+
+def chain_urdf(chain: Chain) -> str:
+    """The URDF text engines are given for a chain: its file without geometry, or the export."""
+    return exported_chain_urdf(chain) if chain.urdf_path is None else original_without_geometry(chain.urdf_path)
+
+
+def chain_source(chain: Chain) -> str:
+    """Where a chain's model comes from, for the rows' detail and ``simparity export``."""
+    if chain.urdf_path is None:
+        return "the adapter's URDF export"
+    return f"{chain.urdf_path} without visual and collision geometry (base link {chain.base_link})"
+
+
+def chain_export(chain: Chain, how: str) -> str:
+    """The URDF an engine gets for a chain, headed by where it comes from and how it is loaded."""
+    header = ET.Comment(f" {chain_source(chain)}; loaded by {how} ")
+    return ET.tostring(header, encoding="unicode") + "\n" + chain_urdf(chain)
