@@ -96,3 +96,34 @@ def far_targets(chain: Chain, n: int, seed: int) -> tuple[np.ndarray, np.ndarray
 def build_ik(engine: str, chain: Chain, solver: str, options: IKOptions):
     """An engine's IK solver, built the way the runner builds it."""
     return make_engine(engine).build_ik(chain, solver, options)
+
+
+HAND_WRENCH = dict(
+    # One body, m = 2 kg, turned a quarter turn about z (body x -> world y), moving at
+    # v = (3, 0, 4) m/s in a wind w = (1, 0, 0) m/s and spinning at omega = (0, 0, 2) rad/s,
+    # under gravity (0, 0, -9.81), linear drag b = 0.5, quadratic drag c = 0.1, angular
+    # drags k = 0.03 and k_q = 0.01, and the force f = (1, 0, 0) N at the body point
+    # p = (0.5, 0, 0) m.
+    mass=2.0, quat_wxyz=(np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4)), velocity=(3.0, 0.0, 4.0),
+    omega=(0.0, 0.0, 2.0), gravity=(0.0, 0.0, -9.81), wind=(1.0, 0.0, 0.0), linear_drag=0.5,
+    quadratic_drag=0.1, angular_linear_drag=0.03, angular_quadratic_drag=0.01,
+    force=(1.0, 0.0, 0.0), point_body=(0.5, 0.0, 0.0),
+    # By hand: u = v - w = (2, 0, 4), |u| = sqrt(20) = 4.47213595499958.
+    #   weight m g = (0, 0, -19.62); -b u = (-1, 0, -2); -c |u| u = (-0.894427190999916, 0, -1.788854381999832)
+    #   total force = (1 - 1 - 0.894427190999916, 0, -19.62 - 2 - 1.788854381999832)
+    expected_force=(-0.894427190999916, 0.0, -23.408854381999832),
+    #   -k omega = (0, 0, -0.06); -k_q |omega| omega = (0, 0, -0.04); lever R p = (0, 0.5, 0),
+    #   (0, 0.5, 0) x (1, 0, 0) = (0, 0, -0.5)
+    expected_torque=(0.0, 0.0, -0.6),
+)
+"""A wrench computed by hand, for the tests of core's forces and of the references' own."""
+
+
+def hand_wrench_forces() -> Forces:
+    """The forces of :data:`HAND_WRENCH` as a scene declares them (one body, index 0)."""
+    from simparity.core.scene import AppliedForce
+
+    h = HAND_WRENCH
+    return Forces(np.array(h["gravity"]), np.array(h["wind"]), np.array([h["linear_drag"]]),
+                  np.array([h["quadratic_drag"]]), np.array([h["angular_linear_drag"]]),
+                  np.array([h["angular_quadratic_drag"]]), (AppliedForce(0, h["force"], h["point_body"]),))

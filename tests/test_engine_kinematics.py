@@ -73,13 +73,9 @@ def test_unlimited_prismatic_joint_is_not_available_in_urdf_engines(engine):
 @pytest.mark.parametrize("engine", sorted(FRAME_TOLERANCES))
 def test_sub_chain_of_a_urdf_file_with_joints_beyond_the_tip(engine):
     """The iiwa file cut at link 5 (two movable joints past the tip): engines map the chain's joints by name."""
-    import dataclasses
-
-    scene = builtin("iiwa-kinematics")
     from simparity.core.urdf import chain_from_urdf
 
-    chain = dataclasses.replace(chain_from_urdf(scene.chain.urdf_path, tip_link="lbr_iiwa_link_5"),
-                                urdf_path=scene.chain.urdf_path)
+    chain = chain_from_urdf(builtin("iiwa-kinematics").chain.urdf_path, tip_link="lbr_iiwa_link_5")
     q = np.random.default_rng(8).uniform(chain.lower, chain.upper, size=(50, chain.n_joints))
     model = make_engine(engine).build_kinematics(chain)
     position_tol, _ = FRAME_TOLERANCES[engine]

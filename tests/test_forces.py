@@ -1,51 +1,45 @@
-"""The scene's forces as a wrench: each term as the lecture writes it, absent terms absent."""
+"""Core's wrench against numbers computed by hand (tests/helpers.py HAND_WRENCH)."""
 
 import numpy as np
 
 from simparity.core.forces import make_wrench, without_gravity
 from simparity.core.rigid_body import MassProperties
-from simparity.core.rotations import so3_exp
-from simparity.core.scene import AppliedForce, Forces
-from tests.helpers import tumbling_box
+from simparity.core.rotations import quat_wxyz_to_matrix
+from simparity.core.scene import AppliedForce, Forces, RigidBody
+from tests.helpers import HAND_WRENCH, hand_wrench_forces
 
-EXACT_TOL = 1e-15  # the same few float64 operations on both sides
-
-
-def _props(n=2):
-    bodies = tumbling_box().bodies * n
-    return MassProperties.of(bodies)
+HAND_TOL = 1e-14  # the hand values are written to 15 digits
 
 
-def _state(rng, n=2):
-    return (rng.normal(size=(n, 3)), so3_exp(rng.normal(size=(n, 3))), rng.normal(size=(n, 3)),
-            rng.normal(size=(n, 3)))
+def _props():
+    h = HAND_WRENCH
+    return MassProperties.of((RigidBody("b", h["mass"], np.diag([0.1, 0.2, 0.3]), np.zeros(3), h["quat_wxyz"],
+                                        h["velocity"], h["omega"]),))
 
 
 def test_no_forces_means_zero_wrench():
     """A scene without forces pushes nothing."""
-    x, r, v, w = _state(np.random.default_rng(1))
-    force, torque = make_wrench(Forces(), _props())(0.0, x, r, v, w)
+    force, torque = make_wrench(Forces(), _props())(0.0, np.zeros((1, 3)), np.eye(3)[None], np.ones((1, 3)),
+                                                    np.ones((1, 3)))
     assert not force.any() and not torque.any()
 
 
-def test_each_term_is_the_lectures():
-    """F = M g - b (v - w) - c |v - w| (v - w) + f; tau = -k omega - kq |omega| omega + (R p) x f."""
-    rng = np.random.default_rng(2)
-    x, r, v, w = _state(rng)
-    g, air = np.array([0, 0, -9.81]), np.array([1.0, 2.0, 0.0])
-    b, c, k, kq = np.array([0.5, 0.0]), np.array([0.1, 0.2]), np.array([0.0, 0.03]), np.array([0.01, 0.0])
-    f, p = np.array([0.0, 1.0, 2.0]), np.array([0.1, -0.2, 0.3])
-    forces = Forces(g, air, b, c, k, kq, (AppliedForce(1, f, p),))
-    props = _props()
-    force, torque = make_wrench(forces, props)(0.0, x, r, v, w)
-    rel = v - air
-    expected_force = (props.mass[:, None] * g - b[:, None] * rel
-                      - c[:, None] * np.linalg.norm(rel, axis=1, keepdims=True) * rel)
-    expected_force[1] += f
-    expected_torque = -k[:, None] * w - kq[:, None] * np.linalg.norm(w, axis=1, keepdims=True) * w
-    expected_torque[1] += np.cross(r[1] @ p, f)
-    np.testing.assert_allclose(force, expected_force, atol=EXACT_TOL)
-    np.testing.assert_allclose(torque, expected_torque, atol=EXACT_TOL)
+def test_every_term_against_the_hand_computed_wrench():
+    """Gravity, drag in wind, quadratic drag, angular drags and a force at a body point, summed by hand."""
+    h = HAND_WRENCH
+    rotation = quat_wxyz_to_matrix(np.array(h["quat_wxyz"]))[None]
+    force, torque = make_wrench(hand_wrench_forces(), _props())(
+        0.0, np.zeros((1, 3)), rotation, np.array([h["velocity"]]), np.array([h["omega"]]))
+    np.testing.assert_allclose(force[0], h["expected_force"], rtol=0, atol=HAND_TOL)
+    np.testing.assert_allclose(torque[0], h["expected_torque"], rtol=0, atol=HAND_TOL)
+
+
+def test_the_lever_turns_with_the_body():
+    """Unturned, the same force at (0.5, 0, 0) has no torque (lever parallel to the force)."""
+    pushed = Forces(applied=(AppliedForce(0, [1.0, 0.0, 0.0], [0.5, 0.0, 0.0]),))
+    _, torque = make_wrench(pushed, _props())(0.0, np.zeros((1, 3)), np.eye(3)[None], np.zeros((1, 3)),
+                                              np.zeros((1, 3)))
+    np.testing.assert_allclose(torque, 0.0, atol=HAND_TOL)
 
 
 def test_conservation_flags_and_names():
