@@ -3,6 +3,7 @@
 import io
 import subprocess
 import sys
+import xml.etree.ElementTree as ET
 
 import pytest
 
@@ -115,7 +116,7 @@ def test_report_rerenders_a_stored_run(tmp_path):
 def test_console_script_help():
     """The installed entry point answers --help for every command."""
     for argv in ([], ["run"], ["list"], ["export"], ["report"]):
-        done = subprocess.run([sys.executable, "-m", "comparisons.cli", *argv, "--help"],
+        done = subprocess.run([sys.executable, "-m", "simparity.comparisons.cli", *argv, "--help"],
                               capture_output=True, text=True, timeout=60)
         assert done.returncode == 0 and "usage: simparity" in done.stdout
 
@@ -144,9 +145,10 @@ def test_repeated_engine_names_run_once(tmp_path):
 
 
 def test_export_output_is_only_the_model():
-    """Piped, 'export --engine pybullet' is pure URDF and says nothing on stderr: PyBullet's banner stays out."""
-    done = subprocess.run([sys.executable, "-m", "comparisons.cli", "export", "lecture-planar-arm", "--engine",
+    """Piped, 'export --engine pybullet' is one XML document (a provenance comment, then the robot) and says
+    nothing on stderr: PyBullet's banner stays out."""
+    done = subprocess.run([sys.executable, "-m", "simparity.comparisons.cli", "export", "lecture-planar-arm", "--engine",
                            "pybullet"], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0
-    assert done.stdout.startswith("<robot") and "build time" not in done.stdout
+    assert ET.fromstring(done.stdout).tag == "robot" and "build time" not in done.stdout
     assert "build time" not in done.stderr
