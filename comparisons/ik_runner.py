@@ -21,14 +21,14 @@ from typing import Callable
 import numpy as np
 
 from simparity.comparisons.ik_targets import ORIENTATION_ONLY, Targets, hard_target, random_targets
-from simparity.comparisons.rows import Case, error_text
+from simparity.comparisons.rows import Case, Measured, error_text, warnings_into_rows
 from simparity.comparisons.timing import best_of
 from simparity.core.engine import Engine, KinematicsModel
 from simparity.core.ik.problem import IKTolerances
 from simparity.core.ik.result import IKResult
 from simparity.core.results import FAILED, NOT_AVAILABLE, OK, ResultRow
-from simparity.core.rotations import geodesic_angle_matrix
 from simparity.core.scene import IKScene
+from simparity.references.conventions import rotation_angle
 
 IK_METRICS = {
     "solve_rate": "1",
@@ -42,7 +42,12 @@ IK_METRICS = {
     "rest_distance_median": "rad or m",
     "cross_eval_solve_rate_min": "1",
     "cross_eval_disagreement_max": "m",
+    "start_rank_deficiency": "1",
 }
+
+RANK_TOLERANCE = 1e-9
+"""A singular value below this fraction of the largest one counts as zero when the rank of a
+Jacobian is taken (relative, so it holds for arms of any size); rounding leaves ~1e-16."""
 
 
 def _summary(result: IKResult, q_start: np.ndarray, seconds: float) -> dict[str, float]:
@@ -71,7 +76,7 @@ def _cross_evaluation(scene: IKScene, targets: Targets, q: np.ndarray,
         solved = (np.linalg.norm(end - targets.position_world, axis=1)
                   <= scene.position_tolerance + position_resolution)
         if targets.rotation_world is not None:
-            solved &= (geodesic_angle_matrix(rotation, targets.rotation_world)
+            solved &= (rotation_angle(rotation, targets.rotation_world)
                        <= scene.orientation_tolerance + orientation_resolution)
         rates.append(float(np.mean(solved)))
         ends.append(end)
@@ -80,14 +85,42 @@ def _cross_evaluation(scene: IKScene, targets: Targets, q: np.ndarray,
     return {"cross_eval_solve_rate_min": min(rates), "cross_eval_disagreement_max": float(spread)}
 
 
+def _task_jacobian(scene: IKScene, model: KinematicsModel, q: np.ndarray) -> np.ndarray:
+    """(B, 3 or 6, n) end-effector Jacobians, position rows only for position targets."""
+    jacobian = model.jacobian_world(q)
+    return jacobian[:, :3] if scene.target_kind == "position" else jacobian
+
+
+def _rank(jacobian: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(numerical ranks (B,), smallest over largest singular value (B,)) of (B, m, n) Jacobians."""
+    sigma = np.linalg.svd(jacobian, compute_uv=False)
+    top = np.maximum(sigma[:, :1], np.finfo(float).tiny)
+    return np.sum(sigma > RANK_TOLERANCE * top, axis=1), sigma[:, -1] / top[:, 0]
+
+
+def start_rank_deficiency(scene: IKScene, model: KinematicsModel) -> Measured:
+    """How many task directions the chain cannot move in at the start pose that it can elsewhere.
+
+    The rank of the end-effector Jacobian at ``q_start`` against its largest rank over the
+    scene's sampled configurations; 0 is a regular start, more is a singular one.
+    """
+    generic, _ = _rank(_task_jacobian(scene, model, scene.configurations()))
+    rank, ratio = _rank(_task_jacobian(scene, model, scene.q_start[None]))
+    deficiency = int(generic.max() - rank[0])
+    verdict = "singular" if deficiency > 0 else "regular"
+    return Measured(float(deficiency), "1", note=(
+        f"start pose {verdict}: Jacobian rank {rank[0]} of {generic.max()} elsewhere, "
+        f"sigma_min/sigma_max {ratio[0]:.2g}"))
+
+
 def _judges(scene: IKScene, engines: list[Engine]) -> dict[str, KinematicsModel]:
     judges = {}
     for engine in engines:
-        if engine.supports_kinematics(scene.chain).ok:
-            try:
+        try:
+            if engine.supports_kinematics(scene.chain).ok:
                 judges[engine.name] = engine.build_kinematics(scene.chain)
-            except Exception:  # noqa: BLE001 - an engine that cannot build the chain judges nothing
-                continue
+        except Exception:  # noqa: BLE001 - an engine that cannot build the chain judges nothing
+            continue
     return judges
 
 
@@ -103,7 +136,7 @@ def _hard_rows(case: Case, hard: list[Targets], results: list[IKResult | None], 
         verdict = "solved" if result.success[0] else f"failed: {result.reason[0]}"
         detail = (f"{verdict}; orientation residual {result.orientation_residual[0]:.3g} rad; "
                   f"limit violation {result.limit_violation[0]:.3g}; {targets.note}")
-        rows += case.rows(metric, OK, detail, {f"hard_{targets.name}": (float(result.position_residual[0]), "m")})
+        rows += case.rows(metric, OK, detail, {f"hard_{targets.name}": Measured(float(result.position_residual[0]), "m")})
     return rows
 
 
@@ -113,7 +146,11 @@ def _solve(model, targets: Targets, q_start: np.ndarray) -> IKResult:
 
 def _case_rows(scene: IKScene, engine: Engine, case: Case, options: IKTolerances, random: Targets,
                hard: list[Targets], judges: dict[str, KinematicsModel], repeats: int) -> list[ResultRow]:
-    support = engine.supports_ik(scene.chain, case.integrator, scene.target_kind == "position")
+    try:
+        support = engine.supports_ik(scene.chain, case.integrator, scene.target_kind == "position")
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        problem = error_text(err)
+        return case.rows(IK_METRICS, FAILED, problem) + _hard_rows(case, hard, [None] * len(hard), FAILED, problem)
     if not support.ok:
         return (case.rows(IK_METRICS, NOT_AVAILABLE, support.reason)
                 + _hard_rows(case, hard, [None] * len(hard), NOT_AVAILABLE, support.reason))
@@ -124,9 +161,11 @@ def _case_rows(scene: IKScene, engine: Engine, case: Case, options: IKTolerances
     except Exception as err:  # noqa: BLE001 - reported in the rows
         problem = error_text(err)
         return case.rows(IK_METRICS, FAILED, problem) + _hard_rows(case, hard, [None] * len(hard), FAILED, problem)
-    values = _summary(result, scene.q_start, seconds)
-    values.update(_cross_evaluation(scene, random, result.q, judges))
-    return (case.rows(IK_METRICS, OK, f"{model.detail}; {random.note}", {m: (v, IK_METRICS[m]) for m, v in values.items()})
+    values = {m: Measured(v, IK_METRICS[m]) for m, v in _summary(result, scene.q_start, seconds).items()}
+    values.update({m: Measured(v, IK_METRICS[m]) for m, v in _cross_evaluation(scene, random, result.q, judges).items()})
+    if engine.name in judges:
+        values["start_rank_deficiency"] = start_rank_deficiency(scene, judges[engine.name])
+    return (case.rows(IK_METRICS, OK, f"{model.detail}; {random.note}", values)
             + _hard_rows(case, hard, hard_results, OK, ""))
 
 
@@ -136,13 +175,14 @@ def run_ik_scene(scene: IKScene, engines: list[Engine], make_reference: Callable
     options = IKTolerances(position_tolerance=scene.position_tolerance, orientation_tolerance=scene.orientation_tolerance,
                         max_iterations=scene.max_iterations)
     reference = make_reference(scene.reference)
-    support = reference.supports_kinematics(scene.chain)
-    fk, status, reason = None, NOT_AVAILABLE, support.reason
-    if support.ok:
-        try:
+    fk, status, reason = None, NOT_AVAILABLE, ""
+    try:
+        support = reference.supports_kinematics(scene.chain)
+        reason = support.reason
+        if support.ok:
             fk = reference.build_kinematics(scene.chain)
-        except Exception as err:  # noqa: BLE001 - reported in the rows
-            status, reason = FAILED, f"failed: {error_text(err)}"
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        status, reason = FAILED, f"failed: {error_text(err)}"
     if fk is None:
         problem = f"reference {scene.reference} cannot make the targets: {reason}"
         return [row for engine in engines for solver in engine.ik_solvers() or ("-",)
@@ -159,6 +199,7 @@ def run_ik_scene(scene: IKScene, engines: list[Engine], make_reference: Callable
     for engine in engines:
         for solver in engine.ik_solvers() or ("-",):
             case = Case(scene.name, engine.name, solver, math.nan, label)
-            rows += _case_rows(scene, engine, case, options, random, hard, judges, repeats)
+            with warnings_into_rows(rows):
+                rows += _case_rows(scene, engine, case, options, random, hard, judges, repeats)
             rows += case.rows(skipped, NOT_AVAILABLE, "position-only scene: no orientation to target")
     return rows

@@ -2,19 +2,42 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import traceback
-from dataclasses import dataclass
+import warnings
+from dataclasses import dataclass, replace
 
 from simparity.core.results import NOT_AVAILABLE, OK, ResultRow
 
 
 @dataclass(frozen=True)
-class Case:
-    """One scene x engine x integrator (or IK solver) x dt: the key its rows share.
+class Measured:
+    """One metric's value, or why it has none that means anything.
 
-    ``rows`` takes values as ``{metric: (value, unit)}``.
+    Attributes
+    ----------
+    value : float
+        In ``unit``; NaN when there is nothing to measure. An unmeasurable value keeps the raw
+        number for the harness (order fits see a saturated error as saturated); its row gets NaN.
+    unit : str
+    unmeasurable : str
+        Non-empty when the value is not a meaningful number (saturated, at the rounding
+        floor, nothing to compare against): the row is then ``n/a`` with this reason.
+    note : str
+        How it was measured when that differs from the metric's definition (a fallback);
+        it goes first in the row's detail.
     """
+
+    value: float
+    unit: str
+    unmeasurable: str = ""
+    note: str = ""
+
+
+@dataclass(frozen=True)
+class Case:
+    """One scene x engine x integrator (or IK solver) x dt: the key its rows share."""
 
     scene: str
     engine: str
@@ -22,22 +45,33 @@ class Case:
     dt: float
     reference: str
 
-    def rows(self, metrics: dict[str, str], status: str, detail: str, values: dict | None = None) -> list[ResultRow]:
-        """One row per metric; an ok metric without a finite value becomes n/a (nothing to measure)."""
+    def _row(self, metric: str, value: float, unit: str, status: str, detail: str) -> ResultRow:
+        return ResultRow(self.scene, self.engine, self.integrator, self.dt, metric, value, unit, self.reference,
+                         status, detail)
+
+    def rows(self, metrics: dict[str, str], status: str, detail: str,
+             values: dict[str, Measured] | None = None) -> list[ResultRow]:
+        """One row per metric of ``metrics`` ({metric: unit}) with the case's ``status`` and ``detail``.
+
+        In an ok case a metric without a finite value, or one marked unmeasurable, is ``n/a``
+        with its own reason only (the case's detail is on its ok rows).
+        """
         values = values or {}
         rows = []
         for metric, unit in metrics.items():
-            value = values.get(metric, (math.nan, unit))[0]
-            if status == OK and not math.isfinite(value):
-                rows.append(ResultRow(self.scene, self.engine, self.integrator, self.dt, metric, value, unit,
-                                      self.reference, NOT_AVAILABLE, f"nothing to measure {metric} against; {detail}"))
+            measured = values.get(metric, Measured(math.nan, unit))
+            if status != OK:
+                rows.append(self._row(metric, measured.value, unit, status, detail))
+            elif measured.unmeasurable:
+                rows.append(self._row(metric, math.nan, unit, NOT_AVAILABLE, measured.unmeasurable))
+            elif not math.isfinite(measured.value):
+                rows.append(self._row(metric, math.nan, unit, NOT_AVAILABLE, f"nothing to measure {metric} against"))
             else:
-                rows.append(ResultRow(self.scene, self.engine, self.integrator, self.dt, metric, value, unit,
-                                      self.reference, status, detail))
+                note = f"{measured.note}; " if measured.note else ""
+                rows.append(self._row(metric, measured.value, unit, OK, note + detail))
         return rows
 
-
-    def partial_rows(self, metrics: dict[str, str], values: dict, detail: str, missing_status: str,
+    def partial_rows(self, metrics: dict[str, str], values: dict[str, Measured], detail: str, missing_status: str,
                      missing_detail: str) -> list[ResultRow]:
         """Rows of the metrics measured (ok), then of the others with why they are missing."""
         measured = {m: u for m, u in metrics.items() if m in values}
@@ -50,3 +84,20 @@ def error_text(err: BaseException) -> str:
     where = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None
     at = f" at {where.filename.rsplit('/', 1)[-1]}:{where.lineno}" if where else ""
     return f"{type(err).__name__}: {err}{at}".replace("\n", " ")
+
+
+@contextlib.contextmanager
+def warnings_into_rows(rows: list[ResultRow]):
+    """Keep Python and NumPy warnings raised while a case runs off the console and in its rows' detail.
+
+    ``rows`` is the list the case's rows are appended to inside the block; those appended in it
+    get ``warnings: ...`` (each distinct message once) at the end of their detail.
+    """
+    start = len(rows)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield
+    messages = list(dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught))
+    if messages:
+        note = "warnings: " + "; ".join(messages)
+        rows[start:] = [replace(r, detail=f"{r.detail}; {note}" if r.detail else note) for r in rows[start:]]

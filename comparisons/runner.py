@@ -8,23 +8,29 @@ becomes ``failed`` rows; the run goes on.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, field
 from typing import Callable
 
 import numpy as np
 
+from simparity.comparisons.divergence import divergence
+from simparity.comparisons.ik_runner import run_ik_scene
 from simparity.comparisons.metrics import (
     KINEMATICS_METRICS,
     ORDER_METRICS,
+    ORDER_SOURCES,
+    ROTATIONAL_ORDERS,
+    SATURATED_ORIENTATION,
     drifts,
     dynamics_metrics,
     kinematics_errors,
     observed_order,
+    rounding_floors,
     trajectory_errors,
 )
-from simparity.comparisons.ik_runner import run_ik_scene
-from simparity.comparisons.rows import Case, error_text
+from simparity.comparisons.rows import Case, Measured, error_text, warnings_into_rows
 from simparity.comparisons.timing import best_of
-from simparity.core.engine import Engine
+from simparity.core.engine import Engine, Support
 from simparity.core.errors import DivergedError
 from simparity.core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
 from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
@@ -32,9 +38,31 @@ from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
 DEFAULT_REPEATS = 3
 """Timed repeats per measurement (the minimum is kept), after one warm-up run."""
 
-BLOW_UP_FACTOR = 1e6
-"""A run whose speed or spin exceeds this many times what the scene could plausibly reach
-(initial speed plus what gravity adds over the duration, plus 1) has blown up: diverged."""
+
+@dataclass
+class _CaseResult:
+    """One dynamics case: its rows, and what the order fits need from it.
+
+    ``errors`` are the raw error values (saturated ones included), ``floors`` their rounding
+    floors; both empty when nothing was measured.
+    """
+
+    rows: list[ResultRow]
+    errors: dict[str, float] = field(default_factory=dict)
+    floors: dict[str, float] = field(default_factory=dict)
+    integrates_rotation: bool = True
+
+
+@dataclass
+class _Ladder:
+    """The cases of one engine x integrator over the scene's time steps, for the order fits."""
+
+    dts: list[float] = field(default_factory=list)
+    cases: list[_CaseResult] = field(default_factory=list)
+
+    @property
+    def integrates_rotation(self) -> bool:
+        return all(case.integrates_rotation for case in self.cases)
 
 
 def _integrators(scene: DynamicsScene, engine: Engine) -> tuple[list[str], str]:
@@ -51,8 +79,11 @@ def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, re
     metrics = dynamics_metrics(scene)
     ref_integrator = reference.integrators()[0]
     ref_label = f"{reference.name}:{ref_integrator}"
-    ref_support = reference.supports_dynamics(scene, ref_integrator)
-    errors: dict[tuple[str, str], list[tuple[float, dict]]] = {}
+    try:
+        ref_support = reference.supports_dynamics(scene, ref_integrator)
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        ref_support = Support.no(f"failed: {error_text(err)}")
+    ladders: dict[tuple[str, str], _Ladder] = {}
     for dt in scene.dts:
         n = scene.n_steps(dt)
         ref_traj, ref_problem, ref_status = None, "", NOT_AVAILABLE
@@ -73,111 +104,113 @@ def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, re
             for integrator in chosen:
                 case = Case(scene.name, engine.name, integrator, dt, ref_label)
                 is_reference = engine.name == reference.name and integrator == ref_integrator
-                case_rows = _dynamics_case(scene, engine, case, metrics, n, ref_traj, (ref_problem, ref_status),
-                                           repeats, is_reference)
-                rows += case_rows
-                errors.setdefault((engine.name, integrator), []).append(
-                    (dt, {r.metric: r.value for r in case_rows if r.status == OK}))
+                with warnings_into_rows(rows):
+                    result = _dynamics_case(scene, engine, case, metrics, n, ref_traj, (ref_problem, ref_status),
+                                            repeats, is_reference)
+                    rows += result.rows
+                ladder = ladders.setdefault((engine.name, integrator), _Ladder())
+                ladder.dts.append(dt)
+                ladder.cases.append(result)
     if len(scene.dts) > 1:
-        rows += _orders(scene, errors, ref_label)
+        rows += _orders(scene, ladders, ref_label)
     return rows
 
 
-def _blown_up(scene: DynamicsScene, traj) -> str:
-    """Why the trajectory counts as blown up (see BLOW_UP_FACTOR), or "" when it does not."""
-    g = 0.0 if scene.forces.gravity_world is None else float(np.linalg.norm(scene.forces.gravity_world))
-    for name, values, start in (
-        ("speed", traj.velocity_world, [b.velocity_world for b in scene.bodies]),
-        ("angular speed", traj.angular_velocity_world, [b.angular_velocity_world for b in scene.bodies]),
-    ):
-        bound = BLOW_UP_FACTOR * (np.linalg.norm(start, axis=-1).max() + g * scene.duration + 1.0)
-        peak = float(np.linalg.norm(values, axis=-1).max())
-        if peak > bound:
-            return f"{name} reached {peak:.3g} (bound {bound:.3g})"
-    return ""
-
-
-def _orders(scene: DynamicsScene, errors: dict, ref_label: str) -> list[ResultRow]:
-    """Observed order of convergence per engine and integrator over the scene's time steps."""
+def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_label: str) -> list[ResultRow]:
+    """Observed orders of convergence per engine and integrator over the scene's time steps."""
     rows = []
-    for (engine, integrator), per_dt in errors.items():
-        dts = [dt for dt, _ in per_dt]
-        for metric, source in (("order_position", "position_error_max"), ("order_orientation", "orientation_error_max")):
-            slope, detail = observed_order(dts, [values.get(source, math.nan) for _, values in per_dt])
-            status = NOT_AVAILABLE if math.isnan(slope) else OK
-            rows.append(ResultRow(scene.name, engine, integrator, math.nan, metric, slope, ORDER_METRICS[metric],
-                                  ref_label, status, detail))
+    for (engine, integrator), ladder in ladders.items():
+        case = Case(scene.name, engine, integrator, math.nan, ref_label)
+        values = {}
+        for metric, source in ORDER_SOURCES.items():
+            if metric in ROTATIONAL_ORDERS and not ladder.integrates_rotation:
+                values[metric] = Measured(math.nan, "1", unmeasurable=(
+                    "point-mass rule: the integrator does not move orientation, so it has no rotational order"))
+                continue
+            saturation = SATURATED_ORIENTATION if source == "orientation_error_max" else math.inf
+            values[metric] = observed_order(ladder.dts, [c.errors.get(source, math.nan) for c in ladder.cases],
+                                            [c.floors.get(source, 0.0) for c in ladder.cases], saturation)
+        rows += case.rows(ORDER_METRICS, OK, f"against {ref_label}", values)
     return rows
 
 
 def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref_traj, ref_problem: tuple[str, str],
-                   repeats: int, is_reference: bool) -> list[ResultRow]:
-    """Rows of one case; ``ref_problem`` is (why there is no reference trajectory, the status that gives)."""
-    support = engine.supports_dynamics(scene, case.integrator)
+                   repeats: int, is_reference: bool) -> _CaseResult:
+    """One case; ``ref_problem`` is (why there is no reference trajectory, the status that gives)."""
+    try:
+        support = engine.supports_dynamics(scene, case.integrator)
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        return _CaseResult(case.rows(metrics, FAILED, error_text(err)))
     if not support.ok:
-        return case.rows(metrics, NOT_AVAILABLE, support.reason)
+        return _CaseResult(case.rows(metrics, NOT_AVAILABLE, support.reason))
     try:
         sim = engine.build_dynamics(scene, case.integrator, case.dt)
         with np.errstate(all="ignore"):  # a diverging run overflows; it is reported as diverged
             seconds, traj = best_of(lambda: sim.run(n), repeats)
     except DivergedError as err:
-        return case.rows(metrics, DIVERGED, str(err))
+        return _CaseResult(case.rows(metrics, DIVERGED, str(err)))
     except Exception as err:  # noqa: BLE001 - reported in the rows
-        return case.rows(metrics, FAILED, error_text(err))
-    values = {"time_per_step": (seconds / n, "s")}
-    if not traj.is_finite():
-        return case.rows(metrics, DIVERGED, "non-finite state; " + sim.detail, values)
-    blown = _blown_up(scene, traj)
-    if blown:
-        return case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values)
+        return _CaseResult(case.rows(metrics, FAILED, error_text(err)))
+    values = {"time_per_step": Measured(seconds / n, "s")}
     with np.errstate(all="ignore"):
+        blown = "non-finite state" if not traj.is_finite() else divergence(scene, traj)
+        if blown:
+            return _CaseResult(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values),
+                               integrates_rotation=sim.integrates_rotation)
         values.update(drifts(scene, traj))
-    if ref_traj is None:
-        problem, status = ref_problem
-        return case.partial_rows(metrics, values, sim.detail, status, problem)
-    values.update(trajectory_errors(traj, ref_traj))
+        floors = rounding_floors(scene, traj, n)
+        if ref_traj is None:
+            problem, status = ref_problem
+            return _CaseResult(case.partial_rows(metrics, values, sim.detail, status, problem), {}, floors,
+                               sim.integrates_rotation)
+        values.update(trajectory_errors(traj, ref_traj))
     detail = ("this is the reference; " if is_reference else "") + sim.detail
-    return case.rows(metrics, OK, detail, values)
+    return _CaseResult(case.rows(metrics, OK, detail, values), {m: v.value for m, v in values.items()}, floors,
+                       sim.integrates_rotation)
 
 
 def _kinematics(scene: KinematicsScene, engines: list[Engine], reference: Engine, repeats: int) -> list[ResultRow]:
     q = scene.configurations()
     ref_label = f"{reference.name}:fk"
     ref, ref_problem, ref_status = None, "", NOT_AVAILABLE
-    ref_support = reference.supports_kinematics(scene.chain)
-    if not ref_support.ok:
-        ref_problem = f"reference {ref_label} cannot do this chain: {ref_support.reason}"
-    else:
-        try:
+    try:
+        ref_support = reference.supports_kinematics(scene.chain)
+        if not ref_support.ok:
+            ref_problem = f"reference {ref_label} cannot do this chain: {ref_support.reason}"
+        else:
             model = reference.build_kinematics(scene.chain)
             ref = (model.forward_kinematics(q), model.jacobian_world(q))
-        except Exception as err:  # noqa: BLE001 - reported in the rows
-            ref_problem, ref_status = f"reference {ref_label} failed: {error_text(err)}", FAILED
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        ref_problem, ref_status = f"reference {ref_label} failed: {error_text(err)}", FAILED
     rows: list[ResultRow] = []
     for engine in engines:
         case = Case(scene.name, engine.name, "", math.nan, ref_label)
+        with warnings_into_rows(rows):
+            rows += _kinematics_case(scene, engine, case, q, ref, (ref_problem, ref_status), repeats,
+                                     engine.name == reference.name)
+    return rows
+
+
+def _kinematics_case(scene: KinematicsScene, engine: Engine, case: Case, q: np.ndarray, ref, ref_problem: tuple[str, str],
+                     repeats: int, is_reference: bool) -> list[ResultRow]:
+    """Rows of one engine's FK and Jacobian at configurations ``q`` against ``ref`` = (poses, Jacobians) or None."""
+    try:
         support = engine.supports_kinematics(scene.chain)
         if not support.ok:
-            rows += case.rows(KINEMATICS_METRICS, NOT_AVAILABLE, support.reason)
-            continue
-        try:
-            model = engine.build_kinematics(scene.chain)
-            fk_seconds, poses = best_of(lambda: model.forward_kinematics(q), repeats)
-            jac_seconds, jac = best_of(lambda: model.jacobian_world(q), repeats)
-        except Exception as err:  # noqa: BLE001 - reported in the rows
-            rows += case.rows(KINEMATICS_METRICS, FAILED, error_text(err))
-            continue
-        values = {"time_per_fk": (fk_seconds / len(q), "s"), "time_per_jacobian": (jac_seconds / len(q), "s")}
-        if not (np.all(np.isfinite(poses.position_world)) and np.all(np.isfinite(jac))):
-            rows += case.rows(KINEMATICS_METRICS, DIVERGED, "non-finite FK or Jacobian", values)
-            continue
-        if ref is None:
-            rows += case.partial_rows(KINEMATICS_METRICS, values, model.detail, ref_status, ref_problem)
-            continue
-        values.update(kinematics_errors(poses, jac, *ref))
-        detail = ("this is the reference; " if engine.name == reference.name else "") + model.detail
-        rows += case.rows(KINEMATICS_METRICS, OK, detail, values)
-    return rows
+            return case.rows(KINEMATICS_METRICS, NOT_AVAILABLE, support.reason)
+        model = engine.build_kinematics(scene.chain)
+        fk_seconds, poses = best_of(lambda: model.forward_kinematics(q), repeats)
+        jac_seconds, jac = best_of(lambda: model.jacobian_world(q), repeats)
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        return case.rows(KINEMATICS_METRICS, FAILED, error_text(err))
+    values = {"time_per_fk": Measured(fk_seconds / len(q), "s"), "time_per_jacobian": Measured(jac_seconds / len(q), "s")}
+    if not (np.all(np.isfinite(poses.position_world)) and np.all(np.isfinite(jac))):
+        return case.rows(KINEMATICS_METRICS, DIVERGED, "non-finite FK or Jacobian", values)
+    if ref is None:
+        problem, status = ref_problem
+        return case.partial_rows(KINEMATICS_METRICS, values, model.detail, status, problem)
+    values.update(kinematics_errors(poses, jac, *ref))
+    return case.rows(KINEMATICS_METRICS, OK, ("this is the reference; " if is_reference else "") + model.detail, values)
 
 
 def run_scene(

@@ -142,6 +142,9 @@ class InHouseEngine(Engine):
         rotating = any(np.any(b.angular_velocity_world != 0) for b in scene.bodies)
         if rotating or scene.forces.exerts_torque:
             return Support.no(f"{integrator} is a point-mass rule; the scene's bodies rotate")
+        if integrator in point_mass.FORCE_FREE_RULES and scene.forces.names():
+            return Support.no(f"{integrator} is the lecture's rule for a point no force acts on; the scene has "
+                              + ", ".join(scene.forces.names()))
         return Support.yes()
 
     def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:

@@ -44,3 +44,6 @@ RULES = {
 The Euler and average-velocity rules are offered through the rigid-body integrators,
 whose translational part they are (``explicit_euler`` and ``average_velocity``).
 """
+
+FORCE_FREE_RULES = ("constant_velocity",)
+"""Rules that never look at the acceleration: the lecture gives them for a point no force acts on."""

@@ -59,9 +59,14 @@ def quat_wxyz_to_matrix(q: np.ndarray) -> np.ndarray:
 
 
 def matrix_to_quat_wxyz(r: np.ndarray) -> np.ndarray:
-    """Unit quaternion of a rotation matrix (sign as SciPy returns it). (..., 3, 3) -> (..., 4)."""
+    """Unit quaternion of a rotation matrix (sign as SciPy returns it); NaN for a non-finite matrix.
+    (..., 3, 3) -> (..., 4)."""
     flat, batch = _batched(r, (3, 3))
-    return Rotation.from_matrix(flat).as_quat(scalar_first=True).reshape(batch + (4,))
+    finite = np.isfinite(flat).all(axis=(1, 2))
+    quat = np.full((len(flat), 4), np.nan)  # a blown-up state stays non-finite, for the runner to call diverged
+    if finite.any():
+        quat[finite] = Rotation.from_matrix(flat[finite]).as_quat(scalar_first=True)
+    return quat.reshape(batch + (4,))
 
 
 def quat_wxyz_multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -117,3 +122,16 @@ def rotation_angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     a, b = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
     relative, batch = _batched(np.swapaxes(a, -1, -2) @ b, (3, 3))
     return Rotation.from_matrix(relative).magnitude().reshape(batch)
+
+
+def quat_wxyz_angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Angle [rad] in [0, pi] of the rotation between two orientations given as quaternions.
+
+    (..., 4) x (..., 4) -> (...); accurate at small angles (SciPy takes it from the relative
+    quaternion's vector part, not from an arccos).
+    """
+    a, b = np.broadcast_arrays(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
+    flat_a, batch = _batched(a, (4,))
+    flat_b, _ = _batched(b, (4,))
+    relative = Rotation.from_quat(flat_a, scalar_first=True).inv() * Rotation.from_quat(flat_b, scalar_first=True)
+    return relative.magnitude().reshape(batch)

@@ -25,6 +25,7 @@ _IK_COLUMNS = [
     ("iterations_median", "iterations median"),
     ("time_per_solve", "time per solve [s]"),
     ("limit_violations", "solutions outside limits"),
+    ("start_rank_deficiency", "start pose rank deficiency"),
     ("rest_distance_median", "distance to start median"),
     ("cross_eval_solve_rate_min", "solve rate, worst engine's FK"),
     ("cross_eval_disagreement_max", "FK disagreement max [m]"),
@@ -37,9 +38,22 @@ _IK_PROTOCOL = (
     "disagreement shown), so no solver passes on its own kinematics alone."
 )
 _ORDER_COLUMNS = [
-    ("order_position", "observed order (position)"),
-    ("order_orientation", "observed order (orientation)"),
+    ("order_position", "order (position)"),
+    ("order_orientation", "order (orientation)"),
+    ("order_velocity", "order (velocity)"),
+    ("order_angular_velocity", "order (angular velocity)"),
 ]
+_TIMING_METRICS = ("time_per_step", "time_per_fk", "time_per_solve")
+_DEFINITIONS = (
+    "Statuses: `ok` measured; `n/a` not measured, with the reason: the engine cannot do what the scene asks, "
+    "or the metric means nothing here (an orientation error saturated at >= pi/2, a drift above 100 %, errors at "
+    "the rounding floor, too few time steps for an order, a point-mass rule that does not move orientation, "
+    "nothing to compare against); `diverged` non-finite, or faster than the scene's forces allow, or a conserved "
+    "quantity more than doubled; `failed` the engine raised. A status cell names the metrics it is about. "
+    "Energy drift is max |E(t) - E(0)| / |E(0)| (potential zero at the world origin; relative to the largest "
+    "kinetic energy when |E(0)| is near zero, and the row says so); angular momentum drift is "
+    "max |L(t) - L(0)| / |L(0)|. Definitions: docs/metrics.md."
+)
 _KINEMATICS_COLUMNS = [
     ("position_error_max", "frame position error max [m]"),
     ("orientation_error_max", "frame orientation error max [rad]"),
@@ -56,12 +70,15 @@ def _number(value: float) -> str:
 
 
 def _status(group: pd.DataFrame) -> str:
-    """'ok', or the first non-ok status with its reason."""
+    """'ok', or each non-ok status with the metrics it is about (none named when it covers them all) and why."""
     bad = group[group["status"] != OK]
     if bad.empty:
         return OK
-    first = bad.iloc[0]
-    return f"{first['status']}: {first['detail']}" if first["detail"] else first["status"]
+    parts = [OK] if len(bad) < len(group) else []
+    for (status, detail), rows in bad.groupby(["status", "detail"], sort=False):
+        label = status if len(rows) == len(group) else f"{status} ({', '.join(rows['metric'])})"
+        parts.append(f"{label}: {detail}" if detail else label)
+    return " · ".join(parts)
 
 
 def _table(scene_rows: pd.DataFrame, columns, keys: list[str]) -> list[str]:
@@ -85,12 +102,24 @@ def _key_cell(name: str, value) -> str:
 
 
 def _notes(scene_rows: pd.DataFrame) -> list[str]:
-    ok = scene_rows[scene_rows["status"] == OK].drop_duplicates(["engine", "integrator"])
+    timed = scene_rows["metric"].isin(_TIMING_METRICS)
+    ok = scene_rows[timed & (scene_rows["status"] == OK)].drop_duplicates(["engine", "integrator"])
     lines = ["", "What each engine was given:", ""]
     for _, row in ok.iterrows():
         label = f"{row['engine']} {row['integrator']}".strip()
         lines.append(f"- **{label}**: {row['detail']}")
     return lines if len(lines) > 3 else []
+
+
+def _fits(orders: pd.DataFrame) -> list[str]:
+    """Each fitted order's range, local slopes and residual, folded away."""
+    fitted = orders[orders["status"] == OK]
+    if fitted.empty:
+        return []
+    lines = ["", "<details><summary>Fits (range, local slopes, residual)</summary>", ""]
+    lines += [f"- {r['engine']} {r['integrator']} `{r['metric']}` = {_number(r['value'])}: {r['detail']}"
+              for _, r in fitted.iterrows()]
+    return lines + ["", "</details>"]
 
 
 def _hard_cell(row) -> str:
@@ -141,6 +170,8 @@ def render(table: pd.DataFrame, info: dict) -> str:
         + f". `{NOT_AVAILABLE}` means the engine cannot do what the scene asks; the reason is given.",
         "Errors are maxima over every body and sample against the reference named per scene; "
         "times are the best of several repeats of the stepping alone (model building excluded).",
+        "",
+        _DEFINITIONS,
     ]
     for scene, rows in table.groupby("scene", sort=False):
         kind = _kind(rows)
@@ -161,8 +192,10 @@ def render(table: pd.DataFrame, info: dict) -> str:
             orders = rows[rows["dt"].isna()]
             if not orders.empty:
                 lines += ["", "Observed order of convergence: slope of log(error max) against log(dt) over the "
-                          "time steps above (errors at rounding level left out).", ""]
+                          "finest time steps whose local slopes agree (the asymptotic range); errors at the rounding "
+                          "floor or saturated are left out.", ""]
                 lines += _table(orders, _ORDER_COLUMNS, ["engine", "integrator"])
+                lines += _fits(orders)
         else:
             lines += _table(rows, _KINEMATICS_COLUMNS, ["engine"])
         lines += _notes(rows)

@@ -59,6 +59,19 @@ def test_references_import_only_the_data_model_of_core(path):
     assert not borrowed, f"{path.name} imports in-house code {sorted(borrowed)}; allowed: {sorted(DATA_MODEL)}"
 
 
+JUDGES = ("metrics.py", "divergence.py", "invariants.py", "ik_runner.py")
+"""The comparisons that measure and judge: like a reference, they must not use the code they judge."""
+
+
+@pytest.mark.parametrize("name", JUDGES)
+def test_metrics_use_no_in_house_method(name):
+    """A metric computed with core's rotations would agree with a bug in them."""
+    path = ROOT / "comparisons" / name
+    borrowed = {n for n in _project_modules(_imports(path)) if n.startswith("simparity.core")} - DATA_MODEL
+    borrowed.discard("simparity.core")
+    assert not borrowed, f"{name} imports in-house code {sorted(borrowed)}; allowed: {sorted(DATA_MODEL)}"
+
+
 @pytest.mark.parametrize("module", sorted(DATA_MODEL))
 def test_the_data_model_imports_no_in_house_method(module):
     """The data model references may use stays free of core's methods, so the contract above is not bypassed."""

@@ -43,6 +43,23 @@ def test_rotation_angle_between_matrices():
     np.testing.assert_allclose(c.rotation_angle(r, r), 0.0, atol=1e-14)
 
 
+def test_quaternion_angle_is_accurate_from_small_to_half_turn():
+    """(cos a/2, sin a/2 n) against the identity measures a, down to 1e-9 rad (no arccos floor), and the sign
+    of a quaternion does not matter."""
+    axis = np.array([2.0, -1.0, 2.0]) / 3.0
+    for angle in (1e-9, 0.3, 3.0):
+        q = np.concatenate([[np.cos(angle / 2)], np.sin(angle / 2) * axis])
+        np.testing.assert_allclose(c.quat_wxyz_angle([1.0, 0, 0, 0], q), angle, rtol=1e-12)
+        np.testing.assert_allclose(c.quat_wxyz_angle([1.0, 0, 0, 0], -q), angle, rtol=1e-12)
+
+
+def test_non_finite_matrix_gives_a_non_finite_quaternion():
+    """A blown-up state stays visibly blown up instead of raising in SciPy's SVD."""
+    q = c.matrix_to_quat_wxyz(np.stack([np.eye(3), np.full((3, 3), np.nan)]))
+    np.testing.assert_allclose(q[0], [1.0, 0, 0, 0])
+    assert np.isnan(q[1]).all()
+
+
 def test_principal_axes_of_a_rotated_box():
     """The tensor Q diag(1, 2, 3) Q^T gives back the moments 1, 2, 3 and a proper rotation."""
     q = c.rotvec_to_matrix([0.3, -0.2, 0.5])

@@ -112,3 +112,16 @@ def test_unavailable_engine_says_why_in_ik_scenes():
     scene = dataclasses.replace(builtin("lecture-2link-ik"), n_targets=5)
     rows = run_ik_scene(scene, [UnavailableEngine("mujoco", "No module named 'mujoco'")], make_engine, repeats=1)
     assert rows and all(r.status == NOT_AVAILABLE and "not importable" in r.detail for r in rows)
+
+
+def test_singular_start_pose_is_reported():
+    """The planar 2-link arm stretched straight (q = 0) loses a direction of motion there: the start pose is
+    reported singular (rank deficiency 1); bent (q2 = 1 rad) it is regular."""
+    from simparity.comparisons.ik_runner import start_rank_deficiency
+
+    scene = builtin("lecture-2link-ik")
+    model = make_engine("pinocchio").build_kinematics(scene.chain)
+    stretched = start_rank_deficiency(dataclasses.replace(scene, q_start=np.zeros(scene.chain.n_joints)), model)
+    assert stretched.value == 1 and "start pose singular" in stretched.note
+    bent = start_rank_deficiency(dataclasses.replace(scene, q_start=np.array([0.3, 1.0])), model)
+    assert bent.value == 0 and "start pose regular" in bent.note

@@ -26,3 +26,19 @@ def test_report_has_scene_table_with_values_and_reasons():
     assert "| core | rk4 | 0.01 | 1.5e-09 |" in text
     assert "n/a: no such integrator" in text
     assert "ok 1, n/a 1, failed 0, diverged 0" in text
+
+
+def test_status_cell_names_the_metric_a_status_is_about():
+    """An ok case with one saturated metric says ok, then n/a with the metric and the reason; a case n/a as a
+    whole names no metric."""
+    common = dict(scene="s", engine="core", integrator="rk4", dt=0.01, reference="analytic:exact")
+    rows = pd.DataFrame([r.as_dict() for r in [
+        ResultRow(metric="position_error_max", value=1e-3, unit="m", status="ok", detail="d", **common),
+        ResultRow(metric="orientation_error_max", value=math.nan, unit="rad", status="n/a",
+                  detail="saturated: orientation error 3 rad", **common),
+        ResultRow(metric="time_per_step", value=1e-6, unit="s", status="ok", detail="d", **common),
+    ]])
+    text = render(rows, {})
+    assert "| ok · n/a (orientation_error_max): saturated: orientation error 3 rad |" in text
+    assert "`n/a` not measured" in text and "saturated" in text.split("## s")[0]  # the definition covers it
+    assert "| n/a: no such integrator |" in render(_rows(), {})

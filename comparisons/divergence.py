@@ -1,0 +1,99 @@
+"""Has a finite run blown up? Bounds the exact motion cannot cross, from the scene's energy budget.
+
+A run is diverged when, for some body,
+
+- its speed exceeds what its forces can give it: the drag pushes v toward the air velocity w
+  and never speeds the body up relative to it, so |v(t)| <= |w| + |v(0) - w| + (|g| + sum |f_i| / m) t;
+- its angular speed exceeds what its angular momentum allows: |omega| <= |L| / I_min, with
+  |L(t)| <= |L(0)| + sum |p_i| |f_i| t (angular drag only takes momentum away); without applied
+  forces also |omega| <= sqrt(2 KE_rot(0) / I_min), as the rotational energy cannot grow;
+- a quantity the scene conserves grows by more than :data:`CONSERVED_GROWTH_LIMIT` of its
+  initial size: the energy (E - E(0) > limit x |E(0)|, when E(0) is not near zero) or |L|.
+
+Speeds are compared with :data:`DIVERGENCE_MARGIN` times their bound. Energies come from
+:mod:`comparisons.metrics`, rotations from SciPy; nothing here is in-house code.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simparity.comparisons.invariants import angular_momentum_world
+from simparity.comparisons.metrics import ENERGY_NEAR_ZERO, energies
+from simparity.core.scene import DynamicsScene
+from simparity.core.trajectory import Trajectory
+from simparity.references.conventions import quat_wxyz_to_matrix
+
+DIVERGENCE_MARGIN = 2.0
+"""A speed more than twice its bound is divergence. The bounds hold for the exact motion; an
+accurate run stays near or below them, a run that is merely inaccurate exceeds them by its
+error, and a blown-up one grows geometrically past any factor."""
+
+CONSERVED_GROWTH_LIMIT = 1.0
+"""A conserved quantity that grows by more than 100 % of its initial size (energy or |L|
+doubled) is divergence, not drift."""
+
+AT_REST = 1e-9
+"""[m/s or rad/s] Added to every speed bound: a body with no motion budget at all may still
+show rounding-level speeds."""
+
+
+def _speed_bounds(scene: DynamicsScene) -> tuple[np.ndarray, np.ndarray]:
+    """(linear [m/s], angular [rad/s]) upper bounds of the exact motion per body, each (B,)."""
+    forces, duration = scene.forces, scene.duration
+    gravity = 0.0 if forces.gravity_world is None else float(np.linalg.norm(forces.gravity_world))
+    air = np.zeros(3) if forces.air_velocity_world is None else forces.air_velocity_world
+    linear, angular = [], []
+    for index, body in enumerate(scene.bodies):
+        pushes = [a for a in forces.applied if a.body == index]
+        force = sum(float(np.linalg.norm(a.force_world)) for a in pushes)
+        torque = sum(float(np.linalg.norm(a.point_body) * np.linalg.norm(a.force_world)) for a in pushes)
+        linear.append(np.linalg.norm(air) + np.linalg.norm(body.velocity_world - air)
+                      + (gravity + force / body.mass) * duration)
+        moments = np.linalg.eigvalsh(body.inertia_body)
+        rotation = quat_wxyz_to_matrix(body.quat_wxyz)
+        momentum = np.linalg.norm(angular_momentum_world(body.inertia_body, body.angular_velocity_world, rotation))
+        bound = (momentum + torque * duration) / moments[0]
+        if not pushes:
+            omega_body = rotation.T @ body.angular_velocity_world
+            bound = min(bound, np.sqrt(max(omega_body @ body.inertia_body @ omega_body, 0.0) / moments[0]))
+        angular.append(bound)
+    return np.array(linear), np.array(angular)
+
+
+def _conserved_growth(scene: DynamicsScene, traj: Trajectory) -> str:
+    if scene.forces.conserves_energy:
+        energy, kinetic, potential = energies(scene, traj)
+        size = np.abs(energy[0])
+        meaningful = size >= ENERGY_NEAR_ZERO * (kinetic + np.abs(potential)).max(axis=0)
+        growth = (energy - energy[0]).max(axis=0)
+        grown = meaningful & (growth > CONSERVED_GROWTH_LIMIT * size)
+        if grown.any():
+            b = int(np.argmax(np.where(grown, growth / np.where(size > 0, size, 1.0), -np.inf)))
+            return (f"energy of {scene.bodies[b].name} grew to {energy[:, b].max() / energy[0, b]:.3g} x E(0) "
+                    f"(conserved; limit {1 + CONSERVED_GROWTH_LIMIT:g} x)")
+    if scene.forces.conserves_angular_momentum:
+        inertia = np.stack([b.inertia_body for b in scene.bodies])
+        size = np.linalg.norm(angular_momentum_world(
+            inertia, traj.angular_velocity_world, quat_wxyz_to_matrix(traj.quat_wxyz)), axis=-1)
+        grown = (size[0] > 0) & (size.max(axis=0) > (1 + CONSERVED_GROWTH_LIMIT) * size[0])
+        if grown.any():
+            b = int(np.argmax(grown))
+            return (f"|L| of {scene.bodies[b].name} grew to {size[:, b].max() / size[0, b]:.3g} x |L(0)| "
+                    f"(conserved; limit {1 + CONSERVED_GROWTH_LIMIT:g} x)")
+    return ""
+
+
+def divergence(scene: DynamicsScene, traj: Trajectory) -> str:
+    """Why a finite trajectory counts as diverged (see the module's bounds), or "" when it does not."""
+    linear, angular = _speed_bounds(scene)
+    for quantity, values, bound in (("speed", traj.velocity_world, linear),
+                                    ("angular speed", traj.angular_velocity_world, angular)):
+        peak = np.linalg.norm(values, axis=-1).max(axis=0)
+        limit = DIVERGENCE_MARGIN * bound + AT_REST
+        over = peak > limit
+        if over.any():
+            b = int(np.argmax(peak / limit))
+            return (f"{quantity} of {scene.bodies[b].name} reached {peak[b]:.3g}, more than {DIVERGENCE_MARGIN:g} x "
+                    f"the {bound[b]:.3g} its forces allow")
+    return _conserved_growth(scene, traj)
