@@ -167,7 +167,7 @@ def render(table: pd.DataFrame, info: dict) -> str:
         f"Engines: {versions}",
         "",
         "Cases (failed or diverged if any row is, ok if anything was measured): " + ", ".join(f"{s} {counts[s]}" for s in STATUSES)
-        + f". `{NOT_AVAILABLE}` means the engine cannot do what the scene asks; the reason is given.",
+        + f". `{NOT_AVAILABLE}`: nothing was measured, and the rows say why (statuses below).",
         "Errors are maxima over every body and sample against the reference named per scene; "
         "times are the best of several repeats of the stepping alone (model building excluded).",
         "",
