@@ -17,11 +17,14 @@ REPEAT_BUDGET_SECONDS = 1.0
 
 
 def best_of(fn: Callable[[], T], repeats: int) -> tuple[float, T]:
-    """(minimum wall time [s] over up to ``repeats`` timed calls, the last call's result)."""
+    """(minimum wall time [s] over up to ``repeats`` timed calls, the last call's result).
+
+    ``repeats = 0`` times the warm-up call itself (a cold, indicative time: the quick profile's).
+    """
     start = time.perf_counter()
     result = fn()  # warm-up: caches, lazy allocations
     best = time.perf_counter() - start
-    if best >= LONG_CALL_SECONDS:
+    if best >= LONG_CALL_SECONDS or repeats == 0:
         return best, result
     best, spent = float("inf"), 0.0
     for _ in range(repeats):

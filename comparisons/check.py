@@ -1,0 +1,155 @@
+"""The CI verdict on a stored run: every bounded metric inside its bound, and what moved since a baseline.
+
+:func:`check_table` holds each row to the most specific bound of the tolerances
+(:mod:`comparisons.tolerances`); a row no bound matches is unchecked (counted, never a pass in
+disguise: the count is printed). :func:`compare_with_baseline` lists every metric that moved by
+more than a relative threshold since another run, every case that appeared or disappeared, and
+timing changes apart (non-blocking: these machines are noisy).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import pandas as pd
+
+from simparity.comparisons.tolerances import Bound, bound_for
+from simparity.core.results import OK
+
+CASE_KEYS = ("scene", "engine", "integrator", "dt")
+ROW_KEYS = CASE_KEYS + ("metric",)
+
+TIMING_PREFIX = "time_per_"
+"""Timing metrics: compared with a baseline only as non-blocking notes."""
+
+BASELINE_RELATIVE = 1e-6
+"""Default relative change of a metric since the baseline that counts as a move: far above the
+1e-15 a recompiled BLAS may shift a result by, far below any tolerance, so a change in numerics
+shows even when it stays inside its bound."""
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One row outside its bound."""
+
+    scene: str
+    engine: str
+    integrator: str
+    dt: float
+    metric: str
+    found: str
+    bound: str
+    reason: str
+
+    def line(self) -> str:
+        dt = "" if math.isnan(self.dt) else f" dt={self.dt:g}"
+        return (f"{self.scene} {self.engine} {self.integrator or '-'}{dt} {self.metric}: {self.found}, "
+                f"bound {self.bound} ({self.reason})")
+
+
+@dataclass
+class CheckResult:
+    """The verdict on one run.
+
+    ``cases`` maps each case key (scene, engine, integrator, dt) to its violations (empty: passed).
+    """
+
+    checked: int = 0
+    unchecked: int = 0
+    violations: list[Violation] = field(default_factory=list)
+    cases: dict[tuple, list[Violation]] = field(default_factory=dict)
+
+    @property
+    def passed(self) -> bool:
+        return not self.violations
+
+
+def _judge(bound: Bound, row) -> tuple[str, str] | None:
+    """(what was found, the bound) when ``row`` breaks ``bound``, else None."""
+    status, value, dt = row["status"], float(row["value"]), float(row["dt"])
+    if status not in bound.statuses:
+        allowed = " or ".join(bound.statuses)
+        why = f"; {row['detail']}" if row["detail"] and status != OK else ""
+        return f"status {status}{why}"[:300], f"status {allowed}"
+    if status != OK or not bound.bounds_a_number:
+        return None
+    low, high = bound.limits(dt)
+    if not (low <= value <= high):
+        return f"{value:.4g} {row['unit']}".strip(), bound.describe(dt)
+    return None
+
+
+def check_table(table: pd.DataFrame, bounds: list[Bound]) -> CheckResult:
+    """Hold every row of a results table to its most specific bound."""
+    result = CheckResult()
+    for row in table.to_dict("records"):
+        key = tuple(row[k] for k in CASE_KEYS)
+        key = key[:3] + ("nan" if math.isnan(float(key[3])) else float(key[3]),)
+        result.cases.setdefault(key, [])
+        bound = bound_for(bounds, row["scene"], row["engine"], row["integrator"], row["metric"], float(row["dt"]))
+        if bound is None:
+            result.unchecked += 1
+            continue
+        result.checked += 1
+        broken = _judge(bound, row)
+        if broken:
+            found, text = broken
+            violation = Violation(row["scene"], row["engine"], row["integrator"], float(row["dt"]), row["metric"],
+                                  found, text, bound.reason)
+            result.violations.append(violation)
+            result.cases[key].append(violation)
+    return result
+
+
+@dataclass
+class BaselineDiff:
+    """What changed since a baseline run: moves block, timing changes do not."""
+
+    moved: list[str] = field(default_factory=list)
+    missing: list[str] = field(default_factory=list)
+    new: list[str] = field(default_factory=list)
+    timing: list[str] = field(default_factory=list)
+
+    @property
+    def blocking(self) -> bool:
+        return bool(self.moved or self.missing)
+
+
+def _label(row) -> str:
+    dt = "" if pd.isna(row["dt"]) else f" dt={float(row['dt']):g}"
+    return f"{row['scene']} {row['engine']} {row['integrator'] or '-'}{dt} {row['metric']}"
+
+
+def _keyed(table: pd.DataFrame) -> pd.DataFrame:
+    keyed = table.copy()
+    keyed["dt_key"] = keyed["dt"].map(lambda d: "nan" if pd.isna(d) else repr(float(d)))
+    keyed["integrator"] = keyed["integrator"].fillna("")
+    keyed = keyed.drop_duplicates(["scene", "engine", "integrator", "dt_key", "metric"], keep="last")
+    return keyed.set_index(["scene", "engine", "integrator", "dt_key", "metric"])
+
+
+def compare_with_baseline(table: pd.DataFrame, baseline: pd.DataFrame,
+                          relative: float = BASELINE_RELATIVE) -> BaselineDiff:
+    """Rows whose status changed or whose value moved by more than ``relative`` (of the baseline's
+    magnitude) since ``baseline``; rows only one run has; timing changes apart."""
+    now, before = _keyed(table), _keyed(baseline)
+    diff = BaselineDiff()
+    for key in before.index.difference(now.index):
+        diff.missing.append(_label(before.loc[key].to_dict() | dict(zip(before.index.names, key))))
+    for key in now.index.difference(before.index):
+        diff.new.append(_label(now.loc[key].to_dict() | dict(zip(now.index.names, key))))
+    for key in now.index.intersection(before.index):
+        a, b = now.loc[key], before.loc[key]
+        label = _label(a.to_dict() | dict(zip(now.index.names, key)))
+        timing = key[-1].startswith(TIMING_PREFIX)
+        if a["status"] != b["status"]:
+            (diff.timing if timing else diff.moved).append(f"{label}: status {b['status']} -> {a['status']}")
+            continue
+        x, y = float(a["value"]), float(b["value"])
+        if math.isnan(x) and math.isnan(y):
+            continue
+        change = abs(x - y) / abs(y) if y != 0 else (0.0 if x == 0 else math.inf)
+        if not change <= relative:
+            (diff.timing if timing else diff.moved).append(f"{label}: {y:.6g} -> {x:.6g} ({change:.2g} relative)")
+    return diff

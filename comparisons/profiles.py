@@ -1,0 +1,68 @@
+"""Run profiles: the ``quick`` CI profile shrinks a scene to a smoke test of the same physics.
+
+``quick`` keeps every scene and every engine, and keeps what the verdicts need (three time
+steps for an order fit, the hard IK targets), but
+
+- a dynamics scene runs on its :data:`QUICK_LADDER` coarsest time steps, for at most
+  :data:`QUICK_MAX_STEPS` of the finest of them (a whole number of the coarsest), with one
+  orientation update per scheme (the default; the ``+matrix`` / ``+expmap`` variants are left to
+  the full run);
+- a kinematics scene samples at most :data:`QUICK_SAMPLES` configurations, an IK scene at most
+  :data:`QUICK_TARGETS` random targets.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from simparity.comparisons.engines import known_integrators
+from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
+
+QUICK_MAX_STEPS = 1000
+"""Steps at the finest kept time step: every built-in scene but the long horizons runs whole
+(so the hard cases show the verdict they show in the full run), and a long horizon is cut to
+2,000 steps, which keeps the suite near half a minute on 2 cores."""
+
+QUICK_LADDER = 3
+"""Time steps kept (the coarsest): the fewest an order fit accepts."""
+
+QUICK_SAMPLES = 100
+"""Configurations a kinematics scene samples: enough to hit every joint range."""
+
+QUICK_TARGETS = 50
+"""Random IK targets: a solve rate to 2 %, at half the cost of a kinematics sample (each target
+is an iterative solve on every engine)."""
+
+VARIANT_MARK = "+"
+"""In-house integrator names with this mark are a scheme with a non-default orientation update."""
+
+PROFILES = ("full", "quick")
+
+
+def _divides(duration: float, dt: float) -> bool:
+    steps = duration / dt
+    return abs(steps - round(steps)) <= 1e-9 * steps
+
+
+def quick(scene):
+    """The ``quick`` version of a scene (see the module docstring); scenes of other kinds unchanged."""
+    if isinstance(scene, DynamicsScene):
+        dts = tuple(sorted(scene.dts, reverse=True)[:QUICK_LADDER])
+        coarsest = dts[0]
+        duration = max(1, math.floor(QUICK_MAX_STEPS * dts[-1] / coarsest + 1e-9)) * coarsest
+        if duration >= scene.duration or not all(_divides(duration, dt) for dt in dts):
+            duration = scene.duration
+        integrators = scene.integrators or tuple(i for i in known_integrators() if VARIANT_MARK not in i)
+        integrators = tuple(i for i in integrators if VARIANT_MARK not in i) or integrators
+        return replace(scene, duration=duration, dts=tuple(sorted(dts)), integrators=integrators)
+    if isinstance(scene, KinematicsScene):
+        return replace(scene, n_configurations=min(scene.n_configurations, QUICK_SAMPLES))
+    if isinstance(scene, IKScene):
+        return replace(scene, n_targets=min(scene.n_targets, QUICK_TARGETS))
+    return scene
+
+
+def apply_profile(scenes: list, profile: str) -> list:
+    """The scenes as the profile runs them (``full``: unchanged)."""
+    return [quick(s) for s in scenes] if profile == "quick" else list(scenes)

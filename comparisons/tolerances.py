@@ -1,0 +1,213 @@
+"""Tolerances: the bounds ``simparity check`` holds a run to, each with its reason.
+
+A tolerances file is TOML with one ``[[bound]]`` table per bound (format: ``docs/check.md``)::
+
+    [[bound]]
+    scene = "*"                      # fnmatch patterns; "*" (the default) matches anything
+    engine = "*"
+    integrator = "rk4*"
+    metric = "order_position"
+    expected = 4.0                   # |value - expected| <= band
+    band = 0.3
+    reason = "RK4 is fourth order; 0.3 covers the next term at the ladders used"
+
+Kinds of bound (one table may combine them): ``max`` (value <= max), ``min`` (value >= min),
+``expected`` with ``band`` (absolute, +-) or ``rel`` (relative to ``expected``), any of them scaled
+by dt^``dt_power`` (a scheme's known error, e.g. C dt^1 for Euler), and ``status`` (the statuses the
+row may have; default ``ok`` when a number is bounded, so a metric that went ``n/a`` is a
+violation, not a pass; ``status = "diverged"`` makes a blow-up the expected verdict).
+
+A bound may name one time step (``dt``, in seconds) or ``dt = "*"`` (every time step, but not
+the order rows, which have none); without ``dt`` it holds for every row.
+The most specific bound wins: a key written out exactly counts 2, a pattern other than ``*``
+counts 1, ``*`` counts 0, summed over scene, engine, integrator, metric and dt; among equally
+specific bounds the later one in the file wins, so a file can be extended by appending.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import math
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from simparity.core.errors import SceneError
+from simparity.core.results import OK, STATUSES
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
+
+DEFAULT_TOLERANCES = Path(__file__).resolve().parent / "tolerances" / "default.toml"
+"""The shipped tolerances: every built-in scene, each bound with its reason."""
+
+MATCH_KEYS = ("scene", "engine", "integrator", "metric")
+NUMBER_KEYS = ("max", "min", "expected", "band", "rel", "dt_power")
+ALLOWED_KEYS = MATCH_KEYS + ("dt",) + NUMBER_KEYS + ("status", "reason")
+DT_MATCH = 1e-9
+"""Relative difference under which a bound's ``dt`` [s] names a row's time step."""
+
+
+class ToleranceError(SceneError):
+    """A tolerances file or one of its values is invalid (file, key, what was wrong, what is allowed)."""
+
+
+@dataclass(frozen=True)
+class Bound:
+    """One bound of a tolerances file.
+
+    Attributes
+    ----------
+    scene, engine, integrator, metric : str
+        fnmatch patterns the row's fields must match.
+    dt : float, "*" or None
+        The time step [s] the bound is for; ``"*"``: every time step (the per-time-step rows, not
+        the order rows, which have none); None: every row.
+    max, min, expected, band, rel, dt_power : float or None
+        See the module docstring; ``None`` where not given.
+    statuses : tuple of str
+        Statuses the row may have.
+    reason : str
+        Why the bound is what it is.
+    where : str
+        ``file: bound[i]``, for messages.
+    order : int
+        Position in the file (later wins among equally specific bounds).
+    """
+
+    scene: str
+    engine: str
+    integrator: str
+    metric: str
+    dt: float | str | None
+    max: float | None
+    min: float | None
+    expected: float | None
+    band: float | None
+    rel: float | None
+    dt_power: float | None
+    statuses: tuple[str, ...]
+    reason: str
+    where: str
+    order: int
+
+    @property
+    def specificity(self) -> int:
+        patterns = (self.scene, self.engine, self.integrator, self.metric)
+        dt_weight = 0 if self.dt is None else 1 if self.dt == "*" else 2
+        return dt_weight + sum(0 if p == "*" else 1 if any(c in p for c in "*?[") else 2 for p in patterns)
+
+    def matches(self, scene: str, engine: str, integrator: str, metric: str, dt: float = math.nan) -> bool:
+        if self.dt == "*" and math.isnan(dt):
+            return False
+        if isinstance(self.dt, float) and not abs(dt - self.dt) <= DT_MATCH * self.dt:
+            return False
+        return all(fnmatch.fnmatchcase(value, pattern) for value, pattern in
+                   zip((scene, engine, integrator, metric), (self.scene, self.engine, self.integrator, self.metric)))
+
+    @property
+    def bounds_a_number(self) -> bool:
+        return self.max is not None or self.min is not None or self.expected is not None
+
+    def limits(self, dt: float) -> tuple[float, float]:
+        """(lowest, highest) value allowed at time step ``dt`` [s] (NaN dt: no scaling)."""
+        scale = dt ** self.dt_power if self.dt_power is not None and math.isfinite(dt) else 1.0
+        low, high = -math.inf, math.inf
+        if self.max is not None:
+            high = self.max * scale
+        if self.min is not None:
+            low = self.min * scale
+        if self.expected is not None:
+            centre = self.expected * scale
+            half = (self.band or 0.0) + (self.rel or 0.0) * abs(centre)
+            low, high = max(low, centre - half), min(high, centre + half)
+        return low, high
+
+    def describe(self, dt: float) -> str:
+        """The bound in words, e.g. ``<= 1e-06`` or ``4 +- 0.3``."""
+        low, high = self.limits(dt)
+        if self.expected is not None:
+            return f"in [{low:.3g}, {high:.3g}]"
+        if self.max is not None and self.min is not None:
+            return f"in [{low:.3g}, {high:.3g}]"
+        return f"<= {high:.3g}" if self.max is not None else f">= {low:.3g}"
+
+
+def _number(source: str, key: str, value, non_negative: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ToleranceError(source, key, f"expected a finite number, got {value!r:.60}", "finite numbers")
+    if non_negative and value < 0:
+        raise ToleranceError(source, key, f"{value!r} is negative", "numbers >= 0")
+    return float(value)
+
+
+def _bound(source: str, index: int, table) -> Bound:
+    where = f"bound[{index}]"
+    if not isinstance(table, dict):
+        raise ToleranceError(source, where, "expected a table", "[[bound]] tables")
+    unknown = sorted(set(table) - set(ALLOWED_KEYS))
+    if unknown:
+        raise ToleranceError(source, f"{where}.{unknown[0]}"[:120], "unknown key", ", ".join(ALLOWED_KEYS))
+    patterns = {}
+    for key in MATCH_KEYS:
+        value = table.get(key, "*")
+        if not isinstance(value, str) or not value:
+            raise ToleranceError(source, f"{where}.{key}", f"expected a non-empty pattern, got {value!r:.60}",
+                                 "a name or an fnmatch pattern such as rk4*")
+        patterns[key] = value
+    dt = table.get("dt")
+    if dt is not None and dt != "*":
+        dt = _number(source, f"{where}.dt", table["dt"])
+        if dt <= 0:
+            raise ToleranceError(source, f"{where}.dt", f"{dt!r} is not a time step", "a time step > 0 [s]")
+    numbers = {key: None for key in NUMBER_KEYS}
+    for key in NUMBER_KEYS:
+        if key in table:
+            numbers[key] = _number(source, f"{where}.{key}", table[key], non_negative=key in ("band", "rel"))
+    if (numbers["band"] is not None or numbers["rel"] is not None) and numbers["expected"] is None:
+        raise ToleranceError(source, f"{where}.band", "band and rel need an expected value", "expected = ...")
+    reason = table.get("reason")
+    if not isinstance(reason, str) or not reason.strip():
+        raise ToleranceError(source, f"{where}.reason", "every bound needs its reason", "a non-empty string")
+    status = table.get("status")
+    if status is None:
+        statuses = (OK,)
+    else:
+        statuses = (status,) if isinstance(status, str) else tuple(status) if isinstance(status, list) else ()
+        if not statuses or any(s not in STATUSES for s in statuses):
+            raise ToleranceError(source, f"{where}.status", f"{status!r:.60} is not a status or a list of them",
+                                 ", ".join(STATUSES))
+    bound = Bound(**patterns, dt=dt, **numbers, statuses=statuses, reason=reason.strip(), where=f"{source}: {where}",
+                  order=index)
+    if not bound.bounds_a_number and status is None:
+        raise ToleranceError(source, where, "bounds nothing", "max, min, expected or status")
+    return bound
+
+
+def load_tolerances(path: str | Path = DEFAULT_TOLERANCES) -> list[Bound]:
+    """The bounds of a tolerances file; raises :class:`ToleranceError` naming the file and key."""
+    source = str(path)
+    try:
+        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ToleranceError(source, "-", "no such file", "a tolerances TOML file") from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise ToleranceError(source, "-", f"unreadable: {type(err).__name__}", "a UTF-8 TOML file") from None
+    except tomllib.TOMLDecodeError as err:
+        raise ToleranceError(source, "-", f"not valid TOML: {err}", "TOML") from None
+    unknown = sorted(set(data) - {"bound"})
+    if unknown:
+        raise ToleranceError(source, unknown[0][:80], "unknown table", "[[bound]]")
+    tables = data.get("bound", [])
+    if not isinstance(tables, list) or not tables:
+        raise ToleranceError(source, "bound", "no bounds", "one or more [[bound]] tables")
+    return [_bound(source, i, table) for i, table in enumerate(tables)]
+
+
+def bound_for(bounds: list[Bound], scene: str, engine: str, integrator: str, metric: str,
+              dt: float = math.nan) -> Bound | None:
+    """The most specific bound that matches (the later one on a tie), or None."""
+    matching = [b for b in bounds if b.matches(scene, engine, integrator, metric, dt)]
+    return max(matching, key=lambda b: (b.specificity, b.order)) if matching else None

@@ -1,0 +1,95 @@
+"""The CI verdict: bounds held row by row, expected blow-ups pass, baselines catch moves inside tolerance."""
+
+import dataclasses
+import math
+
+import pandas as pd
+import pytest
+
+from simparity.comparisons.check import BASELINE_RELATIVE, check_table, compare_with_baseline
+from simparity.comparisons.engines import make_engine
+from simparity.comparisons.profiles import quick
+from simparity.comparisons.runner import run_scene
+from simparity.comparisons.tolerances import load_tolerances
+from simparity.core import integrators
+from simparity.core.results import COLUMNS, ResultRow
+from tests.helpers import builtin
+
+
+def _table(rows):
+    return pd.DataFrame([r.as_dict() for r in rows], columns=list(COLUMNS))
+
+
+def _row(metric="order_position", value=4.02, status="ok", dt=math.nan, integrator="rk4", engine="core", detail=""):
+    return ResultRow("s", engine, integrator, dt, metric, value, "1", "analytic:exact", status, detail)
+
+
+@pytest.fixture
+def bounds(tmp_path):
+    path = tmp_path / "tol.toml"
+    path.write_text("""
+[[bound]]
+metric = "*"
+status = ["ok", "n/a"]
+reason = "must run"
+[[bound]]
+integrator = "rk4"
+metric = "order_*"
+expected = 4.0
+band = 0.5
+reason = "fourth order"
+[[bound]]
+integrator = "euler"
+dt = "*"
+status = "diverged"
+reason = "must blow up"
+""", encoding="utf-8")
+    return load_tolerances(path)
+
+
+def test_rows_inside_pass_outside_fail_with_a_one_line_reason(bounds):
+    result = check_table(_table([_row(value=4.02), _row(metric="order_velocity", value=2.9)]), bounds)
+    assert result.checked == 2 and len(result.violations) == 1
+    line = result.violations[0].line()
+    assert line == "s core rk4 order_velocity: 2.9 1, bound in [3.5, 4.5] (fourth order)"
+
+
+def test_a_bounded_metric_that_went_n_a_is_a_violation_not_a_pass(bounds):
+    result = check_table(_table([_row(value=math.nan, status="n/a", detail="saturated: lost")]), bounds)
+    assert len(result.violations) == 1 and "status n/a; saturated: lost" in result.violations[0].found
+
+
+def test_an_expected_blow_up_passes_and_a_bounded_run_fails(bounds):
+    blew = _row(metric="position_error_max", value=math.nan, status="diverged", dt=0.01, integrator="euler")
+    held = _row(metric="position_error_max", value=1e-3, status="ok", dt=0.02, integrator="euler")
+    result = check_table(_table([blew, held]), bounds)
+    assert [v.dt for v in result.violations] == [0.02] and "must blow up" in result.violations[0].line()
+
+
+def test_baseline_flags_a_1e9_change_inside_tolerance_and_keeps_timing_apart():
+    """An RK4 error of 1e-6 m moved by 1e-9 m (1e-3 relative, far inside any tolerance) is a move;
+    a timing change is a note; a vanished row is missing, an added one new."""
+    before = _table([_row("position_error_max", 1e-6, dt=0.01), _row("time_per_step", 1e-5, dt=0.01),
+                     _row("velocity_error_max", 1e-7, dt=0.01)])
+    after = _table([_row("position_error_max", 1e-6 + 1e-9, dt=0.01), _row("time_per_step", 2e-5, dt=0.01),
+                    _row("angular_velocity_error_max", 1e-7, dt=0.01)])
+    diff = compare_with_baseline(after, before)
+    assert len(diff.moved) == 1 and "position_error_max" in diff.moved[0] and "1e-06 -> 1.001e-06" in diff.moved[0]
+    assert len(diff.timing) == 1 and diff.blocking
+    assert "velocity_error_max" in diff.missing[0] and "angular_velocity_error_max" in diff.new[0]
+    same = compare_with_baseline(before, before)
+    assert not (same.moved or same.missing or same.new or same.timing)
+    assert BASELINE_RELATIVE < 1e-3
+
+
+def test_a_degraded_rk4_fails_the_shipped_tolerances(monkeypatch):
+    """RK4 with a wrong stage weight (b = 1/6, 1/3, 1/3, 1/6 -> 1/6, 1/6, 1/2, 1/6: still consistent, second
+    order at best) fails the shipped order gate on a tumbling box; the true RK4 passes."""
+    scene = dataclasses.replace(quick(builtin("tumbling-box-stable")), integrators=("rk4",))
+    bounds = load_tolerances()
+    good = check_table(_table(run_scene(scene, [make_engine("core")], make_engine, repeats=0)), bounds)
+    assert good.passed, [v.line() for v in good.violations]
+    a, b, c = integrators._TABLEAUX["rk4"]
+    monkeypatch.setitem(integrators._TABLEAUX, "rk4", (a, [1 / 6, 1 / 6, 1 / 2, 1 / 6], c))
+    bad = check_table(_table(run_scene(scene, [make_engine("core")], make_engine, repeats=0)), bounds)
+    assert not bad.passed and any(v.metric == "order_orientation" for v in bad.violations)

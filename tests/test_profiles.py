@@ -1,0 +1,21 @@
+"""The quick profile: the same scenes, shorter, still able to fit an order and show a blow-up."""
+
+from simparity.comparisons.profiles import QUICK_LADDER, QUICK_MAX_STEPS, QUICK_TARGETS, VARIANT_MARK, apply_profile, quick
+from tests.helpers import builtin
+
+
+def test_dynamics_keep_the_coarsest_steps_and_a_whole_number_of_them():
+    full = builtin("long-horizon")
+    short = quick(builtin("dzhanibekov"))
+    assert short.dts == (0.0025, 0.005, 0.01) and len(short.dts) == QUICK_LADDER
+    assert short.duration == QUICK_MAX_STEPS * 0.0025  # 1000 steps of the finest, 250 of the coarsest
+    assert all(VARIANT_MARK not in i for i in short.integrators) and "rk4" in short.integrators
+    assert quick(full).duration == QUICK_MAX_STEPS * full.dts[0] < full.duration
+
+
+def test_short_scenes_run_whole_and_samples_shrink():
+    projectile = builtin("lecture-projectile")
+    assert quick(projectile).duration == projectile.duration  # 720 steps at the finest kept step
+    assert quick(projectile).dts == tuple(sorted(projectile.dts))[-QUICK_LADDER:]
+    assert quick(builtin("iiwa-ik")).n_targets == QUICK_TARGETS
+    assert apply_profile([projectile], "full") == [projectile]
