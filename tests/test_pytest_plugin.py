@@ -1,0 +1,45 @@
+"""The pytest plugin, run under pytester: the documented example passes, a broken variant fails."""
+
+from pathlib import Path
+
+pytest_plugins = ["pytester"]
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "docs" / "examples" / "test_my_numerics.py"
+
+
+def test_the_documented_example_passes(pytester):
+    pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
+    result = pytester.runpytest_subprocess()
+    result.assert_outcomes(passed=1)
+
+
+def test_a_tolerance_the_run_breaks_fails_with_the_violation(pytester):
+    """A bound no RK4 run can meet (order exactly 5) fails the test and names the metric and the bound."""
+    pytester.makefile(".toml", tight='[[bound]]\nintegrator = "rk4"\nmetric = "order_velocity"\n'
+                                     'expected = 5.0\nband = 0.01\nstatus = ["ok", "n/a"]\nreason = "impossible"\n')
+    pytester.makepyfile(test_broken='''
+def test_broken(simparity):
+    simparity.check("falling-linear-drag", engines=["core"], tolerances="tight.toml", profile="quick")
+''')
+    result = pytester.runpytest_subprocess()
+    result.assert_outcomes(failed=1)
+    assert "bound in [4.99, 5.01] (impossible)" in result.stdout.str()
+    result.stdout.fnmatch_lines(["falling-linear-drag core rk4 order_velocity: 4.0* 1, bound in *"])
+
+
+def test_a_baseline_that_differs_fails(pytester, tmp_path):
+    """--simparity-baseline with a stored run whose value differs: the move is reported."""
+    from simparity.comparisons.api import load_scene, run_scene
+    from simparity.comparisons.profiles import quick
+    from simparity.comparisons.store import RunWriter
+    from simparity.core.results import ResultRow
+
+    scene = quick(load_scene("lecture-projectile"))
+    table = run_scene(scene, engines=["core"], repeats=0)
+    table.loc[table["metric"] == "position_error_final", "value"] *= 1.01
+    writer = RunWriter(tmp_path / "base", {}, "test", [scene])
+    writer.append([ResultRow(**row) for row in table.to_dict("records")])
+    pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
+    result = pytester.runpytest_subprocess("--simparity-baseline", str(tmp_path / "base"))
+    result.assert_outcomes(failed=1)
+    result.stdout.fnmatch_lines(["*moved since*position_error_final*"])
