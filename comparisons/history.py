@@ -21,7 +21,7 @@ from pathlib import Path
 import pandas as pd
 
 from simparity.comparisons.store import DEFAULT_OUT_ROOT
-from simparity.core.errors import SimparityError
+from simparity.core.errors import HistoryError
 from simparity.core.results import COLUMNS
 
 HISTORY_ENV = "SIMPARITY_HISTORY"
@@ -46,10 +46,6 @@ CREATE TABLE IF NOT EXISTS results (
 );
 CREATE INDEX IF NOT EXISTS results_by_metric ON results (scene, engine, metric);
 """
-
-
-class HistoryError(SimparityError):
-    """The run history database cannot be read or written (the CSV results are unaffected)."""
 
 
 def history_path(option: str | None = None) -> Path:

@@ -8,16 +8,28 @@ the key path, what was wrong and what is allowed. The format is documented in
 from __future__ import annotations
 
 import math
+import re
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from simparity.comparisons.engines import ENGINE_NAMES, known_integrators
-from simparity.core.errors import SceneError
-from simparity.core.inertia import inertia_problem
-from simparity.core.rotations import rpy_to_matrix
+from simparity.comparisons.scene_limits import (
+    DEFAULT_LIMITS,
+    NORM_RANGES,
+    POSITION_TOLERANCE_OF_REACH,
+    RANGES,
+    Limits,
+    safe_norm,
+)
 from simparity.core.dh import chain_from_dh
+from simparity.core.errors import SceneError
+from simparity.core.files import is_regular_file, read_input
+from simparity.core.ik.reach import reach_upper_bound
+from simparity.core.inertia import inertia_problem
+from simparity.core.names import NAME_RULE, name_problem
+from simparity.core.rotations import rpy_to_matrix
 from simparity.core.scene import HARD_TARGETS, AppliedForce, Chain, DynamicsScene, Forces, IKScene, Joint, KinematicsScene, RigidBody
 from simparity.core.urdf import chain_from_urdf
 
@@ -38,8 +50,9 @@ _REQUIRED = object()  # marks a key without a default
 class _Reader:
     """Typed access to one table of a scene file, with key paths for error messages."""
 
-    def __init__(self, source: str, table: dict, path: str, allowed: tuple[str, ...], length_scale: float) -> None:
-        self.source, self.table, self.path, self.scale = source, table, path, length_scale
+    def __init__(self, source: str, table: dict, path: str, allowed: tuple[str, ...], length_scale: float,
+                 limits: Limits = DEFAULT_LIMITS) -> None:
+        self.source, self.table, self.path, self.scale, self.limits = source, table, path, length_scale, limits
         unknown = sorted(set(table) - set(allowed))
         if unknown:
             raise SceneError(source, self._key(unknown[0]), "unknown key", ", ".join(allowed))
@@ -63,9 +76,25 @@ class _Reader:
     def string(self, key: str, default=None, choices: tuple[str, ...] | None = None) -> str:
         value = self._get(key, _REQUIRED if default is None else default)
         if not isinstance(value, str) or not value:
-            raise self.fail(key, f"expected a non-empty string, got {value!r}")
+            raise self.fail(key, f"expected a non-empty string, got {value!r}",
+                            ", ".join(choices) if choices else "a non-empty string")
         if choices and value not in choices:
             raise self.fail(key, f"'{value}' is not allowed", ", ".join(choices))
+        return value
+
+    def name(self, key: str, default=None) -> str:
+        """A string that names something (see :mod:`core.names`)."""
+        value = self.string(key, default)
+        problem = name_problem(value)
+        if problem:
+            raise self.fail(key, problem, NAME_RULE)
+        return value
+
+    def _in_range(self, key: str, value: float) -> float:
+        """``value`` (SI) if its magnitude is in the key's physical range (:data:`RANGES`)."""
+        allowed = RANGES.get(key.rsplit(".", 1)[-1].split("[", 1)[0])
+        if allowed is not None and not allowed.allows(abs(value)):
+            raise self.fail(key, f"{value:.6g} is outside the physical range", allowed.text())
         return value
 
     def _checked(self, key: str, value, positive: bool) -> float:
@@ -83,14 +112,14 @@ class _Reader:
 
     def number(self, key: str, default=None, *, positive=False, length=0) -> float:
         value = self._get(key, _REQUIRED if default is None else default)
-        return self._checked(key, value, positive) * self.scale**length
+        return self._in_range(key, self._checked(key, value, positive) * self.scale**length)
 
-    def integer(self, key: str, default=None, *, minimum=0) -> int:
+    def integer(self, key: str, default=None, *, minimum=0, maximum=2**63 - 1, why: str = "") -> int:
         value = self._get(key, _REQUIRED if default is None else default)
         if isinstance(value, bool) or not isinstance(value, int):
-            raise self.fail(key, f"expected a whole number, got {value!r}")
-        if value < minimum:
-            raise self.fail(key, f"{value} is too small", f"whole numbers >= {minimum}")
+            raise self.fail(key, f"expected a whole number, got {value!r:.40}", f"whole numbers {minimum} to {maximum}")
+        if not minimum <= value <= maximum:
+            raise self.fail(key, f"{value} is out of range", f"whole numbers {minimum} to {maximum:,}{why}")
         return value
 
     def vector(self, key: str, size: int, default=None, *, length=0, nonzero=False, positive=False) -> np.ndarray:
@@ -102,6 +131,11 @@ class _Reader:
         out *= self.scale**length
         if nonzero and not np.any(out):
             raise self.fail(key, "is all zeros", "a vector with a non-zero entry")
+        norm_range = NORM_RANGES.get(key)
+        if norm_range is not None and not norm_range.allows(safe_norm(out)):
+            raise self.fail(key, f"its norm {safe_norm(out):.3g} is outside the usable range", norm_range.text())
+        for i, v in enumerate(out):
+            self._in_range(f"{key}[{i}]", v)
         return out
 
     def matrix(self, key: str, size: int, *, length=0) -> np.ndarray:
@@ -136,13 +170,16 @@ class _Reader:
         value = self.table[key]
         if not isinstance(value, dict):
             raise self.fail(key, f"expected a table, got {value!r}")
-        return _Reader(self.source, value, self._key(key), allowed, self.scale)
+        return _Reader(self.source, value, self._key(key), allowed, self.scale, self.limits)
 
-    def array_of_tables(self, key: str, allowed: tuple[str, ...]) -> list["_Reader"]:
+    def array_of_tables(self, key: str, allowed: tuple[str, ...], most: int) -> list["_Reader"]:
         value = self._get(key, _REQUIRED)
         if not isinstance(value, list) or not value or not all(isinstance(v, dict) for v in value):
             raise self.fail(key, "expected one or more tables", f"[[{self._key(key)}]] entries")
-        return [_Reader(self.source, v, f"{self._key(key)}[{i}]", allowed, self.scale) for i, v in enumerate(value)]
+        if len(value) > most:
+            raise self.fail(key, f"{len(value):,} entries", f"at most {most:,}")
+        return [_Reader(self.source, v, f"{self._key(key)}[{i}]", allowed, self.scale, self.limits)
+                for i, v in enumerate(value)]
 
 
 
@@ -166,6 +203,10 @@ _JOINT = ("name", "type", "axis", "origin_xyz", "origin_rpy", "lower", "upper")
 
 # duration / dt may differ from a whole number by this much (rounding of a decimal dt).
 _STEP_COUNT_RTOL = 1e-9
+_MAX_SEED = 2**63 - 1
+_SAMPLES_WHY = "; simparity run --max-samples N raises it"
+EXAMPLE_ROBOT_DATA_PREFIX = "example-robot-data:"
+"""A ``urdf`` path starting with this is inside the installed example-robot-data package's robots."""
 
 
 def _body_forces(r: _Reader, index: int) -> tuple[dict, list[AppliedForce]]:
@@ -176,7 +217,7 @@ def _body_forces(r: _Reader, index: int) -> tuple[dict, list[AppliedForce]]:
             raise r.fail(key, f"{value} is negative", "numbers >= 0")
     applied = []
     if r.has("force"):
-        for f in r.array_of_tables("force", _FORCE):
+        for f in r.array_of_tables("force", _FORCE, r.limits.max_bodies):
             applied.append(AppliedForce(index, f.vector("force_world", 3, length=1),
                                         f.vector("point_body", 3, [0.0] * 3, length=1)))
     return drags, applied
@@ -194,7 +235,7 @@ def _body(r: _Reader) -> RigidBody:
         key = "inertia_body" if r.has("inertia_body") else "inertia_body_diagonal"
         raise r.fail(key, problem, "a symmetric positive-definite tensor obeying the triangle inequality")
     return RigidBody(
-        name=r.string("name"),
+        name=r.name("name"),
         mass=r.number("mass", positive=True),
         inertia_body=inertia,
         position_world=r.vector("position_world", 3, [0.0] * 3, length=1),
@@ -208,7 +249,7 @@ def _dynamics(top: _Reader, head: dict) -> DynamicsScene:
     world = top.subtable("world", ("gravity_world", "air_velocity_world"), required=False)
     gravity = world.vector("gravity_world", 3, length=1) if world and world.has("gravity_world") else None
     air = world.vector("air_velocity_world", 3, length=1) if world and world.has("air_velocity_world") else None
-    readers = top.array_of_tables("body", _BODY)
+    readers = top.array_of_tables("body", _BODY, top.limits.max_bodies)
     bodies = tuple(_body(r) for r in readers)
     per_body = [_body_forces(r, i) for i, r in enumerate(readers)]
     drag = {
@@ -226,19 +267,34 @@ def _dynamics(top: _Reader, head: dict) -> DynamicsScene:
     duration = sim.number("duration", positive=True)
     if sim.has("dt") == sim.has("rate_hz"):
         raise sim.fail("dt", "give exactly one of dt and rate_hz")
-    dts = sim.numbers("dt") if sim.has("dt") else tuple(1.0 / h for h in sim.numbers("rate_hz"))
-    for dt in dts:
-        steps = duration / dt
-        if abs(steps - round(steps)) > _STEP_COUNT_RTOL * steps or round(steps) < 1:
-            raise sim.fail("dt" if sim.has("dt") else "rate_hz",
-                           f"duration {duration} s is not a whole number of steps of {dt} s",
-                           "time steps that divide the duration")
+    dts = _ladder(sim, duration, len(bodies))
     integrators = sim.strings("integrators") if sim.has("integrators") else ()
     known = known_integrators() if integrators else ()
     for i, name in enumerate(integrators):
         if name not in known:
             raise sim.fail(f"integrators[{i}]", f"no engine has an integrator '{name}'", ", ".join(known))
     return DynamicsScene(bodies=bodies, forces=forces, duration=duration, dts=dts, integrators=integrators, **head)
+
+
+def _ladder(sim: _Reader, duration: float, n_bodies: int) -> tuple[float, ...]:
+    """The time steps [s]: distinct, each a whole number of steps of the duration, within the limits."""
+    key = "dt" if sim.has("dt") else "rate_hz"
+    values = sim.numbers(key)
+    if len(values) > sim.limits.max_dts:
+        raise sim.fail(key, f"{len(values)} time steps", f"at most {sim.limits.max_dts}")
+    if len(set(values)) != len(values):
+        raise sim.fail(key, f"a time step repeats: {list(values)}", "distinct time steps")
+    dts = values if key == "dt" else tuple(1.0 / h for h in values)
+    for i, dt in enumerate(dts):
+        steps = duration / dt  # finite: both are inside their ranges
+        if dt > duration or abs(steps - round(steps)) > _STEP_COUNT_RTOL * steps:
+            raise sim.fail(f"{key}[{i}]", f"duration {duration} s is not a whole number of steps of {dt} s",
+                           "time steps that divide the duration")
+        if steps * n_bodies > sim.limits.max_steps:
+            raise sim.fail(f"{key}[{i}]", f"{steps:,.0f} steps x {n_bodies} bodies = {steps * n_bodies:,.0f} body-steps "
+                           f"at {dt:g} s", f"at most {sim.limits.max_steps:,} per time step; simparity run "
+                           "--max-steps N raises it")
+    return dts
 
 
 def _joint(r: _Reader) -> Joint:
@@ -251,24 +307,54 @@ def _joint(r: _Reader) -> Joint:
     if lower >= upper:
         raise r.fail("upper", f"upper {upper} is not above lower {lower}")
     return Joint(
-        name=r.string("name"), type=kind, axis=r.vector("axis", 3, nonzero=True),
+        name=r.name("name"), type=kind, axis=r.vector("axis", 3, nonzero=True),
         origin_xyz=r.vector("origin_xyz", 3, [0.0] * 3, length=1),
         origin_rotation=rpy_to_matrix(r.vector("origin_rpy", 3, [0.0] * 3)),
         lower=lower, upper=upper,
     )
 
 
-def _urdf_path(c: _Reader) -> Path:
-    text = c.string("urdf")
-    if text.startswith(PYBULLET_DATA_PREFIX):
+def _package_root(c: _Reader, prefix: str) -> Path:
+    """The folder a prefixed ``urdf`` path is relative to."""
+    if prefix == PYBULLET_DATA_PREFIX:
         import pybullet_data  # data files only; ships with pybullet
 
-        path = Path(pybullet_data.getDataPath()) / text[len(PYBULLET_DATA_PREFIX):]
+        return Path(pybullet_data.getDataPath())
+    from importlib import metadata
+
+    try:
+        robots = metadata.distribution("example-robot-data").locate_file("cmeel.prefix/share/example-robot-data/robots")
+    except metadata.PackageNotFoundError:
+        raise c.fail("urdf", "the example-robot-data package is not installed",
+                     "pip install example-robot-data, or a path to a URDF file") from None
+    return Path(str(robots))
+
+
+def _urdf_path(c: _Reader) -> Path:
+    text = c.string("urdf")
+    prefix = next((p for p in (PYBULLET_DATA_PREFIX, EXAMPLE_ROBOT_DATA_PREFIX) if text.startswith(p)), None)
+    if prefix:
+        path = _package_root(c, prefix) / text[len(prefix):]
     else:
         path = Path(text) if Path(text).is_absolute() else Path(c.source).parent / text
-    if not path.is_file():
-        raise c.fail("urdf", f"no such file: {path}", f"a path relative to the scene file, or {PYBULLET_DATA_PREFIX}...")
+    if not is_regular_file(path):
+        raise c.fail("urdf", f"no such file: {path}", f"a URDF file relative to the scene file, or "
+                     f"{PYBULLET_DATA_PREFIX}... or {EXAMPLE_ROBOT_DATA_PREFIX}...")
     return path
+
+
+def _urdf_chain(c: _Reader) -> Chain:
+    """The chain of a ``urdf`` scene; an error in the URDF names the scene file too."""
+    base, tip = (c.name(key) if c.has(key) else None for key in ("base_link", "tip_link"))
+    path = _urdf_path(c)
+    try:
+        chain = chain_from_urdf(str(path), base_link=base, tip_link=tip, max_joints=c.limits.max_joints,
+                                max_bytes=c.limits.max_file_bytes)
+    except SceneError as err:
+        raise c.fail("urdf", f"{err.source}: {err.key}: {err.problem}", err.allowed) from None
+    if chain.n_joints > c.limits.max_joints:
+        raise c.fail("urdf", f"{chain.n_joints} joints on the chain", f"at most {c.limits.max_joints}")
+    return chain
 
 
 def _dh_chain(c: _Reader, name: str) -> Chain:
@@ -277,7 +363,9 @@ def _dh_chain(c: _Reader, name: str) -> Chain:
     columns = {key: dh.table.get(key) for key in ("a", "alpha", "d", "theta_offset")}
     size = len(columns["a"]) if isinstance(columns["a"], list) else 0
     if size < 1:
-        raise dh.fail("a", "expected a non-empty list of numbers")
+        raise dh.fail("a", "expected a non-empty list of numbers", "one number per joint")
+    if size > dh.limits.max_joints:
+        raise dh.fail("a", f"{size} joints", f"at most {dh.limits.max_joints}")
     values = {key: dh.vector(key, size, [0.0] * size if key == "theta_offset" else None,
                              length=1 if key in ("a", "d") else 0) for key in columns}
     limits = None
@@ -295,17 +383,16 @@ def _chain(top: _Reader, name: str) -> Chain:
     if len(sources) != 1:
         raise c.fail("joint", f"give exactly one chain source, got {sources or 'none'}", "joint, urdf, dh")
     if sources == ["urdf"]:
-        return chain_from_urdf(str(_urdf_path(c)), base_link=c.table.get("base_link"),
-                               tip_link=c.table.get("tip_link"))
+        return _urdf_chain(c)
     if sources == ["dh"]:
-        return _dh_chain(c, c.string("name", name))
-    joints = tuple(_joint(r) for r in c.array_of_tables("joint", _JOINT))
+        return _dh_chain(c, c.name("name", name))
+    joints = tuple(_joint(r) for r in c.array_of_tables("joint", _JOINT, c.limits.max_joints))
     names = [j.name for j in joints]
-    end_effector = c.string("end_effector", "end_effector")
+    end_effector = c.name("end_effector", "end_effector")
     if len(set(names + [end_effector])) != len(names) + 1:
         raise c.fail("joint", f"joint and end-effector names repeat: {names + [end_effector]}", "distinct names")
     return Chain(
-        name=c.string("name", name), joints=joints, end_effector_name=end_effector,
+        name=c.name("name", name), joints=joints, end_effector_name=end_effector,
         end_effector_xyz=c.vector("end_effector_xyz", 3, [0.0] * 3, length=1),
         end_effector_rotation=rpy_to_matrix(c.vector("end_effector_rpy", 3, [0.0] * 3)),
     )
@@ -314,8 +401,9 @@ def _chain(top: _Reader, name: str) -> Chain:
 def _kinematics(top: _Reader, head: dict) -> KinematicsScene:
     chain = _chain(top, head["name"])
     sampling = top.subtable("sampling", ("configurations", "seed"), required=False)
-    n = sampling.integer("configurations", 100, minimum=1) if sampling else 100
-    seed = sampling.integer("seed", 0) if sampling else 0
+    limit = top.limits.max_samples
+    n = sampling.integer("configurations", 100, minimum=1, maximum=limit, why=_SAMPLES_WHY) if sampling else 100
+    seed = sampling.integer("seed", 0, maximum=_MAX_SEED) if sampling else 0
     return KinematicsScene(chain=chain, n_configurations=n, seed=seed, **head)
 
 
@@ -326,14 +414,28 @@ def _start(t: _Reader, chain: Chain) -> np.ndarray:
         prismatic = np.array([j.type == "prismatic" for j in chain.joints])
         q = t.vector("start", chain.n_joints) * np.where(prismatic, t.scale, 1.0)  # lengths in the scene's unit
     elif value in ("zeros", "mid-range"):
-        middle = (chain.lower + chain.upper) / 2
-        q = np.zeros(chain.n_joints) if value == "zeros" else np.where(np.isfinite(middle), middle, 0.0)
+        limited = np.isfinite(chain.lower) & np.isfinite(chain.upper)  # continuous joints: 0, no inf - inf
+        middle = np.where(limited, 0.5 * np.where(limited, chain.lower, 0.0) + 0.5 * np.where(limited, chain.upper, 0.0),
+                          0.0)
+        q = np.zeros(chain.n_joints) if value == "zeros" else middle
     else:
         raise t.fail("start", f"{value!r} is not allowed", f'"zeros", "mid-range" or a list of {chain.n_joints} numbers')
     outside = np.flatnonzero((q < chain.lower) | (q > chain.upper))
     if outside.size:
         raise t.fail("start", f"joint {chain.joints[outside[0]].name} starts outside its limits")
     return q
+
+
+def _position_tolerance(t: _Reader, chain: Chain) -> float:
+    """[m]; at most :data:`POSITION_TOLERANCE_OF_REACH` of the chain's reach."""
+    if not t.has("position_tolerance"):
+        return DEFAULT_POSITION_TOLERANCE
+    value = t.number("position_tolerance", positive=True, length=1)
+    most = POSITION_TOLERANCE_OF_REACH * reach_upper_bound(chain)[1]
+    if value > most:
+        raise t.fail("position_tolerance", f"{value:.3g} m would count misses of a tenth of the arm as solved",
+                     f"at most {POSITION_TOLERANCE_OF_REACH:g} x the chain's reach = {most:.3g} m")
+    return value
 
 
 def _ik(top: _Reader, head: dict) -> IKScene:
@@ -344,23 +446,41 @@ def _ik(top: _Reader, head: dict) -> IKScene:
     if unknown:
         raise t.fail("hard", f"unknown hard target {unknown[0]!r}", ", ".join(HARD_TARGETS))
     return IKScene(
-        chain=chain, n_targets=t.integer("count", 100, minimum=1), seed=t.integer("seed", 0),
+        chain=chain, n_targets=t.integer("count", 100, minimum=1, maximum=t.limits.max_samples, why=_SAMPLES_WHY),
+        seed=t.integer("seed", 0, maximum=_MAX_SEED),
         target_kind=t.string("kind", "pose", choices=("pose", "position")), q_start=_start(t, chain),
-        position_tolerance=(t.number("position_tolerance", positive=True, length=1)
-                            if t.has("position_tolerance") else DEFAULT_POSITION_TOLERANCE),
+        position_tolerance=_position_tolerance(t, chain),
         orientation_tolerance=t.number("orientation_tolerance", 1e-6, positive=True),
-        max_iterations=t.integer("max_iterations", 200, minimum=1), hard_targets=hard, **head,
+        max_iterations=t.integer("max_iterations", 200, minimum=1, maximum=t.limits.max_iterations),
+        hard_targets=hard, **head,
     )
 
 
-def parse_scene(data: dict, source: str = "<scene>"):
+def _check_reference(top: _Reader, scene) -> None:
+    """A ground-truth reference (analytic, tight) that cannot do the scene is an error now, not a run of n/a rows."""
+    if scene.reference not in ("analytic", "tight"):
+        return
+    from simparity.comparisons.engines import make_engine
+
+    engine = make_engine(scene.reference)
+    if isinstance(scene, DynamicsScene):
+        support = engine.supports_dynamics(scene, engine.integrators()[0])
+    else:
+        support = engine.supports_kinematics(scene.chain)
+    if not support.ok:
+        raise top.fail("scene.reference", f"{scene.reference} cannot serve this scene: {support.reason}",
+                       "a reference that can: core, mujoco, pybullet, pinocchio, or tight for dynamics without a "
+                       "closed form")
+
+
+def parse_scene(data: dict, source: str = "<scene>", limits: Limits = DEFAULT_LIMITS):
     """Build a scene from parsed TOML ``data``; ``source`` names it in error messages."""
-    top = _Reader(source, data, "", _TOP, 1.0)
+    top = _Reader(source, data, "", _TOP, 1.0, limits)
     s = top.subtable("scene", _SCENE)
     unit = s.string("length_unit", "m", choices=tuple(LENGTH_UNITS))
     kind = s.string("kind", choices=KINDS)
     head = dict(
-        name=s.string("name"), description=s.string("description", "-"),
+        name=s.name("name"), description=s.string("description", "-"),
         reference=s.string("reference", choices=ENGINE_NAMES), source=source,
     )
     top.scale = LENGTH_UNITS[unit]
@@ -368,21 +488,39 @@ def parse_scene(data: dict, source: str = "<scene>"):
         if top.has(key) and key not in _PARTS[kind]:
             raise top.fail(key, f"not part of a {kind} scene", ", ".join(("scene",) + _PARTS[kind]))
     if kind == "dynamics":
-        return _dynamics(top, dict(head, length_unit=unit))
-    return _kinematics(top, head) if kind == "kinematics" else _ik(top, head)
+        scene = _dynamics(top, dict(head, length_unit=unit))
+    else:
+        scene = _kinematics(top, head) if kind == "kinematics" else _ik(top, head)
+    _check_reference(top, scene)
+    return scene
 
 
-def load_scene(path: str | Path):
-    """Read and check one scene file."""
-    path = Path(path)
+_TOML_POSITION = re.compile(r"\(at line (\d+), column (\d+)\)")
+MAX_NESTING_HINT = "TOML nested at most a few hundred levels deep"
+
+
+def _decode(path: str, data: bytes) -> str:
+    if data.startswith(b"\xef\xbb\xbf"):
+        raise SceneError(path, "line 1, column 1", "the file starts with a UTF-8 byte-order mark (BOM)",
+                         "UTF-8 without a BOM (save it as plain UTF-8)")
     try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise SceneError(str(path), "-", f"cannot read the file: {err.strerror}") from None
+        return data.decode("utf-8")
     except UnicodeDecodeError as err:
-        raise SceneError(str(path), "-", f"not UTF-8 text: {err.reason} at byte {err.start}") from None
+        line = data[: err.start].count(b"\n") + 1
+        raise SceneError(path, f"line {line}, byte {err.start}", f"not UTF-8 text: {err.reason}", "UTF-8 text") from None
+
+
+def load_scene(path: str | Path, limits: Limits = DEFAULT_LIMITS):
+    """Read and check one scene file (a regular file of at most ``limits.max_file_bytes``)."""
+    source = str(path)
+    text = _decode(source, read_input(source, limits.max_file_bytes, "scene file"))
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:
-        raise SceneError(str(path), "-", f"not valid TOML: {err}") from None
-    return parse_scene(data, str(path))
+        where = _TOML_POSITION.search(str(err))
+        key = f"line {where.group(1)}, column {where.group(2)}" if where else "-"
+        problem = _TOML_POSITION.sub("", str(err)).strip()
+        raise SceneError(source, key, f"not valid TOML: {problem}", "TOML (https://toml.io)") from None
+    except RecursionError:
+        raise SceneError(source, "-", "arrays or tables nested too deeply", MAX_NESTING_HINT) from None
+    return parse_scene(data, source, limits)

@@ -32,7 +32,7 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from simparity.core.errors import SceneError
+from simparity.core.errors import ToleranceError
 from simparity.core.results import OK, STATUSES
 
 if sys.version_info >= (3, 11):
@@ -48,10 +48,6 @@ NUMBER_KEYS = ("max", "min", "expected", "band", "rel", "dt_power")
 ALLOWED_KEYS = MATCH_KEYS + ("dt",) + NUMBER_KEYS + ("status", "reason")
 DT_MATCH = 1e-9
 """Relative difference under which a bound's ``dt`` [s] names a row's time step."""
-
-
-class ToleranceError(SceneError):
-    """A tolerances file or one of its values is invalid (file, key, what was wrong, what is allowed)."""
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,26 @@ into a one-line message and exit code 2. Anything else is a bug and keeps its tr
 
 from __future__ import annotations
 
+import unicodedata
+
+ECHO_LIMIT = 200
+"""Characters of a file name, key or value a message echoes before cutting it with an ellipsis:
+a message stays one readable line whatever the input holds (a 50,000-character name, 20,000
+link names)."""
+
+
+def one_line(text: object, limit: int = ECHO_LIMIT) -> str:
+    """``text`` safe for a one-line message: control and other invisible characters escaped as in
+    ``repr`` (a newline becomes ``\\n``), cut to ``limit`` characters with an ellipsis."""
+    out = []
+    for char in str(text):
+        if char == "\t" or unicodedata.category(char) in ("Cc", "Zl", "Zp", "Cf"):
+            out.append(repr(char)[1:-1] if char.isascii() else f"\\u{ord(char):04x}")
+        else:
+            out.append(char)
+    cleaned = "".join(out)
+    return cleaned if len(cleaned) <= limit else cleaned[: limit - 1] + "…"
+
 
 class SimparityError(Exception):
     """Base class of every error simparity raises on purpose."""
@@ -30,10 +50,9 @@ class SceneError(SimparityError):
         self.source = source
         self.key = key
         self.problem = problem
-        self.allowed = allowed
-        text = f"{source}: {key}: {problem}"
-        if allowed:
-            text += f" (allowed: {allowed})"
+        self.allowed = allowed or "see docs/scenes.md"
+        text = (f"{one_line(source)}: {one_line(key)}: {one_line(problem, 2 * ECHO_LIMIT)} "
+                f"(allowed: {one_line(self.allowed, 2 * ECHO_LIMIT)})")
         super().__init__(text)
 
 
@@ -51,3 +70,11 @@ class DivergedError(SimparityError):
 
 class ResultsError(SimparityError):
     """A stored run is missing or unreadable."""
+
+
+class ToleranceError(SceneError):
+    """A tolerances file or one of its values is invalid (file, key, what was wrong, what is allowed)."""
+
+
+class HistoryError(SimparityError):
+    """The run history database cannot be read or written (the CSV results are unaffected)."""

@@ -25,12 +25,17 @@ from dataclasses import replace
 import numpy as np
 
 from simparity.core.errors import SceneError
+from simparity.core.files import MAX_FILE_BYTES, read_input
+from simparity.core.names import NAME_RULE, name_problem
 from simparity.core.rotations import rpy_to_matrix
 from simparity.core.scene import Chain, Joint
 
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 _CHAIN_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed")
 _ALLOWED_ON_PATH = "revolute, continuous, prismatic or fixed joints without <mimic>"
+MAX_URDF_JOINTS = 256
+"""Joints a URDF file may have: every engine loads the whole file (Pinocchio's data for 1,000
+joints wanted 24 GB; 5,000 crashed it). Real arms and humanoids have 7 to ~100."""
 
 
 def chain_from_urdf(
@@ -38,6 +43,8 @@ def chain_from_urdf(
     base_link: str | None = None,
     tip_link: str | None = None,
     source: str | None = None,
+    max_joints: int = MAX_URDF_JOINTS,
+    max_bytes: int = MAX_FILE_BYTES,
 ) -> Chain:
     """Build the serial :class:`~core.scene.Chain` from ``base_link`` to ``tip_link``.
 
@@ -53,6 +60,8 @@ def chain_from_urdf(
         ``base_link`` (an error when there are several).
     source : str, optional
         Name reported in errors; default the file path, or ``"<urdf text>"``.
+    max_joints, max_bytes : int
+        Largest number of ``<joint>`` elements and size of the file accepted.
 
     Returns
     -------
@@ -66,10 +75,15 @@ def chain_from_urdf(
     SceneError
         For malformed XML or numbers, missing links, a link with two parents, several
         roots, an unknown or missing base/tip link, several leaves without ``tip_link``,
-        or a mimic, floating or planar joint on the path. ``key`` names the element,
+        a mimic, floating or planar joint on the path, a joint on the path that cannot move
+        (lower == upper), a name on the path outside :data:`core.names.NAME_RULE`, or a file
+        that is too large, has too many joints or is not a regular file. ``key`` names the element,
         e.g. ``robot/joint[@name='j3']/mimic``.
     """
-    root, source = _parse(path_or_text, source)
+    root, source = _parse(path_or_text, source, max_bytes)
+    count = sum(1 for _ in root.iter("joint"))
+    if count > max_joints:
+        raise SceneError(source, "robot/joint", f"the file has {count} joints", f"at most {max_joints}")
     links = _links(root, source)
     joints = _joints(root, source, links)
     parent_joint = _parent_joints(joints, source)
@@ -85,16 +99,20 @@ def chain_from_urdf(
     return replace(chain, urdf_path=os.fspath(path_or_text) if is_file else None, base_link=base)
 
 
-def _parse(path_or_text: str | os.PathLike, source: str | None) -> tuple[ET.Element, str]:
+def _parse(path_or_text: str | os.PathLike, source: str | None, max_bytes: int) -> tuple[ET.Element, str]:
+    """The root element; a file is read as bytes, so its XML declaration's encoding is honoured."""
     text = os.fspath(path_or_text)
     is_text = text.lstrip().startswith("<")
     source = source or ("<urdf text>" if is_text else text)
+    data = text if is_text else read_input(text, max_bytes, "URDF file")
     try:
-        root = ET.fromstring(text) if is_text else ET.parse(text).getroot()
+        root = ET.fromstring(data)
     except ET.ParseError as err:
         raise SceneError(source, "robot", f"not well-formed XML ({err})", "a URDF document") from None
-    except OSError as err:
-        raise SceneError(source, "robot", f"cannot read the file ({err.strerror})", "a readable URDF file") from None
+    except (LookupError, ValueError) as err:  # an encoding Python does not know
+        raise SceneError(source, "robot", f"unreadable encoding ({err})", "UTF-8, Latin-1, UTF-16, ...") from None
+    except RecursionError:
+        raise SceneError(source, "robot", "elements nested too deeply", "a URDF document") from None
     if root.tag != "robot":
         raise SceneError(source, root.tag, "the root element is not <robot>", "<robot>")
     return root, source
@@ -187,6 +205,8 @@ def _parent_joints(joints: list[dict], source: str) -> dict[str, dict]:
 def _pick_base(base_link: str | None, root_link: str, links: list[str], source: str) -> str:
     if base_link is None:
         return root_link
+    if name_problem(base_link):
+        raise SceneError(source, "base_link", name_problem(base_link), NAME_RULE)
     if base_link not in links:
         raise SceneError(source, "base_link", f"no link named {base_link!r}", ", ".join(links))
     return base_link
@@ -194,6 +214,8 @@ def _pick_base(base_link: str | None, root_link: str, links: list[str], source: 
 
 def _pick_tip(tip_link: str | None, base: str, links: list[str], joints: list[dict], source: str) -> str:
     if tip_link is not None:
+        if name_problem(tip_link):
+            raise SceneError(source, "tip_link", name_problem(tip_link), NAME_RULE)
         if tip_link not in links:
             raise SceneError(source, "tip_link", f"no link named {tip_link!r}", ", ".join(links))
         return tip_link
@@ -237,11 +259,17 @@ def _assemble(robot_name: str, path: list[dict], tip: str, source: str) -> Chain
             raise SceneError(source, f"{key}/@type", f"a {joint['type']} joint on the chain", _ALLOWED_ON_PATH)
         if joint["element"].find("mimic") is not None:
             raise SceneError(source, f"{key}/mimic", "a mimic joint on the chain", _ALLOWED_ON_PATH)
+        for name in (joint["name"], joint["child"]):
+            if name_problem(name):
+                raise SceneError(source, key, f"on the chain: {name_problem(name)}", NAME_RULE)
         position = position + rotation @ joint["xyz"]
         rotation = rotation @ rpy_to_matrix(joint["rpy"])
         if joint["type"] == "fixed":
             continue
         lower, upper = joint["limits"]
+        if not lower < upper:
+            raise SceneError(source, f"{key}/limit", f"on the chain with lower {lower:g} == upper {upper:g}: it cannot move",
+                             "lower < upper, or type='fixed' for a joint that does not move (as in scene files)")
         chain_joints.append(Joint(
             name=joint["name"],
             type="prismatic" if joint["type"] == "prismatic" else "revolute",
@@ -252,6 +280,8 @@ def _assemble(robot_name: str, path: list[dict], tip: str, source: str) -> Chain
             upper=upper,
         ))
         position, rotation = np.zeros(3), np.eye(3)
+    if name_problem(tip):
+        raise SceneError(source, f"robot/link[@name='{tip}']", name_problem(tip), NAME_RULE)
     if not chain_joints:
         raise SceneError(source, "tip_link", f"no movable joint between the base and {tip!r}",
                          "a path with at least one revolute, continuous or prismatic joint")

@@ -6,9 +6,9 @@ import multiprocessing
 import pandas as pd
 import pytest
 
+from simparity.core.errors import HistoryError
 from simparity.comparisons.history import (
     HISTORY_ENV,
-    HistoryError,
     history_path,
     latest_before,
     metric_history,

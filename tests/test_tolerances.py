@@ -4,7 +4,8 @@ import math
 
 import pytest
 
-from simparity.comparisons.tolerances import DEFAULT_TOLERANCES, ToleranceError, bound_for, load_tolerances
+from simparity.comparisons.tolerances import DEFAULT_TOLERANCES, bound_for, load_tolerances
+from simparity.core.errors import ToleranceError
 
 
 def _write(tmp_path, text):
