@@ -1,39 +1,79 @@
-"""The ``simparity`` command: list, run, export, report.
+"""The ``simparity`` command: list, run, check, history, export, report.
 
-User mistakes (bad scene files, unknown names, missing runs) print one line
-``simparity: error: ...`` and exit with code 2; tracebacks are kept for real bugs.
-``run`` exits 0 when every case is ok, n/a or diverged, and 1 when some engine failed
-(raised an error); the results computed before and after a failure are kept either way.
+User mistakes (bad scene or tolerances files, unknown names, missing runs, a folder that already
+holds a run) print one line ``simparity: error: ...`` and exit with code 2; tracebacks are kept
+for real bugs. ``run`` exits 1 when some engine failed (raised), and with ``--check`` when a
+metric is outside its bound; ``check`` exits 0 when every checked metric is inside its bound and
+nothing moved since the baseline, else 1. Results computed before an error are kept either way.
 """
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 
 from simparity.comparisons import library
+from simparity.comparisons.check import BASELINE_RELATIVE, check_table, compare_with_baseline
+from simparity.comparisons.check_output import junit_xml, summary_markdown
 from simparity.comparisons.engines import DEFAULT_ENGINES, ENGINE_NAMES, check_engine_names, make_engine
-from simparity.comparisons.runner import DEFAULT_REPEATS, run_scene
+from simparity.comparisons.history import history_path, latest_before, metric_history, record_run, run_table
+from simparity.comparisons.parallel import default_jobs, run_scenes
+from simparity.comparisons.profiles import PROFILES, apply_profile
+from simparity.comparisons.runner import DEFAULT_REPEATS
+from simparity.comparisons.scene_limits import DEFAULT_LIMITS, Limits
 from simparity.comparisons.store import DEFAULT_OUT_ROOT, RunWriter, default_out_dir
-from simparity.core.errors import SimparityError
-from simparity.core.results import FAILED, REPORT_FILE, case_counts
+from simparity.comparisons.tolerances import DEFAULT_TOLERANCES, load_tolerances
+from simparity.core.errors import HistoryError, SimparityError, UsageError, one_line
+from simparity.core.ranges import RANGES
+from simparity.core.results import FAILED, REPORT_FILE, RESULTS_FILE, RUN_INFO_FILE, case_counts
+from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
 from simparity.reports.markdown import render
 from simparity.reports.store import read_run
 
 EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 EXPORTABLE = ("mujoco", "pybullet", "pinocchio")
+MESSAGE_LIMIT = 1000
+"""Characters of an error message printed: one line, whatever the input echoed into it."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse whose errors are one line and exit 2 like every other bad input (no usage block)."""
+
+    def error(self, message: str):
+        raise UsageError(f"{self.prog}: {message} (allowed: see '{self.prog} --help')")
 
 
 def _engine_list(text: str) -> tuple[str, ...]:
     return tuple(n.strip() for n in text.split(",") if n.strip())
 
 
+def _add_check_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--tolerances", type=Path, default=None, metavar="FILE",
+                        help=f"bounds to hold the run to (default: the shipped {DEFAULT_TOLERANCES.name})")
+    parser.add_argument("--baseline", default=None, metavar="DIR|latest",
+                        help="also flag every metric that moved since this run ('latest': the run before, from the "
+                        "history)")
+    parser.add_argument("--baseline-rel", type=float, default=BASELINE_RELATIVE, metavar="X",
+                        help=f"relative change that counts as a move (default: {BASELINE_RELATIVE:g}); timing "
+                        "changes are listed apart and never fail the check")
+    parser.add_argument("--junit", type=Path, default=None, metavar="FILE",
+                        help="write JUnit XML: one test case per scene x engine x integrator x dt")
+    parser.add_argument("--summary", type=Path, default=None, metavar="FILE",
+                        help="write a Markdown summary (e.g. $GITHUB_STEP_SUMMARY)")
+
+
+def _add_history_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--history", default=None, metavar="PATH",
+                        help=f"run history database (default: $SIMPARITY_HISTORY or {DEFAULT_OUT_ROOT}/history.sqlite)")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="simparity",
         description="Run textbook IK and rigid-body methods beside MuJoCo, PyBullet and Pinocchio "
-        "on identical scenes; report error, drift and speed.",
+        "on identical scenes; report error, drift and speed, and check them against tolerances.",
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
@@ -41,7 +81,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     run = sub.add_parser(
         "run", help="run scenes on engines and write results.csv and report.md",
-        description="Run scenes on engines; write results.csv, run.json and report.md into the output folder.",
+        description="Run scenes on engines; write results.csv, run.json and report.md into a new output folder, "
+        "and record the run in the history database.",
     )
     run.add_argument("scenes", nargs="*", metavar="SCENE|FILE",
                      help="built-in scene names or scene files (default: the whole built-in suite)")
@@ -49,9 +90,45 @@ def build_parser() -> argparse.ArgumentParser:
                      help=f"comma-separated engines to run (default: {','.join(DEFAULT_ENGINES)}; "
                      f"known: {','.join(ENGINE_NAMES)})")
     run.add_argument("--out", type=Path, default=None, metavar="DIR",
-                     help=f"output folder (default: {DEFAULT_OUT_ROOT}/<UTC date-time>/)")
-    run.add_argument("--repeats", type=int, default=DEFAULT_REPEATS, metavar="N",
-                     help=f"timed repeats per case, the best is kept (default: {DEFAULT_REPEATS})")
+                     help=f"output folder; must not hold a run yet (default: a new {DEFAULT_OUT_ROOT}/<UTC date-time>/)")
+    run.add_argument("--force", action="store_true", help="overwrite the run already in --out")
+    run.add_argument("--repeats", type=int, default=None, metavar="N",
+                     help=f"timed repeats per case, the best is kept (default: {DEFAULT_REPEATS}; --quick: 0, one "
+                     "cold timing)")
+    run.add_argument("--quick", action="store_true",
+                     help="the CI profile: every scene shortened (3 coarsest time steps, <= 1000 steps, 50 IK "
+                     "targets), about half a minute")
+    run.add_argument("--jobs", type=int, default=None, metavar="N",
+                     help=f"scenes run at once, one process each (default: one per CPU, here {default_jobs()})")
+    run.add_argument("--max-steps", type=int, default=DEFAULT_LIMITS.max_steps, metavar="N",
+                     help="refuse a case of more than N body-steps per time step, or IK targets x max_iterations "
+                     f"(default: {DEFAULT_LIMITS.max_steps:,})")
+    run.add_argument("--max-samples", type=int, default=DEFAULT_LIMITS.max_samples, metavar="N",
+                     help=f"refuse more than N configurations or IK targets (default: {DEFAULT_LIMITS.max_samples:,})")
+    run.add_argument("--max-joints", type=int, default=DEFAULT_LIMITS.max_joints, metavar="N",
+                     help=f"refuse a chain or URDF file of more than N movable joints (default: "
+                     f"{DEFAULT_LIMITS.max_joints:,})")
+    run.add_argument("--check", action="store_true",
+                     help="check the run against tolerances when it is done (exit 1 on a violation)")
+    _add_check_options(run)
+    _add_history_option(run)
+
+    check = sub.add_parser(
+        "check", help="hold a stored run to tolerances (exit 1 on a violation)",
+        description="Hold every metric of a stored run to its bound; print each violation on one line. Exit 0 "
+        "when all are inside, 1 when any is not (or, with --baseline, when numerics moved), 2 on bad input.",
+    )
+    check.add_argument("run_dir", nargs="?", type=Path, default=None, metavar="RUN_DIR",
+                       help="a folder written by 'simparity run' (default: the latest run in the history)")
+    _add_check_options(check)
+    _add_history_option(check)
+
+    history = sub.add_parser("history", help="how metrics moved across recorded runs",
+                             description="Show one metric (or all) across the runs recorded in the history database.")
+    history.add_argument("scene", nargs="?", default=None, metavar="SCENE")
+    history.add_argument("--engine", default=None)
+    history.add_argument("--metric", default=None)
+    _add_history_option(history)
 
     export = sub.add_parser(
         "export", help="print the model an adapter builds for a scene",
@@ -75,29 +152,68 @@ def cmd_list(args, out) -> int:
     return EXIT_OK
 
 
-def cmd_run(args, out) -> int:
-    if args.repeats < 1:
-        raise SimparityError(f"--repeats {args.repeats}: must be at least 1")
-    names = check_engine_names(args.engines)
-    scenes = library.load(args.scenes or list(library.builtin_paths()))
-    engines = [make_engine(n) for n in names]
-    out_dir = args.out or default_out_dir()
+def _out_dir(args) -> Path:
+    """The run's folder: --out (refused when it holds a run, unless --force), else a new one."""
+    if args.out is None:
+        return default_out_dir()
+    try:
+        return _checked_out_dir(args.out, args.force)
+    except (OSError, ValueError) as err:  # a name the OS rejects: too long, a NUL byte
+        raise SimparityError(f"--out {one_line(args.out)}: {getattr(err, 'strerror', None) or err} (allowed: a "
+                             "folder path the system accepts)") from None
+
+
+def _checked_out_dir(out_dir: Path, force: bool) -> Path:
     if out_dir.exists() and not out_dir.is_dir():
-        raise SimparityError(f"--out {out_dir}: exists and is not a folder")
+        raise SimparityError(f"--out {one_line(out_dir)}: exists and is not a folder (allowed: a new or empty folder)")
+    held = [name for name in (RESULTS_FILE, RUN_INFO_FILE) if (out_dir / name).exists()]
+    if held and not force:
+        raise SimparityError(f"--out {one_line(out_dir)}: already holds a run ({', '.join(held)}); nothing was "
+                             "overwritten (allowed: a new folder, no --out for a new timestamped one, or --force)")
+    return out_dir
+
+
+def _cost(scenes) -> str:
+    """What the run will do, counted before it starts."""
+    steps = sum(s.n_steps(dt) * len(s.bodies) for s in scenes if isinstance(s, DynamicsScene) for dt in s.dts)
+    samples = sum(s.n_configurations for s in scenes if isinstance(s, KinematicsScene))
+    targets = sum(s.n_targets + len(s.hard_targets) for s in scenes if isinstance(s, IKScene))
+    return (f"{len(scenes)} scenes: {steps:,} body-steps per integrator, {samples:,} configurations, "
+            f"{targets:,} IK targets per solver")
+
+
+def cmd_run(args, out) -> int:
+    repeats = (0 if args.quick else DEFAULT_REPEATS) if args.repeats is None else args.repeats
+    if repeats < 0 or repeats > 100:
+        raise SimparityError(f"--repeats {args.repeats}: out of range (allowed: 0 to 100; 0 times one cold call)")
+    jobs = default_jobs() if args.jobs is None else args.jobs
+    for flag, value in (("--max-steps", args.max_steps), ("--max-samples", args.max_samples),
+                        ("--max-joints", args.max_joints), ("--jobs", jobs)):
+        if value < 1:
+            raise SimparityError(f"{flag} {value}: out of range (allowed: a whole number >= 1)")
+    names = check_engine_names(args.engines)
+    limits = Limits(max_steps=args.max_steps, max_samples=args.max_samples, max_joints=args.max_joints)
+    scenes = apply_profile(library.load(args.scenes or list(library.builtin_paths()), limits),
+                           "quick" if args.quick else "full")
+    bounds = load_tolerances(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
+    versions = {n: make_engine(n).version() for n in names}
+    out_dir = _out_dir(args)
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
-    except OSError as err:
-        raise SimparityError(f"--out {out_dir}: cannot create the folder: {err.strerror}") from None
-    writer = RunWriter(out_dir, {e.name: e.version() for e in engines}, " ".join(["simparity"] + sys.argv[1:]), scenes)
+    except (OSError, ValueError) as err:  # ValueError: a NUL byte in the name
+        raise SimparityError(f"--out {one_line(out_dir)}: cannot create the folder: {getattr(err, 'strerror', None) or err} "
+                             "(allowed: a folder you can write)") from None
+    print(f"{_cost(scenes)}; {len(names)} engines, {min(jobs, len(scenes))} at once"
+          + (" (quick profile)" if args.quick else ""), file=out, flush=True)
+    writer = RunWriter(out_dir, versions, " ".join(["simparity"] + sys.argv[1:]), scenes)
     failed = 0
     try:
-        for scene in scenes:
-            rows = run_scene(scene, engines, make_engine, repeats=args.repeats)
+        for scene, rows in run_scenes(scenes, names, repeats, jobs):
             writer.append(rows)
             counts = case_counts(rows)
             failed += counts[FAILED]
             print(f"{scene.name}: {sum(counts.values())} cases ("
-                  + ", ".join(f"{s} {c}" for s, c in counts.items() if c) + ")", file=out)
+                  + ", ".join(f"{s} {c}" for s, c in counts.items() if c) + ")", file=out, flush=True)
     except KeyboardInterrupt:
         print(f"interrupted; results so far are in {writer.results_path}", file=out)
         _write_report(out_dir, out)
@@ -106,7 +222,21 @@ def cmd_run(args, out) -> int:
         _write_report(out_dir, out)  # keep what was computed, then report the error
         raise
     _write_report(out_dir, out)
-    return EXIT_FAILED_CASES if failed else EXIT_OK
+    _record(out_dir, args.history)
+    code = EXIT_FAILED_CASES if failed else EXIT_OK
+    if bounds is not None:
+        code = max(code, _check(out_dir, bounds, args, out))
+    return code
+
+
+def _record(out_dir: Path, history_option: str | None) -> None:
+    """Copy the run into the history database; a database problem is one line, never a lost run."""
+    table, info = read_run(out_dir)
+    try:
+        record_run(history_path(history_option), out_dir.resolve(), info, table)
+    except HistoryError as err:
+        print(f"simparity: history not updated: {one_line(err, MESSAGE_LIMIT)}; the run is in {out_dir}",
+              file=sys.stderr)
 
 
 def _write_report(out_dir: Path, out) -> None:
@@ -116,7 +246,65 @@ def _write_report(out_dir: Path, out) -> None:
     print(f"results: {Path(out_dir) / 'results.csv'}\nreport:  {path}", file=out)
 
 
+def _baseline_table(option: str, run_dir: Path, history_option: str | None):
+    if option == "latest":
+        path = history_path(history_option)
+        run_id, _ = latest_before(path, run_dir.resolve())
+        return run_table(path, run_id)
+    return read_run(Path(option))[0]
+
+
+def _check(run_dir: Path, bounds, args, out) -> int:
+    """Print the verdict on a stored run (and the moves since the baseline); 0 passed, 1 not."""
+    table, _ = read_run(run_dir)
+    result = check_table(table, bounds)
+    diff = None
+    if args.baseline:
+        if not math.isfinite(args.baseline_rel) or args.baseline_rel < 0:
+            raise SimparityError(f"--baseline-rel {args.baseline_rel}: out of range (allowed: a number >= 0)")
+        diff = compare_with_baseline(table, _baseline_table(args.baseline, run_dir, args.history), args.baseline_rel)
+    for violation in result.violations:
+        print(f"violation: {one_line(violation.line(), MESSAGE_LIMIT)}", file=out)
+    if diff is not None:
+        for label, items in (("moved", diff.moved), ("missing", diff.missing), ("new", diff.new),
+                             ("timing (not blocking)", diff.timing)):
+            for item in items:
+                print(f"{label}: {one_line(item, MESSAGE_LIMIT)}", file=out)
+    if args.junit:
+        args.junit.write_text(junit_xml(result, diff), encoding="utf-8")
+    if args.summary:
+        with open(args.summary, "a", encoding="utf-8") as handle:
+            handle.write(summary_markdown(result, diff))
+    passed = result.passed and not (diff and diff.blocking)
+    moved = "" if diff is None else (f"; since the baseline {len(diff.moved)} moved, {len(diff.missing)} missing, "
+                                     f"{len(diff.new)} new")
+    print(f"check {'passed' if passed else 'FAILED'}: {result.checked} metrics checked, {len(result.violations)} "
+          f"outside their bounds, {result.unchecked} without a bound{moved}", file=out)
+    return EXIT_OK if passed else EXIT_FAILED_CASES
+
+
+def cmd_check(args, out) -> int:
+    bounds = load_tolerances(args.tolerances or DEFAULT_TOLERANCES)
+    run_dir = args.run_dir
+    if run_dir is None:
+        _, latest = latest_before(history_path(args.history))
+        run_dir = Path(latest)
+    return _check(run_dir, bounds, args, out)
+
+
+def cmd_history(args, out) -> int:
+    table = metric_history(history_path(args.history), args.scene, args.engine, args.metric)
+    if table.empty:
+        print("no recorded values match", file=out)
+    else:
+        print(table.to_string(index=False), file=out)
+    return EXIT_OK
+
+
 def cmd_export(args, out) -> int:
+    if args.dt is not None and not (args.dt > 0 and RANGES["dt"].allows(args.dt)):
+        raise SimparityError(f"--dt {args.dt}: not a time step (allowed: a finite number of seconds > 0, "
+                             f"{RANGES['dt'].text()})")
     scene = library.load([args.scene])[0]
     engine = make_engine(args.engine)
     print(engine.export(scene, args.integrator, args.dt), file=out, end="")
@@ -128,17 +316,18 @@ def cmd_report(args, out) -> int:
     return EXIT_OK
 
 
-_COMMANDS = {"list": cmd_list, "run": cmd_run, "export": cmd_export, "report": cmd_report}
+_COMMANDS = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "history": cmd_history, "export": cmd_export,
+             "report": cmd_report}
 
 
 def main(argv: list[str] | None = None, out=None) -> int:
     """Entry point of the ``simparity`` console script; returns the exit code."""
     out = out or sys.stdout
-    args = build_parser().parse_args(argv)
     try:
+        args = build_parser().parse_args(argv)
         return _COMMANDS[args.command](args, out)
     except SimparityError as err:
-        print(f"simparity: error: {err}", file=sys.stderr)
+        print(f"simparity: error: {one_line(err, MESSAGE_LIMIT)}", file=sys.stderr)
         return EXIT_USAGE
 
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib
 
 from simparity.core.engine import Engine, KinematicsModel, Simulation, Support
-from simparity.core.errors import UnknownEngineError
+from simparity.core.errors import UnknownEngineError, one_line
 
 _ENGINES = {
     "core": ("simparity.core.inhouse", "InHouseEngine"),
@@ -54,10 +54,10 @@ def check_engine_names(names) -> tuple[str, ...]:
     unknown = [n for n in names if n not in _ENGINES]
     if unknown:
         raise UnknownEngineError(
-            f"unknown engine(s): {', '.join(unknown)} (known: {', '.join(ENGINE_NAMES)})"
+            f"unknown engine(s): {one_line(', '.join(unknown))} (allowed: {', '.join(ENGINE_NAMES)})"
         )
     if not names:
-        raise UnknownEngineError(f"no engine named (known: {', '.join(ENGINE_NAMES)})")
+        raise UnknownEngineError(f"no engine named (allowed: {', '.join(ENGINE_NAMES)})")
     return tuple(dict.fromkeys(names))
 
 

@@ -55,7 +55,7 @@ def history_path(option: str | None = None) -> Path:
 
 def _connect(path: Path, create: bool) -> sqlite3.Connection:
     if not create and not path.is_file():
-        raise HistoryError(f"{path}: no run history here (run 'simparity run' first, or pass --history)")
+        raise HistoryError(f"{path}: no run history here (allowed: a database 'simparity run' wrote; --history PATH or $SIMPARITY_HISTORY points at it)")
     try:
         if create:
             path.parent.mkdir(parents=True, exist_ok=True)
@@ -63,7 +63,7 @@ def _connect(path: Path, create: bool) -> sqlite3.Connection:
         connection.executescript(_SCHEMA)
         return connection
     except (sqlite3.Error, OSError) as err:
-        raise HistoryError(f"{path}: run history unusable: {type(err).__name__}: {err}") from None
+        raise HistoryError(f"{path}: run history unusable: {type(err).__name__}: {err} (allowed: an SQLite file simparity wrote, or a new path)") from None
 
 
 def record_run(path: Path, run_dir: Path, info: dict, table: pd.DataFrame) -> int:
@@ -82,7 +82,7 @@ def record_run(path: Path, run_dir: Path, info: dict, table: pd.DataFrame) -> in
             connection.executemany(f"INSERT INTO results VALUES ({', '.join('?' * (len(COLUMNS) + 1))})", records)
         return run_id
     except (sqlite3.Error, OSError) as err:
-        raise HistoryError(f"{path}: could not record the run: {type(err).__name__}: {err}") from None
+        raise HistoryError(f"{path}: could not record the run: {type(err).__name__}: {err} (allowed: a writable SQLite file simparity wrote)") from None
     finally:
         connection.close()
 
@@ -94,7 +94,7 @@ def runs(path: Path) -> pd.DataFrame:
         return pd.read_sql_query("SELECT id, run_dir, created_utc, git_commit, command FROM runs ORDER BY id",
                                  connection)
     except (sqlite3.Error, pd.errors.DatabaseError) as err:
-        raise HistoryError(f"{path}: unreadable run history: {err}") from None
+        raise HistoryError(f"{path}: unreadable run history: {err} (allowed: an SQLite file simparity wrote)") from None
     finally:
         connection.close()
 
@@ -106,7 +106,7 @@ def run_table(path: Path, run_id: int) -> pd.DataFrame:
         table = pd.read_sql_query(f"SELECT {', '.join(COLUMNS)} FROM results WHERE run_id = ?", connection,
                                   params=(run_id,))
     except (sqlite3.Error, pd.errors.DatabaseError) as err:
-        raise HistoryError(f"{path}: unreadable run history: {err}") from None
+        raise HistoryError(f"{path}: unreadable run history: {err} (allowed: an SQLite file simparity wrote)") from None
     finally:
         connection.close()
     table["integrator"] = table["integrator"].fillna("")
@@ -120,7 +120,7 @@ def latest_before(path: Path, run_dir: Path | None = None) -> tuple[int, str]:
     if run_dir is not None:
         recorded = recorded[recorded["run_dir"] != str(run_dir)]
     if recorded.empty:
-        raise HistoryError(f"{path}: no earlier run recorded to compare with")
+        raise HistoryError(f"{path}: no earlier run recorded to compare with (allowed: --baseline DIR of a stored run)")
     last = recorded.iloc[-1]
     return int(last["id"]), str(last["run_dir"])
 
@@ -140,7 +140,7 @@ def metric_history(path: Path, scene: str | None = None, engine: str | None = No
     try:
         long = pd.read_sql_query(query, connection, params=params)
     except (sqlite3.Error, pd.errors.DatabaseError) as err:
-        raise HistoryError(f"{path}: unreadable run history: {err}") from None
+        raise HistoryError(f"{path}: unreadable run history: {err} (allowed: an SQLite file simparity wrote)") from None
     finally:
         connection.close()
     if long.empty:

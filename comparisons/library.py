@@ -4,8 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from simparity.comparisons.scene_limits import DEFAULT_LIMITS, Limits
 from simparity.comparisons.scene_loader import load_scene
-from simparity.core.errors import UnknownSceneError
+from simparity.core.errors import UnknownSceneError, one_line
+from simparity.core.files import file_problem
 
 SCENES_DIR = Path(__file__).parent / "scenes"
 
@@ -20,15 +22,16 @@ def resolve(name_or_path: str) -> Path:
     builtin = builtin_paths()
     if name_or_path in builtin:
         return builtin[name_or_path]
-    path = Path(name_or_path)
-    if path.is_file():
-        return path
+    problem = file_problem(name_or_path, "scene file")
+    if problem is None:
+        return Path(name_or_path)
+    where = "" if problem.startswith("no such") else f" ({problem})"
     raise UnknownSceneError(
-        f"'{name_or_path}' is neither a built-in scene nor a file "
-        f"(built-in: {', '.join(builtin)}; see 'simparity list')"
+        f"'{one_line(name_or_path)}' is neither a built-in scene nor a scene file{where} "
+        f"(allowed: {', '.join(builtin)}, or the path of a regular TOML file; see 'simparity list')"
     )
 
 
-def load(names_or_paths) -> list:
+def load(names_or_paths, limits: Limits = DEFAULT_LIMITS) -> list:
     """Every named scene, all checked before any is returned (so a run never starts on a bad file)."""
-    return [load_scene(resolve(n)) for n in names_or_paths]
+    return [load_scene(resolve(n), limits) for n in names_or_paths]

@@ -8,6 +8,7 @@ the key path, what was wrong and what is allowed. The format is documented in
 from __future__ import annotations
 
 import math
+import os
 import re
 import sys
 from pathlib import Path
@@ -15,20 +16,14 @@ from pathlib import Path
 import numpy as np
 
 from simparity.comparisons.engines import ENGINE_NAMES, known_integrators
-from simparity.comparisons.scene_limits import (
-    DEFAULT_LIMITS,
-    NORM_RANGES,
-    POSITION_TOLERANCE_OF_REACH,
-    RANGES,
-    Limits,
-    safe_norm,
-)
+from simparity.comparisons.scene_limits import DEFAULT_LIMITS, POSITION_TOLERANCE_OF_REACH, Limits, allowed_at_most
 from simparity.core.dh import chain_from_dh
-from simparity.core.errors import SceneError
-from simparity.core.files import is_regular_file, read_input
+from simparity.core.errors import SceneError, echo, one_line
+from simparity.core.files import file_problem, read_input
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.inertia import inertia_problem
-from simparity.core.names import NAME_RULE, name_problem
+from simparity.core.names import NAME_RULE, TEXT_RULE, name_problem, text_problem
+from simparity.core.ranges import NORM_RANGES, RANGES, safe_norm
 from simparity.core.rotations import rpy_to_matrix
 from simparity.core.scene import HARD_TARGETS, AppliedForce, Chain, DynamicsScene, Forces, IKScene, Joint, KinematicsScene, RigidBody
 from simparity.core.urdf import chain_from_urdf
@@ -60,26 +55,35 @@ class _Reader:
     def _key(self, key: str) -> str:
         return f"{self.path}.{key}" if self.path else key
 
-    def fail(self, key: str, problem: str, allowed: str = "") -> SceneError:
+    def fail(self, key: str, problem: str, allowed: str) -> SceneError:
+        """The error for ``key``: what was wrong and what is allowed (every rejection says both)."""
         return SceneError(self.source, self._key(key), problem, allowed)
 
     def has(self, key: str) -> bool:
         return key in self.table
 
-    def _get(self, key: str, default):
+    def _get(self, key: str, default, allowed: str):
         if key in self.table:
             return self.table[key]
         if default is _REQUIRED:
-            raise self.fail(key, "missing required key")
+            raise self.fail(key, "missing required key", allowed)
         return default
 
     def string(self, key: str, default=None, choices: tuple[str, ...] | None = None) -> str:
-        value = self._get(key, _REQUIRED if default is None else default)
+        allowed = ", ".join(choices) if choices else "a non-empty string"
+        value = self._get(key, _REQUIRED if default is None else default, allowed)
         if not isinstance(value, str) or not value:
-            raise self.fail(key, f"expected a non-empty string, got {value!r}",
-                            ", ".join(choices) if choices else "a non-empty string")
+            raise self.fail(key, f"expected a non-empty string, got {echo(value)}", allowed)
         if choices and value not in choices:
-            raise self.fail(key, f"'{value}' is not allowed", ", ".join(choices))
+            raise self.fail(key, f"{echo(value)} is not allowed", allowed)
+        return value
+
+    def text(self, key: str, default: str) -> str:
+        """Free text for people (a description): one line of printable characters (:mod:`core.names`)."""
+        value = self.string(key, default)
+        problem = text_problem(value)
+        if problem:
+            raise self.fail(key, problem, TEXT_RULE)
         return value
 
     def name(self, key: str, default=None) -> str:
@@ -99,7 +103,7 @@ class _Reader:
 
     def _checked(self, key: str, value, positive: bool) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise self.fail(key, f"expected a number, got {value!r}")
+            raise self.fail(key, f"expected a number, got {echo(value)}", "a number" + (" > 0" if positive else ""))
         try:
             finite = math.isfinite(value)
         except OverflowError:
@@ -111,22 +115,23 @@ class _Reader:
         return float(value)
 
     def number(self, key: str, default=None, *, positive=False, length=0) -> float:
-        value = self._get(key, _REQUIRED if default is None else default)
+        value = self._get(key, _REQUIRED if default is None else default, "a number" + (" > 0" if positive else ""))
         return self._in_range(key, self._checked(key, value, positive) * self.scale**length)
 
     def integer(self, key: str, default=None, *, minimum=0, maximum=2**63 - 1, why: str = "") -> int:
-        value = self._get(key, _REQUIRED if default is None else default)
+        value = self._get(key, _REQUIRED if default is None else default, f"whole numbers {minimum} to {maximum:,}")
         if isinstance(value, bool) or not isinstance(value, int):
-            raise self.fail(key, f"expected a whole number, got {value!r:.40}", f"whole numbers {minimum} to {maximum}")
+            raise self.fail(key, f"expected a whole number, got {echo(value)}", f"whole numbers {minimum} to {maximum}")
         if not minimum <= value <= maximum:
             raise self.fail(key, f"{value} is out of range", f"whole numbers {minimum} to {maximum:,}{why}")
         return value
 
     def vector(self, key: str, size: int, default=None, *, length=0, nonzero=False, positive=False) -> np.ndarray:
-        value = self._get(key, _REQUIRED if default is None else default)
+        allowed = f"a list of {size} numbers"
+        value = self._get(key, _REQUIRED if default is None else default, allowed)
         if not isinstance(value, list) or len(value) != size:
-            got = f"{len(value)} values" if isinstance(value, list) else repr(value)
-            raise self.fail(key, f"expected a list of {size} numbers, got {got}")
+            got = f"{len(value):,} values" if isinstance(value, list) else echo(value)
+            raise self.fail(key, f"expected a list of {size} numbers, got {got}", allowed)
         out = np.array([self._checked(f"{key}[{i}]", v, positive) for i, v in enumerate(value)])
         out *= self.scale**length
         if nonzero and not np.any(out):
@@ -139,45 +144,56 @@ class _Reader:
         return out
 
     def matrix(self, key: str, size: int, *, length=0) -> np.ndarray:
-        rows = self._get(key, _REQUIRED)
+        allowed = f"{size} rows of {size} numbers"
+        rows = self._get(key, _REQUIRED, allowed)
         if not isinstance(rows, list) or len(rows) != size:
-            raise self.fail(key, f"expected {size} rows of {size} numbers")
+            raise self.fail(key, f"expected {size} rows of {size} numbers", allowed)
         for i, row in enumerate(rows):
             if not isinstance(row, list) or len(row) != size:
-                raise self.fail(f"{key}[{i}]", f"expected a list of {size} numbers, got {row!r}")
+                got = f"{len(row):,} values" if isinstance(row, list) else echo(row)
+                raise self.fail(f"{key}[{i}]", f"expected a list of {size} numbers, got {got}", allowed)
         values = [[self._checked(f"{key}[{i}][{j}]", v, False) for j, v in enumerate(row)] for i, row in enumerate(rows)]
         return np.array(values) * self.scale**length
 
     def numbers(self, key: str) -> tuple[float, ...]:
         """A non-empty list of positive numbers."""
-        value = self._get(key, _REQUIRED)
+        value = self._get(key, _REQUIRED, "a list like [0.01, 0.02]")
         if not isinstance(value, list) or not value:
-            raise self.fail(key, f"expected a non-empty list of numbers, got {value!r}")
-        return tuple(self._checked(f"{key}[{i}]", v, True) for i, v in enumerate(value))
+            raise self.fail(key, f"expected a non-empty list of numbers, got {echo(value)}", "a list like [0.01, 0.02]")
+        return tuple(self._in_range(f"{key}[{i}]", self._checked(f"{key}[{i}]", v, True)) for i, v in enumerate(value))
 
-    def strings(self, key: str) -> tuple[str, ...]:
-        """A non-empty list of non-empty strings."""
-        value = self._get(key, _REQUIRED)
+    def strings(self, key: str, choices: tuple[str, ...], unknown: str = "{} is not allowed") -> tuple[str, ...]:
+        """A non-empty list of distinct names, each one of ``choices`` (``unknown`` words the error)."""
+        allowed = f"a list of distinct names from: {', '.join(choices)}"
+        value = self._get(key, _REQUIRED, allowed)
         if not isinstance(value, list) or not value or not all(isinstance(v, str) and v for v in value):
-            raise self.fail(key, f"expected a non-empty list of names, got {value!r}")
+            raise self.fail(key, f"expected a non-empty list of names, got {echo(value)}", allowed)
+        for i, name in enumerate(value):
+            if name not in choices:
+                raise self.fail(f"{key}[{i}]", unknown.format(echo(name)), allowed)
+            if name in value[:i]:
+                raise self.fail(f"{key}[{i}]", f"{echo(name)} is given twice", allowed)
         return tuple(value)
 
     def subtable(self, key: str, allowed: tuple[str, ...], required: bool = True) -> "_Reader | None":
+        table = f"a [{self._key(key)}] table of {', '.join(allowed)}"
         if key not in self.table:
             if required:
-                raise self.fail(key, "missing required table")
+                raise self.fail(key, "missing required table", table)
             return None
         value = self.table[key]
         if not isinstance(value, dict):
-            raise self.fail(key, f"expected a table, got {value!r}")
+            raise self.fail(key, f"expected a table, got {echo(value)}", table)
         return _Reader(self.source, value, self._key(key), allowed, self.scale, self.limits)
 
-    def array_of_tables(self, key: str, allowed: tuple[str, ...], most: int) -> list["_Reader"]:
-        value = self._get(key, _REQUIRED)
+    def array_of_tables(self, key: str, allowed: tuple[str, ...], limit: str) -> list["_Reader"]:
+        """One reader per ``[[key]]`` entry; at most the ``limit`` field of :class:`Limits`."""
+        tables = f"[[{self._key(key)}]] entries"
+        value = self._get(key, _REQUIRED, tables)
         if not isinstance(value, list) or not value or not all(isinstance(v, dict) for v in value):
-            raise self.fail(key, "expected one or more tables", f"[[{self._key(key)}]] entries")
-        if len(value) > most:
-            raise self.fail(key, f"{len(value):,} entries", f"at most {most:,}")
+            raise self.fail(key, "expected one or more tables", tables)
+        if len(value) > getattr(self.limits, limit):
+            raise self.fail(key, f"{len(value):,} entries", allowed_at_most(self.limits, limit))
         return [_Reader(self.source, v, f"{self._key(key)}[{i}]", allowed, self.scale, self.limits)
                 for i, v in enumerate(value)]
 
@@ -199,14 +215,19 @@ _TARGETS = ("count", "seed", "kind", "start", "position_tolerance", "orientation
 DEFAULT_POSITION_TOLERANCE = 1e-6  # [m], in any length unit the scene declares
 PYBULLET_DATA_PREFIX = "pybullet_data:"
 """A ``urdf`` path starting with this is inside the installed pybullet_data package."""
+EXAMPLE_ROBOT_DATA_PREFIX = "example-robot-data:"
+"""A ``urdf`` path starting with this is inside the installed example-robot-data package's
+``robots`` folder (``pip install example-robot-data``)."""
+EXAMPLE_ROBOT_DATA_ROBOTS = "cmeel.prefix/share/example-robot-data/robots"
+"""Where the example-robot-data wheel keeps its robots, relative to its installation."""
 _JOINT = ("name", "type", "axis", "origin_xyz", "origin_rpy", "lower", "upper")
 
 # duration / dt may differ from a whole number by this much (rounding of a decimal dt).
 _STEP_COUNT_RTOL = 1e-9
 _MAX_SEED = 2**63 - 1
 _SAMPLES_WHY = "; simparity run --max-samples N raises it"
-EXAMPLE_ROBOT_DATA_PREFIX = "example-robot-data:"
-"""A ``urdf`` path starting with this is inside the installed example-robot-data package's robots."""
+_WHERE_URDF = (f"a URDF file relative to the scene file, or {PYBULLET_DATA_PREFIX}... or "
+               f"{EXAMPLE_ROBOT_DATA_PREFIX}... inside that package")
 
 
 def _body_forces(r: _Reader, index: int) -> tuple[dict, list[AppliedForce]]:
@@ -217,27 +238,39 @@ def _body_forces(r: _Reader, index: int) -> tuple[dict, list[AppliedForce]]:
             raise r.fail(key, f"{value} is negative", "numbers >= 0")
     applied = []
     if r.has("force"):
-        for f in r.array_of_tables("force", _FORCE, r.limits.max_bodies):
+        for f in r.array_of_tables("force", _FORCE, "max_bodies"):
             applied.append(AppliedForce(index, f.vector("force_world", 3, length=1),
                                         f.vector("point_body", 3, [0.0] * 3, length=1)))
     return drags, applied
 
 
-def _body(r: _Reader) -> RigidBody:
+def _inertia(r: _Reader) -> np.ndarray:
+    """The inertia tensor [kg m^2]: physical, and its principal moments in their range."""
     if r.has("inertia_body_diagonal") == r.has("inertia_body"):
-        raise r.fail("inertia_body_diagonal", "give exactly one of inertia_body_diagonal and inertia_body")
+        raise r.fail("inertia_body_diagonal", "give exactly one of inertia_body_diagonal and inertia_body",
+                     "inertia_body_diagonal = [a, b, c] or inertia_body = a 3 x 3 tensor")
     if r.has("inertia_body"):
-        inertia = r.matrix("inertia_body", 3, length=2)
+        key, inertia = "inertia_body", r.matrix("inertia_body", 3, length=2)
     else:
-        inertia = np.diag(r.vector("inertia_body_diagonal", 3, length=2, positive=True))
+        key, inertia = "inertia_body_diagonal", np.diag(r.vector("inertia_body_diagonal", 3, length=2, positive=True))
+    moments = RANGES["inertia_moment"]
+    largest = float(np.max(np.abs(inertia)))
+    if largest > moments.high:
+        raise r.fail(key, f"an entry of {largest:.3g} kg m^2 is outside the physical range", moments.text())
     problem = inertia_problem(inertia)
     if problem:
-        key = "inertia_body" if r.has("inertia_body") else "inertia_body_diagonal"
         raise r.fail(key, problem, "a symmetric positive-definite tensor obeying the triangle inequality")
+    smallest = float(np.linalg.eigvalsh(inertia)[0])
+    if smallest < moments.low:
+        raise r.fail(key, f"a principal moment of {smallest:.3g} kg m^2 is outside the physical range", moments.text())
+    return inertia
+
+
+def _body(r: _Reader) -> RigidBody:
     return RigidBody(
         name=r.name("name"),
         mass=r.number("mass", positive=True),
-        inertia_body=inertia,
+        inertia_body=_inertia(r),
         position_world=r.vector("position_world", 3, [0.0] * 3, length=1),
         quat_wxyz=r.vector("quat_wxyz", 4, [1.0, 0.0, 0.0, 0.0], nonzero=True),
         velocity_world=r.vector("velocity_world", 3, [0.0] * 3, length=1),
@@ -249,7 +282,7 @@ def _dynamics(top: _Reader, head: dict) -> DynamicsScene:
     world = top.subtable("world", ("gravity_world", "air_velocity_world"), required=False)
     gravity = world.vector("gravity_world", 3, length=1) if world and world.has("gravity_world") else None
     air = world.vector("air_velocity_world", 3, length=1) if world and world.has("air_velocity_world") else None
-    readers = top.array_of_tables("body", _BODY, top.limits.max_bodies)
+    readers = top.array_of_tables("body", _BODY, "max_bodies")
     bodies = tuple(_body(r) for r in readers)
     per_body = [_body_forces(r, i) for i, r in enumerate(readers)]
     drag = {
@@ -257,43 +290,44 @@ def _dynamics(top: _Reader, head: dict) -> DynamicsScene:
         for key in DRAG_KEYS
     }
     if air is not None and drag["linear_drag"] is None and drag["quadratic_drag"] is None:
-        raise world.fail("air_velocity_world", "wind needs a body with linear_drag or quadratic_drag to act on")
+        raise world.fail("air_velocity_world", "wind needs a body with linear_drag or quadratic_drag to act on",
+                         "wind with a drag on some body, or no air_velocity_world")
     forces = Forces(gravity_world=gravity, air_velocity_world=air,
                     applied=tuple(a for _, applied in per_body for a in applied), **drag)
     names = [b.name for b in bodies]
     if len(set(names)) != len(names):
-        raise top.fail("body", f"body names repeat: {names}", "distinct names")
+        repeated = next(n for i, n in enumerate(names) if n in names[:i])
+        raise top.fail("body", f"the body name {repeated!r} repeats", "distinct names")
     sim = top.subtable("simulation", ("duration", "dt", "rate_hz", "integrators"))
     duration = sim.number("duration", positive=True)
     if sim.has("dt") == sim.has("rate_hz"):
-        raise sim.fail("dt", "give exactly one of dt and rate_hz")
+        raise sim.fail("dt", "give exactly one of dt and rate_hz", "dt = [time steps in s] or rate_hz = [steps per s]")
     dts = _ladder(sim, duration, len(bodies))
-    integrators = sim.strings("integrators") if sim.has("integrators") else ()
-    known = known_integrators() if integrators else ()
-    for i, name in enumerate(integrators):
-        if name not in known:
-            raise sim.fail(f"integrators[{i}]", f"no engine has an integrator '{name}'", ", ".join(known))
+    integrators = sim.strings("integrators", known_integrators(), "no engine has an integrator {}") if sim.has("integrators") else ()
     return DynamicsScene(bodies=bodies, forces=forces, duration=duration, dts=dts, integrators=integrators, **head)
 
 
 def _ladder(sim: _Reader, duration: float, n_bodies: int) -> tuple[float, ...]:
-    """The time steps [s]: distinct, each a whole number of steps of the duration, within the limits."""
+    """The time steps [s]: each a whole number of steps of the duration, no two with the same
+    number of steps, each within the step limit."""
     key = "dt" if sim.has("dt") else "rate_hz"
     values = sim.numbers(key)
     if len(values) > sim.limits.max_dts:
-        raise sim.fail(key, f"{len(values)} time steps", f"at most {sim.limits.max_dts}")
-    if len(set(values)) != len(values):
-        raise sim.fail(key, f"a time step repeats: {list(values)}", "distinct time steps")
+        raise sim.fail(key, f"{len(values)} time steps", allowed_at_most(sim.limits, "max_dts"))
     dts = values if key == "dt" else tuple(1.0 / h for h in values)
+    counts: dict[int, int] = {}
     for i, dt in enumerate(dts):
         steps = duration / dt  # finite: both are inside their ranges
         if dt > duration or abs(steps - round(steps)) > _STEP_COUNT_RTOL * steps:
-            raise sim.fail(f"{key}[{i}]", f"duration {duration} s is not a whole number of steps of {dt} s",
+            raise sim.fail(f"{key}[{i}]", f"duration {duration:g} s is not a whole number of steps of {dt:g} s",
                            "time steps that divide the duration")
+        if round(steps) in counts:
+            raise sim.fail(f"{key}[{i}]", f"{values[i]:.17g} gives the same {round(steps):,} steps as "
+                           f"{key}[{counts[round(steps)]}]", "distinct time steps")
+        counts[round(steps)] = i
         if steps * n_bodies > sim.limits.max_steps:
             raise sim.fail(f"{key}[{i}]", f"{steps:,.0f} steps x {n_bodies} bodies = {steps * n_bodies:,.0f} body-steps "
-                           f"at {dt:g} s", f"at most {sim.limits.max_steps:,} per time step; simparity run "
-                           "--max-steps N raises it")
+                           f"at {dt:g} s", allowed_at_most(sim.limits, "max_steps", "per time step"))
     return dts
 
 
@@ -301,11 +335,12 @@ def _joint(r: _Reader) -> Joint:
     kind = r.string("type", choices=JOINT_TYPES)
     length = 1 if kind == "prismatic" else 0
     if r.has("lower") != r.has("upper"):
-        raise r.fail("lower" if not r.has("lower") else "upper", "missing: limits need both lower and upper")
+        raise r.fail("lower" if not r.has("lower") else "upper", "missing: limits need both lower and upper",
+                     "both lower and upper, or neither for an unlimited joint")
     lower = r.number("lower", length=length) if r.has("lower") else -np.inf
     upper = r.number("upper", length=length) if r.has("upper") else np.inf
     if lower >= upper:
-        raise r.fail("upper", f"upper {upper} is not above lower {lower}")
+        raise r.fail("upper", f"upper {upper:g} is not above lower {lower:g}", "lower < upper")
     return Joint(
         name=r.name("name"), type=kind, axis=r.vector("axis", 3, nonzero=True),
         origin_xyz=r.vector("origin_xyz", 3, [0.0] * 3, length=1),
@@ -323,38 +358,39 @@ def _package_root(c: _Reader, prefix: str) -> Path:
     from importlib import metadata
 
     try:
-        robots = metadata.distribution("example-robot-data").locate_file("cmeel.prefix/share/example-robot-data/robots")
+        robots = metadata.distribution("example-robot-data").locate_file(EXAMPLE_ROBOT_DATA_ROBOTS)
     except metadata.PackageNotFoundError:
         raise c.fail("urdf", "the example-robot-data package is not installed",
-                     "pip install example-robot-data, or a path to a URDF file") from None
+                     "pip install example-robot-data, or the path of a URDF file") from None
     return Path(str(robots))
 
 
 def _urdf_path(c: _Reader) -> Path:
+    """The URDF file a scene names: relative to the scene file, absolute, or inside a package."""
     text = c.string("urdf")
     prefix = next((p for p in (PYBULLET_DATA_PREFIX, EXAMPLE_ROBOT_DATA_PREFIX) if text.startswith(p)), None)
     if prefix:
-        path = _package_root(c, prefix) / text[len(prefix):]
+        root = _package_root(c, prefix)
+        path = root / text[len(prefix):]
+        if not os.path.realpath(path).startswith(os.path.realpath(root) + os.sep):
+            raise c.fail("urdf", f"{echo(text)} leaves the {prefix[:-1]} package", _WHERE_URDF)
     else:
         path = Path(text) if Path(text).is_absolute() else Path(c.source).parent / text
-    if not is_regular_file(path):
-        raise c.fail("urdf", f"no such file: {path}", f"a URDF file relative to the scene file, or "
-                     f"{PYBULLET_DATA_PREFIX}... or {EXAMPLE_ROBOT_DATA_PREFIX}...")
+    problem = file_problem(path, "URDF file")
+    if problem:
+        raise c.fail("urdf", f"{problem}: {one_line(path)}", _WHERE_URDF)
     return path
 
 
 def _urdf_chain(c: _Reader) -> Chain:
-    """The chain of a ``urdf`` scene; an error in the URDF names the scene file too."""
+    """The chain of a ``urdf`` scene; an error in the URDF names the scene file, and the URDF as the scene does."""
     base, tip = (c.name(key) if c.has(key) else None for key in ("base_link", "tip_link"))
     path = _urdf_path(c)
     try:
-        chain = chain_from_urdf(str(path), base_link=base, tip_link=tip, max_joints=c.limits.max_joints,
-                                max_bytes=c.limits.max_file_bytes)
+        return chain_from_urdf(str(path), base_link=base, tip_link=tip, max_joints=c.limits.max_joints,
+                               max_bytes=c.limits.max_file_bytes)
     except SceneError as err:
-        raise c.fail("urdf", f"{err.source}: {err.key}: {err.problem}", err.allowed) from None
-    if chain.n_joints > c.limits.max_joints:
-        raise c.fail("urdf", f"{chain.n_joints} joints on the chain", f"at most {c.limits.max_joints}")
-    return chain
+        raise c.fail("urdf", f"{one_line(c.table['urdf'], 120)}: {err.key}: {err.problem}", err.allowed) from None
 
 
 def _dh_chain(c: _Reader, name: str) -> Chain:
@@ -365,7 +401,7 @@ def _dh_chain(c: _Reader, name: str) -> Chain:
     if size < 1:
         raise dh.fail("a", "expected a non-empty list of numbers", "one number per joint")
     if size > dh.limits.max_joints:
-        raise dh.fail("a", f"{size} joints", f"at most {dh.limits.max_joints}")
+        raise dh.fail("a", f"{size:,} joints", allowed_at_most(dh.limits, "max_joints"))
     values = {key: dh.vector(key, size, [0.0] * size if key == "theta_offset" else None,
                              length=1 if key in ("a", "d") else 0) for key in columns}
     limits = None
@@ -373,7 +409,8 @@ def _dh_chain(c: _Reader, name: str) -> Chain:
         limits = np.stack([dh.vector("lower", size), dh.vector("upper", size)], axis=1)
         bad = np.flatnonzero(limits[:, 0] >= limits[:, 1])
         if bad.size:
-            raise dh.fail("upper", f"upper limit of joint {bad[0]} is not above its lower limit")
+            raise dh.fail(f"upper[{bad[0]}]", f"the upper limit of joint {bad[0]} is not above its lower limit",
+                          "lower < upper for every joint")
     return chain_from_dh(name, convention=convention, limits=limits, **values)
 
 
@@ -381,16 +418,18 @@ def _chain(top: _Reader, name: str) -> Chain:
     c = top.subtable("chain", _CHAIN)
     sources = [key for key in ("joint", "urdf", "dh") if c.has(key)]
     if len(sources) != 1:
-        raise c.fail("joint", f"give exactly one chain source, got {sources or 'none'}", "joint, urdf, dh")
+        raise c.fail("joint", f"give exactly one chain source, got {sources or 'none'}",
+                     "one of [[chain.joint]], urdf, [chain.dh]")
     if sources == ["urdf"]:
         return _urdf_chain(c)
     if sources == ["dh"]:
         return _dh_chain(c, c.name("name", name))
-    joints = tuple(_joint(r) for r in c.array_of_tables("joint", _JOINT, c.limits.max_joints))
+    joints = tuple(_joint(r) for r in c.array_of_tables("joint", _JOINT, "max_joints"))
     names = [j.name for j in joints]
     end_effector = c.name("end_effector", "end_effector")
     if len(set(names + [end_effector])) != len(names) + 1:
-        raise c.fail("joint", f"joint and end-effector names repeat: {names + [end_effector]}", "distinct names")
+        repeated = next(n for i, n in enumerate(names + [end_effector]) if n in names[:i])
+        raise c.fail("joint", f"the name {repeated!r} is given to two frames", "distinct joint and end-effector names")
     return Chain(
         name=c.name("name", name), joints=joints, end_effector_name=end_effector,
         end_effector_xyz=c.vector("end_effector_xyz", 3, [0.0] * 3, length=1),
@@ -410,6 +449,7 @@ def _kinematics(top: _Reader, head: dict) -> KinematicsScene:
 def _start(t: _Reader, chain: Chain) -> np.ndarray:
     """The start pose: "zeros", "mid-range" (limits' middle, 0 where unlimited) or a list."""
     value = t.table.get("start", "zeros")
+    allowed = f'"zeros", "mid-range" or a list of {chain.n_joints} numbers'
     if isinstance(value, list):
         prismatic = np.array([j.type == "prismatic" for j in chain.joints])
         q = t.vector("start", chain.n_joints) * np.where(prismatic, t.scale, 1.0)  # lengths in the scene's unit
@@ -419,21 +459,24 @@ def _start(t: _Reader, chain: Chain) -> np.ndarray:
                           0.0)
         q = np.zeros(chain.n_joints) if value == "zeros" else middle
     else:
-        raise t.fail("start", f"{value!r} is not allowed", f'"zeros", "mid-range" or a list of {chain.n_joints} numbers')
+        raise t.fail("start", f"{echo(value)} is not allowed", allowed)
     outside = np.flatnonzero((q < chain.lower) | (q > chain.upper))
     if outside.size:
-        raise t.fail("start", f"joint {chain.joints[outside[0]].name} starts outside its limits")
+        joint = chain.joints[outside[0]]
+        raise t.fail("start", f"joint {joint.name} starts outside its limits",
+                     f"values within [{joint.lower:g}, {joint.upper:g}] for {joint.name}")
     return q
 
 
 def _position_tolerance(t: _Reader, chain: Chain) -> float:
-    """[m]; at most :data:`POSITION_TOLERANCE_OF_REACH` of the chain's reach."""
+    """[m]; in its physical range and at most :data:`POSITION_TOLERANCE_OF_REACH` of the chain's reach."""
     if not t.has("position_tolerance"):
         return DEFAULT_POSITION_TOLERANCE
     value = t.number("position_tolerance", positive=True, length=1)
     most = POSITION_TOLERANCE_OF_REACH * reach_upper_bound(chain)[1]
     if value > most:
-        raise t.fail("position_tolerance", f"{value:.3g} m would count misses of a tenth of the arm as solved",
+        raise t.fail("position_tolerance", f"{value:.3g} m is more than a tenth of the chain's reach: misses that "
+                     "large would count as solved",
                      f"at most {POSITION_TOLERANCE_OF_REACH:g} x the chain's reach = {most:.3g} m")
     return value
 
@@ -441,18 +484,17 @@ def _position_tolerance(t: _Reader, chain: Chain) -> float:
 def _ik(top: _Reader, head: dict) -> IKScene:
     chain = _chain(top, head["name"])
     t = top.subtable("targets", _TARGETS)
-    hard = t.strings("hard") if t.has("hard") else ()
-    unknown = [h for h in hard if h not in HARD_TARGETS]
-    if unknown:
-        raise t.fail("hard", f"unknown hard target {unknown[0]!r}", ", ".join(HARD_TARGETS))
+    count = t.integer("count", 100, minimum=1, maximum=t.limits.max_samples, why=_SAMPLES_WHY)
+    iterations = t.integer("max_iterations", 200, minimum=1, maximum=t.limits.max_iterations)
+    if count * iterations > t.limits.max_steps:
+        raise t.fail("max_iterations", f"{count:,} targets x {iterations:,} iterations = {count * iterations:,} solver "
+                     "iterations at worst", allowed_at_most(t.limits, "max_steps", "per solver"))
     return IKScene(
-        chain=chain, n_targets=t.integer("count", 100, minimum=1, maximum=t.limits.max_samples, why=_SAMPLES_WHY),
-        seed=t.integer("seed", 0, maximum=_MAX_SEED),
+        chain=chain, n_targets=count, seed=t.integer("seed", 0, maximum=_MAX_SEED),
         target_kind=t.string("kind", "pose", choices=("pose", "position")), q_start=_start(t, chain),
         position_tolerance=_position_tolerance(t, chain),
         orientation_tolerance=t.number("orientation_tolerance", 1e-6, positive=True),
-        max_iterations=t.integer("max_iterations", 200, minimum=1, maximum=t.limits.max_iterations),
-        hard_targets=hard, **head,
+        max_iterations=iterations, hard_targets=t.strings("hard", HARD_TARGETS, "unknown hard target {}") if t.has("hard") else (), **head,
     )
 
 
@@ -475,12 +517,22 @@ def _check_reference(top: _Reader, scene) -> None:
 
 def parse_scene(data: dict, source: str = "<scene>", limits: Limits = DEFAULT_LIMITS):
     """Build a scene from parsed TOML ``data``; ``source`` names it in error messages."""
+    try:
+        return _parse(data, source, limits)
+    except SceneError as err:
+        if err.source != "<code>":
+            raise
+        # raised by the data model itself (core.scene): name the file it came from
+        raise SceneError(source, err.key, err.problem, err.allowed) from None
+
+
+def _parse(data: dict, source: str, limits: Limits):
     top = _Reader(source, data, "", _TOP, 1.0, limits)
     s = top.subtable("scene", _SCENE)
     unit = s.string("length_unit", "m", choices=tuple(LENGTH_UNITS))
     kind = s.string("kind", choices=KINDS)
     head = dict(
-        name=s.name("name"), description=s.string("description", "-"),
+        name=s.name("name"), description=s.text("description", "-"),
         reference=s.string("reference", choices=ENGINE_NAMES), source=source,
     )
     top.scale = LENGTH_UNITS[unit]
@@ -497,17 +549,21 @@ def parse_scene(data: dict, source: str = "<scene>", limits: Limits = DEFAULT_LI
 
 _TOML_POSITION = re.compile(r"\(at line (\d+), column (\d+)\)")
 MAX_NESTING_HINT = "TOML nested at most a few hundred levels deep"
+_BOMS = {b"\xef\xbb\xbf": "UTF-8", b"\xff\xfe": "UTF-16", b"\xfe\xff": "UTF-16"}
 
 
 def _decode(path: str, data: bytes) -> str:
-    if data.startswith(b"\xef\xbb\xbf"):
-        raise SceneError(path, "line 1, column 1", "the file starts with a UTF-8 byte-order mark (BOM)",
-                         "UTF-8 without a BOM (save it as plain UTF-8)")
+    for bom, codec in _BOMS.items():
+        if data.startswith(bom):
+            raise SceneError(path, "line 1, column 1", f"the file starts with a {codec} byte-order mark (BOM)",
+                             "UTF-8 without a BOM (save it as plain UTF-8)")
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as err:
         line = data[: err.start].count(b"\n") + 1
-        raise SceneError(path, f"line {line}, byte {err.start}", f"not UTF-8 text: {err.reason}", "UTF-8 text") from None
+        column = err.start - (data.rfind(b"\n", 0, err.start) + 1) + 1
+        raise SceneError(path, f"line {line}, column {column}", f"not UTF-8 text: byte {data[err.start]:#04x} "
+                         f"({err.reason})", "UTF-8 text") from None
 
 
 def load_scene(path: str | Path, limits: Limits = DEFAULT_LIMITS):

@@ -18,7 +18,12 @@ DEFAULT_OUT_ROOT = Path("simparity-results")
 
 
 def default_out_dir() -> Path:
-    return DEFAULT_OUT_ROOT / dt.datetime.now(dt.timezone.utc).strftime("%Y%m%d-%H%M%S")
+    """A new folder ``simparity-results/<UTC date-time>[-k]/`` that does not exist yet."""
+    stamp = DEFAULT_OUT_ROOT / dt.datetime.now(dt.timezone.utc).strftime("%Y%m%d-%H%M%S")
+    candidate, k = stamp, 1
+    while candidate.exists():
+        candidate, k = stamp.with_name(f"{stamp.name}-{k}"), k + 1
+    return candidate
 
 
 def git_commit() -> str:

@@ -176,7 +176,7 @@ class Engine(abc.ABC):
 
     def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
         """Build ``solver`` for ``chain`` with the scene's tolerances and iteration cap (not timed)."""
-        raise SimparityError(f"engine '{self.name}' has no IK solvers")
+        raise SimparityError(f"engine '{self.name}' has no IK solvers (allowed: an engine whose ik_solvers() is not empty)")
 
     def check_integrator(self, integrator: str) -> Support:
         """Support for an integrator name alone."""
@@ -191,14 +191,14 @@ class Engine(abc.ABC):
         ``integrator`` and ``dt`` apply to dynamics scenes; ``None`` picks the engine's
         first integrator and the scene's first time step.
         """
-        raise SimparityError(f"engine '{self.name}' builds no model to export")
+        raise SimparityError(f"engine '{self.name}' builds no model to export (allowed: mujoco, pybullet, pinocchio)")
 
     def _export_settings(self, scene: DynamicsScene, integrator: str | None, dt: float | None) -> tuple[str, float]:
         integrator = integrator or self.integrators()[0]
         support = self.check_integrator(integrator)
         if not support.ok:
-            raise SimparityError(support.reason)
+            raise SimparityError(f"--integrator: {support.reason} (allowed: {', '.join(self.integrators())})")
         dt = scene.dts[0] if dt is None else dt
-        if not dt > 0:
-            raise SimparityError(f"--dt {dt}: must be a positive time step in seconds")
+        if not (dt > 0 and dt < float("inf")):
+            raise SimparityError(f"--dt {dt}: not a time step (allowed: a finite number of seconds > 0)")
         return integrator, dt

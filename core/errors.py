@@ -27,6 +27,16 @@ def one_line(text: object, limit: int = ECHO_LIMIT) -> str:
     return cleaned if len(cleaned) <= limit else cleaned[: limit - 1] + "…"
 
 
+ECHO_VALUE = 80
+"""Characters of a value's ``repr`` a message echoes (a string of 50,000 characters, a list of a
+million numbers) before cutting it with an ellipsis."""
+
+
+def echo(value: object, limit: int = ECHO_VALUE) -> str:
+    """``repr(value)`` for a one-line message: escaped by :func:`one_line`, cut to ``limit`` characters."""
+    return one_line(repr(value), limit)
+
+
 class SimparityError(Exception):
     """Base class of every error simparity raises on purpose."""
 
@@ -54,6 +64,10 @@ class SceneError(SimparityError):
         text = (f"{one_line(source)}: {one_line(key)}: {one_line(problem, 2 * ECHO_LIMIT)} "
                 f"(allowed: {one_line(self.allowed, 2 * ECHO_LIMIT)})")
         super().__init__(text)
+
+
+class UsageError(SimparityError):
+    """A command-line argument is invalid (argparse's errors, one line like every other)."""
 
 
 class UnknownSceneError(SimparityError):

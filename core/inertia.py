@@ -189,7 +189,9 @@ def inertia_world(rotation_world: np.ndarray, inertia_body: np.ndarray) -> np.nd
 def inertia_problem(inertia: np.ndarray, rtol: float = INERTIA_RTOL) -> str | None:
     """What is physically wrong with an inertia tensor, or None if nothing is.
 
-    Checks, in order: shape (3, 3) and finite entries; symmetry (``|I - I^T|`` at most
+    Safe for any finite entries (1e308, denormals): the checks run on the tensor divided by its
+    largest entry, so nothing overflows to NaN and passes. Checks, in order: shape (3, 3) and
+    finite entries; symmetry (``|I - I^T|`` at most
     ``rtol`` times the largest principal moment); positive definiteness (every principal
     moment > 0, no tolerance: a singular tensor cannot be inverted); the triangle
     inequality of the principal moments ``a + b >= c`` (up to ``rtol * c``), which every
@@ -212,20 +214,35 @@ def inertia_problem(inertia: np.ndarray, rtol: float = INERTIA_RTOL) -> str | No
         return f"inertia has shape {inertia.shape}, expected (3, 3)"
     if not np.all(np.isfinite(inertia)):
         return "inertia has non-finite entries"
-    moments = np.linalg.eigvalsh(0.5 * (inertia + inertia.T))
-    scale = np.max(np.abs(moments))
-    asymmetry = np.max(np.abs(inertia - inertia.T))
-    if asymmetry > rtol * scale:
-        return f"inertia is not symmetric: max |I - I^T| = {asymmetry:.3g} kg m^2"
+    # Work on I / max|I_ij|: entries of 1e308 or 1e-320 neither overflow nor lose their digits,
+    # and the eigenvalues of a tensor of order one always converge.
+    scale = float(np.max(np.abs(inertia)))
+    if scale == 0.0:
+        return "inertia is zero, not positive definite"
+    unit = inertia / scale
+    try:
+        moments = np.linalg.eigvalsh(0.5 * (unit + unit.T))
+    except np.linalg.LinAlgError as err:
+        return f"inertia has no principal moments ({err})"
+    asymmetry = np.max(np.abs(unit - unit.T))
+    if asymmetry > rtol * np.max(np.abs(moments)):
+        return f"inertia is not symmetric: max |I - I^T| = {_scaled(asymmetry, scale):.3g} kg m^2"
     if moments[0] <= 0:
-        return f"inertia is not positive definite: eigenvalues {_fmt(moments)} kg m^2"
+        return f"inertia is not positive definite: eigenvalues {_fmt(moments, scale)} kg m^2"
     if moments[0] + moments[1] < moments[2] * (1 - rtol):
+        a, b, c = (_scaled(m, scale) for m in moments)
         return (
-            f"inertia violates the triangle inequality: principal moments {_fmt(moments)} kg m^2 "
-            f"have {moments[0]:.6g} + {moments[1]:.6g} < {moments[2]:.6g}"
+            f"inertia violates the triangle inequality: principal moments {_fmt(moments, scale)} kg m^2 "
+            f"have {a:.6g} + {b:.6g} < {c:.6g}"
         )
     return None
 
 
-def _fmt(values: np.ndarray) -> str:
-    return "(" + ", ".join(f"{v:.6g}" for v in values) + ")"
+def _scaled(value: float, scale: float) -> float:
+    """``value * scale`` for a message (inf rather than a warning where it overflows)."""
+    with np.errstate(over="ignore"):
+        return float(np.float64(value) * scale)
+
+
+def _fmt(values: np.ndarray, scale: float = 1.0) -> str:
+    return "(" + ", ".join(f"{_scaled(v, scale):.6g}" for v in values) + ")"

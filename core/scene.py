@@ -16,6 +16,25 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from simparity.core.arrays import readonly
+from simparity.core.errors import SceneError
+
+_SAFE_NORM = (1e-150, 1e150)
+"""Norms whose square neither under- nor overflows in float64; outside, a vector is first scaled
+by its largest entry (which keeps the direction exact to rounding)."""
+
+
+def _unit(vector, size: int, what: str) -> np.ndarray:
+    """``vector`` normalised without overflow or underflow; SceneError if it has no direction."""
+    v = np.asarray(vector, dtype=float).reshape(size)
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        norm = float(np.linalg.norm(v))
+    if not _SAFE_NORM[0] < norm < _SAFE_NORM[1]:
+        largest = float(np.max(np.abs(v)))
+        if not (np.isfinite(largest) and largest > 0):
+            raise SceneError("<code>", what, f"{v.tolist()} has no direction", "a finite non-zero vector")
+        v = v / largest
+        norm = float(np.linalg.norm(v))
+    return v / norm
 
 
 @dataclass(frozen=True)
@@ -51,8 +70,7 @@ class RigidBody:
     def __post_init__(self) -> None:
         object.__setattr__(self, "inertia_body", readonly(self.inertia_body, shape=(3, 3)))
         object.__setattr__(self, "position_world", readonly(self.position_world, shape=(3,)))
-        q = np.asarray(self.quat_wxyz, dtype=float).reshape(4)
-        object.__setattr__(self, "quat_wxyz", readonly(q / np.linalg.norm(q), shape=(4,)))
+        object.__setattr__(self, "quat_wxyz", readonly(_unit(self.quat_wxyz, 4, f"{self.name}.quat_wxyz"), shape=(4,)))
         object.__setattr__(self, "velocity_world", readonly(self.velocity_world, shape=(3,)))
         object.__setattr__(
             self, "angular_velocity_world", readonly(self.angular_velocity_world, shape=(3,))
@@ -226,8 +244,10 @@ class Joint:
     upper: float = np.inf
 
     def __post_init__(self) -> None:
-        axis = np.asarray(self.axis, dtype=float).reshape(3)
-        object.__setattr__(self, "axis", readonly(axis / np.linalg.norm(axis), shape=(3,)))
+        object.__setattr__(self, "axis", readonly(_unit(self.axis, 3, f"{self.name}.axis"), shape=(3,)))
+        if np.isnan(self.lower) or np.isnan(self.upper) or self.lower > self.upper:
+            raise SceneError("<code>", f"{self.name}.lower", f"limits ({self.lower}, {self.upper})",
+                             "lower <= upper, -inf / inf for none")
         object.__setattr__(self, "origin_xyz", readonly(self.origin_xyz, shape=(3,)))
         object.__setattr__(self, "origin_rotation", readonly(self.origin_rotation, shape=(3, 3)))
 

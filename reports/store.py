@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from simparity.core.errors import ResultsError
+from simparity.core.errors import ResultsError, one_line
 from simparity.core.results import COLUMNS, RESULTS_FILE, RUN_INFO_FILE, SCHEMA_VERSION
 
 
@@ -21,19 +21,20 @@ def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
     results, info = run_dir / RESULTS_FILE, run_dir / RUN_INFO_FILE
     for path in (results, info):
         if not path.is_file():
-            raise ResultsError(f"{path}: missing (is {run_dir} the output folder of 'simparity run'?)")
+            raise ResultsError(f"{one_line(path)}: missing (allowed: the output folder of 'simparity run', holding "
+                               f"{RESULTS_FILE} and {RUN_INFO_FILE})")
     try:
         meta = json.loads(info.read_text(encoding="utf-8"))
         # keep_default_na=False: pandas would read the status "n/a" as missing.
         table = pd.read_csv(results, keep_default_na=False, **_EXACT_FLOATS,
                             na_values={"value": ["", "nan", "NaN"], "dt": ["", "nan", "NaN"]})
     except (json.JSONDecodeError, pd.errors.ParserError, UnicodeDecodeError) as err:
-        raise ResultsError(f"{run_dir}: unreadable stored run: {err}") from None
+        raise ResultsError(f"{one_line(run_dir)}: unreadable stored run: {one_line(err)} (allowed: a folder written by "
+                           "'simparity run')") from None
     if meta.get("schema_version") != SCHEMA_VERSION:
-        raise ResultsError(
-            f"{info}: schema_version {meta.get('schema_version')!r}, this simparity reads {SCHEMA_VERSION}"
-        )
+        raise ResultsError(f"{info}: schema_version {meta.get('schema_version')!r:.20} (allowed: {SCHEMA_VERSION}, the "
+                           "version this simparity reads)")
     missing = [c for c in COLUMNS if c not in table.columns]
     if missing:
-        raise ResultsError(f"{results}: missing columns {missing}")
+        raise ResultsError(f"{results}: missing columns {missing} (allowed: a results.csv with {', '.join(COLUMNS)})")
     return table, meta

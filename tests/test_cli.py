@@ -32,9 +32,9 @@ def test_list_names_every_builtin_scene():
 def test_run_without_scenes_runs_the_whole_builtin_suite(tmp_path, monkeypatch):
     """No scene argument means every built-in scene, each once, on the default engines."""
     seen = []
-    monkeypatch.setattr("simparity.comparisons.cli.run_scene", lambda scene, engines, *a, **k: seen.append(
+    monkeypatch.setattr("simparity.comparisons.parallel.run_scene", lambda scene, engines, *a, **k: seen.append(
         (scene.name, tuple(e.name for e in engines))) or [])
-    code, _ = _run(["run", "--out", str(tmp_path)])
+    code, _ = _run(["run", "--out", str(tmp_path), "--jobs", "1"])
     assert code == EXIT_OK
     assert [name for name, _ in seen] == sorted(builtin_paths())
     assert all(engines == DEFAULT_ENGINES for _, engines in seen)
@@ -73,9 +73,9 @@ def test_broken_scene_exits_2_with_one_line(tmp_path, capsys, name, base, old, n
 @pytest.mark.parametrize(
     "argv, words",
     [
-        (["run", "no-such-scene"], "neither a built-in scene nor a file"),
+        (["run", "no-such-scene"], "neither a built-in scene nor a scene file"),
         (["run", "lecture-projectile", "--engines", "core,havok"], "unknown engine(s): havok"),
-        (["run", "lecture-projectile", "--repeats", "0"], "--repeats 0"),
+        (["run", "lecture-projectile", "--repeats", "-1"], "--repeats -1"),
         (["run", "lecture-projectile", "--engines", ","], "no engine named"),
         (["run", "lecture-projectile", "--out", "/dev/null"], "exists and is not a folder"),
         (["report", "/nonexistent/run"], "missing"),
@@ -152,3 +152,69 @@ def test_export_output_is_only_the_model():
     assert done.returncode == 0
     assert ET.fromstring(done.stdout).tag == "robot" and "build time" not in done.stdout
     assert "build time" not in done.stderr
+
+
+def test_out_holding_a_run_is_refused_unless_forced(tmp_path, capsys):
+    """A second run into the same --out exits 2 and leaves the first run untouched; --force overwrites."""
+    argv = ["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0", "--out", str(tmp_path)]
+    assert main(argv) == EXIT_OK
+    before = (tmp_path / "results.csv").read_bytes()
+    capsys.readouterr()
+    assert main(argv) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert "already holds a run" in err and "--force" in err and err.count("\n") == 1
+    assert (tmp_path / "results.csv").read_bytes() == before
+    assert main(argv + ["--force"]) == EXIT_OK
+
+
+def test_default_output_folders_never_collide(tmp_path, monkeypatch):
+    """Two runs in the same second get two folders."""
+    monkeypatch.chdir(tmp_path)
+    for _ in range(2):
+        assert main(["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0"], out=io.StringIO()) == EXIT_OK
+    assert len([p for p in (tmp_path / "simparity-results").iterdir() if p.is_dir()]) == 2
+
+
+def test_run_check_junit_summary_and_history(tmp_path, capsys):
+    """run --check passes on the shipped tolerances; a tolerance the run breaks gives exit 1 with the violation on one
+    line, a JUnit file with the failing case and a summary; history shows both runs side by side."""
+    first = tmp_path / "first"
+    assert main(["run", "lecture-projectile", "--quick", "--engines", "core", "--out", str(first), "--check",
+                 "--jobs", "1"]) == EXIT_OK
+    assert "check passed" in capsys.readouterr().out
+    tight = tmp_path / "tight.toml"
+    tight.write_text('[[bound]]\nintegrator = "rk4"\nmetric = "position_error_max"\nmax = 1e-20\n'
+                     'reason = "tighter than rounding"\n', encoding="utf-8")
+    junit, summary = tmp_path / "junit.xml", tmp_path / "summary.md"
+    code = main(["check", str(first), "--tolerances", str(tight), "--junit", str(junit), "--summary", str(summary)])
+    out = capsys.readouterr().out
+    assert code == 1
+    violations = [line for line in out.splitlines() if line.startswith("violation: ")]
+    assert len(violations) == 3 and all("rk4" in v and "tighter than rounding" in v for v in violations)
+    assert ET.parse(junit).getroot().get("failures") == "3"
+    assert "## simparity check: failed" in summary.read_text(encoding="utf-8")
+    second = tmp_path / "second"
+    assert main(["run", "lecture-projectile", "--quick", "--engines", "core", "--out", str(second), "--jobs", "1"]) == 0
+    assert main(["check", str(second), "--baseline", "latest"]) == EXIT_OK  # same numerics: nothing moved
+    capsys.readouterr()
+    assert main(["history", "lecture-projectile", "--engine", "core", "--metric", "position_error_final"]) == EXIT_OK
+    shown = capsys.readouterr().out.splitlines()
+    euler = [line for line in shown if " explicit_euler " in line and "0.0333333" in line]
+    assert shown[0].count("#") == 2 and len(euler) == 1 and euler[0].count("0.97536") == 2
+
+
+def test_a_broken_history_database_never_loses_a_run(tmp_path, capsys, monkeypatch):
+    """A corrupt database: one line on stderr, the run's CSV and report are written, exit 0."""
+    corrupt = tmp_path / "history.sqlite"
+    corrupt.write_bytes(b"not a database" * 100)
+    code = main(["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0", "--out", str(tmp_path / "r"),
+                 "--history", str(corrupt)])
+    err = capsys.readouterr().err
+    assert code == EXIT_OK and err.startswith("simparity: history not updated") and err.count("\n") == 1
+    assert (tmp_path / "r" / "results.csv").is_file() and (tmp_path / "r" / "report.md").is_file()
+
+
+@pytest.mark.parametrize("dt", ["inf", "nan", "0", "-0.01"])
+def test_export_refuses_a_time_step_that_is_not_one(capsys, dt):
+    assert main(["export", "lecture-projectile", "--engine", "mujoco", "--dt", dt]) == EXIT_USAGE
+    assert "(allowed: a finite number of seconds > 0" in capsys.readouterr().err

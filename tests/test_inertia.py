@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import mujoco
 import numpy as np
 import pinocchio as pin
@@ -208,3 +210,25 @@ def test_point_masses_match_mujoco(seed):
         np.sort(model.body_inertia[1]), np.linalg.eigvalsh(expected), atol=MUJOCO_RTOL * scale
     )
     np.testing.assert_allclose(rebuilt, expected, atol=MUJOCO_RTOL * scale)
+
+
+@pytest.mark.parametrize("inertia, words", [
+    ([[1e308, 1e308, 0], [1e308, 1e308, 0], [0, 0, 1]], "not positive definite"),  # its check used to overflow to NaN
+    ([[1e300, -1e300, 0], [1e300, 1e300, 0], [0, 0, 1]], "not symmetric"),
+    (np.zeros((3, 3)), "zero"),
+])
+def test_inertia_problem_is_safe_at_extreme_magnitudes(inertia, words):
+    """Entries of 1e308 neither overflow to NaN (and pass) nor stop the eigenvalues converging; no warnings."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        problem = inertia_problem(np.array(inertia, dtype=float))
+    assert problem is not None and words in problem
+
+
+@pytest.mark.parametrize("scale", [1e-320, 1e-300, 1e300, 5e307])
+def test_inertia_problem_judges_the_shape_not_the_size(scale):
+    """A valid tensor stays valid and an invalid one invalid at any finite scale (the range is the loader's)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert inertia_problem(np.diag([1.0, 2.0, 2.5]) * scale) is None
+        assert "triangle" in inertia_problem(np.diag([1.0, 1.0, 3.0]) * scale)

@@ -105,11 +105,11 @@ BROKEN = [
     ("two chain sources", VALID_KINEMATICS, "[chain]", '[chain]\nurdf = "robot.urdf"', "chain.joint",
      "exactly one chain source"),
     ("missing urdf", VALID_KINEMATICS, '[[chain.joint]]\nname = "j1"\ntype = "revolute"\naxis = [0.0, 0.0, 1.0]\n'
-     "lower = -1.0\nupper = 1.0\n", 'urdf = "no-such.urdf"\n', "chain.urdf", "no such file"),
+     "lower = -1.0\nupper = 1.0\n", 'urdf = "no-such.urdf"\n', "chain.urdf", "no such URDF file"),
     ("ik start outside limits", VALID_KINEMATICS.replace('kind = "kinematics"', 'kind = "ik"'), "[chain]",
      "[targets]\nstart = [2.0]\n[chain]", "targets.start", "outside its limits"),
     ("ik unknown hard target", VALID_KINEMATICS.replace('kind = "kinematics"', 'kind = "ik"'), "[chain]",
-     '[targets]\nhard = ["inside_out"]\n[chain]', "targets.hard", "unknown hard target"),
+     '[targets]\nhard = ["inside_out"]\n[chain]', "targets.hard[0]", "unknown hard target"),
     ("zero configurations", VALID_KINEMATICS, "[chain]", "[sampling]\nconfigurations = 0\n[chain]",
      "sampling.configurations", "whole numbers 1 to"),
 ]

@@ -11,7 +11,7 @@ import pytest
 
 from simparity.core.errors import SceneError
 from simparity.core.kinematics import joint_frames
-from simparity.core.urdf import chain_from_urdf
+from simparity.core.urdf import MAX_URDF_JOINTS, chain_from_urdf
 
 IIWA_PATH = os.path.join(pybullet_data.getDataPath(), "kuka_iiwa/model.urdf")
 
@@ -208,3 +208,80 @@ def test_closed_loop_through_the_tip_is_rejected():
     text = _robot(_joint("j0", "r", "a"), _joint("j1", "b", "c"), _joint("j2", "c", "b"), links=("r", "a", "b", "c"))
     with pytest.raises(SceneError, match="closed loop"):
         chain_from_urdf(text, tip_link="c")
+
+
+# Numbers and names on the chain are held to the physical ranges (core.ranges) and the name rule
+# (core.names); off the chain only what the engines' importers need is checked.
+ON_PATH_REJECTED = [
+    ("huge limit", _joint("j1", "a", "b").replace('lower="-1"', 'lower="-1e308"'), "j1']/limit/@lower", "physical range"),
+    ("huge origin", _joint("j1", "a", "b").replace('xyz="0 0 0.1"', 'xyz="1e308 0 0"'), "j1']/origin/@xyz",
+     "physical range"),
+    ("huge rpy", _joint("j1", "a", "b").replace('<origin xyz="0 0 0.1"/>', '<origin rpy="1e300 0 0"/>'),
+     "j1']/origin/@rpy", "physical range"),
+    ("tiny axis", _joint("j1", "a", "b").replace('xyz="0 0 1"', 'xyz="0 0 1e-200"'), "j1']/axis/@xyz", "usable range"),
+    ("huge axis", _joint("j1", "a", "b").replace('xyz="0 0 1"', 'xyz="1e200 1e200 1e200"'), "j1']/axis/@xyz",
+     "usable range"),
+    ("immovable", _joint("j1", "a", "b").replace('lower="-1" upper="1"', 'effort="1" velocity="1"'), "j1']/limit",
+     "cannot move"),
+    ("injected name", _joint('j1&quot;/&gt;&lt;x', "a", "b"), "robot/joint[@name='j1\"/><x']", "allowed set"),
+]
+
+
+@pytest.mark.parametrize("case, joint, key, words", ON_PATH_REJECTED, ids=[row[0] for row in ON_PATH_REJECTED])
+def test_numbers_and_names_on_the_chain_are_held_to_their_ranges(case, joint, key, words):
+    """Each refusal names the element and what is allowed; nothing is normalised to NaN or sampled to overflow."""
+    with pytest.raises(SceneError) as info:
+        chain_from_urdf(_robot(joint, links=("a", "b")), source="test.urdf")
+    assert key in info.value.key and words in info.value.problem and info.value.allowed
+
+
+def test_the_same_joints_off_the_chain_are_ignored():
+    """A side branch with an immovable joint, a limit of 1e16 (as iris.urdf's propellers) and an odd name loads."""
+    side = (_joint("odd name!", "a", "c").replace('lower="-1" upper="1"', 'lower="-1e16" upper="1e16"')
+            + _joint("stuck", "c", "d").replace('lower="-1" upper="1"', 'lower="0" upper="0"'))
+    chain = chain_from_urdf(_robot(_joint("j1", "a", "b"), side, links=("a", "b", "c", "d")), tip_link="b")
+    assert [j.name for j in chain.joints] == ["j1"]
+
+
+def test_robot_name_follows_the_name_rule():
+    with pytest.raises(SceneError, match="allowed set") as info:
+        chain_from_urdf(_robot(_joint("j1", "a", "b"), links=("a", "b")).replace("name='r'", "name='r&lt;x'"))
+    assert info.value.key == "robot/@name"
+
+
+def test_too_many_joints_are_refused_before_reading_them():
+    """Movable joints beyond the limit (Pinocchio's data grows steeply) and joint elements beyond the fixed cap."""
+    links = [f"l{i}" for i in range(201)]
+    movable = [_joint(f"j{i}", f"l{i}", f"l{i + 1}", type="continuous") for i in range(200)]
+    with pytest.raises(SceneError, match="200 movable joints") as info:
+        chain_from_urdf(_robot(*movable, links=links))
+    assert "--max-joints" in info.value.allowed
+    assert chain_from_urdf(_robot(*movable, links=links), max_joints=200).n_joints == 200
+    links = [f"l{i}" for i in range(MAX_URDF_JOINTS + 2)]
+    fixed = [_joint(f"j{i}", f"l{i}", f"l{i + 1}", type="fixed") for i in range(MAX_URDF_JOINTS + 1)]
+    with pytest.raises(SceneError, match="<joint> elements"):
+        chain_from_urdf(_robot(*fixed, links=links))
+
+
+def test_a_loop_cut_off_from_the_root_is_rejected_whatever_the_base():
+    """A base link chosen on a loop below no root used to walk the loop forever."""
+    text = _robot(_joint("j0", "r", "a"), _joint("j1", "b", "c"), _joint("j2", "c", "b"), links=("r", "a", "b", "c"))
+    for base, tip in (("b", None), ("b", "c")):
+        with pytest.raises(SceneError, match="closed loop"):
+            chain_from_urdf(text, base_link=base, tip_link=tip)
+
+
+@pytest.mark.parametrize("encoding, codec", [("ISO-8859-1", "latin-1"), ("UTF-16", "utf-16")])
+def test_a_declared_encoding_is_honoured(tmp_path, encoding, codec):
+    """The file is parsed from bytes, so its XML declaration decides the encoding (a comment in Latin-1 too)."""
+    text = f'<?xml version="1.0" encoding="{encoding}"?>\n<!-- Müller -->' + _robot(_joint("j1", "a", "b"), links=("a", "b"))
+    (tmp_path / "r.urdf").write_bytes(text.encode(codec))
+    assert chain_from_urdf(tmp_path / "r.urdf").joints[0].name == "j1"
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
+def test_files_that_are_not_regular_are_never_opened(tmp_path):
+    os.mkfifo(tmp_path / "fifo.urdf")
+    for path in (tmp_path / "fifo.urdf", tmp_path, "/dev/zero"):
+        with pytest.raises(SceneError, match="not a regular file"):
+            chain_from_urdf(str(path))

@@ -1,0 +1,93 @@
+"""The physical range of every number a scene or URDF may give, and norms that cannot overflow.
+
+Ranges are generous (they admit a microgram bead and a freight train) but physical: a value
+outside them is a typo or an attack, and letting it through would give meaningless numbers (a
+mass of 5e-324 kg, a velocity of 1e308 m/s) or overflow inside an engine. They are held by the
+scene loader (``comparisons.scene_loader``) and the URDF reader (:mod:`core.urdf`), and listed in
+``docs/scenes.md``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Range:
+    """The magnitudes a value may have (SI), and why.
+
+    Attributes
+    ----------
+    low, high : float
+        Smallest and largest magnitude allowed (``low`` 0 allows zero).
+    unit : str
+    why : str
+        What the range admits, for the error message.
+    """
+
+    low: float
+    high: float
+    unit: str
+    why: str
+
+    def allows(self, magnitude: float) -> bool:
+        """True for a magnitude inside [low, high] (False for NaN)."""
+        return self.low <= magnitude <= self.high
+
+    def text(self) -> str:
+        low = "0" if self.low == 0 else f"{self.low:g}"
+        return f"magnitudes {low} to {self.high:g} {self.unit}: {self.why}".strip()
+
+
+_LENGTH = Range(0.0, 1e6, "m", "a scene within 1000 km")
+_ANGLE = Range(0.0, 1e3, "rad", "an angle; larger is a typo")
+_JOINT = Range(0.0, 1e4, "rad or m", "a joint range; leave the limits out (URDF: type='continuous') for none")
+RANGES = {
+    "mass": Range(1e-9, 1e9, "kg", "a microgram to a million tonnes"),
+    "inertia_moment": Range(1e-15, 1e12, "kg m^2", "a microgram bead of 1 mm to a ship"),
+    "position_world": _LENGTH, "origin_xyz": _LENGTH, "end_effector_xyz": _LENGTH, "point_body": _LENGTH,
+    "a": _LENGTH, "d": _LENGTH,
+    "velocity_world": Range(0.0, 1e6, "m/s", "slower than 1000 km/s"),
+    "air_velocity_world": Range(0.0, 1e6, "m/s", "slower than 1000 km/s"),
+    "angular_velocity_world": Range(0.0, 1e6, "rad/s", "below a million rad/s"),
+    "gravity_world": Range(0.0, 1e4, "m/s^2", "up to 1000 g"),
+    "force_world": Range(0.0, 1e12, "N", "up to a terranewton"),
+    "linear_drag": Range(0.0, 1e9, "N s/m", "a drag coefficient"),
+    "quadratic_drag": Range(0.0, 1e9, "N s^2/m^2", "a drag coefficient"),
+    "angular_linear_drag": Range(0.0, 1e9, "N m s", "a drag coefficient"),
+    "angular_quadratic_drag": Range(0.0, 1e9, "N m s^2", "a drag coefficient"),
+    "duration": Range(1e-9, 1e7, "s", "a nanosecond to four months"),
+    "dt": Range(1e-9, 1e3, "s", "a nanosecond to a quarter of an hour"),
+    "rate_hz": Range(1e-3, 1e9, "Hz", "the inverse of the dt range"),
+    "lower": _JOINT, "upper": _JOINT, "start": Range(0.0, 1e4, "rad or m", "a joint value"),
+    "origin_rpy": _ANGLE, "end_effector_rpy": _ANGLE, "alpha": _ANGLE, "theta_offset": _ANGLE,
+    "position_tolerance": Range(1e-15, 1e6, "m", "a tolerance above rounding, and at most a tenth of the reach"),
+    "orientation_tolerance": Range(1e-15, 0.5, "rad", "a tolerance, not a quarter turn"),
+}
+"""By key name (the last component of a key path). Vectors are held to the range entry by entry."""
+
+NORM_RANGES = {
+    "quat_wxyz": Range(1e-6, 1e6, "", "a quaternion is normalised on loading; its norm must survive that"),
+    "axis": Range(1e-9, 1e9, "", "a joint axis is normalised on loading; its norm must survive that"),
+}
+"""Vectors whose direction is all that counts: their norm (computed without overflow) is held."""
+
+
+def safe_norm(vector) -> float:
+    """Euclidean norm without overflow or underflow (scaled by the largest entry); NaN stays NaN."""
+    values = [float(v) for v in vector]
+    if any(math.isnan(v) for v in values):
+        return math.nan
+    largest = max((abs(v) for v in values), default=0.0)
+    if largest == 0.0 or not math.isfinite(largest):
+        return largest
+    return largest * math.sqrt(sum((v / largest) ** 2 for v in values))
+
+
+def range_problem(key: str, value: float) -> str | None:
+    """What is wrong with ``value`` [SI] for a key named ``key`` (:data:`RANGES`), or None."""
+    allowed = RANGES.get(key)
+    if allowed is None or allowed.allows(abs(value)):
+        return None
+    return f"{value:.6g} is outside the physical range"
