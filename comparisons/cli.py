@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 from pathlib import Path
 
@@ -28,7 +29,7 @@ from simparity.comparisons.tolerances import DEFAULT_TOLERANCES, load_tolerances
 from simparity.core.errors import HistoryError, SimparityError, UsageError, one_line
 from simparity.core.ranges import RANGES
 from simparity.core.results import FAILED, REPORT_FILE, RESULTS_FILE, RUN_INFO_FILE, case_counts
-from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
+from simparity.core.scene import SUITES, DynamicsScene, IKScene, KinematicsScene
 from simparity.reports.markdown import render
 from simparity.reports.store import read_run
 
@@ -77,7 +78,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
 
-    sub.add_parser("list", help="list the built-in scenes", description="List the built-in scenes, one per line.")
+    listing = sub.add_parser("list", help="list the built-in scenes",
+                             description="List the built-in scenes, one per line, with the suites they are in.")
+    listing.add_argument("--suite", default=None, choices=SUITES, help="only the scenes of this suite")
 
     run = sub.add_parser(
         "run", help="run scenes on engines and write results.csv and report.md",
@@ -85,7 +88,10 @@ def build_parser() -> argparse.ArgumentParser:
         "and record the run in the history database.",
     )
     run.add_argument("scenes", nargs="*", metavar="SCENE|FILE",
-                     help="built-in scene names or scene files (default: the whole built-in suite)")
+                     help="built-in scene names or scene files (default: the scenes of --suite)")
+    run.add_argument("--suite", default=None, choices=SUITES,
+                     help="run a built-in suite: default (what 'simparity run' runs) or hard (the numerical-"
+                     "stability cases, each with the verdict it must earn)")
     run.add_argument("--engines", type=_engine_list, default=DEFAULT_ENGINES, metavar="A,B,...",
                      help=f"comma-separated engines to run (default: {','.join(DEFAULT_ENGINES)}; "
                      f"known: {','.join(ENGINE_NAMES)})")
@@ -146,9 +152,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def cmd_list(args, out) -> int:
-    for name, path in library.builtin_paths().items():
-        scene = library.load([str(path)])[0]
-        print(f"{name:<28} {scene.kind:<11} reference={scene.reference:<10} {scene.description}", file=out)
+    scenes = library.suite(args.suite) if args.suite else library.load(list(library.builtin_paths().values()))
+    for scene in scenes:
+        print(f"{scene.name:<28} {scene.kind:<11} reference={scene.reference:<10} {','.join(scene.suites):<14} "
+              f"{scene.description}", file=out)
     return EXIT_OK
 
 
@@ -193,8 +200,11 @@ def cmd_run(args, out) -> int:
             raise SimparityError(f"{flag} {value}: out of range (allowed: a whole number >= 1)")
     names = check_engine_names(args.engines)
     limits = Limits(max_steps=args.max_steps, max_samples=args.max_samples, max_joints=args.max_joints)
-    scenes = apply_profile(library.load(args.scenes or list(library.builtin_paths()), limits),
-                           "quick" if args.quick else "full")
+    if args.scenes and args.suite:
+        raise SimparityError(f"--suite {args.suite} with scenes named: give one (allowed: scene names or files, "
+                             "or --suite)")
+    chosen = library.load(args.scenes, limits) if args.scenes else library.suite(args.suite or "default", limits)
+    scenes = apply_profile(chosen, "quick" if args.quick else "full")
     bounds = load_tolerances(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
     versions = {n: make_engine(n).version() for n in names}
     out_dir = _out_dir(args)
@@ -329,6 +339,9 @@ def main(argv: list[str] | None = None, out=None) -> int:
     except SimparityError as err:
         print(f"simparity: error: {one_line(err, MESSAGE_LIMIT)}", file=sys.stderr)
         return EXIT_USAGE
+    except BrokenPipeError:  # the reader went away (`simparity list | head`): stop quietly, like Unix tools
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
 
 
 if __name__ == "__main__":  # pragma: no cover

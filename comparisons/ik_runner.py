@@ -9,8 +9,11 @@ Per engine x solver (the ``integrator`` column holds the solver; ``dt`` is NaN):
   is the lowest solve rate any engine's FK grants (each judge allows its own resolution on
   top of the tolerance: PyBullet's float32 link states cannot tell 1e-6 m apart), ``cross_eval_disagreement_max`` the
   largest distance between two engines' end-effector positions for the same solution;
-- each hard target: one row ``hard_<name>`` whose value is the position residual and
-  whose detail says solved or the reason, with the orientation residual.
+- each hard target: the rows of :func:`hard_metrics`: ``hard_<name>`` the position residual
+  (its detail says solved or the reason, with the orientation residual), and the typed verdicts
+  the shipped tolerances hold hard cases to: ``hard_<name>_solved`` (1 or 0),
+  ``hard_<name>_unreachable`` (1 when the solver reported the target unreachable) and
+  ``hard_<name>_limit_violation`` (how far the returned joint values lie outside the limits).
 """
 
 from __future__ import annotations
@@ -25,8 +28,8 @@ from simparity.comparisons.rows import Case, Measured, error_text, warnings_into
 from simparity.comparisons.timing import best_of
 from simparity.core.engine import Engine, KinematicsModel
 from simparity.core.ik.problem import IKTolerances
-from simparity.core.ik.result import IKResult
-from simparity.core.results import FAILED, NOT_AVAILABLE, OK, ResultRow
+from simparity.core.ik.result import LIMIT_TOLERANCE, IKResult
+from simparity.core.results import FAILED, HARD_VERDICT_SUFFIXES, NOT_AVAILABLE, OK, ResultRow
 from simparity.core.scene import IKScene
 from simparity.references.conventions import rotation_angle
 
@@ -60,21 +63,24 @@ def _summary(result: IKResult, q_start: np.ndarray, seconds: float) -> dict[str,
         "orientation_residual_max": float(result.orientation_residual.max()),
         "iterations_median": float(np.median(iterations)) if iterations.size else math.nan,
         "time_per_solve": seconds / len(result.q),
-        "limit_violations": float(np.count_nonzero(result.limit_violation > 0)),
+        "limit_violations": float(np.count_nonzero(result.limit_violation > LIMIT_TOLERANCE)),
         "rest_distance_median": float(np.median(np.linalg.norm(result.q - q_start, axis=1))),
     }
 
 
 def _cross_evaluation(scene: IKScene, targets: Targets, q: np.ndarray,
                       judges: dict[str, KinematicsModel]) -> dict[str, float]:
-    """Solve rate by each judge's FK (lowest kept) and the spread of their end-effector positions."""
+    """Solve rate by each judge's FK (lowest kept; a solution outside the joint limits is solved by
+    none) and the spread of their end-effector positions."""
+    violation = np.maximum(np.maximum(scene.chain.lower - q, q - scene.chain.upper), 0.0)
+    inside = np.max(violation, axis=1, initial=0.0) <= LIMIT_TOLERANCE
     rates, ends = [], []
     for model in judges.values():
         frames = model.forward_kinematics(q)
         end, rotation = frames.position_world[:, -1], frames.rotation_world[:, -1]
         position_resolution, orientation_resolution = model.resolution
-        solved = (np.linalg.norm(end - targets.position_world, axis=1)
-                  <= scene.position_tolerance + position_resolution)
+        solved = inside & (np.linalg.norm(end - targets.position_world, axis=1)
+                           <= scene.position_tolerance + position_resolution)
         if targets.rotation_world is not None:
             solved &= (rotation_angle(rotation, targets.rotation_world)
                        <= scene.orientation_tolerance + orientation_resolution)
@@ -124,19 +130,28 @@ def _judges(scene: IKScene, engines: list[Engine]) -> dict[str, KinematicsModel]
     return judges
 
 
+def hard_metrics(name: str) -> dict[str, str]:
+    """The metrics of hard target ``name`` and their units: the position residual first, then the
+    typed verdicts (solved, reported unreachable, limit violation)."""
+    units = dict(zip(HARD_VERDICT_SUFFIXES, ("1", "1", "rad or m")))
+    return {f"hard_{name}": "m"} | {f"hard_{name}{suffix}": unit for suffix, unit in units.items()}
+
+
 def _hard_rows(case: Case, hard: list[Targets], results: list[IKResult | None], status: str,
                problem: str) -> list[ResultRow]:
-    """One row per hard target: the position residual, and solved or the reason (or why there is none)."""
+    """The rows of :func:`hard_metrics` per hard target (or why there are none)."""
     rows = []
     for targets, result in zip(hard, results):
-        metric = {f"hard_{targets.name}": "m"}
+        metrics = hard_metrics(targets.name)
         if result is None:
-            rows += case.rows(metric, status, problem)
+            rows += case.rows(metrics, status, problem)
             continue
         verdict = "solved" if result.success[0] else f"failed: {result.reason[0]}"
         detail = (f"{verdict}; orientation residual {result.orientation_residual[0]:.3g} rad; "
                   f"limit violation {result.limit_violation[0]:.3g}; {targets.note}")
-        rows += case.rows(metric, OK, detail, {f"hard_{targets.name}": Measured(float(result.position_residual[0]), "m")})
+        values = [float(result.position_residual[0]), float(result.success[0]),
+                  float(result.reason[0] == "unreachable"), float(result.limit_violation[0])]
+        rows += case.rows(metrics, OK, detail, {m: Measured(v, u) for (m, u), v in zip(metrics.items(), values)})
     return rows
 
 
@@ -203,7 +218,8 @@ def run_ik_scene(scene: IKScene, engines: list[Engine], make_reference: Callable
     random = random_targets(scene, fk)
     hard = [hard_target(scene, name, fk) for name in scene.hard_targets
             if not (position_only and name in ORIENTATION_ONLY)]
-    skipped = {f"hard_{name}": "m" for name in scene.hard_targets if position_only and name in ORIENTATION_ONLY}
+    skipped = {m: u for name in scene.hard_targets if position_only and name in ORIENTATION_ONLY
+               for m, u in hard_metrics(name).items()}
     judges = _judges(scene, engines)
     label = f"{scene.reference}:fk (targets); cross-evaluated by {', '.join(judges)}"
     rows: list[ResultRow] = []

@@ -11,6 +11,9 @@ Hard targets (one each; poses for pose scenes, positions for position scenes):
 - ``beyond_reach``: 1.5 times the reach bound from the first joint: unreachable;
 - ``at_base``: the first joint's own position: unreachable or degenerate;
 - ``near_limits``: every joint 1e-3 of its range inside a (seeded) limit: reachable;
+- ``beyond_limits``: the pose of the start configuration with every limited joint moved a quarter
+  of its range past its upper limit: blocked by the limits (unless another branch reaches it, or
+  a revolute joint's range spans more than a turn): a solver must not pass a limit to get there;
 - ``orientation_in_place``: the start pose turned 90 deg about the end effector's z axis,
   same position (pose scenes only);
 - ``wrist_flip``: the start configuration with its last three joints moved half a turn
@@ -31,6 +34,7 @@ from simparity.core.scene import IKScene
 ORIENTATION_ONLY = ("orientation_in_place", "wrist_flip")
 """Hard targets that only make sense for pose targets."""
 _NEAR_LIMIT_FRACTION = 1e-3
+_BEYOND_LIMIT_FRACTION = 0.25
 
 
 @dataclass(frozen=True)
@@ -94,6 +98,12 @@ def hard_target(scene: IKScene, name: str, fk: KinematicsModel) -> Targets:
         q = np.where(np.isfinite(q), q, np.pi - _NEAR_LIMIT_FRACTION * span)
         position, rotation = _poses(scene, q[None], fk)
         note = f"every joint {_NEAR_LIMIT_FRACTION:g} of its range inside a limit: reachable"
+    elif name == "beyond_limits":
+        q = np.where(np.isfinite(chain.upper - chain.lower),
+                     chain.upper + _BEYOND_LIMIT_FRACTION * (chain.upper - chain.lower), q0)
+        position, rotation = _poses(scene, q[None], fk)
+        note = (f"the start configuration with every limited joint {_BEYOND_LIMIT_FRACTION:g} of its range past its "
+                "upper limit: blocked by the limits unless another branch reaches it")
     elif name == "orientation_in_place":
         position, rotation = _poses(scene, q0[None], fk)
         rotation = rotation @ so3_exp(np.array([0.0, 0.0, np.pi / 2]))

@@ -8,6 +8,7 @@ from simparity.comparisons.scene_limits import DEFAULT_LIMITS, Limits
 from simparity.comparisons.scene_loader import load_scene
 from simparity.core.errors import UnknownSceneError, one_line
 from simparity.core.files import file_problem
+from simparity.core.scene import SUITES
 
 SCENES_DIR = Path(__file__).parent / "scenes"
 
@@ -30,6 +31,13 @@ def resolve(name_or_path: str) -> Path:
         f"'{one_line(name_or_path)}' is neither a built-in scene nor a scene file{where} "
         f"(allowed: {', '.join(builtin)}, or the path of a regular TOML file; see 'simparity list')"
     )
+
+
+def suite(name: str, limits: Limits = DEFAULT_LIMITS) -> list:
+    """The built-in scenes of suite ``name`` (:data:`core.scene.SUITES`), loaded, sorted by name."""
+    if name not in SUITES:
+        raise UnknownSceneError(f"--suite {one_line(name)}: there is no such suite (allowed: {', '.join(SUITES)})")
+    return [scene for scene in load(list(builtin_paths().values()), limits) if name in scene.suites]
 
 
 def load(names_or_paths, limits: Limits = DEFAULT_LIMITS) -> list:

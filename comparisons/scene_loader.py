@@ -25,7 +25,7 @@ from simparity.core.inertia import inertia_problem
 from simparity.core.names import NAME_RULE, TEXT_RULE, name_problem, text_problem
 from simparity.core.ranges import NORM_RANGES, RANGES, safe_norm
 from simparity.core.rotations import rpy_to_matrix
-from simparity.core.scene import HARD_TARGETS, AppliedForce, Chain, DynamicsScene, Forces, IKScene, Joint, KinematicsScene, RigidBody
+from simparity.core.scene import HARD_TARGETS, SUITES, AppliedForce, Chain, DynamicsScene, Forces, IKScene, Joint, KinematicsScene, RigidBody
 from simparity.core.urdf import chain_from_urdf
 
 if sys.version_info >= (3, 11):
@@ -201,7 +201,7 @@ class _Reader:
 
 _TOP = ("scene", "world", "body", "simulation", "chain", "sampling", "targets")
 _PARTS = {"dynamics": ("world", "body", "simulation"), "kinematics": ("chain", "sampling"), "ik": ("chain", "targets")}
-_SCENE = ("name", "description", "kind", "reference", "length_unit")
+_SCENE = ("name", "description", "kind", "reference", "length_unit", "suites")
 # Drag coefficients and the power of length in their units (for length_unit scaling).
 DRAG_KEYS = {"linear_drag": 0, "quadratic_drag": -1, "angular_linear_drag": 2, "angular_quadratic_drag": 2}
 _BODY = ("name", "mass", "inertia_body_diagonal", "inertia_body", "position_world", "quat_wxyz",
@@ -534,6 +534,7 @@ def _parse(data: dict, source: str, limits: Limits):
     head = dict(
         name=s.name("name"), description=s.text("description", "-"),
         reference=s.string("reference", choices=ENGINE_NAMES), source=source,
+        suites=s.strings("suites", SUITES, "there is no suite {}") if s.has("suites") else ("default",),
     )
     top.scale = LENGTH_UNITS[unit]
     for key in _TOP[1:]:

@@ -64,7 +64,8 @@ class RunWriter:
             "machine": machine(),
             "engine_versions": engine_versions,
             "scenes": {
-                s.name: {"kind": s.kind, "description": s.description, "reference": s.reference, "source": s.source}
+                s.name: {"kind": s.kind, "description": s.description, "reference": s.reference, "source": s.source,
+                         "suites": list(s.suites)}
                 for s in scenes
             },
         }

@@ -45,6 +45,12 @@ class ResultRow:
         return asdict(self)
 
 
+HARD_VERDICT_SUFFIXES = ("_solved", "_unreachable", "_limit_violation")
+"""A hard IK target ``<name>`` has the row ``hard_<name>`` (position residual [m]) and one row per
+suffix: ``_solved`` 1 or 0, ``_unreachable`` 1 when the solver reported the target unreachable,
+``_limit_violation`` how far the solution lies outside the joint limits [rad or m]."""
+
+
 _PRECEDENCE = (FAILED, DIVERGED, OK, NOT_AVAILABLE)
 
 

@@ -193,6 +193,8 @@ class DynamicsScene:
         The unit the scene file was written in (values here are already in metres).
     source : str
         File the scene came from, or ``"<code>"``.
+    suites : tuple of str
+        The built-in suites (:data:`SUITES`) the scene belongs to.
     """
 
     name: str
@@ -205,6 +207,7 @@ class DynamicsScene:
     integrators: tuple[str, ...] = ()
     length_unit: str = "m"
     source: str = "<code>"
+    suites: tuple[str, ...] = ("default",)
     kind: str = field(default="dynamics", init=False)
 
     def n_steps(self, dt: float) -> int:
@@ -326,6 +329,8 @@ class KinematicsScene:
         Seed of the configuration sampler (uniform within limits, [-pi, pi] or
         [-1, 1] m where unlimited).
     source : str
+    suites : tuple of str
+        The built-in suites (:data:`SUITES`) the scene belongs to.
     """
 
     name: str
@@ -335,6 +340,7 @@ class KinematicsScene:
     n_configurations: int
     seed: int
     source: str = "<code>"
+    suites: tuple[str, ...] = ("default",)
     kind: str = field(default="kinematics", init=False)
 
     def configurations(self) -> np.ndarray:
@@ -342,7 +348,13 @@ class KinematicsScene:
         return sample_configurations(self.chain, self.n_configurations, self.seed)
 
 
-HARD_TARGETS = ("stretched", "beyond_reach", "at_base", "near_limits", "orientation_in_place", "wrist_flip")
+SUITES = ("default", "hard")
+"""Named groups of built-in scenes (``simparity run --suite``): ``default`` is what ``simparity
+run`` runs; ``hard`` gathers the numerical-stability cases, each with the verdict it must earn
+in the shipped tolerances. A scene may be in several."""
+
+HARD_TARGETS = ("stretched", "beyond_reach", "at_base", "near_limits", "beyond_limits", "orientation_in_place",
+                "wrist_flip")
 """Hard IK targets a scene may ask for (see ``comparisons.ik_targets``)."""
 
 
@@ -371,6 +383,8 @@ class IKScene:
     hard_targets : tuple of str
         Names from :data:`HARD_TARGETS`.
     source : str
+    suites : tuple of str
+        The built-in suites (:data:`SUITES`) the scene belongs to.
     """
 
     name: str
@@ -386,6 +400,7 @@ class IKScene:
     max_iterations: int
     hard_targets: tuple[str, ...] = ()
     source: str = "<code>"
+    suites: tuple[str, ...] = ("default",)
     kind: str = field(default="ik", init=False)
 
     def __post_init__(self) -> None:

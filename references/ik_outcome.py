@@ -5,8 +5,10 @@ Every library IK adapter (:mod:`references.pybullet_ik`, :mod:`references.pinocc
 own stopping rule was:
 
 - success: position residual <= ``options.position_tolerance`` [m] AND orientation
-  residual <= ``options.orientation_tolerance`` [rad] (0 for position-only targets);
-- reason of a failure: ``"unreachable"`` when the target is farther from the first joint
+  residual <= ``options.orientation_tolerance`` [rad] (0 for position-only targets) AND
+  every joint within its limits (up to :data:`core.ik.result.LIMIT_TOLERANCE`): a solution
+  outside the limits is no solution for the robot (the TRAC-IK protocol counts the same way);
+- reason of a failure: ``"outside_limits"`` when only the limits fail, else ``"unreachable"`` when the target is farther from the first joint
   than the chain could possibly reach (:func:`reach_bound`, plus the position tolerance), else
   ``"iteration_cap"``: the libraries report no cause (a stop at their own looser
   threshold, a stall and the cap all look alike), and :data:`core.ik.result.REASONS` has
@@ -19,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.core.ik.problem import IKTolerances
-from simparity.core.ik.result import IKResult
+from simparity.core.ik.result import LIMIT_TOLERANCE, IKResult
 from simparity.core.scene import Chain
 
 
@@ -60,11 +62,14 @@ def ik_outcome(chain: Chain, q: np.ndarray, iterations: np.ndarray, position_res
     -------
     IKResult
     """
-    success = ((position_residual <= options.position_tolerance)
+    reached = ((position_residual <= options.position_tolerance)
                & (orientation_residual <= options.orientation_tolerance))
+    violation = np.max(np.maximum(np.maximum(chain.lower - q, q - chain.upper), 0.0), axis=1, initial=0.0)
+    inside = violation <= LIMIT_TOLERANCE
+    success = reached & inside
     center, radius = reach_bound(chain)
     beyond = np.linalg.norm(target_position_world - center, axis=1) > radius + options.position_tolerance
-    reason = np.where(success, "", np.where(beyond, "unreachable", "iteration_cap"))
-    violation = np.max(np.maximum(np.maximum(chain.lower - q, q - chain.upper), 0.0), axis=1, initial=0.0)
+    reason = np.where(success, "", np.where(reached, "outside_limits",
+                                            np.where(beyond, "unreachable", "iteration_cap")))
     return IKResult(q=q, success=success, iterations=iterations, position_residual=position_residual,
                     orientation_residual=orientation_residual, limit_violation=violation, reason=reason)

@@ -6,7 +6,7 @@ import math
 
 import pandas as pd
 
-from simparity.core.results import NOT_AVAILABLE, OK, STATUSES, case_counts
+from simparity.core.results import HARD_VERDICT_SUFFIXES, NOT_AVAILABLE, OK, STATUSES, case_counts, case_status
 
 _DYNAMICS_COLUMNS = [
     ("position_error_max", "position error max [m]"),
@@ -33,7 +33,8 @@ _IK_COLUMNS = [
 _IK_PROTOCOL = (
     "Protocol (TRAC-IK): seeded random reachable targets (end-effector poses of seeded random configurations "
     "within the limits), every solve from the scene's one start pose, success when the residuals are within "
-    "the scene's tolerances, time per solve = batch time / batch size with failed solves included. Each "
+    "the scene's tolerances and the joint values within their limits (an engine's solver that leaves them "
+    "fails with `outside_limits`), time per solve = batch time / batch size with failed solves included. Each "
     "solution is also put through every engine's forward kinematics (worst solve rate and largest "
     "disagreement shown), so no solver passes on its own kinematics alone."
 )
@@ -131,7 +132,7 @@ def _hard_cell(row) -> str:
 
 def _hard_table(rows: pd.DataFrame) -> list[str]:
     """Engine x solver against each hard target: solved or the reason, with the position residual."""
-    hard = rows[rows["metric"].str.startswith("hard_")]
+    hard = rows[rows["metric"].str.startswith("hard_") & ~rows["metric"].str.endswith(HARD_VERDICT_SUFFIXES)]
     if hard.empty:
         return []
     names = list(dict.fromkeys(hard["metric"]))
@@ -144,6 +145,38 @@ def _hard_table(rows: pd.DataFrame) -> list[str]:
     notes = hard[hard["status"] == OK].drop_duplicates("metric")
     lines += [""] + [f"- `{r['metric'].removeprefix('hard_')}`: {r['detail'].split('; ')[-1]}"
                      for _, r in notes.iterrows()]
+    return lines
+
+
+def _dynamics_verdicts(rows: pd.DataFrame) -> list[str]:
+    """Engine x integrator against each time step: the status each case earned."""
+    per_dt = rows[rows["dt"].notna()]
+    dts = sorted(per_dt["dt"].unique())
+    lines = ["| engine | integrator | " + " | ".join(f"dt {dt:g} s" for dt in dts) + " |",
+             "|---|---|" + "---|" * len(dts)]
+    for (engine, integrator), group in per_dt.groupby(["engine", "integrator"], sort=False):
+        status = {dt: case_status(g["status"]) for dt, g in group.groupby("dt")}
+        lines.append(f"| {engine} | {integrator} | " + " | ".join(status.get(dt, "—") for dt in dts) + " |")
+    return lines
+
+
+def _hard_cases(table: pd.DataFrame, info: dict) -> list[str]:
+    """The verdict every engine earned on each scene of the hard suite in the run."""
+    scenes = [name for name, about in info.get("scenes", {}).items() if "hard" in about.get("suites", ())]
+    scenes = [name for name in scenes if (table["scene"] == name).any()]
+    if not scenes:
+        return []
+    lines = ["", "## Hard cases", "",
+             "The numerical-stability cases of the `hard` suite and the verdict each engine earned: a case is "
+             "`diverged` when a conserved quantity or a speed left its bound, `ok` when it stayed bounded (its "
+             "errors are in the scene's section). The verdict each must earn is in the shipped tolerances "
+             "(`simparity check`)."]
+    for name in scenes:
+        rows = table[table["scene"] == name]
+        lines += ["", f"### {name}", ""]
+        description = info["scenes"][name].get("description")
+        lines += [description, ""] if description else []
+        lines += _hard_table(rows)[1:] if _kind(rows) == "ik" else _dynamics_verdicts(rows)
     return lines
 
 
@@ -173,6 +206,7 @@ def render(table: pd.DataFrame, info: dict) -> str:
         "",
         _DEFINITIONS,
     ]
+    lines += _hard_cases(table, info)
     for scene, rows in table.groupby("scene", sort=False):
         kind = _kind(rows)
         reference = rows["reference"].iloc[0]

@@ -9,6 +9,7 @@ import os
 
 import pybullet_data
 
+from simparity.core.ik.result import LIMIT_TOLERANCE
 from simparity.comparisons.engines import make_engine
 from simparity.comparisons.library import builtin_paths
 from simparity.comparisons.scene_loader import load_scene
@@ -127,3 +128,12 @@ def hand_wrench_forces() -> Forces:
     return Forces(np.array(h["gravity"]), np.array(h["wind"]), np.array([h["linear_drag"]]),
                   np.array([h["quadratic_drag"]]), np.array([h["angular_linear_drag"]]),
                   np.array([h["angular_quadratic_drag"]]), (AppliedForce(0, h["force"], h["point_body"]),))
+
+
+def reached_rate(result) -> float:
+    """Share of targets reached within both tolerances, inside the joint limits or not: how well an
+    engine's solver (which ignores limits by design) converges. ``solve_rate`` counts only the
+    solutions inside the limits; the others fail as ``outside_limits``, each truly outside."""
+    outside = result.reason == "outside_limits"
+    assert np.all(result.limit_violation[outside] > LIMIT_TOLERANCE)
+    return float(np.mean(result.success | outside))

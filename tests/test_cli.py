@@ -1,6 +1,7 @@
 """The simparity command: list, run, export, report, and clean errors for user mistakes."""
 
 import io
+import re
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -29,15 +30,26 @@ def test_list_names_every_builtin_scene():
     assert [line.split()[0] for line in lines] == sorted(builtin_paths())
 
 
-def test_run_without_scenes_runs_the_whole_builtin_suite(tmp_path, monkeypatch):
-    """No scene argument means every built-in scene, each once, on the default engines."""
+@pytest.mark.parametrize("suite", [None, "default", "hard"])
+def test_run_without_scenes_runs_a_whole_builtin_suite(tmp_path, monkeypatch, suite):
+    """No scene argument means every built-in scene of the suite (default: "default"), each once, on
+    the default engines; a scene file lists its suites."""
     seen = []
     monkeypatch.setattr("simparity.comparisons.parallel.run_scene", lambda scene, engines, *a, **k: seen.append(
         (scene.name, tuple(e.name for e in engines))) or [])
-    code, _ = _run(["run", "--out", str(tmp_path), "--jobs", "1"])
+    code, _ = _run(["run", "--out", str(tmp_path), "--jobs", "1"] + (["--suite", suite] if suite else []))
     assert code == EXIT_OK
-    assert [name for name, _ in seen] == sorted(builtin_paths())
+    wanted = suite or "default"
+    in_suite = [name for name, path in builtin_paths().items()
+                if re.search(rf'^suites = \[.*"{wanted}"', path.read_text(encoding="utf-8"), re.M)
+                or (wanted == "default" and "\nsuites = " not in path.read_text(encoding="utf-8"))]
+    assert [name for name, _ in seen] == sorted(in_suite) and len(in_suite) >= 8
     assert all(engines == DEFAULT_ENGINES for _, engines in seen)
+
+
+def test_scenes_and_a_suite_together_are_refused(tmp_path, capsys):
+    assert main(["run", "wind", "--suite", "hard", "--out", str(tmp_path / "o")]) == EXIT_USAGE
+    assert "give one" in capsys.readouterr().err
 
 
 def test_lecture_scenes_end_to_end(tmp_path):

@@ -28,10 +28,12 @@ ROBOTS = {  # name -> (file, base link, tip link)
 }
 DOUBLE_TOL = 1e-12  # [m], [rad]: double-precision FK of a ~1 m arm agrees to ~1e-15
 FLOAT32_TOL = 1e-6  # [m], [rad]: PyBullet's getLinkState is float32 (measured 1e-7 m, 6e-7 rad)
-CONVENTION_FLOOR = 0.5
-"""Lowest solve rate accepted from the solvers below on 30 reachable pose targets. A convention
-error (a wrong frame, quaternion order or base pose) fails every target; measured 0.77-0.97 on
-100 targets (the misses are the solvers' own, from one mid-range start)."""
+REACHED_TOL = 1e-6 + FLOAT32_TOL
+"""[m] Largest median position residual accepted from the solvers below on 30 reachable pose
+targets: the scene's 1e-6 m plus PyBullet's float32 resolution. A convention error (a wrong frame,
+quaternion order or base pose) misses every target; measured: 77-97 % of 100 targets reached (the
+misses are the solvers' own, from one mid-range start; the engines' solvers ignore joint limits,
+so some reached targets count as failed, outside_limits)."""
 SOLVERS = {"core": "damped_least_squares", "mujoco": "dls", "pybullet": "calculateInverseKinematics-tuned",
            "pinocchio": "clik"}
 
@@ -63,15 +65,18 @@ def test_kinematics_is_ok_in_every_engine(robot, tmp_path):
 
 @pytest.mark.parametrize("robot", sorted(ROBOTS))
 def test_ik_is_ok_in_every_engine(robot, tmp_path):
-    """Every engine's solvers give ok rows; the tuned ones solve most targets, judged by every engine's FK."""
+    """Every engine's solvers give ok rows; the tuned ones reach most targets, and every engine's FK puts
+    their solutions at the same place."""
     scene = _scene(tmp_path, robot, "ik", '[targets]\ncount = 30\nseed = 5\nstart = "mid-range"\n')
     rows = _rows(scene)
     for engine in ENGINES:
         statuses = {r.status for r in rows if r.engine == engine}
         assert OK in statuses and statuses <= {OK, NOT_AVAILABLE}, (engine, statuses)
-    rate = {(r.engine, r.integrator): r.value for r in rows if r.metric == "cross_eval_solve_rate_min"}
+    median = {(r.engine, r.integrator): r.value for r in rows if r.metric == "position_residual_median"}
+    spread = {(r.engine, r.integrator): r.value for r in rows if r.metric == "cross_eval_disagreement_max"}
     for engine, solver in SOLVERS.items():
-        assert rate[(engine, solver)] >= CONVENTION_FLOOR, (engine, solver, rate[(engine, solver)])
+        assert median[(engine, solver)] <= REACHED_TOL, (engine, solver, median[(engine, solver)])
+        assert spread[(engine, solver)] <= 2 * FLOAT32_TOL, (engine, solver, spread[(engine, solver)])
 
 
 def test_pybullet_ik_targets_the_link_frame_of_a_tip_with_products_of_inertia(tmp_path):
@@ -83,6 +88,6 @@ def test_pybullet_ik_targets_the_link_frame_of_a_tip_with_products_of_inertia(tm
                     'tip_link = "panda_link7"\n\n[targets]\ncount = 30\nseed = 2\nstart = "mid-range"\n')
     rows = run_scene(load_scene(file), [make_engine("pybullet")], make_engine, repeats=1)
     by_metric = {r.metric: r for r in rows if r.integrator == "calculateInverseKinematics-tuned"}
-    assert by_metric["solve_rate"].value >= CONVENTION_FLOOR
+    assert by_metric["position_residual_median"].value <= REACHED_TOL
     assert np.isfinite(by_metric["orientation_residual_median"].value)
     assert by_metric["orientation_residual_median"].value <= 1e-6

@@ -8,8 +8,15 @@ import numpy as np
 
 from simparity.core.arrays import readonly
 
-REASONS = ("", "unreachable", "singular", "limit_blocked", "iteration_cap")
-"""Failure vocabulary: ``""`` for a success, otherwise why the target was not reached."""
+REASONS = ("", "unreachable", "singular", "limit_blocked", "iteration_cap", "outside_limits")
+"""Failure vocabulary: ``""`` for a success, otherwise why the target was not reached.
+``"outside_limits"``: the residuals are within their tolerances but the joint values are not
+within their limits (an engine's solver that ignores limits): not a solution for the robot."""
+
+LIMIT_TOLERANCE = 1e-6
+"""[rad or m] A joint value this close outside its limit still counts as inside: PyBullet returns
+float32 joint values (resolution 2.4e-7 rad at pi), and URDF limits are often written to 4-6
+significant digits. Far below any limit violation that matters to a robot."""
 
 
 @dataclass(frozen=True)
@@ -23,7 +30,8 @@ class IKResult:
         not reached. The in-house solvers keep it inside the joint limits; an engine's
         solver may not, and ``limit_violation`` says by how much.
     success : (B,) bool ndarray
-        Both residuals within their tolerances.
+        Both residuals within their tolerances and every joint within its limits (up to
+        :data:`LIMIT_TOLERANCE`).
     iterations : (B,) int ndarray
         Joint updates applied to each target.
     position_residual : (B,) ndarray

@@ -1,0 +1,92 @@
+"""The built-in library and its suites (comparisons/library.py), and the hard suite's verdicts."""
+
+import dataclasses
+import fnmatch
+import math
+
+import pandas as pd
+import pytest
+
+from simparity.comparisons import library
+from simparity.comparisons.check import check_table
+from simparity.comparisons.engines import make_engine
+from simparity.comparisons.profiles import quick
+from simparity.comparisons.runner import run_scene
+from simparity.comparisons.tolerances import load_tolerances
+from simparity.core.errors import SceneError, SimparityError
+from simparity.core.results import COLUMNS, DIVERGED, OK, ResultRow
+from simparity.core.scene import DynamicsScene, IKScene
+from tests.helpers import builtin
+
+MIN_HARD_CASES = 20
+"""Issue #8: the hard suite gathers at least 20 cases (a dynamics scene, or one hard IK target)."""
+
+
+def _table(rows):
+    return pd.DataFrame([r.as_dict() for r in rows], columns=list(COLUMNS))
+
+
+def test_default_suite_is_every_scene_marked_default_and_hard_is_its_own():
+    default = {s.name for s in library.suite("default")}
+    hard = {s.name for s in library.suite("hard")}
+    assert "lecture-projectile" in default and "lecture-projectile" not in hard
+    assert "hard-stiff-drag" in hard and "hard-stiff-drag" not in default
+    assert "fast-spinner" in default & hard
+    assert default | hard == set(library.builtin_paths())
+
+
+def test_an_unknown_suite_is_refused_with_the_allowed_names():
+    with pytest.raises(SimparityError, match=r"allowed: default, hard"):
+        library.suite("nightly")
+
+
+def test_a_scene_file_naming_an_unknown_suite_is_refused(tmp_path):
+    path = tmp_path / "s.toml"
+    text = library.builtin_paths()["wind"].read_text(encoding="utf-8")
+    path.write_text(text.replace('reference = "analytic"', 'reference = "analytic"\nsuites = ["nightly"]'),
+                    encoding="utf-8")
+    with pytest.raises(SceneError, match=r"scene\.suites\[0\].*allowed: .*default, hard"):
+        library.load([str(path)])
+
+
+def test_the_hard_suite_has_enough_cases_and_each_has_its_own_expected_verdict():
+    bounds = load_tolerances()
+    scenes = library.suite("hard")
+    cases = [s.name for s in scenes if isinstance(s, DynamicsScene)]
+    cases += [f"{s.name}/{t}" for s in scenes if isinstance(s, IKScene) for t in s.hard_targets]
+    assert len(cases) >= MIN_HARD_CASES, cases
+    for scene in scenes:  # a bound written for this scene or for the hard scenes (not a catch-all)
+        named = [b for b in bounds if b.scene not in ("*", "*-ik") and fnmatch.fnmatchcase(scene.name, b.scene)]
+        assert named, f"{scene.name} has no expected verdict of its own in the shipped tolerances"
+
+
+def test_stiff_drag_verdicts_follow_linear_stability_theory():
+    """h c/m = 2.5: Euler (|1 + z| = 1.5) and the second-order rules (1.625) diverge, RK4 (0.648) and
+    MuJoCo's implicit damping stay bounded; the shipped tolerances hold exactly that."""
+    scene = quick(builtin("hard-stiff-drag"))
+    scene = dataclasses.replace(scene, integrators=("explicit_euler", "midpoint", "rk4", "implicit", "euler"))
+    rows = run_scene(scene, [make_engine("core"), make_engine("mujoco")], make_engine, repeats=0)
+    table = _table(rows)
+    coarse = table[(table["dt"] - 0.05).abs() < 1e-12]
+    status = coarse.groupby(["engine", "integrator"])["status"].agg(set)
+    assert status[("core", "explicit_euler")] == {DIVERGED}
+    assert status[("core", "midpoint")] == {DIVERGED}
+    assert status[("mujoco", "euler")] == {DIVERGED}
+    assert DIVERGED not in status[("core", "rk4")] | status[("mujoco", "rk4")] | status[("mujoco", "implicit")]
+    result = check_table(table, load_tolerances())
+    assert result.passed, [v.line() for v in result.violations][:5]
+
+
+@pytest.mark.parametrize("scene, engine, integrator, dt", [
+    ("hard-stiff-drag", "core", "explicit_euler", 0.05), ("hard-needle", "mujoco", "euler", 0.001),
+    ("hard-needle", "pybullet", "euler", 0.005)])
+def test_a_blow_up_reported_as_bounded_fails_the_hard_gate(scene, engine, integrator, dt):
+    """The gate checks stability: a case theory says must blow up fails the check when it stays ok."""
+    row = ResultRow(scene, engine, integrator, dt, "energy_drift_max", 1e-3, "1", "analytic:exact", OK)
+    result = check_table(_table([row]), load_tolerances())
+    assert not result.passed and "diverged" in result.violations[0].line()
+
+
+def test_a_limit_blocked_target_claimed_solved_fails_the_hard_gate():
+    row = ResultRow("hard-planar-ik", "mujoco", "dls", math.nan, "hard_beyond_limits_solved", 1.0, "1", "analytic:fk", OK)
+    assert not check_table(_table([row]), load_tolerances()).passed
