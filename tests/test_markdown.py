@@ -42,3 +42,22 @@ def test_status_cell_names_the_metric_a_status_is_about():
     assert "| ok · n/a (orientation_error_max): saturated: orientation error 3 rad |" in text
     assert "`n/a` not measured" in text and "saturated" in text.split("## s")[0]  # the definition covers it
     assert "| n/a: no such integrator |" in render(_rows(), {})
+
+
+def test_hard_cases_section_lists_the_verdict_of_every_case_of_a_hard_scene():
+    """A scene of the hard suite gets a line per engine x integrator with each time step's case status;
+    a scene outside the suite is not listed there."""
+    rows = []
+    for scene in ("stiff", "plain"):
+        for engine, integrator, dt, status in [("core", "explicit_euler", 0.01, "ok"), ("core", "explicit_euler", 0.05, "diverged"),
+                                               ("mujoco", "rk4", 0.01, "ok"), ("mujoco", "rk4", 0.05, "ok")]:
+            value = 1e-3 if status == "ok" else math.nan
+            rows.append(ResultRow(scene, engine, integrator, dt, "position_error_max", value, "m", "analytic:exact", status))
+    table = pd.DataFrame([r.as_dict() for r in rows])
+    info = {"scenes": {"stiff": {"suites": ["hard"], "description": "stiff drag"}, "plain": {"suites": ["default"]}}}
+    text = render(table, info)
+    section = text.split("## Hard cases", 1)[1].split("\n## ", 1)[0]
+    assert "### stiff" in section and "### plain" not in section
+    assert "| core | explicit_euler | ok | diverged |" in section
+    assert "| mujoco | rk4 | ok | ok |" in section
+    assert "## Hard cases" not in render(table, {"scenes": {"stiff": {"suites": ["default"]}}})
