@@ -230,3 +230,12 @@ def test_a_broken_history_database_never_loses_a_run(tmp_path, capsys, monkeypat
 def test_export_refuses_a_time_step_that_is_not_one(capsys, dt):
     assert main(["export", "lecture-projectile", "--engine", "mujoco", "--dt", dt]) == EXIT_USAGE
     assert "(allowed: a finite number of seconds > 0" in capsys.readouterr().err
+
+
+def test_a_reader_that_stops_early_gets_no_traceback():
+    """`simparity list | head -1`: the closed pipe ends the command quietly with exit 0."""
+    process = subprocess.Popen([sys.executable, "-m", "simparity.comparisons.cli", "list"], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    process.stdout.close()  # the reader is gone before the first line is written
+    _, err = process.communicate(timeout=120)
+    assert process.returncode == EXIT_OK and "Traceback" not in err, err
