@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
 import pandas as pd
 
 from simparity.comparisons.tolerances import Bound, bound_for
@@ -29,6 +30,12 @@ BASELINE_RELATIVE = 1e-6
 shows even when it stays inside its bound."""
 
 
+def row_label(scene: str, engine: str, integrator: str, dt: float, metric: str) -> str:
+    """One row named for a message: ``scene engine integrator [dt=...] metric`` (``-`` for no integrator)."""
+    at = "" if math.isnan(dt) else f" dt={dt:g}"
+    return f"{scene} {engine} {integrator or '-'}{at} {metric}"
+
+
 @dataclass(frozen=True)
 class Violation:
     """One row outside its bound."""
@@ -43,8 +50,7 @@ class Violation:
     reason: str
 
     def line(self) -> str:
-        dt = "" if math.isnan(self.dt) else f" dt={self.dt:g}"
-        return (f"{self.scene} {self.engine} {self.integrator or '-'}{dt} {self.metric}: {self.found}, "
+        return (f"{row_label(self.scene, self.engine, self.integrator, self.dt, self.metric)}: {self.found}, "
                 f"bound {self.bound} ({self.reason})")
 
 
@@ -116,17 +122,21 @@ class BaselineDiff:
         return bool(self.moved or self.missing)
 
 
-def _label(row) -> str:
-    dt = "" if pd.isna(row["dt"]) else f" dt={float(row['dt']):g}"
-    return f"{row['scene']} {row['engine']} {row['integrator'] or '-'}{dt} {row['metric']}"
+_INDEX = ("scene", "engine", "integrator", "dt_key", "metric")
 
 
 def _keyed(table: pd.DataFrame) -> pd.DataFrame:
+    """The table indexed by row (dt as its exact repr, so 0.1 and 0.1000000001 stay apart)."""
     keyed = table.copy()
     keyed["dt_key"] = keyed["dt"].map(lambda d: "nan" if pd.isna(d) else repr(float(d)))
     keyed["integrator"] = keyed["integrator"].fillna("")
-    keyed = keyed.drop_duplicates(["scene", "engine", "integrator", "dt_key", "metric"], keep="last")
-    return keyed.set_index(["scene", "engine", "integrator", "dt_key", "metric"])
+    keyed = keyed.drop_duplicates(list(_INDEX), keep="last")
+    return keyed.set_index(list(_INDEX))
+
+
+def _key_label(key: tuple) -> str:
+    scene, engine, integrator, dt_key, metric = key
+    return row_label(scene, engine, integrator, float(dt_key), metric)
 
 
 def compare_with_baseline(table: pd.DataFrame, baseline: pd.DataFrame,
@@ -134,22 +144,19 @@ def compare_with_baseline(table: pd.DataFrame, baseline: pd.DataFrame,
     """Rows whose status changed or whose value moved by more than ``relative`` (of the baseline's
     magnitude) since ``baseline``; rows only one run has; timing changes apart."""
     now, before = _keyed(table), _keyed(baseline)
-    diff = BaselineDiff()
-    for key in before.index.difference(now.index):
-        diff.missing.append(_label(before.loc[key].to_dict() | dict(zip(before.index.names, key))))
-    for key in now.index.difference(before.index):
-        diff.new.append(_label(now.loc[key].to_dict() | dict(zip(now.index.names, key))))
-    for key in now.index.intersection(before.index):
-        a, b = now.loc[key], before.loc[key]
-        label = _label(a.to_dict() | dict(zip(now.index.names, key)))
-        timing = key[-1].startswith(TIMING_PREFIX)
-        if a["status"] != b["status"]:
-            (diff.timing if timing else diff.moved).append(f"{label}: status {b['status']} -> {a['status']}")
-            continue
-        x, y = float(a["value"]), float(b["value"])
-        if math.isnan(x) and math.isnan(y):
-            continue
-        change = abs(x - y) / abs(y) if y != 0 else (0.0 if x == 0 else math.inf)
-        if not change <= relative:
-            (diff.timing if timing else diff.moved).append(f"{label}: {y:.6g} -> {x:.6g} ({change:.2g} relative)")
+    diff = BaselineDiff(missing=[_key_label(k) for k in before.index.difference(now.index)],
+                        new=[_key_label(k) for k in now.index.difference(before.index)])
+    common = now.index.intersection(before.index)
+    a, b = now.loc[common], before.loc[common]
+    x, y = a["value"].to_numpy(dtype=float), b["value"].to_numpy(dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        change = np.where(y != 0, np.abs(x - y) / np.abs(y), np.where(x == 0, 0.0, np.inf))
+    status_now, status_before = a["status"].to_numpy(), b["status"].to_numpy()
+    retagged = status_now != status_before
+    moved = ~retagged & ~(np.isnan(x) & np.isnan(y)) & ~(change <= relative)
+    for i in np.flatnonzero(retagged | moved):
+        key = common[i]
+        text = (f"status {status_before[i]} -> {status_now[i]}" if retagged[i]
+                else f"{y[i]:.6g} -> {x[i]:.6g} ({change[i]:.2g} relative)")
+        (diff.timing if key[-1].startswith(TIMING_PREFIX) else diff.moved).append(f"{_key_label(key)}: {text}")
     return diff

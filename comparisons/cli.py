@@ -21,7 +21,7 @@ from simparity.comparisons.check_output import junit_xml, summary_markdown
 from simparity.comparisons.engines import DEFAULT_ENGINES, ENGINE_NAMES, check_engine_names, make_engine
 from simparity.comparisons.history import history_path, latest_before, metric_history, record_run, run_table
 from simparity.comparisons.parallel import default_jobs, run_scenes
-from simparity.comparisons.profiles import PROFILES, apply_profile
+from simparity.comparisons.profiles import apply_profile
 from simparity.comparisons.runner import DEFAULT_REPEATS
 from simparity.comparisons.scene_limits import DEFAULT_LIMITS, Limits
 from simparity.comparisons.store import DEFAULT_OUT_ROOT, RunWriter, default_out_dir

@@ -87,28 +87,25 @@ def record_run(path: Path, run_dir: Path, info: dict, table: pd.DataFrame) -> in
         connection.close()
 
 
-def runs(path: Path) -> pd.DataFrame:
-    """The recorded runs, oldest first: id, run_dir, created_utc, git_commit, command."""
+def _query(path: Path, sql: str, params=()) -> pd.DataFrame:
+    """The result of one read-only query of an existing history database (HistoryError if unreadable)."""
     connection = _connect(path, create=False)
     try:
-        return pd.read_sql_query("SELECT id, run_dir, created_utc, git_commit, command FROM runs ORDER BY id",
-                                 connection)
+        return pd.read_sql_query(sql, connection, params=params)
     except (sqlite3.Error, pd.errors.DatabaseError) as err:
         raise HistoryError(f"{path}: unreadable run history: {err} (allowed: an SQLite file simparity wrote)") from None
     finally:
         connection.close()
+
+
+def runs(path: Path) -> pd.DataFrame:
+    """The recorded runs, oldest first: id, run_dir, created_utc, git_commit, command."""
+    return _query(path, "SELECT id, run_dir, created_utc, git_commit, command FROM runs ORDER BY id")
 
 
 def run_table(path: Path, run_id: int) -> pd.DataFrame:
     """The rows of one recorded run, in the columns of ``results.csv``."""
-    connection = _connect(path, create=False)
-    try:
-        table = pd.read_sql_query(f"SELECT {', '.join(COLUMNS)} FROM results WHERE run_id = ?", connection,
-                                  params=(run_id,))
-    except (sqlite3.Error, pd.errors.DatabaseError) as err:
-        raise HistoryError(f"{path}: unreadable run history: {err} (allowed: an SQLite file simparity wrote)") from None
-    finally:
-        connection.close()
+    table = _query(path, f"SELECT {', '.join(COLUMNS)} FROM results WHERE run_id = ?", (run_id,))
     table["integrator"] = table["integrator"].fillna("")
     table["detail"] = table["detail"].fillna("")
     return table.astype({"dt": float, "value": float})
@@ -128,7 +125,6 @@ def latest_before(path: Path, run_dir: Path | None = None) -> tuple[int, str]:
 def metric_history(path: Path, scene: str | None = None, engine: str | None = None,
                    metric: str | None = None) -> pd.DataFrame:
     """One row per scene x engine x integrator x dt x metric, one column per run (``#id created``)."""
-    connection = _connect(path, create=False)
     where, params = [], []
     for column, value in (("scene", scene), ("engine", engine), ("metric", metric)):
         if value is not None:
@@ -137,12 +133,7 @@ def metric_history(path: Path, scene: str | None = None, engine: str | None = No
     query = ("SELECT runs.id AS run, runs.created_utc AS created, r.scene, r.engine, r.integrator, r.dt, "
              "r.metric, r.value, r.status FROM results r JOIN runs ON runs.id = r.run_id"
              + (" WHERE " + " AND ".join(where) if where else "") + " ORDER BY runs.id")
-    try:
-        long = pd.read_sql_query(query, connection, params=params)
-    except (sqlite3.Error, pd.errors.DatabaseError) as err:
-        raise HistoryError(f"{path}: unreadable run history: {err} (allowed: an SQLite file simparity wrote)") from None
-    finally:
-        connection.close()
+    long = _query(path, query, params)
     if long.empty:
         return long
     long["run"] = "#" + long["run"].astype(str) + " " + long["created"]

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import math
 import os
-import re
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -19,7 +17,7 @@ from simparity.comparisons.engines import ENGINE_NAMES, known_integrators
 from simparity.comparisons.scene_limits import DEFAULT_LIMITS, POSITION_TOLERANCE_OF_REACH, Limits, allowed_at_most
 from simparity.core.dh import chain_from_dh
 from simparity.core.errors import SceneError, echo, one_line
-from simparity.core.files import file_problem, read_input
+from simparity.core.files import file_problem, read_toml
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.inertia import inertia_problem
 from simparity.core.names import NAME_RULE, TEXT_RULE, name_problem, text_problem
@@ -27,11 +25,6 @@ from simparity.core.ranges import NORM_RANGES, RANGES, safe_norm
 from simparity.core.rotations import rpy_to_matrix
 from simparity.core.scene import HARD_TARGETS, SUITES, AppliedForce, Chain, DynamicsScene, Forces, IKScene, Joint, KinematicsScene, RigidBody
 from simparity.core.urdf import chain_from_urdf
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
 
 LENGTH_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "ft": 0.3048, "in": 0.0254}
 """Units a scene may declare for lengths, and their size in metres."""
@@ -137,8 +130,8 @@ class _Reader:
         if nonzero and not np.any(out):
             raise self.fail(key, "is all zeros", "a vector with a non-zero entry")
         norm_range = NORM_RANGES.get(key)
-        if norm_range is not None and not norm_range.allows(safe_norm(out)):
-            raise self.fail(key, f"its norm {safe_norm(out):.3g} is outside the usable range", norm_range.text())
+        if norm_range is not None and not norm_range.allows(norm := safe_norm(out)):
+            raise self.fail(key, f"its norm {norm:.3g} is outside the usable range", norm_range.text())
         for i, v in enumerate(out):
             self._in_range(f"{key}[{i}]", v)
         return out
@@ -455,8 +448,7 @@ def _start(t: _Reader, chain: Chain) -> np.ndarray:
         q = t.vector("start", chain.n_joints) * np.where(prismatic, t.scale, 1.0)  # lengths in the scene's unit
     elif value in ("zeros", "mid-range"):
         limited = np.isfinite(chain.lower) & np.isfinite(chain.upper)  # continuous joints: 0, no inf - inf
-        middle = np.where(limited, 0.5 * np.where(limited, chain.lower, 0.0) + 0.5 * np.where(limited, chain.upper, 0.0),
-                          0.0)
+        middle = 0.5 * np.where(limited, chain.lower, 0.0) + 0.5 * np.where(limited, chain.upper, 0.0)
         q = np.zeros(chain.n_joints) if value == "zeros" else middle
     else:
         raise t.fail("start", f"{echo(value)} is not allowed", allowed)
@@ -548,36 +540,7 @@ def _parse(data: dict, source: str, limits: Limits):
     return scene
 
 
-_TOML_POSITION = re.compile(r"\(at line (\d+), column (\d+)\)")
-MAX_NESTING_HINT = "TOML nested at most a few hundred levels deep"
-_BOMS = {b"\xef\xbb\xbf": "UTF-8", b"\xff\xfe": "UTF-16", b"\xfe\xff": "UTF-16"}
-
-
-def _decode(path: str, data: bytes) -> str:
-    for bom, codec in _BOMS.items():
-        if data.startswith(bom):
-            raise SceneError(path, "line 1, column 1", f"the file starts with a {codec} byte-order mark (BOM)",
-                             "UTF-8 without a BOM (save it as plain UTF-8)")
-    try:
-        return data.decode("utf-8")
-    except UnicodeDecodeError as err:
-        line = data[: err.start].count(b"\n") + 1
-        column = err.start - (data.rfind(b"\n", 0, err.start) + 1) + 1
-        raise SceneError(path, f"line {line}, column {column}", f"not UTF-8 text: byte {data[err.start]:#04x} "
-                         f"({err.reason})", "UTF-8 text") from None
-
-
 def load_scene(path: str | Path, limits: Limits = DEFAULT_LIMITS):
     """Read and check one scene file (a regular file of at most ``limits.max_file_bytes``)."""
     source = str(path)
-    text = _decode(source, read_input(source, limits.max_file_bytes, "scene file"))
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        where = _TOML_POSITION.search(str(err))
-        key = f"line {where.group(1)}, column {where.group(2)}" if where else "-"
-        problem = _TOML_POSITION.sub("", str(err)).strip()
-        raise SceneError(source, key, f"not valid TOML: {problem}", "TOML (https://toml.io)") from None
-    except RecursionError:
-        raise SceneError(source, "-", "arrays or tables nested too deeply", MAX_NESTING_HINT) from None
-    return parse_scene(data, source, limits)
+    return parse_scene(read_toml(source, limits.max_file_bytes, "scene file"), source, limits)

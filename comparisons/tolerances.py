@@ -28,17 +28,13 @@ from __future__ import annotations
 
 import fnmatch
 import math
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from simparity.core.errors import ToleranceError
+from simparity.core.errors import SceneError, ToleranceError
+from simparity.core.files import read_toml
 from simparity.core.results import OK, STATUSES
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover - exercised on Python 3.10 only
-    import tomli as tomllib
 
 DEFAULT_TOLERANCES = Path(__file__).resolve().parent / "tolerances" / "default.toml"
 """The shipped tolerances: every built-in scene, each bound with its reason."""
@@ -124,9 +120,7 @@ class Bound:
     def describe(self, dt: float) -> str:
         """The bound in words, e.g. ``<= 1e-06`` or ``4 +- 0.3``."""
         low, high = self.limits(dt)
-        if self.expected is not None:
-            return f"in [{low:.3g}, {high:.3g}]"
-        if self.max is not None and self.min is not None:
+        if self.expected is not None or (self.max is not None and self.min is not None):
             return f"in [{low:.3g}, {high:.3g}]"
         return f"<= {high:.3g}" if self.max is not None else f">= {low:.3g}"
 
@@ -186,13 +180,9 @@ def load_tolerances(path: str | Path = DEFAULT_TOLERANCES) -> list[Bound]:
     """The bounds of a tolerances file; raises :class:`ToleranceError` naming the file and key."""
     source = str(path)
     try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ToleranceError(source, "-", "no such file", "a tolerances TOML file") from None
-    except (OSError, UnicodeDecodeError) as err:
-        raise ToleranceError(source, "-", f"unreadable: {type(err).__name__}", "a UTF-8 TOML file") from None
-    except tomllib.TOMLDecodeError as err:
-        raise ToleranceError(source, "-", f"not valid TOML: {err}", "TOML") from None
+        data = read_toml(source, what="tolerances file")
+    except SceneError as err:  # the file itself: missing, not a regular file, too large, not TOML
+        raise ToleranceError(err.source, err.key, err.problem, err.allowed) from None
     unknown = sorted(set(data) - {"bound"})
     if unknown:
         raise ToleranceError(source, unknown[0][:80], "unknown table", "[[bound]]")

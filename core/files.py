@@ -1,4 +1,5 @@
-"""Reading input files safely: regular files only, of bounded size, every OS error a SceneError.
+"""Reading input files safely: regular files only, of bounded size, every OS error a SceneError;
+TOML files (scenes, tolerances) decoded with the line and column of a mistake.
 
 A folder, a FIFO or a device (``/dev/zero``) is never opened: opening a FIFO blocks forever and a
 device can be endless. Paths the OS rejects (a component longer than it allows, a NUL byte) are
@@ -8,9 +9,16 @@ reported like a missing file, never as a traceback.
 from __future__ import annotations
 
 import os
+import re
 import stat
+import sys
 
 from simparity.core.errors import SceneError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - exercised on Python 3.10 only
+    import tomli as tomllib
 
 MAX_FILE_BYTES = 10_000_000
 """Default largest scene or URDF file read [bytes]: the largest real robot descriptions are ~1 MB
@@ -58,3 +66,38 @@ def read_input(path: str | os.PathLike, max_bytes: int = MAX_FILE_BYTES, what: s
 def is_regular_file(path: str | os.PathLike) -> bool:
     """True for an existing regular file; False for anything else, including a path the OS rejects."""
     return file_problem(path) is None
+
+
+_TOML_POSITION = re.compile(r"\(at line (\d+), column (\d+)\)")
+MAX_NESTING_HINT = "TOML nested at most a few hundred levels deep"
+_BOMS = {b"\xef\xbb\xbf": "UTF-8", b"\xff\xfe": "UTF-16", b"\xfe\xff": "UTF-16"}
+
+
+def _decode(path: str, data: bytes) -> str:
+    for bom, codec in _BOMS.items():
+        if data.startswith(bom):
+            raise SceneError(path, "line 1, column 1", f"the file starts with a {codec} byte-order mark (BOM)",
+                             "UTF-8 without a BOM (save it as plain UTF-8)")
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = data[: err.start].count(b"\n") + 1
+        column = err.start - (data.rfind(b"\n", 0, err.start) + 1) + 1
+        raise SceneError(path, f"line {line}, column {column}", f"not UTF-8 text: byte {data[err.start]:#04x} "
+                         f"({err.reason})", "UTF-8 text") from None
+
+
+def read_toml(path: str | os.PathLike, max_bytes: int = MAX_FILE_BYTES, what: str = "file") -> dict:
+    """The parsed TOML of ``path`` (read by :func:`read_input`); SceneError with the line and column
+    of a syntax or encoding mistake, a BOM named as such, and too deep a nesting refused."""
+    source = os.fspath(path)
+    text = _decode(source, read_input(source, max_bytes, what))
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        where = _TOML_POSITION.search(str(err))
+        key = f"line {where.group(1)}, column {where.group(2)}" if where else "-"
+        problem = _TOML_POSITION.sub("", str(err)).strip()
+        raise SceneError(source, key, f"not valid TOML: {problem}", "TOML (https://toml.io)") from None
+    except RecursionError:
+        raise SceneError(source, "-", "arrays or tables nested too deeply", MAX_NESTING_HINT) from None

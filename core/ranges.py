@@ -84,10 +84,3 @@ def safe_norm(vector) -> float:
         return largest
     return largest * math.sqrt(sum((v / largest) ** 2 for v in values))
 
-
-def range_problem(key: str, value: float) -> str | None:
-    """What is wrong with ``value`` [SI] for a key named ``key`` (:data:`RANGES`), or None."""
-    allowed = RANGES.get(key)
-    if allowed is None or allowed.allows(abs(value)):
-        return None
-    return f"{value:.6g} is outside the physical range"

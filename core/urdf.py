@@ -241,11 +241,17 @@ def _parent_joints(joints: list[dict], source: str) -> dict[str, dict]:
     return parent_joint
 
 
-def _check_tree(root_link: str, links: list[str], joints: list[dict], source: str) -> None:
-    """Every link hangs below the root: a link outside its subtree is on a closed loop."""
+def _children(joints: list[dict]) -> dict[str, list[str]]:
+    """Parent link -> its child links."""
     children: dict[str, list[str]] = {}
     for joint in joints:
         children.setdefault(joint["parent"], []).append(joint["child"])
+    return children
+
+
+def _check_tree(root_link: str, links: list[str], joints: list[dict], source: str) -> None:
+    """Every link hangs below the root: a link outside its subtree is on a closed loop."""
+    children = _children(joints)
     reached, stack = {root_link}, [root_link]
     while stack:
         for child in children.get(stack.pop(), []):
@@ -275,9 +281,7 @@ def _pick_tip(tip_link: str | None, base: str, links: list[str], joints: list[di
         if tip_link not in set(links):
             raise SceneError(source, "tip_link", f"no link named {tip_link!r}", ", ".join(links))
         return tip_link
-    children: dict[str, list[str]] = {}
-    for joint in joints:
-        children.setdefault(joint["parent"], []).append(joint["child"])
+    children = _children(joints)
     leaves, stack = [], [base]
     while stack:  # a tree (checked by _check_tree): every link is visited once
         link = stack.pop()

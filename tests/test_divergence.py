@@ -3,7 +3,6 @@
 import math
 
 import numpy as np
-import pytest
 
 from simparity.comparisons.divergence import AT_REST, DIVERGENCE_MARGIN, divergence
 from simparity.comparisons.engines import make_engine

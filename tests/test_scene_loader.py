@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.library import builtin_paths
-from simparity.comparisons.scene_loader import LENGTH_UNITS, load_scene, parse_scene, tomllib
+from simparity.comparisons.scene_loader import LENGTH_UNITS, load_scene, parse_scene
+from simparity.core.files import tomllib
 from simparity.core.errors import SceneError
 
 VALID_DYNAMICS = """

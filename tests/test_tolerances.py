@@ -1,6 +1,7 @@
 """Tolerances files: bounds with reasons, the most specific wins, bad files refused with the key."""
 
 import math
+import os
 
 import pytest
 
@@ -90,7 +91,7 @@ reason = "order 4"
     ('[[bound]]\nmetric = "m"\nreason = "r"\n', "bound[0]", "bounds nothing"),
     ('[[bound]]\nmetric = "m"\ndt = -1.0\nmax = 1.0\nreason = "r"\n', "bound[0].dt", "not a time step"),
     ('[[bounds]]\nmetric = "m"\n', "bounds", "unknown table"),
-    ('[[bound]\n', "-", "not valid TOML"),
+    ('[[bound]\n', "line 1, column 8", "not valid TOML"),
 ])
 def test_bad_tolerances_name_the_key_and_what_is_allowed(tmp_path, text, key, words):
     with pytest.raises(ToleranceError) as caught:
@@ -102,3 +103,13 @@ def test_bad_tolerances_name_the_key_and_what_is_allowed(tmp_path, text, key, wo
 def test_the_shipped_tolerances_load_and_give_every_bound_a_reason():
     bounds = load_tolerances(DEFAULT_TOLERANCES)
     assert len(bounds) > 20 and all(len(b.reason) > 20 for b in bounds)
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes need a POSIX system")
+def test_a_tolerances_path_that_is_no_regular_file_is_refused_without_opening_it(tmp_path):
+    """A FIFO would block forever and /dev/zero never ends: neither is opened."""
+    fifo = tmp_path / "tol.toml"
+    os.mkfifo(fifo)
+    for path in (fifo, tmp_path, "/dev/zero"):
+        with pytest.raises(ToleranceError, match=r"not a regular file.*\(allowed: the path of a regular tolerances file\)"):
+            load_tolerances(path)
