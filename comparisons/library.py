@@ -7,7 +7,7 @@ from pathlib import Path
 from simparity.comparisons.scene_limits import DEFAULT_LIMITS, Limits
 from simparity.comparisons.scene_loader import load_scene
 from simparity.core.errors import UnknownSceneError, one_line
-from simparity.core.files import file_problem
+from simparity.core.files import file_problem, read_toml
 from simparity.core.scene import SUITES
 
 SCENES_DIR = Path(__file__).parent / "scenes"
@@ -33,11 +33,19 @@ def resolve(name_or_path: str) -> Path:
     )
 
 
+def _declared_suites(path: Path) -> list:
+    """The suites a scene file names in ``[scene] suites`` (default ``["default"]``), read without
+    loading the scene: a suite never depends on what the scenes outside it need."""
+    head = read_toml(path, what="scene file").get("scene", {})
+    return head.get("suites", ["default"]) if isinstance(head, dict) else []
+
+
 def suite(name: str, limits: Limits = DEFAULT_LIMITS) -> list:
     """The built-in scenes of suite ``name`` (:data:`core.scene.SUITES`), loaded, sorted by name."""
     if name not in SUITES:
         raise UnknownSceneError(f"--suite {one_line(name)}: there is no such suite (allowed: {', '.join(SUITES)})")
-    return [scene for scene in load(list(builtin_paths().values()), limits) if name in scene.suites]
+    members = [path for path in builtin_paths().values() if name in _declared_suites(path)]
+    return load(members, limits)
 
 
 def load(names_or_paths, limits: Limits = DEFAULT_LIMITS) -> list:

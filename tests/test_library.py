@@ -4,6 +4,8 @@ import dataclasses
 import fnmatch
 import math
 
+from pathlib import Path
+
 import pandas as pd
 import pytest
 
@@ -11,9 +13,11 @@ from simparity.comparisons import library
 from simparity.comparisons.check import check_table
 from simparity.comparisons.engines import make_engine
 from simparity.comparisons.profiles import quick
+from simparity.comparisons.scene_loader import EXAMPLE_ROBOT_DATA_PREFIX
 from simparity.comparisons.runner import run_scene
 from simparity.comparisons.tolerances import load_tolerances
 from simparity.core.errors import SceneError, SimparityError
+from simparity.core.files import tomllib
 from simparity.core.results import COLUMNS, DIVERGED, OK, ResultRow
 from simparity.core.scene import DynamicsScene, IKScene
 from tests.helpers import builtin
@@ -90,3 +94,21 @@ def test_a_blow_up_reported_as_bounded_fails_the_hard_gate(scene, engine, integr
 def test_a_limit_blocked_target_claimed_solved_fails_the_hard_gate():
     row = ResultRow("hard-planar-ik", "mujoco", "dls", math.nan, "hard_beyond_limits_solved", 1.0, "1", "analytic:fk", OK)
     assert not check_table(_table([row]), load_tolerances()).passed
+
+
+def test_a_suite_loads_only_its_own_scenes(monkeypatch):
+    """A scene outside the suite is never loaded, so what it needs cannot break the suite."""
+    loaded = []
+    real_load = library.load
+    monkeypatch.setattr(library, "load", lambda paths, *a: loaded.extend(Path(p).stem for p in paths) or real_load(paths, *a))
+    names = [s.name for s in library.suite("default")]
+    assert sorted(loaded) == sorted(names) and "hard-stiff-drag" not in loaded
+
+
+def test_built_in_scenes_need_only_the_runtime_dependencies():
+    """`pip install .` must run every built-in suite: no built-in scene names a robot from a test extra."""
+    extras = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text(encoding="utf-8"))
+    runtime = " ".join(extras["project"]["dependencies"])
+    for name, path in library.builtin_paths().items():
+        if EXAMPLE_ROBOT_DATA_PREFIX in path.read_text(encoding="utf-8"):
+            assert "example-robot-data" in runtime, f"{name} needs example-robot-data, a test-only extra"
