@@ -22,15 +22,16 @@ from simparity.comparisons.engines import DEFAULT_ENGINES, ENGINE_NAMES, check_e
 from simparity.comparisons.history import history_path, latest_before, metric_history, record_run, run_table
 from simparity.comparisons.parallel import default_jobs, run_scenes
 from simparity.comparisons.profiles import apply_profile
-from simparity.comparisons.runner import DEFAULT_REPEATS
+from simparity.comparisons.progress import ProgressBar
+from simparity.comparisons.runner import DEFAULT_REPEATS, count_cases
 from simparity.comparisons.scene_limits import DEFAULT_LIMITS, Limits
 from simparity.comparisons.store import DEFAULT_OUT_ROOT, RunWriter, default_out_dir
 from simparity.comparisons.tolerances import DEFAULT_TOLERANCES, load_tolerances
 from simparity.core.errors import HistoryError, SimparityError, UsageError, one_line
 from simparity.core.ranges import RANGES
-from simparity.core.results import FAILED, REPORT_FILE, RESULTS_FILE, RUN_INFO_FILE, case_counts
+from simparity.core.results import FAILED, RESULTS_FILE, RUN_INFO_FILE, case_counts
 from simparity.core.scene import SUITES, DynamicsScene, IKScene, KinematicsScene
-from simparity.reports.markdown import render
+from simparity.reports.render import write_report
 from simparity.reports.store import read_run
 
 EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
@@ -145,9 +146,13 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("--integrator", default=None, help="dynamics only (default: the engine's first)")
     export.add_argument("--dt", type=float, default=None, help="dynamics only, [s] (default: the scene's first)")
 
-    report = sub.add_parser("report", help="re-render report.md of a stored run",
-                            description="Re-render report.md from a stored run's results.csv and run.json.")
+    report = sub.add_parser(
+        "report", help="re-render report.md, report.html and figures/ of a stored run",
+        description="Re-render report.md, report.html and the figures (SVG, PNG) from a stored run's results.csv, "
+        "series.csv.gz and run.json; runs no engine. Flagged findings hold the run to --tolerances.")
     report.add_argument("run_dir", type=Path, metavar="DIR")
+    report.add_argument("--tolerances", type=Path, default=None, metavar="FILE",
+                        help=f"bounds for the flagged findings (default: the shipped {DEFAULT_TOLERANCES.name})")
     return parser
 
 
@@ -206,7 +211,7 @@ def cmd_run(args, out) -> int:
     chosen = library.load(args.scenes, limits) if args.scenes else library.suite(args.suite or "default", limits)
     scenes = apply_profile(chosen, "quick" if args.quick else "full")
     bounds = load_tolerances(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
-    versions = {n: make_engine(n).version() for n in names}
+    engines = [make_engine(n) for n in names]
     out_dir = _out_dir(args)
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
@@ -215,23 +220,28 @@ def cmd_run(args, out) -> int:
                              "(allowed: a folder you can write)") from None
     print(f"{_cost(scenes)}; {len(names)} engines, {min(jobs, len(scenes))} at once"
           + (" (quick profile)" if args.quick else ""), file=out, flush=True)
-    writer = RunWriter(out_dir, versions, " ".join(["simparity"] + sys.argv[1:]), scenes)
+    writer = RunWriter(out_dir, engines, " ".join(["simparity"] + sys.argv[1:]), scenes)
+    sizes = [count_cases(scene, engines) for scene in scenes]
+    bar = ProgressBar(sum(sizes), sys.stderr)
     failed = 0
     try:
-        for scene, rows in run_scenes(scenes, names, repeats, jobs):
-            writer.append(rows)
+        for k, (scene, rows, series) in enumerate(run_scenes(scenes, names, repeats, jobs,
+                                                             bar.case_done if bar.active else None)):
+            writer.append(rows, series)
             counts = case_counts(rows)
             failed += counts[FAILED]
+            bar.scene_done(sum(sizes[:k + 1]))
             print(f"{scene.name}: {sum(counts.values())} cases ("
                   + ", ".join(f"{s} {c}" for s, c in counts.items() if c) + ")", file=out, flush=True)
     except KeyboardInterrupt:
+        bar.clear()
         print(f"interrupted; results so far are in {writer.results_path}", file=out)
-        _write_report(out_dir, out)
+        _write_report(out_dir, out, bounds)
         return EXIT_INTERRUPTED
     except SimparityError:
-        _write_report(out_dir, out)  # keep what was computed, then report the error
+        _write_report(out_dir, out, bounds)  # keep what was computed, then report the error
         raise
-    _write_report(out_dir, out)
+    _write_report(out_dir, out, bounds)
     _record(out_dir, args.history)
     code = EXIT_FAILED_CASES if failed else EXIT_OK
     if bounds is not None:
@@ -249,11 +259,13 @@ def _record(out_dir: Path, history_option: str | None) -> None:
               file=sys.stderr)
 
 
-def _write_report(out_dir: Path, out) -> None:
-    table, info = read_run(out_dir)
-    path = Path(out_dir) / REPORT_FILE
-    path.write_text(render(table, info), encoding="utf-8")
-    print(f"results: {Path(out_dir) / 'results.csv'}\nreport:  {path}", file=out)
+def _write_report(out_dir: Path, out, bounds=None) -> None:
+    """report.md, report.html and figures/ of the run; its metrics are held to ``bounds`` (default: the
+    shipped tolerances) for the report's flagged findings, which never changes an exit code."""
+    table, _ = read_run(out_dir)
+    result = check_table(table, bounds if bounds is not None else load_tolerances(DEFAULT_TOLERANCES))
+    markdown, page = write_report(out_dir, [v.line() for v in result.violations])
+    print(f"results: {Path(out_dir) / RESULTS_FILE}\nreport:  {markdown}\n         {page}", file=out)
 
 
 def _baseline_table(option: str, run_dir: Path, history_option: str | None):
@@ -322,7 +334,7 @@ def cmd_export(args, out) -> int:
 
 
 def cmd_report(args, out) -> int:
-    _write_report(args.run_dir, out)
+    _write_report(args.run_dir, out, load_tolerances(args.tolerances) if args.tolerances else None)
     return EXIT_OK
 
 

@@ -25,11 +25,12 @@ import numpy as np
 
 from simparity.comparisons.ik_targets import ORIENTATION_ONLY, Targets, hard_target, random_targets
 from simparity.comparisons.rows import Case, Measured, error_text, warnings_into_rows
+from simparity.comparisons.series import disagreement_matrix, quantiles
 from simparity.comparisons.timing import best_of
 from simparity.core.engine import Engine, KinematicsModel
 from simparity.core.ik.problem import IKTolerances
 from simparity.core.ik.result import LIMIT_TOLERANCE, IKResult
-from simparity.core.results import FAILED, HARD_VERDICT_SUFFIXES, NOT_AVAILABLE, OK, ResultRow
+from simparity.core.results import FAILED, HARD_VERDICT_SUFFIXES, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
 from simparity.core.scene import IKScene
 from simparity.references.conventions import rotation_angle
 
@@ -69,13 +70,13 @@ def _summary(result: IKResult, q_start: np.ndarray, seconds: float) -> dict[str,
 
 
 def _cross_evaluation(scene: IKScene, targets: Targets, q: np.ndarray,
-                      judges: dict[str, KinematicsModel]) -> dict[str, float]:
-    """Solve rate by each judge's FK (lowest kept; a solution outside the joint limits is solved by
-    none) and the spread of their end-effector positions."""
+                      judges: dict[str, KinematicsModel]) -> tuple[dict[str, float], dict[str, np.ndarray]]:
+    """(solve rate by each judge's FK (lowest kept; a solution outside the joint limits is solved by
+    none) and the spread of their end-effector positions, each judge's end-effector positions (N, 3))."""
     violation = np.maximum(np.maximum(scene.chain.lower - q, q - scene.chain.upper), 0.0)
     inside = np.max(violation, axis=1, initial=0.0) <= LIMIT_TOLERANCE
-    rates, ends = [], []
-    for model in judges.values():
+    rates, ends = [], {}
+    for name, model in judges.items():
         frames = model.forward_kinematics(q)
         end, rotation = frames.position_world[:, -1], frames.rotation_world[:, -1]
         position_resolution, orientation_resolution = model.resolution
@@ -85,10 +86,10 @@ def _cross_evaluation(scene: IKScene, targets: Targets, q: np.ndarray,
             solved &= (rotation_angle(rotation, targets.rotation_world)
                        <= scene.orientation_tolerance + orientation_resolution)
         rates.append(float(np.mean(solved)))
-        ends.append(end)
-    ends = np.stack(ends)
-    spread = np.linalg.norm(ends[:, None] - ends[None, :], axis=-1).max() if len(ends) > 1 else 0.0
-    return {"cross_eval_solve_rate_min": min(rates), "cross_eval_disagreement_max": float(spread)}
+        ends[name] = end
+    stacked = np.stack(list(ends.values()))
+    spread = np.linalg.norm(stacked[:, None] - stacked[None, :], axis=-1).max() if len(ends) > 1 else 0.0
+    return {"cross_eval_solve_rate_min": min(rates), "cross_eval_disagreement_max": float(spread)}, ends
 
 
 def _task_jacobian(scene: IKScene, model: KinematicsModel, q: np.ndarray) -> np.ndarray:
@@ -170,8 +171,17 @@ def _solve_each(model, hard: list[Targets], q_start: np.ndarray) -> list[IKResul
     return [IKResult(**{f: getattr(batch, f)[i:i + 1] for f in fields}) for i in range(len(hard))]
 
 
+def _distributions(case: Case, result: IKResult) -> list[SeriesRecord]:
+    """Residuals and iterations over the random targets, as quantiles (failed solves included)."""
+    iterations = result.iterations[result.iterations >= 0]
+    return ([quantiles(case, "position_residual", "m", result.position_residual),
+             quantiles(case, "orientation_residual", "rad", result.orientation_residual)]
+            + ([quantiles(case, "iterations", "1", iterations)] if iterations.size else []))
+
+
 def _case_rows(scene: IKScene, engine: Engine, case: Case, options: IKTolerances, random: Targets,
-               hard: list[Targets], judges: dict[str, KinematicsModel], repeats: int) -> list[ResultRow]:
+               hard: list[Targets], judges: dict[str, KinematicsModel], repeats: int,
+               series: _SceneSeries) -> list[ResultRow]:
     try:
         support = engine.supports_ik(scene.chain, case.integrator, scene.target_kind == "position")
     except Exception as err:  # noqa: BLE001 - reported in the rows
@@ -188,16 +198,39 @@ def _case_rows(scene: IKScene, engine: Engine, case: Case, options: IKTolerances
         problem = error_text(err)
         return case.rows(IK_METRICS, FAILED, problem) + _hard_rows(case, hard, [None] * len(hard), FAILED, problem)
     values = {m: Measured(v, IK_METRICS[m]) for m, v in _summary(result, scene.q_start, seconds).items()}
-    values.update({m: Measured(v, IK_METRICS[m]) for m, v in _cross_evaluation(scene, random, result.q, judges).items()})
+    agreement, ends = _cross_evaluation(scene, random, result.q, judges)
+    values.update({m: Measured(v, IK_METRICS[m]) for m, v in agreement.items()})
+    series.add(_distributions(case, result), ends)
     if engine.name in judges:
         values["start_rank_deficiency"] = start_rank_deficiency(scene, judges[engine.name])
     return (case.rows(IK_METRICS, OK, f"{model.detail}; {random.note}", values)
             + _hard_rows(case, hard, hard_results, OK, ""))
 
 
+class _SceneSeries:
+    """The series of an IK scene: each case's distributions, and every solution's end-effector
+    position by each judge, for the FK agreement matrix."""
+
+    def __init__(self) -> None:
+        self.records: list[SeriesRecord] = []
+        self.ends: dict[str, list[np.ndarray]] = {}
+
+    def add(self, records: list[SeriesRecord], ends: dict[str, np.ndarray]) -> None:
+        self.records += records
+        for judge, end in ends.items():
+            self.ends.setdefault(judge, []).append(end)
+
+    def all(self, case: Case) -> list[SeriesRecord]:
+        ends = {judge: np.concatenate(parts) for judge, parts in self.ends.items()}
+        return self.records + disagreement_matrix(case, ends)
+
+
 def run_ik_scene(scene: IKScene, engines: list[Engine], make_reference: Callable[[str], Engine],
-                 repeats: int) -> list[ResultRow]:
-    """All rows of an IK scene; the reference engine's FK generates the targets."""
+                 repeats: int, series: list[SeriesRecord] | None = None,
+                 progress: Callable[[str, str], None] = lambda engine, solver: None) -> list[ResultRow]:
+    """All rows of an IK scene; the reference engine's FK generates the targets. When ``series`` is
+    a list, the scene's sampled series (:mod:`comparisons.series`) are appended to it; ``progress(engine,
+    solver)`` is called after each case."""
     options = IKTolerances(position_tolerance=scene.position_tolerance, orientation_tolerance=scene.orientation_tolerance,
                         max_iterations=scene.max_iterations)
     reference = make_reference(scene.reference)
@@ -223,10 +256,14 @@ def run_ik_scene(scene: IKScene, engines: list[Engine], make_reference: Callable
     judges = _judges(scene, engines)
     label = f"{scene.reference}:fk (targets); cross-evaluated by {', '.join(judges)}"
     rows: list[ResultRow] = []
+    collected = _SceneSeries()
     for engine in engines:
         for solver in engine.ik_solvers() or ("-",):
             case = Case(scene.name, engine.name, solver, math.nan, label)
             with warnings_into_rows(rows):
-                rows += _case_rows(scene, engine, case, options, random, hard, judges, repeats)
+                rows += _case_rows(scene, engine, case, options, random, hard, judges, repeats, collected)
             rows += case.rows(skipped, NOT_AVAILABLE, "position-only scene: no orientation to target")
+            progress(engine.name, solver)
+    if series is not None:
+        series += collected.all(Case(scene.name, "", "", math.nan, label))
     return rows

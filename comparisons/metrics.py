@@ -135,6 +135,13 @@ def dynamics_metrics(scene: DynamicsScene) -> dict[str, str]:
     return metrics
 
 
+def headline_metric(scene: DynamicsScene) -> str:
+    """The error a report ranks a dynamics scene's schemes by: the orientation error when a body
+    turns (it starts spinning or a force exerts a torque), else the position error."""
+    turns = scene.forces.exerts_torque or any(np.any(b.angular_velocity_world != 0) for b in scene.bodies)
+    return "orientation_error_max" if turns else "position_error_max"
+
+
 def energies(scene: DynamicsScene, traj: Trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(total E, kinetic, potential) [J] per sample and body, each (T, B); potential -m g.x, zero at
     the world origin (0 without gravity)."""

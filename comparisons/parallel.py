@@ -9,13 +9,15 @@ suite's order whatever finishes first.
 from __future__ import annotations
 
 import concurrent.futures
+import contextlib
 import multiprocessing
 import os
-from typing import Iterator
+import queue
+from typing import Callable, Iterator
 
 from simparity.comparisons.engines import make_engine
 from simparity.comparisons.runner import run_scene
-from simparity.core.results import ResultRow
+from simparity.core.results import ResultRow, SeriesRecord
 
 
 def default_jobs() -> int:
@@ -23,22 +25,56 @@ def default_jobs() -> int:
     return max(1, os.cpu_count() or 1)
 
 
-def _run_named(scene, engine_names: tuple[str, ...], repeats: int) -> list[ResultRow]:
-    return run_scene(scene, [make_engine(n) for n in engine_names], make_engine, repeats=repeats)
+OnCase = Callable[[str, str, str], None]
+"""Called with (scene, engine, integrator or solver) after each case, in the calling process."""
+
+_POLL_SECONDS = 0.2
+"""How often the calling process looks for finished cases while workers run."""
 
 
-def run_scenes(scenes: list, engine_names: tuple[str, ...], repeats: int, jobs: int) -> Iterator[tuple[object, list]]:
-    """(scene, rows) for every scene, in order, computed on ``jobs`` processes."""
+def _run(scene, engines: list, repeats: int, progress=None) -> tuple[list[ResultRow], list[SeriesRecord]]:
+    series: list[SeriesRecord] = []
+    return run_scene(scene, engines, make_engine, repeats=repeats, series=series, progress=progress), series
+
+
+def _run_named(scene, engine_names: tuple[str, ...], repeats: int, events=None) -> tuple[list[ResultRow], list[SeriesRecord]]:
+    progress = None if events is None else (lambda engine, integrator: events.put((scene.name, engine, integrator)))
+    return _run(scene, [make_engine(n) for n in engine_names], repeats, progress)
+
+
+def run_scenes(scenes: list, engine_names: tuple[str, ...], repeats: int, jobs: int,
+               on_case: OnCase | None = None) -> Iterator[tuple[object, list[ResultRow], list[SeriesRecord]]]:
+    """(scene, rows, sampled series) for every scene, in order, computed on ``jobs`` processes;
+    ``on_case`` hears of every case as it finishes, whichever process ran it."""
     if jobs <= 1 or len(scenes) <= 1:
         engines = [make_engine(n) for n in engine_names]
         for scene in scenes:
-            yield scene, run_scene(scene, engines, make_engine, repeats=repeats)
+            progress = None if on_case is None else (lambda e, i, name=scene.name: on_case(name, e, i))
+            yield (scene, *_run(scene, engines, repeats, progress))
         return
     context = multiprocessing.get_context("spawn")
-    pool = concurrent.futures.ProcessPoolExecutor(max_workers=min(jobs, len(scenes)), mp_context=context)
-    try:
-        futures = [pool.submit(_run_named, scene, engine_names, repeats) for scene in scenes]
+    with contextlib.ExitStack() as stack:
+        events = None if on_case is None else stack.enter_context(context.Manager()).Queue()
+        pool = concurrent.futures.ProcessPoolExecutor(max_workers=min(jobs, len(scenes)), mp_context=context)
+        stack.callback(pool.shutdown, wait=False, cancel_futures=True)
+        futures = [pool.submit(_run_named, scene, engine_names, repeats, events) for scene in scenes]
         for scene, future in zip(scenes, futures):
-            yield scene, future.result()
-    finally:
-        pool.shutdown(wait=False, cancel_futures=True)
+            while events is not None and not future.done():
+                _drain(events, on_case, timeout=_POLL_SECONDS)
+            if events is not None:
+                _drain(events, on_case, timeout=0.0)
+            yield (scene, *future.result())
+
+
+def _drain(events, on_case: OnCase, timeout: float) -> None:
+    """Hand every event waiting in ``events`` to ``on_case``, waiting up to ``timeout`` for the first."""
+    try:
+        event = events.get(timeout=timeout) if timeout else events.get_nowait()
+    except queue.Empty:
+        return
+    on_case(*event)
+    while True:
+        try:
+            on_case(*events.get_nowait())
+        except queue.Empty:
+            return

@@ -29,11 +29,15 @@ from simparity.comparisons.metrics import (
     trajectory_errors,
 )
 from simparity.comparisons.rows import Case, Measured, error_text, warnings_into_rows
+from simparity.comparisons.series import dynamics_series
 from simparity.comparisons.timing import best_of
 from simparity.core.engine import Engine, Support
 from simparity.core.errors import DivergedError
-from simparity.core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
+from simparity.core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
 from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
+
+Progress = Callable[[str, str], None]
+"""Called with (engine, integrator or solver) after each case of a scene."""
 
 DEFAULT_REPEATS = 3
 """Timed repeats per measurement (the minimum is kept), after one warm-up run."""
@@ -74,7 +78,8 @@ def _integrators(scene: DynamicsScene, engine: Engine) -> tuple[list[str], str]:
     return chosen, reason
 
 
-def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, repeats: int) -> list[ResultRow]:
+def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, repeats: int,
+              series: list[SeriesRecord] | None, progress: Progress) -> list[ResultRow]:
     rows: list[ResultRow] = []
     metrics = dynamics_metrics(scene)
     ref_integrator = reference.integrators()[0]
@@ -106,11 +111,12 @@ def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, re
                 is_reference = engine.name == reference.name and integrator == ref_integrator
                 with warnings_into_rows(rows):
                     result = _dynamics_case(scene, engine, case, metrics, n, ref_traj, (ref_problem, ref_status),
-                                            repeats, is_reference)
+                                            repeats, is_reference, series)
                     rows += result.rows
                 ladder = ladders.setdefault((engine.name, integrator), _Ladder())
                 ladder.dts.append(dt)
                 ladder.cases.append(result)
+                progress(engine.name, integrator)
     if len(scene.dts) > 1:
         rows += _orders(scene, ladders, ref_label)
     return rows
@@ -135,8 +141,9 @@ def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_l
 
 
 def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref_traj, ref_problem: tuple[str, str],
-                   repeats: int, is_reference: bool) -> _CaseResult:
-    """One case; ``ref_problem`` is (why there is no reference trajectory, the status that gives)."""
+                   repeats: int, is_reference: bool, series: list[SeriesRecord] | None) -> _CaseResult:
+    """One case; ``ref_problem`` is (why there is no reference trajectory, the status that gives).
+    The case's sampled series go to ``series`` unless it is None."""
     try:
         support = engine.supports_dynamics(scene, case.integrator)
     except Exception as err:  # noqa: BLE001 - reported in the rows
@@ -158,6 +165,8 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
             return _CaseResult(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values),
                                integrates_rotation=sim.integrates_rotation)
         values.update(drifts(scene, traj))
+        if series is not None:
+            series += dynamics_series(scene, case, traj, ref_traj)
         floors = rounding_floors(scene, traj, n)
         if ref_traj is None:
             problem, status = ref_problem
@@ -169,7 +178,8 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
                        sim.integrates_rotation)
 
 
-def _kinematics(scene: KinematicsScene, engines: list[Engine], reference: Engine, repeats: int) -> list[ResultRow]:
+def _kinematics(scene: KinematicsScene, engines: list[Engine], reference: Engine, repeats: int,
+                progress: Progress) -> list[ResultRow]:
     q = scene.configurations()
     ref_label = f"{reference.name}:fk"
     ref, ref_problem, ref_status = None, "", NOT_AVAILABLE
@@ -188,6 +198,7 @@ def _kinematics(scene: KinematicsScene, engines: list[Engine], reference: Engine
         with warnings_into_rows(rows):
             rows += _kinematics_case(scene, engine, case, q, ref, (ref_problem, ref_status), repeats,
                                      engine.name == reference.name)
+        progress(engine.name, "")
     return rows
 
 
@@ -214,12 +225,31 @@ def _kinematics_case(scene: KinematicsScene, engine: Engine, case: Case, q: np.n
 
 
 def run_scene(
-    scene, engines: list[Engine], make_reference: Callable[[str], Engine], repeats: int = DEFAULT_REPEATS
+    scene, engines: list[Engine], make_reference: Callable[[str], Engine], repeats: int = DEFAULT_REPEATS,
+    series: list[SeriesRecord] | None = None, progress: Progress | None = None,
 ) -> list[ResultRow]:
-    """All rows of one scene on ``engines``, measured against ``make_reference(scene.reference)``."""
+    """All rows of one scene on ``engines``, measured against ``make_reference(scene.reference)``.
+
+    When ``series`` is a list, the scene's sampled series (:mod:`comparisons.series`) are appended to it;
+    ``progress(engine, integrator)`` is called after each case (:func:`count_cases` of them).
+    """
+    progress = progress or _no_progress
     if isinstance(scene, IKScene):
-        return run_ik_scene(scene, engines, make_reference, repeats)
+        return run_ik_scene(scene, engines, make_reference, repeats, series, progress)
     reference = make_reference(scene.reference)
     if isinstance(scene, DynamicsScene):
-        return _dynamics(scene, engines, reference, repeats)
-    return _kinematics(scene, engines, reference, repeats)
+        return _dynamics(scene, engines, reference, repeats, series, progress)
+    return _kinematics(scene, engines, reference, repeats, progress)
+
+
+def count_cases(scene, engines: list[Engine]) -> int:
+    """How many times :func:`run_scene` calls ``progress`` for ``scene``: its cases, order fits aside."""
+    if isinstance(scene, IKScene):
+        return sum(len(engine.ik_solvers() or ("-",)) for engine in engines)
+    if isinstance(scene, DynamicsScene):
+        return len(scene.dts) * sum(len(_integrators(scene, engine)[0]) for engine in engines)
+    return len(engines)
+
+
+def _no_progress(engine: str, integrator: str) -> None:
+    return None

@@ -1,4 +1,4 @@
-"""Writing a stored run: ``results.csv`` (appended scene by scene) and ``run.json``."""
+"""Writing a stored run: ``results.csv`` and ``series.csv.gz`` (appended scene by scene) and ``run.json``."""
 
 from __future__ import annotations
 
@@ -11,7 +11,19 @@ from pathlib import Path
 
 import pandas as pd
 
-from simparity.core.results import COLUMNS, RESULTS_FILE, RUN_INFO_FILE, SCHEMA_VERSION, ResultRow
+from simparity.comparisons.metrics import headline_metric
+from simparity.core.engine import Engine
+from simparity.core.results import (
+    COLUMNS,
+    RESULTS_FILE,
+    RUN_INFO_FILE,
+    SCHEMA_VERSION,
+    SERIES_COLUMNS,
+    SERIES_FILE,
+    ResultRow,
+    SeriesRecord,
+)
+from simparity.core.scene import DynamicsScene, IKScene
 
 DEFAULT_OUT_ROOT = Path("simparity-results")
 """Default parent folder of runs: each run goes to ``simparity-results/<UTC time>/``."""
@@ -48,29 +60,51 @@ def machine() -> dict:
     }
 
 
-class RunWriter:
-    """Appends rows to ``results.csv`` as they are produced, so nothing computed is lost."""
+def _orders(engine: Engine) -> dict[str, int]:
+    orders = {i: engine.theoretical_order(i) for i in engine.integrators()}
+    return {i: order for i, order in orders.items() if order is not None}
 
-    def __init__(self, out_dir: Path, engine_versions: dict[str, str], command: str, scenes: list) -> None:
+
+def _scene_info(scene) -> dict:
+    """What a report needs of a scene beside its rows: what it is, where from, and for dynamics
+    the number of bodies (per-call overhead) and the error its schemes are ranked by."""
+    info = {"kind": scene.kind, "description": scene.description, "reference": scene.reference,
+            "source": scene.source, "suites": list(scene.suites)}
+    if isinstance(scene, DynamicsScene):
+        info |= {"bodies": len(scene.bodies), "headline_metric": headline_metric(scene)}
+    if isinstance(scene, IKScene):
+        info |= {"position_tolerance": scene.position_tolerance}
+    return info
+
+
+class RunWriter:
+    """Appends rows to ``results.csv`` and series to ``series.csv.gz`` as they are produced, so nothing
+    computed is lost."""
+
+    def __init__(self, out_dir: Path, engines: list[Engine], command: str, scenes: list) -> None:
         self.out_dir = Path(out_dir)
         self.out_dir.mkdir(parents=True, exist_ok=True)
         self.results_path = self.out_dir / RESULTS_FILE
+        self.series_path = self.out_dir / SERIES_FILE
         pd.DataFrame(columns=list(COLUMNS)).to_csv(self.results_path, index=False)
+        pd.DataFrame(columns=list(SERIES_COLUMNS)).to_csv(self.series_path, index=False)
         info = {
             "schema_version": SCHEMA_VERSION,
             "created_utc": dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds"),
             "command": command,
             "git_commit": git_commit(),
             "machine": machine(),
-            "engine_versions": engine_versions,
-            "scenes": {
-                s.name: {"kind": s.kind, "description": s.description, "reference": s.reference, "source": s.source,
-                         "suites": list(s.suites)}
-                for s in scenes
-            },
+            "engine_versions": {e.name: e.version() for e in engines},
+            "theoretical_orders": {e.name: orders for e in engines
+                                   if (orders := _orders(e))},
+            "scenes": {s.name: _scene_info(s) for s in scenes},
         }
         (self.out_dir / RUN_INFO_FILE).write_text(json.dumps(info, indent=2) + "\n", encoding="utf-8")
 
-    def append(self, rows: list[ResultRow]) -> None:
+    def append(self, rows: list[ResultRow], series: list[SeriesRecord] = ()) -> None:
         frame = pd.DataFrame([r.as_dict() for r in rows], columns=list(COLUMNS))
         frame.to_csv(self.results_path, mode="a", header=False, index=False, float_format="%.17g")
+        if series:
+            # Each append is one more gzip member; readers (gzip, pandas) read the members as one file.
+            points = pd.DataFrame([p for record in series for p in record.as_rows()], columns=list(SERIES_COLUMNS))
+            points.to_csv(self.series_path, mode="a", header=False, index=False, float_format="%.9g")

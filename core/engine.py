@@ -163,6 +163,11 @@ class Engine(abc.ABC):
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
         """Build the model for ``chain`` (not timed). Call only when supported."""
 
+    def theoretical_order(self, integrator: str) -> int | None:
+        """Global order of accuracy the integrator has in theory (None: unknown, or it depends on the
+        scene). Reports draw it beside the observed order."""
+        return None
+
     def ik_solvers(self) -> tuple[str, ...]:
         """Names of the IK solvers the engine offers (empty if none)."""
         return ()

@@ -13,7 +13,7 @@ from simparity.core.forces import make_wrench
 from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik
 from simparity.core.ik.problem import IKTolerances
 from simparity.core.ik.result import IKResult
-from simparity.core.integrators import ORIENTATION_UPDATES, SCHEMES, make_step
+from simparity.core.integrators import ORDER, ORIENTATION_UPDATES, SCHEMES, make_step
 from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.rigid_body import MassProperties, State, initial_state, velocities
 from simparity.core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
@@ -134,6 +134,10 @@ class InHouseEngine(Engine):
 
     def integrators(self) -> tuple[str, ...]:
         return integrator_names()
+
+    def theoretical_order(self, integrator: str) -> int | None:
+        """The scheme's order (:data:`core.integrators.ORDER`); the particle rules' depend on the scene."""
+        return ORDER.get(parse_integrator(integrator)[0])
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         named = self.check_integrator(integrator)

@@ -12,6 +12,7 @@ SCHEMA_VERSION = 1
 RESULTS_FILE = "results.csv"
 RUN_INFO_FILE = "run.json"
 REPORT_FILE = "report.md"
+REPORT_HTML_FILE = "report.html"
 
 COLUMNS = ("scene", "engine", "integrator", "dt", "metric", "value", "unit", "reference", "status", "detail")
 
@@ -45,6 +46,11 @@ class ResultRow:
         return asdict(self)
 
 
+GROUND_TRUTH_ENGINES = ("analytic", "tight")
+"""Engines that compute a scene's truth (closed form, or a tight adaptive solve), not schemes a user
+would pick: reports rank the other engines and never offer these as the cheapest scheme."""
+
+
 HARD_VERDICT_SUFFIXES = ("_solved", "_unreachable", "_limit_violation")
 """A hard IK target ``<name>`` has the row ``hard_<name>`` (position residual [m]) and one row per
 suffix: ``_solved`` 1 or 0, ``_unreachable`` 1 when the solver reported the target unreachable,
@@ -76,3 +82,48 @@ def case_counts(rows) -> dict[str, int]:
     for statuses in cases.values():
         counts[case_status(statuses)] += 1
     return counts
+
+
+SERIES_FILE = "series.csv.gz"
+"""Sampled series of a run, next to ``results.csv``: gzip-compressed CSV, one row per point,
+readable with ``pandas.read_csv`` (docs/metrics.md, "Sampled series")."""
+
+SERIES_COLUMNS = ("scene", "engine", "integrator", "dt", "quantity", "unit", "x", "value")
+
+SERIES_QUANTITIES = {
+    "energy_change": "(E(t) - E(0)) / the energy scale of energy_drift_max, signed (x: time [s])",
+    "angular_momentum_change": "|L(t) - L(0)| / |L(0)| (x: time [s])",
+    "position_error": "largest body position error against the reference [m] (x: time [s])",
+    "orientation_error": "largest body orientation error against the reference [rad] (x: time [s])",
+    "position_residual": "IK position residual [m] at cumulative fraction x of the random targets",
+    "orientation_residual": "IK orientation residual [rad] at cumulative fraction x of the random targets",
+    "iterations": "IK iterations at cumulative fraction x of the random targets (failed solves included)",
+    "fk_disagreement_max": "largest end-effector distance [m] between the FK of `engine` and of the engine in "
+                           "`integrator`, over every solver's solutions (x: 0)",
+}
+"""What each series quantity holds. Time series keep, of each of at most ``SERIES_POINTS`` runs of
+consecutive samples, the sample of largest magnitude (at its own time), so their maxima are the
+run's maxima and an oscillation shows its envelope; distributions are quantiles."""
+
+SERIES_POINTS = 101
+"""Points per series: enough for a smooth curve on a report figure, small enough that a run of
+the default suite keeps its series in a few megabytes."""
+
+
+@dataclass(frozen=True)
+class SeriesRecord:
+    """One sampled series of a case: ``value`` against ``x`` (both (K,), K <= SERIES_POINTS)."""
+
+    scene: str
+    engine: str
+    integrator: str
+    dt: float
+    quantity: str
+    unit: str
+    x: tuple
+    value: tuple
+
+    def as_rows(self) -> list[dict]:
+        head = {"scene": self.scene, "engine": self.engine, "integrator": self.integrator, "dt": self.dt,
+                "quantity": self.quantity, "unit": self.unit}
+        return [{**head, "x": x, "value": v} for x, v in zip(self.x, self.value)]

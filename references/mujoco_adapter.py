@@ -272,6 +272,11 @@ class MujocoEngine(Engine):
     def integrators(self) -> tuple[str, ...]:
         return tuple(INTEGRATORS)
 
+    def theoretical_order(self, integrator: str) -> int | None:
+        """Euler (semi-implicit), implicit and implicitfast are first order, RK4 fourth (MuJoCo's docs,
+        "Numerical integration")."""
+        return {"euler": 1, "implicit": 1, "implicitfast": 1, "rk4": 4}.get(integrator)
+
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         return self.check_integrator(integrator)
 

@@ -245,6 +245,10 @@ class PinocchioEngine(UrdfChains, Engine):
     def integrators(self) -> tuple[str, ...]:
         return INTEGRATORS
 
+    def theoretical_order(self, integrator: str) -> int | None:
+        """The harness's steppers: the engines' first-order scheme, classical RK4."""
+        return {"euler": 1, "rk4": 4}.get(integrator)
+
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         return self.check_integrator(integrator)
 

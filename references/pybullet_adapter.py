@@ -284,6 +284,10 @@ class PybulletEngine(UrdfChains, Engine):
     def integrators(self) -> tuple[str, ...]:
         return ("euler",)
 
+    def theoretical_order(self, integrator: str) -> int | None:
+        """Bullet's semi-implicit Euler step is first order."""
+        return 1 if integrator == "euler" else None
+
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         return self.check_integrator(integrator)
 

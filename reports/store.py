@@ -8,7 +8,7 @@ from pathlib import Path
 import pandas as pd
 
 from simparity.core.errors import ResultsError, one_line
-from simparity.core.results import COLUMNS, RESULTS_FILE, RUN_INFO_FILE, SCHEMA_VERSION
+from simparity.core.results import COLUMNS, RESULTS_FILE, RUN_INFO_FILE, SCHEMA_VERSION, SERIES_COLUMNS, SERIES_FILE
 
 
 # pandas < 3 parses floats inexactly unless asked; pandas 3 is exact and deprecates the option.
@@ -38,3 +38,20 @@ def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
     if missing:
         raise ResultsError(f"{results}: missing columns {missing} (allowed: a results.csv with {', '.join(COLUMNS)})")
     return table, meta
+
+
+def read_series(run_dir: str | Path) -> pd.DataFrame:
+    """The sampled series of a stored run (columns :data:`core.results.SERIES_COLUMNS`); empty for a run
+    stored without them. Raises ResultsError if the file is unreadable."""
+    path = Path(run_dir) / SERIES_FILE
+    if not path.is_file():
+        return pd.DataFrame(columns=list(SERIES_COLUMNS))
+    try:
+        series = pd.read_csv(path, keep_default_na=False, na_values={c: ["", "nan", "NaN"] for c in ("dt", "x", "value")})
+    except (pd.errors.ParserError, UnicodeDecodeError, OSError, EOFError) as err:
+        raise ResultsError(f"{one_line(path)}: unreadable series: {one_line(err)} (allowed: the {SERIES_FILE} "
+                           "written by 'simparity run')") from None
+    missing = [c for c in SERIES_COLUMNS if c not in series.columns]
+    if missing:
+        raise ResultsError(f"{path}: missing columns {missing} (allowed: {', '.join(SERIES_COLUMNS)})")
+    return series

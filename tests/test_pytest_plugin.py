@@ -37,7 +37,7 @@ def test_a_baseline_that_differs_fails(pytester, tmp_path):
     scene = quick(load_scene("lecture-projectile"))
     table = run_scene(scene, engines=["core"], repeats=0)
     table.loc[table["metric"] == "position_error_final", "value"] *= 1.01
-    writer = RunWriter(tmp_path / "base", {}, "test", [scene])
+    writer = RunWriter(tmp_path / "base", [], "test", [scene])
     writer.append([ResultRow(**row) for row in table.to_dict("records")])
     pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
     result = pytester.runpytest_subprocess("--simparity-baseline", str(tmp_path / "base"))

@@ -16,7 +16,7 @@ def _python_blocks() -> list[str]:
 
 def test_loading_recipes_give_numeric_columns_and_keep_n_a(tmp_path):
     """Both loading recipes read dt and value as numbers and the status n/a as text."""
-    writer = RunWriter(tmp_path, {"core": "1"}, "test", [])
+    writer = RunWriter(tmp_path, [], "test", [])
     writer.append([ResultRow("s", "core", "rk4", 0.01, "m", 1.5, "m", "r", "ok"),
                    ResultRow("s", "core", "", math.nan, "m", math.nan, "m", "r", "n/a", "why")])
     pandas_recipe = next(b for b in _python_blocks() if "pd.read_csv(path" in b)

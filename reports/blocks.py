@@ -1,0 +1,52 @@
+"""The report as typed blocks, built once and rendered twice: to Markdown (``report.md``) and to HTML
+(``report.html``). A block says what it is; the renderers decide how it looks."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class Heading:
+    level: int
+    text: str
+    anchor: str = ""
+
+
+@dataclass(frozen=True)
+class Paragraph:
+    """Text with Markdown's inline marks only: `code`, **bold**, [links](url)."""
+
+    text: str
+
+
+@dataclass(frozen=True)
+class Bullets:
+    items: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Table:
+    head: tuple[str, ...]
+    rows: tuple[tuple[str, ...], ...]
+
+
+@dataclass(frozen=True)
+class Figure:
+    """A figure written by :func:`reports.figures.save` as ``figures/<name>.svg`` (and .png)."""
+
+    name: str
+    caption: str
+
+
+@dataclass(frozen=True)
+class Details:
+    """Folded content: collapsed in HTML; in Markdown a ``<details>`` block, or left out when
+    ``markdown`` is False (it is in ``results.csv`` and the HTML)."""
+
+    summary: str
+    blocks: tuple = field(default_factory=tuple)
+    markdown: bool = True
+
+
+Block = Heading | Paragraph | Bullets | Table | Figure | Details

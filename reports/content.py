@@ -1,0 +1,442 @@
+"""What a report says, as blocks (:mod:`reports.blocks`): the summary first, then per scene its figures,
+a compact table and (folded) the full one. Reads a stored run only; figures are drawn and saved here.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pandas as pd
+
+from simparity.core.results import (
+    GROUND_TRUTH_ENGINES,
+    HARD_VERDICT_SUFFIXES,
+    NOT_AVAILABLE,
+    OK,
+    STATUSES,
+    case_counts,
+    case_status,
+)
+from simparity.reports import figures, summary
+from simparity.reports.blocks import Block, Bullets, Details, Figure, Heading, Paragraph, Table
+
+FIGURES_DIR = "figures"
+"""Sub-folder of the run folder the figures are written to (SVG and PNG)."""
+
+_DYNAMICS_COLUMNS = [
+    ("position_error_max", "position error max [m]"),
+    ("orientation_error_max", "orientation error max [rad]"),
+    ("velocity_error_max", "velocity error max [m/s]"),
+    ("angular_velocity_error_max", "angular velocity error max [rad/s]"),
+    ("energy_drift_max", "energy drift max (rel.)"),
+    ("angular_momentum_drift_max", "angular momentum drift max (rel.)"),
+    ("time_per_step", "time per step [s]"),
+]
+_IK_COLUMNS = [
+    ("solve_rate", "solve rate"),
+    ("position_residual_median", "position residual median [m]"),
+    ("position_residual_max", "position residual max [m]"),
+    ("orientation_residual_max", "orientation residual max [rad]"),
+    ("iterations_median", "iterations median"),
+    ("time_per_solve", "time per solve [s]"),
+    ("limit_violations", "solutions outside limits"),
+    ("start_rank_deficiency", "start pose rank deficiency"),
+    ("rest_distance_median", "distance to start median"),
+    ("cross_eval_solve_rate_min", "solve rate, worst engine's FK"),
+    ("cross_eval_disagreement_max", "FK disagreement max [m]"),
+]
+_IK_COMPACT = ("solve_rate", "position_residual_median", "iterations_median", "time_per_solve", "limit_violations",
+               "cross_eval_solve_rate_min")
+_IK_PROTOCOL = (
+    "Protocol (TRAC-IK): seeded random reachable targets (end-effector poses of seeded random configurations "
+    "within the limits), every solve from the scene's one start pose, success when the residuals are within "
+    "the scene's tolerances and the joint values within their limits (an engine's solver that leaves them "
+    "fails with `outside_limits`), time per solve = batch time / batch size with failed solves included. Each "
+    "solution is also put through every engine's forward kinematics (worst solve rate and largest "
+    "disagreement shown), so no solver passes on its own kinematics alone."
+)
+_ORDER_COLUMNS = [
+    ("order_position", "order (position)"),
+    ("order_orientation", "order (orientation)"),
+    ("order_velocity", "order (velocity)"),
+    ("order_angular_velocity", "order (angular velocity)"),
+]
+_KINEMATICS_COLUMNS = [
+    ("position_error_max", "frame position error max [m]"),
+    ("orientation_error_max", "frame orientation error max [rad]"),
+    ("jacobian_error_max", "Jacobian error max"),
+    ("time_per_fk", "time per FK [s]"),
+    ("time_per_jacobian", "time per Jacobian [s]"),
+]
+_TIMING_METRICS = ("time_per_step", "time_per_fk", "time_per_solve")
+_DEFINITIONS = (
+    "Statuses: `ok` measured; `n/a` not measured, with the reason: the engine cannot do what the scene asks, "
+    "or the metric means nothing here (an orientation error saturated at >= pi/2, a drift above 100 %, errors at "
+    "the rounding floor, too few time steps for an order, a point-mass rule that does not move orientation, "
+    "nothing to compare against); `diverged` non-finite, or faster than the scene's forces allow, or a conserved "
+    "quantity more than doubled; `failed` the engine raised. A status cell names the metrics it is about. "
+    "Energy drift is max |E(t) - E(0)| / |E(0)| (potential zero at the world origin; relative to the largest "
+    "kinetic energy when |E(0)| is near zero, and the row says so); angular momentum drift is "
+    "max |L(t) - L(0)| / |L(0)|. Cost is compute per simulated second, time per step / dt. Definitions: "
+    "docs/metrics.md."
+)
+_HEADLINE_NAMES = {"position_error_max": ("position error max", "m"),
+                   "orientation_error_max": ("orientation error max", "rad")}
+
+
+def number(value: float) -> str:
+    """Three significant digits; an em dash for no value."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "—"
+    return "0" if value == 0 else f"{value:.3g}"
+
+
+def _status(group: pd.DataFrame) -> str:
+    """'ok', or each non-ok status with the metrics it is about (none named when it covers them all) and why."""
+    bad = group[group["status"] != OK]
+    if bad.empty:
+        return OK
+    parts = [OK] if len(bad) < len(group) else []
+    for (status, detail), rows in bad.groupby(["status", "detail"], sort=False):
+        label = status if len(rows) == len(group) else f"{status} ({', '.join(rows['metric'])})"
+        parts.append(f"{label}: {detail}" if detail else label)
+    return " · ".join(parts)
+
+
+def _table(scene_rows: pd.DataFrame, columns, keys: list[str]) -> Table:
+    present = set(scene_rows["metric"])
+    columns = [(metric, label) for metric, label in columns if metric in present]
+    rows = []
+    for key, group in scene_rows.groupby(keys, sort=False, dropna=False):
+        key = key if isinstance(key, tuple) else (key,)
+        values = dict(zip(group["metric"], group["value"]))
+        cells = [number(float(v)) if name == "dt" else str(v) for name, v in zip(keys, key)]
+        cells += [number(values.get(metric, math.nan)) for metric, _ in columns]
+        rows.append(tuple(cells + [_status(group)]))
+    return Table(tuple(keys + [label for _, label in columns] + ["status"]), tuple(rows))
+
+
+def _notes(scene_rows: pd.DataFrame) -> list[Block]:
+    timed = scene_rows["metric"].isin(_TIMING_METRICS)
+    ok = scene_rows[timed & (scene_rows["status"] == OK)].drop_duplicates(["engine", "integrator"])
+    items = tuple(f"**{r['engine']} {r['integrator']}**".replace(" **", "**") + f": {r['detail']}"
+                  for _, r in ok.iterrows())
+    return [Details("What each engine was given", (Bullets(items),), markdown=False)] if items else []
+
+
+def _fits(orders: pd.DataFrame) -> list[Block]:
+    fitted = orders[orders["status"] == OK]
+    return [Bullets(tuple(f"{r['engine']} {r['integrator']} `{r['metric']}` = {number(r['value'])}: {r['detail']}"
+                          for _, r in fitted.iterrows()))] if not fitted.empty else []
+
+
+def _hard_cell(row) -> str:
+    if row["status"] != OK:
+        return row["status"]
+    verdict = row["detail"].split(";")[0]
+    return f"{'✓' if verdict == 'solved' else '✗ ' + verdict.removeprefix('failed: ')} {number(row['value'])} m"
+
+
+def _hard_table(rows: pd.DataFrame) -> list[Block]:
+    """Engine x solver against each hard target: solved or the reason, with the position residual."""
+    hard = rows[rows["metric"].str.startswith("hard_") & ~rows["metric"].str.endswith(HARD_VERDICT_SUFFIXES)]
+    if hard.empty:
+        return []
+    names = list(dict.fromkeys(hard["metric"]))
+    table_rows = []
+    for (engine, solver), group in hard.groupby(["engine", "integrator"], sort=False):
+        cells = {r["metric"]: _hard_cell(r) for _, r in group.iterrows()}
+        table_rows.append(tuple([engine, solver] + [cells.get(n, "—") for n in names]))
+    notes = hard[hard["status"] == OK].drop_duplicates("metric")
+    return [Paragraph("Hard targets (✓ solved, ✗ the reason; position residual):"),
+            Table(tuple(["engine", "solver"] + [n.removeprefix("hard_") for n in names]), tuple(table_rows)),
+            Bullets(tuple(f"`{r['metric'].removeprefix('hard_')}`: {r['detail'].split('; ')[-1]}"
+                          for _, r in notes.iterrows()))]
+
+
+def _dynamics_verdicts(rows: pd.DataFrame) -> Table:
+    """Engine x integrator against each time step: the status each case earned."""
+    per_dt = rows[rows["dt"].notna()]
+    dts = sorted(per_dt["dt"].unique())
+    out = []
+    for (engine, integrator), group in per_dt.groupby(["engine", "integrator"], sort=False):
+        status = {dt: case_status(g["status"]) for dt, g in group.groupby("dt")}
+        out.append(tuple([engine, integrator] + [status.get(dt, "—") for dt in dts]))
+    return Table(tuple(["engine", "integrator"] + [f"dt {dt:g} s" for dt in dts]), tuple(out))
+
+
+def _verdict_line(name: str, rows: pd.DataFrame) -> str:
+    """One line per hard dynamics scene: how many cases earned each status, and which diverged."""
+    per_dt = rows[rows["dt"].notna()]
+    statuses = per_dt.groupby(["engine", "integrator", "dt"], sort=False)["status"].agg(case_status)
+    counts = statuses.value_counts()
+    diverged = sorted({f"{e} {i}" for (e, i, _), s in statuses.items() if s == "diverged"})
+    text = f"**{name}**: " + ", ".join(f"{s} {counts[s]}" for s in STATUSES if s in counts)
+    return text + (f"; diverged: {', '.join(diverged)}" if diverged else "")
+
+
+def _hard_cases(table: pd.DataFrame, info: dict) -> list[Block]:
+    """The verdict every engine earned on each scene of the hard suite in the run."""
+    scenes = [name for name, about in info.get("scenes", {}).items() if "hard" in about.get("suites", ())]
+    scenes = [name for name in scenes if (table["scene"] == name).any()]
+    if not scenes:
+        return []
+    blocks: list[Block] = [
+        Heading(2, "Hard cases", "hard-cases"),
+        Paragraph("The numerical-stability cases of the `hard` suite and the verdict each engine earned: a case is "
+                  "`diverged` when a conserved quantity or a speed left its bound, `ok` when it stayed bounded (its "
+                  "errors are in the scene's section). The verdict each must earn is in the shipped tolerances "
+                  "(`simparity check`).")]
+    lines = []
+    for name in scenes:
+        rows = table[table["scene"] == name]
+        if _kind(rows) == "ik":
+            solved = rows[rows["metric"].str.endswith("_solved") & (rows["status"] == OK)]
+            lines.append(f"**{name}**: {int(solved['value'].sum())} of {len(solved)} hard IK solves succeeded")
+        else:
+            lines.append(_verdict_line(name, rows))
+    blocks.append(Bullets(tuple(lines)))
+    for name in scenes:
+        rows = table[table["scene"] == name]
+        grid = _hard_table(rows) if _kind(rows) == "ik" else [_dynamics_verdicts(rows)]
+        blocks.append(Details(f"{name}: every verdict", tuple(grid), markdown=False))
+    return blocks
+
+
+def _kind(rows: pd.DataFrame) -> str:
+    if (rows["metric"] == "solve_rate").any():
+        return "ik"
+    return "dynamics" if rows["dt"].notna().any() else "kinematics"
+
+
+def _headline(about: dict) -> str:
+    return about.get("headline_metric", "position_error_max")
+
+
+def _scheme(case: pd.Series | None, unit: str) -> str:
+    if case is None:
+        return "none"
+    return (f"{case['engine']} {case['integrator']} @ dt {case['dt']:g}: {number(case['error'])} {unit}, "
+            f"{number(case['cost'])} s/s")
+
+
+_OVERHEAD_MARK = "†"
+
+
+def _overhead_mark(engine: str, about: dict) -> str:
+    """A mark on core's time when the scene's batch is small enough for per-call overhead to dominate."""
+    bodies = about.get("bodies")
+    return f" {_OVERHEAD_MARK}" if engine == "core" and bodies is not None and bodies < summary.OVERHEAD_DOMINATED_BODIES else ""
+
+
+class _Builder:
+    def __init__(self, table: pd.DataFrame, info: dict, series: pd.DataFrame, violations: list[str] | None,
+                 figure_dir: Path) -> None:
+        self.table, self.info, self.series, self.violations = table, info, series, violations
+        self.figure_dir = figure_dir
+        self.svgs: dict[str, str] = {}
+
+    def about(self, scene: str) -> dict:
+        return self.info.get("scenes", {}).get(scene, {})
+
+    def figure(self, fig, name: str, caption: str) -> list[Block]:
+        if fig is None:
+            return []
+        self.svgs[name] = figures.save(fig, self.figure_dir, name)
+        return [Figure(name, caption)]
+
+    # -- summary -------------------------------------------------------------------------------
+
+    def summary(self) -> list[Block]:
+        blocks: list[Block] = [Heading(2, "Summary", "summary")]
+        dyn_rows, ik_rows = [], []
+        for scene, rows in self.table.groupby("scene", sort=False):
+            kind, about = _kind(rows), self.about(scene)
+            if kind == "dynamics":
+                headline = _headline(about)
+                name, unit = _HEADLINE_NAMES[headline]
+                cases = summary.dynamics_cases(rows, headline)
+                cells = [f"[{scene}](#{_anchor(scene)})", f"{name} [{unit}] vs `{rows['reference'].iloc[0]}`"]
+                cells += [_scheme(summary.cheapest_within(cases, b), unit) for b in summary.ERROR_BUDGETS]
+                cells += [_scheme(summary.most_accurate_within(cases, b), unit) for b in summary.TIME_BUDGETS]
+                dyn_rows.append(tuple(cells))
+            elif kind == "ik":
+                best, fastest = summary.best_ik(summary.ik_solvers(rows[~rows["metric"].str.startswith("hard_")]))
+                ik_rows.append((f"[{scene}](#{_anchor(scene)})", _solver(best), _solver(fastest)))
+        if dyn_rows:
+            blocks += [
+                Heading(3, "Which integrator for this scene?", "which-integrator"),
+                Paragraph("Per dynamics scene, the cheapest engine × integrator × dt whose error is within each budget, "
+                          "and the most accurate within each compute budget (cost = compute per simulated second "
+                          "[s/s]; 1e-2 s/s is 100× faster than real time). Errors are in the scene's headline metric "
+                          "(the orientation error where a body turns, else the position error) against the named "
+                          f"reference; ground truths ({', '.join(GROUND_TRUTH_ENGINES)}) are not ranked. "
+                          "\"none\": no scheme run reached it."),
+                Table(("scene", "error (reference)") + tuple(f"error ≤ {b:g}" for b in summary.ERROR_BUDGETS)
+                      + tuple(f"most accurate at ≤ {b:g} s/s" for b in summary.TIME_BUDGETS), tuple(dyn_rows)),
+                Paragraph("Each dynamics scene's section below has its work-precision, convergence and drift figures "
+                          "and, per engine × integrator, the time step of least error with its cost and time per "
+                          "step, the observed order of that error (theory in brackets) and the status of its time "
+                          "steps; every engine × integrator × dt is in the HTML report and `results.csv`. "
+                          f"{_OVERHEAD_MARK} on core's time per step: the scene has fewer than "
+                          f"{summary.OVERHEAD_DOMINATED_BODIES} bodies, so the time is mostly NumPy's per-call "
+                          "overhead, not arithmetic; per body it falls tenfold and more with 100 bodies in one batch "
+                          "(`python benchmarks/batch_speed.py`).")]
+        if ik_rows:
+            blocks += [Heading(3, "Which IK solver?", "which-solver"),
+                       Paragraph(f"Best solve rate (the faster on a tie) and the fastest solver at ≥ "
+                                 f"{summary.SOLVED_ENOUGH:.0%} solve rate, on the scene's random targets."),
+                       Table(("scene", "best solve rate", f"fastest at ≥ {summary.SOLVED_ENOUGH:.0%}"), tuple(ik_rows))]
+        return blocks + self.findings() + self.unresolved()
+
+    def findings(self) -> list[Block]:
+        items = []
+        gains = summary.energy_gains(self.series) if not self.series.empty else pd.DataFrame()
+        for scene, g in gains.groupby("scene", sort=False) if not gains.empty else ():
+            cases = ", ".join(f"{r['engine']} {r['integrator']} +{number(r['gain_max'])} (dt "
+                              f"{', '.join(f'{d:g}' for d in r['dts'])})" for _, r in g.iterrows())
+            items.append(f"**energy gained** in {scene} (conserves energy; largest (E - E(0)) / E(0) per scheme): "
+                         + cases)
+        for _, s in summary.saturated(self.table).iterrows():
+            items.append(f"**saturated**: {s['scene']} `{s['metric']}` in {s['n_cases']} cases (n/a: the error "
+                         "lost all meaning there)")
+        blocks: list[Block] = [Heading(3, "Flagged findings", "findings")]
+        if self.violations is None:
+            items.append("**tolerances**: not checked in this report")
+        elif self.violations:
+            items.append(f"**outside the tolerances**: {len(self.violations)} metrics (an engine disagreeing with "
+                         "the truth or the others beyond its bound); listed below")
+        else:
+            items.append("**tolerances**: every bounded metric is inside its bound")
+        blocks.append(Bullets(tuple(items)) if items else Paragraph("Nothing flagged."))
+        if self.violations:
+            blocks.append(Details(f"{len(self.violations)} metrics outside their bounds",
+                                  (Bullets(tuple(f"`{v}`" for v in self.violations)),)))
+        return blocks
+
+    def unresolved(self) -> list[Block]:
+        groups = summary.unresolved_cases(self.table)
+        if groups.empty:
+            return [Heading(3, "Cases without a result", "unresolved"), Paragraph("None: every case was measured.")]
+        def line(g) -> str:
+            return f"{g['reason'] or 'no reason given'} — " + "; ".join(g["cases"])
+
+        # A failed or diverged run gets a line per reason; the n/a ones (the engine cannot, or nothing to fit)
+        # share a line per kind, their reasons separated by " · ".
+        alone = groups[groups["status"] != NOT_AVAILABLE]
+        lines = [f"**{g['status']}** ({g['n_cases']} cases): {line(g)}" for _, g in alone.iterrows()]
+        for order_fit, shared in groups[groups["status"] == NOT_AVAILABLE].groupby("order_fit", sort=False):
+            lines.append(f"**n/a** {'order fits' if order_fit else 'runs'} ({shared['n_cases'].sum()}): "
+                         + " · ".join(f"{line(g)} ({g['n_cases']})" for _, g in shared.iterrows()))
+        lines = tuple(lines)
+        return [Heading(3, "Cases without a result", "unresolved"),
+                Paragraph("Every failed, diverged or n/a case, grouped by its reason."), Bullets(lines)]
+
+    # -- scenes --------------------------------------------------------------------------------
+
+    def scene(self, scene: str, rows: pd.DataFrame) -> list[Block]:
+        kind, about = _kind(rows), self.about(scene)
+        reference = rows["reference"].iloc[0]
+        solved = rows[rows["metric"].str.endswith("_solved") & (rows["status"] == OK)]
+        hard = (f" Hard targets: {int(solved['value'].sum())} of {len(solved)} solves succeeded (each solver's "
+                "verdict per target: the HTML report, `results.csv`).") if not solved.empty else ""
+        blocks: list[Block] = [Heading(2, f"{scene} ({kind})", _anchor(scene)),
+                               Paragraph((f"{about['description']} " if about.get("description") else "")
+                                         + f"Reference: `{reference}`."
+                                         + (f" Scene file: `{about['source']}`." if about.get("source") else "")
+                                         + hard)]
+        series = self.series[self.series["scene"] == scene] if not self.series.empty else self.series
+        if kind == "dynamics":
+            blocks += self.dynamics(scene, rows, about, reference, series)
+        elif kind == "ik":
+            blocks += self.ik(scene, rows, about, reference, series)
+        else:
+            blocks.append(_table(rows, _KINEMATICS_COLUMNS, ["engine"]))
+        return blocks + _notes(rows)
+
+    def dynamics(self, scene, rows, about, reference, series) -> list[Block]:
+        headline = _headline(about)
+        name, unit = _HEADLINE_NAMES[headline]
+        cases = summary.dynamics_cases(rows, headline)
+        observed = summary.orders(rows, headline)
+        theory = self.info.get("theoretical_orders", {})
+        blocks = self.figure(figures.work_precision_figure(scene, cases, headline, reference), f"{scene}-work-precision",
+                             f"Work-precision: {name} [{unit}] against compute per simulated second, one point per dt.")
+        blocks += self.figure(figures.convergence_figure(scene, cases, headline, reference, observed, theory),
+                              f"{scene}-convergence", f"Convergence: {name} [{unit}] against dt, observed and "
+                              "theoretical order.")
+        blocks += self.figure(figures.drift_figure(scene, series, reference), f"{scene}-drift",
+                              "Drift over time at the coarsest dt, from the stored series.")
+        best = summary.best_per_scheme(cases)
+        table_rows = []
+        for _, b in best[best["statuses"] != f"{NOT_AVAILABLE} {summary.n_dts(cases)}"].iterrows():
+            p = theory.get(b["engine"], {}).get(b["integrator"])
+            fitted = observed.get((b["engine"], b["integrator"]), math.nan)
+            table_rows.append((b["engine"], b["integrator"], number(b["dt"]), number(b["error"]), number(b["cost"]),
+                               number(b["time_per_step"]) + _overhead_mark(b["engine"], about),
+                               f"{number(fitted)} ({p})" if p else number(fitted), b["statuses"]))
+        blocks += [Table(("engine", "integrator", "best dt [s]", f"error [{unit}]", "cost [s/s]", "time per step [s]",
+                          "order (theory)", "time steps"), tuple(table_rows))]
+
+        full = [_table(rows[rows["dt"].notna()], _DYNAMICS_COLUMNS, ["engine", "integrator", "dt"])]
+        orders = rows[rows["dt"].isna()]
+        if not orders.empty:
+            full += [Paragraph("Observed order of convergence: slope of log(error max) against log(dt) over the finest "
+                               "time steps whose local slopes agree; errors at the rounding floor or saturated are "
+                               "left out."), _table(orders, _ORDER_COLUMNS, ["engine", "integrator"])] + _fits(orders)
+        return blocks + [Details(f"{scene}: every engine × integrator × dt", tuple(full), markdown=False)]
+
+    def ik(self, scene, rows, about, reference, series) -> list[Block]:
+        solvers = summary.ik_solvers(rows[~rows["metric"].str.startswith("hard_")])
+        blocks = self.figure(figures.ik_rate_figure(scene, solvers, reference), f"{scene}-solve-rate",
+                             "Solve rate against time per solve.")
+        blocks += self.figure(figures.ik_distribution_figure(scene, series, about.get("position_tolerance")),
+                              f"{scene}-residuals", "Distributions of the position residual [m] and the iterations.")
+        blocks += self.figure(figures.fk_matrix_figure(scene, series), f"{scene}-fk-agreement",
+                              "Cross-engine FK agreement on every solution [m].")
+        plain = rows[~rows["metric"].str.startswith("hard_")].rename(columns={"integrator": "solver"})
+        measured = plain.groupby(["engine", "solver"], sort=False)["status"].transform(lambda s: (s != NOT_AVAILABLE).any())
+        compact = [c for c in _IK_COLUMNS if c[0] in _IK_COMPACT]
+        blocks.append(_table(plain[measured], compact, ["engine", "solver"]))
+        hard = _hard_table(rows)
+        return blocks + [Details(f"{scene}: every metric and hard target",
+                                 (_table(plain, _IK_COLUMNS, ["engine", "solver"]), *hard), markdown=False)]
+
+
+def _solver(row: pd.Series | None) -> str:
+    if row is None:
+        return "none"
+    return f"{row['engine']} {row['integrator']}: {row['solve_rate']:.1%} at {number(row['time_per_solve'])} s"
+
+
+def _anchor(scene: str) -> str:
+    return "scene-" + "".join(c if c.isalnum() else "-" for c in scene.lower())
+
+
+def build(table: pd.DataFrame, info: dict, series: pd.DataFrame, violations: list[str] | None,
+          run_dir: Path) -> tuple[list[Block], dict[str, str]]:
+    """(the report's blocks, the SVG text of each figure by name); figures are written to
+    ``run_dir/figures``. ``violations``: lines of metrics outside their tolerances, None if not checked."""
+    builder = _Builder(table, info, series, violations, Path(run_dir) / FIGURES_DIR)
+    versions = ", ".join(f"{k} {v}" for k, v in info.get("engine_versions", {}).items())
+    m = info.get("machine", {})
+    counts = case_counts(table.to_dict("records"))
+    blocks: list[Block] = [
+        Heading(1, "simparity report", "top"),
+        Paragraph(f"Run {info.get('created_utc', '?')} · commit {info.get('git_commit', '?')} · "
+                  f"{m.get('platform', '?')} · {m.get('cpu_count', '?')} CPUs · Python {m.get('python', '?')}"),
+        Paragraph(f"Engines: {versions}"),
+        Paragraph("Cases (failed or diverged if any row is, ok if anything was measured): "
+                  + ", ".join(f"{s} {counts[s]}" for s in STATUSES)
+                  + f". `{NOT_AVAILABLE}`: nothing was measured, and the rows say why. Errors are maxima over every "
+                  "body and sample against the reference named per scene; times are the best of several repeats of "
+                  "the stepping alone (model building excluded). Every value of every case: `results.csv`; sampled "
+                  "series: `series.csv.gz`."),
+    ]
+    blocks += builder.summary()
+    blocks += _hard_cases(table, info)
+    blocks += [Details("Definitions", (Paragraph(_DEFINITIONS), Paragraph(_IK_PROTOCOL)))]
+    for scene, rows in table.groupby("scene", sort=False):
+        blocks += builder.scene(scene, rows)
+    return blocks, builder.svgs

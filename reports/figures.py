@@ -1,0 +1,197 @@
+"""The report's figures, drawn with matplotlib (headless ``Agg``) from a stored run's rows and series.
+
+Each ``*_figure`` function returns a matplotlib Figure, or None when the run holds nothing to draw;
+:func:`save` writes it as SVG and PNG. Every axis names its quantity and unit, every title the
+reference the errors are measured against.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+matplotlib.rcParams["svg.hashsalt"] = "simparity"  # the same figure gives the same SVG text
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from simparity.reports.summary import ERROR_BUDGETS  # noqa: E402
+
+_ENGINE_MARKERS = {"core": "o", "mujoco": "s", "pybullet": "^", "pinocchio": "D"}
+_HEADLINE_LABELS = {"position_error_max": "position error max [m]",
+                    "orientation_error_max": "orientation error max [rad]"}
+_DRIFT_PANELS = [("energy_change", "|E(t) - E(0)| / |E(0)|"), ("angular_momentum_change", "|L(t) - L(0)| / |L(0)|"),
+                 ("position_error", "position error [m]"), ("orientation_error", "orientation error [rad]")]
+_WIDTH = 9.0
+"""[in] Figure width: a report column at 100 dpi."""
+
+
+def _style(index: int, engine: str) -> dict:
+    colors = plt.get_cmap("tab20").colors
+    return {"color": colors[index % len(colors)], "marker": _ENGINE_MARKERS.get(engine, "x"), "markersize": 4,
+            "linewidth": 1.2}
+
+
+def _legend(ax) -> None:
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, frameon=False)
+
+
+def _positive(values) -> np.ndarray:
+    values = np.asarray(values, dtype=float)
+    return np.where(values > 0, values, np.nan)
+
+
+def work_precision_figure(scene: str, cases: pd.DataFrame, headline: str, reference: str):
+    """Error (x, log) against cost per simulated second (y, log): one line per engine x integrator,
+    one point per dt, with the error budgets of the summary as dotted lines.
+
+    ``cases``: :func:`reports.summary.dynamics_cases`."""
+    measured = cases[(cases["status"] == "ok") & (cases["error"] > 0) & (cases["cost"] > 0)]
+    if measured.empty:
+        return None
+    fig, ax = plt.subplots(figsize=(_WIDTH, 4.8))
+    for i, ((engine, integrator), g) in enumerate(measured.groupby(["engine", "integrator"], sort=False)):
+        g = g.sort_values("dt")
+        ax.plot(g["error"], g["cost"], label=f"{engine} {integrator}", **_style(i, engine))
+    for budget in ERROR_BUDGETS:
+        ax.axvline(budget, color="0.6", linestyle=":", linewidth=0.8)
+    ax.set(xscale="log", yscale="log", xlabel=_HEADLINE_LABELS[headline],
+           ylabel="compute per simulated second [s/s]",
+           title=f"{scene}: work against precision (one point per dt; error against {reference})")
+    ax.grid(True, which="major", alpha=0.3)
+    _legend(ax)
+    fig.tight_layout()
+    return fig
+
+
+def convergence_figure(scene: str, cases: pd.DataFrame, headline: str, reference: str,
+                       observed: dict[tuple[str, str], float], theory: dict[str, dict[str, int]]):
+    """Error (log) against dt (log) per engine x integrator, the observed order in the legend, and the
+    theoretical slope drawn dashed through the finest point."""
+    measured = cases[(cases["status"] == "ok") & (cases["error"] > 0)]
+    if measured["dt"].nunique() < 2:
+        return None
+    fig, ax = plt.subplots(figsize=(_WIDTH, 4.8))
+    for i, ((engine, integrator), g) in enumerate(measured.groupby(["engine", "integrator"], sort=False)):
+        g = g.sort_values("dt")
+        style = _style(i, engine)
+        p = theory.get(engine, {}).get(integrator)
+        fitted = observed.get((engine, integrator), math.nan)
+        label = (f"{engine} {integrator}: observed {fitted:.2f}" if math.isfinite(fitted) else
+                 f"{engine} {integrator}: no fit") + (f", theory {p}" if p else "")
+        ax.plot(g["dt"], g["error"], label=label, **style)
+        if p and len(g) > 1:
+            dt0, e0 = g["dt"].iloc[0], g["error"].iloc[0]
+            dts = np.array([g["dt"].iloc[0], g["dt"].iloc[-1]])
+            ax.plot(dts, e0 * (dts / dt0) ** p, linestyle="--", linewidth=0.7, color=style["color"])
+    ax.set(xscale="log", yscale="log", xlabel="time step dt [s]", ylabel=_HEADLINE_LABELS[headline],
+           title=f"{scene}: convergence against {reference} (dashed: theoretical slope)")
+    ax.grid(True, which="major", alpha=0.3)
+    _legend(ax)
+    fig.tight_layout()
+    return fig
+
+
+def drift_figure(scene: str, series: pd.DataFrame, reference: str):
+    """Drift of the conserved quantities and error against time, at the scene's coarsest time step with
+    series (where drift shows most), one line per engine x integrator. Magnitudes on a log axis."""
+    timed = series[series["quantity"].isin([q for q, _ in _DRIFT_PANELS])]
+    if timed.empty or not timed["quantity"].isin(["energy_change", "angular_momentum_change"]).any():
+        return None
+    dt = timed["dt"].max()
+    at_dt = timed[timed["dt"] == dt]
+    # A panel whose values are all zero (a body that does not move) has nothing to show on a log axis.
+    panels = [(q, label) for q, label in _DRIFT_PANELS if (at_dt.loc[at_dt["quantity"] == q, "value"] != 0).any()]
+    fig, axes = plt.subplots(len(panels), 1, figsize=(_WIDTH, 2.3 * len(panels)), sharex=True, squeeze=False)
+    schemes = list(dict.fromkeys(zip(at_dt["engine"], at_dt["integrator"])))
+    for ax, (quantity, label) in zip(axes[:, 0], panels):
+        for i, (engine, integrator) in enumerate(schemes):
+            g = at_dt[(at_dt["quantity"] == quantity) & (at_dt["engine"] == engine) & (at_dt["integrator"] == integrator)]
+            if not g.empty:
+                ax.plot(g["x"], _positive(np.abs(g["value"])), label=f"{engine} {integrator}",
+                        **(_style(i, engine) | {"marker": None}))
+        ax.set(yscale="log", ylabel=label)
+        ax.grid(True, which="major", alpha=0.3)
+    axes[0, 0].set_title(f"{scene}: drift and error against time at dt = {dt:g} s (errors against {reference})")
+    axes[-1, 0].set_xlabel("time [s]")
+    _legend(axes[0, 0])
+    fig.tight_layout()
+    return fig
+
+
+def ik_rate_figure(scene: str, solvers: pd.DataFrame, reference: str):
+    """Solve rate against time per solve (log), one point per engine x solver."""
+    rated = solvers.dropna(subset=["solve_rate", "time_per_solve"])
+    if rated.empty:
+        return None
+    fig, ax = plt.subplots(figsize=(_WIDTH, 4.0))
+    for i, (_, r) in enumerate(rated.iterrows()):
+        ax.plot([r["time_per_solve"]], [r["solve_rate"]], linestyle="none",
+                label=f"{r['engine']} {r['integrator']}", **_style(i, r["engine"]) | {"markersize": 7})
+    ax.set(xscale="log", xlabel="time per solve [s]", ylabel="solve rate", ylim=(-0.03, 1.03),
+           title=f"{scene}: solve rate against time per solve (targets from {reference})")
+    ax.grid(True, alpha=0.3)
+    _legend(ax)
+    fig.tight_layout()
+    return fig
+
+
+def ik_distribution_figure(scene: str, series: pd.DataFrame, position_tolerance: float | None):
+    """Cumulative distributions of the position residual and the iterations per engine x solver."""
+    panels = [(q, label) for q, label in (("position_residual", "position residual [m]"),
+                                          ("iterations", "iterations")) if (series["quantity"] == q).any()]
+    if not panels:
+        return None
+    fig, axes = plt.subplots(1, len(panels), figsize=(_WIDTH, 3.8), squeeze=False)
+    for ax, (quantity, label) in zip(axes[0], panels):
+        rows = series[series["quantity"] == quantity]
+        for i, ((engine, solver), g) in enumerate(rows.groupby(["engine", "integrator"], sort=False)):
+            ax.plot(_positive(g["value"]), g["x"], label=f"{engine} {solver}", **(_style(i, engine) | {"marker": None}))
+        if quantity == "position_residual" and position_tolerance:
+            ax.axvline(position_tolerance, color="0.3", linestyle=":", linewidth=0.9, label="scene tolerance")
+        ax.set(xscale="log", xlabel=label, ylabel="fraction of targets at or below", ylim=(0, 1.02))
+        ax.grid(True, alpha=0.3)
+    axes[0, 0].set_title(f"{scene}: distributions over the random targets", loc="left")
+    _legend(axes[0, -1])
+    fig.tight_layout()
+    return fig
+
+
+def fk_matrix_figure(scene: str, series: pd.DataFrame):
+    """Largest end-effector distance [m] between every two engines' FK over all IK solutions."""
+    rows = series[series["quantity"] == "fk_disagreement_max"]
+    if rows.empty:
+        return None
+    names = list(dict.fromkeys(rows["engine"]))
+    matrix = np.full((len(names), len(names)), np.nan)
+    for _, r in rows.iterrows():
+        matrix[names.index(r["engine"]), names.index(r["integrator"])] = r["value"]
+    fig, ax = plt.subplots(figsize=(1.2 * len(names) + 2.5, 1.0 * len(names) + 1.2))
+    shown = np.log10(np.maximum(matrix, 1e-17))
+    image = ax.imshow(shown, cmap="viridis")
+    for i in range(len(names)):
+        for j in range(len(names)):
+            text = "—" if i == j else f"{matrix[i, j]:.1e}"
+            ax.text(j, i, text, ha="center", va="center", fontsize=8, color="white" if i != j else "0.5")
+    ax.set_xticks(range(len(names)), names)
+    ax.set_yticks(range(len(names)), names)
+    fig.colorbar(image, ax=ax, label="log10 distance [m]")
+    ax.set_title(f"{scene}: FK agreement, largest distance [m]", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def save(fig, folder: Path, name: str) -> str:
+    """Write ``name.svg`` and ``name.png`` into ``folder``; return the SVG text (for embedding)."""
+    folder.mkdir(parents=True, exist_ok=True)
+    buffer = io.StringIO()
+    fig.savefig(buffer, format="svg", metadata={"Date": None})
+    svg = buffer.getvalue()
+    (folder / f"{name}.svg").write_text(svg, encoding="utf-8")
+    fig.savefig(folder / f"{name}.png", dpi=100)
+    plt.close(fig)
+    return svg

@@ -1,0 +1,49 @@
+"""report.html in a real browser: headless Chromium (Debian's ``chromium``) opens it from disk, every
+figure renders with a non-zero size, the page asks no host for anything, and a screenshot is kept."""
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from simparity.comparisons.cli import main
+from simparity.core.results import REPORT_HTML_FILE
+
+ARTIFACTS = Path(__file__).resolve().parents[1] / "test-artifacts"
+"""Where the screenshot is written (kept by CI as a test artifact; ignored by git)."""
+
+BROWSERS = ("chromium", "chromium-browser", "google-chrome")
+
+
+def _browser() -> str:
+    found = next((path for name in BROWSERS if (path := shutil.which(name))), None)
+    if found is None:
+        pytest.skip(f"no browser to open the report: none of {', '.join(BROWSERS)} on PATH (.ci/run installs Debian's "
+                    "chromium)")
+    return found
+
+
+def test_report_renders_in_chromium_without_network(tmp_path):
+    sync_api = pytest.importorskip("playwright.sync_api", reason="playwright (a test dependency) is not installed")
+    browser_path = _browser()
+    run = tmp_path / "run"
+    assert main(["run", "dzhanibekov", "lecture-2link-ik", "--quick", "--repeats", "0", "--jobs", "1",
+                 "--engines", "core,analytic,mujoco", "--out", str(run)]) == 0
+    page_url = (run / REPORT_HTML_FILE).resolve().as_uri()
+    requests: list[str] = []
+    with sync_api.sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=browser_path, args=["--no-sandbox"])
+        page = browser.new_page(viewport={"width": 1280, "height": 900})
+        page.on("request", lambda request: requests.append(request.url))
+        page.goto(page_url, wait_until="load")
+        sizes = page.eval_on_selector_all(
+            "figure.plot svg", "els => els.map(e => { const r = e.getBoundingClientRect(); return [r.width, r.height]; })")
+        names = page.eval_on_selector_all("figure.plot", "els => els.map(e => e.dataset.name)")
+        ARTIFACTS.mkdir(exist_ok=True)
+        screenshot = ARTIFACTS / "report.png"
+        page.screenshot(path=str(screenshot), full_page=True)
+        browser.close()
+    assert len(sizes) == len(names) >= 5, names
+    assert all(width > 100 and height > 100 for width, height in sizes), list(zip(names, sizes))
+    assert requests == [page_url], f"the page asked for more than itself: {requests[1:]}"
+    assert screenshot.stat().st_size > 10_000
