@@ -16,7 +16,7 @@ import sys
 from pathlib import Path
 
 from simparity.comparisons import library
-from simparity.comparisons.check import BASELINE_RELATIVE, check_table, compare_with_baseline
+from simparity.comparisons.check import BASELINE_RELATIVE, CheckResult, check_table, compare_with_baseline
 from simparity.comparisons.check_output import junit_xml, summary_markdown
 from simparity.comparisons.engines import DEFAULT_ENGINES, ENGINE_NAMES, check_engine_names, make_engine
 from simparity.comparisons.history import history_path, latest_before, metric_history, record_run, run_table
@@ -31,6 +31,7 @@ from simparity.core.errors import HistoryError, SimparityError, UsageError, one_
 from simparity.core.ranges import RANGES
 from simparity.core.results import FAILED, RESULTS_FILE, RUN_INFO_FILE, case_counts
 from simparity.core.scene import SUITES, DynamicsScene, IKScene, KinematicsScene
+from simparity.reports.content import ToleranceVerdict
 from simparity.reports.render import write_report
 from simparity.reports.store import read_run
 
@@ -241,11 +242,11 @@ def cmd_run(args, out) -> int:
     except SimparityError:
         _write_report(out_dir, out, bounds)  # keep what was computed, then report the error
         raise
-    _write_report(out_dir, out, bounds)
+    checked = _write_report(out_dir, out, bounds)
     _record(out_dir, args.history)
     code = EXIT_FAILED_CASES if failed else EXIT_OK
     if bounds is not None:
-        code = max(code, _check(out_dir, bounds, args, out))
+        code = max(code, _check(out_dir, bounds, args, out, checked))
     return code
 
 
@@ -259,13 +260,16 @@ def _record(out_dir: Path, history_option: str | None) -> None:
               file=sys.stderr)
 
 
-def _write_report(out_dir: Path, out, bounds=None) -> None:
+def _write_report(out_dir: Path, out, bounds=None) -> CheckResult:
     """report.md, report.html and figures/ of the run; its metrics are held to ``bounds`` (default: the
-    shipped tolerances) for the report's flagged findings, which never changes an exit code."""
+    shipped tolerances) for the report's flagged findings, which never changes an exit code. Returns
+    that verdict, for ``--check`` to print."""
     table, _ = read_run(out_dir)
     result = check_table(table, bounds if bounds is not None else load_tolerances(DEFAULT_TOLERANCES))
-    markdown, page = write_report(out_dir, [v.line() for v in result.violations])
+    verdict = ToleranceVerdict(result.checked, result.unchecked, tuple(v.line() for v in result.violations))
+    markdown, page = write_report(out_dir, verdict)
     print(f"results: {Path(out_dir) / RESULTS_FILE}\nreport:  {markdown}\n         {page}", file=out)
+    return result
 
 
 def _baseline_table(option: str, run_dir: Path, history_option: str | None):
@@ -276,10 +280,11 @@ def _baseline_table(option: str, run_dir: Path, history_option: str | None):
     return read_run(Path(option))[0]
 
 
-def _check(run_dir: Path, bounds, args, out) -> int:
-    """Print the verdict on a stored run (and the moves since the baseline); 0 passed, 1 not."""
+def _check(run_dir: Path, bounds, args, out, result: CheckResult | None = None) -> int:
+    """Print the verdict on a stored run (and the moves since the baseline); 0 passed, 1 not.
+    ``result``: the run already held to ``bounds``."""
     table, _ = read_run(run_dir)
-    result = check_table(table, bounds)
+    result = check_table(table, bounds) if result is None else result
     diff = None
     if args.baseline:
         if not math.isfinite(args.baseline_rel) or args.baseline_rel < 0:

@@ -11,6 +11,7 @@ in-house code these metrics judge.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -177,27 +178,69 @@ def _relative_drift(change: np.ndarray, scale: np.ndarray, quantity: str) -> Mea
     return Measured(drift, "1")
 
 
-def drifts(scene: DynamicsScene, traj: Trajectory) -> dict[str, Measured]:
-    """Relative drifts of what the scene conserves, the worst body's:
+@dataclass(frozen=True)
+class ConservedChanges:
+    """How far what a scene conserves moved, per sample and body; None where the scene does not
+    conserve it (:func:`dynamics_metrics`). Computed once per case, read by the drift metrics and
+    the sampled series.
 
-    - ``energy_drift_max`` = max_t |E(t) - E(0)| / |E(0)| (fallback: :func:`energy_scale`);
-    - ``angular_momentum_drift_max`` = max_t |L(t) - L(0)| / |L(0)|, L about the COM.
+    Attributes
+    ----------
+    energy : (T, B) ndarray or None
+        E(t) - E(0) [J], signed.
+    energy_scale : (B,) ndarray or None
+        What energy drift is relative to (:func:`energy_scale`).
+    energy_fallback : (B,) ndarray of bool or None
+        Where that scale is the fallback (|E(0)| near zero).
+    angular_momentum : (T, B) ndarray or None
+        |L(t) - L(0)| [kg m^2/s], L about the COM.
+    angular_momentum_size : (B,) ndarray or None
+        |L(0)|.
     """
+
+    energy: np.ndarray | None = None
+    energy_scale: np.ndarray | None = None
+    energy_fallback: np.ndarray | None = None
+    angular_momentum: np.ndarray | None = None
+    angular_momentum_size: np.ndarray | None = None
+
+
+def conserved_changes(scene: DynamicsScene, traj: Trajectory) -> ConservedChanges:
+    """Energy and angular momentum changes of ``traj`` where the scene conserves them."""
     wanted = dynamics_metrics(scene)
     out = {}
     if "energy_drift_max" in wanted:
         energy, kinetic, potential = energies(scene, traj)
         scale, fallback = energy_scale(kinetic, potential)
-        drift = _relative_drift(np.abs(energy - energy[0]), scale, "energy")
-        if fallback[scale > 0].any() and not drift.unmeasurable:
-            drift = Measured(drift.value, "1", note=(
-                f"relative to the run's largest kinetic energy: |E(0)| < {ENERGY_NEAR_ZERO:g} x its energies"))
-        out["energy_drift_max"] = drift
+        out |= {"energy": energy - energy[0], "energy_scale": scale, "energy_fallback": fallback}
     if "angular_momentum_drift_max" in wanted:
         inertia = np.stack([b.inertia_body for b in scene.bodies])
         momentum = angular_momentum_world(inertia, traj.angular_velocity_world, quat_wxyz_to_matrix(traj.quat_wxyz))
-        out["angular_momentum_drift_max"] = _relative_drift(
-            np.linalg.norm(momentum - momentum[0], axis=-1), np.linalg.norm(momentum[0], axis=-1), "angular momentum")
+        out |= {"angular_momentum": np.linalg.norm(momentum - momentum[0], axis=-1),
+                "angular_momentum_size": np.linalg.norm(momentum[0], axis=-1)}
+    return ConservedChanges(**out)
+
+
+def drifts(scene: DynamicsScene, traj: Trajectory, changes: ConservedChanges | None = None) -> dict[str, Measured]:
+    """Relative drifts of what the scene conserves, the worst body's:
+
+    - ``energy_drift_max`` = max_t |E(t) - E(0)| / |E(0)| (fallback: :func:`energy_scale`);
+    - ``angular_momentum_drift_max`` = max_t |L(t) - L(0)| / |L(0)|, L about the COM.
+
+    ``changes``: :func:`conserved_changes` of ``traj`` when already computed.
+    """
+    changes = changes or conserved_changes(scene, traj)
+    out = {}
+    if changes.energy is not None:
+        scale = changes.energy_scale
+        drift = _relative_drift(np.abs(changes.energy), scale, "energy")
+        if changes.energy_fallback[scale > 0].any() and not drift.unmeasurable:
+            drift = Measured(drift.value, "1", note=(
+                f"relative to the run's largest kinetic energy: |E(0)| < {ENERGY_NEAR_ZERO:g} x its energies"))
+        out["energy_drift_max"] = drift
+    if changes.angular_momentum is not None:
+        out["angular_momentum_drift_max"] = _relative_drift(changes.angular_momentum, changes.angular_momentum_size,
+                                                            "angular momentum")
     return out
 
 

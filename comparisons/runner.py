@@ -21,6 +21,7 @@ from simparity.comparisons.metrics import (
     ORDER_SOURCES,
     ROTATIONAL_ORDERS,
     SATURATED_ORIENTATION,
+    conserved_changes,
     drifts,
     dynamics_metrics,
     kinematics_errors,
@@ -164,9 +165,10 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
         if blown:
             return _CaseResult(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values),
                                integrates_rotation=sim.integrates_rotation)
-        values.update(drifts(scene, traj))
+        changes = conserved_changes(scene, traj)
+        values.update(drifts(scene, traj, changes))
         if series is not None:
-            series += dynamics_series(scene, case, traj, ref_traj)
+            series += dynamics_series(case, traj, ref_traj, changes)
         floors = rounding_floors(scene, traj, n)
         if ref_traj is None:
             problem, status = ref_problem

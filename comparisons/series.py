@@ -7,13 +7,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from simparity.comparisons.invariants import angular_momentum_world
-from simparity.comparisons.metrics import dynamics_metrics, energies, energy_scale
+from simparity.comparisons.metrics import ConservedChanges
 from simparity.comparisons.rows import Case
 from simparity.core.results import SERIES_POINTS, SeriesRecord
-from simparity.core.scene import DynamicsScene
 from simparity.core.trajectory import Trajectory
-from simparity.references.conventions import quat_wxyz_angle, quat_wxyz_to_matrix
+from simparity.references.conventions import quat_wxyz_angle
 
 
 def envelope(times: np.ndarray, values: np.ndarray, points: int = SERIES_POINTS) -> tuple[np.ndarray, np.ndarray]:
@@ -32,8 +30,7 @@ def envelope(times: np.ndarray, values: np.ndarray, points: int = SERIES_POINTS)
 
 
 def _record(case: Case, quantity: str, unit: str, x: np.ndarray, value: np.ndarray) -> SeriesRecord:
-    return SeriesRecord(case.scene, case.engine, case.integrator, case.dt, quantity, unit,
-                        tuple(float(v) for v in x), tuple(float(v) for v in value))
+    return SeriesRecord(case.scene, case.engine, case.integrator, case.dt, quantity, unit, x, value)
 
 
 def _worst(change: np.ndarray, scale: np.ndarray) -> np.ndarray:
@@ -43,26 +40,19 @@ def _worst(change: np.ndarray, scale: np.ndarray) -> np.ndarray:
     return np.take_along_axis(relative, np.argmax(np.abs(relative), axis=1)[:, None], axis=1)[:, 0]
 
 
-def dynamics_series(scene: DynamicsScene, case: Case, traj: Trajectory, ref: Trajectory | None) -> list[SeriesRecord]:
-    """Drift of what the scene conserves and error against ``ref`` (when there is one), against time."""
-    wanted = dynamics_metrics(scene)
-    times = np.asarray(traj.times, dtype=float)
+def dynamics_series(case: Case, traj: Trajectory, ref: Trajectory | None,
+                    changes: ConservedChanges) -> list[SeriesRecord]:
+    """Drift of what the scene conserves (``changes``: :func:`comparisons.metrics.conserved_changes` of
+    ``traj``) and error against ``ref`` (when there is one), against time."""
     out: list[tuple[str, str, np.ndarray]] = []
-    if "energy_drift_max" in wanted:
-        energy, kinetic, potential = energies(scene, traj)
-        scale, _ = energy_scale(kinetic, potential)
-        if (scale > 0).any():
-            out.append(("energy_change", "1", _worst(energy - energy[0], scale)))
-    if "angular_momentum_drift_max" in wanted:
-        inertia = np.stack([b.inertia_body for b in scene.bodies])
-        momentum = angular_momentum_world(inertia, traj.angular_velocity_world, quat_wxyz_to_matrix(traj.quat_wxyz))
-        size = np.linalg.norm(momentum[0], axis=-1)
-        if (size > 0).any():
-            out.append(("angular_momentum_change", "1",
-                        _worst(np.linalg.norm(momentum - momentum[0], axis=-1), size)))
+    if changes.energy is not None and (changes.energy_scale > 0).any():
+        out.append(("energy_change", "1", _worst(changes.energy, changes.energy_scale)))
+    if changes.angular_momentum is not None and (changes.angular_momentum_size > 0).any():
+        out.append(("angular_momentum_change", "1", _worst(changes.angular_momentum, changes.angular_momentum_size)))
     if ref is not None:
         out.append(("position_error", "m", np.linalg.norm(traj.position_world - ref.position_world, axis=-1).max(axis=1)))
         out.append(("orientation_error", "rad", quat_wxyz_angle(traj.quat_wxyz, ref.quat_wxyz).max(axis=1)))
+    times = np.asarray(traj.times, dtype=float)
     return [_record(case, quantity, unit, *envelope(times, values)) for quantity, unit, values in out]
 
 

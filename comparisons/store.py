@@ -9,6 +9,7 @@ import platform
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from simparity.comparisons.metrics import headline_metric
@@ -65,6 +66,12 @@ def _orders(engine: Engine) -> dict[str, int]:
     return {i: order for i, order in orders.items() if order is not None}
 
 
+def _variants(engine: Engine) -> dict[str, list[str]]:
+    """{integrator: [scheme, variant]} of the integrators that are variants of a scheme."""
+    parts = {i: list(engine.integrator_variant(i)) for i in engine.integrators()}
+    return {i: p for i, p in parts.items() if p[1]}
+
+
 def _scene_info(scene) -> dict:
     """What a report needs of a scene beside its rows: what it is, where from, and for dynamics
     the number of bodies (per-call overhead) and the error its schemes are ranked by."""
@@ -75,6 +82,15 @@ def _scene_info(scene) -> dict:
     if isinstance(scene, IKScene):
         info |= {"position_tolerance": scene.position_tolerance}
     return info
+
+
+def _series_frame(series: list[SeriesRecord]) -> pd.DataFrame:
+    """The points of ``series`` as rows of :data:`SERIES_COLUMNS`: each record's keys repeated along its points."""
+    lengths = [len(record.x) for record in series]
+    keys = {column: np.repeat([getattr(record, column) for record in series], lengths)
+            for column in SERIES_COLUMNS if column not in ("x", "value")}
+    return pd.DataFrame(keys | {"x": np.concatenate([r.x for r in series]),
+                                "value": np.concatenate([r.value for r in series])}, columns=list(SERIES_COLUMNS))
 
 
 class RunWriter:
@@ -97,6 +113,7 @@ class RunWriter:
             "engine_versions": {e.name: e.version() for e in engines},
             "theoretical_orders": {e.name: orders for e in engines
                                    if (orders := _orders(e))},
+            "integrator_variants": {e.name: variants for e in engines if (variants := _variants(e))},
             "scenes": {s.name: _scene_info(s) for s in scenes},
         }
         (self.out_dir / RUN_INFO_FILE).write_text(json.dumps(info, indent=2) + "\n", encoding="utf-8")
@@ -106,5 +123,5 @@ class RunWriter:
         frame.to_csv(self.results_path, mode="a", header=False, index=False, float_format="%.17g")
         if series:
             # Each append is one more gzip member; readers (gzip, pandas) read the members as one file.
-            points = pd.DataFrame([p for record in series for p in record.as_rows()], columns=list(SERIES_COLUMNS))
+            points = _series_frame(series)
             points.to_csv(self.series_path, mode="a", header=False, index=False, float_format="%.9g")

@@ -168,6 +168,12 @@ class Engine(abc.ABC):
         scene). Reports draw it beside the observed order."""
         return None
 
+    def integrator_variant(self, integrator: str) -> tuple[str, str]:
+        """(scheme, variant) of an integrator: integrators that differ only in a variant of one scheme
+        (core's orientation updates of RK4, say) share the scheme, and reports put them on one row.
+        "" when the integrator has no variants."""
+        return integrator, ""
+
     def ik_solvers(self) -> tuple[str, ...]:
         """Names of the IK solvers the engine offers (empty if none)."""
         return ()

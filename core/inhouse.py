@@ -21,6 +21,8 @@ from simparity.core.scene import Chain, DynamicsScene
 from simparity.core.trajectory import FramePoses, Trajectory
 
 _DEFAULT_ORIENTATION = "quaternion"
+_SINGLE_ORIENTATION_SCHEMES = ("engine_euler",)
+"""Schemes with one orientation update of their own (the engines' scheme: always the exponential map)."""
 
 
 def integrator_names() -> tuple[str, ...]:
@@ -28,7 +30,7 @@ def integrator_names() -> tuple[str, ...]:
     names = []
     for scheme in SCHEMES:
         names.append(scheme)
-        if scheme != "engine_euler":  # always the exponential map: no variants
+        if scheme not in _SINGLE_ORIENTATION_SCHEMES:
             names.extend(f"{scheme}+{o}" for o in ORIENTATION_UPDATES if o != _DEFAULT_ORIENTATION)
     return tuple(names) + tuple(point_mass.RULES)
 
@@ -134,6 +136,13 @@ class InHouseEngine(Engine):
 
     def integrators(self) -> tuple[str, ...]:
         return integrator_names()
+
+    def integrator_variant(self, integrator: str) -> tuple[str, str]:
+        """(scheme, orientation update) of a rigid-body integrator; a particle rule has no variants."""
+        scheme, orientation = parse_integrator(integrator)
+        if integrator in point_mass.RULES or scheme in _SINGLE_ORIENTATION_SCHEMES:
+            return integrator, ""
+        return scheme, orientation
 
     def theoretical_order(self, integrator: str) -> int | None:
         """The scheme's order (:data:`core.integrators.ORDER`); the particle rules' depend on the scene."""

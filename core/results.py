@@ -8,6 +8,10 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
+import numpy as np
+
+from simparity.core.arrays import readonly
+
 SCHEMA_VERSION = 1
 RESULTS_FILE = "results.csv"
 RUN_INFO_FILE = "run.json"
@@ -112,7 +116,7 @@ the default suite keeps its series in a few megabytes."""
 
 @dataclass(frozen=True)
 class SeriesRecord:
-    """One sampled series of a case: ``value`` against ``x`` (both (K,), K <= SERIES_POINTS)."""
+    """One sampled series of a case: ``value`` against ``x``, both (K,) read-only arrays, K <= SERIES_POINTS."""
 
     scene: str
     engine: str
@@ -120,10 +124,12 @@ class SeriesRecord:
     dt: float
     quantity: str
     unit: str
-    x: tuple
-    value: tuple
+    x: np.ndarray
+    value: np.ndarray
 
-    def as_rows(self) -> list[dict]:
-        head = {"scene": self.scene, "engine": self.engine, "integrator": self.integrator, "dt": self.dt,
-                "quantity": self.quantity, "unit": self.unit}
-        return [{**head, "x": x, "value": v} for x, v in zip(self.x, self.value)]
+    def __post_init__(self) -> None:
+        x, value = np.asarray(self.x, dtype=float), np.asarray(self.value, dtype=float)
+        if x.ndim != 1 or x.shape != value.shape:
+            raise ValueError(f"SeriesRecord x {x.shape} and value {value.shape} must be two (K,) arrays")
+        object.__setattr__(self, "x", readonly(x))
+        object.__setattr__(self, "value", readonly(value))

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 
@@ -10,7 +11,12 @@ from dataclasses import dataclass, field
 class Heading:
     level: int
     text: str
-    anchor: str = ""
+
+    @property
+    def anchor(self) -> str:
+        """The id GitHub gives this heading in rendered Markdown (lower case, punctuation dropped, spaces
+        to hyphens), so a ``[...](#anchor)`` link works in report.md on GitHub and in report.html alike."""
+        return re.sub(r"[^\w\- ]", "", self.text.lower()).replace(" ", "-")
 
 
 @dataclass(frozen=True)

@@ -5,6 +5,7 @@ a compact table and (folded) the full one. Reads a stored run only; figures are 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
@@ -23,6 +24,16 @@ from simparity.reports.blocks import Block, Bullets, Details, Figure, Heading, P
 
 FIGURES_DIR = "figures"
 """Sub-folder of the run folder the figures are written to (SVG and PNG)."""
+
+@dataclass(frozen=True)
+class ToleranceVerdict:
+    """The run held to tolerances, as the report's flagged findings show it: how many metrics had a bound,
+    how many had none, and one line per metric outside its bound."""
+
+    checked: int
+    unchecked: int
+    violations: tuple[str, ...] = ()
+
 
 _DYNAMICS_COLUMNS = [
     ("position_error_max", "position error max [m]"),
@@ -120,8 +131,7 @@ def _table(scene_rows: pd.DataFrame, columns, keys: list[str]) -> Table:
 def _notes(scene_rows: pd.DataFrame) -> list[Block]:
     timed = scene_rows["metric"].isin(_TIMING_METRICS)
     ok = scene_rows[timed & (scene_rows["status"] == OK)].drop_duplicates(["engine", "integrator"])
-    items = tuple(f"**{r['engine']} {r['integrator']}**".replace(" **", "**") + f": {r['detail']}"
-                  for _, r in ok.iterrows())
+    items = tuple(f"**{' '.join(filter(None, (r['engine'], r['integrator'])))}**: {r['detail']}" for _, r in ok.iterrows())
     return [Details("What each engine was given", (Bullets(items),), markdown=False)] if items else []
 
 
@@ -129,6 +139,13 @@ def _fits(orders: pd.DataFrame) -> list[Block]:
     fitted = orders[orders["status"] == OK]
     return [Bullets(tuple(f"{r['engine']} {r['integrator']} `{r['metric']}` = {number(r['value'])}: {r['detail']}"
                           for _, r in fitted.iterrows()))] if not fitted.empty else []
+
+
+def _hard_solved(rows: pd.DataFrame) -> tuple[int, int]:
+    """(hard IK solves that succeeded, hard IK solves measured) of a scene's rows."""
+    verdicts = rows[rows["metric"].str.startswith("hard_") & rows["metric"].str.endswith("_solved")
+                    & (rows["status"] == OK)]
+    return int(verdicts["value"].sum()), len(verdicts)
 
 
 def _hard_cell(row) -> str:
@@ -183,7 +200,7 @@ def _hard_cases(table: pd.DataFrame, info: dict) -> list[Block]:
     if not scenes:
         return []
     blocks: list[Block] = [
-        Heading(2, "Hard cases", "hard-cases"),
+        Heading(2, "Hard cases"),
         Paragraph("The numerical-stability cases of the `hard` suite and the verdict each engine earned: a case is "
                   "`diverged` when a conserved quantity or a speed left its bound, `ok` when it stayed bounded (its "
                   "errors are in the scene's section). The verdict each must earn is in the shipped tolerances "
@@ -192,8 +209,8 @@ def _hard_cases(table: pd.DataFrame, info: dict) -> list[Block]:
     for name in scenes:
         rows = table[table["scene"] == name]
         if _kind(rows) == "ik":
-            solved = rows[rows["metric"].str.endswith("_solved") & (rows["status"] == OK)]
-            lines.append(f"**{name}**: {int(solved['value'].sum())} of {len(solved)} hard IK solves succeeded")
+            solved, total = _hard_solved(rows)
+            lines.append(f"**{name}**: {solved} of {total} hard IK solves succeeded")
         else:
             lines.append(_verdict_line(name, rows))
     blocks.append(Bullets(tuple(lines)))
@@ -231,9 +248,9 @@ def _overhead_mark(engine: str, about: dict) -> str:
 
 
 class _Builder:
-    def __init__(self, table: pd.DataFrame, info: dict, series: pd.DataFrame, violations: list[str] | None,
+    def __init__(self, table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: ToleranceVerdict | None,
                  figure_dir: Path) -> None:
-        self.table, self.info, self.series, self.violations = table, info, series, violations
+        self.table, self.info, self.series, self.verdict = table, info, series, verdict
         self.figure_dir = figure_dir
         self.svgs: dict[str, str] = {}
 
@@ -249,7 +266,7 @@ class _Builder:
     # -- summary -------------------------------------------------------------------------------
 
     def summary(self) -> list[Block]:
-        blocks: list[Block] = [Heading(2, "Summary", "summary")]
+        blocks: list[Block] = [Heading(2, "Summary")]
         dyn_rows, ik_rows = [], []
         for scene, rows in self.table.groupby("scene", sort=False):
             kind, about = _kind(rows), self.about(scene)
@@ -257,16 +274,16 @@ class _Builder:
                 headline = _headline(about)
                 name, unit = _HEADLINE_NAMES[headline]
                 cases = summary.dynamics_cases(rows, headline)
-                cells = [f"[{scene}](#{_anchor(scene)})", f"{name} [{unit}] vs `{rows['reference'].iloc[0]}`"]
+                cells = [f"[{scene}](#{_scene_heading(scene, kind).anchor})", f"{name} [{unit}] vs `{rows['reference'].iloc[0]}`"]
                 cells += [_scheme(summary.cheapest_within(cases, b), unit) for b in summary.ERROR_BUDGETS]
                 cells += [_scheme(summary.most_accurate_within(cases, b), unit) for b in summary.TIME_BUDGETS]
                 dyn_rows.append(tuple(cells))
             elif kind == "ik":
                 best, fastest = summary.best_ik(summary.ik_solvers(rows[~rows["metric"].str.startswith("hard_")]))
-                ik_rows.append((f"[{scene}](#{_anchor(scene)})", _solver(best), _solver(fastest)))
+                ik_rows.append((f"[{scene}](#{_scene_heading(scene, kind).anchor})", _solver(best), _solver(fastest)))
         if dyn_rows:
             blocks += [
-                Heading(3, "Which integrator for this scene?", "which-integrator"),
+                Heading(3, "Which integrator for this scene?"),
                 Paragraph("Per dynamics scene, the cheapest engine × integrator × dt whose error is within each budget, "
                           "and the most accurate within each compute budget (cost = compute per simulated second "
                           "[s/s]; 1e-2 s/s is 100× faster than real time). Errors are in the scene's headline metric "
@@ -278,13 +295,16 @@ class _Builder:
                 Paragraph("Each dynamics scene's section below has its work-precision, convergence and drift figures "
                           "and, per engine × integrator, the time step of least error with its cost and time per "
                           "step, the observed order of that error (theory in brackets) and the status of its time "
-                          "steps; every engine × integrator × dt is in the HTML report and `results.csv`. "
+                          "steps; an integrator with variants (core's orientation updates: quaternion, matrix, "
+                          "expmap) has one row, each cell listing its variants' values in the order named, or one "
+                          "value where they agree. Every engine × integrator × dt is in the HTML report and "
+                          "`results.csv`. "
                           f"{_OVERHEAD_MARK} on core's time per step: the scene has fewer than "
                           f"{summary.OVERHEAD_DOMINATED_BODIES} bodies, so the time is mostly NumPy's per-call "
                           "overhead, not arithmetic; per body it falls tenfold and more with 100 bodies in one batch "
                           "(`python benchmarks/batch_speed.py`).")]
         if ik_rows:
-            blocks += [Heading(3, "Which IK solver?", "which-solver"),
+            blocks += [Heading(3, "Which IK solver?"),
                        Paragraph(f"Best solve rate (the faster on a tie) and the fastest solver at ≥ "
                                  f"{summary.SOLVED_ENOUGH:.0%} solve rate, on the scene's random targets."),
                        Table(("scene", "best solve rate", f"fastest at ≥ {summary.SOLVED_ENOUGH:.0%}"), tuple(ik_rows))]
@@ -292,8 +312,7 @@ class _Builder:
 
     def findings(self) -> list[Block]:
         items = []
-        gains = summary.energy_gains(self.series) if not self.series.empty else pd.DataFrame()
-        for scene, g in gains.groupby("scene", sort=False) if not gains.empty else ():
+        for scene, g in summary.energy_gains(self.series).groupby("scene", sort=False):
             cases = ", ".join(f"{r['engine']} {r['integrator']} +{number(r['gain_max'])} (dt "
                               f"{', '.join(f'{d:g}' for d in r['dts'])})" for _, r in g.iterrows())
             items.append(f"**energy gained** in {scene} (conserves energy; largest (E - E(0)) / E(0) per scheme): "
@@ -301,59 +320,80 @@ class _Builder:
         for _, s in summary.saturated(self.table).iterrows():
             items.append(f"**saturated**: {s['scene']} `{s['metric']}` in {s['n_cases']} cases (n/a: the error "
                          "lost all meaning there)")
-        blocks: list[Block] = [Heading(3, "Flagged findings", "findings")]
-        if self.violations is None:
+        blocks: list[Block] = [Heading(3, "Flagged findings")]
+        verdict = self.verdict
+        unbounded = f"; {verdict.unchecked} without a bound, so not held to anything" if verdict and verdict.unchecked else ""
+        if verdict is None:
             items.append("**tolerances**: not checked in this report")
-        elif self.violations:
-            items.append(f"**outside the tolerances**: {len(self.violations)} metrics (an engine disagreeing with "
-                         "the truth or the others beyond its bound); listed below")
+        elif verdict.violations:
+            items.append(f"**outside the tolerances**: {len(verdict.violations)} of {verdict.checked} checked metrics "
+                         f"(an engine disagreeing with the truth or the others beyond its bound; listed below){unbounded}")
+        elif verdict.checked:
+            items.append(f"**tolerances**: all {verdict.checked} checked metrics inside their bounds{unbounded}")
         else:
-            items.append("**tolerances**: every bounded metric is inside its bound")
-        blocks.append(Bullets(tuple(items)) if items else Paragraph("Nothing flagged."))
-        if self.violations:
-            blocks.append(Details(f"{len(self.violations)} metrics outside their bounds",
-                                  (Bullets(tuple(f"`{v}`" for v in self.violations)),)))
+            items.append(f"**tolerances**: nothing checked: no bound matches this run's metrics ({verdict.unchecked} "
+                         "without a bound)")
+        blocks.append(Bullets(tuple(items)))
+        if verdict and verdict.violations:
+            blocks.append(Details(f"{len(verdict.violations)} metrics outside their bounds",
+                                  (Bullets(tuple(f"`{v}`" for v in verdict.violations)),)))
         return blocks
 
     def unresolved(self) -> list[Block]:
-        groups = summary.unresolved_cases(self.table)
-        if groups.empty:
-            return [Heading(3, "Cases without a result", "unresolved"), Paragraph("None: every case was measured.")]
-        def line(g) -> str:
-            return f"{g['reason'] or 'no reason given'} — " + "; ".join(g["cases"])
+        cases = summary.unresolved_cases(self.table)
+        if cases.empty:
+            return [Heading(3, "Cases without a result"), Paragraph("None: every case was measured.")]
 
-        # A failed or diverged run gets a line per reason; the n/a ones (the engine cannot, or nothing to fit)
-        # share a line per kind, their reasons separated by " · ".
-        alone = groups[groups["status"] != NOT_AVAILABLE]
-        lines = [f"**{g['status']}** ({g['n_cases']} cases): {line(g)}" for _, g in alone.iterrows()]
-        for order_fit, shared in groups[groups["status"] == NOT_AVAILABLE].groupby("order_fit", sort=False):
+        def label(c) -> str:
+            dts = f" (dt {', '.join(f'{dt:g}' for dt in c['dts'])})" if c["dts"] else ""
+            return f"{c['engine']} {c['integrator']}".strip() + dts
+
+        # Failed and diverged cases get a line per scene, each case with its reason; n/a cases (the engine
+        # cannot, or nothing to fit) share one line per kind, grouped by reason.
+        lines = []
+        for (status, scene), group in cases[cases["status"] != NOT_AVAILABLE].groupby(["status", "scene"], sort=False):
+            lines.append(f"**{status}** in {scene} ({group['n_cases'].sum()} cases): "
+                         + "; ".join(f"{label(c)}: {c['reason'] or 'no reason given'}" for _, c in group.iterrows()))
+        for order_fit, shared in cases[cases["status"] == NOT_AVAILABLE].groupby("order_fit", sort=False):
+            reasons = [f"{reason or 'no reason given'} ({g['n_cases'].sum()}) — "
+                       + "; ".join(f"{c['scene']} {label(c)}" for _, c in g.iterrows())
+                       for reason, g in shared.groupby("reason", sort=False)]
             lines.append(f"**n/a** {'order fits' if order_fit else 'runs'} ({shared['n_cases'].sum()}): "
-                         + " · ".join(f"{line(g)} ({g['n_cases']})" for _, g in shared.iterrows()))
-        lines = tuple(lines)
-        return [Heading(3, "Cases without a result", "unresolved"),
-                Paragraph("Every failed, diverged or n/a case, grouped by its reason."), Bullets(lines)]
+                         + " · ".join(reasons))
+        return [Heading(3, "Cases without a result"),
+                Paragraph("Every failed, diverged or n/a case with its reason."), Bullets(tuple(lines))]
 
     # -- scenes --------------------------------------------------------------------------------
 
+    def introduction(self, scene: str, rows: pd.DataFrame) -> str:
+        """What the scene is, its reference and file, and how its hard IK targets fared."""
+        about = self.about(scene)
+        solved, total = _hard_solved(rows)
+        return ((f"{about['description']} " if about.get("description") else "")
+                + f"Reference: `{rows['reference'].iloc[0]}`."
+                + (f" Scene file: `{about['source']}`." if about.get("source") else "")
+                + (f" Hard targets: {solved} of {total} solves succeeded (each solver's verdict per target: the "
+                   "HTML report, `results.csv`)." if total else ""))
+
     def scene(self, scene: str, rows: pd.DataFrame) -> list[Block]:
+        """The section of a dynamics or IK scene."""
         kind, about = _kind(rows), self.about(scene)
         reference = rows["reference"].iloc[0]
-        solved = rows[rows["metric"].str.endswith("_solved") & (rows["status"] == OK)]
-        hard = (f" Hard targets: {int(solved['value'].sum())} of {len(solved)} solves succeeded (each solver's "
-                "verdict per target: the HTML report, `results.csv`).") if not solved.empty else ""
-        blocks: list[Block] = [Heading(2, f"{scene} ({kind})", _anchor(scene)),
-                               Paragraph((f"{about['description']} " if about.get("description") else "")
-                                         + f"Reference: `{reference}`."
-                                         + (f" Scene file: `{about['source']}`." if about.get("source") else "")
-                                         + hard)]
-        series = self.series[self.series["scene"] == scene] if not self.series.empty else self.series
+        blocks: list[Block] = [_scene_heading(scene, kind), Paragraph(self.introduction(scene, rows))]
+        series = self.series[self.series["scene"] == scene]
         if kind == "dynamics":
             blocks += self.dynamics(scene, rows, about, reference, series)
-        elif kind == "ik":
-            blocks += self.ik(scene, rows, about, reference, series)
         else:
-            blocks.append(_table(rows, _KINEMATICS_COLUMNS, ["engine"]))
+            blocks += self.ik(scene, rows, about, reference, series)
         return blocks + _notes(rows)
+
+    def kinematics(self, rows: pd.DataFrame) -> list[Block]:
+        """One section for every kinematics scene: frame and Jacobian errors against each scene's reference."""
+        scenes = list(dict.fromkeys(rows["scene"]))
+        return [Heading(2, "Kinematics"),
+                Bullets(tuple(f"**{scene}**: {self.introduction(scene, rows[rows['scene'] == scene])}"
+                              for scene in scenes)),
+                _table(rows, _KINEMATICS_COLUMNS, ["scene", "engine"])] + _notes(rows)
 
     def dynamics(self, scene, rows, about, reference, series) -> list[Block]:
         headline = _headline(about)
@@ -369,15 +409,19 @@ class _Builder:
         blocks += self.figure(figures.drift_figure(scene, series, reference), f"{scene}-drift",
                               "Drift over time at the coarsest dt, from the stored series.")
         best = summary.best_per_scheme(cases)
-        table_rows = []
-        for _, b in best[best["statuses"] != f"{NOT_AVAILABLE} {summary.n_dts(cases)}"].iterrows():
+        variants = self.info.get("integrator_variants", {})
+        per_scheme: dict[tuple[str, str], list[tuple[str, tuple[str, ...]]]] = {}
+        for _, b in best[best["any_result"]].iterrows():
             p = theory.get(b["engine"], {}).get(b["integrator"])
             fitted = observed.get((b["engine"], b["integrator"]), math.nan)
-            table_rows.append((b["engine"], b["integrator"], number(b["dt"]), number(b["error"]), number(b["cost"]),
-                               number(b["time_per_step"]) + _overhead_mark(b["engine"], about),
-                               f"{number(fitted)} ({p})" if p else number(fitted), b["statuses"]))
+            scheme, variant = variants.get(b["engine"], {}).get(b["integrator"], (b["integrator"], ""))
+            per_scheme.setdefault((b["engine"], scheme), []).append((variant, (
+                number(b["dt"]), number(b["error"]), number(b["cost"]),
+                number(b["time_per_step"]) + _overhead_mark(b["engine"], about),
+                f"{number(fitted)} ({p})" if p else number(fitted), b["statuses"])))
         blocks += [Table(("engine", "integrator", "best dt [s]", f"error [{unit}]", "cost [s/s]", "time per step [s]",
-                          "order (theory)", "time steps"), tuple(table_rows))]
+                          "order (theory)", "time steps"),
+                         tuple(_scheme_row(engine, scheme, members) for (engine, scheme), members in per_scheme.items()))]
 
         full = [_table(rows[rows["dt"].notna()], _DYNAMICS_COLUMNS, ["engine", "integrator", "dt"])]
         orders = rows[rows["dt"].isna()]
@@ -404,26 +448,38 @@ class _Builder:
                                  (_table(plain, _IK_COLUMNS, ["engine", "solver"]), *hard), markdown=False)]
 
 
+def _scheme_row(engine: str, scheme: str, members: list[tuple[str, tuple[str, ...]]]) -> tuple[str, ...]:
+    """One compact-table row for the variants of a scheme (core's orientation updates): each cell lists
+    the variants' values in the order the integrator cell names them, or one value where they agree."""
+    if len(members) == 1 and not members[0][0]:
+        return (engine, scheme, *members[0][1])
+    names = " / ".join(variant for variant, _ in members)
+    cells = [cells for _, cells in members]
+    return (engine, f"{scheme} ({names})",
+            *(column[0] if len(set(column)) == 1 else " / ".join(column) for column in zip(*cells)))
+
+
 def _solver(row: pd.Series | None) -> str:
     if row is None:
         return "none"
     return f"{row['engine']} {row['integrator']}: {row['solve_rate']:.1%} at {number(row['time_per_solve'])} s"
 
 
-def _anchor(scene: str) -> str:
-    return "scene-" + "".join(c if c.isalnum() else "-" for c in scene.lower())
+def _scene_heading(scene: str, kind: str) -> Heading:
+    """A scene section's heading; the summary links to its anchor."""
+    return Heading(2, f"{scene} ({kind})")
 
 
-def build(table: pd.DataFrame, info: dict, series: pd.DataFrame, violations: list[str] | None,
+def build(table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: ToleranceVerdict | None,
           run_dir: Path) -> tuple[list[Block], dict[str, str]]:
     """(the report's blocks, the SVG text of each figure by name); figures are written to
-    ``run_dir/figures``. ``violations``: lines of metrics outside their tolerances, None if not checked."""
-    builder = _Builder(table, info, series, violations, Path(run_dir) / FIGURES_DIR)
+    ``run_dir/figures``. ``verdict``: the run held to tolerances, None if it was not."""
+    builder = _Builder(table, info, series, verdict, Path(run_dir) / FIGURES_DIR)
     versions = ", ".join(f"{k} {v}" for k, v in info.get("engine_versions", {}).items())
     m = info.get("machine", {})
     counts = case_counts(table.to_dict("records"))
     blocks: list[Block] = [
-        Heading(1, "simparity report", "top"),
+        Heading(1, "simparity report"),
         Paragraph(f"Run {info.get('created_utc', '?')} · commit {info.get('git_commit', '?')} · "
                   f"{m.get('platform', '?')} · {m.get('cpu_count', '?')} CPUs · Python {m.get('python', '?')}"),
         Paragraph(f"Engines: {versions}"),
@@ -437,6 +493,10 @@ def build(table: pd.DataFrame, info: dict, series: pd.DataFrame, violations: lis
     blocks += builder.summary()
     blocks += _hard_cases(table, info)
     blocks += [Details("Definitions", (Paragraph(_DEFINITIONS), Paragraph(_IK_PROTOCOL)))]
+    kinds = {scene: _kind(rows) for scene, rows in table.groupby("scene", sort=False)}
     for scene, rows in table.groupby("scene", sort=False):
-        blocks += builder.scene(scene, rows)
+        blocks += builder.scene(scene, rows) if kinds[scene] != "kinematics" else []
+    kinematics = table[table["scene"].map(kinds) == "kinematics"]
+    if not kinematics.empty:
+        blocks += builder.kinematics(kinematics)
     return blocks, builder.svgs

@@ -6,19 +6,19 @@ from __future__ import annotations
 from pathlib import Path
 
 from simparity.core.results import REPORT_FILE, REPORT_HTML_FILE
-from simparity.reports.content import build
+from simparity.reports.content import ToleranceVerdict, build
 from simparity.reports.html import to_html
 from simparity.reports.markdown import to_markdown
 from simparity.reports.store import read_run, read_series
 
 
-def write_report(run_dir: str | Path, violations: list[str] | None = None) -> tuple[Path, Path]:
+def write_report(run_dir: str | Path, verdict: ToleranceVerdict | None = None) -> tuple[Path, Path]:
     """Render the run in ``run_dir``; return the paths of (report.md, report.html).
 
-    ``violations``: one line per metric outside its tolerance (None: the run was not checked)."""
+    ``verdict``: the run held to tolerances (None: it was not)."""
     run_dir = Path(run_dir)
     table, info = read_run(run_dir)
-    blocks, svgs = build(table, info, read_series(run_dir), violations, run_dir)
+    blocks, svgs = build(table, info, read_series(run_dir), verdict, run_dir)
     markdown, page = run_dir / REPORT_FILE, run_dir / REPORT_HTML_FILE
     markdown.write_text(to_markdown(blocks), encoding="utf-8")
     page.write_text(to_html(blocks, svgs, f"simparity report {info.get('created_utc', '')}".strip()), encoding="utf-8")

@@ -37,20 +37,17 @@ def dynamics_cases(rows: pd.DataFrame, headline: str) -> pd.DataFrame:
     """One row per engine x integrator x dt of a dynamics scene, ground truths left out.
 
     Columns: engine, integrator, dt [s], status (the case's), error (the headline metric where it
-    was measured, else NaN), time_per_step [s], cost [s of compute per simulated second], and
-    energy_drift (NaN where not measured).
+    was measured, else NaN), time_per_step [s] and cost [s of compute per simulated second].
     """
+    keys = ["engine", "integrator", "dt"]
     per_dt = rows[rows["dt"].notna() & ~rows["engine"].isin(GROUND_TRUTH_ENGINES)]
-    out = []
-    for (engine, integrator, dt), group in per_dt.groupby(["engine", "integrator", "dt"], sort=False):
-        ok = group[group["status"] == OK].set_index("metric")["value"]
-        step = float(ok.get("time_per_step", math.nan))
-        out.append({"engine": engine, "integrator": integrator, "dt": float(dt),
-                    "status": case_status(group["status"]), "error": float(ok.get(headline, math.nan)),
-                    "time_per_step": step, "cost": step / float(dt),
-                    "energy_drift": float(ok.get("energy_drift_max", math.nan))})
-    return pd.DataFrame(out, columns=["engine", "integrator", "dt", "status", "error", "time_per_step", "cost",
-                                      "energy_drift"])
+    cases = per_dt.groupby(keys, sort=False)["status"].agg(case_status).rename("status").reset_index()
+    measured = per_dt[(per_dt["status"] == OK) & per_dt["metric"].isin([headline, "time_per_step"])]
+    values = measured.pivot_table(index=keys, columns="metric", values="value", sort=False)
+    cases = cases.merge(values.reindex(columns=[headline, "time_per_step"]).reset_index(), on=keys, how="left")
+    cases = cases.rename(columns={headline: "error"})
+    cases["cost"] = cases["time_per_step"] / cases["dt"]
+    return cases[["engine", "integrator", "dt", "status", "error", "time_per_step", "cost"]]
 
 
 def _measured(cases: pd.DataFrame) -> pd.DataFrame:
@@ -72,25 +69,15 @@ def most_accurate_within(cases: pd.DataFrame, time_budget: float) -> pd.Series |
 
 
 def best_per_scheme(cases: pd.DataFrame) -> pd.DataFrame:
-    """Per engine x integrator: the time step of least error (the cheaper on a tie), with its error and
-    cost, and how many of its time steps ended ok / diverged / failed / n/a."""
-    out = []
-    for (engine, integrator), group in cases.groupby(["engine", "integrator"], sort=False):
-        measured = _measured(group).sort_values(["error", "cost"])
-        counts = group["status"].value_counts()
-        best = measured.iloc[0] if not measured.empty else None
-        out.append({"engine": engine, "integrator": integrator,
-                    "dt": best["dt"] if best is not None else math.nan,
-                    "error": best["error"] if best is not None else math.nan,
-                    "cost": best["cost"] if best is not None else math.nan,
-                    "time_per_step": best["time_per_step"] if best is not None else math.nan,
-                    "statuses": ", ".join(f"{s} {counts[s]}" for s in counts.index)})
-    return pd.DataFrame(out)
-
-
-def n_dts(cases: pd.DataFrame) -> int:
-    """How many time steps the scene ran."""
-    return cases["dt"].nunique()
+    """Per engine x integrator: the time step of least error (the cheaper on a tie) with its error, cost
+    and time per step (NaN where none was measured), ``statuses`` (how many of its time steps ended ok /
+    diverged / failed / n/a) and ``any_result`` (False when every time step is n/a)."""
+    keys = ["engine", "integrator"]
+    best = _measured(cases).sort_values(["error", "cost"]).drop_duplicates(keys)
+    summary = cases.groupby(keys, sort=False)["status"].agg(
+        statuses=lambda s: ", ".join(f"{status} {n}" for status, n in s.value_counts().items()),
+        any_result=lambda s: bool((s != NOT_AVAILABLE).any())).reset_index()
+    return summary.merge(best[keys + ["dt", "error", "cost", "time_per_step"]], on=keys, how="left")
 
 
 def orders(rows: pd.DataFrame, headline: str) -> dict[tuple[str, str], float]:
@@ -118,27 +105,21 @@ def best_ik(solvers: pd.DataFrame) -> tuple[pd.Series | None, pd.Series | None]:
 
 
 def unresolved_cases(table: pd.DataFrame) -> pd.DataFrame:
-    """Every case that is not ok, grouped by (status, reason): columns status, reason, order_fit (the
-    cases are observed-order fits over a scene's time steps), n_cases, cases (list of "scene engine
-    integrator [dt]" labels, one per engine x integrator with its time steps)."""
+    """Every case that is not ok, one row per status x reason x scene x engine x integrator: columns
+    status, order_fit (the cases are observed-order fits over a scene's time steps), scene, engine,
+    integrator, reason, n_cases and dts (the cases' time steps, empty where there are none); failed
+    first, then diverged, then n/a."""
     keys = ["scene", "engine", "integrator", "dt"]
     statuses = table.groupby(keys, sort=False, dropna=False)["status"].agg(case_status).rename("case_status")
     cases = table.merge(statuses.reset_index(), on=keys)
-    cases = cases[(cases["case_status"] != OK) & (cases["status"] == cases["case_status"])]
-    cases = cases.drop_duplicates(keys)
+    cases = cases[(cases["case_status"] != OK) & (cases["status"] == cases["case_status"])].drop_duplicates(keys)
     has_dt = table.groupby("scene")["dt"].agg(lambda d: d.notna().any())
-    cases["order_fit"] = cases["dt"].isna() & cases["scene"].map(has_dt)
-    out = []
-    for (status, reason, order_fit), group in cases.groupby(["case_status", "detail", "order_fit"], sort=False):
-        labels = []
-        for (scene, engine, integrator), g in group.groupby(["scene", "engine", "integrator"], sort=False):
-            dts = ", ".join(f"{dt:g}" for dt in g["dt"] if not math.isnan(dt))
-            labels.append(f"{scene} {engine} {integrator}".strip() + (f" (dt {dts})" if dts else ""))
-        out.append({"status": status, "reason": reason, "order_fit": order_fit, "n_cases": len(group), "cases": labels})
-    frame = pd.DataFrame(out, columns=["status", "reason", "order_fit", "n_cases", "cases"])
-    order = {s: i for i, s in enumerate(("failed", "diverged", NOT_AVAILABLE))}
-    return frame.sort_values(["status", "n_cases"], key=lambda c: c.map(order) if c.name == "status" else -c,
-                             kind="stable")
+    cases = cases.assign(order_fit=cases["dt"].isna() & cases["scene"].map(has_dt))
+    grouped = cases.groupby(["case_status", "order_fit", "scene", "engine", "integrator", "detail"], sort=False)
+    out = grouped["dt"].agg(n_cases="size", dts=lambda d: [float(v) for v in d if not math.isnan(v)]).reset_index()
+    out = out.rename(columns={"case_status": "status", "detail": "reason"})
+    rank = {s: i for i, s in enumerate(("failed", "diverged", NOT_AVAILABLE))}
+    return out.sort_values("status", key=lambda c: c.map(rank), kind="stable").reset_index(drop=True)
 
 
 def energy_gains(series: pd.DataFrame) -> pd.DataFrame:
@@ -148,8 +129,9 @@ def energy_gains(series: pd.DataFrame) -> pd.DataFrame:
     energy = series[(series["quantity"] == "energy_change") & ~series["engine"].isin(GROUND_TRUTH_ENGINES)]
     peak = energy.groupby(["scene", "engine", "integrator", "dt"], sort=False)["value"].max().reset_index()
     gained = peak[peak["value"] > ENERGY_GAIN_FLAGGED]
-    return (gained.groupby(["scene", "engine", "integrator"], sort=False)
-            .agg(gain_max=("value", "max"), dts=("dt", lambda d: sorted(d))).reset_index())
+    per_scheme = gained.groupby(["scene", "engine", "integrator"], sort=False).agg(
+        gain_max=("value", "max"), dts=("dt", lambda d: sorted(d)))
+    return per_scheme.reset_index().reindex(columns=["scene", "engine", "integrator", "gain_max", "dts"])
 
 
 def saturated(table: pd.DataFrame) -> pd.DataFrame:

@@ -6,22 +6,32 @@ import shutil
 import subprocess
 import sys
 import textwrap
-from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from simparity.comparisons.cli import main
-from simparity.core.results import REPORT_FILE, REPORT_HTML_FILE
+from simparity.core.results import REPORT_FILE, REPORT_HTML_FILE, SERIES_COLUMNS, ResultRow
+from simparity.reports.content import ToleranceVerdict, build
+from simparity.reports.markdown import to_markdown
+from simparity.reports.store import read_run
 
 SCENES = ["dzhanibekov", "lecture-2link-ik", "iiwa-kinematics"]
+ORDER_BAND = 0.5
+"""Half the gap between neighbouring integer orders, as the shipped tolerances allow: an observed order
+within it of the theoretical one confirms the theory; outside it, the theory is wrong for the scheme."""
+MIN_FIGURE_BYTES = 1000
+"""An SVG or PNG of an empty canvas is a few hundred bytes; a drawn figure (axes, ticks, lines) is tens of
+kilobytes. Anything under this is a figure with nothing on it."""
+MIN_PAGE_BYTES = 10_000
+"""The page's styles and summary alone come to a few kilobytes; with its inline figures it is far larger."""
 
 
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
-    """A quick run of a dynamics, an IK and a kinematics scene on core, analytic and MuJoCo."""
+    """A quick run of a dynamics, an IK and a kinematics scene on the default engines."""
     out = tmp_path_factory.mktemp("report") / "run"
-    assert main(["run", *SCENES, "--quick", "--repeats", "0", "--jobs", "1", "--engines", "core,analytic,mujoco",
-                 "--out", str(out)]) == 0
+    assert main(["run", *SCENES, "--quick", "--repeats", "0", "--jobs", "1", "--out", str(out)]) == 0
     return out
 
 
@@ -30,11 +40,13 @@ def test_markdown_starts_with_the_summary_and_links_existing_figures(run_dir):
     headings = re.findall(r"^(#+) (.*)$", text, flags=re.M)
     assert headings[0] == ("#", "simparity report") and headings[1] == ("##", "Summary")
     summary = text.split("## Summary", 1)[1].split("\n## ", 1)[0]
-    assert "[dzhanibekov](#scene-dzhanibekov)" in summary and "[lecture-2link-ik]" in summary
+    assert "[dzhanibekov](#dzhanibekov-dynamics)" in summary and "[lecture-2link-ik](#lecture-2link-ik-ik)" in summary
+    page = (run_dir / REPORT_HTML_FILE).read_text()
+    assert 'href="#dzhanibekov-dynamics"' in page and '<h2 id="dzhanibekov-dynamics">' in page   # the link lands
     assert "### Cases without a result" in summary and "### Flagged findings" in summary
     for name in re.findall(r"\]\(figures/([^)]+)\.svg\)", text):
         for suffix in (".svg", ".png"):
-            assert (run_dir / "figures" / f"{name}{suffix}").stat().st_size > 1000
+            assert (run_dir / "figures" / f"{name}{suffix}").stat().st_size > MIN_FIGURE_BYTES
     names = set(re.findall(r"\]\(figures/([^)]+)\.svg\)", text))
     assert {"dzhanibekov-work-precision", "dzhanibekov-convergence", "dzhanibekov-drift",
             "lecture-2link-ik-solve-rate", "lecture-2link-ik-residuals", "lecture-2link-ik-fk-agreement"} <= names
@@ -46,6 +58,23 @@ def test_compact_table_names_reference_units_and_theoretical_order(run_dir):
     assert "| engine | integrator | best dt [s] | error [rad] | cost [s/s] |" in section
     rk4 = next(line for line in section.splitlines() if line.startswith("| mujoco | rk4 |"))
     assert rk4.split("|")[7].strip().endswith("(4)")   # the order column shows RK4's theory
+
+
+def test_theoretical_orders_are_the_ones_observed(run_dir):
+    """The order each engine claims for its integrators (drawn as the convergence plot's slope) matches the
+    order measured on the Dzhanibekov flip, wherever an order was fitted; every engine claims some."""
+    table, info = read_run(run_dir)
+    theory = info["theoretical_orders"]
+    assert {"core", "mujoco", "pybullet", "pinocchio"} <= set(theory)
+    fitted = table[(table["scene"] == "dzhanibekov") & (table["metric"] == "order_orientation")
+                   & (table["status"] == "ok")]
+    checked = 0
+    for _, row in fitted.iterrows():
+        claimed = theory.get(row["engine"], {}).get(row["integrator"])
+        if claimed is not None:
+            assert abs(row["value"] - claimed) <= ORDER_BAND, (row["engine"], row["integrator"], row["value"], claimed)
+            checked += 1
+    assert {e for e in fitted["engine"] if e in theory} == {"core", "mujoco", "pybullet", "pinocchio"} and checked >= 10
 
 
 def test_html_is_self_contained(run_dir):
@@ -81,4 +110,22 @@ def test_report_regenerates_a_copied_run_with_no_engine_importable(run_dir, tmp_
     assert done.returncode == 0, done.stderr
     assert (copy / REPORT_FILE).read_text() == (run_dir / REPORT_FILE).read_text()
     assert (copy / "figures" / "dzhanibekov-drift.svg").read_text() == (run_dir / "figures" / "dzhanibekov-drift.svg").read_text()
-    assert (copy / REPORT_HTML_FILE).stat().st_size > 10_000
+    assert (copy / REPORT_HTML_FILE).stat().st_size > MIN_PAGE_BYTES
+
+
+def _findings(verdict, tmp_path) -> str:
+    rows = [ResultRow("s", "core", "rk4", 0.01, metric, 1e-6, "rad", "analytic:exact", "ok")
+            for metric in ("orientation_error_max", "time_per_step")]
+    series = pd.DataFrame(columns=list(SERIES_COLUMNS))
+    blocks, _ = build(pd.DataFrame([r.as_dict() for r in rows]), {}, series, verdict, tmp_path)
+    text = to_markdown(blocks)
+    return text.split("### Flagged findings", 1)[1].split("###", 1)[0]
+
+
+def test_tolerance_findings_say_what_was_held_to_a_bound(tmp_path):
+    """A run nothing was held to never reads as passing; violations and unbounded metrics are counted."""
+    assert "nothing checked: no bound matches" in _findings(ToleranceVerdict(0, 7), tmp_path)
+    mixed = _findings(ToleranceVerdict(3, 2, ("s core rk4 dt=0.01 x: 1, bound <= 0.5 (why)",)), tmp_path)
+    assert "1 of 3 checked metrics" in mixed and "2 without a bound" in mixed
+    assert "all 3 checked metrics inside their bounds" in _findings(ToleranceVerdict(3, 0), tmp_path)
+    assert "not checked in this report" in _findings(None, tmp_path)

@@ -13,6 +13,11 @@ ARTIFACTS = Path(__file__).resolve().parents[1] / "test-artifacts"
 """Where the screenshot is written (kept by CI as a test artifact; ignored by git)."""
 
 BROWSERS = ("chromium", "chromium-browser", "google-chrome")
+MIN_FIGURE_PIXELS = 100
+"""[CSS px] Every side of a rendered figure: a figure that failed to render collapses to 0 (or to the
+height of its caption, ~15); a drawn one is hundreds of pixels wide."""
+MIN_SCREENSHOT_BYTES = 10_000
+"""A blank full-page PNG compresses to a few kilobytes; a page of text and figures is far larger."""
 
 
 def _browser() -> str:
@@ -44,6 +49,6 @@ def test_report_renders_in_chromium_without_network(tmp_path):
         page.screenshot(path=str(screenshot), full_page=True)
         browser.close()
     assert len(sizes) == len(names) >= 5, names
-    assert all(width > 100 and height > 100 for width, height in sizes), list(zip(names, sizes))
+    assert all(width > MIN_FIGURE_PIXELS and height > MIN_FIGURE_PIXELS for width, height in sizes), list(zip(names, sizes))
     assert requests == [page_url], f"the page asked for more than itself: {requests[1:]}"
-    assert screenshot.stat().st_size > 10_000
+    assert screenshot.stat().st_size > MIN_SCREENSHOT_BYTES

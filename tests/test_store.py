@@ -26,6 +26,9 @@ def test_rows_round_trip_with_full_precision(tmp_path):
     assert info["engine_versions"] == {"core": core.version()} and "lecture-projectile" in info["scenes"]
     assert info["theoretical_orders"]["core"]["rk4"] == 4 and "taylor2" not in info["theoretical_orders"]["core"]
     assert info["scenes"]["lecture-projectile"]["bodies"] == 1
+    variants = info["integrator_variants"]["core"]
+    assert variants["rk4+matrix"] == ["rk4", "matrix"] and variants["rk4"] == ["rk4", "quaternion"]
+    assert "engine_euler" not in variants and "taylor2" not in variants   # one orientation update; a particle rule
     assert {"platform", "cpu_count", "python"} <= set(info["machine"]) and info["git_commit"]
 
 

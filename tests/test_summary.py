@@ -7,6 +7,7 @@ import pandas as pd
 
 from simparity.core.results import ResultRow
 from simparity.reports import summary
+from simparity.reports.content import _scheme_row
 
 
 def _case(engine, integrator, dt, error, seconds_per_step, status="ok", detail=""):
@@ -42,10 +43,13 @@ def test_cheapest_within_budget_skips_ground_truths_and_diverged_cases():
 
 def test_best_per_scheme_takes_least_error_and_counts_statuses():
     table = _table([_case("core", "rk4", 0.1, 1e-5, 1e-4), _case("core", "rk4", 0.05, 1e-6, 2e-4),
-                    _case("core", "rk4", 0.2, math.nan, 0, status="diverged", detail="x")])
-    best = summary.best_per_scheme(summary.dynamics_cases(table, "orientation_error_max")).iloc[0]
-    assert best["dt"] == 0.05 and best["error"] == 1e-6
+                    _case("core", "rk4", 0.2, math.nan, 0, status="diverged", detail="x"),
+                    _case("core", "taylor2", 0.1, math.nan, 0, status="n/a", detail="point-mass rule")])
+    schemes = summary.best_per_scheme(summary.dynamics_cases(table, "orientation_error_max")).set_index("integrator")
+    best = schemes.loc["rk4"]
+    assert best["dt"] == 0.05 and best["error"] == 1e-6 and best["any_result"]
     assert best["statuses"] in ("ok 2, diverged 1", "diverged 1, ok 2")
+    assert not schemes.loc["taylor2", "any_result"] and math.isnan(schemes.loc["taylor2", "error"])
 
 
 def test_ik_best_solver_and_fastest_reliable_one():
@@ -60,16 +64,17 @@ def test_ik_best_solver_and_fastest_reliable_one():
     assert fastest["engine"] == "mujoco"   # pybullet is faster but below 99 %
 
 
-def test_unresolved_cases_grouped_by_status_and_reason_failed_first():
+def test_unresolved_cases_grouped_with_their_reasons_failed_first():
     table = _table([_case("core", "rk4", 0.1, 1e-5, 1e-4),
                     _case("mujoco", "euler", 0.1, 0, 0, status="diverged", detail="blew up"),
                     _case("mujoco", "euler", 0.2, 0, 0, status="diverged", detail="blew up"),
                     _case("pybullet", "x", 0.1, 0, 0, status="n/a", detail="no such integrator"),
                     _case("pinocchio", "rk4", 0.1, 0, 0, status="failed", detail="raised")])
-    groups = summary.unresolved_cases(table)
-    assert list(groups["status"]) == ["failed", "diverged", "n/a"]
-    diverged = groups[groups["status"] == "diverged"].iloc[0]
-    assert diverged["n_cases"] == 2 and diverged["cases"] == ["s mujoco euler (dt 0.1, 0.2)"]
+    cases = summary.unresolved_cases(table)
+    assert list(cases["status"]) == ["failed", "diverged", "n/a"]
+    diverged = cases[cases["status"] == "diverged"].iloc[0]
+    assert (diverged["scene"], diverged["engine"], diverged["integrator"]) == ("s", "mujoco", "euler")
+    assert diverged["n_cases"] == 2 and diverged["dts"] == [0.1, 0.2]
     assert diverged["reason"] == "blew up" and not diverged["order_fit"]
 
 
@@ -82,3 +87,12 @@ def test_energy_gain_flagged_only_above_threshold_and_not_for_truths():
                           + points("analytic", [0, 10 * gain]))
     flagged = summary.energy_gains(series)
     assert list(flagged["engine"]) == ["core"] and math.isclose(flagged["gain_max"].iloc[0], 3 * gain)
+
+
+def test_variants_of_a_scheme_share_a_row_listing_what_differs():
+    """Core's orientation updates of one scheme: one row; a cell lists each variant's value in the order the
+    integrator cell names them, or one value where they all agree."""
+    row = _scheme_row("core", "rk4", [("quaternion", ("0.01", "2e-10", "ok 4")), ("matrix", ("0.01", "4e-09", "ok 4")),
+                                      ("expmap", ("0.01", "2e-12", "ok 4"))])
+    assert row == ("core", "rk4 (quaternion / matrix / expmap)", "0.01", "2e-10 / 4e-09 / 2e-12", "ok 4")
+    assert _scheme_row("mujoco", "rk4", [("", ("0.01", "1e-10", "ok 4"))]) == ("mujoco", "rk4", "0.01", "1e-10", "ok 4")
