@@ -26,12 +26,16 @@ _HEADLINE_LABELS = {"position_error_max": "position error max [m]",
                     "orientation_error_max": "orientation error max [rad]"}
 _DRIFT_PANELS = [("energy_change", "|E(t) - E(0)| / |E(0)|"), ("angular_momentum_change", "|L(t) - L(0)| / |L(0)|"),
                  ("position_error", "position error [m]"), ("orientation_error", "orientation error [rad]")]
+_COLORS = plt.get_cmap("tab20").colors + plt.get_cmap("tab20b").colors
+"""40 distinct colours: a scene's schemes (up to ~25 with core's orientation updates) each get their own."""
+_TITLE = {"loc": "left", "fontsize": 10}
+"""Titles start at the axes' left edge, so a long one runs over the legend's side, never off the figure."""
 _WIDTH = 9.0
 """[in] Figure width: a report column at 100 dpi."""
 
 
 def _style(index: int, engine: str) -> dict:
-    colors = plt.get_cmap("tab20").colors
+    colors = _COLORS
     return {"color": colors[index % len(colors)], "marker": _ENGINE_MARKERS.get(engine, "x"), "markersize": 4,
             "linewidth": 1.2}
 
@@ -60,8 +64,8 @@ def work_precision_figure(scene: str, cases: pd.DataFrame, headline: str, refere
     for budget in ERROR_BUDGETS:
         ax.axvline(budget, color="0.6", linestyle=":", linewidth=0.8)
     ax.set(xscale="log", yscale="log", xlabel=_HEADLINE_LABELS[headline],
-           ylabel="compute per simulated second [s/s]",
-           title=f"{scene}: work against precision (one point per dt; error against {reference})")
+           ylabel="compute per simulated second [s/s]")
+    ax.set_title(f"{scene}: work against precision (one point per dt; error against {reference})", **_TITLE)
     ax.grid(True, which="major", alpha=0.3)
     _legend(ax)
     fig.tight_layout()
@@ -88,8 +92,8 @@ def convergence_figure(scene: str, cases: pd.DataFrame, headline: str, reference
             dt0, e0 = g["dt"].iloc[0], g["error"].iloc[0]
             dts = np.array([g["dt"].iloc[0], g["dt"].iloc[-1]])
             ax.plot(dts, e0 * (dts / dt0) ** p, linestyle="--", linewidth=0.7, color=style["color"])
-    ax.set(xscale="log", yscale="log", xlabel="time step dt [s]", ylabel=_HEADLINE_LABELS[headline],
-           title=f"{scene}: convergence against {reference} (dashed: theoretical slope)")
+    ax.set(xscale="log", yscale="log", xlabel="time step dt [s]", ylabel=_HEADLINE_LABELS[headline])
+    ax.set_title(f"{scene}: convergence against {reference} (dashed: theoretical slope)", **_TITLE)
     ax.grid(True, which="major", alpha=0.3)
     _legend(ax)
     fig.tight_layout()
@@ -116,7 +120,8 @@ def drift_figure(scene: str, series: pd.DataFrame, reference: str):
                         **(_style(i, engine) | {"marker": None}))
         ax.set(yscale="log", ylabel=label)
         ax.grid(True, which="major", alpha=0.3)
-    axes[0, 0].set_title(f"{scene}: drift and error against time at dt = {dt:g} s (errors against {reference})")
+    axes[0, 0].set_title(f"{scene}: drift and error against time at dt = {dt:g} s (errors against {reference})",
+                         **_TITLE)
     axes[-1, 0].set_xlabel("time [s]")
     _legend(axes[0, 0])
     fig.tight_layout()
@@ -132,8 +137,8 @@ def ik_rate_figure(scene: str, solvers: pd.DataFrame, reference: str):
     for i, (_, r) in enumerate(rated.iterrows()):
         ax.plot([r["time_per_solve"]], [r["solve_rate"]], linestyle="none",
                 label=f"{r['engine']} {r['integrator']}", **_style(i, r["engine"]) | {"markersize": 7})
-    ax.set(xscale="log", xlabel="time per solve [s]", ylabel="solve rate", ylim=(-0.03, 1.03),
-           title=f"{scene}: solve rate against time per solve (targets from {reference})")
+    ax.set(xscale="log", xlabel="time per solve [s]", ylabel="solve rate", ylim=(-0.03, 1.03))
+    ax.set_title(f"{scene}: solve rate against time per solve (targets from {reference})", **_TITLE)
     ax.grid(True, alpha=0.3)
     _legend(ax)
     fig.tight_layout()
@@ -155,7 +160,7 @@ def ik_distribution_figure(scene: str, series: pd.DataFrame, position_tolerance:
             ax.axvline(position_tolerance, color="0.3", linestyle=":", linewidth=0.9, label="scene tolerance")
         ax.set(xscale="log", xlabel=label, ylabel="fraction of targets at or below", ylim=(0, 1.02))
         ax.grid(True, alpha=0.3)
-    axes[0, 0].set_title(f"{scene}: distributions over the random targets", loc="left")
+    axes[0, 0].set_title(f"{scene}: distributions over the random targets", **_TITLE)
     _legend(axes[0, -1])
     fig.tight_layout()
     return fig
