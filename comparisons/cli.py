@@ -18,6 +18,7 @@ from pathlib import Path
 from simparity.comparisons import library
 from simparity.comparisons.check import BASELINE_RELATIVE, CheckResult, check_table, compare_with_baseline
 from simparity.comparisons.check_output import junit_xml, summary_markdown
+from simparity.comparisons.describe import describe
 from simparity.comparisons.engines import DEFAULT_ENGINES, ENGINE_NAMES, check_engine_names, make_engine
 from simparity.comparisons.history import history_path, latest_before, metric_history, record_run, run_table
 from simparity.comparisons.parallel import default_jobs, run_scenes
@@ -92,8 +93,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("scenes", nargs="*", metavar="SCENE|FILE",
                      help="built-in scene names or scene files (default: the scenes of --suite)")
     run.add_argument("--suite", default=None, choices=SUITES,
-                     help="run a built-in suite: default (what 'simparity run' runs) or hard (the numerical-"
-                     "stability cases, each with the verdict it must earn)")
+                     help="run a built-in suite: default (what 'simparity run' runs), contact (every scene with "
+                     "planes) or hard (the numerical-stability cases, each with the verdict it must earn)")
     run.add_argument("--engines", type=_engine_list, default=DEFAULT_ENGINES, metavar="A,B,...",
                      help=f"comma-separated engines to run (default: {','.join(DEFAULT_ENGINES)}; "
                      f"known: {','.join(ENGINE_NAMES)})")
@@ -146,6 +147,12 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("--engine", required=True, choices=EXPORTABLE)
     export.add_argument("--integrator", default=None, help="dynamics only (default: the engine's first)")
     export.add_argument("--dt", type=float, default=None, help="dynamics only, [s] (default: the scene's first)")
+
+    show = sub.add_parser(
+        "show", help="print a scene as the loader understood it",
+        description="Print a scene in SI units as loaded: bodies (mass, COM and inertia tensor, computed for a body "
+        "built from point masses), forces, planes (normalised), shapes and every body-plane material.")
+    show.add_argument("scene", metavar="SCENE|FILE")
 
     report = sub.add_parser(
         "report", help="re-render report.md, report.html and figures/ of a stored run",
@@ -338,13 +345,18 @@ def cmd_export(args, out) -> int:
     return EXIT_OK
 
 
+def cmd_show(args, out) -> int:
+    print(describe(library.load([args.scene])[0]), file=out, end="")
+    return EXIT_OK
+
+
 def cmd_report(args, out) -> int:
     _write_report(args.run_dir, out, load_tolerances(args.tolerances) if args.tolerances else None)
     return EXIT_OK
 
 
 _COMMANDS = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "history": cmd_history, "export": cmd_export,
-             "report": cmd_report}
+             "show": cmd_show, "report": cmd_report}
 
 
 def main(argv: list[str] | None = None, out=None) -> int:

@@ -6,9 +6,12 @@ A run is diverged when, for some body,
   and never speeds the body up relative to it, so |v(t)| <= |w| + |v(0) - w| + (|g| + sum |f_i| / m) t;
 - its angular speed exceeds what its angular momentum allows: |omega| <= |L| / I_min, with
   |L(t)| <= |L(0)| + sum |p_i| |f_i| t (angular drag only takes momentum away); without applied
-  forces also |omega| <= sqrt(2 KE_rot(0) / I_min), as the rotational energy cannot grow;
+  forces also |omega| <= sqrt(2 KE_rot(0) / I_min), as the rotational energy cannot grow. With
+  contact a plane's impulse can turn a body, and the bound is its energy budget instead:
+  |omega| <= sqrt(2 (KE(0) + (m |g| + sum |f_i|) v_max t) / I_min);
 - a quantity the scene conserves grows by more than :data:`CONSERVED_GROWTH_LIMIT` of its
-  initial size: the energy (E - E(0) > limit x |E(0)|, when E(0) is not near zero) or |L|.
+  initial size: the energy (E - E(0) > limit x |E(0)|, when E(0) is not near zero; contact only
+  takes energy away, so this holds with contact too) or |L| (not with contact).
 
 Speeds are compared with :data:`DIVERGENCE_MARGIN` times their bound. Energies come from
 :mod:`comparisons.metrics`, rotations from SciPy; nothing here is in-house code.
@@ -54,9 +57,17 @@ def _speed_bounds(scene: DynamicsScene) -> tuple[np.ndarray, np.ndarray]:
         rotation = quat_wxyz_to_matrix(body.quat_wxyz)
         momentum = np.linalg.norm(angular_momentum_world(body.inertia_body, body.angular_velocity_world, rotation))
         bound = (momentum + torque * duration) / moments[0]
-        if not pushes:
-            omega_body = rotation.T @ body.angular_velocity_world
-            bound = min(bound, np.sqrt(max(omega_body @ body.inertia_body @ omega_body, 0.0) / moments[0]))
+        omega_body = rotation.T @ body.angular_velocity_world
+        spin_energy = max(omega_body @ body.inertia_body @ omega_body, 0.0) / 2
+        if scene.contact is not None:
+            # A plane's impulse can turn the body (a box landing on an edge), so |L| is no bound; its
+            # energy is: contact only takes energy away, and gravity and the applied forces give at
+            # most their force times the distance the COM can travel.
+            work = (body.mass * gravity + force) * linear[-1] * duration
+            kinetic = spin_energy + body.mass * float(body.velocity_world @ body.velocity_world) / 2
+            bound = max(bound, np.sqrt(2 * (kinetic + work) / moments[0]))
+        elif not pushes:
+            bound = min(bound, np.sqrt(2 * spin_energy / moments[0]))
         angular.append(bound)
     return np.array(linear), np.array(angular)
 
@@ -72,7 +83,7 @@ def _conserved_growth(scene: DynamicsScene, traj: Trajectory) -> str:
             b = int(np.argmax(np.where(grown, growth / np.where(size > 0, size, 1.0), -np.inf)))
             return (f"energy of {scene.bodies[b].name} grew to {energy[:, b].max() / energy[0, b]:.3g} x E(0) "
                     f"(conserved; limit {1 + CONSERVED_GROWTH_LIMIT:g} x)")
-    if scene.forces.conserves_angular_momentum:
+    if scene.forces.conserves_angular_momentum and scene.contact is None:
         inertia = np.stack([b.inertia_body for b in scene.bodies])
         size = np.linalg.norm(angular_momentum_world(
             inertia, traj.angular_velocity_world, quat_wxyz_to_matrix(traj.quat_wxyz)), axis=-1)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from simparity.comparisons.contact_metrics import CONTACT_METRICS
 from simparity.comparisons.invariants import angular_momentum_world, kinetic_energy, potential_energy
 from simparity.comparisons.rows import Measured
 from simparity.core.scene import DynamicsScene
@@ -129,6 +130,8 @@ def kinematics_errors(poses: FramePoses, jacobian: np.ndarray, ref_poses: FrameP
 def dynamics_metrics(scene: DynamicsScene) -> dict[str, str]:
     """The per-case metrics of a scene: errors and time, plus drift of what the scene conserves."""
     metrics = dict(DYNAMICS_METRICS)
+    if scene.contact is not None:  # contact takes energy away and turns bodies: nothing is conserved
+        return metrics | CONTACT_METRICS
     if scene.forces.conserves_energy:
         metrics["energy_drift_max"] = DRIFT_METRICS["energy_drift_max"]
     if scene.forces.conserves_angular_momentum and any(np.any(b.angular_velocity_world) for b in scene.bodies):

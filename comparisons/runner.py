@@ -13,6 +13,7 @@ from typing import Callable
 
 import numpy as np
 
+from simparity.comparisons.contact_metrics import contact_metrics, read_contact
 from simparity.comparisons.divergence import divergence
 from simparity.comparisons.ik_runner import run_ik_scene
 from simparity.comparisons.metrics import (
@@ -31,11 +32,12 @@ from simparity.comparisons.metrics import (
 )
 from simparity.comparisons.rows import Case, Measured, error_text, warnings_into_rows
 from simparity.comparisons.series import dynamics_series
+from simparity.comparisons.stability import STABILITY_METRICS, stable_dt_max
 from simparity.comparisons.timing import best_of
 from simparity.core.engine import Engine, Support
 from simparity.core.errors import DivergedError
 from simparity.core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
-from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
+from simparity.core.scene import PENALTY_PREFIX, DynamicsScene, IKScene, KinematicsScene
 
 Progress = Callable[[str, str], None]
 """Called with (engine, integrator or solver) after each case of a scene."""
@@ -72,7 +74,7 @@ class _Ladder:
 
 def _integrators(scene: DynamicsScene, engine: Engine) -> tuple[list[str], str]:
     """(the engine's integrators the scene runs, reason when none)."""
-    offered = list(engine.integrators())
+    offered = list(engine.scene_integrators(scene))
     chosen = [i for i in offered if not scene.integrators or i in scene.integrators]
     reason = "" if chosen else (
         f"the scene runs only {', '.join(scene.integrators)}; {engine.name} offers {', '.join(offered)}")
@@ -83,7 +85,7 @@ def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, re
               series: list[SeriesRecord] | None, progress: Progress) -> list[ResultRow]:
     rows: list[ResultRow] = []
     metrics = dynamics_metrics(scene)
-    ref_integrator = reference.integrators()[0]
+    ref_integrator = reference.scene_integrators(scene)[0]
     ref_label = f"{reference.name}:{ref_integrator}"
     try:
         ref_support = reference.supports_dynamics(scene, ref_integrator)
@@ -120,6 +122,30 @@ def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, re
                 progress(engine.name, integrator)
     if len(scene.dts) > 1:
         rows += _orders(scene, ladders, ref_label)
+    if scene.contact is not None:
+        rows += _stability_limits(scene, engines, ref_label)
+    return rows
+
+
+def _stability_limits(scene: DynamicsScene, engines: list[Engine], ref_label: str) -> list[ResultRow]:
+    """The measured stability limit of every penalty-method integrator of the scene (:mod:`comparisons.stability`)."""
+    rows: list[ResultRow] = []
+    for engine in engines:
+        for integrator in _integrators(scene, engine)[0]:
+            if not integrator.startswith(PENALTY_PREFIX):
+                continue
+            case = Case(scene.name, engine.name, integrator, math.nan, ref_label)
+            with warnings_into_rows(rows):
+                try:
+                    support = engine.supports_dynamics(scene, integrator)
+                    if not support.ok:
+                        rows += case.rows(STABILITY_METRICS, NOT_AVAILABLE, support.reason)
+                        continue
+                    limit = stable_dt_max(scene, engine, integrator)
+                    rows += case.rows(STABILITY_METRICS, OK, f"measured by bisection on {scene.name}",
+                                      {"stable_dt_max": limit})
+                except Exception as err:  # noqa: BLE001 - reported in the rows
+                    rows += case.rows(STABILITY_METRICS, FAILED, error_text(err))
     return rows
 
 
@@ -130,6 +156,11 @@ def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_l
         case = Case(scene.name, engine, integrator, math.nan, ref_label)
         values = {}
         for metric, source in ORDER_SOURCES.items():
+            if scene.contact is not None:
+                values[metric] = Measured(math.nan, "1", unmeasurable=(
+                    "contact: an impact timed a fraction of a step off makes the error jump with dt; the error "
+                    "has no asymptotic order"))
+                continue
             if metric in ROTATIONAL_ORDERS and not ladder.integrates_rotation:
                 values[metric] = Measured(math.nan, "1", unmeasurable=(
                     "point-mass rule: the integrator does not move orientation, so it has no rotational order"))
@@ -167,14 +198,20 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
                                integrates_rotation=sim.integrates_rotation)
         changes = conserved_changes(scene, traj)
         values.update(drifts(scene, traj, changes))
+        reading = read_contact(scene, traj) if scene.contact is not None else None
         if series is not None:
-            series += dynamics_series(case, traj, ref_traj, changes)
+            heights = None if reading is None else reading.distance[:, 0].min(axis=-1)
+            series += dynamics_series(case, traj, ref_traj, changes, heights)
         floors = rounding_floors(scene, traj, n)
         if ref_traj is None:
+            if reading is not None:
+                values.update(contact_metrics(scene, traj, None, reading))
             problem, status = ref_problem
             return _CaseResult(case.partial_rows(metrics, values, sim.detail, status, problem), {}, floors,
                                sim.integrates_rotation)
         values.update(trajectory_errors(traj, ref_traj))
+        if reading is not None:
+            values.update(contact_metrics(scene, traj, ref_traj, reading))
     detail = ("this is the reference; " if is_reference else "") + sim.detail
     return _CaseResult(case.rows(metrics, OK, detail, values), {m: v.value for m, v in values.items()}, floors,
                        sim.integrates_rotation)

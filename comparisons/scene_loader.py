@@ -19,12 +19,31 @@ from simparity.core.dh import chain_from_dh
 from simparity.core.errors import SceneError, echo, one_line
 from simparity.core.files import file_problem, read_toml
 from simparity.core.ik.reach import reach_upper_bound
-from simparity.core.inertia import inertia_problem
+from simparity.core.inertia import inertia_from_point_masses, inertia_problem, mass_and_center_of_mass
 from simparity.core.names import NAME_RULE, TEXT_RULE, name_problem, text_problem
 from simparity.core.ranges import NORM_RANGES, RANGES, safe_norm
 from simparity.core.rotations import rpy_to_matrix
-from simparity.core.scene import HARD_TARGETS, SUITES, AppliedForce, Chain, DynamicsScene, Forces, IKScene, Joint, KinematicsScene, RigidBody
+from simparity.core.scene import (
+    CONTACT_METHODS,
+    HARD_TARGETS,
+    SHAPES,
+    SUITES,
+    AppliedForce,
+    Chain,
+    Contact,
+    DynamicsScene,
+    Forces,
+    IKScene,
+    Joint,
+    KinematicsScene,
+    Material,
+    Plane,
+    PointMasses,
+    RigidBody,
+    Shape,
+)
 from simparity.core.urdf import chain_from_urdf
+from simparity.references.conventions import quat_wxyz_to_matrix
 
 LENGTH_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "ft": 0.3048, "in": 0.0254}
 """Units a scene may declare for lengths, and their size in metres."""
@@ -192,13 +211,23 @@ class _Reader:
 
 
 
-_TOP = ("scene", "world", "body", "simulation", "chain", "sampling", "targets")
-_PARTS = {"dynamics": ("world", "body", "simulation"), "kinematics": ("chain", "sampling"), "ik": ("chain", "targets")}
+_TOP = ("scene", "world", "body", "simulation", "plane", "contact", "chain", "sampling", "targets")
+_PARTS = {"dynamics": ("world", "body", "simulation", "plane", "contact"), "kinematics": ("chain", "sampling"),
+          "ik": ("chain", "targets")}
 _SCENE = ("name", "description", "kind", "reference", "length_unit", "suites")
 # Drag coefficients and the power of length in their units (for length_unit scaling).
 DRAG_KEYS = {"linear_drag": 0, "quadratic_drag": -1, "angular_linear_drag": 2, "angular_quadratic_drag": 2}
-_BODY = ("name", "mass", "inertia_body_diagonal", "inertia_body", "position_world", "quat_wxyz",
-         "velocity_world", "angular_velocity_world", "force") + tuple(DRAG_KEYS)
+_MATERIAL = ("restitution", "friction_static", "friction_kinetic")
+_SHAPE = ("shape", "radius", "half_extents", "shape_center_body")
+_BODY = ("name", "mass", "inertia_body_diagonal", "inertia_body", "point_mass", "position_world", "quat_wxyz",
+         "velocity_world", "angular_velocity_world", "force") + tuple(DRAG_KEYS) + _SHAPE + _MATERIAL
+_POINT_MASS = ("mass", "position")
+_PLANE = ("name", "coefficients")
+_CONTACT = ("methods", "rest_speed", "penalty_stiffness", "penalty_damping", "pair") + _MATERIAL
+_PAIR = ("body", "plane") + _MATERIAL
+START_INSIDE_TOLERANCE = 1e-9
+"""[m] A body may start this far inside a plane (a value typed to 9 digits that puts it on the plane);
+deeper is a body that starts inside the plane: an error, not an impact at t = 0."""
 _FORCE = ("force_world", "point_body")
 _CHAIN = ("name", "joint", "end_effector", "end_effector_xyz", "end_effector_rpy", "urdf", "base_link", "tip_link",
           "dh")
@@ -259,16 +288,135 @@ def _inertia(r: _Reader) -> np.ndarray:
     return inertia
 
 
+def _point_masses(r: _Reader) -> tuple[float, np.ndarray, PointMasses]:
+    """(M, inertia about the COM, the points) of a body built from ``[[body.point_mass]]``."""
+    for key in ("mass", "inertia_body", "inertia_body_diagonal"):
+        if r.has(key):
+            raise r.fail(key, "given with point_mass: the mass and inertia are computed from the point masses",
+                         "either point_mass entries or mass with inertia_body(_diagonal)")
+    points = r.array_of_tables("point_mass", _POINT_MASS, "max_bodies")
+    masses = np.array([p.number("mass", positive=True) for p in points])
+    given = np.stack([p.vector("position", 3, length=1) for p in points])
+    total, center = mass_and_center_of_mass(masses, given)
+    relative = given - center
+    inertia = inertia_from_point_masses(masses, relative)
+    problem = inertia_problem(inertia)
+    if problem or np.linalg.eigvalsh(inertia)[0] < RANGES["inertia_moment"].low:
+        raise r.fail("point_mass", f"the points give no solid body ({problem or 'a principal moment is ~0'}: "
+                     "collinear or coincident points)", "at least three points not on one line")
+    return float(total), inertia, PointMasses(masses, relative, center)
+
+
 def _body(r: _Reader) -> RigidBody:
+    quat = r.vector("quat_wxyz", 4, [1.0, 0.0, 0.0, 0.0], nonzero=True)
+    position = r.vector("position_world", 3, [0.0] * 3, length=1)
+    if r.has("point_mass"):
+        mass, inertia, points = _point_masses(r)
+        # position_world places the frame the points are given in; the body's state is its COM's.
+        position = position + quat_wxyz_to_matrix(quat) @ points.center_of_mass_given
+    else:
+        mass, inertia, points = r.number("mass", positive=True), _inertia(r), None
     return RigidBody(
-        name=r.name("name"),
-        mass=r.number("mass", positive=True),
-        inertia_body=_inertia(r),
-        position_world=r.vector("position_world", 3, [0.0] * 3, length=1),
-        quat_wxyz=r.vector("quat_wxyz", 4, [1.0, 0.0, 0.0, 0.0], nonzero=True),
+        name=r.name("name"), mass=mass, inertia_body=inertia, position_world=position, quat_wxyz=quat,
         velocity_world=r.vector("velocity_world", 3, [0.0] * 3, length=1),
-        angular_velocity_world=r.vector("angular_velocity_world", 3, [0.0] * 3),
+        angular_velocity_world=r.vector("angular_velocity_world", 3, [0.0] * 3), point_masses=points,
     )
+
+
+def _material(r: _Reader, default: Material) -> Material:
+    """The restitution and friction a table sets, the others from ``default``."""
+    k = r.number("restitution", default.restitution)
+    if not 0.0 <= k <= 1.0:
+        raise r.fail("restitution", f"{k:g} is outside [0, 1]", "0 (plastic) to 1 (elastic)")
+    kinetic = r.number("friction_kinetic", default.friction_kinetic)
+    static = r.number("friction_static", max(default.friction_static, kinetic) if r.has("friction_kinetic")
+                      else default.friction_static)
+    if min(static, kinetic) < 0:
+        raise r.fail("friction_static" if static < 0 else "friction_kinetic", "is negative", "numbers >= 0")
+    if kinetic > static:
+        raise r.fail("friction_kinetic", f"{kinetic:g} exceeds friction_static {static:g}",
+                     "friction_kinetic <= friction_static (sliding never grips harder than sticking)")
+    return Material(k, static, kinetic)
+
+
+def _shape(r: _Reader, body: RigidBody) -> Shape:
+    kind = r.string("shape", "points" if body.point_masses is not None else "point", choices=SHAPES)
+    for key in ("radius", "half_extents", "shape_center_body"):
+        needed = {"radius": "sphere", "half_extents": "box", "shape_center_body": "box"}[key]
+        if r.has(key) and kind != needed:
+            raise r.fail(key, f"given for a {kind} shape", f"{key} with shape = \"{needed}\" only")
+    if kind == "sphere":
+        return Shape("sphere", radius=r.number("radius", positive=True, length=1))
+    if kind == "box":
+        return Shape("box", half_extents_body=r.vector("half_extents", 3, length=1, positive=True),
+                     center_body=r.vector("shape_center_body", 3, [0.0] * 3, length=1))
+    if kind == "points":
+        if body.point_masses is None:
+            raise r.fail("shape", "\"points\" needs the body's [[body.point_mass]] entries",
+                         "point, sphere, box; points for a body built from point masses")
+        return Shape("points", points_body=body.point_masses.points_body)
+    return Shape("point")
+
+
+_CONTACT_KEYS = _SHAPE + _MATERIAL
+
+
+def _contact(top: _Reader, readers: list[_Reader], bodies: tuple[RigidBody, ...]) -> Contact | None:
+    """The scene's planes and contact parameters, or None when it has no [[plane]]."""
+    if not top.has("plane"):
+        for key in ("contact",):
+            if top.has(key):
+                raise top.fail(key, "contact settings without a [[plane]]", "[[plane]] entries to collide with")
+        for r in readers:
+            for key in _CONTACT_KEYS:
+                if r.has(key):
+                    raise r.fail(key, "a contact property, but the scene has no [[plane]] to touch",
+                                 "[[plane]] entries, or no shape and material keys")
+        return None
+    planes = []
+    for p in top.array_of_tables("plane", _PLANE, "max_bodies"):
+        abcd = p.vector("coefficients", 4)
+        if not np.any(abcd[:3]):
+            raise p.fail("coefficients", "the normal (a, b, c) is all zeros", "[a, b, c, d] with (a, b, c) != 0")
+        d = p._in_range("coefficients[3]", abcd[3] * p.scale)
+        planes.append(Plane(abcd[:3], d, p.name("name", f"plane{len(planes)}")))
+    names = [plane.name for plane in planes]
+    if len(set(names)) != len(names):
+        raise top.fail("plane", f"the plane name {next(n for i, n in enumerate(names) if n in names[:i])!r} repeats",
+                       "distinct names")
+    c = top.subtable("contact", _CONTACT, required=False) or _Reader(top.source, {}, "contact", _CONTACT, top.scale,
+                                                                     top.limits)
+    default = _material(c, Material())
+    shapes = tuple(_shape(r, body) for r, body in zip(readers, bodies))
+    materials = [[_material(r, default)] * len(planes) for r in readers]
+    if c.has("pair"):
+        for pair in c.array_of_tables("pair", _PAIR, "max_bodies"):
+            body, plane = pair.string("body", choices=tuple(b.name for b in bodies)), pair.string("plane", choices=tuple(names))
+            i, j = [b.name for b in bodies].index(body), names.index(plane)
+            materials[i][j] = _material(pair, materials[i][j])
+    contact = Contact(
+        planes=tuple(planes), shapes=shapes, materials=tuple(tuple(row) for row in materials),
+        methods=c.strings("methods", CONTACT_METHODS, "no contact method {}") if c.has("methods") else CONTACT_METHODS,
+        rest_speed=c.number("rest_speed", 1e-3, positive=True, length=1),
+        penalty_stiffness=c.number("penalty_stiffness", 1e5, positive=True),
+        penalty_damping=c.number("penalty_damping", 0.0),
+    )
+    if contact.penalty_damping < 0:
+        raise c.fail("penalty_damping", "is negative", "numbers >= 0")
+    _check_start_outside(top, contact, bodies)
+    return contact
+
+
+def _check_start_outside(top: _Reader, contact: Contact, bodies: tuple[RigidBody, ...]) -> None:
+    """Every body starts on the free side of every plane (within :data:`START_INSIDE_TOLERANCE`)."""
+    for i, (body, shape) in enumerate(zip(bodies, contact.shapes)):
+        rotation = quat_wxyz_to_matrix(body.quat_wxyz)
+        vertices = body.position_world + shape.vertices_body() @ rotation.T
+        for plane in contact.planes:
+            depth = -(float((vertices @ plane.normal_world + plane.offset).min()) - shape.radius)
+            if depth > START_INSIDE_TOLERANCE:
+                raise top.fail(f"body[{i}].position_world", f"body {body.name!r} starts {depth:.3g} m inside plane "
+                               f"{plane.name!r}", "every body on the free side (E >= 0) of every plane at t = 0")
 
 
 def _dynamics(top: _Reader, head: dict) -> DynamicsScene:
@@ -291,13 +439,15 @@ def _dynamics(top: _Reader, head: dict) -> DynamicsScene:
     if len(set(names)) != len(names):
         repeated = next(n for i, n in enumerate(names) if n in names[:i])
         raise top.fail("body", f"the body name {repeated!r} repeats", "distinct names")
+    contact = _contact(top, readers, bodies)
     sim = top.subtable("simulation", ("duration", "dt", "rate_hz", "integrators"))
     duration = sim.number("duration", positive=True)
     if sim.has("dt") == sim.has("rate_hz"):
         raise sim.fail("dt", "give exactly one of dt and rate_hz", "dt = [time steps in s] or rate_hz = [steps per s]")
     dts = _ladder(sim, duration, len(bodies))
     integrators = sim.strings("integrators", known_integrators(), "no engine has an integrator {}") if sim.has("integrators") else ()
-    return DynamicsScene(bodies=bodies, forces=forces, duration=duration, dts=dts, integrators=integrators, **head)
+    return DynamicsScene(bodies=bodies, forces=forces, duration=duration, dts=dts, integrators=integrators,
+                         contact=contact, **head)
 
 
 def _ladder(sim: _Reader, duration: float, n_bodies: int) -> tuple[float, ...]:

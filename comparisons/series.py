@@ -41,10 +41,13 @@ def _worst(change: np.ndarray, scale: np.ndarray) -> np.ndarray:
 
 
 def dynamics_series(case: Case, traj: Trajectory, ref: Trajectory | None,
-                    changes: ConservedChanges) -> list[SeriesRecord]:
+                    changes: ConservedChanges, heights: np.ndarray | None = None) -> list[SeriesRecord]:
     """Drift of what the scene conserves (``changes``: :func:`comparisons.metrics.conserved_changes` of
-    ``traj``) and error against ``ref`` (when there is one), against time."""
+    ``traj``), error against ``ref`` (when there is one) and, in a contact scene, ``heights`` (T,): the first
+    body's lowest point above its nearest plane [m], against time."""
     out: list[tuple[str, str, np.ndarray]] = []
+    if heights is not None:
+        out.append(("support_height", "m", heights))
     if changes.energy is not None and (changes.energy_scale > 0).any():
         out.append(("energy_change", "1", _worst(changes.energy, changes.energy_scale)))
     if changes.angular_momentum is not None and (changes.angular_momentum_size > 0).any():

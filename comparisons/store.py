@@ -74,11 +74,16 @@ def _variants(engine: Engine) -> dict[str, list[str]]:
 
 def _scene_info(scene) -> dict:
     """What a report needs of a scene beside its rows: what it is, where from, and for dynamics
-    the number of bodies (per-call overhead) and the error its schemes are ranked by."""
+    the number of bodies (per-call overhead), the error its schemes are ranked by and, with contact, the
+    planes, the requested restitution (body x plane), core's methods and the rest speed."""
     info = {"kind": scene.kind, "description": scene.description, "reference": scene.reference,
             "source": scene.source, "suites": list(scene.suites)}
     if isinstance(scene, DynamicsScene):
         info |= {"bodies": len(scene.bodies), "headline_metric": headline_metric(scene)}
+        if scene.contact is not None:
+            info["contact"] = {"planes": [p.name for p in scene.contact.planes],
+                               "restitution": scene.contact.restitution.tolist(),
+                               "methods": list(scene.contact.methods), "rest_speed": scene.contact.rest_speed}
     if isinstance(scene, IKScene):
         info |= {"position_tolerance": scene.position_tolerance}
     return info

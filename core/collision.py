@@ -9,57 +9,24 @@ has collided when E(p(t_i)) <= 0. The lecture lists three ways to handle it, all
 - "back up time to the first instant the collision occurs and determine the appropriate
   response" (:func:`time_of_impact`, and ``method="backup"`` of :func:`step_particles`).
 
-Arrays are float64 in the world frame and SI units, batched over B particles.
+Arrays are float64 in the world frame and SI units, batched over B particles. The rigid-body
+methods the engine runs on scenes with contact (:mod:`core.contact` and the modules it names) build
+on :func:`penalty_force` and :func:`entry_time`; the particle steppers here are the lecture's
+recipes as written, checked against closed forms in ``tests/test_collision.py``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from simparity.core.arrays import readonly
 from simparity.core.point_mass import average_velocity_step
+from simparity.core.scene import Plane
 
 METHODS = ("backup", "detect_and_reflect")
 """Collision handling offered by :func:`step_particles`."""
 
-ZERO_NORMAL = "the plane's normal (a, b, c) must be finite and non-zero"
 BAD_RESTITUTION = "restitution must lie in [0, 1]"
 UNKNOWN_METHOD = "unknown collision method"
-
-
-@dataclass(frozen=True)
-class Plane:
-    """The plane E(p) = N . p + d = 0 with unit normal N, free side E > 0.
-
-    Built from the lecture's coefficients: ``Plane((a, b, c), d)``; (a, b, c) is normalised
-    and d divided by the same length, so that E is a signed distance.
-
-    Attributes
-    ----------
-    normal_world : (3,) ndarray
-        Unit normal N, pointing to the free side.
-    offset : float
-        d [m]: the plane passes through -d N.
-    """
-
-    normal_world: np.ndarray
-    offset: float
-
-    def __post_init__(self) -> None:
-        abc = np.asarray(self.normal_world, dtype=float).reshape(3)
-        length = float(np.linalg.norm(abc))
-        if not np.isfinite(length) or length == 0.0:
-            raise ValueError(f"{ZERO_NORMAL}, got {abc.tolist()}")
-        if not np.isfinite(self.offset):
-            raise ValueError(f"the plane's offset d must be finite, got {self.offset}")
-        object.__setattr__(self, "normal_world", readonly(abc / length, shape=(3,)))
-        object.__setattr__(self, "offset", float(self.offset) / length)
-
-    def signed_distance(self, position_world: np.ndarray) -> np.ndarray:
-        """E(p) = N . p + d [m] of points (..., 3) [m]; (...,), negative inside the plane."""
-        return np.asarray(position_world) @ self.normal_world + self.offset
 
 
 def reflect_velocity(velocity_world: np.ndarray, unit_normal_world: np.ndarray, restitution: float) -> np.ndarray:
@@ -147,8 +114,11 @@ def time_of_impact(start_world: np.ndarray, end_world: np.ndarray, plane: Plane)
     return np.where(crossed, e0 / np.where(crossed, e0 - e1, 1.0), 1.0)
 
 
-def _entry_time(e0: np.ndarray, normal_speed: np.ndarray, half_normal_gravity: float, dt: float):
+def entry_time(e0: np.ndarray, normal_speed: np.ndarray, half_normal_gravity, dt):
     """First root s in [0, dt] where E(s) = e0 + u s + a s^2 crosses zero going in (E' <= 0).
+
+    Shared with the rigid-body backup method (:mod:`core.contact_backup`), whose bodies that do not
+    turn move their contact points on such parabolas. Arguments broadcast against each other.
 
     Of the two roots (-u -+ sqrt(u^2 - 4 a e0)) / (2 a), the entering one is always the
     '-' root (E' = -sqrt(.) there); it is taken in the cancellation-free form. Returns
@@ -167,7 +137,7 @@ def _entry_time(e0: np.ndarray, normal_speed: np.ndarray, half_normal_gravity: f
 def _backed_up_flight(p, v, gravity_world, dt, plane, restitution):
     """Fly to the entry time, reflect there, fly the rest of the step ((B, 3) each)."""
     normal = plane.normal_world
-    hit, s = _entry_time(plane.signed_distance(p), v @ normal, gravity_world @ normal / 2.0, dt)
+    hit, s = entry_time(plane.signed_distance(p), v @ normal, gravity_world @ normal / 2.0, dt)
     p, v = average_velocity_step(p, v, gravity_world, s[:, None])
     v = np.where(hit[:, None], reflect_velocity(v, normal, restitution), v)
     return average_velocity_step(p, v, gravity_world, (dt - s)[:, None])

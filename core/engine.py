@@ -147,6 +147,12 @@ class Engine(abc.ABC):
     def integrators(self) -> tuple[str, ...]:
         """Names of the dynamics integrators the engine offers (empty if none)."""
 
+    def scene_integrators(self, scene: DynamicsScene) -> tuple[str, ...]:
+        """The integrators this engine runs on ``scene``: all of :meth:`integrators` unless the engine's
+        methods differ by kind of scene (core runs its contact methods on a scene with contact, and its
+        free-body integrators on the others). Each is a case of the scene; unsupported ones are n/a rows."""
+        return self.integrators()
+
     @abc.abstractmethod
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         """Whether :meth:`build_dynamics` can simulate ``scene`` with ``integrator``."""

@@ -8,6 +8,16 @@ from dataclasses import asdict, replace
 import numpy as np
 
 from simparity.core import point_mass
+from simparity.core.contact import (
+    PENALTY_SCHEMES,
+    Bodies,
+    ContactModel,
+    EventLog,
+    penalty_stability_limit,
+    penalty_wrench,
+)
+from simparity.core.contact_act_after import GAUSS_SEIDEL_PASSES, ActAfterStepper
+from simparity.core.contact_backup import FREE, MAX_EVENTS_PER_STEP, BackupStepper
 from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
 from simparity.core.forces import make_wrench
 from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik
@@ -17,7 +27,7 @@ from simparity.core.integrators import ORDER, ORIENTATION_UPDATES, SCHEMES, make
 from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.rigid_body import MassProperties, State, initial_state, velocities
 from simparity.core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
-from simparity.core.scene import Chain, DynamicsScene
+from simparity.core.scene import PENALTY_PREFIX, Chain, DynamicsScene
 from simparity.core.trajectory import FramePoses, Trajectory
 
 _DEFAULT_ORIENTATION = "quaternion"
@@ -33,6 +43,17 @@ def integrator_names() -> tuple[str, ...]:
         if scheme not in _SINGLE_ORIENTATION_SCHEMES:
             names.extend(f"{scheme}+{o}" for o in ORIENTATION_UPDATES if o != _DEFAULT_ORIENTATION)
     return tuple(names) + tuple(point_mass.RULES)
+
+
+CONTACT_INTEGRATORS = ("backup", "act_after") + tuple(PENALTY_PREFIX + scheme for scheme in PENALTY_SCHEMES)
+"""Core's contact methods (:data:`core.scene.CONTACT_METHODS`) as integrator names: ``penalty`` once per
+scheme that integrates it."""
+
+
+def contact_integrators(methods: tuple[str, ...]) -> tuple[str, ...]:
+    """The integrator names of contact methods: ``penalty`` -> every ``penalty_<scheme>``."""
+    return tuple(name for method in methods for name in CONTACT_INTEGRATORS
+                 if name == method or (method == "penalty" and name.startswith(PENALTY_PREFIX)))
 
 
 def parse_integrator(name: str) -> tuple[str, str]:
@@ -97,6 +118,59 @@ class _ParticleSimulation(Simulation):
         return Trajectory(np.arange(n_steps + 1) * dt, pos, quat, vel, omg)
 
 
+class _ContactSimulation(Simulation):
+    """Bodies against the scene's planes by one of core's contact methods.
+
+    After :meth:`run`, ``events`` holds the backup method's contact events (:class:`core.contact.EventLog`;
+    empty for the other methods).
+    """
+
+    def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
+        contact = scene.contact
+        self._props = MassProperties.of(scene.bodies)
+        self._state0 = initial_state(scene.bodies, self._props, quaternion=True)
+        self._model = ContactModel.of(contact)
+        self._dt, self._method = dt, integrator
+        self.events = EventLog()
+        if integrator == "backup":
+            self._backup = BackupStepper(Bodies(self._props, self._model, scene.forces))
+            self.detail = (f"in-house backup: time backed up to each contact (exact root for bodies that do not "
+                           f"turn, bracketed root finder otherwise), impulse with restitution and Coulomb friction, "
+                           f"resting contact below rest_speed {contact.rest_speed:g} m/s; free flight rk4 "
+                           f"(quaternion); at most {MAX_EVENTS_PER_STEP} events per body and step")
+        elif integrator == "act_after":
+            self._step = ActAfterStepper(Bodies(self._props, self._model, scene.forces)).step
+            self.detail = (f"in-house act_after: free flight rk4 (quaternion), then push-out and impulse with "
+                           f"restitution and Coulomb friction ({GAUSS_SEIDEL_PASSES} Gauss-Seidel passes), plastic "
+                           f"below rest_speed {contact.rest_speed:g} m/s and for a body touching since the step's "
+                           f"start")
+        else:
+            scheme = integrator.removeprefix(PENALTY_PREFIX)
+            wrench = penalty_wrench(self._model, self._props, make_wrench(scene.forces, self._props))
+            self._step = make_step(scheme, "quaternion", self._props, wrench)
+            undamped = float(penalty_stability_limit(scheme, contact.penalty_stiffness, self._props.mass).min())
+            self.detail = (f"in-house penalty: k_s {contact.penalty_stiffness:g} N/m, k_d {contact.penalty_damping:g} "
+                           f"N s/m, regularised Coulomb friction (mu_k), integrated by {scheme} (quaternion); "
+                           f"restitution and rest_speed not used; in theory an undamped linear spring is "
+                           + (f"stable below {undamped:.3g} s" if undamped > 0 else "unstable at every step"))
+
+    def run(self, n_steps: int) -> Trajectory:
+        state, dt = self._state0, self._dt
+        self.events = EventLog()
+        resting = np.full(len(self._props.mass), FREE)
+        pos, mom, ang = (np.empty((n_steps + 1,) + state.position_world.shape) for _ in range(3))
+        ori = np.empty((n_steps + 1,) + state.orientation.shape)
+        for i in range(n_steps + 1):
+            if i and self._method == "backup":
+                state, resting = self._backup.step((i - 1) * dt, state, resting, dt, self.events)
+            elif i:
+                state = self._step((i - 1) * dt, state, dt)
+            pos[i], ori[i], mom[i], ang[i] = (state.position_world, state.orientation, state.momentum_world,
+                                              state.angular_momentum_world)
+        vel, omg = velocities(State(pos, ori, mom, ang), self._props)
+        return Trajectory(np.arange(n_steps + 1) * dt, pos, ori, vel, omg)
+
+
 class _Kinematics(KinematicsModel):
     def __init__(self, chain: Chain) -> None:
         self._chain = chain
@@ -135,22 +209,43 @@ class InHouseEngine(Engine):
         return f"numpy {np.__version__}, python {platform.python_version()}"
 
     def integrators(self) -> tuple[str, ...]:
-        return integrator_names()
+        return integrator_names() + CONTACT_INTEGRATORS
+
+    def scene_integrators(self, scene: DynamicsScene) -> tuple[str, ...]:
+        """Of :meth:`integrators`: the contact methods the scene asks for on a scene with contact, the
+        free-body integrators otherwise."""
+        if scene.contact is None:
+            return tuple(i for i in self.integrators() if i not in CONTACT_INTEGRATORS)
+        return tuple(i for i in contact_integrators(scene.contact.methods) if i in self.integrators())
 
     def integrator_variant(self, integrator: str) -> tuple[str, str]:
-        """(scheme, orientation update) of a rigid-body integrator; a particle rule has no variants."""
+        """(scheme, orientation update) of a rigid-body integrator; particle rules and contact methods have none."""
         scheme, orientation = parse_integrator(integrator)
-        if integrator in point_mass.RULES or scheme in _SINGLE_ORIENTATION_SCHEMES:
+        no_variants = integrator in point_mass.RULES or integrator in CONTACT_INTEGRATORS
+        if no_variants or scheme in _SINGLE_ORIENTATION_SCHEMES:
             return integrator, ""
         return scheme, orientation
 
     def theoretical_order(self, integrator: str) -> int | None:
-        """The scheme's order (:data:`core.integrators.ORDER`); the particle rules' depend on the scene."""
+        """The scheme's order (:data:`core.integrators.ORDER`); None for the particle rules (it depends on the
+        scene) and the contact methods (a contact's first-order or exact treatment dominates the scheme's)."""
+        if integrator in CONTACT_INTEGRATORS:
+            return None
         return ORDER.get(parse_integrator(integrator)[0])
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         named = self.check_integrator(integrator)
-        if not named.ok or integrator not in point_mass.RULES:
+        if not named.ok:
+            return named
+        if scene.contact is not None and len(scene.contact.shapes) != len(scene.bodies):
+            return Support.no(f"the scene's contact has {len(scene.contact.shapes)} shapes for {len(scene.bodies)} "
+                              f"bodies")
+        if (integrator in CONTACT_INTEGRATORS) != (scene.contact is not None):
+            if scene.contact is None:
+                return Support.no(f"{integrator} is a contact method; the scene has no contact planes")
+            return Support.no(f"{integrator} ignores contact; the scene has contact planes (core runs "
+                              f"{', '.join(contact_integrators(scene.contact.methods))} on it)")
+        if integrator not in point_mass.RULES:
             return named
         rotating = any(np.any(b.angular_velocity_world != 0) for b in scene.bodies)
         if rotating or scene.forces.exerts_torque:
@@ -161,6 +256,8 @@ class InHouseEngine(Engine):
         return Support.yes()
 
     def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
+        if integrator in CONTACT_INTEGRATORS:
+            return _ContactSimulation(scene, integrator, dt)
         if integrator in point_mass.RULES:
             return _ParticleSimulation(scene, integrator, dt)
         return _RigidBodySimulation(scene, integrator, dt)

@@ -64,6 +64,14 @@ RANGES = {
     "origin_rpy": _ANGLE, "end_effector_rpy": _ANGLE, "alpha": _ANGLE, "theta_offset": _ANGLE,
     "position_tolerance": Range(1e-15, 1e6, "m", "a tolerance above rounding, and at most a tenth of the reach"),
     "orientation_tolerance": Range(1e-15, 0.5, "rad", "a tolerance, not a quarter turn"),
+    "radius": Range(1e-6, 1e6, "m", "a micrometre to 1000 km"),
+    "half_extents": Range(1e-6, 1e6, "m", "a micrometre to 1000 km"),
+    "shape_center_body": _LENGTH, "position": _LENGTH,
+    "rest_speed": Range(1e-9, 1e3, "m/s", "a rebound slower than this comes to rest: above rounding, below a bullet"),
+    "penalty_stiffness": Range(1e-3, 1e12, "N/m", "a spring from a rubber band to steel contact"),
+    "penalty_damping": Range(0.0, 1e9, "N s/m", "a damper coefficient"),
+    "friction_static": Range(0.0, 1e2, "1", "a Coulomb coefficient (rubber on rough concrete is ~1)"),
+    "friction_kinetic": Range(0.0, 1e2, "1", "a Coulomb coefficient (rubber on rough concrete is ~1)"),
 }
 """By key name (the last component of a key path). Vectors are held to the range entry by entry."""
 

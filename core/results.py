@@ -99,6 +99,8 @@ SERIES_QUANTITIES = {
     "angular_momentum_change": "|L(t) - L(0)| / |L(0)| (x: time [s])",
     "position_error": "largest body position error against the reference [m] (x: time [s])",
     "orientation_error": "largest body orientation error against the reference [rad] (x: time [s])",
+    "support_height": "contact scenes: signed distance of the first body's lowest point from its nearest plane [m] "
+                      "(negative: penetration; x: time [s])",
     "position_residual": "IK position residual [m] at cumulative fraction x of the random targets",
     "orientation_residual": "IK orientation residual [rad] at cumulative fraction x of the random targets",
     "iterations": "IK iterations at cumulative fraction x of the random targets (failed solves included)",

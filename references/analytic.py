@@ -11,12 +11,15 @@ decouple (no force here couples them), and each is solved per body:
   angular drag on an isotropic body.
 
 Anything else (applied forces, both drags at once, quadratic angular drag, ...) gets
-``n/a`` with the reason. Kinematics: planar chains (revolute joints about z, origins in
-the xy plane): the end effector is a sum of rotated link vectors, sum_k Rz(phi_k) o_k with
-phi_k the cumulative angle, and the Jacobian is its closed-form derivative. IK: the planar
-2-link arm solved geometrically (the elbow is where the circle |e| = l1 about the base
-meets the circle |p - e| = l2 about the target), a formulation of its own, independent of
-core's law-of-cosines solver that it checks. Rotations are SciPy's
+``n/a`` with the reason. Scenes with contact go to :mod:`references.analytic_contact`
+(translating bodies bouncing, resting and sliding on a plane, event by event).
+
+Kinematics: planar chains (revolute joints about z, origins in the xy plane): the end
+effector is a sum of rotated link vectors, sum_k Rz(phi_k) o_k with phi_k the cumulative
+angle, and the Jacobian is its closed-form derivative. IK: the planar 2-link arm solved
+geometrically (the elbow is where the circle |e| = l1 about the base meets the circle
+|p - e| = l2 about the target), a formulation of its own, independent of core's
+law-of-cosines solver that it checks. Rotations are SciPy's
 (:mod:`simparity.references.conventions`).
 """
 
@@ -29,6 +32,7 @@ from simparity.core.ik.problem import IKTolerances, check_inputs
 from simparity.core.ik.result import IKResult
 from simparity.core.scene import Chain, DynamicsScene
 from simparity.core.trajectory import FramePoses, Trajectory
+from simparity.references import analytic_contact
 from simparity.references import analytic_solutions as closed
 from simparity.references.conventions import matrix_to_quat_wxyz, principal_axes, quat_wxyz_to_matrix, rotvec_to_matrix
 
@@ -281,6 +285,8 @@ class AnalyticEngine(Engine):
         named = self.check_integrator(integrator)
         if not named.ok:
             return named
+        if scene.contact is not None:
+            return analytic_contact.supports(scene)
         for k in range(len(scene.bodies)):
             for kind, reason in (_translation_kind(scene, k), _rotation_kind(scene, k)):
                 if not kind:
@@ -288,6 +294,8 @@ class AnalyticEngine(Engine):
         return Support.yes()
 
     def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
+        if scene.contact is not None:
+            return analytic_contact.ContactSimulation(scene, dt)
         kinds = [(_translation_kind(scene, k)[0], _rotation_kind(scene, k)[0]) for k in range(len(scene.bodies))]
         return _Simulation(scene, dt, kinds)
 

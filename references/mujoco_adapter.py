@@ -32,6 +32,14 @@ Conversions (each pinned by a test in ``tests/test_mujoco_adapter.py``)
   kinematics-only file without ``<inertial>`` compiles (masses play no part in
   kinematics), and a site added at the tip link; poses are re-expressed in the chain's base
   link (:mod:`references.base_frame`). Other chains come from the adapter's MJCF.
+- Contact (a scene with ``contact``; model in :mod:`references.mjcf`, parameters and their
+  reasons in :mod:`references.contact_params`): planes and shapes as geoms, one explicit
+  contact pair per body geom and plane with that pair's material, elliptic cone. What MuJoCo
+  cannot give the scene: a restitution coefficient (a damped contact spring whose damping
+  ratio is derived from k; the restitution it produces is measured, not assumed), static
+  friction above kinetic (one coefficient, mu_k), the rest speed (no such rule: small bounces
+  decay inside the soft contact), and rigid non-penetration (a soft contact penetrates, about
+  2 v dt during an impact at speed v). The detail of every row says so.
 """
 
 from __future__ import annotations
@@ -45,7 +53,7 @@ from simparity.core.errors import DivergedError
 from simparity.core.ik.problem import IKTolerances
 from simparity.core.scene import Chain, DynamicsScene, Forces
 from simparity.core.trajectory import FramePoses, Trajectory
-from simparity.references import external_forces, mujoco_ik
+from simparity.references import contact_params, external_forces, mujoco_ik
 from simparity.references.base_frame import BaseFrame
 from simparity.references.conventions import fmt, quat_wxyz_to_matrix
 from simparity.references.mjcf import INTEGRATORS, chain_mjcf, dynamics_mjcf
@@ -111,7 +119,8 @@ class _Simulation(Simulation):
         stepwise = (["mj_applyFT at each applied force's world point"] if self._applied else []) + (
             [f"quadratic drag as xfrc_applied ({external_forces.DETAIL})"] if self._drags else [])
         self.detail = (
-            f"MuJoCo integrator {INTEGRATORS[integrator]}; explicit inertia; contact disabled"
+            f"MuJoCo integrator {INTEGRATORS[integrator]}; explicit inertia; "
+            + ("contact disabled" if scene.contact is None else contact_detail(scene, dt))
             + ("" if forces.gravity_world is not None else "; gravity disabled")
             + (f"; {' and '.join(native)} as dof_damping, eulerdamp disabled" if native else "")
             + ("; wind as constant xfrc_applied b w" if wind is not None else "")
@@ -178,6 +187,24 @@ class _Simulation(Simulation):
         omega_world = np.einsum("tbij,tbj->tbi", quat_wxyz_to_matrix(quat), qvel[..., 3:])
         times = np.arange(n_steps + 1) * self._dt
         return Trajectory(times, qpos[..., :3], quat, qvel[..., :3], omega_world)
+
+
+def contact_detail(scene: DynamicsScene, dt: float) -> str:
+    """What MuJoCo's contact model is given for a contact scene, and what it cannot express."""
+    contact = scene.contact
+    k = sorted({float(v) for v in np.ravel(contact.restitution)})
+    solrefs = ", ".join(f"k {v:g} -> zeta {contact_params.damping_ratio(v):.4g}, solref "
+                        f"{fmt(contact_params.mujoco_solref(v, dt))}" for v in k)
+    static = contact_params.static_friction_note(contact)
+    return (f"contact: {len(contact.planes)} plane geom(s), one <pair> per body geom and plane (no body-body "
+            f"contact), elliptic cone, condim 3 with friction mu_k (condim 1 where mu_k = 0); soft contact: direct "
+            f"solref (-K, -b), K = (1/(2 dt))^2 (MuJoCo's refsafe limit), b = 2 zeta/(2 dt) with zeta = -ln k / "
+            f"sqrt(pi^2 + ln^2 k) ({solrefs}); solreffriction {fmt(contact_params.mujoco_solreffriction(dt))}; "
+            f"solimp {fmt(contact_params.SOLIMP)} (constant impedance); points as spheres of "
+            f"{contact_params.POINT_RADIUS:g} m with pair margin -{contact_params.POINT_RADIUS:g} m (contact at the "
+            f"centre); restitution approximate (measured, not imposed); rest_speed {contact.rest_speed:g} m/s not "
+            f"modelled (no rest rule; small bounces decay in the soft contact); penetration up to ~2 v dt in an "
+            f"impact at speed v" + (f"; {static}" if static else ""))
 
 
 def _chain_model(chain: Chain) -> mujoco.MjModel:
@@ -321,4 +348,6 @@ class MujocoEngine(Engine):
             extra += (f"<!-- each step, mj_applyFT of {fmt(applied.force_world)} N at body point "
                       f"{fmt(applied.point_body)} m (world position from the state at the step's start), "
                       f"body {applied.body + 1} -->\n")
+        if scene.contact is not None:
+            extra += f"<!-- {contact_detail(scene, dt)} -->\n"
         return dynamics_mjcf(scene, integrator, dt) + velocities + extra

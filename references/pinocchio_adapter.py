@@ -26,6 +26,12 @@ Conversions (each pinned by a test in ``tests/test_pinocchio_adapter.py``)
   ``buildModelFromXML``; fixed base. A ``continuous`` joint has nq = 2 (cos, sin). Joint
   frames are the child links' frames; Jacobians are LOCAL_WORLD_ALIGNED; poses are
   re-expressed in the chain's base link (:mod:`references.base_frame`).
+- Contact: a scene with contact is n/a (:data:`NO_CONTACT`). Pinocchio 4.1 has the pieces of ONE
+  contact problem (``PointContactConstraintModel`` with a ``CoulombFrictionCone``, Delassus
+  operators, ``PGSConstraintSolver`` / ``ADMMConstraintSolver`` for a single conic problem,
+  ``constraintDynamics`` for bilateral rigid constraints, ``impulseDynamics`` with a restitution
+  coefficient for bilateral impacts) but no time-stepping contact simulation; assembling one
+  here would be the harness's own contact method, not Pinocchio's.
 """
 
 from __future__ import annotations
@@ -54,6 +60,17 @@ def free_bodies_model(scene: DynamicsScene) -> pin.Model:
     model.gravity = pin.Motion(np.zeros(3) if gravity is None else gravity, np.zeros(3))
     return model
 
+
+NO_CONTACT = (
+    "Pinocchio 4.1 has no time-stepping contact simulation: it solves single contact problems "
+    "(PointContactConstraintModel with one CoulombFrictionCone mu per contact, Delassus operators and the "
+    "PGSConstraintSolver/ADMMConstraintSolver conic solvers; constraintDynamics for bilateral rigid "
+    "constraints; impulseDynamics with a restitution coefficient for bilateral impacts only), but nothing "
+    "that detects the plane contacts step by step, applies Newton restitution in a unilateral frictional "
+    "impact, separates static from kinetic friction or applies the rest speed; stepping those pieces would "
+    "be the harness's own contact integrator, not Pinocchio's"
+)
+"""Why a dynamics scene with contact is n/a for Pinocchio (checked against ``dir(pinocchio)`` of 4.1)."""
 
 INTEGRATORS = ("euler", "rk4")
 """Harness-side steppers of aba's accelerations: the engines' first-order scheme, and RK4 (RKMK on SO(3))."""
@@ -250,6 +267,8 @@ class PinocchioEngine(UrdfChains, Engine):
         return {"euler": 1, "rk4": 4}.get(integrator)
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
+        if scene.contact is not None:
+            return Support.no(NO_CONTACT)
         return self.check_integrator(integrator)
 
     def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
@@ -277,5 +296,6 @@ class PinocchioEngine(UrdfChains, Engine):
             f"# Pinocchio model built in code (no file): one free-flyer per body.\n"
             f"# gravity: {model.gravity.linear}; stepped by the harness ({integrator}, dt = {dt!r} s)\n"
             + (f"# each step, aba's fext (local frame, about the COM): {', '.join(external)}\n" if external else "")
+            + (f"# contact: n/a, not simulated: {NO_CONTACT}\n" if scene.contact is not None else "")
             + f"{model}\n{inertias}"
         )

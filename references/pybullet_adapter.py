@@ -32,6 +32,43 @@ Conversions and overridden defaults (each pinned by a test in ``tests/test_pybul
   force at the COM and a world-frame torque (``applyExternalTorque``). All with
   WORLD_FRAME (in 3.2.7 both honour the flag, which bullet3 #1949 once had swapped for the
   base); PyBullet clears them after every step.
+- Contact (a scene with ``contact``; shared parameters in :mod:`references.contact_params`):
+  every plane is a static multibody with a ``GEOM_PLANE`` shape of normal N placed at -d N;
+  every body keeps its URDF inertia (``URDF_USE_INERTIA_FROM_FILE``) and gets collision
+  spheres: a sphere of radius r + POINT_RADIUS, a point (each of "points", each box corner)
+  a sphere of POINT_RADIUS, with ``contactSlop`` = POINT_RADIUS (Bullet's multibody solver
+  adds the slop to every contact distance), so every shape touches exactly where the scene
+  says (a box with its corners, as box-plane contact is; no box margin to round them).
+  Collision groups let bodies touch planes only. Bullet MULTIPLIES the two objects'
+  restitution and lateral friction: planes get 1, each body its k and mu_k (one lateral
+  friction coefficient: mu_k), rolling and spinning friction 0; a body whose material
+  differs between planes is n/a. Bullet's multibody contact (Bullet 3.2.7 source,
+  btMultiBodyConstraintSolver) works on velocities: restitution makes the normal velocity
+  -k times the approach velocity; a contact found before the bodies touch ("speculative",
+  distance D > 0) lets the body approach by at most D/dt; a penetration is pushed out by
+  contactERP (adds D erp / dt to the rebound, which inflates restitution: measured 0.63 for
+  k = 0.5 at dt = 0.01 with erp 0.2) and split impulse is NOT implemented for multibodies
+  (commented out there; ``useSplitImpulse`` changes nothing, which a test pins). Hence:
+  ``contactERP`` = 0; a body with k = 0 gets speculative contacts (contactProcessingThreshold
+  1e9 m: it stops exactly on the plane, no penetration); a body with k > 0 only contacts at
+  distance <= POINT_RADIUS (contactProcessingThreshold 0, the maintainers' advice when
+  restitution matters, bullet3 #1701 and #3096; pybullet ignores a negative one: a speculative
+  contact would replace the bounce by k|v| - D/dt, measured e = 0.02 instead of 0.5), so an
+  impact leaves a penetration of at most v dt until the body leaves. ``restitutionVelocityThreshold``
+  is the scene's rest rule on Bullet's terms: Bullet drops restitution when the APPROACH speed
+  is below it, the scene when the REBOUND k |v| is below ``rest_speed``, so the threshold is
+  rest_speed / k (the largest k > 0 of the scene when bodies differ). Generated contacts:
+  ``contactBreakingThreshold`` (Bullet's factor of each body's bounding radius) 1e5, so that a
+  contact is generated at least 1.7 m ahead (capped by Bullet's AABB overflow check, see
+  :data:`BREAKING_FACTOR`); it is a PROCESS-GLOBAL variable in Bullet, set again before every
+  run. ``numSolverIterations`` 100 (PGS sweeps; a box rests on 4 corners),
+  ``solverResidualThreshold`` 1e-12 (:data:`SOLVER_RESIDUAL`), ``globalCFM`` 0,
+  ``deterministicOverlappingPairs`` 1.
+- What Bullet's time stepping does with the rest rule: the approach speed it sees includes the
+  g dt gained in the step, so a body with k > 0 resting on a plane hops by about k |g| dt^2 every
+  step unless rest_speed / k exceeds |g| dt (measured 3.3e-6 m at k = 0.5, dt = 1e-3), and
+  bounces settle at a rebound speed k |g| dt / (1 - k) instead of dying out (hard-zeno, k = 0.9,
+  dt = 0.01: still bouncing ~7 cm high at the end).
 """
 
 from __future__ import annotations
@@ -47,7 +84,7 @@ from simparity.core.errors import DivergedError
 from simparity.core.ik.problem import IKTolerances
 from simparity.core.scene import Chain, DynamicsScene
 from simparity.core.trajectory import FramePoses, Trajectory
-from simparity.references import external_forces, pybullet_ik
+from simparity.references import contact_params, external_forces, pybullet_ik
 from simparity.references.base_frame import BaseFrame
 from simparity.references.conventions import (
     fmt,
@@ -84,6 +121,70 @@ def _load_urdf(client: int, text: str, **kwargs) -> int:
         os.unlink(path)
 
 
+CONTACT_ERP = 0.0
+"""contactERP: no position correction by velocity (it adds energy to bounces; see the module docstring)."""
+SOLVER_ITERATIONS = 100
+"""numSolverIterations (Bullet's PGS sweeps; default 50): simultaneous contacts (a box on 4 corners)."""
+SOLVER_RESIDUAL = 1e-12
+"""solverResidualThreshold: PGS stops early below this residual. Bullet's 1e-7 stops it too early for a box resting
+on its corners, which then sinks steadily (there is no position correction: contactERP 0): measured 1e-5 m/s;
+1e-12 lets it run its sweeps, 1e-7 m/s."""
+BREAKING_FACTOR = 1e5
+"""contactBreakingThreshold, Bullet's RELATIVE threshold: a contact is generated within this factor times the
+shape's bounding radius, at least 1e5 sqrt(3) POINT_RADIUS = 1.7 m for the smallest shape (a point), so a body
+with k = 0 is caught before it touches unless it moves more than that in one step. Bullet also widens every
+object's AABB by the factor itself (in metres) and silently stops simulating an object whose AABB exceeds
+1e6 m (btCollisionWorld::updateSingleAabb: a factor 1e6 let a point fall through the plane), so 1e5."""
+SPECULATIVE_RANGE = 1e9  # [m]
+"""contactProcessingThreshold of a body with k = 0 against every plane: all its contacts are solved, also before
+touching, so it stops on the plane without penetrating. Bodies with k > 0 get 0 (module docstring)."""
+MAX_FRICTION = 10.0
+"""Bullet clamps a combined friction coefficient to [-10, 10] (btManifoldResult::calculateCombinedFriction)."""
+BODY_GROUP, PLANE_GROUP = 1, 2
+"""Collision filter groups: a body collides with planes only (group & other mask on both sides)."""
+
+
+def restitution_threshold(contact) -> float:
+    """Bullet's restitutionVelocityThreshold [m/s]: the approach speed below which the scene's rule (a rebound
+    k |v| below rest_speed ends in resting contact) drops restitution, rest_speed / k; the largest k > 0 of the
+    scene when bodies differ (rest_speed when no k > 0)."""
+    k = float(np.max(contact.restitution)) if contact.restitution.size else 0.0
+    return contact.rest_speed / k if k > 0 else contact.rest_speed
+
+
+def contact_parameters(contact, dt: float) -> dict:
+    """setPhysicsEngineParameter arguments of a contact scene (module docstring gives each reason)."""
+    return dict(contactERP=CONTACT_ERP, contactSlop=contact_params.POINT_RADIUS,
+                restitutionVelocityThreshold=restitution_threshold(contact), useSplitImpulse=0,
+                numSolverIterations=SOLVER_ITERATIONS, solverResidualThreshold=SOLVER_RESIDUAL, globalCFM=0.0,
+                deterministicOverlappingPairs=1, contactBreakingThreshold=BREAKING_FACTOR)
+
+
+def body_contact_dynamics(restitution: float, friction: float) -> dict:
+    """changeDynamics arguments of a body in a contact scene (planes get restitution 1, lateral friction 1)."""
+    return dict(restitution=restitution, lateralFriction=friction, rollingFriction=0.0, spinningFriction=0.0,
+                contactProcessingThreshold=0.0 if restitution > 0 else SPECULATIVE_RANGE)
+
+
+PLANE_DYNAMICS = dict(restitution=1.0, lateralFriction=1.0, rollingFriction=0.0, spinningFriction=0.0)
+"""changeDynamics of every plane: 1, the neutral factor of Bullet's products."""
+
+
+def contact_support(contact) -> Support:
+    """Whether PyBullet can give every body-plane pair its material (one value per body, friction <= 10)."""
+    if contact is None:
+        return Support.yes()
+    values, reason = contact_params.body_materials(contact)
+    if values is None:
+        return Support.no("PyBullet multiplies the restitution and friction of the two objects in contact, so a "
+                          f"body has one value against every plane; {reason}")
+    too_rough = [b for b, (_, mu) in enumerate(values) if mu > MAX_FRICTION]
+    if too_rough:
+        return Support.no(f"Bullet clamps friction coefficients to {MAX_FRICTION:g}; body {too_rough[0]} has mu_k "
+                          f"{values[too_rough[0]][1]:g}")
+    return Support.yes()
+
+
 class _Client:
     """A private DIRECT-mode PyBullet world, disconnected when garbage-collected."""
 
@@ -97,7 +198,25 @@ class _Client:
             pass
 
 
+READ_BACK = ("fixedTimeStep", "numSubSteps", "numSolverIterations", "numNonContactInnerIterations")
+"""The engine parameters PyBullet 3.2.7 reports back (getPhysicsEngineParameters returns only these, the
+real-time flag and gravity; restitutionVelocityThreshold, contactERP, contactSlop, split impulse and the
+breaking threshold cannot be read back: tests check their effect instead)."""
+
+
 class _Simulation(Simulation):
+    """A scene in a private PyBullet world.
+
+    Attributes
+    ----------
+    client : int
+        The PyBullet client id.
+    body_ids, plane_ids : list of int
+        Multibody ids of the scene's bodies and planes (no planes without contact).
+    engine_parameters : dict
+        getPhysicsEngineParameters after configuring a contact scene ({} without contact).
+    """
+
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
         self._client = _Client()
         c = self._client.id
@@ -105,13 +224,22 @@ class _Simulation(Simulation):
         pybullet.setGravity(*(gravity if gravity is not None else (0.0, 0.0, 0.0)), physicsClientId=c)
         pybullet.setTimeStep(dt, physicsClientId=c)
         pybullet.setPhysicsEngineParameter(numSubSteps=0, physicsClientId=c)
+        contact = scene.contact
+        if contact is not None:
+            pybullet.setPhysicsEngineParameter(**contact_parameters(contact, dt), physicsClientId=c)
+            materials, _ = contact_params.body_materials(contact)
+            self._planes = [self._add_plane(plane) for plane in contact.planes]
         self._bodies, self._axes, self._initial = [], [], []
-        for body in scene.bodies:
-            uid = _load_urdf(c, body_urdf(body))
+        for b, body in enumerate(scene.bodies):
+            spheres = () if contact is None else contact_params.inflated_spheres(contact.shapes[b])
+            uid = _load_urdf(c, body_urdf(body, spheres))
             pybullet.changeDynamics(
                 uid, -1, linearDamping=0.0, angularDamping=0.0, maxJointVelocity=_MAX_VELOCITY,
                 activationState=pybullet.ACTIVATION_STATE_DISABLE_SLEEPING, physicsClientId=c,
             )
+            if contact is not None:
+                pybullet.changeDynamics(uid, -1, **body_contact_dynamics(*materials[b]), physicsClientId=c)
+                pybullet.setCollisionFilterGroupMask(uid, -1, BODY_GROUP, PLANE_GROUP, physicsClientId=c)
             _, axes = principal_axes(body.inertia_body)
             quat_inertial = matrix_to_quat_wxyz(quat_wxyz_to_matrix(body.quat_wxyz) @ axes)
             self._bodies.append(uid)
@@ -125,15 +253,36 @@ class _Simulation(Simulation):
         self._applied = [(a.body, a.force_world.tolist(), self._axes[a.body].T @ a.point_body)
                          for a in scene.forces.applied]
         self._dt = dt
+        self._contact = contact
+        self.client, self.body_ids = c, list(self._bodies)
+        self.plane_ids = list(self._planes) if contact is not None else []
+        self.engine_parameters = pybullet.getPhysicsEngineParameters(physicsClientId=c) if contact is not None else {}
+        read_back = ", ".join(f"{name}={self.engine_parameters[name]!r}" for name in READ_BACK
+                              if name in self.engine_parameters)
         self.detail = (
             "PyBullet multibody; inertia from file; damping 0; sleeping off; gravity set explicitly"
+            + ("" if contact is None else f"; {contact_detail(contact, dt)}; read back by "
+               f"getPhysicsEngineParameters: {read_back}")
             + ("; applyExternalForce at each applied force's world point" if self._applied else "")
             + (f"; {external_forces.DETAIL}, as applyExternalForce at the COM and applyExternalTorque"
                if self._drag else "")
         )
 
+    def _add_plane(self, plane) -> int:
+        """A static multibody whose GEOM_PLANE (normal N, through its origin) sits at -d N; touches bodies only."""
+        c = self._client.id
+        shape = pybullet.createCollisionShape(pybullet.GEOM_PLANE, planeNormal=plane.normal_world.tolist(),
+                                              physicsClientId=c)
+        uid = pybullet.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=shape,
+                                       basePosition=(-plane.offset * plane.normal_world).tolist(), physicsClientId=c)
+        pybullet.changeDynamics(uid, -1, **PLANE_DYNAMICS, physicsClientId=c)
+        pybullet.setCollisionFilterGroupMask(uid, -1, PLANE_GROUP, BODY_GROUP, physicsClientId=c)
+        return uid
+
     def run(self, n_steps: int) -> Trajectory:
         c = self._client.id
+        if self._contact is not None:  # Bullet's breaking threshold is process-global: another world may have set it
+            pybullet.setPhysicsEngineParameter(contactBreakingThreshold=BREAKING_FACTOR, physicsClientId=c)
         for uid, (pos, quat, vel, omega) in zip(self._bodies, self._initial):
             pybullet.resetBasePositionAndOrientation(uid, pos, quat, physicsClientId=c)
             pybullet.resetBaseVelocity(uid, vel, omega, physicsClientId=c)
@@ -173,6 +322,25 @@ class _Simulation(Simulation):
         for k, uid in enumerate(self._bodies):
             pybullet.applyExternalForce(uid, -1, force[k], raw[k, :3], pybullet.WORLD_FRAME, physicsClientId=c)
             pybullet.applyExternalTorque(uid, -1, torque[k], pybullet.WORLD_FRAME, physicsClientId=c)
+
+
+def contact_detail(contact, dt: float) -> str:
+    """What PyBullet's contact is given for a contact scene (module docstring has the reasons)."""
+    static = contact_params.static_friction_note(contact)
+    return (f"contact: {len(contact.planes)} static GEOM_PLANE multibody(ies) at -d N (restitution 1, lateral friction "
+            f"1, rolling/spinning 0); bodies: collision spheres (sphere r + {contact_params.POINT_RADIUS:g} m; point, "
+            f"points and box corners {contact_params.POINT_RADIUS:g} m) with contactSlop "
+            f"{contact_params.POINT_RADIUS:g} m, restitution k and lateral friction mu_k per body (Bullet multiplies "
+            f"them with the plane's 1), rolling/spinning 0; bodies touch planes only (collision groups); "
+            f"restitutionVelocityThreshold {restitution_threshold(contact):g} m/s = rest_speed "
+            f"{contact.rest_speed:g} / max k (Bullet tests the approach speed, the scene the rebound); "
+            f"contactERP {CONTACT_ERP:g}; useSplitImpulse "
+            f"0 (not implemented for multibody contacts); contactProcessingThreshold 0 for k > 0 (penetration up to "
+            f"v dt after an impact) and {SPECULATIVE_RANGE:g} m for k = 0 (speculative: no penetration); "
+            f"contactBreakingThreshold {BREAKING_FACTOR:g} (relative, process-global, set before each run); "
+            f"numSolverIterations {SOLVER_ITERATIONS}, solverResidualThreshold {SOLVER_RESIDUAL:g}, globalCFM 0, "
+            f"deterministicOverlappingPairs 1; two friction rows per contact, each within mu N (Bullet's multibody "
+            f"friction)" + (f"; {static}" if static else ""))
 
 
 LINK_STATE_RESOLUTION = (1e-6, 2e-6)
@@ -289,7 +457,8 @@ class PybulletEngine(UrdfChains, Engine):
         return 1 if integrator == "euler" else None
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
-        return self.check_integrator(integrator)
+        named = self.check_integrator(integrator)
+        return contact_support(scene.contact) if named.ok else named
 
     def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
         return _Simulation(scene, integrator, dt)
@@ -330,4 +499,22 @@ class PybulletEngine(UrdfChains, Engine):
         for applied in scene.forces.applied:
             api += (f"<!-- each step: applyExternalForce({fmt(applied.force_world)} N) at the world position of "
                     f"body point {fmt(applied.point_body)} m (WORLD_FRAME), body {applied.body} -->\n")
-        return api + "".join(body_urdf(b) for b in scene.bodies)
+        contact = scene.contact
+        if contact is None:
+            return api + "".join(body_urdf(b) for b in scene.bodies)
+        settings = ", ".join(f"{name}={value!r}" for name, value in contact_parameters(contact, dt).items())
+        api += f"<!-- setPhysicsEngineParameter({settings}); contactBreakingThreshold again before each run -->\n"
+        for p, plane in enumerate(contact.planes):
+            api += (f"<!-- plane {p}: createCollisionShape(GEOM_PLANE, planeNormal={fmt(plane.normal_world)}), "
+                    f"createMultiBody(baseMass=0, basePosition={fmt(-plane.offset * plane.normal_world)}), "
+                    f"changeDynamics({', '.join(f'{n}={v!r}' for n, v in PLANE_DYNAMICS.items())}), "
+                    f"setCollisionFilterGroupMask(group={PLANE_GROUP}, mask={BODY_GROUP}) -->\n")
+        materials, _ = contact_params.body_materials(contact)
+        for b in range(len(scene.bodies)):
+            if materials is not None:
+                dynamics = ", ".join(f"{n}={v!r}" for n, v in body_contact_dynamics(*materials[b]).items())
+                api += (f"<!-- body {b}: changeDynamics({dynamics}), setCollisionFilterGroupMask(group={BODY_GROUP}, "
+                        f"mask={PLANE_GROUP}) -->\n")
+        api += f"<!-- {contact_detail(contact, dt)} -->\n"
+        return api + "".join(body_urdf(b, contact_params.inflated_spheres(s))
+                             for b, s in zip(scene.bodies, contact.shapes))

@@ -9,7 +9,9 @@ What the engines are given, and why
   PRINCIPAL axes (``origin rpy`` = the principal frame, off-diagonal terms zero): PyBullet
   keeps only a diagonal inertia and reports the base pose in this inertial frame, so the
   adapters convert with the same rotation (:func:`references.conventions.principal_axes`).
-  No ``<collision>`` or ``<visual>``: nothing collides.
+  No ``<collision>`` or ``<visual>``: nothing collides. In a scene with contact, PyBullet's
+  body gets its contact spheres as ``<collision>`` elements (``spheres``, centres in the body
+  frame, which is the link frame); loaded with ``URDF_USE_INERTIA_FROM_FILE`` they add no mass.
 - A chain read from a URDF file: the ORIGINAL file, parsed (its XML declaration's encoding
   honoured) with every link's ``<visual>`` and ``<collision>`` removed. Kinematics and IK
   need no geometry ("model only what a scene needs"), so no engine opens a mesh: not one
@@ -51,11 +53,19 @@ def _inertial(link: ET.Element, mass: float, moments, rpy) -> None:
     ET.SubElement(inertial, "inertia", ixx=fmt([ixx]), ixy="0", ixz="0", iyy=fmt([iyy]), iyz="0", izz=fmt([izz]))
 
 
-def body_urdf(body: RigidBody) -> str:
-    """URDF text of one free rigid body (a single link, inertia in principal axes)."""
+def body_urdf(body: RigidBody, spheres=()) -> str:
+    """URDF text of one free rigid body (a single link, inertia in principal axes).
+
+    ``spheres``: collision spheres ((centre (3,) in the body frame [m], radius [m]), ...); none by default.
+    """
     moments, axes = principal_axes(body.inertia_body)
     root = ET.Element("robot", name=body.name)
-    _inertial(ET.SubElement(root, "link", name=body.name), body.mass, moments, matrix_to_rpy(axes))
+    link = ET.SubElement(root, "link", name=body.name)
+    _inertial(link, body.mass, moments, matrix_to_rpy(axes))
+    for centre, radius in spheres:
+        collision = ET.SubElement(link, "collision")
+        ET.SubElement(collision, "origin", xyz=fmt(centre), rpy="0 0 0")
+        ET.SubElement(ET.SubElement(collision, "geometry"), "sphere", radius=fmt([radius]))
     return _text(root)
 
 

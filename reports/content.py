@@ -43,6 +43,18 @@ _DYNAMICS_COLUMNS = [
     ("energy_drift_max", "energy drift max (rel.)"),
     ("angular_momentum_drift_max", "angular momentum drift max (rel.)"),
     ("time_per_step", "time per step [s]"),
+    ("impact_time_error", "impact time error [s]"),
+    ("rebound_velocity_error", "rebound velocity error [m/s]"),
+    ("apex_height_error", "apex height error [m]"),
+    ("impacts_missed", "impacts missed"),
+    ("restitution_measured", "restitution measured"),
+    ("restitution_error", "restitution error"),
+    ("penetration_max", "penetration max [m]"),
+    ("tunnelled", "bodies tunnelled"),
+    ("energy_gain_max", "energy gained max (rel.)"),
+    ("rest_time_error", "rest time error [s]"),
+    ("stopping_distance", "stopping distance [m]"),
+    ("stopping_distance_error", "stopping distance error [m]"),
 ]
 _IK_COLUMNS = [
     ("solve_rate", "solve rate"),
@@ -317,6 +329,11 @@ class _Builder:
                               f"{', '.join(f'{d:g}' for d in r['dts'])})" for _, r in g.iterrows())
             items.append(f"**energy gained** in {scene} (conserves energy; largest (E - E(0)) / E(0) per scheme): "
                          + cases)
+        for (scene, metric), g in summary.contact_flags(self.table).groupby(["scene", "metric"], sort=False):
+            what = ("**energy gained at an impact**" if metric == "energy_gain_max" else "**tunnelling**")
+            cases = ", ".join(f"{r['engine']} {r['integrator']} {number(r['value_max'])} (dt "
+                              f"{', '.join(f'{d:g}' for d in r['dts'])})" for _, r in g.iterrows())
+            items.append(f"{what} in {scene} (`{metric}`): " + cases)
         for _, s in summary.saturated(self.table).iterrows():
             items.append(f"**saturated**: {s['scene']} `{s['metric']}` in {s['n_cases']} cases (n/a: the error "
                          "lost all meaning there)")
@@ -408,6 +425,8 @@ class _Builder:
                               "theoretical order.")
         blocks += self.figure(figures.drift_figure(scene, series, reference), f"{scene}-drift",
                               "Drift over time at the coarsest dt, from the stored series.")
+        if about.get("contact"):
+            blocks += self.contact(scene, rows, about, reference, series)
         best = summary.best_per_scheme(cases)
         variants = self.info.get("integrator_variants", {})
         per_scheme: dict[tuple[str, str], list[tuple[str, tuple[str, ...]]]] = {}
@@ -430,6 +449,41 @@ class _Builder:
                                "time steps whose local slopes agree; errors at the rounding floor or saturated are "
                                "left out."), _table(orders, _ORDER_COLUMNS, ["engine", "integrator"])] + _fits(orders)
         return blocks + [Details(f"{scene}: every engine × integrator × dt", tuple(full), markdown=False)]
+
+    def contact(self, scene, rows, about, reference, series) -> list[Block]:
+        """The height figure, the contact table (restitution at every dt, the worst penetration and energy
+        gain, errors at the finest dt) and the penalty method's measured stability limits."""
+        blocks = self.figure(figures.contact_height_figure(scene, series, reference), f"{scene}-height",
+                             "Height of the lowest point above the plane against time, from the stored series.")
+        cases = summary.contact_cases(rows)
+        dts = sorted(cases["dt"].unique())
+        requested = sorted({k for row in about["contact"]["restitution"] for k in row})
+        table = []
+        for (engine, integrator), g in cases.groupby(["engine", "integrator"], sort=False):
+            g = g.sort_values("dt")
+            finest = g[g["status"] == OK].head(1)
+            at = (lambda m: number(float(finest[m].iloc[0])) if not finest.empty else "—")
+            table.append((engine, integrator)
+                         + tuple(number(float(g.loc[g["dt"] == dt, "restitution_measured"].max())) for dt in dts)
+                         + (number(float(g["penetration_max"].max())), number(float(g["energy_gain_max"].max())),
+                            at("impact_time_error"), at("apex_height_error"), at("rest_time_error"),
+                            at("stopping_distance"), " · ".join(dict.fromkeys(g["status"]))))
+        blocks += [Paragraph(f"Contact: requested restitution {', '.join(f'{k:g}' for k in requested)}; measured "
+                             "from each run's first rebound (v_out / |v_in|, extrapolated along the free flight "
+                             "from the samples either side), at each dt. Penetration and energy gained: the worst "
+                             "over the time steps; errors at the finest time step measured."),
+                   Table(("engine", "integrator") + tuple(f"restitution at dt {dt:g}" for dt in dts)
+                         + ("penetration max [m]", "energy gained max (rel.)", "impact time error [s]",
+                            "apex height error [m]", "rest time error [s]", "stopping distance [m]", "time steps"),
+                         tuple(table))]
+        limits = summary.stability_limits(rows)
+        if not limits.empty:
+            items = tuple(f"{r['engine']} {r['integrator']}: "
+                          + (f"{number(r['value'])} s" if r["status"] == OK else f"{r['status']}")
+                          + f" ({r['detail']})" for _, r in limits.iterrows())
+            blocks += [Paragraph("Penalty method, measured stability limit (the largest step that neither blows "
+                                 "up nor gains energy at an impact):"), Bullets(items)]
+        return blocks
 
     def ik(self, scene, rows, about, reference, series) -> list[Block]:
         solvers = summary.ik_solvers(rows[~rows["metric"].str.startswith("hard_")])

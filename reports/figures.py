@@ -128,6 +128,27 @@ def drift_figure(scene: str, series: pd.DataFrame, reference: str):
     return fig
 
 
+def contact_height_figure(scene: str, series: pd.DataFrame, reference: str):
+    """Height of the first body's lowest point above its nearest plane against time, at the scene's coarsest
+    time step, one line per engine x integrator and the reference's (envelope of the samples: apexes and
+    penetrations kept)."""
+    heights = series[series["quantity"] == "support_height"]
+    if heights.empty:
+        return None
+    dt = heights["dt"].max()
+    at_dt = heights[heights["dt"] == dt]
+    fig, ax = plt.subplots(figsize=(_WIDTH, 3.2))
+    for i, ((engine, integrator), g) in enumerate(at_dt.groupby(["engine", "integrator"], sort=False)):
+        ax.plot(g["x"], g["value"], label=f"{engine} {integrator}", **(_style(i, engine) | {"marker": None}))
+    ax.axhline(0.0, color="black", linewidth=0.8)
+    ax.set(xlabel="time [s]", ylabel="lowest point above the plane [m]")
+    ax.grid(True, which="major", alpha=0.3)
+    ax.set_title(f"{scene}: height of the lowest point at dt = {dt:g} s (reference {reference})", **_TITLE)
+    _legend(ax)
+    fig.tight_layout()
+    return fig
+
+
 def ik_rate_figure(scene: str, solvers: pd.DataFrame, reference: str):
     """Solve rate against time per solve (log), one point per engine x solver."""
     rated = solvers.dropna(subset=["solve_rate", "time_per_solve"])

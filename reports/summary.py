@@ -139,3 +139,37 @@ def saturated(table: pd.DataFrame) -> pd.DataFrame:
     rows = table[(table["status"] == NOT_AVAILABLE) & table["detail"].str.startswith("saturated")]
     return rows.groupby(["scene", "metric"], sort=False).size().rename("n_cases").reset_index()
 
+
+
+CONTACT_COLUMNS = ("restitution_measured", "penetration_max", "energy_gain_max", "impact_time_error",
+                   "apex_height_error", "rest_time_error", "stopping_distance")
+"""The contact metrics a contact scene's compact table shows, per engine x integrator."""
+
+
+def contact_cases(rows: pd.DataFrame) -> pd.DataFrame:
+    """One row per engine x integrator x dt of a contact scene with its contact metrics (ok values, NaN
+    otherwise) and the case's status; ground truths left out."""
+    keys = ["engine", "integrator", "dt"]
+    per_dt = rows[rows["dt"].notna() & ~rows["engine"].isin(GROUND_TRUTH_ENGINES)]
+    cases = per_dt.groupby(keys, sort=False)["status"].agg(case_status).rename("status").reset_index()
+    measured = per_dt[(per_dt["status"] == OK) & per_dt["metric"].isin(CONTACT_COLUMNS)]
+    values = measured.pivot_table(index=keys, columns="metric", values="value", sort=False)
+    return cases.merge(values.reindex(columns=list(CONTACT_COLUMNS)).reset_index(), on=keys, how="left")
+
+
+def stability_limits(rows: pd.DataFrame) -> pd.DataFrame:
+    """The measured stable_dt_max rows of a scene: engine, integrator, status, value [s], detail."""
+    limits = rows[rows["metric"] == "stable_dt_max"]
+    return limits[["engine", "integrator", "status", "value", "detail"]]
+
+
+def contact_flags(table: pd.DataFrame) -> pd.DataFrame:
+    """Contact cases that gained energy (energy_gain_max above :data:`ENERGY_GAIN_FLAGGED`) or let a body
+    through a plane (tunnelled > 0), ground truths left out: per scene x metric x engine x integrator the
+    largest value and the time steps it happened at."""
+    ok = table[(table["status"] == OK) & ~table["engine"].isin(GROUND_TRUTH_ENGINES)]
+    flagged = ok[((ok["metric"] == "energy_gain_max") & (ok["value"] > ENERGY_GAIN_FLAGGED))
+                 | ((ok["metric"] == "tunnelled") & (ok["value"] > 0))]
+    per_scheme = flagged.groupby(["scene", "metric", "engine", "integrator"], sort=False).agg(
+        value_max=("value", "max"), dts=("dt", lambda d: sorted(d)))
+    return per_scheme.reset_index().reindex(columns=["scene", "metric", "engine", "integrator", "value_max", "dts"])

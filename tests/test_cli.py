@@ -241,3 +241,16 @@ def test_a_reader_that_stops_early_gets_no_traceback():
     process.stdout.close()  # the reader is gone before the first line is written
     _, err = process.communicate(timeout=120)
     assert process.returncode == EXIT_OK and "Traceback" not in err, err
+
+
+def test_show_reports_a_point_mass_body_and_the_contact_settings():
+    """`simparity show` prints what the loader computed: a point-mass body's mass, COM and tensor (physical
+    sign), normalised planes and every body-plane material."""
+    code, text = _run(["show", "point-mass-tumble"])
+    assert code == EXIT_OK
+    # By hand: masses 1, 0.5, 0.5, 0.5 at (0.2,0,0), (-0.2,0,0), (0,0.15,0), (0,0,0.25): M = 2.5,
+    # COM = (0.1, 0.075, 0.125) / 2.5 = (0.04, 0.03, 0.05); I_xy = -sum m (x - 0.04)(y - 0.03) = 0.003.
+    assert "mass 2.5 kg" in text and "COM = sum m_i q_i / M = [0.04, 0.03, 0.05]" in text
+    assert "[[0.034, 0.003, 0.005], [0.003, 0.081, 0.00375], [0.005, 0.00375, 0.065]]" in text
+    assert "-sum m x y" in text and "plane floor: E(p) = N . p + d, N = [0, 0, 1]" in text
+    assert "tetra on floor: restitution 0.3, friction static 0.5, kinetic 0.5" in text

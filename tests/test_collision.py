@@ -8,7 +8,6 @@ import pytest
 from simparity.core.collision import (
     BAD_RESTITUTION,
     UNKNOWN_METHOD,
-    ZERO_NORMAL,
     Plane,
     penalty_force,
     reflect_velocity,
@@ -16,6 +15,7 @@ from simparity.core.collision import (
     step_particles,
     time_of_impact,
 )
+from simparity.core.scene import ZERO_NORMAL
 
 G = 9.81  # [m/s^2]
 SEED = 20240617

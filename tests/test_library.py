@@ -33,14 +33,23 @@ def _table(rows):
 def test_default_suite_is_every_scene_marked_default_and_hard_is_its_own():
     default = {s.name for s in library.suite("default")}
     hard = {s.name for s in library.suite("hard")}
+    contact = {s.name for s in library.suite("contact")}
     assert "lecture-projectile" in default and "lecture-projectile" not in hard
     assert "hard-stiff-drag" in hard and "hard-stiff-drag" not in default
     assert "fast-spinner" in default & hard
-    assert default | hard == set(library.builtin_paths())
+    assert default | hard | contact == set(library.builtin_paths())
+
+
+def test_the_contact_suite_is_every_scene_with_planes():
+    """Issue #10: every built-in scene with a plane is in the contact suite, and nothing else is."""
+    scenes = library.load(list(library.builtin_paths().values()))
+    with_planes = {s.name for s in scenes if getattr(s, "contact", None) is not None}
+    assert {s.name for s in library.suite("contact")} == with_planes
+    assert {"hard-fast-impact", "hard-penalty-stiff", "hard-zeno"} <= {s.name for s in library.suite("hard")}
 
 
 def test_an_unknown_suite_is_refused_with_the_allowed_names():
-    with pytest.raises(SimparityError, match=r"allowed: default, hard"):
+    with pytest.raises(SimparityError, match=r"allowed: default, hard, contact"):
         library.suite("nightly")
 
 

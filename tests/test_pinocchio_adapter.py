@@ -74,3 +74,17 @@ def test_harness_rk4_on_aba_is_fourth_order():
         orientation.append(geodesic_angle_quat_wxyz(traj.quat_wxyz, exact.quat_wxyz).max())
     for errors in (position, orientation):
         assert abs(observed_order(ladder, errors).value - 4) <= ORDER_TOL
+
+
+def test_a_point_mass_body_keeps_its_hand_computed_tensor_in_pinocchio():
+    """Issue #10: the tensor of a body built from point masses (physical sign, -sum m x y off the diagonal)
+    is the one Pinocchio's compiled model holds (contact scenes are n/a in Pinocchio; the tensor is not)."""
+    import dataclasses
+
+    scene = dataclasses.replace(builtin("point-mass-tumble"), contact=None)
+    # By hand, about the COM (0.04, 0.03, 0.05) of 1, 0.5, 0.5, 0.5 kg at (0.2,0,0), (-0.2,0,0), (0,0.15,0),
+    # (0,0,0.25): I_xx = sum m (y^2 + z^2) = 0.034, I_xy = -sum m x y = 0.003, ...
+    hand = np.array([[0.034, 0.003, 0.005], [0.003, 0.081, 0.00375], [0.005, 0.00375, 0.065]])
+    model = free_bodies_model(scene)
+    np.testing.assert_allclose(model.inertias[1].inertia, hand, rtol=0, atol=1e-15)
+    assert model.inertias[1].mass == 2.5

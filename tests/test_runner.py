@@ -4,6 +4,7 @@ import dataclasses
 import math
 
 import numpy as np
+import pytest
 
 from simparity.comparisons.engines import make_engine
 from simparity.comparisons.metrics import DYNAMICS_METRICS, KINEMATICS_METRICS, ORDER_METRICS, dynamics_metrics
@@ -173,3 +174,55 @@ def test_warnings_raised_in_a_case_go_into_its_rows_not_the_console(recwarn):
     per_dt = [r for r in rows if not math.isnan(r.dt)]
     assert per_dt and all("warnings: RuntimeWarning: overflow encountered in multiply" in r.detail for r in per_dt)
     assert len(recwarn) == 0
+
+
+def _drop_scene(**contact):
+    """A particle dropped 0.2 m onto z = 0 with restitution 0.5 (a contact scene built in code)."""
+    from simparity.core.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
+
+    body = RigidBody("particle", 1.0, np.eye(3) * 1e-3, np.array([0.0, 0.0, 0.2]), np.array([1.0, 0, 0, 0]),
+                     np.zeros(3), np.zeros(3))
+    settings = dict(methods=("backup", "penalty"), rest_speed=0.01, penalty_stiffness=1e4, penalty_damping=43.1)
+    settings.update(contact)
+    return DynamicsScene("drop", "-", "analytic", (body,), Forces(gravity_world=np.array([0.0, 0.0, -9.81])), 0.5,
+                         (0.0025, 0.005, 0.01), integrators=("backup", "penalty_semi_implicit_euler"),
+                         contact=Contact((Plane((0, 0, 1), 0.0, "floor"),), (Shape("point"),), ((Material(0.5),),),
+                                         **settings))
+
+
+CONTACT_EXACT = 1e-12  # [m] backing up time is exact for a dropped particle; rounding of O(1) values is ~1e-15
+
+
+def test_a_contact_scene_gets_contact_metrics_na_orders_and_a_stability_limit():
+    """Issue #10: every case of a contact scene has the contact metrics; observed orders are n/a (impacts make the
+    error jump with dt); the penalty integrator gets its measured stability limit; backing up time is exact."""
+    scene = _drop_scene()
+    rows = run_scene(scene, [make_engine("core"), make_engine("analytic")], make_engine, repeats=0)
+    per_case = {}
+    for r in rows:
+        per_case.setdefault((r.engine, r.integrator, r.dt), set()).add(r.metric)
+    for (engine, integrator, dt), metrics in per_case.items():
+        if not math.isnan(dt):
+            assert set(dynamics_metrics(scene)) <= metrics, (engine, integrator, dt)
+            assert {"restitution_measured", "penetration_max", "impact_time_error"} <= metrics
+    orders = [r for r in rows if r.metric in ORDER_METRICS]
+    assert orders and all(r.status == NOT_AVAILABLE and r.detail.startswith("contact") for r in orders)
+    limits = [r for r in rows if r.metric == "stable_dt_max"]
+    assert [(r.engine, r.integrator) for r in limits] == [("core", "penalty_semi_implicit_euler")]
+    assert limits[0].status == OK and limits[0].value > 0
+    backup = {r.metric: r for r in rows if r.integrator == "backup" and r.dt == 0.01}
+    assert backup["position_error_max"].value <= CONTACT_EXACT
+    assert backup["penetration_max"].value <= CONTACT_EXACT
+    assert backup["restitution_measured"].value == pytest.approx(0.5, abs=CONTACT_EXACT)
+
+
+def test_core_runs_only_contact_methods_on_contact_scenes_and_none_elsewhere():
+    """A contact scene's cases are core's contact methods (not its free-body integrators); a scene without
+    planes has no contact method among its cases."""
+    core = make_engine("core")
+    contact = core.scene_integrators(_drop_scene())  # methods backup and penalty, not act_after
+    schemes = ("explicit_euler", "semi_implicit_euler", "midpoint", "average_velocity", "rk4")
+    assert set(contact) == {"backup"} | {f"penalty_{s}" for s in schemes}
+    free = core.scene_integrators(builtin("lecture-projectile"))
+    assert "rk4" in free and not {"backup", "act_after"} & set(free)
+    assert not any(name.startswith("penalty_") for name in free)

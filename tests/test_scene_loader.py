@@ -201,3 +201,141 @@ def test_every_builtin_scene_loads(name):
     """The built-in library is valid: every file loads and names itself after its file."""
     scene = load_scene(builtin_paths()[name])
     assert scene.name == name
+
+
+VALID_CONTACT = """
+[scene]
+name = "bounce"
+kind = "dynamics"
+reference = "core"
+
+[world]
+gravity_world = [0.0, 0.0, -9.81]
+
+[[plane]]
+name = "floor"
+coefficients = [0.0, 0.0, 2.0, 1.0]
+
+[[plane]]
+name = "wall"
+coefficients = [-3.0, 4.0, 0.0, 10.0]
+
+[contact]
+methods = ["backup", "penalty"]
+restitution = 0.8
+friction_kinetic = 0.2
+rest_speed = 0.01
+
+[[contact.pair]]
+body = "ball"
+plane = "wall"
+restitution = 0.3
+
+[[body]]
+name = "ball"
+mass = 1.0
+inertia_body_diagonal = [0.004, 0.004, 0.004]
+position_world = [0.0, 0.0, 1.0]
+shape = "sphere"
+radius = 0.1
+
+[[body]]
+name = "tri"
+position_world = [0.0, 0.0, 1.0]
+friction_static = 0.6
+friction_kinetic = 0.5
+
+[[body.point_mass]]
+mass = 1.0
+position = [1.0, 0.0, 0.0]
+
+[[body.point_mass]]
+mass = 2.0
+position = [0.0, 1.0, 0.0]
+
+[[body.point_mass]]
+mass = 1.0
+position = [0.0, 0.0, 1.0]
+
+[simulation]
+duration = 1.0
+dt = [0.01]
+"""
+
+
+def test_contact_scene_loads_planes_materials_and_point_mass_bodies(tmp_path):
+    """Planes are normalised; materials cascade scene -> body -> pair; a point-mass body's mass, COM and
+    tensor are computed with the physical sign (checked against values worked out by hand)."""
+    scene = load_scene(_write(tmp_path, VALID_CONTACT))
+    floor, wall = scene.contact.planes
+    np.testing.assert_array_equal(floor.normal_world, [0.0, 0.0, 1.0])
+    assert floor.offset == 0.5  # 2 z + 1 = 0 is z = -0.5
+    np.testing.assert_allclose(wall.normal_world, [-0.6, 0.8, 0.0], rtol=0, atol=1e-15)
+    assert wall.offset == 2.0
+    np.testing.assert_array_equal(scene.contact.restitution, [[0.8, 0.3], [0.8, 0.8]])
+    np.testing.assert_array_equal(scene.contact.friction_kinetic, [[0.2, 0.2], [0.5, 0.5]])
+    np.testing.assert_array_equal(scene.contact.friction_static, [[0.2, 0.2], [0.6, 0.6]])
+    assert scene.contact.methods == ("backup", "penalty") and scene.contact.rest_speed == 0.01
+    tri = scene.bodies[1]
+    # By hand: M = 4; COM = (1, 2, 1) / 4; r_i = q_i - COM; I = sum m (|r|^2 E - r r^T).
+    assert tri.mass == 4.0
+    np.testing.assert_allclose(tri.position_world, [0.25, 0.5, 1.25], rtol=0, atol=1e-15)
+    hand = np.array([[1.75, 0.5, 0.25], [0.5, 1.5, 0.5], [0.25, 0.5, 1.75]])
+    np.testing.assert_allclose(tri.inertia_body, hand, rtol=0, atol=1e-14)
+    assert scene.contact.shapes[1].kind == "points"
+    np.testing.assert_allclose(scene.contact.shapes[1].points_body[0], [0.75, -0.5, -0.25], rtol=0, atol=1e-15)
+    assert scene.contact.shapes[0].kind == "sphere" and scene.contact.shapes[0].radius == 0.1
+
+
+def test_scene_without_planes_has_no_contact():
+    """No [[plane]]: contact is None, and engines are given none."""
+    assert parse_scene(tomllib.loads(VALID_DYNAMICS)).contact is None
+
+
+BROKEN_CONTACT = [
+    ("restitution above 1", "restitution = 0.8", "restitution = 1.2", "contact.restitution", "outside [0, 1]"),
+    ("negative friction", "friction_kinetic = 0.2", "friction_kinetic = -0.2", "contact.friction_kinetic",
+     "negative"),
+    ("kinetic above static", "friction_static = 0.6", "friction_static = 0.4", "body[1].friction_kinetic",
+     "exceeds friction_static"),
+    ("zero normal", "coefficients = [0.0, 0.0, 2.0, 1.0]", "coefficients = [0.0, 0.0, 0.0, 1.0]",
+     "plane[0].coefficients", "all zeros"),
+    ("short plane", "coefficients = [0.0, 0.0, 2.0, 1.0]", "coefficients = [0.0, 0.0, 2.0]",
+     "plane[0].coefficients", "expected a list of 4 numbers"),
+    ("unknown method", 'methods = ["backup", "penalty"]', 'methods = ["teleport"]', "contact.methods[0]",
+     "no contact method"),
+    ("unknown shape", 'shape = "sphere"', 'shape = "cone"', "body[0].shape", "not allowed"),
+    ("radius on a box", 'shape = "sphere"', 'shape = "box"\nhalf_extents = [0.1, 0.1, 0.1]', "body[0].radius",
+     "given for a box shape"),
+    ("sphere without radius", "radius = 0.1\n", "", "body[0].radius", "missing required key"),
+    ("zero rest speed", "rest_speed = 0.01", "rest_speed = 0.0", "contact.rest_speed", "not positive"),
+    ("pair with unknown plane", 'plane = "wall"', 'plane = "ceiling"', "contact.pair[0].plane", "not allowed"),
+    ("starts inside", "position_world = [0.0, 0.0, 1.0]\nshape", "position_world = [0.0, 0.0, -0.55]\nshape",
+     "body[0].position_world", "starts 0.15 m inside plane 'floor'"),
+    ("mass with point masses", 'name = "tri"', 'name = "tri"\nmass = 3.0', "body[1].mass",
+     "computed from the point masses"),
+    ("collinear point masses", "position = [0.0, 0.0, 1.0]", "position = [2.0, -1.0, 0.0]", "body[1].point_mass",
+     "no solid body"),
+    ("points shape without masses", 'shape = "sphere"\nradius = 0.1', 'shape = "points"', "body[0].shape",
+     "needs the body's [[body.point_mass]]"),
+]
+
+
+@pytest.mark.parametrize("name, old, new, key, words", BROKEN_CONTACT, ids=[b[0] for b in BROKEN_CONTACT])
+def test_broken_contact_scene_is_rejected_with_key_and_reason(tmp_path, name, old, new, key, words):
+    """Each meaningless contact value raises SceneError naming the file, the key path and what was wrong."""
+    assert old in VALID_CONTACT, f"test table out of date: {old!r}"
+    path = _write(tmp_path, VALID_CONTACT.replace(old, new, 1))
+    with pytest.raises(SceneError) as caught:
+        load_scene(path)
+    assert caught.value.source == str(path)
+    assert caught.value.key == key
+    assert words in str(caught.value)
+
+
+def test_contact_keys_without_a_plane_are_rejected(tmp_path):
+    """A restitution with nothing to bounce on is a mistake, not a silent no-op."""
+    text = VALID_DYNAMICS.replace('name = "ball"', 'name = "ball"\nrestitution = 0.5')
+    with pytest.raises(SceneError) as caught:
+        load_scene(_write(tmp_path, text))
+    assert caught.value.key == "body[0].restitution" and "no [[plane]]" in str(caught.value)

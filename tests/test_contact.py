@@ -1,0 +1,582 @@
+"""Core's contact methods for rigid bodies against planes: backup, act_after and penalty.
+
+Expected values are closed forms written out here (bouncing ball, sliding block, block on an incline)
+or single impulses computed by hand; nothing is taken from the code under test.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from simparity.core.contact import ContactModel, impulse_response, penalty_stability_limit
+from simparity.core.inhouse import CONTACT_INTEGRATORS, InHouseEngine, integrator_names
+from simparity.core.rotations import quat_wxyz_from_rotvec, quat_wxyz_to_matrix
+from simparity.core.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
+
+G = 9.81  # [m/s^2]
+SEED = 20261123
+FLOOR = Plane((0.0, 0.0, 1.0), 0.0, "floor")
+ENGINE = InHouseEngine()
+
+# Backing up time is exact for these scenes: what is left is the roundoff of a few hundred float64
+# operations on O(1) numbers per bounce (measured ~1e-14 relative after 10 bounces at dt = 0.001).
+EXACT_RTOL = 1e-9
+# The brief's bound on a stopping distance and on a sliding block: exact piecewise-constant motion
+# leaves roundoff only (measured ~1e-15 m).
+STOP_TOL = 1e-6  # [m]
+SLIDE_TOL = 1e-9  # [m]
+# A resting body is held exactly; roundoff of one projection per step is ~1e-17 m.
+REST_TOL = 1e-12  # [m]
+# After a response the body is pushed back out of the plane: what may remain is the roundoff of that
+# projection (~1e-16 m on O(1) positions).
+INSIDE_TOL = 1e-12  # [m]
+# Hand values (a few roundings of O(1) numbers).
+ROUNDOFF = 1e-12
+# RK4 integrates the spinning box's rotation with an angle error ~(omega dt)^5 / 120 ~ 1e-4 rad at
+# omega dt = 0.6: the dip's contact instant moves by ~1e-4 / omega.
+DIP_TIME_TOL = 1e-3  # [s]
+# act_after's first-apex error / dt is constant up to O(dt) terms: a few per cent at 20-80 steps to impact.
+FIRST_ORDER_RTOL = 0.05
+# Semi-implicit Euler on the undamped contact spring well inside its stability limit: energy error
+# O(omega dt) per contact, omega dt = 0.2 here, but it returns when the contact ends (symplectic):
+# measured +1 % at worst out of contact.
+BOUNDED_ENERGY_RTOL = 0.05
+# Energy gained per impact: none, up to roundoff of the kinetic energy's sums.
+ENERGY_RTOL = 1e-12
+# RK4 (the free flight) on a box tumbling at up to ~10 rad/s, dt = 0.01: its energy drifts by ~1e-9
+# relative before the first impact (measured 7e-10).
+TUMBLING_ENERGY_RTOL = 1e-8
+# Penalty friction is regularised below 1e-2 m/s: the stopping distance moves by ~1e-4 relative.
+PENALTY_FRICTION_RTOL = 1e-3
+
+
+def _ball(position, velocity=(0.0, 0.0, 0.0), mass=1.0, inertia=None, quat=(1.0, 0.0, 0.0, 0.0),
+          omega=(0.0, 0.0, 0.0)):
+    inertia = np.eye(3) * 0.004 * mass if inertia is None else inertia
+    return RigidBody("body", mass, np.asarray(inertia, dtype=float), np.array(position, dtype=float),
+                     np.array(quat, dtype=float), np.array(velocity, dtype=float), np.array(omega, dtype=float))
+
+
+def _box_inertia(mass, half):
+    a, b, c = half
+    return mass / 3.0 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])
+
+
+def _scene(bodies, shapes, materials, planes=(FLOOR,), dt=0.01, duration=1.0, gravity=(0.0, 0.0, -G),
+           rest_speed=1e-3, stiffness=1e5, damping=0.0, methods=("backup", "act_after", "penalty")):
+    forces = Forces(gravity_world=None if gravity is None else np.array(gravity, dtype=float))
+    contact = Contact(tuple(planes), tuple(shapes), tuple(tuple(row) for row in materials), methods, rest_speed,
+                      stiffness, damping)
+    return DynamicsScene("contact", "-", "analytic", tuple(bodies), forces, duration, (dt,), contact=contact)
+
+
+def _run(scene, integrator):
+    dt = scene.dts[0]
+    simulation = ENGINE.build_dynamics(scene, integrator, dt)
+    return simulation.run(scene.n_steps(dt)), simulation
+
+
+def _impact_times(height, restitution, count):
+    """t_1 = sqrt(2h/g), t_{n+1} = t_n + 2 k^n sqrt(2gh) / g."""
+    times = [math.sqrt(2.0 * height / G)]
+    for n in range(1, count):
+        times.append(times[-1] + 2.0 * restitution**n * math.sqrt(2.0 * G * height) / G)
+    return np.array(times)
+
+
+def _corner_heights(trajectory, half, planes=(FLOOR,)):
+    """E of every box corner at every sample, (planes, T, B, 8)."""
+    corners = Shape("box", half_extents_body=np.array(half)).vertices_body()
+    rotation = quat_wxyz_to_matrix(trajectory.quat_wxyz)
+    points = np.einsum("tbij,vj->tbvi", rotation, corners) + trajectory.position_world[:, :, None, :]
+    return np.stack([points @ p.normal_world + p.offset for p in planes])
+
+
+# --- the engine interface -------------------------------------------------------------------------------------
+
+
+def test_engine_runs_contact_methods_only_on_scenes_with_contact():
+    """Contact names are listed, chosen by the scene's methods, and refused on the wrong kind of scene."""
+    penalties = tuple(f"penalty_{s}" for s in ("explicit_euler", "semi_implicit_euler", "midpoint",
+                                               "average_velocity", "rk4"))
+    assert set(("backup", "act_after") + penalties) <= set(ENGINE.integrators())
+    assert not any("+" in name for name in CONTACT_INTEGRATORS)
+    contact = _scene([_ball((0, 0, 1))], [Shape("point")], [[Material(0.5)]], methods=("backup", "penalty"))
+    free = DynamicsScene("free", "-", "analytic", (_ball((0, 0, 1)),), Forces(), 1.0, (0.1,))
+    assert ENGINE.scene_integrators(contact) == ("backup",) + penalties
+    assert ENGINE.scene_integrators(free) == integrator_names()
+    assert not set(CONTACT_INTEGRATORS) & set(ENGINE.scene_integrators(free))
+    refused = ENGINE.supports_dynamics(free, "backup")
+    assert not refused.ok and "no contact planes" in refused.reason
+    refused = ENGINE.supports_dynamics(contact, "rk4")
+    assert not refused.ok and "contact planes" in refused.reason
+    assert ENGINE.supports_dynamics(contact, "act_after").ok
+    for name in CONTACT_INTEGRATORS:
+        assert ENGINE.theoretical_order(name) is None
+        assert ENGINE.integrator_variant(name) == (name, "")
+    assert "rest_speed 0.001" in ENGINE.build_dynamics(contact, "backup", 0.01).detail
+    detail = ENGINE.build_dynamics(contact, "penalty_midpoint", 0.01).detail
+    assert "k_s 100000" in detail and "midpoint" in detail
+
+
+# --- backup: bounces ------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("dt", [0.001, 0.01, 0.1])
+def test_backup_bounces_follow_the_closed_form(dt):
+    """Particles and spheres dropped from 1 m (k = 0.8 and 0.5): 10 impact times and apex heights h k^2n."""
+    height, radius, duration = 1.0, 0.1, 3.7  # t_10 = 3.58 s at k = 0.8
+    restitutions = (0.8, 0.5, 0.8, 0.5)
+    bodies = [_ball((0, 0, height)), _ball((0, 0, height)), _ball((0.5, 0, height + radius)),
+              _ball((0.5, 0, height + radius))]
+    shapes = [Shape("point"), Shape("point"), Shape("sphere", radius=radius), Shape("sphere", radius=radius)]
+    scene = _scene(bodies, shapes, [[Material(k)] for k in restitutions], dt=dt, duration=duration)
+    trajectory, simulation = _run(scene, "backup")
+    for b, k in enumerate(restitutions):
+        impacts = simulation.events.of(b)[:10]
+        expected = _impact_times(height, k, 10)
+        np.testing.assert_allclose(impacts[:, 0], expected, rtol=EXACT_RTOL)
+        apex = impacts[:, 2] ** 2 / (2.0 * G)  # rebound speed -> height reached
+        np.testing.assert_allclose(apex, height * k ** (2 * np.arange(1, 11)), rtol=EXACT_RTOL)
+        np.testing.assert_allclose(impacts[:, 2], -k * impacts[:, 1], rtol=EXACT_RTOL)
+        # between impacts every sample lies on the right parabola: z + v^2 / 2g = h k^2n
+        z = trajectory.position_world[:, b, 2] - (radius if b >= 2 else 0.0)
+        assert z.min() >= 0.0
+        flight = z + trajectory.velocity_world[:, b, 2] ** 2 / (2.0 * G)
+        done = np.searchsorted(_impact_times(height, k, 60), trajectory.times, side="right")
+        early = done <= 10
+        np.testing.assert_allclose(flight[early], height * k ** (2 * done[early]), rtol=EXACT_RTOL)
+    np.testing.assert_allclose(trajectory.angular_velocity_world, 0.0, atol=0.0)
+
+
+def test_backup_ends_the_bounces_at_rest_on_the_plane():
+    """Past the pile-up of bounces the ball rests: one "rest" event, then exactly on the plane, no motion."""
+    radius = 0.1
+    scene = _scene([_ball((0, 0, 1.0 + radius), velocity=(0.3, 0, 0))], [Shape("sphere", radius=radius)],
+                   [[Material(0.5, 0.4, 0.3)]], dt=0.01, duration=3.0)
+    trajectory, simulation = _run(scene, "backup")
+    assert simulation.events.kind.count("rest") == 1
+    rest_time = simulation.events.of(0, "rest")[0, 0]
+    after = trajectory.times > rest_time + 0.5  # long after: the friction has stopped it too
+    np.testing.assert_allclose(trajectory.position_world[after, 0, 2], radius, rtol=0, atol=REST_TOL)
+    np.testing.assert_array_equal(trajectory.velocity_world[after], 0.0)
+
+
+def test_backup_never_leaves_a_fast_particle_inside_the_plane():
+    """50 m/s into the floor at dt = 0.1: the impact is found inside the step and the particle bounces there."""
+    start, velocity, k = 1.0, np.array([3.0, 0.0, -50.0]), 0.5
+    scene = _scene([_ball((0, 0, start), velocity=velocity)], [Shape("point")], [[Material(k)]], dt=0.1,
+                   duration=1.0)
+    trajectory, simulation = _run(scene, "backup")
+    assert trajectory.position_world[:, 0, 2].min() >= 0.0
+    arrival = math.sqrt(50.0**2 + 2.0 * G * start)
+    first = simulation.events.of(0)[0]
+    np.testing.assert_allclose(first, [2.0 * start / (50.0 + arrival), -arrival, k * arrival], rtol=EXACT_RTOL)
+
+
+def test_backup_catches_a_grazing_contact_within_one_step():
+    """Thrown up to 1e-7 m beyond a ceiling: in and out within one 0.1 s step, the contact is still found."""
+    ceiling = Plane((0.0, 0.0, -1.0), 2.0, "ceiling")  # z = 2, free side below
+    gap, overshoot = 0.1, 1e-7
+    up = math.sqrt(2.0 * G * (gap + overshoot))
+    scene = _scene([_ball((0, 0, 2.0 - gap), velocity=(0, 0, up))], [Shape("point")], [[Material(1.0)]],
+                   planes=(ceiling,), dt=0.1, duration=0.5)
+    trajectory, simulation = _run(scene, "backup")
+    speed = math.sqrt(2.0 * G * overshoot)
+    hit = simulation.events.of(0)
+    assert len(hit) == 1
+    np.testing.assert_allclose(hit[0], [2.0 * gap / (up + speed), -speed, speed], rtol=EXACT_RTOL)
+    assert trajectory.position_world[:, 0, 2].max() <= 2.0
+    assert trajectory.velocity_world[-1, 0, 2] < -up  # turned back early: faster down than a free flight
+
+
+def test_backup_catches_a_corner_dipping_in_and_out_within_one_step():
+    """A spinning box (no gravity) whose corner sweeps 1.8 mm through the floor between two samples bounces."""
+    half, omega, dt = (0.2, 0.15, 0.1), 6.0, 0.1
+    reach = math.hypot(half[1], half[2])  # corner distance from the x axis
+    lowest = math.atan2(half[1], half[2])  # rotation about x putting corner (., -b, -c) straight down
+    height = 0.99 * reach
+    quat = quat_wxyz_from_rotvec(np.array([lowest - 0.3, 0.0, 0.0]))  # 0.05 s before the lowest point
+    box = _ball((0, 0, height), mass=2.0, inertia=_box_inertia(2.0, half), quat=quat, omega=(omega, 0, 0))
+    scene = _scene([box], [Shape("box", half_extents_body=np.array(half))], [[Material(0.5)]], dt=dt,
+                   duration=0.4, gravity=None)
+    corners = _corner_heights(_run(scene, "act_after")[0], half)
+    assert corners[0, 1, 0].min() > 0.0  # at the samples the corner is above the floor: nothing to see after
+    trajectory, simulation = _run(scene, "backup")
+    hit = simulation.events.of(0)
+    assert len(hit) >= 1
+    assert hit[0, 0] == pytest.approx((0.3 - math.acos(0.99)) / omega, abs=DIP_TIME_TOL)
+    assert trajectory.velocity_world[-1, 0, 2] > 0.0  # pushed up by the floor
+    assert _corner_heights(trajectory, half).min() >= -INSIDE_TOL
+
+
+# --- backup: resting and sliding ------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("dt", [0.01, 0.05])
+def test_backup_block_sliding_on_the_floor_stops_at_v2_over_2_mu_g(dt):
+    """A point and a box lying flat, 2 m/s, mu_k = 0.3: they stop at v^2 / (2 mu_k g), flat on the floor."""
+    speed, mu_k, half = 2.0, 0.3, (0.2, 0.15, 0.1)
+    bodies = [_ball((0, 0, 0), velocity=(speed, 0, 0)),
+              _ball((0, 1, half[2]), velocity=(speed, 0, 0), mass=2.0, inertia=_box_inertia(2.0, half))]
+    shapes = [Shape("point"), Shape("box", half_extents_body=np.array(half))]
+    scene = _scene(bodies, shapes, [[Material(0.5, 0.5, mu_k)]] * 2, dt=dt, duration=1.0)
+    trajectory, _ = _run(scene, "backup")
+    np.testing.assert_allclose(trajectory.position_world[-1, :, 0], speed**2 / (2.0 * mu_k * G), rtol=0,
+                               atol=STOP_TOL)
+    np.testing.assert_allclose(trajectory.position_world[:, :, 2], [[0.0, half[2]]] * len(trajectory.times),
+                               rtol=0, atol=REST_TOL)
+    np.testing.assert_array_equal(trajectory.velocity_world[-1], 0.0)
+    np.testing.assert_array_equal(trajectory.angular_velocity_world, 0.0)
+
+
+def _incline_scene(angle, mu_s, mu_k, dt, duration):
+    normal = np.array([-math.sin(angle), 0.0, math.cos(angle)])  # z = x tan(angle)
+    half = (0.2, 0.15, 0.1)
+    start = np.array([0.3, 0.0, 0.3 * math.tan(angle)])
+    tilt = quat_wxyz_from_rotvec(np.array([0.0, -angle, 0.0]))  # body z along the normal
+    bodies = [_ball(start), _ball(start + half[2] * normal, mass=2.0, inertia=_box_inertia(2.0, half), quat=tilt)]
+    shapes = [Shape("point"), Shape("box", half_extents_body=np.array(half))]
+    scene = _scene(bodies, shapes, [[Material(0.5, mu_s, mu_k)]] * 2, planes=(Plane(normal, 0.0, "incline"),),
+                   dt=dt, duration=duration)
+    return scene, start + np.array([[0.0, 0.0, 0.0], half[2] * normal])
+
+
+def test_backup_block_below_the_friction_angle_stays_put():
+    """tan 20 deg = 0.364 < mu_s = 0.5: a point and a box on the incline do not move."""
+    scene, start = _incline_scene(math.radians(20.0), 0.5, 0.4, 0.01, 2.0)
+    trajectory, _ = _run(scene, "backup")
+    np.testing.assert_allclose(trajectory.position_world, np.broadcast_to(start, trajectory.position_world.shape),
+                               rtol=0, atol=SLIDE_TOL)
+
+
+@pytest.mark.parametrize("dt", [0.01, 0.05])
+def test_backup_block_above_the_friction_angle_slides_by_the_closed_form(dt):
+    """tan 20 deg > mu_s = 0.3: x(t) = x0 + g (sin a - mu_k cos a) t^2 / 2 down the slope, exactly."""
+    angle, mu_k = math.radians(20.0), 0.2
+    scene, start = _incline_scene(angle, 0.3, mu_k, dt, 1.0)
+    trajectory, _ = _run(scene, "backup")
+    down = np.array([-math.cos(angle), 0.0, -math.sin(angle)])
+    along = 0.5 * G * (math.sin(angle) - mu_k * math.cos(angle)) * trajectory.times**2
+    expected = start[None, :, :] + along[:, None, None] * down
+    np.testing.assert_allclose(trajectory.position_world, expected, rtol=0, atol=SLIDE_TOL)
+
+
+def test_backup_resting_bodies_neither_sink_nor_jitter():
+    """A sphere, a point and a box placed on the floor: 1000 steps later not a picometre has moved."""
+    half = (0.2, 0.15, 0.1)
+    bodies = [_ball((0, 0, 0.1)), _ball((1, 0, 0)), _ball((2, 0, half[2]), mass=2.0, inertia=_box_inertia(2.0, half))]
+    shapes = [Shape("sphere", radius=0.1), Shape("point"), Shape("box", half_extents_body=np.array(half))]
+    scene = _scene(bodies, shapes, [[Material(0.8, 0.5, 0.3)]] * 3, dt=0.01, duration=10.0)
+    trajectory, _ = _run(scene, "backup")
+    drift = trajectory.position_world - trajectory.position_world[0]
+    assert np.abs(drift).max() < REST_TOL
+
+
+# --- backup: bodies that turn ---------------------------------------------------------------------------------
+
+
+def test_backup_box_dropped_flat_bounces_like_a_particle():
+    """A box landing on a face: the particle's impact times and apexes, offset by its half height; no spin."""
+    half, k, height = (0.2, 0.15, 0.1), 0.8, 1.0
+    box = _ball((0, 0, height + half[2]), mass=2.0, inertia=_box_inertia(2.0, half))
+    scene = _scene([box], [Shape("box", half_extents_body=np.array(half))], [[Material(k)]], dt=0.01,
+                   duration=3.7)
+    trajectory, simulation = _run(scene, "backup")
+    impacts = simulation.events.of(0)[:10]
+    np.testing.assert_allclose(impacts[:, 0], _impact_times(height, k, 10), rtol=EXACT_RTOL)
+    np.testing.assert_allclose(impacts[:, 2] ** 2 / (2 * G), height * k ** (2 * np.arange(1, 11)), rtol=EXACT_RTOL)
+    np.testing.assert_array_equal(trajectory.angular_velocity_world, 0.0)
+
+
+def test_backup_box_dropped_on_an_edge_starts_to_spin_by_the_hand_impulse():
+    """Tilted 0.3 rad about x, the box lands on an edge; j = (1 + k) v / (1/m + r_y^2 / I_xx) at the edge."""
+    half, mass, k, theta, z0 = (0.2, 0.15, 0.1), 2.0, 0.5, 0.3, 1.0
+    a, b, c = half
+    inertia_xx = mass * (b * b + c * c) / 3.0
+    box = _ball((0, 0, z0), mass=mass, inertia=_box_inertia(mass, half), quat=(math.cos(theta / 2),
+                                                                              math.sin(theta / 2), 0, 0))
+    scene = _scene([box], [Shape("box", half_extents_body=np.array(half))], [[Material(k)]], dt=0.01, duration=0.6)
+    trajectory, simulation = _run(scene, "backup")
+    r_y, r_z = -b * math.cos(theta) + c * math.sin(theta), -(b * math.sin(theta) + c * math.cos(theta))
+    drop = z0 + r_z
+    t1, v = math.sqrt(2.0 * drop / G), math.sqrt(2.0 * G * drop)
+    j = (1.0 + k) * v / (1.0 / mass + r_y**2 / inertia_xx)
+    v_after, omega_after = -v + j / mass, r_y * j / inertia_xx
+    energy_before = 0.5 * mass * v**2
+    energy_after = 0.5 * mass * v_after**2 + 0.5 * inertia_xx * omega_after**2
+    assert omega_after != 0.0 and energy_after < energy_before
+    hits = simulation.events.of(0)
+    np.testing.assert_allclose(hits[0], [t1, -v, k * v], rtol=EXACT_RTOL)
+    sample = int(np.searchsorted(trajectory.times, t1))
+    assert trajectory.times[sample] < hits[1, 0]  # a sample of the first rebound
+    np.testing.assert_allclose(trajectory.angular_velocity_world[sample, 0], [omega_after, 0.0, 0.0],
+                               rtol=0, atol=ROUNDOFF)
+    np.testing.assert_allclose(trajectory.velocity_world[sample, 0, 2], v_after - G * (trajectory.times[sample] - t1),
+                               rtol=0, atol=ROUNDOFF)
+
+
+def test_backup_point_masses_land_flat_like_a_particle_and_tilted_with_spin():
+    """Four 0.25 kg points in a square: flat, they bounce like one particle; tilted, they pick up spin."""
+    points = np.array([[0.1, 0.1, 0.0], [0.1, -0.1, 0.0], [-0.1, 0.1, 0.0], [-0.1, -0.1, 0.0]])
+    inertia = np.diag([0.01, 0.01, 0.02])  # sum m (r^2 1 - r r^T) of the four points
+    tilt = quat_wxyz_from_rotvec(np.array([0.2, 0.1, 0.0]))
+    bodies = [_ball((0, 0, 1.0), inertia=inertia), _ball((1, 0, 1.0), inertia=inertia, quat=tilt)]
+    shape = Shape("points", points_body=points)
+    k = 0.8
+    scene = _scene(bodies, [shape, shape], [[Material(k)]] * 2, dt=0.01, duration=1.6)
+    trajectory, simulation = _run(scene, "backup")
+    flat = simulation.events.of(0)[:2]
+    np.testing.assert_allclose(flat[:, 0], _impact_times(1.0, k, 2), rtol=EXACT_RTOL)
+    np.testing.assert_array_equal(trajectory.angular_velocity_world[:, 0], 0.0)
+    first = simulation.events.of(1)[0, 0]
+    after = trajectory.times > first
+    assert np.abs(trajectory.angular_velocity_world[after, 1]).max() > 0.1
+    energy = (0.5 * np.sum(trajectory.velocity_world[:, 1] ** 2, axis=1)
+              + 0.5 * np.einsum("ti,tij,tj->t", trajectory.angular_velocity_world[:, 1],
+                                _world_inertia(trajectory.quat_wxyz[:, 1], inertia),
+                                trajectory.angular_velocity_world[:, 1])
+              + G * trajectory.position_world[:, 1, 2])
+    assert energy[after].max() < energy[0]
+
+
+def _world_inertia(quat, inertia_body):
+    rotation = quat_wxyz_to_matrix(quat)
+    return rotation @ inertia_body @ np.swapaxes(rotation, -1, -2)
+
+
+def test_backup_tumbling_bodies_never_gain_energy_nor_go_inside():
+    """Seeded random boxes thrown spinning at a floor and an incline: energy never above the start, no corner
+    inside a plane at any sample, all at rest in the end."""
+    rng = np.random.default_rng(SEED)
+    planes = (FLOOR, Plane((-0.5, 0.0, 1.0), -0.5, "incline"))
+    bodies, shapes, materials, halves = [], [], [], []
+    for _ in range(8):
+        half = rng.uniform(0.05, 0.3, 3)
+        mass = rng.uniform(0.5, 3.0)
+        quat = rng.normal(size=4)
+        bodies.append(_ball((rng.uniform(-1, 0.5), rng.uniform(-1, 1), rng.uniform(1.3, 2.5)), rng.normal(size=3),
+                            mass=mass, inertia=_box_inertia(mass, half), quat=quat / np.linalg.norm(quat),
+                            omega=3.0 * rng.normal(size=3)))
+        shapes.append(Shape("box", half_extents_body=half))
+        materials.append([Material(rng.uniform(0.0, 0.9), 0.6, 0.4), Material(0.5, 0.3, 0.3)])
+        halves.append(half)
+    scene = _scene(bodies, shapes, materials, planes=planes, dt=0.01, duration=3.0)
+    trajectory, _ = _run(scene, "backup")
+    masses = np.array([b.mass for b in bodies])
+    inertia = np.stack([b.inertia_body for b in bodies])
+    rotation = quat_wxyz_to_matrix(trajectory.quat_wxyz)
+    world = rotation @ inertia @ np.swapaxes(rotation, -1, -2)
+    omega = trajectory.angular_velocity_world
+    energy = (0.5 * masses * np.sum(trajectory.velocity_world**2, axis=-1)
+              + 0.5 * np.einsum("tbi,tbij,tbj->tb", omega, world, omega)
+              + masses * G * trajectory.position_world[..., 2])
+    assert np.all(energy <= energy[0] * (1.0 + TUMBLING_ENERGY_RTOL))
+    for b, half in enumerate(halves):
+        corners = Shape("box", half_extents_body=half).vertices_body()
+        points = np.einsum("tij,vj->tvi", rotation[:, b], corners) + trajectory.position_world[:, b, None, :]
+        for plane in planes:
+            assert (points @ plane.normal_world + plane.offset).min() >= -INSIDE_TOL
+    np.testing.assert_array_equal(trajectory.velocity_world[-1], 0.0)
+
+
+def test_backup_ball_between_a_floor_and_an_incline():
+    """Dropped onto a 45 deg incline: it bounces down onto the floor, never inside either, and rests there."""
+    radius, mass = 0.1, 2.0
+    incline = Plane((-1.0, 0.0, 1.0), 0.0, "incline")
+    ball = _ball((0.3, 0, 1.0), mass=mass, inertia=np.eye(3) * 0.4 * mass * radius**2)
+    scene = _scene([ball], [Shape("sphere", radius=radius)], [[Material(0.5, 0.3, 0.2)] * 2],
+                   planes=(FLOOR, incline), dt=0.01, duration=4.0)
+    trajectory, simulation = _run(scene, "backup")
+    x = trajectory.position_world[:, 0]
+    for plane in (FLOOR, incline):
+        assert (x @ plane.normal_world + plane.offset - radius).min() >= -INSIDE_TOL
+    assert {0, 1} <= set(simulation.events.plane)
+    energy = (0.5 * mass * np.sum(trajectory.velocity_world[:, 0] ** 2, axis=1)
+              + 0.2 * mass * radius**2 * np.sum(trajectory.angular_velocity_world[:, 0] ** 2, axis=1)
+              + mass * G * x[:, 2])
+    assert np.all(np.diff(energy) <= ENERGY_RTOL * energy[0])
+    assert x[-1, 2] == pytest.approx(radius, abs=REST_TOL)
+    np.testing.assert_array_equal(trajectory.velocity_world[-1], 0.0)
+
+
+def test_backup_ball_wedged_in_a_valley_is_put_at_rest():
+    """Between two 45 deg slopes a ball resting on one slides into the other: the step's rest cap stops it."""
+    planes = (Plane((-1.0, 0.0, 1.0), 0.0, "left"), Plane((1.0, 0.0, 1.0), 0.0, "right"))
+    scene = _scene([_ball((0.05, 0, 1.0))], [Shape("point")], [[Material(0.5)] * 2], planes=planes, dt=0.01,
+                   duration=3.0)
+    trajectory, simulation = _run(scene, "backup")
+    assert "cap" in simulation.events.kind
+    np.testing.assert_allclose(trajectory.position_world[-1, 0], 0.0, atol=INSIDE_TOL)
+
+
+# --- impulses -------------------------------------------------------------------------------------------------
+
+
+def test_impulses_never_add_energy():
+    """Seeded random bodies, contacts and materials: kinetic energy after <= before; frictionless: -k u.N."""
+    rng = np.random.default_rng(SEED)
+    n = 2000
+    mass = rng.uniform(0.1, 10.0, n)
+    root = rng.normal(size=(n, 3, 3))
+    inertia_body = root @ np.swapaxes(root, 1, 2) + 0.01 * np.eye(3)
+    quat = rng.normal(size=(n, 4))
+    rotation = quat_wxyz_to_matrix(quat)
+    inertia = rotation @ inertia_body @ np.swapaxes(rotation, 1, 2)
+    inertia_inv = np.linalg.inv(inertia)
+    lever = 0.5 * rng.normal(size=(n, 3))
+    normal = rng.normal(size=(n, 3))
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    momentum, angular = mass[:, None] * rng.normal(size=(n, 3)), rng.normal(size=(n, 3))
+    k = rng.uniform(0.0, 1.0, n)
+    mu_s = rng.uniform(0.0, 1.0, n)
+    mu_k = mu_s * rng.uniform(0.0, 1.0, n)
+    frictionless = np.arange(n) % 4 == 0
+    mu_s, mu_k = np.where(frictionless, 0.0, mu_s), np.where(frictionless, 0.0, mu_k)
+
+    def energy(p, l):
+        return 0.5 * np.sum(p * p, axis=1) / mass + 0.5 * np.einsum("ni,nij,nj->n", l, inertia_inv, l)
+
+    def normal_speed(p, l):
+        return np.sum((p / mass[:, None] + np.cross(np.einsum("nij,nj->ni", inertia_inv, l), lever)) * normal, axis=1)
+
+    p, l, j_n = impulse_response(mass, inertia_inv, momentum, angular, lever, normal, k, mu_s, mu_k)
+    before = energy(momentum, angular)
+    assert np.all(energy(p, l) <= before * (1.0 + ENERGY_RTOL))
+    approaching = normal_speed(momentum, angular) < 0.0
+    assert 0.3 * n < approaching.sum() < 0.7 * n
+    np.testing.assert_array_equal(j_n[~approaching], 0.0)
+    np.testing.assert_array_equal(p[~approaching], momentum[~approaching])
+    check = frictionless & approaching
+    np.testing.assert_allclose(normal_speed(p, l)[check], -k[check] * normal_speed(momentum, angular)[check],
+                               rtol=1e-9, atol=ROUNDOFF)
+
+
+def test_impulse_on_a_particle_is_the_lectures_reflection_plus_coulomb():
+    """r = 0: v - (1 + k)(v.N) N, then the tangential speed stops (mu_s j_n enough) or loses mu_k j_n / m."""
+    mass, k = np.array([2.0, 2.0]), np.array([0.5, 0.5])
+    v = np.array([[1.0, 0.0, -4.0], [3.0, 0.0, -4.0]])
+    zero, normal = np.zeros((2, 3)), np.array([[0.0, 0.0, 1.0]] * 2)
+    p, l, j_n = impulse_response(mass, np.stack([np.eye(3)] * 2), mass[:, None] * v, zero, zero, normal, k,
+                                 np.array([0.2, 0.2]), np.array([0.1, 0.1]))
+    np.testing.assert_allclose(j_n, [12.0, 12.0], rtol=0, atol=ROUNDOFF)  # (1 + k) m |v.N|
+    # stick: j_stop = m |v_t| = 2 <= mu_s j_n = 2.4; slide: 6 > 2.4, so |v_t| -= mu_k j_n / m = 0.6
+    np.testing.assert_allclose(p / mass[:, None], [[0.0, 0.0, 2.0], [2.4, 0.0, 2.0]], rtol=0, atol=ROUNDOFF)
+    np.testing.assert_array_equal(l, 0.0)
+
+
+def test_sphere_with_friction_picks_up_spin():
+    """A ball skidding onto the floor is held back at its lowest point r = -R N: it spins about +y."""
+    radius = 0.1
+    scene = _scene([_ball((0, 0, 0.5 + radius), velocity=(2.0, 0, 0))], [Shape("sphere", radius=radius)],
+                   [[Material(0.5, 0.3, 0.3)]], dt=0.01, duration=0.5)
+    trajectory, simulation = _run(scene, "backup")
+    after = trajectory.times > simulation.events.of(0)[0, 0]
+    spin = trajectory.angular_velocity_world[after, 0]
+    assert np.all(spin[:, 1] > 0.0)  # r x F = (0, 0, -R) x (-F, 0, 0) = (0, R F, 0)
+    np.testing.assert_array_equal(spin[:, [0, 2]], 0.0)
+
+
+# --- act_after --------------------------------------------------------------------------------------------------
+
+
+def test_act_after_is_first_order_and_pushes_out():
+    """First-apex error proportional to dt (the bounce starts from where the step found the ball), never inside."""
+    height, k = 1.0, 0.8
+    t1 = math.sqrt(2.0 * height / G)
+    slopes = []
+    for steps_to_impact in (20, 40, 80):
+        dt = t1 / (steps_to_impact + 0.5)  # the floor is crossed mid-step at every dt
+        scene = _scene([_ball((0, 0, height))], [Shape("point")], [[Material(k)]], dt=dt,
+                       duration=dt * (steps_to_impact + 5))
+        trajectory, _ = _run(scene, "act_after")
+        z, vz = trajectory.position_world[-1, 0, 2], trajectory.velocity_world[-1, 0, 2]
+        assert vz > 0.0 and trajectory.position_world[:, 0, 2].min() >= 0.0
+        slopes.append((z + vz**2 / (2.0 * G) - height * k**2) / dt)
+    assert slopes[0] > 0.0
+    np.testing.assert_allclose(slopes, slopes[-1], rtol=FIRST_ORDER_RTOL)
+
+
+def test_act_after_box_landing_flat_does_not_tip_and_rest_stays():
+    """A flat box landing stays flat (its four corners respond together); a resting sphere does not move."""
+    half = (0.2, 0.15, 0.1)
+    bodies = [_ball((0, 0, 1.0), mass=2.0, inertia=_box_inertia(2.0, half)), _ball((2, 0, 0.1))]
+    shapes = [Shape("box", half_extents_body=np.array(half)), Shape("sphere", radius=0.1)]
+    scene = _scene(bodies, shapes, [[Material(0.5, 0.5, 0.3)]] * 2, dt=0.01, duration=2.0)
+    trajectory, _ = _run(scene, "act_after")
+    np.testing.assert_array_equal(trajectory.angular_velocity_world, 0.0)
+    assert _corner_heights(trajectory, half)[0, :, 0].min() >= -INSIDE_TOL
+    np.testing.assert_allclose(trajectory.position_world[:, 1, 2], 0.1, rtol=0, atol=REST_TOL)
+
+
+# --- penalty --------------------------------------------------------------------------------------------------
+
+
+def test_penalty_stability_limits_of_the_undamped_spring():
+    """omega = sqrt(k_s / m): 0 for explicit Euler and the second-order pair, 2/omega, 2 sqrt 2 / omega."""
+    mass = np.array([1.0, 4.0])
+    omega = np.sqrt(1e4 / mass)
+    expected = {"explicit_euler": 0.0, "midpoint": 0.0, "average_velocity": 0.0, "semi_implicit_euler": 2.0,
+                "rk4": 2.0 * math.sqrt(2.0)}
+    for scheme, c in expected.items():
+        np.testing.assert_allclose(penalty_stability_limit(scheme, 1e4, mass), c / omega, rtol=ROUNDOFF)
+
+
+def _penalty_drop(dt, duration, stiffness=1e4, damping=0.0, position=(0, 0, 0.2), velocity=(0, 0, 0), mu=0.0):
+    return _scene([_ball(position, velocity=velocity)], [Shape("point")], [[Material(0.8, mu, mu)]], dt=dt,
+                  duration=duration, stiffness=stiffness, damping=damping)
+
+
+@pytest.mark.parametrize("fraction, stable", [(0.1, True), (1.5, False)])
+def test_penalty_semi_implicit_euler_is_bounded_only_below_2_over_omega(fraction, stable):
+    """Dropped on an undamped k_s = 1e4 N/m plane (omega = 100 rad/s): energy kept at dt = 0.1 (2/omega),
+    gained many times over at 1.5 (2/omega)."""
+    dt = fraction * 2.0 / 100.0
+    scene = _penalty_drop(dt, 3.0)
+    trajectory, _ = _run(scene, "penalty_semi_implicit_euler")
+    z = trajectory.position_world[:, 0, 2]
+    energy = 0.5 * trajectory.velocity_world[:, 0, 2] ** 2 + G * z
+    out = z > 0.0  # out of contact: no spring energy
+    assert out[-10:].any() or not stable
+    if stable:
+        np.testing.assert_allclose(energy[out], energy[0], rtol=BOUNDED_ENERGY_RTOL)
+    else:
+        assert not np.isfinite(energy).all() or energy[out].max() > 2.0 * energy[0]
+
+
+def test_penalty_rests_at_the_static_depth_and_slides_by_coulomb():
+    """Damped (zeta = 0.5), a particle settles m g / k_s deep; sliding at 2 m/s with mu = 0.3 it stops
+    after v^2 / (2 mu g), up to the friction's regularisation."""
+    stiffness, damping = 1e4, 100.0
+    settle = _penalty_drop(1e-3, 1.0, stiffness, damping, position=(0, 0, 0))
+    trajectory, _ = _run(settle, "penalty_rk4")
+    assert -trajectory.position_world[-1, 0, 2] == pytest.approx(G / stiffness, rel=EXACT_RTOL)
+    slide = _penalty_drop(1e-3, 1.0, stiffness, damping, position=(0, 0, -G / stiffness), velocity=(2, 0, 0),
+                          mu=0.3)
+    trajectory, _ = _run(slide, "penalty_rk4")
+    assert trajectory.position_world[-1, 0, 0] == pytest.approx(4.0 / (2.0 * 0.3 * G), rel=PENALTY_FRICTION_RTOL)
+
+
+# --- many bodies ----------------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("integrator", ["backup", "act_after", "penalty_rk4"])
+def test_a_thousand_bodies_run_vectorised(integrator):
+    """1000 seeded boxes, spheres and points thrown at a floor: finite, and (backup, act_after) none inside."""
+    rng = np.random.default_rng(SEED)
+    bodies, shapes = [], []
+    for i in range(1000):
+        half = rng.uniform(0.05, 0.2, 3)
+        quat = rng.normal(size=4)
+        bodies.append(_ball(rng.uniform([-5, -5, 0.3], [5, 5, 1.0]), 2.0 * rng.normal(size=3),
+                            inertia=_box_inertia(1.0, half), quat=quat / np.linalg.norm(quat),
+                            omega=rng.normal(size=3)))
+        shapes.append([Shape("box", half_extents_body=half), Shape("sphere", radius=half[0]), Shape("point")][i % 3])
+    scene = _scene(bodies, shapes, [[Material(0.5, 0.4, 0.3)]] * 1000, dt=0.01, duration=0.3)
+    trajectory, _ = _run(scene, integrator)
+    assert trajectory.is_finite()
+    if integrator != "penalty_rk4":
+        model = ContactModel.of(scene.contact)
+        rotation = quat_wxyz_to_matrix(trajectory.quat_wxyz[-1])
+        assert model.points(trajectory.position_world[-1], rotation)[1].min() >= -INSIDE_TOL
