@@ -47,7 +47,9 @@ def _contact_lines(scene: DynamicsScene) -> list[str]:
     if contact is None:
         return ["contact: none (no engine is given any)"]
     lines = [f"contact: methods {', '.join(contact.methods)}; rest_speed {contact.rest_speed:.10g} m/s; penalty "
-             f"stiffness {contact.penalty_stiffness:.10g} N/m, damping {contact.penalty_damping:.10g} N s/m"]
+             f"stiffness {contact.penalty_stiffness:.10g} N/m, damping "
+             + (f"{contact.penalty_damping:.10g} N s/m" if contact.penalty_damping is not None else
+                "from each pair's restitution (linear spring-damper)")]
     for plane in contact.planes:
         lines.append(f"plane {plane.name}: E(p) = N . p + d, N = {_vector(plane.normal_world)}, "
                      f"d = {plane.offset:.10g} m (normalised)")

@@ -13,7 +13,7 @@ from typing import Callable
 
 import numpy as np
 
-from simparity.comparisons.contact_metrics import contact_metrics, read_contact
+from simparity.comparisons.contact_metrics import contact_blow_up, contact_metrics, read_contact
 from simparity.comparisons.divergence import divergence
 from simparity.comparisons.ik_runner import run_ik_scene
 from simparity.comparisons.metrics import (
@@ -193,12 +193,13 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
     values = {"time_per_step": Measured(seconds / n, "s")}
     with np.errstate(all="ignore"):
         blown = "non-finite state" if not traj.is_finite() else divergence(scene, traj)
+        reading = read_contact(scene, traj) if scene.contact is not None and not blown else None
+        blown = blown or (contact_blow_up(scene, reading) if reading is not None else "")
         if blown:
             return _CaseResult(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values),
                                integrates_rotation=sim.integrates_rotation)
         changes = conserved_changes(scene, traj)
         values.update(drifts(scene, traj, changes))
-        reading = read_contact(scene, traj) if scene.contact is not None else None
         if series is not None:
             heights = None if reading is None else reading.distance[:, 0].min(axis=-1)
             series += dynamics_series(case, traj, ref_traj, changes, heights)

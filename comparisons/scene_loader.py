@@ -391,7 +391,8 @@ def _contact(top: _Reader, readers: list[_Reader], bodies: tuple[RigidBody, ...]
     materials = [[_material(r, default)] * len(planes) for r in readers]
     if c.has("pair"):
         for pair in c.array_of_tables("pair", _PAIR, "max_bodies"):
-            body, plane = pair.string("body", choices=tuple(b.name for b in bodies)), pair.string("plane", choices=tuple(names))
+            body = pair.string("body", choices=tuple(b.name for b in bodies))
+            plane = pair.string("plane", choices=tuple(names))
             i, j = [b.name for b in bodies].index(body), names.index(plane)
             materials[i][j] = _material(pair, materials[i][j])
     contact = Contact(
@@ -399,9 +400,9 @@ def _contact(top: _Reader, readers: list[_Reader], bodies: tuple[RigidBody, ...]
         methods=c.strings("methods", CONTACT_METHODS, "no contact method {}") if c.has("methods") else CONTACT_METHODS,
         rest_speed=c.number("rest_speed", 1e-3, positive=True, length=1),
         penalty_stiffness=c.number("penalty_stiffness", 1e5, positive=True),
-        penalty_damping=c.number("penalty_damping", 0.0),
+        penalty_damping=c.number("penalty_damping") if c.has("penalty_damping") else None,
     )
-    if contact.penalty_damping < 0:
+    if contact.penalty_damping is not None and contact.penalty_damping < 0:
         raise c.fail("penalty_damping", "is negative", "numbers >= 0")
     _check_start_outside(top, contact, bodies)
     return contact
@@ -641,7 +642,12 @@ def _ik(top: _Reader, head: dict) -> IKScene:
 
 
 def _check_reference(top: _Reader, scene) -> None:
-    """A ground-truth reference (analytic, tight) that cannot do the scene is an error now, not a run of n/a rows."""
+    """A ground-truth reference (analytic, tight) that cannot do the scene is an error now, not a run of n/a rows;
+    so is core as the reference of a contact scene that does not run its exact method, backup."""
+    contact = getattr(scene, "contact", None)
+    if scene.reference == "core" and contact is not None and "backup" not in contact.methods:
+        raise top.fail("scene.reference", "core is the reference, but the scene's contact methods leave out backup, "
+                       "its exact one", 'contact.methods with "backup", or another reference')
     if scene.reference not in ("analytic", "tight"):
         return
     from simparity.comparisons.engines import make_engine

@@ -74,6 +74,18 @@ def penalty_stability_limit(scheme: str, stiffness: float, mass: np.ndarray) -> 
     return _UNDAMPED_LIMIT[scheme] / np.sqrt(stiffness / np.asarray(mass, dtype=float))
 
 
+def penalty_damping(contact: Contact, mass: np.ndarray) -> np.ndarray:
+    """(B, P) penalty damping k_d [N s/m]: the scene's, or where it gives none the damping ratio
+    zeta = -ln k / sqrt(pi^2 + ln^2 k) of a linear spring-damper that rebounds at the pair's k,
+    c = 2 zeta sqrt(k_s m). mass (B,) [kg]."""
+    k = np.asarray(contact.restitution, dtype=float)
+    if contact.penalty_damping is not None:
+        return np.full(k.shape, float(contact.penalty_damping))
+    log_k = np.log(np.where(k > 0.0, k, 1.0))
+    zeta = np.where(k > 0.0, -log_k / np.sqrt(np.pi**2 + log_k**2), 1.0)
+    return 2.0 * zeta * np.sqrt(contact.penalty_stiffness * np.asarray(mass, dtype=float))[:, None]
+
+
 @dataclass(frozen=True)
 class ContactModel:
     """A scene's :class:`Contact` as arrays over B bodies, P planes and V vertices.
@@ -94,8 +106,10 @@ class ContactModel:
     restitution, friction_static, friction_kinetic : (B, P) ndarray
     rest_speed : float
         [m/s]
-    stiffness, damping : float
-        Penalty k_s [N/m], k_d [N s/m].
+    stiffness : float
+        Penalty k_s [N/m].
+    damping : (B, P) ndarray
+        Penalty k_d [N s/m] per body and plane (:attr:`core.scene.Contact.penalty_damping`).
     """
 
     normals: np.ndarray
@@ -108,10 +122,11 @@ class ContactModel:
     friction_kinetic: np.ndarray
     rest_speed: float
     stiffness: float
-    damping: float
+    damping: np.ndarray
 
     @classmethod
-    def of(cls, contact: Contact) -> "ContactModel":
+    def of(cls, contact: Contact, mass: np.ndarray) -> "ContactModel":
+        """The model of ``contact`` for bodies of ``mass`` (B,) [kg] (the penalty damping may depend on it)."""
         vertices = [s.vertices_body() for s in contact.shapes]
         count = max(len(v) for v in vertices)
         padded = np.stack([np.concatenate([v, np.repeat(v[:1], count - len(v), axis=0)]) for v in vertices])
@@ -120,14 +135,14 @@ class ContactModel:
             np.stack([p.normal_world for p in contact.planes]), np.array([p.offset for p in contact.planes]),
             padded, weights, np.array([s.radius for s in contact.shapes]), np.array(contact.restitution),
             np.array(contact.friction_static), np.array(contact.friction_kinetic), float(contact.rest_speed),
-            float(contact.penalty_stiffness), float(contact.penalty_damping),
+            float(contact.penalty_stiffness), penalty_damping(contact, mass),
         )
 
     def take(self, idx: np.ndarray) -> "ContactModel":
         """The model of the bodies ``idx`` (planes unchanged)."""
         return replace(self, vertices_body=self.vertices_body[idx], weights=self.weights[idx], radius=self.radius[idx],
                        restitution=self.restitution[idx], friction_static=self.friction_static[idx],
-                       friction_kinetic=self.friction_kinetic[idx])
+                       friction_kinetic=self.friction_kinetic[idx], damping=self.damping[idx])
 
     @property
     def rotation_free(self) -> np.ndarray:
@@ -224,8 +239,35 @@ def supported(lever: np.ndarray, distance: np.ndarray, normal: np.ndarray, weigh
     return on_point | (np.maximum(gaps, wrap) < np.pi - SUPPORT_ANGLE_MARGIN)
 
 
+FACE_POINTS = 3
+"""Touching points that make a face: fewer (a sphere's or a corner's one point, an edge's two) leave the friction's
+moment unbalanced, and the body turns."""
+
+
+def contact_lever(lever: np.ndarray, distance: np.ndarray, speed: np.ndarray, weights: np.ndarray,
+                  normal: np.ndarray, omega: np.ndarray, rest_speed: float) -> np.ndarray:
+    """Where the impulse of a body touching one plane acts, relative to its COM (n, 3) [m].
+
+    The patch's middle (:func:`patch_lever`), except for a body landing flat: one that does not turn (its
+    points move by rotation slower than ``rest_speed`` [m/s]) and whose touching points hold its COM up
+    (:func:`supported`) over a face, at least :data:`FACE_POINTS` of them. The normal impulses over a face
+    spread so that their moment cancels the friction's, as long as the centre of pressure stays inside the
+    face (tipping is not modelled), so the impulse acts as if at the COM: a box landing flat, sliding or not,
+    does not start to spin.
+    lever (n, V, 3) [m], distance (n, V) [m], speed (n, V) [m/s], weights (n, V), normal (n, 3),
+    omega (n, 3) [rad/s].
+    """
+    middle = patch_lever(lever, distance, speed, weights)
+    still = np.linalg.norm(omega, axis=1) * np.linalg.norm(lever, axis=-1).max(axis=1) <= rest_speed
+    touching = (distance <= distance.min(axis=1, keepdims=True) + CONTACT_TOLERANCE) & (weights > 0.0)
+    face = touching.sum(axis=1) >= FACE_POINTS
+    flat = still & face & supported(lever, distance, normal, weights, np.full(len(normal), CONTACT_TOLERANCE))
+    return np.where(flat[:, None], 0.0, middle)
+
+
 def _effective_inverse_mass(inverse_mass, inertia_inv, lever, direction):
-    """1/m + d.((I^-1 (r x d)) x r): the velocity change along d of the point r per unit impulse along d."""
+    """1/m + d.((I^-1 (r x d)) x r) [1/kg]: the velocity change along d of the point r per unit impulse along d.
+    inverse_mass (n,) [1/kg], inertia_inv (n, 3, 3) [1/(kg m^2)], lever (n, 3) [m], direction (n, 3) unit -> (n,)."""
     turn = np.einsum("nij,nj->ni", inertia_inv, cross(lever, direction))
     return inverse_mass + np.sum(direction * cross(turn, lever), axis=-1)
 
@@ -291,7 +333,7 @@ def penalty_wrench(model: ContactModel, props: MassProperties, external: Wrench)
         for p, plane in enumerate(planes):
             r = lever[:, p]
             u = v[:, None, :] + cross(omega[:, None, :], r)
-            f_n = penalty_force(x[:, None, :] + r, u, plane, model.stiffness, model.damping)
+            f_n = penalty_force(x[:, None, :] + r, u, plane, model.stiffness, model.damping[:, p, None])
             u_t = u - (u @ plane.normal_world)[..., None] * plane.normal_world
             slip = np.maximum(np.linalg.norm(u_t, axis=-1, keepdims=True), FRICTION_REGULARISATION_SPEED)
             magnitude = np.linalg.norm(f_n, axis=-1, keepdims=True)

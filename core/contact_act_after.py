@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simparity.core.contact import CONTACT_TOLERANCE, Bodies, impulse_response, patch_lever, put_state, take_state
+from simparity.core.contact import CONTACT_TOLERANCE, Bodies, contact_lever, impulse_response, put_state, take_state
 from simparity.core.forces import make_wrench
 from simparity.core.integrators import make_step
 from simparity.core.rigid_body import State, velocities
@@ -66,7 +66,8 @@ def resolve_after(bodies: Bodies, state: State, touched: np.ndarray) -> State:
         depth = np.where(moving_in[idx], distance[idx], np.inf).reshape(len(idx), -1)
         plane = depth.argmin(axis=1) // distance.shape[2]
         normal = model.normals[plane]
-        r = patch_lever(lever[idx, plane], distance[idx, plane], speed[idx, plane], model.weights[idx])
+        r = contact_lever(lever[idx, plane], distance[idx, plane], speed[idx, plane], model.weights[idx], normal,
+                          omega[idx], model.rest_speed)
         arrival = np.sum((v[idx] + cross(omega[idx], r)) * normal, axis=1)
         k = model.restitution[idx, plane]
         plastic = touched[idx, plane] | (k * np.maximum(-arrival, 0.0) < model.rest_speed)

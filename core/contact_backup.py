@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simparity.core.contact import (RESTING_GAP, Bodies, EventLog, impulse_response, patch_lever, put_state, supported,
+from simparity.core.contact import (RESTING_GAP, Bodies, EventLog, contact_lever, impulse_response, put_state, supported,
                                     take_state)
 from simparity.core.contact_act_after import resolve_after
 from simparity.core.contact_roots import distances, exact_contact, root_contact
@@ -166,7 +166,9 @@ def _respond(bodies: Bodies, state: State, resting: np.ndarray, dt: float, clock
     normal = model.normals[plane]
     rotation = state.rotation_world
     inertia_inv = bodies.props.inertia_world_inv(rotation)
-    r = patch_lever(lever[body, plane], distance[body, plane], speed[body, plane], model.weights)
+    omega = np.einsum("nij,nj->ni", inertia_inv, state.angular_momentum_world)
+    r = contact_lever(lever[body, plane], distance[body, plane], speed[body, plane], model.weights, normal, omega,
+                      model.rest_speed)
 
     def normal_speed(p, l):
         return np.sum((p / mass[:, None] + cross(np.einsum("nij,nj->ni", inertia_inv, l), r)) * normal, axis=1)

@@ -51,9 +51,11 @@ scheme that integrates it."""
 
 
 def contact_integrators(methods: tuple[str, ...]) -> tuple[str, ...]:
-    """The integrator names of contact methods: ``penalty`` -> every ``penalty_<scheme>``."""
-    return tuple(name for method in methods for name in CONTACT_INTEGRATORS
-                 if name == method or (method == "penalty" and name.startswith(PENALTY_PREFIX)))
+    """The integrator names of contact methods, in :data:`CONTACT_INTEGRATORS`' order (``backup``, the exact
+    one, first: a scene whose reference is core is measured against it): ``penalty`` -> every
+    ``penalty_<scheme>``."""
+    return tuple(name for name in CONTACT_INTEGRATORS
+                 if name in methods or ("penalty" in methods and name.startswith(PENALTY_PREFIX)))
 
 
 def parse_integrator(name: str) -> tuple[str, str]:
@@ -129,7 +131,7 @@ class _ContactSimulation(Simulation):
         contact = scene.contact
         self._props = MassProperties.of(scene.bodies)
         self._state0 = initial_state(scene.bodies, self._props, quaternion=True)
-        self._model = ContactModel.of(contact)
+        self._model = ContactModel.of(contact, self._props.mass)
         self._dt, self._method = dt, integrator
         self.events = EventLog()
         if integrator == "backup":
@@ -137,20 +139,25 @@ class _ContactSimulation(Simulation):
             self.detail = (f"in-house backup: time backed up to each contact (exact root for bodies that do not "
                            f"turn, bracketed root finder otherwise), impulse with restitution and Coulomb friction, "
                            f"resting contact below rest_speed {contact.rest_speed:g} m/s; free flight rk4 "
-                           f"(quaternion); at most {MAX_EVENTS_PER_STEP} events per body and step")
+                           f"(quaternion); at most {MAX_EVENTS_PER_STEP} events per body and step (more: put at "
+                           f"rest); a body at rest slides or stays, it never rolls (a sphere sliding with friction "
+                           f"stops instead of rolling)")
         elif integrator == "act_after":
             self._step = ActAfterStepper(Bodies(self._props, self._model, scene.forces)).step
             self.detail = (f"in-house act_after: free flight rk4 (quaternion), then push-out and impulse with "
                            f"restitution and Coulomb friction ({GAUSS_SEIDEL_PASSES} Gauss-Seidel passes), plastic "
                            f"below rest_speed {contact.rest_speed:g} m/s and for a body touching since the step's "
-                           f"start")
+                           f"start; pushed out before each sample, so no penetration shows")
         else:
             scheme = integrator.removeprefix(PENALTY_PREFIX)
             wrench = penalty_wrench(self._model, self._props, make_wrench(scene.forces, self._props))
             self._step = make_step(scheme, "quaternion", self._props, wrench)
             undamped = float(penalty_stability_limit(scheme, contact.penalty_stiffness, self._props.mass).min())
-            self.detail = (f"in-house penalty: k_s {contact.penalty_stiffness:g} N/m, k_d {contact.penalty_damping:g} "
-                           f"N s/m, regularised Coulomb friction (mu_k), integrated by {scheme} (quaternion); "
+            damping = (f"k_d {contact.penalty_damping:g} N s/m" if contact.penalty_damping is not None else
+                       "k_d " + ", ".join(f"{c:.4g}" for c in np.unique(self._model.damping)) + " N s/m (from each "
+                       "pair's restitution, linear spring-damper)")
+            self.detail = (f"in-house penalty: k_s {contact.penalty_stiffness:g} N/m, {damping}, regularised "
+                           f"Coulomb friction (mu_k), integrated by {scheme} (quaternion); "
                            f"restitution and rest_speed not used; in theory an undamped linear spring is "
                            + (f"stable below {undamped:.3g} s" if undamped > 0 else "unstable at every step"))
 

@@ -278,12 +278,6 @@ class Shape:
             return np.array(self.points_body)
         return np.zeros((1, 3))
 
-    def support_distance(self, plane: "Plane", position_world: np.ndarray, rotation_world: np.ndarray) -> np.ndarray:
-        """Signed distance [m] of the shape's lowest point from ``plane``: min over vertices of E,
-        minus the radius for a sphere. position (..., 3), rotation (..., 3, 3) -> (...,)."""
-        vertices = np.einsum("...ij,vj->...vi", rotation_world, self.vertices_body()) + position_world[..., None, :]
-        return plane.signed_distance(vertices).min(axis=-1) - self.radius
-
 
 @dataclass(frozen=True)
 class Material:
@@ -330,8 +324,10 @@ class Contact:
         velocity threshold); the analytic reference applies it too.
     penalty_stiffness : float
         k_s [N/m] of the penalty method.
-    penalty_damping : float
-        k_d [N s/m] of the penalty method.
+    penalty_damping : float or None
+        k_d [N s/m] of the penalty method; None: per body and plane, the damping that gives the linear
+        spring-damper on the body's mass the pair's restitution k, c = 2 zeta sqrt(k_s m) with
+        zeta = -ln k / sqrt(pi^2 + ln^2 k) (critical for k = 0, none for k = 1).
     """
 
     planes: tuple[Plane, ...]
@@ -340,7 +336,7 @@ class Contact:
     methods: tuple[str, ...] = CONTACT_METHODS
     rest_speed: float = 1e-3
     penalty_stiffness: float = 1e5
-    penalty_damping: float = 0.0
+    penalty_damping: float | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "planes", tuple(self.planes))

@@ -577,6 +577,36 @@ def test_a_thousand_bodies_run_vectorised(integrator):
     trajectory, _ = _run(scene, integrator)
     assert trajectory.is_finite()
     if integrator != "penalty_rk4":
-        model = ContactModel.of(scene.contact)
+        model = ContactModel.of(scene.contact, np.array([b.mass for b in scene.bodies]))
         rotation = quat_wxyz_to_matrix(trajectory.quat_wxyz[-1])
         assert model.points(trajectory.position_world[-1], rotation)[1].min() >= -INSIDE_TOL
+
+
+@pytest.mark.parametrize("method", ["backup", "act_after"])
+def test_a_box_landing_flat_while_sliding_does_not_spin(method):
+    """A box landing flat at 1 m/s sideways with mu = 0.1: the face's normal impulses cancel the friction's moment,
+    so it does not turn, and friction takes mu (1 + k) |v_n| of its sideways speed (by hand: v_n = sqrt(2 g h))."""
+    half, height, k, mu = (0.15, 0.1, 0.05), 0.5, 0.5, 0.1
+    box = _ball((0.0, 0.0, height + half[2]), velocity=(1.0, 0.0, 0.0), mass=3.0, inertia=_box_inertia(3.0, half))
+    scene = _scene([box], [Shape("box", half_extents_body=np.array(half))], [[Material(k, mu, mu)]], dt=0.01,
+                   duration=0.5, methods=(method,))
+    trajectory, _ = _run(scene, method)
+    assert np.abs(trajectory.angular_velocity_world).max() <= ROUNDOFF
+    after = trajectory.times > math.sqrt(2 * height / G) + 0.01  # past the first impact
+    expected = 1.0 - mu * (1 + k) * math.sqrt(2 * G * height)
+    # backup meets the plane at the impact's instant; act_after finds it up to a step late, its normal speed up to
+    # g dt larger, so friction takes up to mu (1 + k) g dt more (first order).
+    late = 0.0 if method == "backup" else mu * (1 + k) * G * scene.dts[0]
+    np.testing.assert_allclose(trajectory.velocity_world[after, 0, 0][:5], expected, rtol=0, atol=late + 1e-9)
+
+
+def test_default_penalty_damping_gives_each_pair_its_restitution():
+    """Without penalty_damping, each pair's damping is that of a linear spring-damper rebounding at its k:
+    by hand for k_s = 1e4 N/m, m = 2 kg: k = 0.5 -> zeta = ln 2 / sqrt(pi^2 + ln^2 2) = 0.21545, c = 60.94 N s/m;
+    k = 0 -> critical, 2 sqrt(k_s m) = 282.84 N s/m; k = 1 -> 0."""
+    ball = _ball((0.0, 0.0, 1.0), mass=2.0)
+    walls = (FLOOR, Plane((1.0, 0.0, 0.0), 5.0, "wall"), Plane((-1.0, 0.0, 0.0), 5.0, "other"))
+    scene = _scene([ball], [Shape("point")], [[Material(0.5), Material(0.0), Material(1.0)]], planes=walls,
+                   stiffness=1e4, damping=None)
+    model = ContactModel.of(scene.contact, np.array([2.0]))
+    np.testing.assert_allclose(model.damping, [[60.94, 282.84, 0.0]], rtol=0, atol=0.01)

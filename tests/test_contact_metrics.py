@@ -106,6 +106,7 @@ def test_a_bouncier_run_shows_its_restitution_energy_gain_and_late_impacts():
     values = contact_metrics(_scene(0.5), bouncier, truth)
     v1 = math.sqrt(2 * G * H)
     assert values["restitution_error"].value == pytest.approx(0.1, abs=EXACT)
+    assert values["energy_loss_error"].value == pytest.approx(0.6**2 - 0.5**2, abs=EXACT)  # e^2 against k^2
     assert values["impact_time_error"].value == pytest.approx(2 * 0.1 * v1 / G, abs=EXACT)
     assert values["rebound_velocity_error"].value == pytest.approx(0.11 * v1, abs=EXACT)
     assert values["impacts_missed"].value == 1.0

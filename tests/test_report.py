@@ -16,7 +16,7 @@ from simparity.reports.content import ToleranceVerdict, build
 from simparity.reports.markdown import to_markdown
 from simparity.reports.store import read_run
 
-SCENES = ["dzhanibekov", "lecture-2link-ik", "iiwa-kinematics"]
+SCENES = ["dzhanibekov", "lecture-2link-ik", "iiwa-kinematics", "ball-bounce-k05"]
 ORDER_BAND = 0.5
 """Half the gap between neighbouring integer orders, as the shipped tolerances allow: an observed order
 within it of the theoretical one confirms the theory; outside it, the theory is wrong for the scheme."""
@@ -29,7 +29,7 @@ MIN_PAGE_BYTES = 10_000
 
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
-    """A quick run of a dynamics, an IK and a kinematics scene on the default engines."""
+    """A quick run of a dynamics, an IK, a kinematics and a contact scene on the default engines."""
     out = tmp_path_factory.mktemp("report") / "run"
     assert main(["run", *SCENES, "--quick", "--repeats", "0", "--jobs", "1", "--out", str(out)]) == 0
     return out
@@ -50,6 +50,21 @@ def test_markdown_starts_with_the_summary_and_links_existing_figures(run_dir):
     names = set(re.findall(r"\]\(figures/([^)]+)\.svg\)", text))
     assert {"dzhanibekov-work-precision", "dzhanibekov-convergence", "dzhanibekov-drift",
             "lecture-2link-ik-solve-rate", "lecture-2link-ik-residuals", "lecture-2link-ik-fk-agreement"} <= names
+
+
+def test_contact_section_shows_measured_restitution_at_every_dt_and_the_height_figure(run_dir):
+    """Issue #10: a contact scene's section has the height figure (no convergence figure: no order with
+    impacts) and a table of the restitution each engine measured at each dt next to the requested one."""
+    section = (run_dir / REPORT_FILE).read_text().split("## ball-bounce-k05 (dynamics)", 1)[1].split("\n## ", 1)[0]
+    assert "figures/ball-bounce-k05-height.svg" in section and "ball-bounce-k05-convergence" not in section
+    assert "requested restitution 0.5" in section
+    header = next(line for line in section.splitlines() if line.startswith("| engine | integrator | restitution"))
+    dts = re.findall(r"restitution at dt ([0-9.e-]+)", header)
+    assert len(dts) == 3   # the quick profile's three time steps
+    backup = next(line for line in section.splitlines() if line.startswith("| core | backup |"))
+    assert [cell.strip() for cell in backup.split("|")[3:6]] == ["0.5"] * 3   # exact at every dt
+    pinocchio = next(line for line in section.splitlines() if line.startswith("| pinocchio | euler |"))
+    assert pinocchio.rstrip(" |").endswith("n/a")
 
 
 def test_compact_table_names_reference_units_and_theoretical_order(run_dir):

@@ -316,6 +316,8 @@ BROKEN_CONTACT = [
      "computed from the point masses"),
     ("collinear point masses", "position = [0.0, 0.0, 1.0]", "position = [2.0, -1.0, 0.0]", "body[1].point_mass",
      "no solid body"),
+    ("core reference without backup", 'methods = ["backup", "penalty"]', 'methods = ["act_after", "penalty"]',
+     "scene.reference", "leave out backup"),
     ("points shape without masses", 'shape = "sphere"\nradius = 0.1', 'shape = "points"', "body[0].shape",
      "needs the body's [[body.point_mass]]"),
 ]
