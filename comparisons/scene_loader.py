@@ -334,8 +334,12 @@ def _material(r: _Reader, default: Material) -> Material:
     if min(static, kinetic) < 0:
         raise r.fail("friction_static" if static < 0 else "friction_kinetic", "is negative", "numbers >= 0")
     if kinetic > static:
-        raise r.fail("friction_kinetic", f"{kinetic:g} exceeds friction_static {static:g}",
-                     "friction_kinetic <= friction_static (sliding never grips harder than sticking)")
+        allowed = "friction_kinetic <= friction_static (sliding never grips harder than sticking)"
+        if not r.has("friction_kinetic"):
+            raise r.fail("friction_static", f"{static:g} is below the friction_kinetic {kinetic:g} this table inherits "
+                         "([contact], or the body for a pair)", allowed)
+        source = "" if r.has("friction_static") else " (inherited from [contact], or the body for a pair)"
+        raise r.fail("friction_kinetic", f"{kinetic:g} exceeds friction_static {static:g}{source}", allowed)
     return Material(k, static, kinetic)
 
 

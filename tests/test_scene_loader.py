@@ -298,6 +298,8 @@ BROKEN_CONTACT = [
      "negative"),
     ("kinetic above static", "friction_static = 0.6", "friction_static = 0.4", "body[1].friction_kinetic",
      "exceeds friction_static"),
+    ("static below inherited kinetic", 'name = "ball"\nmass', 'name = "ball"\nfriction_static = 0.1\nmass',
+     "body[0].friction_static", "below the friction_kinetic 0.2 this table inherits"),
     ("zero normal", "coefficients = [0.0, 0.0, 2.0, 1.0]", "coefficients = [0.0, 0.0, 0.0, 1.0]",
      "plane[0].coefficients", "all zeros"),
     ("short plane", "coefficients = [0.0, 0.0, 2.0, 1.0]", "coefficients = [0.0, 0.0, 2.0]",
