@@ -416,11 +416,21 @@ def contact_metrics(scene: DynamicsScene, traj: Trajectory, ref: Trajectory | No
         energies.append(_compare((got.velocity_out[:m] / got.velocity_in[:m])[still] ** 2,
                                  (expected.velocity_out[:m] / expected.velocity_in[:m])[still] ** 2))
     note = f"over the reference's first {IMPACTS_COMPARED} impacts per body and plane ({compared} here)"
+    shared = sum(min(len(truth.impacts[key].time), IMPACTS_COMPARED, len(got.time))
+                 for key, got in reading.impacts.items())
+    unknown = {
+        "impact_time_error": "no impact time: neither body falls toward the plane at the impacts compared",
+        "rebound_velocity_error": "the runs end inside the impacts compared: their rebounds are unknown",
+        "apex_height_error": "no apex: gravity does not pull the body back toward the plane (or the runs end in "
+                             "contact)",
+        "energy_loss_error": "the bodies turn at the impacts compared: the COM's rebound is not the contact point's",
+    }
     for metric, values, unit in (("impact_time_error", times, "s"), ("rebound_velocity_error", rebounds, "m/s"),
                                  ("apex_height_error", apexes, "m"), ("energy_loss_error", energies, "1")):
         finite = [v for v in values if math.isfinite(v)]
-        out[metric] = (Measured(max(finite), unit, note=note) if finite else
-                       Measured(math.nan, unit, unmeasurable="no impact in both this run and the reference"))
+        why = (unknown[metric] if shared else "the reference has no impact" if not compared else
+               "this run has none of the reference's impacts (impacts_missed counts them)")
+        out[metric] = Measured(max(finite), unit, note=note) if finite else Measured(math.nan, unit, unmeasurable=why)
     out["impacts_missed"] = (Measured(float(missed), "1", note=note) if compared else
                              Measured(math.nan, "1", unmeasurable="the reference has no impact"))
     out["rest_time_error"] = _rest_time_error(reading.rest_time, truth.rest_time, float(traj.times[-1]))

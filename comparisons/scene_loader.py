@@ -19,7 +19,7 @@ from simparity.core.dh import chain_from_dh
 from simparity.core.errors import SceneError, echo, one_line
 from simparity.core.files import file_problem, read_toml
 from simparity.core.ik.reach import reach_upper_bound
-from simparity.core.inertia import inertia_from_point_masses, inertia_problem, mass_and_center_of_mass
+from simparity.core.inertia import INERTIA_RTOL, inertia_from_point_masses, inertia_problem, mass_and_center_of_mass
 from simparity.core.names import NAME_RULE, TEXT_RULE, name_problem, text_problem
 from simparity.core.ranges import NORM_RANGES, RANGES, safe_norm
 from simparity.core.rotations import rpy_to_matrix
@@ -301,9 +301,14 @@ def _point_masses(r: _Reader) -> tuple[float, np.ndarray, PointMasses]:
     relative = given - center
     inertia = inertia_from_point_masses(masses, relative)
     problem = inertia_problem(inertia)
-    if problem or np.linalg.eigvalsh(inertia)[0] < RANGES["inertia_moment"].low:
+    moments = np.linalg.eigvalsh(inertia)
+    if problem or moments[0] < RANGES["inertia_moment"].low:
         raise r.fail("point_mass", f"the points give no solid body ({problem or 'a principal moment is ~0'}: "
                      "collinear or coincident points)", "at least three points not on one line")
+    if moments[0] + moments[1] - moments[2] <= INERTIA_RTOL * moments[2]:
+        raise r.fail("point_mass", "the points lie in one plane: their tensor sits on the edge of the triangle "
+                     "inequality (A + B = C), which MuJoCo refuses after rounding and PyBullet turns wrongly",
+                     "at least four points, one of them off the plane of the others")
     return float(total), inertia, PointMasses(masses, relative, center)
 
 
@@ -380,10 +385,15 @@ def _contact(top: _Reader, readers: list[_Reader], bodies: tuple[RigidBody, ...]
     planes = []
     for p in top.array_of_tables("plane", _PLANE, "max_bodies"):
         abcd = p.vector("coefficients", 4)
-        if not np.any(abcd[:3]):
+        length = safe_norm(abcd[:3])
+        if not (length > 0 and np.isfinite(length)):
             raise p.fail("coefficients", "the normal (a, b, c) is all zeros", "[a, b, c, d] with (a, b, c) != 0")
-        d = p._in_range("coefficients[3]", abcd[3] * p.scale)
-        planes.append(Plane(abcd[:3], d, p.name("name", f"plane{len(planes)}")))
+        scaled = abcd / np.max(np.abs(abcd[:3]))  # the same plane, its normal's largest entry 1: no overflow
+        offset = scaled[3] / float(np.linalg.norm(scaled[:3])) * p.scale  # the plane's distance from the origin
+        if not RANGES["position_world"].allows(abs(offset)):
+            raise p.fail("coefficients", f"the plane lies {abs(offset):.3g} m from the origin",
+                         RANGES["position_world"].text())
+        planes.append(Plane(scaled[:3], scaled[3] * p.scale, p.name("name", f"plane{len(planes)}")))
     names = [plane.name for plane in planes]
     if len(set(names)) != len(names):
         raise top.fail("plane", f"the plane name {next(n for i, n in enumerate(names) if n in names[:i])!r} repeats",
@@ -649,6 +659,9 @@ def _check_reference(top: _Reader, scene) -> None:
     """A ground-truth reference (analytic, tight) that cannot do the scene is an error now, not a run of n/a rows;
     so is core as the reference of a contact scene that does not run its exact method, backup."""
     contact = getattr(scene, "contact", None)
+    if scene.reference == "pinocchio" and contact is not None:
+        raise top.fail("scene.reference", "pinocchio has no contact solver for these scenes: every row would be n/a",
+                       "analytic, core (its backup method), mujoco or pybullet for a scene with planes")
     if scene.reference == "core" and contact is not None and "backup" not in contact.methods:
         raise top.fail("scene.reference", "core is the reference, but the scene's contact methods leave out backup, "
                        "its exact one", 'contact.methods with "backup", or another reference')
@@ -662,9 +675,10 @@ def _check_reference(top: _Reader, scene) -> None:
     else:
         support = engine.supports_kinematics(scene.chain)
     if not support.ok:
-        raise top.fail("scene.reference", f"{scene.reference} cannot serve this scene: {support.reason}",
-                       "a reference that can: core, mujoco, pybullet, pinocchio, or tight for dynamics without a "
-                       "closed form")
+        allowed = ("a reference that can: core (its backup method), mujoco or pybullet for contact" if contact is not None
+                   else "a reference that can: core, mujoco, pybullet, pinocchio, or tight for dynamics without a "
+                        "closed form")
+        raise top.fail("scene.reference", f"{scene.reference} cannot serve this scene: {support.reason}", allowed)
 
 
 def parse_scene(data: dict, source: str = "<scene>", limits: Limits = DEFAULT_LIMITS):

@@ -245,24 +245,40 @@ moment unbalanced, and the body turns."""
 
 
 def contact_lever(lever: np.ndarray, distance: np.ndarray, speed: np.ndarray, weights: np.ndarray,
-                  normal: np.ndarray, omega: np.ndarray, rest_speed: float) -> np.ndarray:
-    """Where the impulse of a body touching one plane acts, relative to its COM (n, 3) [m].
+                  normal: np.ndarray, velocity: np.ndarray, omega: np.ndarray, restitution: np.ndarray,
+                  friction_static: np.ndarray, friction_kinetic: np.ndarray,
+                  rest_speed: float) -> tuple[np.ndarray, np.ndarray]:
+    """(where the impulse of a body touching one plane acts, relative to its COM (n, 3) [m]; whether it tips (n,)).
 
     The patch's middle (:func:`patch_lever`), except for a body landing flat: one that does not turn (its
-    points move by rotation slower than ``rest_speed`` [m/s]) and whose touching points hold its COM up
-    (:func:`supported`) over a face, at least :data:`FACE_POINTS` of them. The normal impulses over a face
-    spread so that their moment cancels the friction's, as long as the centre of pressure stays inside the
-    face (tipping is not modelled), so the impulse acts as if at the COM: a box landing flat, sliding or not,
-    does not start to spin.
-    lever (n, V, 3) [m], distance (n, V) [m], speed (n, V) [m/s], weights (n, V), normal (n, 3),
-    omega (n, 3) [rad/s].
+    points move by rotation slower than ``rest_speed`` [m/s]) and touches with a face of at least
+    :data:`FACE_POINTS` points. Over a face the normal impulses spread so that their moment cancels the
+    friction's: the centre of pressure moves ahead of the COM's projection by rho h along the slip (h the
+    COM's height above the face, rho = j_t / j_n the friction impulse over the normal one: the slip speed
+    over (1 + k) times the approach speed while that sticks within mu_s, else mu_k). While that point stays
+    inside the face, the impulse acts as if at the COM and the body does not start to spin; past the face's
+    edge the body tips (it must not be put at rest), and the impulse acts at the patch's middle, which sets it
+    turning.
+    lever (n, V, 3) [m], distance (n, V) [m], speed (n, V) [m/s], weights (n, V), normal (n, 3), velocity (n, 3)
+    [m/s] (the COM's), omega (n, 3) [rad/s], restitution, friction_static, friction_kinetic (n,) (k as the
+    impact will use it).
     """
     middle = patch_lever(lever, distance, speed, weights)
     still = np.linalg.norm(omega, axis=1) * np.linalg.norm(lever, axis=-1).max(axis=1) <= rest_speed
     touching = (distance <= distance.min(axis=1, keepdims=True) + CONTACT_TOLERANCE) & (weights > 0.0)
     face = touching.sum(axis=1) >= FACE_POINTS
-    flat = still & face & supported(lever, distance, normal, weights, np.full(len(normal), CONTACT_TOLERANCE))
-    return np.where(flat[:, None], 0.0, middle)
+    approach = np.maximum(-np.sum(velocity * normal, axis=1), 0.0)
+    slip = velocity - np.sum(velocity * normal, axis=1, keepdims=True) * normal
+    slip_speed = np.linalg.norm(slip, axis=1)
+    impact = (1.0 + restitution) * approach
+    needed = np.divide(slip_speed, impact, out=np.full_like(slip_speed, np.inf), where=impact > 0.0)
+    ratio = np.where(needed <= friction_static, needed, friction_kinetic)
+    height = np.max(np.where(touching, -np.sum(lever * normal[:, None, :], axis=-1), 0.0), axis=1)
+    ahead = (ratio * height / np.maximum(slip_speed, np.finfo(float).tiny))[:, None] * slip
+    gap = np.full(len(normal), CONTACT_TOLERANCE)
+    holds = supported(lever - ahead[:, None, :], distance, normal, weights, gap)
+    flat = still & face & holds
+    return np.where(flat[:, None], 0.0, middle), still & face & ~holds
 
 
 def _effective_inverse_mass(inverse_mass, inertia_inv, lever, direction):

@@ -9,7 +9,8 @@ passes repeat this for the points still moving in, so that a box landing flat do
 in a corner leaves both planes.
 
 The impulse is plastic (k = 0) where the rebound would be slower than ``rest_speed``, and where the body
-already touched that plane at the start of the step: the step cannot resolve a flight shorter than
+already rested on that plane at the start of the step (touching it without moving into it faster than
+``rest_speed``; a body that starts on a plane striking it bounces): the step cannot resolve a flight shorter than
 itself, and the normal speed it gathered in the plane is what the plane's support would have removed
 (a resting body then sits on the plane at every sample, and a sliding one loses mu_k |g_n| dt of speed
 per step). First order in dt: the bounce starts from where the body was found, up to |v| dt inside.
@@ -66,8 +67,12 @@ def resolve_after(bodies: Bodies, state: State, touched: np.ndarray) -> State:
         depth = np.where(moving_in[idx], distance[idx], np.inf).reshape(len(idx), -1)
         plane = depth.argmin(axis=1) // distance.shape[2]
         normal = model.normals[plane]
-        r = contact_lever(lever[idx, plane], distance[idx, plane], speed[idx, plane], model.weights[idx], normal,
-                          omega[idx], model.rest_speed)
+        k_com = model.restitution[idx, plane]
+        approach = np.maximum(-np.sum(v[idx] * normal, axis=1), 0.0)
+        k_com = np.where(touched[idx, plane] | (k_com * approach < model.rest_speed), 0.0, k_com)
+        r, _ = contact_lever(lever[idx, plane], distance[idx, plane], speed[idx, plane], model.weights[idx], normal,
+                          v[idx], omega[idx], k_com, model.friction_static[idx, plane],
+                          model.friction_kinetic[idx, plane], model.rest_speed)
         arrival = np.sum((v[idx] + cross(omega[idx], r)) * normal, axis=1)
         k = model.restitution[idx, plane]
         plastic = touched[idx, plane] | (k * np.maximum(-arrival, 0.0) < model.rest_speed)
@@ -91,5 +96,11 @@ class ActAfterStepper:
     def step(self, t: float, state: State, dt: float) -> State:
         """Advance every body by dt [s] from time t."""
         model = self._bodies.model
-        touched = model.points(state.position_world, state.rotation_world)[1].min(axis=2) <= CONTACT_TOLERANCE
+        rotation = state.rotation_world
+        lever, distance = model.points(state.position_world, rotation)
+        v, omega = velocities(state, self._bodies.props, rotation)
+        touching = distance <= CONTACT_TOLERANCE
+        striking = touching & (model.normal_speeds(v, omega, lever) < -model.rest_speed)
+        # Resting on a plane at the step's start (touching, not striking it): that plane's impulse is plastic.
+        touched = touching.any(axis=2) & ~striking.any(axis=2)
         return resolve_after(self._bodies, self._flight(t, state, dt), touched)

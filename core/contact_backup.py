@@ -167,16 +167,19 @@ def _respond(bodies: Bodies, state: State, resting: np.ndarray, dt: float, clock
     rotation = state.rotation_world
     inertia_inv = bodies.props.inertia_world_inv(rotation)
     omega = np.einsum("nij,nj->ni", inertia_inv, state.angular_momentum_world)
-    r = contact_lever(lever[body, plane], distance[body, plane], speed[body, plane], model.weights, normal, omega,
-                      model.rest_speed)
+    velocity = state.momentum_world / mass[:, None]
+    k = model.restitution[body, plane]
+    approach = np.maximum(-np.sum(velocity * normal, axis=1), 0.0)
+    r, tips = contact_lever(lever[body, plane], distance[body, plane], speed[body, plane], model.weights, normal, velocity,
+                      omega, np.where(k * approach < model.rest_speed, 0.0, k), model.friction_static[body, plane],
+                      model.friction_kinetic[body, plane], model.rest_speed)
 
     def normal_speed(p, l):
         return np.sum((p / mass[:, None] + cross(np.einsum("nij,nj->ni", inertia_inv, l), r)) * normal, axis=1)
 
     before = normal_speed(state.momentum_world, state.angular_momentum_world)
-    k = model.restitution[body, plane]
     slow = (k * np.maximum(-before, 0.0) < model.rest_speed) & (before <= model.rest_speed)
-    rest = slow & supported(lever[body, plane], distance[body, plane], normal, model.weights, _settling_gap(
+    rest = slow & ~tips & supported(lever[body, plane], distance[body, plane], normal, model.weights, _settling_gap(
         bodies, state, normal, dt))
     p, l, _ = impulse_response(mass, inertia_inv, state.momentum_world, state.angular_momentum_world, r, normal,
                                np.where(slow, 0.0, k), model.friction_static[body, plane],

@@ -50,6 +50,12 @@ def distances(bodies: Bodies, state: State, resting: np.ndarray):
     return lever, np.where(own[:, :, None], np.inf, distance), bodies.model.normal_speeds(v, omega, lever)
 
 
+ROUNDING_SPEED_RTOL = 1e-12
+"""A normal speed within this fraction of the body's speed (plus what the step's acceleration adds) is rounding:
+a body placed on a tilted plane starts at E ~ -1e-17 m with u . N ~ +1e-16 m/s, and must count as touching now
+(it is pushed in by gravity), not as leaving the plane for a whole step of free fall."""
+
+
 def exact_contact(flight, t: float, state: State, distance: np.ndarray, horizon: np.ndarray) -> np.ndarray:
     """First contact of bodies whose points move on parabolas: time (n,) [s], inf if none within the horizon."""
     rotation = state.rotation_world
@@ -61,7 +67,8 @@ def exact_contact(flight, t: float, state: State, distance: np.ndarray, horizon:
     candidate = np.isfinite(e0)
     e0 = np.where(candidate, e0, 1.0)
     hit, s = entry_time(e0, u, a / 2.0, horizon[:, None])
-    now = (e0 <= 0.0) & ((u < 0.0) | ((u == 0.0) & (a < 0.0)))
+    speed_rounding = ROUNDING_SPEED_RTOL * (np.linalg.norm(v, axis=1)[:, None] + np.abs(a) * horizon[:, None])
+    now = (e0 <= 0.0) & ((u < 0.0) | ((u <= speed_rounding) & (a < 0.0)))
     return np.where(candidate & now, 0.0, np.where(candidate & hit, s, np.inf)).min(axis=1)
 
 

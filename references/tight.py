@@ -111,6 +111,8 @@ class TightSolveEngine(Engine):
         return ("dop853",)
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
+        if scene.contact is not None:
+            return Support.no("the tight solve has no contact: its bodies would fly through the planes")
         return self.check_integrator(integrator)
 
     def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:

@@ -34,13 +34,15 @@ OVERHEAD_DOMINATED_BODIES = 100
 
 
 def dynamics_cases(rows: pd.DataFrame, headline: str) -> pd.DataFrame:
-    """One row per engine x integrator x dt of a dynamics scene, ground truths left out.
+    """One row per engine x integrator x dt of a dynamics scene, ground truths and the scene's reference scheme
+    (core backup where core is the reference) left out: a scheme measured against itself ranks nothing.
 
     Columns: engine, integrator, dt [s], status (the case's), error (the headline metric where it
     was measured, else NaN), time_per_step [s] and cost [s of compute per simulated second].
     """
     keys = ["engine", "integrator", "dt"]
-    per_dt = rows[rows["dt"].notna() & ~rows["engine"].isin(GROUND_TRUTH_ENGINES)]
+    per_dt = rows[rows["dt"].notna() & ~rows["engine"].isin(GROUND_TRUTH_ENGINES)
+                  & (rows["engine"] + ":" + rows["integrator"] != rows["reference"])]
     cases = per_dt.groupby(keys, sort=False)["status"].agg(case_status).rename("status").reset_index()
     measured = per_dt[(per_dt["status"] == OK) & per_dt["metric"].isin([headline, "time_per_step"])]
     values = measured.pivot_table(index=keys, columns="metric", values="value", sort=False)

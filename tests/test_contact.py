@@ -610,3 +610,34 @@ def test_default_penalty_damping_gives_each_pair_its_restitution():
                    stiffness=1e4, damping=None)
     model = ContactModel.of(scene.contact, np.array([2.0]))
     np.testing.assert_allclose(model.damping, [[60.94, 282.84, 0.0]], rtol=0, atol=0.01)
+
+
+def test_act_after_bounces_a_body_that_starts_on_the_plane_striking_it():
+    """A point at z = 0 moving down at 8 m/s, k = 0.5: it strikes the plane at once, so act_after reflects it
+    (first order: the velocity it has after flying one step, 8 + g dt, times k) instead of stopping it."""
+    dt, k = 0.01, 0.5
+    point = _ball((0.0, 0.0, 0.0), velocity=(0.0, 0.0, -8.0))
+    scene = _scene([point], [Shape("point")], [[Material(k)]], dt=dt, duration=0.1, methods=("act_after",))
+    trajectory, _ = _run(scene, "act_after")
+    assert trajectory.velocity_world[1, 0, 2] == pytest.approx(k * (8.0 + G * dt), abs=1e-9)
+
+
+TIPPED_TOL = 1.0  # [deg] lying on a side: its face flat on the floor up to the settling's rounding
+
+
+@pytest.mark.parametrize("method", ["backup", "act_after"])
+def test_a_tall_box_landing_while_sliding_fast_tips_over(method):
+    """A 0.1 x 0.1 x 1 m box landing flat at 5 m/s sideways with mu = 0.5: friction moves the centre of pressure
+    mu h = 0.5 x 0.5 = 0.25 m ahead, far past the 0.05 m half-width of its face (by hand), so it tips over and
+    ends lying on a side (turned 90 degrees, its COM 0.05 m up) instead of sliding upright."""
+    half = (0.05, 0.05, 0.5)
+    box = _ball((0.0, 0.0, 0.55), velocity=(5.0, 0.0, 0.0), mass=1.0, inertia=_box_inertia(1.0, half))
+    scene = _scene([box], [Shape("box", half_extents_body=np.array(half))], [[Material(0.0, 0.5, 0.5)]], dt=0.001,
+                   duration=1.0, methods=(method,))
+    trajectory, _ = _run(scene, method)
+    tilt = np.degrees(2 * np.arccos(np.clip(np.abs(trajectory.quat_wxyz[-1, 0, 0]), 0.0, 1.0)))
+    assert abs(tilt - 90.0) <= TIPPED_TOL
+    # backup puts a settling body at rest within its resting gap (core.contact.RESTING_GAP, 1e-6 m) of the plane;
+    # act_after pushes out after each step and keeps a hop of order g dt^2
+    settled = 2e-6 if method == "backup" else 2 * G * scene.dts[0] ** 2
+    assert trajectory.position_world[-1, 0, 2] == pytest.approx(0.05, abs=settled)

@@ -257,6 +257,10 @@ position = [0.0, 1.0, 0.0]
 mass = 1.0
 position = [0.0, 0.0, 1.0]
 
+[[body.point_mass]]
+mass = 1.0
+position = [0.0, 0.0, 0.0]
+
 [simulation]
 duration = 1.0
 dt = [0.01]
@@ -277,13 +281,14 @@ def test_contact_scene_loads_planes_materials_and_point_mass_bodies(tmp_path):
     np.testing.assert_array_equal(scene.contact.friction_static, [[0.2, 0.2], [0.6, 0.6]])
     assert scene.contact.methods == ("backup", "penalty") and scene.contact.rest_speed == 0.01
     tri = scene.bodies[1]
-    # By hand: M = 4; COM = (1, 2, 1) / 4; r_i = q_i - COM; I = sum m (|r|^2 E - r r^T).
-    assert tri.mass == 4.0
-    np.testing.assert_allclose(tri.position_world, [0.25, 0.5, 1.25], rtol=0, atol=1e-15)
-    hand = np.array([[1.75, 0.5, 0.25], [0.5, 1.5, 0.5], [0.25, 0.5, 1.75]])
+    # By hand: M = 5; COM = (1, 2, 1) / 5; r_i = q_i - COM; I = sum m (|r|^2 E - r r^T), e.g.
+    # I_xy = -sum m x y = -(0.8 (-0.4) + 2 (-0.2) 0.6 + (-0.2)(-0.4) + (-0.2)(-0.4)) = 0.4.
+    assert tri.mass == 5.0
+    np.testing.assert_allclose(tri.position_world, [0.2, 0.4, 1.2], rtol=0, atol=1e-15)
+    hand = np.array([[2.0, 0.4, 0.2], [0.4, 1.6, 0.4], [0.2, 0.4, 2.0]])
     np.testing.assert_allclose(tri.inertia_body, hand, rtol=0, atol=1e-14)
     assert scene.contact.shapes[1].kind == "points"
-    np.testing.assert_allclose(scene.contact.shapes[1].points_body[0], [0.75, -0.5, -0.25], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(scene.contact.shapes[1].points_body[0], [0.8, -0.4, -0.2], rtol=0, atol=1e-15)
     assert scene.contact.shapes[0].kind == "sphere" and scene.contact.shapes[0].radius == 0.1
 
 
@@ -302,6 +307,8 @@ BROKEN_CONTACT = [
      "body[0].friction_static", "below the friction_kinetic 0.2 this table inherits"),
     ("zero normal", "coefficients = [0.0, 0.0, 2.0, 1.0]", "coefficients = [0.0, 0.0, 0.0, 1.0]",
      "plane[0].coefficients", "all zeros"),
+    ("far plane", "coefficients = [0.0, 0.0, 2.0, 1.0]", "coefficients = [0.0, 0.0, 1e-300, 2.0]",
+     "plane[0].coefficients", "the plane lies 2e+300 m from the origin"),
     ("short plane", "coefficients = [0.0, 0.0, 2.0, 1.0]", "coefficients = [0.0, 0.0, 2.0]",
      "plane[0].coefficients", "expected a list of 4 numbers"),
     ("unknown method", 'methods = ["backup", "penalty"]', 'methods = ["teleport"]', "contact.methods[0]",
@@ -316,8 +323,8 @@ BROKEN_CONTACT = [
      "body[0].position_world", "starts 0.15 m inside plane 'floor'"),
     ("mass with point masses", 'name = "tri"', 'name = "tri"\nmass = 3.0', "body[1].mass",
      "computed from the point masses"),
-    ("collinear point masses", "position = [0.0, 0.0, 1.0]", "position = [2.0, -1.0, 0.0]", "body[1].point_mass",
-     "no solid body"),
+    ("coplanar point masses", "position = [0.0, 0.0, 1.0]", "position = [2.0, -1.0, 0.0]", "body[1].point_mass",
+     "the points lie in one plane"),
     ("core reference without backup", 'methods = ["backup", "penalty"]', 'methods = ["act_after", "penalty"]',
      "scene.reference", "leave out backup"),
     ("points shape without masses", 'shape = "sphere"\nradius = 0.1', 'shape = "points"', "body[0].shape",
