@@ -175,7 +175,15 @@ class _ContactSimulation(Simulation):
             pos[i], ori[i], mom[i], ang[i] = (state.position_world, state.orientation, state.momentum_world,
                                               state.angular_momentum_world)
         vel, omg = velocities(State(pos, ori, mom, ang), self._props)
+        self._report_caps()
         return Trajectory(np.arange(n_steps + 1) * dt, pos, ori, vel, omg)
+
+    def _report_caps(self) -> None:
+        """Say in the detail how often a body hit the per-step event cap and was put at rest (never silently)."""
+        self._base_detail = getattr(self, "_base_detail", self.detail)
+        capped = self.events.kind.count("cap")
+        self.detail = self._base_detail + (f"; {capped} times a body reached the cap of {MAX_EVENTS_PER_STEP} "
+                                           "events in a step and was put at rest" if capped else "")
 
 
 class _Kinematics(KinematicsModel):

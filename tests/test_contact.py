@@ -641,3 +641,14 @@ def test_a_tall_box_landing_while_sliding_fast_tips_over(method):
     # act_after pushes out after each step and keeps a hop of order g dt^2
     settled = 2e-6 if method == "backup" else 2 * G * scene.dts[0] ** 2
     assert trajectory.position_world[-1, 0, 2] == pytest.approx(0.05, abs=settled)
+
+
+def test_hitting_the_event_cap_is_said_in_the_detail():
+    """A ball with k = 0.99 and a rest speed of 1e-12 m/s bounces ever faster toward its accumulation time; the
+    bounces left when a step holds more than the cap of events are cut short by putting the ball at rest, and
+    the case's detail says so (never silently)."""
+    ball = _ball((0.0, 0.0, 1.0))
+    scene = _scene([ball], [Shape("point")], [[Material(0.99)]], dt=0.1, duration=200.0, rest_speed=1e-12,
+                   methods=("backup",))
+    _, simulation = _run(scene, "backup")
+    assert "reached the cap of" in simulation.detail
