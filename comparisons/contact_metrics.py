@@ -163,12 +163,12 @@ def episode_samples(times: np.ndarray, distance: np.ndarray, normal_velocity: np
 
 def impacts(times: np.ndarray, distance: np.ndarray, normal_velocity: np.ndarray, normal_gravity: float,
             min_speed: float = 0.0, spin_speed: np.ndarray | None = None,
-            nearest: np.ndarray | None = None) -> Impacts:
+            episodes: list[tuple[int, int]] | None = None) -> Impacts:
     """The impact episodes of one body against one plane from its samples; episodes whose impact speed is
     below ``min_speed`` [m/s] are settling, not impacts, and are left out. ``spin_speed`` (T,) [m/s]: how
     fast the body's points move by its rotation (|omega| x its extent); an impact where it exceeds
-    ``min_speed`` is marked turning. ``nearest`` (T - 1,) bool: steps in which this plane is the body's
-    nearest (with several planes, a jump within a step belongs to the nearest; None: every step).
+    ``min_speed`` is marked turning. ``episodes``: :func:`episode_samples` of these samples when already
+    found (None: found here, every step counted).
 
     Parameters
     ----------
@@ -184,7 +184,9 @@ def impacts(times: np.ndarray, distance: np.ndarray, normal_velocity: np.ndarray
     g = -normal_gravity  # > 0 when gravity pulls toward the plane
     touch = distance <= TOUCH_GAP
     out: list[tuple[float, float, float, float, bool]] = []
-    for before, after in episode_samples(times, distance, normal_velocity, normal_gravity, nearest):
+    if episodes is None:
+        episodes = episode_samples(times, distance, normal_velocity, normal_gravity)
+    for before, after in episodes:
         if touch[before] or normal_velocity[before] ** 2 + 2 * g * distance[before] < 0:
             continue  # starts in contact (a body placed on the plane): not an impact
         d, v = distance[before], normal_velocity[before]
@@ -259,10 +261,10 @@ def read_contact(scene: DynamicsScene, traj: Trajectory) -> ContactReading:
     for b in range(len(scene.bodies)):
         for p, plane in enumerate(scene.contact.planes):
             normal_velocity, g_n = traj.velocity_world[:, b] @ plane.normal_world, _normal_gravity(scene, p)
+            episodes[b, p] = episode_samples(traj.times, distance[:, b, p], normal_velocity, g_n, closest[:, b] == p)
             found[b, p] = impacts(traj.times, distance[:, b, p], normal_velocity, g_n,
                                   _settling_speed(scene.contact.rest_speed, restitution[b, p]), spin[:, b],
-                                  closest[:, b] == p)
-            episodes[b, p] = episode_samples(traj.times, distance[:, b, p], normal_velocity, g_n, closest[:, b] == p)
+                                  episodes[b, p])
     return ContactReading(found, episodes, distance, highest, _rest_times(scene, traj), kinetic + potential, kinetic)
 
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from simparity.comparisons.contact_metrics import ContactReading, contact_blow_up, read_contact
 from simparity.comparisons.invariants import angular_momentum_world
 from simparity.comparisons.metrics import ENERGY_NEAR_ZERO, energies
 from simparity.core.scene import DynamicsScene
@@ -108,3 +109,14 @@ def divergence(scene: DynamicsScene, traj: Trajectory) -> str:
             return (f"{quantity} of {scene.bodies[b].name} reached {peak[b]:.3g}, more than {DIVERGENCE_MARGIN:g} x "
                     f"the {bound[b]:.3g} its forces allow")
     return _conserved_growth(scene, traj)
+
+
+def blow_up(scene: DynamicsScene, traj: Trajectory) -> tuple[str, ContactReading | None]:
+    """(why ``traj`` counts as diverged, "" if it does not; its contact reading, None without contact or when
+    it blew up before one was taken). Non-finite, :func:`divergence`, or with contact energy gained across
+    one beyond :data:`comparisons.contact_metrics.UNSTABLE_ENERGY_GAIN`."""
+    blown = "non-finite state" if not traj.is_finite() else divergence(scene, traj)
+    if blown or scene.contact is None:
+        return blown, None
+    reading = read_contact(scene, traj)
+    return contact_blow_up(scene, reading), reading

@@ -13,8 +13,8 @@ from typing import Callable
 
 import numpy as np
 
-from simparity.comparisons.contact_metrics import contact_blow_up, contact_metrics, read_contact
-from simparity.comparisons.divergence import divergence
+from simparity.comparisons.contact_metrics import contact_metrics
+from simparity.comparisons.divergence import blow_up
 from simparity.comparisons.ik_runner import run_ik_scene
 from simparity.comparisons.metrics import (
     KINEMATICS_METRICS,
@@ -192,9 +192,7 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
         return _CaseResult(case.rows(metrics, FAILED, error_text(err)))
     values = {"time_per_step": Measured(seconds / n, "s")}
     with np.errstate(all="ignore"):
-        blown = "non-finite state" if not traj.is_finite() else divergence(scene, traj)
-        reading = read_contact(scene, traj) if scene.contact is not None and not blown else None
-        blown = blown or (contact_blow_up(scene, reading) if reading is not None else "")
+        blown, reading = blow_up(scene, traj)
         if blown:
             return _CaseResult(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values),
                                integrates_rotation=sim.integrates_rotation)

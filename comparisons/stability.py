@@ -28,8 +28,7 @@ import math
 
 import numpy as np
 
-from simparity.comparisons.contact_metrics import contact_blow_up, read_contact
-from simparity.comparisons.divergence import divergence
+from simparity.comparisons.divergence import blow_up
 from simparity.comparisons.rows import Measured
 from simparity.core.engine import Engine
 from simparity.core.errors import SimparityError
@@ -59,16 +58,11 @@ def _unstable(scene: DynamicsScene, engine: Engine, integrator: str, dt: float) 
             traj = engine.build_dynamics(scene, integrator, dt).run(max(1, math.ceil(scene.duration / dt)))
     except SimparityError as err:
         return str(err)
-    if not traj.is_finite():
-        return "non-finite state"
     with np.errstate(all="ignore"):
-        blown = divergence(scene, traj)
-        if blown:
-            return blown
-        reading = read_contact(scene, traj)
-    if not any(reading.episodes.values()):
+        blown, reading = blow_up(scene, traj)
+    if reading is not None and not any(reading.episodes.values()):
         raise _NoContact(f"the run at {dt:.3g} s touches no plane")
-    return contact_blow_up(scene, reading)
+    return blown
 
 
 def stable_dt_max(scene: DynamicsScene, engine: Engine, integrator: str) -> Measured:

@@ -20,10 +20,12 @@ kinetic energy.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
 from simparity.core.collision import penalty_force
+from simparity.core.forces import make_wrench
 from simparity.core.rigid_body import MassProperties, State, Wrench
 from simparity.core.rotations import cross
 from simparity.core.scene import AppliedForce, Contact, Forces, Plane
@@ -170,6 +172,11 @@ class Bodies:
     model: ContactModel
     forces: Forces
 
+    @cached_property
+    def external(self) -> Wrench:
+        """The scene's forces on these bodies (:func:`core.forces.make_wrench`), built once per batch."""
+        return make_wrench(self.forces, self.props)
+
     def take(self, idx: np.ndarray) -> "Bodies":
         """The bodies ``idx`` (n,) as a batch of their own (an applied force follows its body)."""
         if len(idx) == len(self.props.mass) and np.all(idx == np.arange(len(idx))):
@@ -201,6 +208,12 @@ def put_state(state: State, idx: np.ndarray, part: State) -> State:
     return State(*arrays)
 
 
+def _touching(distance: np.ndarray, weights: np.ndarray, gap) -> np.ndarray:
+    """(n, V) bool: a body's own points within ``gap`` [m] (scalar or (n,)) of its lowest one."""
+    gap = np.reshape(gap, (-1, 1)) if np.ndim(gap) else gap
+    return (distance <= distance.min(axis=1, keepdims=True) + gap) & (weights > 0.0)
+
+
 def patch_lever(lever: np.ndarray, distance: np.ndarray, speed: np.ndarray, weights: np.ndarray) -> np.ndarray:
     """Where a body touches one plane: the mean lever of its touching points (n, 3) [m].
 
@@ -209,7 +222,7 @@ def patch_lever(lever: np.ndarray, distance: np.ndarray, speed: np.ndarray, weig
     landing flat at the face's centre, so that the impulse has the symmetry of the contact.
     lever (n, V, 3), distance (n, V) [m], speed (n, V) [m/s] (u . N), weights (n, V).
     """
-    touching = (distance <= distance.min(axis=1, keepdims=True) + CONTACT_TOLERANCE) & (weights > 0.0)
+    touching = _touching(distance, weights, CONTACT_TOLERANCE)
     moving_in = touching & (speed < 0.0)
     members = np.where(moving_in.any(axis=1, keepdims=True), moving_in, touching).astype(float)
     return np.einsum("nv,nvi->ni", members, lever) / members.sum(axis=1)[:, None]
@@ -224,7 +237,7 @@ def supported(lever: np.ndarray, distance: np.ndarray, normal: np.ndarray, weigh
     reaches pi (less :data:`SUPPORT_ANGLE_MARGIN`), or when it coincides with one of them.
     lever (n, V, 3) [m], distance (n, V) [m], normal (n, 3), weights (n, V).
     """
-    touching = (distance <= distance.min(axis=1, keepdims=True) + gap[:, None]) & (weights > 0.0)
+    touching = _touching(distance, weights, gap)
     flat = lever - np.sum(lever * normal[:, None, :], axis=-1, keepdims=True) * normal[:, None, :]
     first = cross(normal, np.where(np.abs(normal[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]]))
     first /= np.linalg.norm(first, axis=1, keepdims=True)
@@ -265,7 +278,7 @@ def contact_lever(lever: np.ndarray, distance: np.ndarray, speed: np.ndarray, we
     """
     middle = patch_lever(lever, distance, speed, weights)
     still = np.linalg.norm(omega, axis=1) * np.linalg.norm(lever, axis=-1).max(axis=1) <= rest_speed
-    touching = (distance <= distance.min(axis=1, keepdims=True) + CONTACT_TOLERANCE) & (weights > 0.0)
+    touching = _touching(distance, weights, CONTACT_TOLERANCE)
     face = touching.sum(axis=1) >= FACE_POINTS
     approach = np.maximum(-np.sum(velocity * normal, axis=1), 0.0)
     slip = velocity - np.sum(velocity * normal, axis=1, keepdims=True) * normal
@@ -275,8 +288,7 @@ def contact_lever(lever: np.ndarray, distance: np.ndarray, speed: np.ndarray, we
     ratio = np.where(needed <= friction_static, needed, friction_kinetic)
     height = np.max(np.where(touching, -np.sum(lever * normal[:, None, :], axis=-1), 0.0), axis=1)
     ahead = (ratio * height / np.maximum(slip_speed, np.finfo(float).tiny))[:, None] * slip
-    gap = np.full(len(normal), CONTACT_TOLERANCE)
-    holds = supported(lever - ahead[:, None, :], distance, normal, weights, gap)
+    holds = supported(lever - ahead[:, None, :], distance, normal, weights, np.full(len(normal), CONTACT_TOLERANCE))
     flat = still & face & holds
     return np.where(flat[:, None], 0.0, middle), still & face & ~holds
 

@@ -21,7 +21,6 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.core.contact import CONTACT_TOLERANCE, Bodies, contact_lever, impulse_response, put_state, take_state
-from simparity.core.forces import make_wrench
 from simparity.core.integrators import make_step
 from simparity.core.rigid_body import State, velocities
 from simparity.core.rotations import cross
@@ -91,7 +90,7 @@ class ActAfterStepper:
 
     def __init__(self, bodies: Bodies) -> None:
         self._bodies = bodies
-        self._flight = make_step("rk4", "quaternion", bodies.props, make_wrench(bodies.forces, bodies.props))
+        self._flight = make_step("rk4", "quaternion", bodies.props, bodies.external)
 
     def step(self, t: float, state: State, dt: float) -> State:
         """Advance every body by dt [s] from time t."""

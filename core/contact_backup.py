@@ -42,7 +42,6 @@ from simparity.core.contact import (RESTING_GAP, Bodies, EventLog, contact_lever
                                     take_state)
 from simparity.core.contact_act_after import resolve_after
 from simparity.core.contact_roots import distances, exact_contact, root_contact
-from simparity.core.forces import make_wrench
 from simparity.core.integrators import make_step
 from simparity.core.rigid_body import State, velocities
 from simparity.core.rotations import cross
@@ -68,7 +67,7 @@ class _Flight:
 
     def __init__(self, bodies: Bodies, normal, slide, stuck, mu_k) -> None:
         self.bodies, self.normal, self.slide, self.stuck, self.mu_k = bodies, normal, slide, stuck, mu_k
-        self._external = make_wrench(bodies.forces, bodies.props)
+        self._external = bodies.external
         self._step = make_step("rk4", "quaternion", bodies.props, self.wrench)
 
     def take(self, idx: np.ndarray) -> "_Flight":
@@ -105,7 +104,7 @@ def _support(bodies: Bodies, t: float, state: State, resting: np.ndarray):
     model, mass = bodies.model, bodies.props.mass
     rotation = state.rotation_world
     v, omega = velocities(state, bodies.props, rotation)
-    force, _ = make_wrench(bodies.forces, bodies.props)(t, state.position_world, rotation, v, omega)
+    force, _ = bodies.external(t, state.position_world, rotation, v, omega)
     plane = np.maximum(resting, 0)
     normal = np.where((resting >= 0)[:, None], model.normals[plane], 0.0)
     f_n = np.sum(force * normal, axis=1)
@@ -146,7 +145,7 @@ def _settling_gap(bodies: Bodies, state: State, normal: np.ndarray, dt: float) -
     (:data:`core.contact.RESTING_GAP`)."""
     rotation = state.rotation_world
     v, omega = velocities(state, bodies.props, rotation)
-    force, _ = make_wrench(bodies.forces, bodies.props)(0.0, state.position_world, rotation, v, omega)
+    force, _ = bodies.external(0.0, state.position_world, rotation, v, omega)
     return RESTING_GAP + np.abs(np.sum(force * normal, axis=1)) / bodies.props.mass * dt * dt
 
 
@@ -166,8 +165,7 @@ def _respond(bodies: Bodies, state: State, resting: np.ndarray, dt: float, clock
     normal = model.normals[plane]
     rotation = state.rotation_world
     inertia_inv = bodies.props.inertia_world_inv(rotation)
-    omega = np.einsum("nij,nj->ni", inertia_inv, state.angular_momentum_world)
-    velocity = state.momentum_world / mass[:, None]
+    velocity, omega = velocities(state, bodies.props, rotation)
     k = model.restitution[body, plane]
     approach = np.maximum(-np.sum(velocity * normal, axis=1), 0.0)
     r, tips = contact_lever(lever[body, plane], distance[body, plane], speed[body, plane], model.weights, normal, velocity,

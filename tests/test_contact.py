@@ -49,6 +49,11 @@ ENERGY_RTOL = 1e-12
 TUMBLING_ENERGY_RTOL = 1e-8
 # Penalty friction is regularised below 1e-2 m/s: the stopping distance moves by ~1e-4 relative.
 PENALTY_FRICTION_RTOL = 1e-3
+# Velocities of a few m/s after a handful of exact impulses round at ~1e-15 m/s; 1e-9 leaves margin and still
+# tells any first-order error (g dt ~ 0.1 m/s) apart.
+VELOCITY_ROUNDOFF = 1e-9
+# The expected dampings in N s/m are written by hand to two decimals.
+HAND_DIGITS = 0.01
 
 
 def _ball(position, velocity=(0.0, 0.0, 0.0), mass=1.0, inertia=None, quat=(1.0, 0.0, 0.0, 0.0),
@@ -450,7 +455,7 @@ def test_impulses_never_add_energy():
     np.testing.assert_array_equal(p[~approaching], momentum[~approaching])
     check = frictionless & approaching
     np.testing.assert_allclose(normal_speed(p, l)[check], -k[check] * normal_speed(momentum, angular)[check],
-                               rtol=1e-9, atol=ROUNDOFF)
+                               rtol=EXACT_RTOL, atol=ROUNDOFF)
 
 
 def test_impulse_on_a_particle_is_the_lectures_reflection_plus_coulomb():
@@ -597,7 +602,7 @@ def test_a_box_landing_flat_while_sliding_does_not_spin(method):
     # backup meets the plane at the impact's instant; act_after finds it up to a step late, its normal speed up to
     # g dt larger, so friction takes up to mu (1 + k) g dt more (first order).
     late = 0.0 if method == "backup" else mu * (1 + k) * G * scene.dts[0]
-    np.testing.assert_allclose(trajectory.velocity_world[after, 0, 0][:5], expected, rtol=0, atol=late + 1e-9)
+    np.testing.assert_allclose(trajectory.velocity_world[after, 0, 0][:5], expected, rtol=0, atol=late + VELOCITY_ROUNDOFF)
 
 
 def test_default_penalty_damping_gives_each_pair_its_restitution():
@@ -609,7 +614,7 @@ def test_default_penalty_damping_gives_each_pair_its_restitution():
     scene = _scene([ball], [Shape("point")], [[Material(0.5), Material(0.0), Material(1.0)]], planes=walls,
                    stiffness=1e4, damping=None)
     model = ContactModel.of(scene.contact, np.array([2.0]))
-    np.testing.assert_allclose(model.damping, [[60.94, 282.84, 0.0]], rtol=0, atol=0.01)
+    np.testing.assert_allclose(model.damping, [[60.94, 282.84, 0.0]], rtol=0, atol=HAND_DIGITS)
 
 
 def test_act_after_bounces_a_body_that_starts_on_the_plane_striking_it():
@@ -619,7 +624,7 @@ def test_act_after_bounces_a_body_that_starts_on_the_plane_striking_it():
     point = _ball((0.0, 0.0, 0.0), velocity=(0.0, 0.0, -8.0))
     scene = _scene([point], [Shape("point")], [[Material(k)]], dt=dt, duration=0.1, methods=("act_after",))
     trajectory, _ = _run(scene, "act_after")
-    assert trajectory.velocity_world[1, 0, 2] == pytest.approx(k * (8.0 + G * dt), abs=1e-9)
+    assert trajectory.velocity_world[1, 0, 2] == pytest.approx(k * (8.0 + G * dt), abs=VELOCITY_ROUNDOFF)
 
 
 TIPPED_TOL = 1.0  # [deg] lying on a side: its face flat on the floor up to the settling's rounding

@@ -79,7 +79,7 @@ def test_a_soft_contact_spread_over_samples_is_one_impact():
     velocity = np.where(soft, 0.0, velocity)  # inside the contact: not read (the samples touch the plane)
     found = impacts(times, height, velocity, -G)
     assert len(found.time) == 1
-    assert found.velocity_out[0] / -found.velocity_in[0] == pytest.approx(k, abs=1e-9)
+    assert found.velocity_out[0] / -found.velocity_in[0] == pytest.approx(k, abs=EXACT)
 
 
 def test_contact_metrics_against_the_same_truth_are_zero_and_restitution_matches():

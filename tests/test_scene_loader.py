@@ -203,6 +203,11 @@ def test_every_builtin_scene_loads(name):
     assert scene.name == name
 
 
+HAND_EXACT = 1e-15
+"""[m, kg m^2] Values worked out by hand from numbers with few digits: the loader's arithmetic rounds them at
+~1e-16 relative on entries of order 1."""
+
+
 VALID_CONTACT = """
 [scene]
 name = "bounce"
@@ -274,7 +279,7 @@ def test_contact_scene_loads_planes_materials_and_point_mass_bodies(tmp_path):
     floor, wall = scene.contact.planes
     np.testing.assert_array_equal(floor.normal_world, [0.0, 0.0, 1.0])
     assert floor.offset == 0.5  # 2 z + 1 = 0 is z = -0.5
-    np.testing.assert_allclose(wall.normal_world, [-0.6, 0.8, 0.0], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(wall.normal_world, [-0.6, 0.8, 0.0], rtol=0, atol=HAND_EXACT)
     assert wall.offset == 2.0
     np.testing.assert_array_equal(scene.contact.restitution, [[0.8, 0.3], [0.8, 0.8]])
     np.testing.assert_array_equal(scene.contact.friction_kinetic, [[0.2, 0.2], [0.5, 0.5]])
@@ -284,11 +289,11 @@ def test_contact_scene_loads_planes_materials_and_point_mass_bodies(tmp_path):
     # By hand: M = 5; COM = (1, 2, 1) / 5; r_i = q_i - COM; I = sum m (|r|^2 E - r r^T), e.g.
     # I_xy = -sum m x y = -(0.8 (-0.4) + 2 (-0.2) 0.6 + (-0.2)(-0.4) + (-0.2)(-0.4)) = 0.4.
     assert tri.mass == 5.0
-    np.testing.assert_allclose(tri.position_world, [0.2, 0.4, 1.2], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(tri.position_world, [0.2, 0.4, 1.2], rtol=0, atol=HAND_EXACT)
     hand = np.array([[2.0, 0.4, 0.2], [0.4, 1.6, 0.4], [0.2, 0.4, 2.0]])
-    np.testing.assert_allclose(tri.inertia_body, hand, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(tri.inertia_body, hand, rtol=0, atol=HAND_EXACT)
     assert scene.contact.shapes[1].kind == "points"
-    np.testing.assert_allclose(scene.contact.shapes[1].points_body[0], [0.8, -0.4, -0.2], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(scene.contact.shapes[1].points_body[0], [0.8, -0.4, -0.2], rtol=0, atol=HAND_EXACT)
     assert scene.contact.shapes[0].kind == "sphere" and scene.contact.shapes[0].radius == 0.1
 
 
