@@ -13,6 +13,7 @@ import argparse
 import math
 import os
 import sys
+import time
 from pathlib import Path
 
 from simparity.comparisons import library
@@ -27,6 +28,7 @@ from simparity.comparisons.progress import ProgressBar
 from simparity.comparisons.runner import DEFAULT_REPEATS, count_cases
 from simparity.comparisons.scene_limits import DEFAULT_LIMITS, Limits
 from simparity.comparisons.store import DEFAULT_OUT_ROOT, RunWriter, default_out_dir
+from simparity.comparisons.timing import resource_line
 from simparity.comparisons.tolerances import DEFAULT_TOLERANCES, load_tolerances
 from simparity.core.errors import HistoryError, SimparityError, UsageError, one_line
 from simparity.core.ranges import RANGES
@@ -154,6 +156,16 @@ def build_parser() -> argparse.ArgumentParser:
         "built from point masses), forces, planes (normalised), shapes and every body-plane material.")
     show.add_argument("scene", metavar="SCENE|FILE")
 
+    bench = sub.add_parser(
+        "bench", help="measure speed with accuracy, core against the engines; write BENCHMARKS.md",
+        description="Time rigid-body stepping (B = 1, 100, 10,000 bodies), FK + Jacobian and IK (the bench suite's "
+        "arms, 10,000 targets each) for core and every engine in one run, each time with the error it reaches; "
+        "write BENCHMARKS.md and benchmarks.csv with the ratios and the targets met or missed. About 5 minutes "
+        "(--quick: about 1).")
+    bench.add_argument("--out", type=Path, default=Path("."), metavar="DIR",
+                       help="folder for BENCHMARKS.md and benchmarks.csv (default: the current folder)")
+    bench.add_argument("--quick", action="store_true", help="B = 1 and 100 only, 300 IK targets per arm")
+
     report = sub.add_parser(
         "report", help="re-render report.md, report.html and figures/ of a stored run",
         description="Re-render report.md, report.html and the figures (SVG, PNG) from a stored run's results.csv, "
@@ -203,6 +215,14 @@ def _cost(scenes) -> str:
 
 
 def cmd_run(args, out) -> int:
+    start = time.perf_counter()
+    try:
+        return _run(args, out)
+    finally:
+        print(resource_line(time.perf_counter() - start), file=out, flush=True)
+
+
+def _run(args, out) -> int:
     repeats = (0 if args.quick else DEFAULT_REPEATS) if args.repeats is None else args.repeats
     if repeats < 0 or repeats > 100:
         raise SimparityError(f"--repeats {args.repeats}: out of range (allowed: 0 to 100; 0 times one cold call)")
@@ -350,13 +370,24 @@ def cmd_show(args, out) -> int:
     return EXIT_OK
 
 
+def cmd_bench(args, out) -> int:
+    from simparity.comparisons.bench import run_bench  # imports every engine: only when asked
+
+    def say(line: str) -> None:
+        print(line, file=out, flush=True)
+
+    path = run_bench(args.out, args.quick, " ".join(["simparity"] + sys.argv[1:]), say)
+    say(f"wrote {path} and {path.with_name('benchmarks.csv')}")
+    return EXIT_OK
+
+
 def cmd_report(args, out) -> int:
     _write_report(args.run_dir, out, load_tolerances(args.tolerances) if args.tolerances else None)
     return EXIT_OK
 
 
 _COMMANDS = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "history": cmd_history, "export": cmd_export,
-             "show": cmd_show, "report": cmd_report}
+             "show": cmd_show, "report": cmd_report, "bench": cmd_bench}
 
 
 def main(argv: list[str] | None = None, out=None) -> int:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import resource
+import sys
 import time
 from typing import Callable, TypeVar
 
@@ -35,3 +37,17 @@ def best_of(fn: Callable[[], T], repeats: int) -> tuple[float, T]:
         if spent >= REPEAT_BUDGET_SECONDS:
             break
     return best, result
+
+
+def peak_memory_bytes() -> tuple[int, int]:
+    """(peak resident memory of this process, of its largest finished child process) [bytes]."""
+    scale = 1 if sys.platform == "darwin" else 1024  # ru_maxrss is in bytes on macOS, KiB on Linux
+    return (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale,
+            resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * scale)
+
+
+def resource_line(seconds: float) -> str:
+    """What a run cost: its wall time and the peak memory of the process and of its largest worker."""
+    own, worker = peak_memory_bytes()
+    return (f"wall time {seconds:.1f} s; peak memory {own / 2**20:,.0f} MiB"
+            + (f" (largest worker process {worker / 2**20:,.0f} MiB)" if worker else ""))

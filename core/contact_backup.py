@@ -42,7 +42,7 @@ from simparity.core.contact import (RESTING_GAP, Bodies, EventLog, contact_lever
                                     take_state)
 from simparity.core.contact_act_after import resolve_after
 from simparity.core.contact_roots import distances, exact_contact, root_contact
-from simparity.core.integrators import make_step
+from simparity.core.quaternion_integrators import make_packed_step, pack, unpack
 from simparity.core.rigid_body import State, velocities
 from simparity.core.rotations import cross
 
@@ -68,7 +68,7 @@ class _Flight:
     def __init__(self, bodies: Bodies, normal, slide, stuck, mu_k) -> None:
         self.bodies, self.normal, self.slide, self.stuck, self.mu_k = bodies, normal, slide, stuck, mu_k
         self._external = bodies.external
-        self._step = make_step("rk4", "quaternion", bodies.props, self.wrench)
+        self._step = make_packed_step("rk4", bodies.props, self.wrench)
 
     def take(self, idx: np.ndarray) -> "_Flight":
         """The flight of the bodies ``idx`` (itself if that is all of them)."""
@@ -89,7 +89,7 @@ class _Flight:
 
     def __call__(self, t: float, state: State, duration: np.ndarray) -> State:
         """Every body flown for its own duration (n,) [s] (0: unchanged)."""
-        new = self._step(t, state, duration[:, None])
+        new = unpack(self._step(t, pack(state), duration))
         moved = duration[:, None] > 0.0
         return State(*(np.where(moved, a, b) for a, b in zip(
             (new.position_world, new.orientation, new.momentum_world, new.angular_momentum_world),

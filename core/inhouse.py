@@ -8,6 +8,7 @@ from dataclasses import asdict, replace
 import numpy as np
 
 from simparity.core import point_mass
+from simparity.core.allocator import keep_freed_memory
 from simparity.core.contact import (
     PENALTY_SCHEMES,
     Bodies,
@@ -22,8 +23,10 @@ from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, 
 from simparity.core.forces import make_wrench
 from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik
 from simparity.core.ik.problem import IKTolerances
+from simparity.core.ik.restarts import Restarts, solve_ik_with_restarts
 from simparity.core.ik.result import IKResult
 from simparity.core.integrators import ORDER, ORIENTATION_UPDATES, SCHEMES, make_step
+from simparity.core.quaternion_integrators import PackedBodies, make_packed_step, pack
 from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.rigid_body import MassProperties, State, initial_state, velocities
 from simparity.core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
@@ -68,16 +71,36 @@ class _RigidBodySimulation(Simulation):
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
         scheme, orientation = parse_integrator(integrator)
         self._props = MassProperties.of(scene.bodies)
-        self._state0 = initial_state(scene.bodies, self._props, quaternion=orientation == "quaternion")
-        self._step = make_step(scheme, orientation, self._props, make_wrench(scene.forces, self._props))
+        wrench = make_wrench(scene.forces, self._props)
+        # Quaternion updates and the engines' scheme step the packed layout (the speed path).
+        self._packed = orientation == "quaternion" or scheme in _SINGLE_ORIENTATION_SCHEMES
+        self._state0 = initial_state(scene.bodies, self._props, quaternion=self._packed)
+        if self._packed:
+            self._bodies = PackedBodies(self._props)
+            self._step = make_packed_step(scheme, self._props, wrench)
+        else:
+            self._step = make_step(scheme, orientation, self._props, wrench)
         self._dt = dt
         self.detail = f"in-house {scheme}, orientation update: {orientation}"
 
     def run(self, n_steps: int) -> Trajectory:
+        times = np.arange(n_steps + 1) * self._dt
+        return Trajectory(times, *(self._run_packed(n_steps) if self._packed else self._run_matrix(n_steps)))
+
+    def _run_packed(self, n_steps: int) -> tuple[np.ndarray, ...]:
+        """(x, q, v, omega) at every step, each (T, B, k), from the packed state."""
+        state, dt = pack(self._state0), self._dt
+        record = np.empty((n_steps + 1,) + state.shape)
+        record[0] = state
+        for i in range(1, n_steps + 1):
+            state = record[i] = self._step((i - 1) * dt, state, dt)
+        return self._bodies.samples(record.transpose(1, 0, 2))
+
+    def _run_matrix(self, n_steps: int) -> tuple[np.ndarray, ...]:
+        """(x, q, v, omega) at every step, each (T, B, k), from rotation-matrix states."""
         state, dt = self._state0, self._dt
-        o = state.orientation
         pos, mom, ang = (np.empty((n_steps + 1,) + state.position_world.shape) for _ in range(3))
-        ori = np.empty((n_steps + 1,) + o.shape)
+        ori = np.empty((n_steps + 1,) + state.orientation.shape)
         for i in range(n_steps + 1):
             if i:
                 state = self._step((i - 1) * dt, state, dt)
@@ -85,8 +108,7 @@ class _RigidBodySimulation(Simulation):
                                               state.angular_momentum_world)
         # Velocities and quaternions of all samples at once, broadcast over (T, B).
         vel, omg = velocities(State(pos, ori, mom, ang), self._props)
-        quat = ori if o.shape[-1] == 4 else matrix_to_quat_wxyz(ori)
-        return Trajectory(np.arange(n_steps + 1) * dt, pos, quat, vel, omg)
+        return pos, matrix_to_quat_wxyz(ori), vel, omg
 
 
 class _ParticleSimulation(Simulation):
@@ -201,17 +223,27 @@ class _Kinematics(KinematicsModel):
 NULLSPACE = "damped_least_squares+nullspace"
 """Damped least squares plus the lecture's control expression pulling toward the start pose."""
 
+RESTARTS = "damped_least_squares+restarts"
+"""Damped least squares with TRAC-IK's restarts from seeded random configurations (:mod:`core.ik.restarts`)."""
+
 
 class _InHouseIK(IKModel):
     def __init__(self, chain: Chain, solver: str, options: IKOptions) -> None:
         self._chain, self._options = chain, options
         self._method = solver.partition("+")[0]
         self._nullspace = solver == NULLSPACE
+        self._restarts = Restarts() if solver == RESTARTS else None
+        restarts = self._restarts
         self.detail = (f"in-house {self._method} (batched), max step {options.max_step:g} rad, hard joint limits"
-                       + ("; null-space term H = sum a (q - q_start)^2 toward the start pose" if self._nullspace else ""))
+                       + ("; null-space term H = sum a (q - q_start)^2 toward the start pose" if self._nullspace else "")
+                       + (f"; failed targets restarted from up to {restarts.attempts} seeded random configurations "
+                          f"({restarts.starts_per_round} per round, seed {restarts.seed})" if restarts else ""))
 
     def solve(self, target_position_world, target_rotation_world, q_start) -> IKResult:
         options = replace(self._options, rest_pose=np.asarray(q_start, dtype=float)) if self._nullspace else self._options
+        if self._restarts is not None:
+            return solve_ik_with_restarts(self._chain, target_position_world, target_rotation_world, q_start,
+                                          self._method, options, self._restarts)
         return solve_ik(self._chain, target_position_world, target_rotation_world, q_start, self._method, options)
 
 
@@ -219,6 +251,9 @@ class InHouseEngine(Engine):
     """The lecture's methods as implemented in ``core``."""
 
     name = "core"
+
+    def __init__(self) -> None:
+        keep_freed_memory()  # batched temporaries: see core/allocator.py
 
     def version(self) -> str:
         return f"numpy {np.__version__}, python {platform.python_version()}"
@@ -284,7 +319,7 @@ class InHouseEngine(Engine):
         return _Kinematics(chain)
 
     def ik_solvers(self) -> tuple[str, ...]:
-        return METHODS + (NULLSPACE,)
+        return METHODS + (NULLSPACE, RESTARTS)
 
     def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
         named = super().supports_ik(chain, solver, position_only)

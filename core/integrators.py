@@ -22,6 +22,9 @@ expmap
     Lie-group update R <- exp(u) R. Runge-Kutta stages use the Runge-Kutta-Munthe-Kaas
     construction (stage increments corrected by the inverse of dexp), which keeps the
     scheme's order.
+
+The quaternion updates and engine_euler are implemented on a component-major packed state in
+:mod:`core.quaternion_integrators` (the speed path); the matrix and expmap updates here.
 """
 
 from __future__ import annotations
@@ -31,29 +34,18 @@ from typing import Callable
 
 import numpy as np
 
+from simparity.core.quaternion_integrators import TABLEAUX, state_step
 from simparity.core.rigid_body import MassProperties, State, Wrench, velocities
 from simparity.core.rotations import (
     cross,
-    matrix_to_quat_wxyz,
     orthonormalize,
-    quat_wxyz_from_rotvec,
-    quat_wxyz_multiply,
-    quat_wxyz_normalize,
     skew,
     so3_exp,
 )
 
 ORIENTATION_UPDATES = ("quaternion", "matrix", "expmap")
 
-# Butcher tableaux (a, b, c) of the explicit Runge-Kutta schemes.
-_TABLEAUX: dict[str, tuple[list[list[float]], list[float], list[float]]] = {
-    "explicit_euler": ([[]], [1.0], [0.0]),
-    "average_velocity": ([[], [1.0]], [0.5, 0.5], [0.0, 1.0]),
-    "midpoint": ([[], [0.5]], [0.0, 1.0], [0.0, 0.5]),
-    "rk4": ([[], [0.5], [0.0, 0.5], [0.0, 0.0, 1.0]], [1 / 6, 1 / 3, 1 / 3, 1 / 6], [0.0, 0.5, 0.5, 1.0]),
-}
-
-SCHEMES = tuple(_TABLEAUX) + ("semi_implicit_euler", "engine_euler")
+SCHEMES = tuple(TABLEAUX) + ("semi_implicit_euler", "engine_euler")
 
 ORDER = {
     "explicit_euler": 1,
@@ -89,25 +81,19 @@ def dexpinv_so3(u: np.ndarray, omega: np.ndarray) -> np.ndarray:
 
 
 def _project(state: State) -> State:
-    """Renormalise the orientation after an additive update."""
-    o = state.orientation
-    o = quat_wxyz_normalize(o) if o.shape[-1] == 4 else orthonormalize(o)
-    return State(state.position_world, o, state.momentum_world, state.angular_momentum_world)
+    """Re-orthonormalise the rotation matrix after an additive update."""
+    return State(state.position_world, orthonormalize(state.orientation), state.momentum_world,
+                 state.angular_momentum_world)
 
 
-def _orientation_rate(orientation: np.ndarray, omega: np.ndarray) -> np.ndarray:
-    """d/dt of R (omega* R) or of q (1/2 (0, omega) q). World omega (B, 3)."""
-    if orientation.shape[-1] == 4:
-        zero = np.zeros(omega.shape[:-1] + (1,))
-        return 0.5 * quat_wxyz_multiply(np.concatenate([zero, omega], axis=-1), orientation)
-    return skew(omega) @ orientation
+def _orientation_rate(rotation: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """dR/dt = omega* R. World omega (B, 3)."""
+    return skew(omega) @ rotation
 
 
-def _rotate(orientation: np.ndarray, rotvec_world: np.ndarray) -> np.ndarray:
-    """exp(rotvec) applied on the left (a world-frame increment) to R (B, 3, 3) or q (B, 4)."""
-    if orientation.shape[-1] == 4:
-        return quat_wxyz_multiply(quat_wxyz_from_rotvec(rotvec_world), orientation)
-    return so3_exp(rotvec_world) @ orientation
+def _rotate(rotation: np.ndarray, rotvec_world: np.ndarray) -> np.ndarray:
+    """exp(rotvec) applied on the left (a world-frame increment) to R (B, 3, 3)."""
+    return so3_exp(rotvec_world) @ rotation
 
 
 @dataclass(frozen=True)
@@ -129,7 +115,7 @@ def runge_kutta_step(
     scheme: str, orientation_update: str, props: MassProperties, wrench: Wrench
 ) -> Step:
     """One step of an explicit Runge-Kutta scheme. Returns ``step(t, state, dt) -> state``."""
-    a, b, c = _TABLEAUX[scheme]
+    a, b, c = TABLEAUX[scheme]
     lie = orientation_update == "expmap"
 
     def step(t: float, s: State, dt: float) -> State:
@@ -191,33 +177,16 @@ def semi_implicit_euler_step(orientation_update: str, props: MassProperties, wre
     return step
 
 
-def engine_euler_step(props: MassProperties, wrench: Wrench) -> Step:
-    """The engines' first-order scheme in body-frame angular velocity (see module docstring)."""
-
-    def step(t: float, s: State, dt: float) -> State:
-        rotation = s.rotation_world
-        rt = np.swapaxes(rotation, -1, -2)
-        v, omega = velocities(s, props, rotation)
-        force, torque = wrench(t, s.position_world, rotation, v, omega)
-        omega_body = np.einsum("bij,bj->bi", rt, omega)
-        torque_body = np.einsum("bij,bj->bi", rt, torque)
-        gyro = cross(omega_body, np.einsum("bij,bj->bi", props.inertia_body, omega_body))
-        omega_body = omega_body + dt * np.einsum("bij,bj->bi", props.inertia_body_inv, torque_body - gyro)
-        v = v + dt * force / props.mass[:, None]
-        new_rotation = rotation @ so3_exp(dt * omega_body)
-        angular_momentum = np.einsum("bij,bj->bi", new_rotation @ props.inertia_body, omega_body)
-        orientation = matrix_to_quat_wxyz(new_rotation) if s.orientation.shape[-1] == 4 else new_rotation
-        return State(s.position_world + dt * v, orientation, props.mass[:, None] * v, angular_momentum)
-
-    return step
-
-
 def make_step(scheme: str, orientation_update: str, props: MassProperties, wrench: Wrench) -> Step:
-    """The step function of ``scheme`` with ``orientation_update`` (see module docstring)."""
-    if scheme in _TABLEAUX:
+    """The step function of ``scheme`` with ``orientation_update`` (see module docstring).
+
+    Quaternion updates and ``engine_euler`` run on the packed layout of
+    :mod:`core.quaternion_integrators`; matrix and exponential-map updates here.
+    """
+    if scheme not in SCHEMES:
+        raise ValueError(f"unknown scheme '{scheme}' (known: {', '.join(SCHEMES)})")
+    if orientation_update == "quaternion" or scheme == "engine_euler":
+        return state_step(scheme, props, wrench)
+    if scheme in TABLEAUX:
         return runge_kutta_step(scheme, orientation_update, props, wrench)
-    if scheme == "semi_implicit_euler":
-        return semi_implicit_euler_step(orientation_update, props, wrench)
-    if scheme == "engine_euler":
-        return engine_euler_step(props, wrench)
-    raise ValueError(f"unknown scheme '{scheme}' (known: {', '.join(SCHEMES)})")
+    return semi_implicit_euler_step(orientation_update, props, wrench)

@@ -75,6 +75,15 @@ def jacobian_world(chain: Chain, q: np.ndarray) -> np.ndarray:
     world axes. (B, n) -> (B, 6, n), linear rows first.
     """
     positions, _, axes = joint_frames(chain, q)
+    return jacobian_of_frames(chain, positions, axes)
+
+
+def jacobian_of_frames(chain: Chain, positions: np.ndarray, axes_world: np.ndarray) -> np.ndarray:
+    """:func:`jacobian_world` from the frames :func:`joint_frames` returned (no second FK pass).
+
+    positions (B, n + 1, 3), axes_world (B, n, 3) -> (B, 6, n).
+    """
+    axes = axes_world
     end = positions[:, -1:, :]
     revolute = np.array([j.type == "revolute" for j in chain.joints])[None, :, None]
     linear = np.where(revolute, np.cross(axes, end - positions[:, :-1, :]), axes)

@@ -572,10 +572,11 @@ class KinematicsScene:
         return sample_configurations(self.chain, self.n_configurations, self.seed)
 
 
-SUITES = ("default", "hard", "contact")
+SUITES = ("default", "hard", "contact", "bench")
 """Named groups of built-in scenes (``simparity run --suite``): ``default`` is what ``simparity
 run`` runs; ``hard`` gathers the numerical-stability cases, each with the verdict it must earn
-in the shipped tolerances; ``contact`` every scene with planes. A scene may be in several."""
+in the shipped tolerances; ``contact`` every scene with planes; ``bench`` the real arms whose IK
+``simparity bench`` times (10,000 targets each). A scene may be in several."""
 
 HARD_TARGETS = ("stretched", "beyond_reach", "at_base", "near_limits", "beyond_limits", "orientation_in_place",
                 "wrist_flip")
@@ -635,8 +636,11 @@ class IKScene:
         return sample_configurations(self.chain, self.n_targets, self.seed)
 
 
-def sample_configurations(chain: Chain, count: int, seed: int) -> np.ndarray:
-    """(count, n) uniform joint values within the limits; [-pi, pi] rad or [-1, 1] m where unlimited."""
+def sample_configurations(chain: Chain, count: int, seed: int | np.random.Generator) -> np.ndarray:
+    """(count, n) uniform joint values within the limits; [-pi, pi] rad or [-1, 1] m where unlimited.
+
+    ``seed`` is a seed or a generator to draw from.
+    """
     rng = np.random.default_rng(seed)
     default = np.array([np.pi if j.type == "revolute" else 1.0 for j in chain.joints])
     lo = np.where(np.isfinite(chain.lower), chain.lower, -default)

@@ -44,6 +44,8 @@ Conversions (each pinned by a test in ``tests/test_mujoco_adapter.py``)
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import mujoco
 import numpy as np
 from mujoco import rollout
@@ -351,3 +353,51 @@ class MujocoEngine(Engine):
         if scene.contact is not None:
             extra += f"<!-- {contact_detail(scene, dt)} -->\n"
         return dynamics_mjcf(scene, integrator, dt) + velocities + extra
+
+
+class BatchRollout:
+    """B identical free bodies as B rollouts of one single-body model, stepped by ``mujoco.rollout``'s batch
+    API on ``nthread`` threads: MuJoCo's fastest way through a batch (a benchmark's workload, not a scene
+    engine). The bodies must share mass, inertia and forces; each rollout starts from its body's state,
+    converted as in the scene adapter (angular velocity to body axes)."""
+
+    def __init__(self, scene: DynamicsScene, integrator: str, dt: float, nthread: int) -> None:
+        first = scene.bodies[0]
+        if any(b.mass != first.mass or not np.array_equal(b.inertia_body, first.inertia_body) for b in scene.bodies):
+            raise ValueError("a batch rollout needs bodies of one mass and inertia")
+        single = _Simulation(replace(scene, bodies=(first,), forces=_first_body_forces(scene.forces)), integrator, dt)
+        if scene.forces.applied or single._stepwise or np.any(single._xfrc):
+            raise ValueError("a batch rollout steps without per-step forces (no applied forces, wind or "
+                             "quadratic drag)")
+        self._single, self._nthread = single, nthread
+        qpos_at, nq = single._qpos_at, single.model.nq
+        self._states0 = np.repeat(single._state0[None], len(scene.bodies), axis=0)
+        for k, body in enumerate(scene.bodies):
+            self._states0[k, qpos_at:qpos_at + 3] = body.position_world
+            self._states0[k, qpos_at + 3:qpos_at + 7] = body.quat_wxyz
+            self._states0[k, qpos_at + nq:qpos_at + nq + 3] = body.velocity_world
+            self._states0[k, qpos_at + nq + 3:qpos_at + nq + 6] = (quat_wxyz_to_matrix(body.quat_wxyz).T
+                                                                    @ body.angular_velocity_world)
+        self._datas = [mujoco.MjData(single.model) for _ in range(nthread)]
+        self.detail = f"{single.detail}; {len(scene.bodies)} rollouts of a single-body model on {nthread} threads"
+
+    def run(self, n_steps: int) -> Trajectory:
+        """The B bodies' trajectory, (n_steps + 1, B, k) arrays like a scene adapter's."""
+        m = self._single.model
+        with rollout.Rollout(nthread=self._nthread) as runner:
+            stepped, _ = runner.rollout([m] * len(self._states0), self._datas, self._states0, nstep=n_steps)
+        states = np.concatenate([self._states0[:, None], stepped], axis=1).transpose(1, 0, 2)  # (T, B, nstate)
+        at, nq = self._single._qpos_at, m.nq
+        qpos, qvel = states[..., at:at + nq], states[..., at + nq:at + nq + m.nv]
+        omega_world = np.einsum("tbij,tbj->tbi", quat_wxyz_to_matrix(qpos[..., 3:]), qvel[..., 3:])
+        return Trajectory(np.arange(n_steps + 1) * self._single._dt, qpos[..., :3], qpos[..., 3:], qvel[..., :3],
+                          omega_world)
+
+
+def _first_body_forces(forces: Forces) -> Forces:
+    """The forces of body 0 alone (per-body arrays cut to their first entry)."""
+    def first(values):
+        return None if values is None else values[:1]
+    return replace(forces, linear_drag=first(forces.linear_drag), quadratic_drag=first(forces.quadratic_drag),
+                   angular_linear_drag=first(forces.angular_linear_drag),
+                   angular_quadratic_drag=first(forces.angular_quadratic_drag), applied=())

@@ -314,7 +314,7 @@ class _Builder:
                           f"{_OVERHEAD_MARK} on core's time per step: the scene has fewer than "
                           f"{summary.OVERHEAD_DOMINATED_BODIES} bodies, so the time is mostly NumPy's per-call "
                           "overhead, not arithmetic; per body it falls tenfold and more with 100 bodies in one batch "
-                          "(`python benchmarks/batch_speed.py`).")]
+                          "(`simparity bench`, BENCHMARKS.md).")]
         if ik_rows:
             blocks += [Heading(3, "Which IK solver?"),
                        Paragraph(f"Best solve rate (the faster on a tie) and the fastest solver at ≥ "

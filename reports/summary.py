@@ -29,8 +29,8 @@ scheme that can blow up."""
 
 OVERHEAD_DOMINATED_BODIES = 100
 """Below this many bodies, core's time per step is mostly NumPy's per-call overhead, not arithmetic:
-``benchmarks/batch_speed.py`` measured core's first-order step at 305, 39 and 3 us per body-step for
-1, 10 and 100 bodies (2026-11-23, 2 cores), so the cost per body keeps falling tenfold up to 100."""
+``simparity bench`` measured core's rk4 step at 173, 2.1 and 0.3 us per body-step for 1, 100 and
+10,000 bodies (2026-11-23, 2 cores; BENCHMARKS.md), so the cost per body falls a hundredfold up to 100."""
 
 
 def dynamics_cases(rows: pd.DataFrame, headline: str) -> pd.DataFrame:

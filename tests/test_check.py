@@ -11,7 +11,7 @@ from simparity.comparisons.engines import make_engine
 from simparity.comparisons.profiles import quick
 from simparity.comparisons.runner import run_scene
 from simparity.comparisons.tolerances import load_tolerances
-from simparity.core import integrators
+from simparity.core import quaternion_integrators
 from simparity.core.results import COLUMNS, ResultRow
 from tests.helpers import builtin
 
@@ -89,7 +89,7 @@ def test_a_degraded_rk4_fails_the_shipped_tolerances(monkeypatch):
     bounds = load_tolerances()
     good = check_table(_table(run_scene(scene, [make_engine("core")], make_engine, repeats=0)), bounds)
     assert good.passed, [v.line() for v in good.violations]
-    a, b, c = integrators._TABLEAUX["rk4"]
-    monkeypatch.setitem(integrators._TABLEAUX, "rk4", (a, [1 / 6, 1 / 6, 1 / 2, 1 / 6], c))
+    a, b, c = quaternion_integrators.TABLEAUX["rk4"]
+    monkeypatch.setitem(quaternion_integrators.TABLEAUX, "rk4", (a, [1 / 6, 1 / 6, 1 / 2, 1 / 6], c))
     bad = check_table(_table(run_scene(scene, [make_engine("core")], make_engine, repeats=0)), bounds)
     assert not bad.passed and any(v.metric == "order_orientation" for v in bad.violations)

@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 
 import pandas as pd
+import numpy as np
 import pytest
 
 from simparity.comparisons import library
@@ -34,10 +35,21 @@ def test_default_suite_is_every_scene_marked_default_and_hard_is_its_own():
     default = {s.name for s in library.suite("default")}
     hard = {s.name for s in library.suite("hard")}
     contact = {s.name for s in library.suite("contact")}
+    bench = {s.name for s in library.suite("bench")}
     assert "lecture-projectile" in default and "lecture-projectile" not in hard
     assert "hard-stiff-drag" in hard and "hard-stiff-drag" not in default
     assert "fast-spinner" in default & hard
-    assert default | hard | contact == set(library.builtin_paths())
+    assert default | hard | contact | bench == set(library.builtin_paths())
+
+
+def test_the_bench_suite_is_the_three_arms_with_10000_targets_each():
+    """Issue #11: the arms `simparity bench` times, TRAC-IK protocol (10,000 targets from mid-range, 1e-6)."""
+    bench = library.suite("bench")
+    assert sorted(s.name for s in bench) == ["bench-iiwa-ik", "bench-panda-ik", "bench-ur5-ik"]
+    for scene in bench:
+        assert scene.n_targets == 10_000 and scene.position_tolerance == scene.orientation_tolerance == 1e-6
+        mid = np.where(np.isfinite(scene.chain.lower + scene.chain.upper), (scene.chain.lower + scene.chain.upper) / 2, 0)
+        np.testing.assert_array_equal(scene.q_start, mid)
 
 
 def test_the_contact_suite_is_every_scene_with_planes():

@@ -55,7 +55,7 @@ from simparity.core.ik.problem import IKTolerances, check_inputs
 from simparity.core.ik.nullspace import limit_penalty_gradient, nullspace_term, penalty_gradient
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.ik.result import IKResult
-from simparity.core.kinematics import jacobian_world, joint_frames
+from simparity.core.kinematics import jacobian_of_frames, joint_frames
 from simparity.core.rotations import so3_log
 from simparity.core.scene import Chain
 
@@ -194,8 +194,10 @@ def solve_ik(
         if idx.size == 0:
             break
         qa = q[idx]
-        err, pos_res, rot_res, end_world = _error(
-            chain, qa, target_position[idx], None if target_rotation is None else target_rotation[idx])
+        positions, rotations, axes = joint_frames(chain, qa)  # one FK pass gives the error and the Jacobian
+        end_world = positions[:, -1]
+        err, pos_res, rot_res = _error(end_world, rotations[:, -1], target_position[idx],
+                                       None if target_rotation is None else target_rotation[idx])
         merit = np.linalg.norm(err, axis=1)
         better = merit < best_merit[idx]
         since_best[idx] = np.where(merit < best_merit[idx] * (1 - options.stall_ratio), 0, since_best[idx] + 1)
@@ -205,17 +207,24 @@ def solve_ik(
         best_merit[idx[better]] = merit[better]
         reason[idx[solved]] = ""
 
-        jac = jacobian_world(chain, qa)[:, :rows]
+        jac = jacobian_of_frames(chain, positions, axes)[:, :rows]
         dq, locked = _update(method, jac, err, qa, lower, upper, revolute, options)
-        cause = _classify(jac, locked, end_world, target_position[idx], center, beyond_reach[idx], options)
+        # Only a target that has not progressed for stall_window iterations can stop unsolved: only those are
+        # classified (the singular values cost more than the rest of the iteration).
+        cause = np.full(len(idx), "iteration_cap", dtype=object)
+        due = np.flatnonzero((since_best[idx] >= options.stall_window) & ~solved)
+        if due.size:
+            cause[due] = _classify(jac[due], locked[due], end_world[due], target_position[idx[due]], center,
+                                   beyond_reach[idx[due]], options)
         # A stalled iterate that oscillates about a singular best configuration (the
         # pseudo-inverse at a stretched arm) is judged at that configuration, which it returns.
-        waiting = (since_best[idx] >= options.stall_window) & (cause == "iteration_cap") & ~solved
-        if np.any(waiting):
+        waiting = due[cause[due] == "iteration_cap"]
+        if waiting.size:
             w = idx[waiting]
-            best_positions = joint_frames(chain, best_q[w])[0]
-            cause[waiting] = _classify(jacobian_world(chain, best_q[w])[:, :rows], locked[waiting],
-                                       best_positions[:, -1], target_position[w], center, beyond_reach[w], options)
+            best_positions, _, best_axes = joint_frames(chain, best_q[w])
+            cause[waiting] = _classify(jacobian_of_frames(chain, best_positions, best_axes)[:, :rows],
+                                       locked[waiting], best_positions[:, -1], target_position[w], center,
+                                       beyond_reach[w], options)
         stalled = (since_best[idx] >= options.stall_window) & (cause != "iteration_cap") & ~solved
         escape = stalled & (cause == "limit_blocked") & np.any(locked & crossable, axis=1) & (crossings_left[idx] > 0)
         stalled &= ~escape
@@ -234,43 +243,55 @@ def solve_ik(
         iterations[idx[step | escape]] += 1
         active[idx[~(step | escape)]] = False
 
-    _, pos_res, rot_res, _ = _error(chain, best_q, target_position, target_rotation)
+    positions, rotations, _ = joint_frames(chain, best_q)
+    _, pos_res, rot_res = _error(positions[:, -1], rotations[:, -1], target_position, target_rotation)
     violation = np.max(np.maximum(np.maximum(lower - best_q, best_q - upper), 0.0), axis=1, initial=0.0)
     return IKResult(q=best_q, success=reason == "", iterations=iterations, position_residual=pos_res,
                     orientation_residual=rot_res, limit_violation=violation, reason=reason.astype(str))
 
 
-def _error(chain, q, target_position, target_rotation):
-    """Task error (B, m), position and orientation residuals (B,), end-effector position (B, 3)."""
-    positions, rotations, _ = joint_frames(chain, q)
-    end = positions[:, -1]
-    pos_err = target_position - end
+def _error(end_world, end_rotation, target_position, target_rotation):
+    """Task error (B, m) and the position and orientation residuals (B,) of the end effector's pose."""
+    pos_err = target_position - end_world
     pos_res = np.linalg.norm(pos_err, axis=1)
     if target_rotation is None:
-        return pos_err, pos_res, np.zeros(len(q)), end
-    rot_err = so3_log(target_rotation @ np.swapaxes(rotations[:, -1], 1, 2))
-    return np.concatenate([pos_err, rot_err], axis=1), pos_res, np.linalg.norm(rot_err, axis=1), end
+        return pos_err, pos_res, np.zeros(len(end_world))
+    rot_err = so3_log(target_rotation @ np.swapaxes(end_rotation, 1, 2))
+    return np.concatenate([pos_err, rot_err], axis=1), pos_res, np.linalg.norm(rot_err, axis=1)
 
 
 def _update(method, jac, err, q, lower, upper, revolute, options):
-    """Joint update (B, n), scaled to ``max_step``, and the joints locked at a limit (B, n)."""
+    """Joint update (B, n), scaled to ``max_step``, and the joints locked at a limit (B, n).
+
+    A joint at a limit whose update points outward is locked and the update of its target recomputed
+    (only those targets), until no free joint pushes outward.
+    """
     locked = np.zeros(q.shape, bool)
     z = _secondary_gradient(q, lower, upper, options)
-    for _ in range(q.shape[1]):
-        reduced = jac * ~locked[:, None, :]
-        dq = _rule(method, reduced, err, options)
-        if z is not None:
-            dq = dq + nullspace_term(reduced, np.where(locked, 0.0, z), options.rank_rcond)
-        if method == "jacobian_inverse":
+    dq = _direction(method, jac, err, z, locked, options)
+    redo = np.arange(len(q))
+    for _ in range(q.shape[1] if method != "jacobian_inverse" else 0):
+        qr, dr = q[redo], dq[redo]
+        pushing = ~locked[redo] & (((qr <= lower) & (dr < 0)) | ((qr >= upper) & (dr > 0)))
+        pushing &= ~inside(wrap_into_limits(qr + dr, revolute, lower, upper), lower, upper)
+        again = np.any(pushing, axis=1)
+        if not np.any(again):
             break
-        pushing = ~locked & (((q <= lower) & (dq < 0)) | ((q >= upper) & (dq > 0)))
-        pushing &= ~inside(wrap_into_limits(q + dq, revolute, lower, upper), lower, upper)
-        if not np.any(pushing):
-            break
-        locked |= pushing
+        redo = redo[again]
+        locked[redo] |= pushing[again]
+        dq[redo] = _direction(method, jac[redo], err[redo], None if z is None else z[redo], locked[redo], options)
     largest = np.max(np.abs(dq), axis=1, initial=0.0)
     scale = np.minimum(1.0, options.max_step / np.where(largest > 0, largest, 1.0))
     return dq * scale[:, None], locked
+
+
+def _direction(method, jac, err, z, locked, options):
+    """The method's update with the ``locked`` joints' columns zeroed, plus the null-space term of ``z``."""
+    reduced = jac * ~locked[:, None, :]
+    dq = _rule(method, reduced, err, options)
+    if z is not None:
+        dq = dq + nullspace_term(reduced, np.where(locked, 0.0, z), options.rank_rcond)
+    return dq
 
 
 def _rule(method, jac, err, options):

@@ -70,6 +70,25 @@ def transpose_step(jac: np.ndarray, err: np.ndarray) -> np.ndarray:
     return np.where(denom > 0, alpha, 0.0)[:, None] * grad
 
 
+def positive_definite(sym: np.ndarray) -> np.ndarray:
+    """(B,) True where the symmetric (B, k, k) matrix has a Cholesky factorisation (all pivots > 0).
+
+    The factorisation runs column by column over the whole batch at once: ~k^3 / 6 element-wise
+    operations on (B,) arrays, where a batched eigenvalue solver pays LAPACK's overhead per matrix.
+    """
+    k = sym.shape[-1]
+    lower = np.zeros_like(sym)
+    ok = np.ones(len(sym), bool)
+    for j in range(k):
+        pivot = sym[:, j, j] - np.einsum("bi,bi->b", lower[:, j, :j], lower[:, j, :j])
+        ok &= pivot > 0
+        root = np.sqrt(np.where(ok, pivot, 1.0))
+        lower[:, j, j] = root
+        below = sym[:, j + 1:, j] - np.einsum("bri,bi->br", lower[:, j + 1:, :j], lower[:, j, :j])
+        lower[:, j + 1:, j] = below / root[:, None]
+    return ok
+
+
 def damped_least_squares_step(jac: np.ndarray, err: np.ndarray, threshold: float, damping_max: float) -> np.ndarray:
     """dq = J^T (J J^T + lambda^2 I)^-1 e with damping that adapts near singularities.
 
@@ -77,12 +96,24 @@ def damped_least_squares_step(jac: np.ndarray, err: np.ndarray, threshold: float
     value sigma_min of J is below ``threshold``, 0 above it (Nakamura and Hanafusa;
     Chiaverini): the exact pseudo-inverse away from singularities, and near them each
     1 / sigma_i becomes sigma_i / (sigma_i^2 + lambda^2), finite even at sigma_i = 0.
-    Computed through the SVD, J^T (J J^T + lambda^2 I)^-1 = V diag(sigma / (sigma^2 +
-    lambda^2)) U^T, which also holds for tall J.
+    Computed as J^T (J J^T + lambda^2 I)^-1 e (wide or square J) or (J^T J + lambda^2 I)^-1 J^T e
+    (tall J), the same matrix; sigma_min^2 is the smallest eigenvalue of that Gram matrix. The
+    damping keeps the Gram matrix's smallest eigenvalue at ~lambda^2 or above (a zero Jacobian gets
+    damping_max^2 I), so the solve stays well conditioned; a batched SVD costs several times the Gram
+    matrix's eigenvalues and solve. sigma_min is only computed where a Cholesky factorisation of
+    J J^T - threshold^2 I fails, i.e. where sigma_min < threshold and the damping depends on it.
     """
-    u, sigma, vt = np.linalg.svd(jac, full_matrices=False)
-    smin = sigma[:, -1]
+    _, m, n = jac.shape
+    jt = np.swapaxes(jac, 1, 2)
+    wide = m <= n
+    gram = jac @ jt if wide else jt @ jac
+    smin = np.full(len(gram), np.inf)  # where sigma_min >= threshold its value does not matter
+    near = ~positive_definite(gram - threshold**2 * np.eye(gram.shape[-1]))
+    if np.any(near):
+        smin[near] = np.sqrt(np.maximum(np.linalg.eigvalsh(gram[near])[:, 0], 0.0))
     lam2 = np.where(smin < threshold, damping_max**2 * (1 - (smin / threshold) ** 2), 0.0)
-    denom = sigma**2 + lam2[:, None]
-    gain = np.where(denom > 0, sigma / np.where(denom > 0, denom, 1.0), 0.0)
-    return np.einsum("bkn,bk,bmk,bm->bn", vt, gain, u, err)
+    gram = gram + lam2[:, None, None] * np.eye(gram.shape[-1])
+    if wide:
+        return np.einsum("bnm,bm->bn", jt, _solve(gram, err))
+    return _solve(gram, np.einsum("bnm,bm->bn", jt, err))
+
