@@ -96,7 +96,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="built-in scene names or scene files (default: the scenes of --suite)")
     run.add_argument("--suite", default=None, choices=SUITES,
                      help="run a built-in suite: default (what 'simparity run' runs), contact (every scene with "
-                     "planes) or hard (the numerical-stability cases, each with the verdict it must earn)")
+                     "planes), hard (the numerical-stability cases, each with the verdict it must earn) or bench (the "
+                     "arms 'simparity bench' times, 10,000 IK targets each)")
     run.add_argument("--engines", type=_engine_list, default=DEFAULT_ENGINES, metavar="A,B,...",
                      help=f"comma-separated engines to run (default: {','.join(DEFAULT_ENGINES)}; "
                      f"known: {','.join(ENGINE_NAMES)})")

@@ -237,7 +237,8 @@ class _InHouseIK(IKModel):
         self.detail = (f"in-house {self._method} (batched), max step {options.max_step:g} rad, hard joint limits"
                        + ("; null-space term H = sum a (q - q_start)^2 toward the start pose" if self._nullspace else "")
                        + (f"; failed targets restarted from up to {restarts.attempts} seeded random configurations "
-                          f"({restarts.starts_per_round} per round, seed {restarts.seed})" if restarts else ""))
+                          f"({restarts.starts_per_round} per round, seed {restarts.seed}), each attempt at most "
+                          f"{restarts.max_iterations} iterations" if restarts else ""))
 
     def solve(self, target_position_world, target_rotation_world, q_start) -> IKResult:
         options = replace(self._options, rest_pose=np.asarray(q_start, dtype=float)) if self._nullspace else self._options

@@ -6,9 +6,11 @@ n joints; every joint step is one vectorised NumPy operation over the batch.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
-from simparity.core.rotations import so3_exp, so3_log
+from simparity.core.rotations import skew, so3_log
 from simparity.core.scene import Chain
 from simparity.core.trajectory import FramePoses
 
@@ -20,6 +22,118 @@ def _as_batch(chain: Chain, q: np.ndarray) -> np.ndarray:
     if q.ndim != 2 or q.shape[1] != chain.n_joints:
         raise ValueError(f"q has shape {q.shape}, expected (B, {chain.n_joints}) for chain '{chain.name}'")
     return q
+
+
+Sparse = tuple[tuple[int, ...], ...]
+"""The nonzero entries of a constant vector ((k, value), ...) or matrix ((k, j, value), ...)."""
+
+
+def _sparse(a: np.ndarray) -> Sparse:
+    return tuple(tuple(int(i) for i in index) + (float(a[index]),) for index in zip(*np.nonzero(a)))
+
+
+@dataclass(frozen=True)
+class _JointPlan:
+    """Constants of one joint for the packed FK, as their nonzero entries: its origin, its axis and the
+    axis's cross-product matrices K, K^2."""
+
+    revolute: bool
+    origin_xyz: Sparse
+    origin_rotation: Sparse | None  # None: the identity
+    axis: Sparse
+    k: Sparse
+    k2: Sparse
+
+
+_PLANS: dict[int, tuple[Chain, list[_JointPlan]]] = {}
+"""Joint plans of recently used chains, by id (a chain's arrays make it unhashable); checked by identity."""
+_PLAN_CACHE_SIZE = 64
+
+
+def _plan(chain: Chain) -> list[_JointPlan]:
+    cached = _PLANS.get(id(chain))
+    if cached is not None and cached[0] is chain:
+        return cached[1]
+    plan = []
+    for joint in chain.joints:
+        rotation = np.asarray(joint.origin_rotation, dtype=float)
+        k = skew(np.asarray(joint.axis, dtype=float))
+        plan.append(_JointPlan(joint.type == "revolute", _sparse(np.asarray(joint.origin_xyz, dtype=float)),
+                               None if np.array_equal(rotation, np.eye(3)) else _sparse(rotation),
+                               _sparse(np.asarray(joint.axis, dtype=float)), _sparse(k), _sparse(k @ k)))
+    if len(_PLANS) >= _PLAN_CACHE_SIZE:
+        _PLANS.clear()
+    _PLANS[id(chain)] = (chain, plan)
+    return plan
+
+
+def _times_constant(r: np.ndarray, m: Sparse) -> np.ndarray:
+    """r m for packed rotations r (3, 3, B) and a constant matrix given by its nonzeros."""
+    out = np.zeros_like(r)
+    for k, j, value in m:
+        out[:, j] += r[:, k] * value
+    return out
+
+
+def _apply_constant(r: np.ndarray, v: Sparse) -> np.ndarray:
+    """r v for packed rotations r (3, 3, B) and a constant vector given by its nonzeros. -> (3, B)."""
+    out = np.zeros(r.shape[::2])
+    for k, value in v:
+        out += r[:, k] * value
+    return out
+
+
+@dataclass(frozen=True)
+class PackedFrames:
+    """The frames of :func:`joint_frames`, component-major (batch last).
+
+    Attributes
+    ----------
+    positions : (n + 1, 3, B) ndarray
+        Joint positions P_i, then the end effector E [m].
+    end_rotation : (3, 3, B) ndarray
+        The end effector's rotation to world.
+    axes_world : (n, 3, B) ndarray
+        Joint axes a_i in world axes.
+    rotations : (n + 1, 3, 3, B) ndarray or None
+        Every frame's rotation, when asked for.
+    """
+
+    positions: np.ndarray
+    end_rotation: np.ndarray
+    axes_world: np.ndarray
+    rotations: np.ndarray | None = None
+
+
+def packed_frames(chain: Chain, q: np.ndarray, all_rotations: bool = False) -> PackedFrames:
+    """FK of a batch of configurations (B, n), one joint at a time, each joint's terms a few element-wise
+    operations over the batch (the lecture's chain of frames: p += R o; R = R R_o exp(q K); a = R axis)."""
+    q = _as_batch(chain, q)
+    batch = q.shape[0]
+    p = np.zeros((3, batch))
+    r = np.zeros((3, 3, batch))
+    r[0, 0] = r[1, 1] = r[2, 2] = 1.0
+    positions, axes, rotations = [], [], []
+    for i, joint in enumerate(_plan(chain)):
+        p = p + _apply_constant(r, joint.origin_xyz)
+        if joint.origin_rotation is not None:
+            r = _times_constant(r, joint.origin_rotation)
+        axis_world = _apply_constant(r, joint.axis)
+        if joint.revolute:
+            angle = q[:, i]
+            r = r + np.sin(angle) * _times_constant(r, joint.k) + (1 - np.cos(angle)) * _times_constant(r, joint.k2)
+        else:
+            p = p + q[:, i] * axis_world
+        positions.append(p)
+        axes.append(axis_world)
+        if all_rotations:
+            rotations.append(r)
+    positions.append(p + _apply_constant(r, _sparse(np.asarray(chain.end_effector_xyz, dtype=float))))
+    end = _times_constant(r, _sparse(np.asarray(chain.end_effector_rotation, dtype=float)))
+    if all_rotations:
+        rotations.append(end)
+    return PackedFrames(np.stack(positions), end, np.stack(axes) if axes else np.zeros((0, 3, batch)),
+                        np.stack(rotations) if all_rotations else None)
 
 
 def joint_frames(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -40,25 +154,9 @@ def joint_frames(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     axes_world : (B, n, 3) ndarray
         Joint axes a_i in world axes.
     """
-    q = _as_batch(chain, q)
-    batch = q.shape[0]
-    p = np.zeros((batch, 3))
-    r = np.broadcast_to(np.eye(3), (batch, 3, 3))
-    positions, rotations, axes = [], [], []
-    for i, joint in enumerate(chain.joints):
-        p = p + r @ joint.origin_xyz
-        r = r @ joint.origin_rotation
-        axis_world = r @ joint.axis
-        if joint.type == "revolute":
-            r = r @ so3_exp(q[:, i, None] * joint.axis)
-        else:
-            p = p + q[:, i, None] * axis_world
-        positions.append(p)
-        rotations.append(r)
-        axes.append(axis_world)
-    positions.append(p + r @ chain.end_effector_xyz)
-    rotations.append(r @ chain.end_effector_rotation)
-    return np.stack(positions, axis=1), np.stack(rotations, axis=1), np.stack(axes, axis=1)
+    frames = packed_frames(chain, q, all_rotations=True)
+    return (frames.positions.transpose(2, 0, 1), frames.rotations.transpose(3, 0, 1, 2),
+            frames.axes_world.transpose(2, 0, 1))
 
 
 def forward_kinematics(chain: Chain, q: np.ndarray) -> FramePoses:
@@ -74,21 +172,17 @@ def jacobian_world(chain: Chain, q: np.ndarray) -> np.ndarray:
     one, with a_i the joint axis, P_i the joint position and E the end effector, all in
     world axes. (B, n) -> (B, 6, n), linear rows first.
     """
-    positions, _, axes = joint_frames(chain, q)
-    return jacobian_of_frames(chain, positions, axes)
+    return jacobian_of_frames(chain, packed_frames(chain, q))
 
 
-def jacobian_of_frames(chain: Chain, positions: np.ndarray, axes_world: np.ndarray) -> np.ndarray:
-    """:func:`jacobian_world` from the frames :func:`joint_frames` returned (no second FK pass).
-
-    positions (B, n + 1, 3), axes_world (B, n, 3) -> (B, 6, n).
-    """
-    axes = axes_world
-    end = positions[:, -1:, :]
-    revolute = np.array([j.type == "revolute" for j in chain.joints])[None, :, None]
-    linear = np.where(revolute, np.cross(axes, end - positions[:, :-1, :]), axes)
+def jacobian_of_frames(chain: Chain, frames: PackedFrames) -> np.ndarray:
+    """:func:`jacobian_world` from the frames :func:`packed_frames` returned (no second FK pass). -> (B, 6, n)."""
+    axes = frames.axes_world  # (n, 3, B)
+    lever = frames.positions[-1] - frames.positions[:-1]
+    revolute = np.array([j.type == "revolute" for j in chain.joints])[:, None, None]
+    linear = np.where(revolute, np.cross(axes, lever, axis=1), axes)
     angular = np.where(revolute, axes, 0.0)
-    return np.concatenate([linear, angular], axis=2).transpose(0, 2, 1)
+    return np.concatenate([linear, angular], axis=1).transpose(2, 1, 0)
 
 
 def finite_difference_jacobian_world(chain: Chain, q: np.ndarray, step: float = 1e-6) -> np.ndarray:

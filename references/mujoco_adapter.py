@@ -58,7 +58,7 @@ from simparity.core.trajectory import FramePoses, Trajectory
 from simparity.references import contact_params, external_forces, mujoco_ik
 from simparity.references.base_frame import BaseFrame
 from simparity.references.conventions import fmt, quat_wxyz_to_matrix
-from simparity.references.mjcf import INTEGRATORS, chain_mjcf, dynamics_mjcf
+from simparity.references.mjcf import INTEGRATORS, arena_kib, chain_mjcf, dynamics_mjcf
 from simparity.references.quiet import captured_output
 from simparity.references.urdf_export import chain_export, chain_source, chain_urdf
 
@@ -122,7 +122,8 @@ class _Simulation(Simulation):
             [f"quadratic drag as xfrc_applied ({external_forces.DETAIL})"] if self._drags else [])
         self.detail = (
             f"MuJoCo integrator {INTEGRATORS[integrator]}; explicit inertia; "
-            + ("contact disabled" if scene.contact is None else contact_detail(scene, dt))
+            + (f"contact disabled, arena {arena_kib(scene)} KiB (MuJoCo's default grows as nv^2)"
+               if scene.contact is None else contact_detail(scene, dt))
             + ("" if forces.gravity_world is not None else "; gravity disabled")
             + (f"; {' and '.join(native)} as dof_damping, eulerdamp disabled" if native else "")
             + ("; wind as constant xfrc_applied b w" if wind is not None else "")

@@ -50,14 +50,16 @@ from simparity.references.quiet import captured_output
 from simparity.references.urdf_export import UrdfChains, chain_export, chain_source, chain_urdf
 
 
-def free_bodies_model(scene: DynamicsScene) -> pin.Model:
-    """One free-flyer joint per body, attached to the universe, with the scene's inertia."""
+def free_body_model(body, gravity_world: np.ndarray | None) -> pin.Model:
+    """One free-flyer joint attached to the universe, with the body's mass and inertia about its COM.
+
+    Each body of a scene gets its own model: the bodies are independent, and a model holding B free
+    flyers makes ``createData`` allocate nv x nv matrices and larger (measured: 13 GiB at B = 100).
+    """
     model = pin.Model()
-    for body in scene.bodies:
-        jid = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), f"{body.name}_free")
-        model.appendBodyToJoint(jid, pin.Inertia(body.mass, np.zeros(3), body.inertia_body), pin.SE3.Identity())
-    gravity = scene.forces.gravity_world
-    model.gravity = pin.Motion(np.zeros(3) if gravity is None else gravity, np.zeros(3))
+    jid = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), f"{body.name}_free")
+    model.appendBodyToJoint(jid, pin.Inertia(body.mass, np.zeros(3), body.inertia_body), pin.SE3.Identity())
+    model.gravity = pin.Motion(np.zeros(3) if gravity_world is None else gravity_world, np.zeros(3))
     return model
 
 
@@ -91,15 +93,21 @@ class _Simulation(Simulation):
     """
 
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
-        self._model = free_bodies_model(scene)
-        self._data = self._model.createData()
+        models: dict[bytes, tuple[pin.Model, pin.Data]] = {}  # bodies of one mass and inertia share a model
+        self._models = []
+        for body in scene.bodies:
+            key = np.append(body.mass, body.inertia_body).tobytes()
+            if key not in models:
+                model = free_body_model(body, scene.forces.gravity_world)
+                models[key] = (model, model.createData())
+            self._models.append(models[key])
         self._position0 = np.stack([b.position_world for b in scene.bodies])
         self._rotation0 = quat_wxyz_to_matrix(np.stack([b.quat_wxyz for b in scene.bodies]))
         self._velocity0 = np.stack([b.velocity_world for b in scene.bodies])
         self._omega_local0 = np.einsum(
             "bji,bj->bi", self._rotation0, np.stack([b.angular_velocity_world for b in scene.bodies])
         )
-        self._tau = np.zeros(self._model.nv)
+        self._tau = np.zeros(6)
         self._forces = scene.forces
         self._drag = external_forces.has_drag(scene.forces) or external_forces.has_angular_drag(scene.forces)
         self._external = self._drag or bool(scene.forces.applied)
@@ -122,33 +130,37 @@ class _Simulation(Simulation):
         times = np.arange(n_steps + 1) * dt
         return Trajectory(times, pos, matrix_to_quat_wxyz(rot), vel, omg)
 
-    def _fext(self, r: np.ndarray, v: np.ndarray, w_local: np.ndarray) -> pin.StdVec_Force:
-        """aba's external forces per joint (universe first), LOCAL frame, about each COM."""
+    def _fext(self, r: np.ndarray, v: np.ndarray, w_local: np.ndarray) -> list[pin.StdVec_Force]:
+        """aba's external forces of each body's model (universe, then its joint), LOCAL frame, about the COM."""
         b = len(r)
         force, torque = np.zeros((b, 3)), np.zeros((b, 3))
         if self._drag:
             force = external_forces.drag_force_world(self._forces, v)
             torque = external_forces.drag_torque_world(self._forces, np.einsum("bij,bj->bi", r, w_local))
-        per_joint = [pin.Force.Zero()] + [pin.Force(r[k].T @ force[k], r[k].T @ torque[k]) for k in range(b)]
+        per_body = [pin.Force(r[k].T @ force[k], r[k].T @ torque[k]) for k in range(b)]
         for applied in self._forces.applied:
             k = applied.body
             at_point = pin.SE3(np.eye(3), applied.point_body)
-            per_joint[k + 1] = per_joint[k + 1] + at_point.act(pin.Force(r[k].T @ applied.force_world, np.zeros(3)))
-        fext = pin.StdVec_Force()
-        for spatial in per_joint:
+            per_body[k] = per_body[k] + at_point.act(pin.Force(r[k].T @ applied.force_world, np.zeros(3)))
+        out = []
+        for spatial in per_body:
+            fext = pin.StdVec_Force()
+            fext.append(pin.Force.Zero())
             fext.append(spatial)
-        return fext
+            out.append(fext)
+        return out
 
     def _accelerations(self, t, p, r, v, w_local) -> tuple[np.ndarray, np.ndarray]:
         """(dv/dt world (B, 3), dw/dt local (B, 3)) from aba, the scene's non-gravity forces as fext."""
         b = len(p)
-        q = np.concatenate([pin.SE3ToXYZQUAT(pin.SE3(r[k], p[k])) for k in range(b)])
         v_local = np.einsum("bji,bj->bi", r, v)
-        qd = np.concatenate([v_local, w_local], axis=1).ravel()
-        if self._external:
-            a = pin.aba(self._model, self._data, q, qd, self._tau, self._fext(r, v, w_local)).reshape(b, 6)
-        else:
-            a = pin.aba(self._model, self._data, q, qd, self._tau).reshape(b, 6)
+        qd = np.concatenate([v_local, w_local], axis=1)
+        fext = self._fext(r, v, w_local) if self._external else None
+        a = np.empty((b, 6))
+        for k, (model, data) in enumerate(self._models):
+            q = pin.SE3ToXYZQUAT(pin.SE3(r[k], p[k]))
+            a[k] = (pin.aba(model, data, q, qd[k], self._tau, fext[k]) if fext is not None
+                    else pin.aba(model, data, q, qd[k], self._tau))
         # aba's linear part is the spatial acceleration; the COM's classical one adds w x v.
         return np.einsum("bij,bj->bi", r, a[:, :3] + np.cross(w_local, v_local)), a[:, 3:]
 
@@ -287,15 +299,14 @@ class PinocchioEngine(UrdfChains, Engine):
         if not isinstance(scene, DynamicsScene):
             return chain_export(scene.chain, "pinocchio.buildModelFromXML (fixed base)")
         integrator, dt = self._export_settings(scene, integrator, dt)
-        model = free_bodies_model(scene)
-        inertias = "".join(
-            f"{model.names[j]}: {model.inertias[j]}\n" for j in range(1, model.njoints)
-        )
+        models = [free_body_model(body, scene.forces.gravity_world) for body in scene.bodies]
+        inertias = "".join(f"{m.names[1]}: {m.inertias[1]}\n" for m in models)
         external = [n for n in scene.forces.names() if n != "gravity"]
+        gravity = models[0].gravity.linear if models else scene.forces.gravity_world
         return (
-            f"# Pinocchio model built in code (no file): one free-flyer per body.\n"
-            f"# gravity: {model.gravity.linear}; stepped by the harness ({integrator}, dt = {dt!r} s)\n"
+            f"# Pinocchio models built in code (no file): one model with one free-flyer per body.\n"
+            f"# gravity: {gravity}; stepped by the harness ({integrator}, dt = {dt!r} s)\n"
             + (f"# each step, aba's fext (local frame, about the COM): {', '.join(external)}\n" if external else "")
             + (f"# contact: n/a, not simulated: {NO_CONTACT}\n" if scene.contact is not None else "")
-            + f"{model}\n{inertias}"
+            + (f"{models[0]}\n" if models else "") + inertias
         )

@@ -254,3 +254,20 @@ def test_show_reports_a_point_mass_body_and_the_contact_settings():
     assert "[[0.034, 0.003, 0.005], [0.003, 0.081, 0.00375], [0.005, 0.00375, 0.065]]" in text
     assert "-sum m x y" in text and "plane floor: E(p) = N . p + d, N = [0, 0, 1]" in text
     assert "tetra on floor: restitution 0.3, friction static 0.5, kinetic 0.5" in text
+
+
+def test_every_run_ends_with_its_wall_time_and_peak_memory(tmp_path):
+    """Issue #11: the last line of `simparity run` is what the run cost, also when it was refused."""
+    code, text = _run(["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0", "--out",
+                       str(tmp_path / "o")])
+    last = text.strip().splitlines()[-1]
+    assert code == EXIT_OK
+    assert re.fullmatch(r"wall time \d+\.\d s; peak memory [\d,]+ MiB( \(largest worker process [\d,]+ MiB\))?", last)
+    code, text = _run(["run", "no-such-scene", "--out", str(tmp_path / "p")])
+    assert code == EXIT_USAGE and text.strip().splitlines()[-1].startswith("wall time ")
+
+
+def test_bench_is_a_command_with_help():
+    with pytest.raises(SystemExit) as done:
+        main(["bench", "--help"])
+    assert done.value.code == 0

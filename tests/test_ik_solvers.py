@@ -357,3 +357,32 @@ def test_options_are_checked():
 def test_methods_listed():
     """The four lecture methods are offered."""
     assert METHODS == ("jacobian_inverse", "pseudo_inverse", "transpose", "damped_least_squares")
+
+
+def test_the_batched_cholesky_test_is_positive_definiteness():
+    """steps.positive_definite decides damping in DLS without an SVD; it must agree with the eigenvalues."""
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(4000, 6, 7))
+    gram = a @ a.transpose(0, 2, 1)
+    for shift in (0.0, 0.5, 1.0, 3.0):
+        shifted = gram - shift * np.eye(6)
+        smallest = np.linalg.eigvalsh(shifted)[:, 0]
+        clear = np.abs(smallest) > ALGEBRA_TOLERANCE * np.abs(shifted).max()  # rounding decides at 0
+        np.testing.assert_array_equal(steps.positive_definite(shifted)[clear], (smallest > 0)[clear])
+    assert not steps.positive_definite(np.zeros((1, 6, 6)))[0]
+
+
+def test_damped_least_squares_is_the_svd_formula():
+    """The Gram-matrix form equals V diag(sigma / (sigma^2 + lambda^2)) U^T e, wide, tall and singular J."""
+    rng = np.random.default_rng(4)
+    for m, n in ((6, 7), (6, 6), (6, 5), (3, 7)):
+        jac = rng.normal(size=(200, m, n)) * rng.uniform(0.001, 1, size=(200, 1, 1))
+        jac[:20, :, 0] = 0.0  # rank-deficient
+        err = rng.normal(size=(200, m))
+        u, sigma, vt = np.linalg.svd(jac, full_matrices=False)
+        smin = sigma[:, -1]
+        lam2 = np.where(smin < 1e-2, 1e-3**2 * (1 - (smin / 1e-2) ** 2), 0.0)
+        gain = sigma / (sigma**2 + lam2[:, None])
+        expected = np.einsum("bkn,bk,bmk,bm->bn", vt, gain, u, err)
+        got = steps.damped_least_squares_step(jac, err, 1e-2, 1e-3)
+        np.testing.assert_allclose(got, expected, rtol=PINV_TOLERANCE, atol=PINV_TOLERANCE * np.abs(expected).max())

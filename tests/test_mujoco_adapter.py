@@ -121,3 +121,29 @@ def test_euler_damping_is_implicit_unless_eulerdamp_is_disabled():
     sim.model.opt.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)  # back to MuJoCo's default
     implicit = sim.run(1).velocity_world[1, 0]
     np.testing.assert_allclose(implicit, v0 / (1 + dt * b / m), rtol=1e-14)
+
+
+def test_a_scene_without_contact_gets_an_arena_sized_by_its_bodies():
+    """Issue #11: MuJoCo's default arena grows as nv^2 (1.7 GiB at 1,000 bodies; 10,000 failed to allocate);
+    a scene without contact has no constraints and gets 1 MiB + 2 KiB per body, in the detail too."""
+    from simparity.comparisons.bench import boxes
+    from simparity.references.mjcf import arena_kib
+
+    scene = boxes(3000, drag=False)
+    sim = MujocoEngine().build_dynamics(scene, "euler", 1e-3)
+    assert sim.model.narena == arena_kib(scene) * 1024 == (1024 + 2 * 3000) * 1024
+    assert "arena 7024 KiB" in sim.detail
+    assert np.all(np.isfinite(sim.run(2).position_world))
+
+
+def test_the_batch_rollout_steps_each_body_as_the_scene_adapter_does():
+    """BatchRollout (B single-body rollouts, the bench's MuJoCo batch) is bit-identical to the B-body model."""
+    from simparity.comparisons.bench import boxes
+    from simparity.references.mujoco_adapter import BatchRollout
+
+    for drag in (False, True):
+        scene = boxes(5, drag)
+        one_model = MujocoEngine().build_dynamics(scene, "rk4", 1e-3).run(50)
+        batch = BatchRollout(scene, "rk4", 1e-3, nthread=2).run(50)
+        for name in ("position_world", "quat_wxyz", "velocity_world", "angular_velocity_world"):
+            np.testing.assert_array_equal(getattr(batch, name), getattr(one_model, name))

@@ -55,7 +55,7 @@ from simparity.core.ik.problem import IKTolerances, check_inputs
 from simparity.core.ik.nullspace import limit_penalty_gradient, nullspace_term, penalty_gradient
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.ik.result import IKResult
-from simparity.core.kinematics import jacobian_of_frames, joint_frames
+from simparity.core.kinematics import jacobian_of_frames, packed_frames
 from simparity.core.rotations import so3_log
 from simparity.core.scene import Chain
 
@@ -194,9 +194,9 @@ def solve_ik(
         if idx.size == 0:
             break
         qa = q[idx]
-        positions, rotations, axes = joint_frames(chain, qa)  # one FK pass gives the error and the Jacobian
-        end_world = positions[:, -1]
-        err, pos_res, rot_res = _error(end_world, rotations[:, -1], target_position[idx],
+        frames = packed_frames(chain, qa)  # one FK pass gives the error and the Jacobian
+        end_world = frames.positions[-1].T
+        err, pos_res, rot_res = _error(end_world, frames.end_rotation.transpose(2, 0, 1), target_position[idx],
                                        None if target_rotation is None else target_rotation[idx])
         merit = np.linalg.norm(err, axis=1)
         better = merit < best_merit[idx]
@@ -207,7 +207,7 @@ def solve_ik(
         best_merit[idx[better]] = merit[better]
         reason[idx[solved]] = ""
 
-        jac = jacobian_of_frames(chain, positions, axes)[:, :rows]
+        jac = jacobian_of_frames(chain, frames)[:, :rows]
         dq, locked = _update(method, jac, err, qa, lower, upper, revolute, options)
         # Only a target that has not progressed for stall_window iterations can stop unsolved: only those are
         # classified (the singular values cost more than the rest of the iteration).
@@ -221,9 +221,9 @@ def solve_ik(
         waiting = due[cause[due] == "iteration_cap"]
         if waiting.size:
             w = idx[waiting]
-            best_positions, _, best_axes = joint_frames(chain, best_q[w])
-            cause[waiting] = _classify(jacobian_of_frames(chain, best_positions, best_axes)[:, :rows],
-                                       locked[waiting], best_positions[:, -1], target_position[w], center,
+            best = packed_frames(chain, best_q[w])
+            cause[waiting] = _classify(jacobian_of_frames(chain, best)[:, :rows],
+                                       locked[waiting], best.positions[-1].T, target_position[w], center,
                                        beyond_reach[w], options)
         stalled = (since_best[idx] >= options.stall_window) & (cause != "iteration_cap") & ~solved
         escape = stalled & (cause == "limit_blocked") & np.any(locked & crossable, axis=1) & (crossings_left[idx] > 0)
@@ -243,8 +243,9 @@ def solve_ik(
         iterations[idx[step | escape]] += 1
         active[idx[~(step | escape)]] = False
 
-    positions, rotations, _ = joint_frames(chain, best_q)
-    _, pos_res, rot_res = _error(positions[:, -1], rotations[:, -1], target_position, target_rotation)
+    frames = packed_frames(chain, best_q)
+    _, pos_res, rot_res = _error(frames.positions[-1].T, frames.end_rotation.transpose(2, 0, 1), target_position,
+                                 target_rotation)
     violation = np.max(np.maximum(np.maximum(lower - best_q, best_q - upper), 0.0), axis=1, initial=0.0)
     return IKResult(q=best_q, success=reason == "", iterations=iterations, position_residual=pos_res,
                     orientation_residual=rot_res, limit_violation=violation, reason=reason.astype(str))

@@ -1,0 +1,81 @@
+"""TRAC-IK's restarts around the lecture's solvers (core/ik/restarts.py)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from simparity.comparisons.ik_targets import random_targets
+from simparity.core.ik.jacobian_solvers import IKOptions, solve_ik
+from simparity.core.ik.restarts import RESTART_STREAM, Restarts, solve_ik_with_restarts
+from simparity.core.inhouse import InHouseEngine
+from simparity.core.scene import sample_configurations
+from tests.helpers import builtin
+
+N_TARGETS = 300
+"""Enough of the Panda's TRAC-IK targets that the plain solver fails some (7 % of 10,000 from mid-range)."""
+REQUIRED_WITH_RESTARTS = 0.99
+"""Solve rate the restarted solver must reach on them (measured 99.99 % on 10,000, BENCHMARKS.md)."""
+
+
+@pytest.fixture(scope="module")
+def panda():
+    scene = builtin("bench-panda-ik")
+    targets = random_targets(scene, InHouseEngine().build_kinematics(scene.chain))
+    n = slice(0, N_TARGETS)
+    options = IKOptions(scene.position_tolerance, scene.orientation_tolerance, scene.max_iterations)
+    return scene, targets.position_world[n], targets.rotation_world[n], options
+
+
+def test_restarts_solve_what_one_start_does_not_inside_the_limits(panda):
+    scene, p, r, options = panda
+    plain = solve_ik(scene.chain, p, r, scene.q_start, "damped_least_squares", options)
+    restarted = solve_ik_with_restarts(scene.chain, p, r, scene.q_start, "damped_least_squares", options)
+    assert plain.solve_rate < REQUIRED_WITH_RESTARTS <= restarted.solve_rate
+    first = solve_ik(scene.chain, p, r, scene.q_start, "damped_least_squares",
+                     dataclasses.replace(options, max_iterations=Restarts().max_iterations))
+    assert np.all(restarted.success[first.success])  # a first-attempt success is kept
+    assert not np.any(restarted.limit_violation)
+    assert np.all(restarted.position_residual[restarted.success] <= options.position_tolerance)
+
+
+def test_restarts_are_deterministic_and_zero_attempts_is_the_plain_solver(panda):
+    scene, p, r, options = panda
+    a = solve_ik_with_restarts(scene.chain, p, r, scene.q_start, "damped_least_squares", options)
+    b = solve_ik_with_restarts(scene.chain, p, r, scene.q_start, "damped_least_squares", options)
+    np.testing.assert_array_equal(a.q, b.q)
+    none = solve_ik_with_restarts(scene.chain, p, r, scene.q_start, "damped_least_squares", options,
+                                  Restarts(0, max_iterations=None))
+    plain = solve_ik(scene.chain, p, r, scene.q_start, "damped_least_squares", options)
+    np.testing.assert_array_equal(none.q, plain.q)
+    np.testing.assert_array_equal(none.reason, plain.reason)
+
+
+def test_a_target_beyond_the_reach_bound_is_not_restarted(panda):
+    scene, p, r, options = panda
+    far = np.array([[50.0, 0.0, 0.0]])
+    plain = solve_ik(scene.chain, far, r[:1], scene.q_start, "damped_least_squares", options)
+    restarted = solve_ik_with_restarts(scene.chain, far, r[:1], scene.q_start, "damped_least_squares", options)
+    assert restarted.reason[0] == plain.reason[0] == "unreachable"
+    assert restarted.iterations[0] == plain.iterations[0]
+
+
+def test_restart_draws_never_replay_the_target_sampler():
+    """The restarts' stream of a seed is not the stream the random targets were drawn from."""
+    scene = builtin("bench-panda-ik")
+    seed = scene.seed
+    rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(RESTART_STREAM,)))
+    draws = sample_configurations(scene.chain, 50, rng)
+    targets = sample_configurations(scene.chain, 50, seed)
+    assert np.min(np.abs(draws - targets).max(axis=1)) > 1e-3
+
+
+def test_the_in_house_engine_offers_the_restarted_solver_with_what_it_does_in_its_detail():
+    scene = builtin("bench-iiwa-ik")
+    model = InHouseEngine().build_ik(scene.chain, "damped_least_squares+restarts",
+                                     IKOptions(scene.position_tolerance, scene.orientation_tolerance))
+    assert "restarted from up to 16 seeded random configurations" in model.detail
+    with pytest.raises(ValueError, match="attempts"):
+        Restarts(attempts=-1)
