@@ -393,6 +393,7 @@ LECTURE_PROJECTILE_MJCF = """<mujoco model="lecture-projectile">
       <inertial pos="0 0 0" mass="1.0" fullinertia="0.09290304 0.09290304 0.09290304 0.0 0.0 0.0" />
     </body>
   </worldbody>
+  <size memory="1026K" />
 </mujoco>
 <!-- initial qvel of point: linear (world) 30.48 30.48 0.0, angular (body) 0.0 0.0 0.0 -->
 """
@@ -410,7 +411,8 @@ LECTURE_PROJECTILE_URDF = """<robot name="point">
 
 
 def test_scene_without_contact_is_unchanged():
-    """No contact: MuJoCo's model text, contact disabled and no geom; PyBullet's URDF without collision, no planes."""
+    """No contact: MuJoCo's model text, contact disabled and no geom (and an arena sized by the bodies, issue #11);
+    PyBullet's URDF without collision, no planes."""
     scene = builtin("lecture-projectile")
     assert scene.contact is None
     assert MujocoEngine().export(scene, None, None) == LECTURE_PROJECTILE_MJCF

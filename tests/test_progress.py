@@ -45,3 +45,28 @@ def test_every_case_is_reported_from_worker_processes():
     engines = [make_engine(n) for n in names]
     assert len(heard) == sum(count_cases(s, engines) for s in scenes)
     assert {event[0] for event in heard} == {s.name for s in scenes}
+
+
+def test_the_costliest_scene_starts_first_and_rows_still_come_back_in_order(monkeypatch):
+    """Issue #11: the long scene is submitted first (it would otherwise end the run alone on one CPU),
+    results keep the suite's order, and workers get one BLAS thread each unless the user chose."""
+    from simparity.comparisons import parallel
+
+    scenes = [builtin("lecture-planar-arm"), builtin("lecture-projectile")]
+    engines = [make_engine("core")]
+    assert parallel.estimated_cost(scenes[1], engines) > parallel.estimated_cost(scenes[0], engines)
+    submitted = []
+    real_submit = parallel.concurrent.futures.ProcessPoolExecutor.submit
+
+    def recording_submit(self, fn, scene, *args):
+        submitted.append(scene.name)
+        return real_submit(self, fn, scene, *args)
+
+    monkeypatch.setattr(parallel.concurrent.futures.ProcessPoolExecutor, "submit", recording_submit)
+    monkeypatch.delenv("OPENBLAS_NUM_THREADS", raising=False)
+    monkeypatch.setenv("OMP_NUM_THREADS", "3")
+    results = list(run_scenes(scenes, ("core",), 0, 2))
+    assert submitted == ["lecture-projectile", "lecture-planar-arm"]
+    assert [scene.name for scene, _, _ in results] == ["lecture-planar-arm", "lecture-projectile"]
+    import os
+    assert os.environ["OPENBLAS_NUM_THREADS"] == "1" and os.environ["OMP_NUM_THREADS"] == "3"
