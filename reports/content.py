@@ -4,6 +4,8 @@ a compact table and (folded) the full one. Reads a stored run only; figures are 
 
 from __future__ import annotations
 
+import concurrent.futures
+
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -261,10 +263,10 @@ def _overhead_mark(engine: str, about: dict) -> str:
 
 class _Builder:
     def __init__(self, table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: ToleranceVerdict | None,
-                 figure_dir: Path) -> None:
+                 figure_dir: Path, writer: figures.FigureWriter) -> None:
         self.table, self.info, self.series, self.verdict = table, info, series, verdict
-        self.figure_dir = figure_dir
-        self.svgs: dict[str, str] = {}
+        self.figure_dir, self.writer = figure_dir, writer
+        self.svgs: dict[str, concurrent.futures.Future] = {}
 
     def about(self, scene: str) -> dict:
         return self.info.get("scenes", {}).get(scene, {})
@@ -272,7 +274,7 @@ class _Builder:
     def figure(self, fig, name: str, caption: str) -> list[Block]:
         if fig is None:
             return []
-        self.svgs[name] = figures.save(fig, self.figure_dir, name)
+        self.svgs[name] = self.writer.submit(fig, self.figure_dir, name)
         return [Figure(name, caption)]
 
     # -- summary -------------------------------------------------------------------------------
@@ -528,8 +530,16 @@ def _scene_heading(scene: str, kind: str) -> Heading:
 def build(table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: ToleranceVerdict | None,
           run_dir: Path) -> tuple[list[Block], dict[str, str]]:
     """(the report's blocks, the SVG text of each figure by name); figures are written to
-    ``run_dir/figures``. ``verdict``: the run held to tolerances, None if it was not."""
-    builder = _Builder(table, info, series, verdict, Path(run_dir) / FIGURES_DIR)
+    ``run_dir/figures``, on one process per CPU. ``verdict``: the run held to tolerances, None if it was not."""
+    with figures.FigureWriter() as writer:
+        builder = _Builder(table, info, series, verdict, Path(run_dir) / FIGURES_DIR, writer)
+        blocks = _blocks(builder, table, info)
+        svgs = {name: future.result() for name, future in builder.svgs.items()}
+    return blocks, svgs
+
+
+def _blocks(builder: _Builder, table: pd.DataFrame, info: dict) -> list[Block]:
+    """Every block of the report, in order."""
     versions = ", ".join(f"{k} {v}" for k, v in info.get("engine_versions", {}).items())
     m = info.get("machine", {})
     counts = case_counts(table.to_dict("records"))
@@ -542,7 +552,8 @@ def build(table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: Tolera
                   + ", ".join(f"{s} {counts[s]}" for s in STATUSES)
                   + f". `{NOT_AVAILABLE}`: nothing was measured, and the rows say why. Errors are maxima over every "
                   "body and sample against the reference named per scene; times are the best of several repeats of "
-                  "the stepping alone (model building excluded). Every value of every case: `results.csv`; sampled "
+                  "the stepping alone (model building excluded; a run of 0.1 s or more is timed once), indicative: "
+                  "`simparity bench` measures speed precisely. Every value of every case: `results.csv`; sampled "
                   "series: `series.csv.gz`."),
     ]
     blocks += builder.summary()
@@ -554,4 +565,4 @@ def build(table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: Tolera
     kinematics = table[table["scene"].map(kinds) == "kinematics"]
     if not kinematics.empty:
         blocks += builder.kinematics(kinematics)
-    return blocks, builder.svgs
+    return blocks

@@ -7,8 +7,12 @@ reference the errors are measured against.
 
 from __future__ import annotations
 
+import concurrent.futures
 import io
 import math
+import multiprocessing
+import os
+import pickle
 from pathlib import Path
 
 import matplotlib
@@ -221,3 +225,37 @@ def save(fig, folder: Path, name: str) -> str:
     fig.savefig(folder / f"{name}.png", dpi=100)
     plt.close(fig)
     return svg
+
+
+def _save_pickled(pickled: bytes, folder: Path, name: str) -> str:
+    return save(pickle.loads(pickled), folder, name)
+
+
+class FigureWriter:
+    """Writes figures on one process per CPU while the report goes on (the drawing is most of a report's
+    time: measured 28 s of 30 for the default suite's 51 figures on one CPU). Use as a context manager;
+    :meth:`submit` returns a future of :func:`save`'s SVG text. One CPU: written at once, in this process."""
+
+    def __init__(self, workers: int | None = None) -> None:
+        self._workers = max(1, os.cpu_count() or 1) if workers is None else workers
+        self._pool: concurrent.futures.ProcessPoolExecutor | None = None
+
+    def __enter__(self) -> "FigureWriter":
+        if self._workers > 1:
+            self._pool = concurrent.futures.ProcessPoolExecutor(
+                self._workers, mp_context=multiprocessing.get_context("spawn"))
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=True, cancel_futures=exc[0] is not None)
+
+    def submit(self, fig, folder: Path, name: str) -> concurrent.futures.Future:
+        if self._pool is None:
+            done: concurrent.futures.Future = concurrent.futures.Future()
+            done.set_result(save(fig, folder, name))
+            return done
+        folder.mkdir(parents=True, exist_ok=True)
+        pickled = pickle.dumps(fig)
+        plt.close(fig)
+        return self._pool.submit(_save_pickled, pickled, folder, name)
