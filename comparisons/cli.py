@@ -217,13 +217,6 @@ def _cost(scenes) -> str:
 
 def cmd_run(args, out) -> int:
     start = time.perf_counter()
-    try:
-        return _run(args, out)
-    finally:
-        print(resource_line(time.perf_counter() - start), file=out, flush=True)
-
-
-def _run(args, out) -> int:
     repeats = (0 if args.quick else DEFAULT_REPEATS) if args.repeats is None else args.repeats
     if repeats < 0 or repeats > 100:
         raise SimparityError(f"--repeats {args.repeats}: out of range (allowed: 0 to 100; 0 times one cold call)")
@@ -249,6 +242,13 @@ def _run(args, out) -> int:
                              "(allowed: a folder you can write)") from None
     print(f"{_cost(scenes)}; {len(names)} engines, {min(jobs, len(scenes))} at once"
           + (" (quick profile)" if args.quick else ""), file=out, flush=True)
+    try:
+        return _run(args, out, scenes, names, engines, repeats, jobs, bounds, out_dir)
+    finally:  # what the run cost, also when it was interrupted or stopped by an error
+        print(resource_line(time.perf_counter() - start), file=out, flush=True)
+
+
+def _run(args, out, scenes, names, engines, repeats: int, jobs: int, bounds, out_dir: Path) -> int:
     writer = RunWriter(out_dir, engines, " ".join(["simparity"] + sys.argv[1:]), scenes)
     sizes = [count_cases(scene, engines) for scene in scenes]
     bar = ProgressBar(sum(sizes), sys.stderr)

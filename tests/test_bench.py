@@ -68,3 +68,14 @@ def test_a_small_real_run_measures_every_section(monkeypatch, tmp_path):
     assert core_rk4 and all(r.accuracy < 1e-9 for r in core_rk4)  # rk4 at dt 1e-3 over 20 steps
     bench.write_csv(rows, tmp_path / "benchmarks.csv")
     assert (tmp_path / "benchmarks.csv").read_text().count("\n") == len(rows) + 1
+
+
+def test_a_measurement_over_budget_is_skipped_with_its_probed_estimate(monkeypatch):
+    """The skip rule probes the batch size itself (a smaller batch's cost per body-step overestimated core's
+    batched cost a hundredfold and skipped rows that take a quarter second)."""
+    monkeypatch.setattr(bench, "DYNAMICS", (("core", "rk4"),))
+    monkeypatch.setattr(bench, "ERROR_STEPS", 5)
+    monkeypatch.setattr(bench, "BUDGET_SECONDS", 0.0)
+    rows = bench.dynamics_rows([2], quick=True, say=lambda line: None)
+    assert rows and all(not math.isfinite(r.value) and "steps predict" in r.note for r in rows)
+    assert all(math.isfinite(r.accuracy) for r in rows)  # the error is still measured

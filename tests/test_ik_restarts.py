@@ -9,6 +9,7 @@ import pytest
 
 from simparity.comparisons.ik_targets import random_targets
 from simparity.core.ik.jacobian_solvers import IKOptions, solve_ik
+from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.ik.restarts import RESTART_STREAM, Restarts, solve_ik_with_restarts
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.scene import sample_configurations
@@ -77,5 +78,25 @@ def test_the_in_house_engine_offers_the_restarted_solver_with_what_it_does_in_it
     model = InHouseEngine().build_ik(scene.chain, "damped_least_squares+restarts",
                                      IKOptions(scene.position_tolerance, scene.orientation_tolerance))
     assert "restarted from up to 16 seeded random configurations" in model.detail
-    with pytest.raises(ValueError, match="attempts"):
-        Restarts(attempts=-1)
+    for bad in (dict(attempts=-1), dict(attempts=2.5), dict(seed=None), dict(seed=-1), dict(max_iterations=0),
+                dict(starts_per_round=0)):
+        with pytest.raises(ValueError, match=f"Restarts.{next(iter(bad))} is .* \\(allowed: "):
+            Restarts(**bad)
+
+
+def test_a_target_beyond_the_real_reach_is_named_unreachable_not_capped():
+    """Held-out finding: beyond the arm's real reach but inside the triangle-inequality bound, short capped
+    attempts ended "iteration_cap"; judged at the best configuration they are "unreachable" like the plain
+    solver's (UR5 position targets 5 % farther than the farthest of its 10,000 random reachable targets)."""
+    scene = builtin("bench-ur5-ik")
+    chain = scene.chain
+    center, bound = reach_upper_bound(chain)
+    reachable = random_targets(scene, InHouseEngine().build_kinematics(chain)).position_world
+    distance = np.linalg.norm(reachable - center, axis=1)
+    targets = center + (reachable[:20] - center) / distance[:20, None] * 1.05 * distance.max()
+    assert np.all(np.linalg.norm(targets - center, axis=1) < bound)  # the cheap bound cannot tell
+    options = IKOptions(1e-6, 1e-6, 200)
+    plain = solve_ik(chain, targets, None, scene.q_start, "damped_least_squares", options)
+    restarted = solve_ik_with_restarts(chain, targets, None, scene.q_start, "damped_least_squares", options)
+    assert not restarted.success.any() and np.sum(plain.reason == "unreachable") >= 15
+    assert np.sum(restarted.reason == "unreachable") >= np.sum(plain.reason == "unreachable") - 2

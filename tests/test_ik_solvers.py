@@ -386,3 +386,12 @@ def test_damped_least_squares_is_the_svd_formula():
         expected = np.einsum("bkn,bk,bmk,bm->bn", vt, gain, u, err)
         got = steps.damped_least_squares_step(jac, err, 1e-2, 1e-3)
         np.testing.assert_allclose(got, expected, rtol=PINV_TOLERANCE, atol=PINV_TOLERANCE * np.abs(expected).max())
+
+
+def test_a_target_astronomically_far_is_refused_with_the_allowed_range():
+    """Held-out finding: [1e300, 0, 0] overflowed the squared residual (a RuntimeWarning, then an error about
+    IKResult); now the input check names the coordinate and the allowed range."""
+    with pytest.raises(ValueError, match=r"coordinate of 1e\+300 m \(allowed: up to 1e\+09 m"):
+        solve_ik(IIWA, np.array([[1e300, 0.0, 0.0]]))
+    far = solve_ik(IIWA, np.array([[1e8, 0.0, 0.0]]))
+    assert far.reason.tolist() == ["unreachable"]

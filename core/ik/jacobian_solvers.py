@@ -317,6 +317,19 @@ def _secondary_gradient(q, lower, upper, options):
     return z
 
 
+def failure_causes(chain: Chain, q: np.ndarray, target_position: np.ndarray, rows: int,
+                   options: IKTolerances) -> np.ndarray:
+    """The reason (B,) each target would get if its iteration stopped, unsolved, at ``q`` (B, n): the stall
+    rules of the module docstring, with a joint sitting at a limit counted as locked ("iteration_cap" where
+    none applies). ``rows``: 3 for position targets, 6 for poses."""
+    center, radius = reach_upper_bound(chain)
+    beyond = np.linalg.norm(target_position - center, axis=1) > radius + options.position_tolerance
+    frames = packed_frames(chain, q)
+    at_limit = (q <= chain.lower) | (q >= chain.upper)
+    return _classify(jacobian_of_frames(chain, frames)[:, :rows], at_limit, frames.positions[-1].T, target_position,
+                     center, beyond, options).astype(str)
+
+
 def _classify(jac, locked, end_world, target_position, center, beyond_reach, options):
     """Failure reason (B,) each target would get if it stopped now (see the module docstring)."""
     sigma_task = np.linalg.svd(jac, compute_uv=False)[:, -1]

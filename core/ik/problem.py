@@ -13,6 +13,10 @@ import numpy as np
 
 from simparity.core.scene import Chain
 
+MAX_TARGET_DISTANCE = 1e9
+"""[m] Largest distance of a target from the origin: a million kilometres is beyond any robot, and its
+residual's square (1e18) stays far from float64's overflow (1e308), where a 1e300 m target overflowed."""
+
 # Largest |R^T R - I| accepted for a target rotation: rotations built in float64 are
 # orthonormal to ~1e-15; 1e-9 still rejects anything that is not a rotation.
 _ROTATION_TOLERANCE = 1e-9
@@ -53,6 +57,10 @@ def check_inputs(chain: Chain, target_position, target_rotation, q_start):
     p = np.asarray(target_position, dtype=float)
     if p.ndim != 2 or p.shape[1] != 3 or not np.all(np.isfinite(p)):
         raise ValueError(f"target_position must be a finite (B, 3) array, got shape {p.shape}")
+    farthest = float(np.max(np.abs(p), initial=0.0))
+    if farthest > MAX_TARGET_DISTANCE:
+        raise ValueError(f"target_position has a coordinate of {farthest:.3g} m (allowed: up to "
+                         f"{MAX_TARGET_DISTANCE:.0e} m from the origin)")
     batch = p.shape[0]
     r = None
     if target_rotation is not None:

@@ -10,7 +10,11 @@ they are; this module only chooses where they start:
    uniform draws within the limits ([-pi, pi] rad or [-1, 1] m where unlimited), round after
    round until ``attempts`` draws per target are used;
 3. each target keeps a success, or else its best attempt (smallest
-   sqrt(position_residual^2 + orientation_residual^2)) with that attempt's reason.
+   sqrt(position_residual^2 + orientation_residual^2)) with that attempt's reason; where that
+   reason is only "iteration_cap" (a short attempt ends at its cap before it can stall), the
+   target is judged at its best configuration by the solver's stall rules
+   (:func:`core.ik.jacobian_solvers.failure_causes`: e.g. "unreachable" for an arm stretched
+   toward a target beyond it).
 
 A target beyond the chain's reach bound (:func:`core.ik.reach.reach_upper_bound`) is provably
 unreachable and is not restarted. The draws come from their own stream of ``seed`` (a
@@ -25,7 +29,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from simparity.core.ik.jacobian_solvers import IKOptions, solve_ik
+from simparity.core.ik.jacobian_solvers import IKOptions, failure_causes, solve_ik
 from simparity.core.ik.problem import check_inputs
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.ik.result import IKResult
@@ -64,9 +68,19 @@ class Restarts:
     seed: int = 0
 
     def __post_init__(self) -> None:
-        if self.attempts < 0 or self.starts_per_round < 1:
-            raise ValueError(f"Restarts needs attempts >= 0 and starts_per_round >= 1, got {self.attempts} and "
-                             f"{self.starts_per_round}")
+        def whole(value) -> bool:
+            return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+
+        checks = (("attempts", whole(self.attempts) and self.attempts >= 0, "a whole number >= 0"),
+                  ("starts_per_round", whole(self.starts_per_round) and self.starts_per_round >= 1,
+                   "a whole number >= 1"),
+                  ("max_iterations", self.max_iterations is None or (whole(self.max_iterations)
+                                                                     and self.max_iterations >= 1),
+                   "None or a whole number >= 1"),
+                  ("seed", whole(self.seed) and self.seed >= 0, "a whole number >= 0 (results are deterministic)"))
+        for name, ok, allowed in checks:
+            if not ok:
+                raise ValueError(f"Restarts.{name} is {getattr(self, name)!r} (allowed: {allowed})")
 
 
 _FIELDS = ("q", "success", "iterations", "position_residual", "orientation_residual", "limit_violation", "reason")
@@ -90,6 +104,7 @@ def solve_ik_with_restarts(
         options, max_iterations=min(options.max_iterations, restarts.max_iterations))
     result = solve_ik(chain, target_position, target_rotation, q_start, method, attempt)
     best = {name: np.array(getattr(result, name)) for name in _FIELDS}
+    best["reason"] = best["reason"].astype(object)  # a later attempt's reason may be longer than any so far
     center, radius = reach_upper_bound(chain)
     retry = np.linalg.norm(target_position - center, axis=1) <= radius + options.position_tolerance
     rng = np.random.default_rng(np.random.SeedSequence(restarts.seed, spawn_key=(RESTART_STREAM,)))
@@ -111,6 +126,10 @@ def solve_ik_with_restarts(
         for name in _FIELDS:
             if name != "iterations":
                 best[name][todo[take]] = getattr(again, name)[pick[take]]
+    capped = np.flatnonzero(best["reason"] == "iteration_cap")
+    if capped.size:
+        best["reason"][capped] = failure_causes(chain, best["q"][capped], target_position[capped],
+                                                3 if target_rotation is None else 6, options)
     return IKResult(**best)
 
 
