@@ -79,3 +79,13 @@ def test_a_measurement_over_budget_is_skipped_with_its_probed_estimate(monkeypat
     rows = bench.dynamics_rows([2], quick=True, say=lambda line: None)
     assert rows and all(not math.isfinite(r.value) and "steps predict" in r.note for r in rows)
     assert all(math.isfinite(r.accuracy) for r in rows)  # the error is still measured
+
+
+def test_memory_targets_say_whether_memory_is_flat_in_the_steps():
+    rows = [BenchRow("memory", "hard-million-steps", "simparity run", "every default engine", steps, mib, "MiB", 1.0,
+                     "s") for steps, mib in ((100_000, 330.0), (1_000_000, 960.0))]
+    verdicts = {target.split(" (")[0].split(" for ")[0]: (measured, met) for target, measured, met in targets(rows)
+                if "memory" in target}
+    assert verdicts["peak memory <= 1,024 MiB"][1] is True
+    flat_measured, flat_met = verdicts["memory flat in the number of steps"]
+    assert flat_met is False and "734 bytes per step" in flat_measured  # (960 - 330) MiB / 900,000 steps
