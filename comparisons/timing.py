@@ -42,11 +42,27 @@ def best_of(fn: Callable[[], T], repeats: int) -> tuple[float, T]:
     return best, result
 
 
+def _high_water_mark_bytes() -> int | None:
+    """This process's peak resident memory from Linux's /proc (VmHWM), None elsewhere. Unlike ru_maxrss, it
+    starts afresh at exec: a process started by a large one (a benchmark, a test run) does not report its
+    parent's size."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError):
+        return None
+    return None
+
+
 def peak_memory_bytes() -> tuple[int, int]:
-    """(peak resident memory of this process, of its largest finished child process) [bytes]."""
+    """(peak resident memory of this process, of its largest finished child process) [bytes].
+
+    A child's figure is ru_maxrss, which counts the parent's resident memory at the time it was started."""
     scale = 1 if sys.platform == "darwin" else 1024  # ru_maxrss is in bytes on macOS, KiB on Linux
-    return (resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale,
-            resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * scale)
+    own = _high_water_mark_bytes() or resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale
+    return own, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * scale
 
 
 def resource_line(seconds: float) -> str:
