@@ -67,6 +67,9 @@ DYNAMICS = (("core", "rk4"), ("core", "semi_implicit_euler"), ("core", "engine_e
 """(engine, integrator) of the stepping table; ``mujoco-rollout`` is :class:`BatchRollout`."""
 
 KINEMATICS = ("core", "pinocchio", "mujoco", "pybullet")
+KINEMATICS_SEED = 5
+ERROR_CONFIGURATIONS = 100
+"""Configurations of each batch (its first) whose FK and Jacobian are compared with Pinocchio's."""
 IK = (("core", "damped_least_squares"), ("core", "damped_least_squares+restarts"), ("mujoco", "dls"),
       ("pybullet", "calculateInverseKinematics"), ("pybullet", "calculateInverseKinematics-tuned"),
       ("pinocchio", "clik"))
@@ -181,23 +184,25 @@ def _kinematics_chains() -> list:
 def kinematics_rows(batches: list[int], say: Callable[[str], None]) -> list[BenchRow]:
     rows = []
     for chain in _kinematics_chains():
+        # Errors on every batch's first ERROR_CONFIGURATIONS configurations (one seeded draw), judged once.
+        judged = sample_configurations(chain, ERROR_CONFIGURATIONS, KINEMATICS_SEED)
         judge = make_engine("pinocchio").build_kinematics(chain)
+        ref_poses, ref_jacobian = judge.forward_kinematics(judged), judge.jacobian_world(judged)
         for engine in KINEMATICS:
             model = make_engine(engine).build_kinematics(chain)
             for batch in batches:
                 # Engines answer one configuration per call: their time per configuration is measured on
-                # at most 1,000, and the error on every batch's first 100.
+                # at most 1,000.
                 count = batch if engine == "core" else min(batch, 1000)
-                q = sample_configurations(chain, count, 5)
+                q = sample_configurations(chain, count, KINEMATICS_SEED)
 
                 def both():
                     return model.forward_kinematics(q), model.jacobian_world(q)
 
                 seconds = median_time(both, REPEATS if count * chain.n_joints < 50_000 else 2)
                 poses, jac = both()
-                k = min(count, 100)
-                ref = judge.forward_kinematics(q[:k])
-                errors = kinematics_errors(poses_slice(poses, k), jac[:k], ref, judge.jacobian_world(q[:k]))
+                k = min(count, ERROR_CONFIGURATIONS)
+                errors = kinematics_errors(poses_slice(poses, k), jac[:k], poses_slice(ref_poses, k), ref_jacobian[:k])
                 error = max(errors["position_error_max"].value, errors["jacobian_error_max"].value)
                 rows.append(BenchRow("kinematics", chain.name, engine, "fk+jacobian", batch, seconds / count * 1e6,
                                      "us/configuration", error, "m", "vs pinocchio" if engine != "pinocchio" else ""))

@@ -45,12 +45,21 @@ class _JointPlan:
     k2: Sparse
 
 
-_PLANS: dict[int, tuple[Chain, list[_JointPlan]]] = {}
+@dataclass(frozen=True)
+class _ChainPlan:
+    """A chain's constants for the packed FK: its joints', then the end effector's offset and rotation."""
+
+    joints: tuple[_JointPlan, ...]
+    end_xyz: Sparse
+    end_rotation: Sparse
+
+
+_PLANS: dict[int, tuple[Chain, _ChainPlan]] = {}
 """Joint plans of recently used chains, by id (a chain's arrays make it unhashable); checked by identity."""
 _PLAN_CACHE_SIZE = 64
 
 
-def _plan(chain: Chain) -> list[_JointPlan]:
+def _plan(chain: Chain) -> _ChainPlan:
     cached = _PLANS.get(id(chain))
     if cached is not None and cached[0] is chain:
         return cached[1]
@@ -61,6 +70,8 @@ def _plan(chain: Chain) -> list[_JointPlan]:
         plan.append(_JointPlan(joint.type == "revolute", _sparse(np.asarray(joint.origin_xyz, dtype=float)),
                                None if np.array_equal(rotation, np.eye(3)) else _sparse(rotation),
                                _sparse(np.asarray(joint.axis, dtype=float)), _sparse(k), _sparse(k @ k)))
+    plan = _ChainPlan(tuple(plan), _sparse(np.asarray(chain.end_effector_xyz, dtype=float)),
+                      _sparse(np.asarray(chain.end_effector_rotation, dtype=float)))
     if len(_PLANS) >= _PLAN_CACHE_SIZE:
         _PLANS.clear()
     _PLANS[id(chain)] = (chain, plan)
@@ -114,7 +125,8 @@ def packed_frames(chain: Chain, q: np.ndarray, all_rotations: bool = False) -> P
     r = np.zeros((3, 3, batch))
     r[0, 0] = r[1, 1] = r[2, 2] = 1.0
     positions, axes, rotations = [], [], []
-    for i, joint in enumerate(_plan(chain)):
+    plan = _plan(chain)
+    for i, joint in enumerate(plan.joints):
         p = p + _apply_constant(r, joint.origin_xyz)
         if joint.origin_rotation is not None:
             r = _times_constant(r, joint.origin_rotation)
@@ -128,8 +140,8 @@ def packed_frames(chain: Chain, q: np.ndarray, all_rotations: bool = False) -> P
         axes.append(axis_world)
         if all_rotations:
             rotations.append(r)
-    positions.append(p + _apply_constant(r, _sparse(np.asarray(chain.end_effector_xyz, dtype=float))))
-    end = _times_constant(r, _sparse(np.asarray(chain.end_effector_rotation, dtype=float)))
+    positions.append(p + _apply_constant(r, plan.end_xyz))
+    end = _times_constant(r, plan.end_rotation)
     if all_rotations:
         rotations.append(end)
     return PackedFrames(np.stack(positions), end, np.stack(axes) if axes else np.zeros((0, 3, batch)),

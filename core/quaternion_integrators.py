@@ -24,6 +24,7 @@ from typing import Callable
 import numpy as np
 
 from simparity.core.rigid_body import MassProperties, State, Wrench
+from simparity.core.rotations import quat_wxyz_from_rotvec, quat_wxyz_multiply, quat_wxyz_normalize
 
 X, Q, P, L = slice(0, 3), slice(3, 7), slice(7, 10), slice(10, 13)
 """Rows of the packed state."""
@@ -37,9 +38,6 @@ TABLEAUX: dict[str, tuple[list[list[float]], list[float], list[float]]] = {
     "midpoint": ([[], [0.5]], [0.0, 1.0], [0.0, 0.5]),
     "rk4": ([[], [0.5], [0.0, 0.5], [0.0, 0.0, 1.0]], [1 / 6, 1 / 3, 1 / 3, 1 / 6], [0.0, 0.5, 0.5, 1.0]),
 }
-
-# Below this half angle [rad] sin(h)/h uses its series (error ~1e-17 there).
-_SMALL_HALF_ANGLE = 1e-4
 
 CHUNK_ELEMENTS = 1 << 15
 """Samples x bodies per chunk of :meth:`PackedBodies.samples`: 256 KiB per row, in L2 cache."""
@@ -207,21 +205,13 @@ def semi_implicit_euler(bodies: PackedBodies, wrench: Wrench) -> PackedStep:
 
 def _quat_exp_body(q: np.ndarray, rotvec_body: np.ndarray) -> np.ndarray:
     """q exp(rotvec) (a body-frame increment), sign fixed to w >= 0. (4, B) x (3, B) -> (4, B)."""
-    half = 0.5 * np.sqrt(np.einsum("ib,ib->b", rotvec_body, rotvec_body))
-    small = half < _SMALL_HALF_ANGLE
-    h = np.where(small, 1.0, half)
-    scale = np.where(small, 0.5 * (1 - half * half / 6), np.sin(h) / (2 * h))
-    bw, (bx, by, bz) = np.cos(half), scale * rotvec_body
-    aw, ax, ay, az = q
-    out = np.empty_like(q)
-    out[0], out[1] = aw * bw - ax * bx - ay * by - az * bz, aw * bx + ax * bw + ay * bz - az * by
-    out[2], out[3] = aw * by - ax * bz + ay * bw + az * bx, aw * bz + ax * by - ay * bx + az * bw
-    out *= np.where(out[0] < 0, -1.0, 1.0)
-    return out / np.sqrt(np.einsum("ib,ib->b", out, out))
+    out = quat_wxyz_normalize(quat_wxyz_multiply(q.T, quat_wxyz_from_rotvec(rotvec_body.T)))
+    return (out * np.where(out[:, :1] < 0, -1.0, 1.0)).T
 
 
 def engine_euler(bodies: PackedBodies, wrench: Wrench) -> PackedStep:
-    """The engines' first-order scheme (:func:`core.integrators.engine_euler_step`) on the packed state."""
+    """The engines' first-order scheme (``engine_euler`` in :mod:`core.integrators`' docstring) on the packed
+    state."""
 
     def step(t: float, s: np.ndarray, dt: float) -> np.ndarray:
         v, omega, rotation = bodies.velocities(s)

@@ -34,6 +34,7 @@ from simparity.core.engine import IKModel
 from simparity.core.ik.problem import IKTolerances, check_inputs
 from simparity.core.ik.result import IKResult
 from simparity.core.scene import Chain
+from simparity.references.conventions import rotation_angle
 from simparity.references.ik_outcome import ik_outcome
 
 DT = 1e-2
@@ -57,10 +58,6 @@ def available(name: str) -> str:
 
 def _converged(options: IKTolerances, position: float, angle: float) -> bool:
     return position <= options.position_tolerance and angle <= options.orientation_tolerance
-
-
-def _angle(r: np.ndarray, r_target: np.ndarray) -> float:
-    return float(np.arccos(np.clip((np.trace(r.T @ r_target) - 1) / 2, -1.0, 1.0)))
 
 
 class MinkIK(IKModel):
@@ -96,7 +93,7 @@ class MinkIK(IKModel):
             while True:
                 pose = self._configuration.get_transform_frame_to_world(self._site, "site")
                 position[k] = np.linalg.norm(pose.translation() - p_world[k])
-                angle[k] = 0.0 if r is None else _angle(pose.rotation().as_matrix(), rotation)
+                angle[k] = 0.0 if r is None else float(rotation_angle(pose.rotation().as_matrix(), rotation))
                 if _converged(self._options, position[k], angle[k]) or steps >= self._options.max_iterations:
                     break
                 v = mink.solve_ik(self._configuration, [task], DT, QP_SOLVER, damping=DAMPING, limits=self._limits)
@@ -136,7 +133,7 @@ class PinkIK(IKModel):
             while True:
                 pose = configuration.get_transform_frame_to_world(self._frame)
                 position[k] = np.linalg.norm(pose.translation - p_world[k])
-                angle[k] = 0.0 if r is None else _angle(pose.rotation, rotation)
+                angle[k] = 0.0 if r is None else float(rotation_angle(pose.rotation, rotation))
                 if _converged(self._options, position[k], angle[k]) or steps >= self._options.max_iterations:
                     break
                 try:
