@@ -5,6 +5,7 @@ The project's top-level folders install as this package's subpackages
 ``simparity.reports``). The public API, importable from ``simparity``:
 
 - :func:`load_scene` ``(name_or_path) -> Scene``: a built-in scene by name, or a scene file;
+- :func:`load_scenes` ``(name_or_path) -> list[Scene]``: the same, or the variants of a file's ``[sweep]``;
 - :func:`run_scene` ``(scene, engines=..., repeats=...) -> pandas.DataFrame``: one tidy row
   per scene x engine x integrator x dt x metric;
 - :func:`read_run` ``(run_dir) -> (pandas.DataFrame, dict)``: a run stored by ``simparity run``.
@@ -17,6 +18,7 @@ from __future__ import annotations
 
 _PUBLIC = {
     "load_scene": "simparity.comparisons.api",
+    "load_scenes": "simparity.comparisons.api",
     "run_scene": "simparity.comparisons.api",
     "read_run": "simparity.reports.store",
 }

@@ -1,4 +1,4 @@
-"""The public Python API behind ``simparity.load_scene`` and ``simparity.run_scene``."""
+"""The public Python API behind ``simparity.load_scene``, ``simparity.load_scenes`` and ``simparity.run_scene``."""
 
 from __future__ import annotations
 
@@ -7,19 +7,27 @@ import pandas as pd
 from simparity.comparisons import library
 from simparity.comparisons.engines import DEFAULT_ENGINES, check_engine_names, make_engine
 from simparity.comparisons.runner import DEFAULT_REPEATS, run_scene as _run_scene
+from simparity.comparisons.scene_loader import load_scene as load_scene_file
 from simparity.core.results import COLUMNS
 from simparity.core.scene import Scene
 
 
 def load_scene(name_or_path: str) -> Scene:
-    """A built-in scene by name (see ``simparity list``) or a scene file, checked.
+    """A built-in scene by name (see ``simparity list``) or a scene file, checked; a file with a ``[sweep]``
+    is several scenes: :func:`load_scenes`.
 
     Raises
     ------
     simparity.core.errors.SimparityError
         For an unknown name or a bad scene file (the message names the file and key).
     """
-    return library.load([str(name_or_path)])[0]
+    return load_scene_file(library.resolve(str(name_or_path)))
+
+
+def load_scenes(name_or_path: str) -> list[Scene]:
+    """The scenes of a built-in scene name or a scene file, checked: its one scene, or the variants of its
+    ``[sweep]`` in the sweep's order (each with its swept values in ``scene.sweep``)."""
+    return library.load([str(name_or_path)])
 
 
 def run_scene(scene: Scene | str, engines=DEFAULT_ENGINES, repeats: int = DEFAULT_REPEATS) -> pd.DataFrame:

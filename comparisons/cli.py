@@ -1,4 +1,4 @@
-"""The ``simparity`` command: list, run, check, history, export, report.
+"""The ``simparity`` command: list, engines, run, check, history, export, show, report, bench.
 
 User mistakes (bad scene or tolerances files, unknown names, missing runs, a folder that already
 holds a run) print one line ``simparity: error: ...`` and exit with code 2; tracebacks are kept
@@ -10,6 +10,7 @@ nothing moved since the baseline, else 1. Results computed before an error are k
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import os
 import sys
@@ -20,12 +21,14 @@ from simparity.comparisons import library
 from simparity.comparisons.check import BASELINE_RELATIVE, CheckResult, check_table, compare_with_baseline
 from simparity.comparisons.check_output import junit_xml, summary_markdown
 from simparity.comparisons.describe import describe
-from simparity.comparisons.engines import DEFAULT_ENGINES, ENGINE_NAMES, check_engine_names, make_engine
+from simparity.comparisons.engines import DEFAULT_ENGINES, allowed_engines, check_engine_names, make_engine
 from simparity.comparisons.history import history_path, latest_before, metric_history, record_run, run_table
-from simparity.comparisons.parallel import default_jobs, run_scenes
+from simparity.comparisons.execution import count_cases, default_jobs, run_scenes
+from simparity.comparisons.isolation import DEFAULT_CASE_SECONDS, GIB, CaseLimits, IsolatedPool
+from simparity.comparisons.journal import Journal, read_request, run_lock, write_request
 from simparity.comparisons.profiles import apply_profile
 from simparity.comparisons.progress import ProgressBar
-from simparity.comparisons.runner import DEFAULT_REPEATS, count_cases
+from simparity.comparisons.runner import DEFAULT_REPEATS
 from simparity.comparisons.scene_limits import DEFAULT_LIMITS, Limits
 from simparity.comparisons.store import DEFAULT_OUT_ROOT, RunWriter, default_out_dir
 from simparity.comparisons.timing import resource_line
@@ -40,6 +43,11 @@ from simparity.reports.store import read_run
 
 EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 EXPORTABLE = ("mujoco", "pybullet", "pinocchio")
+EXECUTORS = ("local", "dask")
+MEMORY_HELP = "80%% of this machine's memory shared between the workers, at least 1 GiB"
+RESUMED_OPTIONS = ("scenes", "suite", "engines", "out", "force", "quick", "repeats", "max_steps", "max_samples",
+                   "max_joints")
+"""What a resumed run takes from the run it resumes (``resume.json``), never from the command line."""
 MESSAGE_LIMIT = 1000
 """Characters of an error message printed: one line, whatever the input echoed into it."""
 
@@ -87,6 +95,14 @@ def build_parser() -> argparse.ArgumentParser:
                              description="List the built-in scenes, one per line, with the suites they are in.")
     listing.add_argument("--suite", default=None, choices=SUITES, help="only the scenes of this suite")
 
+    sub.add_parser(
+        "engines", help="list the engines: built-in and installed plugins, with what each supports",
+        description="List every engine, one per line: its name (what --engines takes), where it comes from (built-in, "
+        "or the installed package and entry point of a plugin in the group 'simparity.engines'), its version, its "
+        "dynamics integrators, IK solvers and whether it does kinematics; an engine that cannot run says why, a "
+        "plugin shadowed by a built-in of the same name says so. Code that is not packaged runs as "
+        "--engines module:Class. Writing one: docs/plugins.md.")
+
     run = sub.add_parser(
         "run", help="run scenes on engines and write results.csv and report.md",
         description="Run scenes on engines; write results.csv, run.json and report.md into a new output folder, "
@@ -100,7 +116,7 @@ def build_parser() -> argparse.ArgumentParser:
                      "arms 'simparity bench' times, 10,000 IK targets each)")
     run.add_argument("--engines", type=_engine_list, default=DEFAULT_ENGINES, metavar="A,B,...",
                      help=f"comma-separated engines to run (default: {','.join(DEFAULT_ENGINES)}; "
-                     f"known: {','.join(ENGINE_NAMES)})")
+                     f"known: {allowed_engines()}; 'simparity engines' lists them)")
     run.add_argument("--out", type=Path, default=None, metavar="DIR",
                      help=f"output folder; must not hold a run yet (default: a new {DEFAULT_OUT_ROOT}/<UTC date-time>/)")
     run.add_argument("--force", action="store_true", help="overwrite the run already in --out")
@@ -111,7 +127,22 @@ def build_parser() -> argparse.ArgumentParser:
                      help="the CI profile: every scene shortened (3 coarsest time steps, <= 1000 steps, 50 IK "
                      "targets), about half a minute")
     run.add_argument("--jobs", type=int, default=None, metavar="N",
-                     help=f"scenes run at once, one process each (default: one per CPU, here {default_jobs()})")
+                     help=f"worker processes (with --executor dask and no --scheduler: the local cluster's workers; "
+                     f"default: one per CPU, here {default_jobs()})")
+    run.add_argument("--executor", choices=EXECUTORS, default="local",
+                     help="where cases run: local worker processes (default), or a Dask distributed cluster (a "
+                     "LocalCluster on this machine unless --scheduler is given; needs pip install 'simparity[dask]')")
+    run.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                     help="with --executor dask: the scheduler of a running cluster, e.g. tcp://10.0.0.5:8786")
+    run.add_argument("--case-timeout", type=float, default=DEFAULT_CASE_SECONDS, metavar="SECONDS",
+                     help="a case still running after this long is killed and becomes a failed row (default: "
+                     f"{DEFAULT_CASE_SECONDS:g})")
+    run.add_argument("--case-memory", type=float, default=None, metavar="GIB",
+                     help="a case whose worker's resident memory passes this is killed and becomes a failed row "
+                     f"(default: {MEMORY_HELP})")
+    run.add_argument("--resume", type=Path, default=None, metavar="DIR",
+                     help="finish the interrupted run in DIR: its finished cases are kept, the rest run; give no "
+                     "scenes, --suite, --engines, --out, --quick, --repeats or --max-* (the run's own are used)")
     run.add_argument("--max-steps", type=int, default=DEFAULT_LIMITS.max_steps, metavar="N",
                      help="refuse a case of more than N body-steps per time step, or IK targets x max_iterations "
                      f"(default: {DEFAULT_LIMITS.max_steps:,})")
@@ -185,6 +216,14 @@ def cmd_list(args, out) -> int:
     return EXIT_OK
 
 
+def cmd_engines(args, out) -> int:
+    from simparity.comparisons.engine_listing import engine_lines  # builds every engine: only when asked
+
+    for line in engine_lines():
+        print(line, file=out)
+    return EXIT_OK
+
+
 def _out_dir(args) -> Path:
     """The run's folder: --out (refused when it holds a run, unless --force), else a new one."""
     if args.out is None:
@@ -206,17 +245,49 @@ def _checked_out_dir(out_dir: Path, force: bool) -> Path:
     return out_dir
 
 
-def _cost(scenes) -> str:
-    """What the run will do, counted before it starts."""
-    steps = sum(s.n_steps(dt) * len(s.bodies) for s in scenes if isinstance(s, DynamicsScene) for dt in s.dts)
-    samples = sum(s.n_configurations for s in scenes if isinstance(s, KinematicsScene))
-    targets = sum(s.n_targets + len(s.hard_targets) for s in scenes if isinstance(s, IKScene))
-    return (f"{len(scenes)} scenes: {steps:,} body-steps per integrator, {samples:,} configurations, "
-            f"{targets:,} IK targets per solver")
+def _resumed(args) -> None:
+    """Fill ``args`` with what the run in ``--resume DIR`` was asked to do; refuse options that would change it."""
+    defaults = build_parser().parse_args(["run"])
+    given = [name for name in RESUMED_OPTIONS if getattr(args, name) != getattr(defaults, name)]
+    if given:
+        flags = ", ".join("SCENE" if name == "scenes" else "--" + name.replace("_", "-") for name in given)
+        raise SimparityError(f"--resume {one_line(args.resume)} with {flags}: a resumed run does what it was asked to "
+                             "(allowed with --resume: --jobs, --executor, --scheduler, --case-timeout, --case-memory, "
+                             "--check and its options, --history)")
+    request = read_request(args.resume)
+    try:
+        for name in RESUMED_OPTIONS:
+            if name not in ("out", "force"):
+                setattr(args, name, request[name] if name != "engines" else tuple(request[name]))
+    except (KeyError, TypeError) as err:
+        raise SimparityError(f"--resume {one_line(args.resume)}: its request lacks {one_line(err)} (allowed: the "
+                             "file a run wrote)") from None
+    args.out, args.force = args.resume, True
+
+
+def _request(args, names: tuple[str, ...], repeats: int) -> dict:
+    """What this run is asked to do, for ``--resume``: scene files by absolute path, everything else as given."""
+    scenes = [str(Path(a).resolve()) if Path(a).is_file() else a for a in args.scenes]
+    return {"scenes": scenes, "suite": args.suite, "engines": list(names), "repeats": repeats, "quick": args.quick,
+            "max_steps": args.max_steps, "max_samples": args.max_samples, "max_joints": args.max_joints}
+
+
+def _limits(args, jobs: int) -> CaseLimits:
+    """The per-case limits from --case-timeout and --case-memory (default: a share of this machine)."""
+    if not (math.isfinite(args.case_timeout) and args.case_timeout > 0):
+        raise SimparityError(f"--case-timeout {args.case_timeout}: out of range (allowed: a number of seconds > 0)")
+    limits = CaseLimits.default(jobs)
+    if args.case_memory is None:
+        return CaseLimits(args.case_timeout, limits.memory_bytes)
+    if not (math.isfinite(args.case_memory) and 0 < args.case_memory <= 1e6):
+        raise SimparityError(f"--case-memory {args.case_memory}: out of range (allowed: GiB > 0, up to 1e6)")
+    return CaseLimits(args.case_timeout, int(args.case_memory * GIB))
 
 
 def cmd_run(args, out) -> int:
     start = time.perf_counter()
+    if args.resume is not None:
+        _resumed(args)
     repeats = (0 if args.quick else DEFAULT_REPEATS) if args.repeats is None else args.repeats
     if repeats < 0 or repeats > 100:
         raise SimparityError(f"--repeats {args.repeats}: out of range (allowed: 0 to 100; 0 times one cold call)")
@@ -225,12 +296,16 @@ def cmd_run(args, out) -> int:
                         ("--max-joints", args.max_joints), ("--jobs", jobs)):
         if value < 1:
             raise SimparityError(f"{flag} {value}: out of range (allowed: a whole number >= 1)")
+    if args.scheduler is not None and args.executor != "dask":
+        raise SimparityError(f"--scheduler {one_line(args.scheduler)} without --executor dask (allowed: add --executor "
+                             "dask, or drop --scheduler)")
+    limits = _limits(args, jobs)
     names = check_engine_names(args.engines)
-    limits = Limits(max_steps=args.max_steps, max_samples=args.max_samples, max_joints=args.max_joints)
+    run_limits = Limits(max_steps=args.max_steps, max_samples=args.max_samples, max_joints=args.max_joints)
     if args.scenes and args.suite:
         raise SimparityError(f"--suite {args.suite} with scenes named: give one (allowed: scene names or files, "
                              "or --suite)")
-    chosen = library.load(args.scenes, limits) if args.scenes else library.suite(args.suite or "default", limits)
+    chosen = library.load(args.scenes, run_limits) if args.scenes else library.suite(args.suite or "default", run_limits)
     scenes = apply_profile(chosen, "quick" if args.quick else "full")
     bounds = load_tolerances(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
     engines = [make_engine(n) for n in names]
@@ -240,36 +315,69 @@ def cmd_run(args, out) -> int:
     except (OSError, ValueError) as err:  # ValueError: a NUL byte in the name
         raise SimparityError(f"--out {one_line(out_dir)}: cannot create the folder: {getattr(err, 'strerror', None) or err} "
                              "(allowed: a folder you can write)") from None
-    print(f"{_cost(scenes)}; {len(names)} engines, {min(jobs, len(scenes))} at once"
-          + (" (quick profile)" if args.quick else ""), file=out, flush=True)
-    try:
-        return _run(args, out, scenes, names, engines, repeats, jobs, bounds, out_dir)
-    finally:  # what the run cost, also when it was interrupted or stopped by an error
-        print(resource_line(time.perf_counter() - start), file=out, flush=True)
+    with run_lock(out_dir):
+        if args.resume is None:  # a new run: nothing of a run --force replaces is reused
+            write_request(out_dir, _request(args, names, repeats))
+            Journal(out_dir).clear()
+        where = (f"{jobs} worker processes" if args.executor == "local" else
+                 f"Dask at {args.scheduler}" if args.scheduler else f"a local Dask cluster of {jobs} workers")
+        print(f"{_cost(scenes)}; {len(names)} engines; {where}" + (" (quick profile)" if args.quick else "")
+              + (f"; resuming {len(Journal(out_dir))} finished cases" if args.resume else ""), file=out, flush=True)
+        try:
+            return _run(args, out, scenes, engines, repeats, _executor(args, jobs, limits), bounds, out_dir,
+                        dict(zip((e.name for e in engines), names)))
+        finally:  # what the run cost, also when it was interrupted or stopped by an error
+            print(resource_line(time.perf_counter() - start), file=out, flush=True)
 
 
-def _run(args, out, scenes, names, engines, repeats: int, jobs: int, bounds, out_dir: Path) -> int:
+def _executor(args, jobs: int, limits: CaseLimits):
+    if args.executor == "dask":
+        from simparity.comparisons.dask_executor import DaskExecutor  # imports Dask: only when asked
+
+        return DaskExecutor(args.scheduler, jobs, limits)
+    return IsolatedPool(jobs, limits)
+
+
+def _cost(scenes) -> str:
+    """What the run will do, counted before it starts."""
+    steps = sum(s.n_steps(dt) * len(s.bodies) for s in scenes if isinstance(s, DynamicsScene) for dt in s.dts)
+    samples = sum(s.n_configurations for s in scenes if isinstance(s, KinematicsScene))
+    targets = sum(s.n_targets + len(s.hard_targets) for s in scenes if isinstance(s, IKScene))
+    return (f"{len(scenes)} scenes: {steps:,} body-steps per integrator, {samples:,} configurations, "
+            f"{targets:,} IK targets per solver")
+
+
+def _run(args, out, scenes, engines, repeats: int, executor, bounds, out_dir: Path, specs: dict[str, str]) -> int:
     writer = RunWriter(out_dir, engines, " ".join(["simparity"] + sys.argv[1:]), scenes)
-    sizes = [count_cases(scene, engines) for scene in scenes]
+    sizes = count_cases(scenes, engines, make_engine)
     bar = ProgressBar(sum(sizes), sys.stderr)
     failed = 0
+    journal = Journal(out_dir)
     try:
-        for k, (scene, rows, series) in enumerate(run_scenes(scenes, names, repeats, jobs,
-                                                             bar.case_done if bar.active else None)):
-            writer.append(rows, series)
-            counts = case_counts(rows)
-            failed += counts[FAILED]
-            bar.scene_done(sum(sizes[:k + 1]))
-            print(f"{scene.name}: {sum(counts.values())} cases ("
-                  + ", ".join(f"{s} {c}" for s, c in counts.items() if c) + ")", file=out, flush=True)
+        with contextlib.closing(executor):
+            results = run_scenes(scenes, engines, make_engine, repeats, executor, journal,
+                                 bar.case_done if bar.active else None, specs)
+            for k, (scene, rows, series) in enumerate(results):
+                writer.append(rows, series)
+                counts = case_counts(rows)
+                failed += counts[FAILED]
+                bar.scene_done(sum(sizes[:k + 1]))
+                print(f"{scene.name}: {sum(counts.values())} cases ("
+                      + ", ".join(f"{s} {c}" for s, c in counts.items() if c) + ")", file=out, flush=True)
     except KeyboardInterrupt:
         bar.clear()
-        print(f"interrupted; results so far are in {writer.results_path}", file=out)
+        print(f"interrupted; results so far are in {writer.results_path}; finish the run with: simparity run "
+              f"--resume {out_dir}", file=out)
         _write_report(out_dir, out, bounds)
         return EXIT_INTERRUPTED
     except SimparityError:
         _write_report(out_dir, out, bounds)  # keep what was computed, then report the error
         raise
+    if journal.unfinished:
+        print(f"{journal.unfinished} cases did not finish (crashed, hung or out of memory): 'simparity run --resume "
+              f"{out_dir}' tries them again", file=out)
+    else:
+        journal.remove()
     checked = _write_report(out_dir, out, bounds)
     _record(out_dir, args.history)
     code = EXIT_FAILED_CASES if failed else EXIT_OK
@@ -360,14 +468,19 @@ def cmd_export(args, out) -> int:
     if args.dt is not None and not (args.dt > 0 and RANGES["dt"].allows(args.dt)):
         raise SimparityError(f"--dt {args.dt}: not a time step (allowed: a finite number of seconds > 0, "
                              f"{RANGES['dt'].text()})")
-    scene = library.load([args.scene])[0]
+    scenes = library.load([args.scene])
+    if len(scenes) > 1:
+        raise SimparityError(f"{one_line(args.scene)}: a sweep of {len(scenes)} variants; export takes one (allowed: a "
+                             f"variant's name as 'simparity list' prints it, e.g. {scenes[0].name}, or a file without "
+                             "[sweep])")
+    scene = scenes[0]
     engine = make_engine(args.engine)
     print(engine.export(scene, args.integrator, args.dt), file=out, end="")
     return EXIT_OK
 
 
 def cmd_show(args, out) -> int:
-    print(describe(library.load([args.scene])[0]), file=out, end="")
+    print("\n".join(describe(scene) for scene in library.load([args.scene])), file=out, end="")
     return EXIT_OK
 
 
@@ -387,7 +500,7 @@ def cmd_report(args, out) -> int:
     return EXIT_OK
 
 
-_COMMANDS = {"list": cmd_list, "run": cmd_run, "check": cmd_check, "history": cmd_history, "export": cmd_export,
+_COMMANDS = {"list": cmd_list, "engines": cmd_engines, "run": cmd_run, "check": cmd_check, "history": cmd_history, "export": cmd_export,
              "show": cmd_show, "report": cmd_report, "bench": cmd_bench}
 
 

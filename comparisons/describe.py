@@ -1,14 +1,15 @@
 """``simparity show``: a scene as the loader understood it, in SI units and the project's conventions.
 
 It reports what the loader computed (a body built from point masses: its mass, centre of mass and
-inertia tensor; planes normalised to unit normals; every body-plane material) so a user can check
-the scene before running it.
+inertia tensor; planes normalised to unit normals; every body-plane material; a sweep's variant: its
+swept values) so a user can check the scene before running it.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from simparity.comparisons.sweep import value_text
 from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
 
 
@@ -64,6 +65,10 @@ def describe(scene) -> str:
     """The text ``simparity show`` prints for ``scene``."""
     head = [f"scene {scene.name} ({scene.kind}), reference {scene.reference}, suites {', '.join(scene.suites)}",
             f"from {scene.source}"]
+    if scene.sweep is not None:
+        values = ", ".join(f"{key} = {value_text(value)}" for key, value in scene.sweep.values)
+        head.append(f"variant {scene.sweep.index + 1} of {scene.sweep.count} of the sweep of {scene.sweep.base}: "
+                    f"{values} (as written in the file)")
     if isinstance(scene, DynamicsScene):
         forces = scene.forces
         gravity = "none" if forces.gravity_world is None else f"{_vector(forces.gravity_world)} m/s^2"

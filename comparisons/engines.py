@@ -1,10 +1,19 @@
-"""The engines simparity knows, by name, imported only when asked for."""
+"""The engines simparity knows, by name, imported only when asked for: the built-ins, the installed plugins
+(:mod:`comparisons.plugins`), and any engine named by its spec ``module:attr``.
+
+A built-in name wins over a plugin of the same name. Asking for a built-in never looks for plugins, and
+nothing here raises for an engine that cannot run: it comes back as an engine standing in for it
+(:mod:`comparisons.placeholder_engines`), whose rows say why.
+"""
 
 from __future__ import annotations
 
+import functools
 import importlib
 
-from simparity.core.engine import Engine, KinematicsModel, Simulation, Support
+from simparity.comparisons.placeholder_engines import UnavailableEngine
+from simparity.comparisons.plugins import discover, is_spec, load_engine
+from simparity.core.engine import Engine
 from simparity.core.errors import UnknownEngineError, one_line
 
 _ENGINES = {
@@ -16,65 +25,57 @@ _ENGINES = {
     "tight": ("simparity.references.tight", "TightSolveEngine"),
 }
 ENGINE_NAMES = tuple(_ENGINES)
+"""The built-in engines (a scene's reference is one of them)."""
 DEFAULT_ENGINES = ("core", "analytic", "mujoco", "pybullet", "pinocchio")
 """What ``simparity run`` runs unless told otherwise; ``tight`` serves as a reference only."""
 
 
-class UnavailableEngine(Engine):
-    """An engine whose library failed to import: every scene gets n/a with the import error."""
+def plugin_names() -> tuple[str, ...]:
+    """The installed plugins ``--engines`` can name (shadowed ones left out)."""
+    return tuple(discover(ENGINE_NAMES).usable())
 
-    def __init__(self, name: str, error: str) -> None:
-        self.name = name
-        self._reason = f"{name} is not importable here: {error}"
 
-    def version(self) -> str:
-        return "unavailable"
-
-    def integrators(self) -> tuple[str, ...]:
-        return ("-",)
-
-    def supports_dynamics(self, scene, integrator: str) -> Support:
-        return Support.no(self._reason)
-
-    def build_dynamics(self, scene, integrator: str, dt: float) -> Simulation:
-        raise RuntimeError(self._reason)
-
-    def supports_kinematics(self, chain) -> Support:
-        return Support.no(self._reason)
-
-    def build_kinematics(self, chain) -> KinematicsModel:
-        raise RuntimeError(self._reason)
-
-    def supports_ik(self, chain, solver: str, position_only: bool) -> Support:
-        return Support.no(self._reason)
+def allowed_engines() -> str:
+    """What ``--engines`` takes, for messages and help: the built-ins, the installed plugins, a spec."""
+    plugins = "".join(f", {name} (plugin)" for name in plugin_names())
+    return f"{', '.join(ENGINE_NAMES)}{plugins}, or module:Class"
 
 
 def check_engine_names(names) -> tuple[str, ...]:
-    """The names, checked against :data:`ENGINE_NAMES`, duplicates dropped; raises UnknownEngineError."""
-    unknown = [n for n in names if n not in _ENGINES]
+    """The names, checked against the built-ins, the installed plugins and the spec form ``module:attr``
+    (not imported here), duplicates dropped; raises UnknownEngineError."""
+    unknown = [n for n in names if n not in _ENGINES and not is_spec(n)]
+    if unknown:  # only now look for plugins: naming built-ins never does
+        unknown = [n for n in unknown if n not in plugin_names()]
     if unknown:
-        raise UnknownEngineError(
-            f"unknown engine(s): {one_line(', '.join(unknown))} (allowed: {', '.join(ENGINE_NAMES)})"
-        )
+        raise UnknownEngineError(f"unknown engine(s): {one_line(', '.join(unknown))} (allowed: {allowed_engines()}; "
+                                 "'simparity engines' lists them)")
     if not names:
-        raise UnknownEngineError(f"no engine named (allowed: {', '.join(ENGINE_NAMES)})")
+        raise UnknownEngineError(f"no engine named (allowed: {allowed_engines()})")
     return tuple(dict.fromkeys(names))
 
 
 def make_engine(name: str) -> Engine:
-    """The engine called ``name``, or an :class:`UnavailableEngine` if its library won't import."""
+    """The engine called ``name`` (a built-in, a plugin, or a spec ``module:attr``), or one standing in for it
+    when it cannot run (:mod:`comparisons.placeholder_engines`)."""
     check_engine_names([name])
-    module, cls = _ENGINES[name]
-    try:
-        return getattr(importlib.import_module(module), cls)()
-    except ImportError as err:
-        return UnavailableEngine(name, str(err))
+    if name in _ENGINES:
+        module, cls = _ENGINES[name]
+        try:
+            return getattr(importlib.import_module(module), cls)()
+        except ImportError as err:
+            return UnavailableEngine(name, str(err))
+    plugins = discover(ENGINE_NAMES).usable()
+    if name in plugins:
+        return load_engine(plugins[name].target, name)
+    return load_engine(name, taken=frozenset(ENGINE_NAMES) | frozenset(plugins))
 
 
+@functools.lru_cache(maxsize=1)
 def known_integrators() -> tuple[str, ...]:
-    """Every integrator name some engine offers (for checking scene files)."""
+    """Every integrator name some engine offers, built-in or plugin (for checking scene files). Cached: each
+    engine is built once per process; a plugin that cannot run offers none."""
     names = {}
-    for engine in ENGINE_NAMES:
+    for engine in ENGINE_NAMES + plugin_names():
         names.update(dict.fromkeys(make_engine(engine).integrators()))
-    names.pop("-", None)
     return tuple(names)

@@ -19,10 +19,11 @@ Per engine x solver (the ``integrator`` column holds the solver; ``dt`` is NaN):
 from __future__ import annotations
 
 import math
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 
+from simparity.comparisons.cases import CaseGroup, CaseOutcome, CaseSpec
 from simparity.comparisons.ik_targets import ORIENTATION_ONLY, Targets, hard_target, random_targets
 from simparity.comparisons.rows import Case, Measured, error_text, warnings_into_rows
 from simparity.comparisons.series import disagreement_matrix, quantiles
@@ -179,91 +180,108 @@ def _distributions(case: Case, result: IKResult) -> list[SeriesRecord]:
             + ([quantiles(case, "iterations", "1", iterations)] if iterations.size else []))
 
 
-def _case_rows(scene: IKScene, engine: Engine, case: Case, options: IKTolerances, random: Targets,
-               hard: list[Targets], judges: dict[str, KinematicsModel], repeats: int,
-               series: _SceneSeries) -> list[ResultRow]:
+def _case_outcome(scene: IKScene, engine: Engine, case: Case, options: IKTolerances, random: Targets,
+                  hard: list[Targets], judges: dict[str, KinematicsModel], repeats: int) -> CaseOutcome:
     try:
         support = engine.supports_ik(scene.chain, case.integrator, scene.target_kind == "position")
     except Exception as err:  # noqa: BLE001 - reported in the rows
         problem = error_text(err)
-        return case.rows(IK_METRICS, FAILED, problem) + _hard_rows(case, hard, [None] * len(hard), FAILED, problem)
+        return CaseOutcome(case.rows(IK_METRICS, FAILED, problem)
+                           + _hard_rows(case, hard, [None] * len(hard), FAILED, problem))
     if not support.ok:
-        return (case.rows(IK_METRICS, NOT_AVAILABLE, support.reason)
-                + _hard_rows(case, hard, [None] * len(hard), NOT_AVAILABLE, support.reason))
+        return CaseOutcome(case.rows(IK_METRICS, NOT_AVAILABLE, support.reason)
+                           + _hard_rows(case, hard, [None] * len(hard), NOT_AVAILABLE, support.reason))
     try:
         model = engine.build_ik(scene.chain, case.integrator, options)
         seconds, result = best_of(lambda: _solve(model, random, scene.q_start), repeats)
         hard_results = _solve_each(model, hard, scene.q_start)
     except Exception as err:  # noqa: BLE001 - reported in the rows
         problem = error_text(err)
-        return case.rows(IK_METRICS, FAILED, problem) + _hard_rows(case, hard, [None] * len(hard), FAILED, problem)
+        return CaseOutcome(case.rows(IK_METRICS, FAILED, problem)
+                           + _hard_rows(case, hard, [None] * len(hard), FAILED, problem))
     values = {m: Measured(v, IK_METRICS[m]) for m, v in _summary(result, scene.q_start, seconds).items()}
     agreement, ends = _cross_evaluation(scene, random, result.q, judges)
     values.update({m: Measured(v, IK_METRICS[m]) for m, v in agreement.items()})
-    series.add(_distributions(case, result), ends)
     if engine.name in judges:
         values["start_rank_deficiency"] = start_rank_deficiency(scene, judges[engine.name])
-    return (case.rows(IK_METRICS, OK, f"{model.detail}; {random.note}", values)
+    rows = (case.rows(IK_METRICS, OK, f"{model.detail}; {random.note}", values)
             + _hard_rows(case, hard, hard_results, OK, ""))
+    return CaseOutcome(rows, _distributions(case, result), ends=ends, reference_label=case.reference)
 
 
-class _SceneSeries:
-    """The series of an IK scene: each case's distributions, and every solution's end-effector
-    position by each judge, for the FK agreement matrix."""
-
-    def __init__(self) -> None:
-        self.records: list[SeriesRecord] = []
-        self.ends: dict[str, list[np.ndarray]] = {}
-
-    def add(self, records: list[SeriesRecord], ends: dict[str, np.ndarray]) -> None:
-        self.records += records
-        for judge, end in ends.items():
-            self.ends.setdefault(judge, []).append(end)
-
-    def all(self, case: Case) -> list[SeriesRecord]:
-        ends = {judge: np.concatenate(parts) for judge, parts in self.ends.items()}
-        return self.records + disagreement_matrix(case, ends)
+def _skipped(scene: IKScene) -> dict[str, str]:
+    """The metrics of the hard targets a position-only scene has no orientation for."""
+    return {m: u for name in scene.hard_targets if scene.target_kind == "position" and name in ORIENTATION_ONLY
+            for m, u in hard_metrics(name).items()}
 
 
-def run_ik_scene(scene: IKScene, engines: list[Engine], make_reference: Callable[[str], Engine],
-                 repeats: int, series: list[SeriesRecord] | None = None,
-                 progress: Callable[[str, str], None] = lambda engine, solver: None) -> list[ResultRow]:
-    """All rows of an IK scene; the reference engine's FK generates the targets. When ``series`` is
-    a list, the scene's sampled series (:mod:`comparisons.series`) are appended to it; ``progress(engine,
-    solver)`` is called after each case."""
-    options = IKTolerances(position_tolerance=scene.position_tolerance, orientation_tolerance=scene.orientation_tolerance,
+def _options(scene: IKScene) -> IKTolerances:
+    return IKTolerances(position_tolerance=scene.position_tolerance, orientation_tolerance=scene.orientation_tolerance,
                         max_iterations=scene.max_iterations)
-    reference = make_reference(scene.reference)
-    fk, status, reason = None, NOT_AVAILABLE, ""
-    try:
-        support = reference.supports_kinematics(scene.chain)
-        reason = support.reason
-        if support.ok:
-            fk = reference.build_kinematics(scene.chain)
-    except Exception as err:  # noqa: BLE001 - reported in the rows
-        status, reason = FAILED, f"failed: {error_text(err)}"
+
+
+def run_ik_group(group: CaseGroup, engine_for: Callable[[str], Engine], on_start: Callable[[int | None], None],
+                 skip: frozenset[int], reference_failure: str) -> Iterator[tuple[int, CaseOutcome]]:
+    """(index, outcome) of every case of an IK group but those in ``skip``: the reference engine's FK
+    generates the targets, every engine of the run that can build the chain judges the solutions.
+    ``reference_failure``: why the targets are not to be made again (it took the worker down)."""
+    scene = group.scene
+    on_start(None)
+    fk, status, reason = None, FAILED, f"failed: {reference_failure}"
+    if not reference_failure:
+        status, reason = NOT_AVAILABLE, ""
+        try:
+            support = engine_for(scene.reference).supports_kinematics(scene.chain)
+            reason = support.reason
+            if support.ok:
+                fk = engine_for(scene.reference).build_kinematics(scene.chain)
+        except Exception as err:  # noqa: BLE001 - reported in the rows
+            status, reason = FAILED, f"failed: {error_text(err)}"
+    skipped = _skipped(scene)
     if fk is None:
         problem = f"reference {scene.reference} cannot make the targets: {reason}"
-        return [row for engine in engines for solver in engine.ik_solvers() or ("-",)
-                for row in Case(scene.name, engine.name, solver, math.nan, f"{scene.reference}:fk").rows(
-                    IK_METRICS, status, problem)]
-    position_only = scene.target_kind == "position"
+        for index, spec in enumerate(group.cases):
+            if index not in skip:
+                case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label)
+                yield index, CaseOutcome(case.rows(IK_METRICS, status, problem))
+        return
     random = random_targets(scene, fk)
     hard = [hard_target(scene, name, fk) for name in scene.hard_targets
-            if not (position_only and name in ORIENTATION_ONLY)]
-    skipped = {m: u for name in scene.hard_targets if position_only and name in ORIENTATION_ONLY
-               for m, u in hard_metrics(name).items()}
-    judges = _judges(scene, engines)
+            if not (scene.target_kind == "position" and name in ORIENTATION_ONLY)]
+    judges = _judges(scene, [engine_for(name) for name in group.engine_names])
     label = f"{scene.reference}:fk (targets); cross-evaluated by {', '.join(judges)}"
-    rows: list[ResultRow] = []
-    collected = _SceneSeries()
-    for engine in engines:
-        for solver in engine.ik_solvers() or ("-",):
-            case = Case(scene.name, engine.name, solver, math.nan, label)
-            with warnings_into_rows(rows):
-                rows += _case_rows(scene, engine, case, options, random, hard, judges, repeats, collected)
-            rows += case.rows(skipped, NOT_AVAILABLE, "position-only scene: no orientation to target")
-            progress(engine.name, solver)
-    if series is not None:
-        series += collected.all(Case(scene.name, "", "", math.nan, label))
-    return rows
+    for index, spec in enumerate(group.cases):
+        if index in skip:
+            continue
+        on_start(index)
+        case = Case(scene.name, spec.engine, spec.integrator, math.nan, label)
+        rows: list[ResultRow] = []
+        with warnings_into_rows(rows):
+            outcome = _case_outcome(scene, engine_for(spec.engine), case, _options(scene), random, hard, judges,
+                                    group.repeats)
+            rows += outcome.rows
+        outcome.rows = rows + case.rows(skipped, NOT_AVAILABLE, "position-only scene: no orientation to target")
+        outcome.reference_label = label
+        yield index, outcome
+
+
+def failed_ik_outcome(group: CaseGroup, spec: CaseSpec, cause: str) -> CaseOutcome:
+    """``failed`` rows of every metric of an IK case that did not finish (its worker crashed, hung or ran out
+    of memory), naming ``cause``."""
+    scene = group.scene
+    case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label)
+    metrics = dict(IK_METRICS)
+    for name in scene.hard_targets:
+        metrics |= hard_metrics(name)
+    return CaseOutcome(case.rows(metrics, FAILED, cause), harness_failure=True)
+
+
+def ik_scene_series(scene: IKScene, outcomes: list[CaseOutcome]) -> list[SeriesRecord]:
+    """The FK agreement matrix of an IK scene: every judge's end-effector positions over every case's solutions."""
+    ends: dict[str, list[np.ndarray]] = {}
+    for outcome in outcomes:
+        for judge, end in outcome.ends.items():
+            ends.setdefault(judge, []).append(end)
+    label = next((o.reference_label for o in outcomes if o.reference_label), f"{scene.reference}:fk")
+    return disagreement_matrix(Case(scene.name, "", "", math.nan, label),
+                               {judge: np.concatenate(parts) for judge, parts in ends.items()})

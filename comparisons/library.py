@@ -1,11 +1,13 @@
-"""The built-in scene library (``comparisons/scenes/*.toml``) and scene lookup by name or path."""
+"""The built-in scene library (``comparisons/scenes/*.toml``) and scene lookup by name or path; a file with a
+``[sweep]`` gives its variants, in the sweep's order."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from simparity.comparisons.scene_limits import DEFAULT_LIMITS, Limits
-from simparity.comparisons.scene_loader import load_scene
+from simparity.comparisons.scene_loader import load_scenes
+from simparity.comparisons.sweep import SWEEP_TABLE
 from simparity.core.errors import UnknownSceneError, one_line
 from simparity.core.files import file_problem, read_toml
 from simparity.core.scene import SUITES
@@ -48,6 +50,28 @@ def suite(name: str, limits: Limits = DEFAULT_LIMITS) -> list:
     return load(members, limits)
 
 
+def _builtin_variant(name: str, limits: Limits):
+    """The variant named ``name`` (as ``simparity list`` shows it) of a built-in file with a ``[sweep]``, or None.
+    Found by loading the built-in sweeps, never by reading values back from the name."""
+    for path in builtin_paths().values():
+        if SWEEP_TABLE in read_toml(path, what="scene file"):
+            found = [scene for scene in load_scenes(path, limits) if scene.name == name]
+            if found:
+                return found[0]
+    return None
+
+
 def load(names_or_paths, limits: Limits = DEFAULT_LIMITS) -> list:
-    """Every named scene, all checked before any is returned (so a run never starts on a bad file)."""
-    return [load_scene(resolve(n), limits) for n in names_or_paths]
+    """Every named scene, all checked before any is returned (so a run never starts on a bad file); a file
+    with a ``[sweep]`` in its place gives its variants, in the sweep's order, and a built-in variant's name
+    (``restitution-sweep_restitution-0.7``) that one variant."""
+    scenes = []
+    for name in names_or_paths:
+        try:
+            scenes += load_scenes(resolve(name), limits)
+        except UnknownSceneError:
+            variant = _builtin_variant(str(name), limits)
+            if variant is None:
+                raise
+            scenes.append(variant)
+    return scenes

@@ -1,21 +1,38 @@
-"""Runs scenes on engines and measures them against each scene's reference.
+"""Runs cases on engines and measures them against each scene's reference.
 
 Every scene x engine x integrator x dt gets one row per metric: ``ok`` with a value, or
 ``n/a`` / ``failed`` / ``diverged`` with the reason in ``detail``. An engine that raises
 becomes ``failed`` rows; the run goes on.
+
+A scene is planned into groups of cases (:mod:`comparisons.cases`); :func:`run_group` runs one
+group wherever it is sent (this process, a worker process, a Dask worker), yielding each case's
+outcome as it finishes; :func:`assemble_scene` puts a scene's outcomes together in its stored
+order, with the observed orders of convergence and the IK agreement matrix. :func:`run_scene` does
+all three in this process.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 
+from simparity.comparisons.cases import (
+    DYNAMICS,
+    IK,
+    KINEMATICS,
+    NO_INTEGRATOR,
+    STABILITY,
+    CaseGroup,
+    CaseOutcome,
+    CaseSpec,
+    plan_scene,
+)
 from simparity.comparisons.contact_metrics import contact_metrics
 from simparity.comparisons.divergence import blow_up
-from simparity.comparisons.ik_runner import run_ik_scene
+from simparity.comparisons.ik_runner import failed_ik_outcome, ik_scene_series, run_ik_group
 from simparity.comparisons.metrics import (
     KINEMATICS_METRICS,
     ORDER_METRICS,
@@ -37,10 +54,16 @@ from simparity.comparisons.timing import best_of
 from simparity.core.engine import Engine, Support
 from simparity.core.errors import DivergedError
 from simparity.core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
-from simparity.core.scene import PENALTY_PREFIX, DynamicsScene, IKScene, KinematicsScene
+from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
 
 Progress = Callable[[str, str], None]
 """Called with (engine, integrator or solver) after each case of a scene."""
+
+EngineFor = Callable[[str], Engine]
+"""The engine of a name (the run's engines, the scene's reference)."""
+
+OnStart = Callable[[int | None], None]
+"""Called before a group's shared part (None: the reference) and before each case (its index)."""
 
 DEFAULT_REPEATS = 3
 """Timed repeats per measurement (the minimum is kept), after one warm-up run."""
@@ -65,88 +88,213 @@ class _Ladder:
     """The cases of one engine x integrator over the scene's time steps, for the order fits."""
 
     dts: list[float] = field(default_factory=list)
-    cases: list[_CaseResult] = field(default_factory=list)
+    cases: list[CaseOutcome] = field(default_factory=list)
 
     @property
     def integrates_rotation(self) -> bool:
         return all(case.integrates_rotation for case in self.cases)
 
 
-def _integrators(scene: DynamicsScene, engine: Engine) -> tuple[list[str], str]:
-    """(the engine's integrators the scene runs, reason when none)."""
-    offered = list(engine.scene_integrators(scene))
-    chosen = [i for i in offered if not scene.integrators or i in scene.integrators]
-    reason = "" if chosen else (
-        f"the scene runs only {', '.join(scene.integrators)}; {engine.name} offers {', '.join(offered)}")
-    return chosen, reason
+def _ignore_start(index: int | None) -> None:
+    return None
 
 
-def _dynamics(scene: DynamicsScene, engines: list[Engine], reference: Engine, repeats: int,
-              series: list[SeriesRecord] | None, progress: Progress) -> list[ResultRow]:
-    rows: list[ResultRow] = []
+def run_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart = _ignore_start,
+              skip: frozenset[int] = frozenset(), reference_failure: str = "") -> Iterator[tuple[int, CaseOutcome]]:
+    """(index, outcome) of every case of ``group`` but those in ``skip``, as each finishes.
+
+    ``reference_failure``, when given, is why the group's shared part (reference trajectory, FK,
+    targets) is not to be computed again (it took its worker down): the cases run without it.
+    """
+    runner = {DYNAMICS: _dynamics_group, STABILITY: _stability_group, KINEMATICS: _kinematics_group,
+              IK: run_ik_group}[group.kind]
+    yield from runner(group, engine_for, on_start, skip, reference_failure)
+
+
+def _dynamics_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart, skip: frozenset[int],
+                    reference_failure: str) -> Iterator[tuple[int, CaseOutcome]]:
+    scene, dt = group.scene, group.dt
+    n = scene.n_steps(dt)
     metrics = dynamics_metrics(scene)
-    ref_integrator = reference.scene_integrators(scene)[0]
-    ref_label = f"{reference.name}:{ref_integrator}"
+    on_start(None)
+    ref_traj, ref_problem = _reference_trajectory(scene, engine_for(scene.reference), dt, group.reference_label,
+                                                  reference_failure)
+    for index, spec in enumerate(group.cases):
+        if index in skip:
+            continue
+        on_start(index)
+        engine = engine_for(spec.engine)
+        case = Case(scene.name, spec.engine, spec.integrator, dt, group.reference_label)
+        if spec.integrator == NO_INTEGRATOR:
+            yield index, CaseOutcome(_no_integrator_rows(scene, engine, case, metrics))
+            continue
+        rows: list[ResultRow] = []
+        series: list[SeriesRecord] = []
+        is_reference = group.reference_label == f"{spec.engine}:{spec.integrator}"
+        with warnings_into_rows(rows):
+            result = _dynamics_case(scene, engine, case, metrics, n, ref_traj, ref_problem, group.repeats,
+                                    is_reference, series)
+            rows += result.rows
+        yield index, CaseOutcome(rows, series, result.errors, result.floors, result.integrates_rotation)
+
+
+def _no_integrator_rows(scene: DynamicsScene, engine: Engine, case: Case, metrics: dict) -> list[ResultRow]:
+    """The rows of an engine that runs none of the scene's integrators: n/a with why (the engine's own refusal
+    when it offers none, e.g. its library does not import), failed when it cannot even say."""
     try:
-        ref_support = reference.supports_dynamics(scene, ref_integrator)
-    except Exception as err:  # noqa: BLE001 - reported in the rows
-        ref_support = Support.no(f"failed: {error_text(err)}")
-    ladders: dict[tuple[str, str], _Ladder] = {}
-    for dt in scene.dts:
-        n = scene.n_steps(dt)
-        ref_traj, ref_problem, ref_status = None, "", NOT_AVAILABLE
-        if not ref_support.ok:
-            ref_problem = f"reference {ref_label} cannot do this scene: {ref_support.reason}"
+        offered = tuple(engine.scene_integrators(scene))
+        if offered:
+            reason = f"the scene runs only {', '.join(scene.integrators)}; {engine.name} offers {', '.join(offered)}"
         else:
+            reason = engine.supports_dynamics(scene, NO_INTEGRATOR).reason or f"{engine.name} offers no integrator"
+    except Exception as err:  # noqa: BLE001 - a user's engine failed to describe itself
+        return case.rows(metrics, FAILED, error_text(err))
+    return case.rows(metrics, NOT_AVAILABLE, reason)
+
+
+def _reference_trajectory(scene: DynamicsScene, reference: Engine, dt: float, label: str,
+                          reference_failure: str) -> tuple[object, tuple[str, str]]:
+    """(the reference trajectory at ``dt`` or None, (why there is none, the status that gives))."""
+    if reference_failure:
+        return None, (f"reference {label} failed: {reference_failure}", FAILED)
+    integrator = label.split(":", 1)[1]
+    try:
+        support = reference.supports_dynamics(scene, integrator)
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        support = Support.no(f"failed: {error_text(err)}")
+    if not support.ok:
+        return None, (f"reference {label} cannot do this scene: {support.reason}", NOT_AVAILABLE)
+    try:
+        with np.errstate(all="ignore"):
+            traj = reference.build_dynamics(scene, integrator, dt).run(scene.n_steps(dt))
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        return None, (f"reference {label} failed: {error_text(err)}", FAILED)
+    if not traj.is_finite():
+        return None, (f"reference {label} diverged (non-finite state)", NOT_AVAILABLE)
+    return traj, ("", NOT_AVAILABLE)
+
+
+def _stability_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart, skip: frozenset[int],
+                     reference_failure: str) -> Iterator[tuple[int, CaseOutcome]]:
+    """The measured stability limit of every penalty-method integrator of the group (:mod:`comparisons.stability`)."""
+    scene = group.scene
+    on_start(None)
+    for index, spec in enumerate(group.cases):
+        if index in skip:
+            continue
+        on_start(index)
+        engine = engine_for(spec.engine)
+        case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label)
+        rows: list[ResultRow] = []
+        with warnings_into_rows(rows):
             try:
-                with np.errstate(all="ignore"):
-                    ref_traj = reference.build_dynamics(scene, ref_integrator, dt).run(n)
-                if not ref_traj.is_finite():
-                    ref_traj, ref_problem = None, f"reference {ref_label} diverged (non-finite state)"
-            except Exception as err:  # noqa: BLE001 - reported in the rows
-                ref_problem, ref_status = f"reference {ref_label} failed: {error_text(err)}", FAILED
-        for engine in engines:
-            chosen, reason = _integrators(scene, engine)
-            if not chosen:
-                rows += Case(scene.name, engine.name, "-", dt, ref_label).rows(metrics, NOT_AVAILABLE, reason)
-            for integrator in chosen:
-                case = Case(scene.name, engine.name, integrator, dt, ref_label)
-                is_reference = engine.name == reference.name and integrator == ref_integrator
-                with warnings_into_rows(rows):
-                    result = _dynamics_case(scene, engine, case, metrics, n, ref_traj, (ref_problem, ref_status),
-                                            repeats, is_reference, series)
-                    rows += result.rows
-                ladder = ladders.setdefault((engine.name, integrator), _Ladder())
-                ladder.dts.append(dt)
-                ladder.cases.append(result)
-                progress(engine.name, integrator)
-    if len(scene.dts) > 1:
-        rows += _orders(scene, ladders, ref_label)
-    if scene.contact is not None:
-        rows += _stability_limits(scene, engines, ref_label)
-    return rows
-
-
-def _stability_limits(scene: DynamicsScene, engines: list[Engine], ref_label: str) -> list[ResultRow]:
-    """The measured stability limit of every penalty-method integrator of the scene (:mod:`comparisons.stability`)."""
-    rows: list[ResultRow] = []
-    for engine in engines:
-        for integrator in _integrators(scene, engine)[0]:
-            if not integrator.startswith(PENALTY_PREFIX):
-                continue
-            case = Case(scene.name, engine.name, integrator, math.nan, ref_label)
-            with warnings_into_rows(rows):
-                try:
-                    support = engine.supports_dynamics(scene, integrator)
-                    if not support.ok:
-                        rows += case.rows(STABILITY_METRICS, NOT_AVAILABLE, support.reason)
-                        continue
-                    limit = stable_dt_max(scene, engine, integrator)
+                support = engine.supports_dynamics(scene, spec.integrator)
+                if not support.ok:
+                    rows += case.rows(STABILITY_METRICS, NOT_AVAILABLE, support.reason)
+                else:
+                    limit = stable_dt_max(scene, engine, spec.integrator)
                     rows += case.rows(STABILITY_METRICS, OK, f"measured by bisection on {scene.name}",
                                       {"stable_dt_max": limit})
-                except Exception as err:  # noqa: BLE001 - reported in the rows
-                    rows += case.rows(STABILITY_METRICS, FAILED, error_text(err))
-    return rows
+            except Exception as err:  # noqa: BLE001 - reported in the rows
+                rows += case.rows(STABILITY_METRICS, FAILED, error_text(err))
+        yield index, CaseOutcome(rows)
+
+
+def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref_traj, ref_problem: tuple[str, str],
+                   repeats: int, is_reference: bool, series: list[SeriesRecord]) -> _CaseResult:
+    """One case; ``ref_problem`` is (why there is no reference trajectory, the status that gives).
+    The case's sampled series are appended to ``series``."""
+    try:
+        support = engine.supports_dynamics(scene, case.integrator)
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        return _CaseResult(case.rows(metrics, FAILED, error_text(err)))
+    if not support.ok:
+        return _CaseResult(case.rows(metrics, NOT_AVAILABLE, support.reason))
+    try:
+        sim = engine.build_dynamics(scene, case.integrator, case.dt)
+        with np.errstate(all="ignore"):  # a diverging run overflows; it is reported as diverged
+            seconds, traj = best_of(lambda: sim.run(n), repeats)
+    except DivergedError as err:
+        return _CaseResult(case.rows(metrics, DIVERGED, str(err)))
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        return _CaseResult(case.rows(metrics, FAILED, error_text(err)))
+    values = {"time_per_step": Measured(seconds / n, "s")}
+    with np.errstate(all="ignore"):
+        blown, reading = blow_up(scene, traj)
+        if blown:
+            return _CaseResult(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values),
+                               integrates_rotation=sim.integrates_rotation)
+        changes = conserved_changes(scene, traj)
+        values.update(drifts(scene, traj, changes))
+        heights = None if reading is None else reading.distance[:, 0].min(axis=-1)
+        series += dynamics_series(case, traj, ref_traj, changes, heights)
+        floors = rounding_floors(scene, traj, n)
+        if ref_traj is None:
+            if reading is not None:
+                values.update(contact_metrics(scene, traj, None, reading))
+            problem, status = ref_problem
+            return _CaseResult(case.partial_rows(metrics, values, sim.detail, status, problem), {}, floors,
+                               sim.integrates_rotation)
+        values.update(trajectory_errors(traj, ref_traj))
+        if reading is not None:
+            values.update(contact_metrics(scene, traj, ref_traj, reading))
+    detail = ("this is the reference; " if is_reference else "") + sim.detail
+    return _CaseResult(case.rows(metrics, OK, detail, values), {m: v.value for m, v in values.items()}, floors,
+                       sim.integrates_rotation)
+
+
+def _kinematics_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart, skip: frozenset[int],
+                      reference_failure: str) -> Iterator[tuple[int, CaseOutcome]]:
+    scene = group.scene
+    q = scene.configurations()
+    ref_label = group.reference_label
+    ref, ref_problem, ref_status = None, "", NOT_AVAILABLE
+    on_start(None)
+    if reference_failure:
+        ref_problem, ref_status = f"reference {ref_label} failed: {reference_failure}", FAILED
+    else:
+        try:
+            reference = engine_for(scene.reference)
+            ref_support = reference.supports_kinematics(scene.chain)
+            if not ref_support.ok:
+                ref_problem = f"reference {ref_label} cannot do this chain: {ref_support.reason}"
+            else:
+                model = reference.build_kinematics(scene.chain)
+                ref = (model.forward_kinematics(q), model.jacobian_world(q))
+        except Exception as err:  # noqa: BLE001 - reported in the rows
+            ref_problem, ref_status = f"reference {ref_label} failed: {error_text(err)}", FAILED
+    for index, spec in enumerate(group.cases):
+        if index in skip:
+            continue
+        on_start(index)
+        case = Case(scene.name, spec.engine, "", math.nan, ref_label)
+        rows: list[ResultRow] = []
+        with warnings_into_rows(rows):
+            rows += _kinematics_case(scene, engine_for(spec.engine), case, q, ref, (ref_problem, ref_status),
+                                     group.repeats, spec.engine == scene.reference)
+        yield index, CaseOutcome(rows)
+
+
+def _kinematics_case(scene: KinematicsScene, engine: Engine, case: Case, q: np.ndarray, ref, ref_problem: tuple[str, str],
+                     repeats: int, is_reference: bool) -> list[ResultRow]:
+    """Rows of one engine's FK and Jacobian at configurations ``q`` against ``ref`` = (poses, Jacobians) or None."""
+    try:
+        support = engine.supports_kinematics(scene.chain)
+        if not support.ok:
+            return case.rows(KINEMATICS_METRICS, NOT_AVAILABLE, support.reason)
+        model = engine.build_kinematics(scene.chain)
+        fk_seconds, poses = best_of(lambda: model.forward_kinematics(q), repeats)
+        jac_seconds, jac = best_of(lambda: model.jacobian_world(q), repeats)
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        return case.rows(KINEMATICS_METRICS, FAILED, error_text(err))
+    values = {"time_per_fk": Measured(fk_seconds / len(q), "s"), "time_per_jacobian": Measured(jac_seconds / len(q), "s")}
+    if not (np.all(np.isfinite(poses.position_world)) and np.all(np.isfinite(jac))):
+        return case.rows(KINEMATICS_METRICS, DIVERGED, "non-finite FK or Jacobian", values)
+    if ref is None:
+        problem, status = ref_problem
+        return case.partial_rows(KINEMATICS_METRICS, values, model.detail, status, problem)
+    values.update(kinematics_errors(poses, jac, *ref))
+    return case.rows(KINEMATICS_METRICS, OK, ("this is the reference; " if is_reference else "") + model.detail, values)
 
 
 def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_label: str) -> list[ResultRow]:
@@ -172,121 +320,71 @@ def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_l
     return rows
 
 
-def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref_traj, ref_problem: tuple[str, str],
-                   repeats: int, is_reference: bool, series: list[SeriesRecord] | None) -> _CaseResult:
-    """One case; ``ref_problem`` is (why there is no reference trajectory, the status that gives).
-    The case's sampled series go to ``series`` unless it is None."""
-    try:
-        support = engine.supports_dynamics(scene, case.integrator)
-    except Exception as err:  # noqa: BLE001 - reported in the rows
-        return _CaseResult(case.rows(metrics, FAILED, error_text(err)))
-    if not support.ok:
-        return _CaseResult(case.rows(metrics, NOT_AVAILABLE, support.reason))
-    try:
-        sim = engine.build_dynamics(scene, case.integrator, case.dt)
-        with np.errstate(all="ignore"):  # a diverging run overflows; it is reported as diverged
-            seconds, traj = best_of(lambda: sim.run(n), repeats)
-    except DivergedError as err:
-        return _CaseResult(case.rows(metrics, DIVERGED, str(err)))
-    except Exception as err:  # noqa: BLE001 - reported in the rows
-        return _CaseResult(case.rows(metrics, FAILED, error_text(err)))
-    values = {"time_per_step": Measured(seconds / n, "s")}
-    with np.errstate(all="ignore"):
-        blown, reading = blow_up(scene, traj)
-        if blown:
-            return _CaseResult(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values),
-                               integrates_rotation=sim.integrates_rotation)
-        changes = conserved_changes(scene, traj)
-        values.update(drifts(scene, traj, changes))
-        if series is not None:
-            heights = None if reading is None else reading.distance[:, 0].min(axis=-1)
-            series += dynamics_series(case, traj, ref_traj, changes, heights)
-        floors = rounding_floors(scene, traj, n)
-        if ref_traj is None:
-            if reading is not None:
-                values.update(contact_metrics(scene, traj, None, reading))
-            problem, status = ref_problem
-            return _CaseResult(case.partial_rows(metrics, values, sim.detail, status, problem), {}, floors,
-                               sim.integrates_rotation)
-        values.update(trajectory_errors(traj, ref_traj))
-        if reading is not None:
-            values.update(contact_metrics(scene, traj, ref_traj, reading))
-    detail = ("this is the reference; " if is_reference else "") + sim.detail
-    return _CaseResult(case.rows(metrics, OK, detail, values), {m: v.value for m, v in values.items()}, floors,
-                       sim.integrates_rotation)
+def failed_outcome(group: CaseGroup, spec: CaseSpec, cause: str) -> CaseOutcome:
+    """The outcome of a case that did not finish (its worker crashed, hung or ran out of memory):
+    ``failed`` rows of every metric the case has, naming ``cause``."""
+    scene = group.scene
+    if group.kind == IK:
+        return failed_ik_outcome(group, spec, cause)
+    metrics = {DYNAMICS: lambda: dynamics_metrics(scene), STABILITY: lambda: STABILITY_METRICS,
+               KINEMATICS: lambda: KINEMATICS_METRICS}[group.kind]()
+    case = Case(scene.name, spec.engine, spec.integrator, group.dt, group.reference_label)
+    return CaseOutcome(case.rows(metrics, FAILED, cause), harness_failure=True)
 
 
-def _kinematics(scene: KinematicsScene, engines: list[Engine], reference: Engine, repeats: int,
-                progress: Progress) -> list[ResultRow]:
-    q = scene.configurations()
-    ref_label = f"{reference.name}:fk"
-    ref, ref_problem, ref_status = None, "", NOT_AVAILABLE
-    try:
-        ref_support = reference.supports_kinematics(scene.chain)
-        if not ref_support.ok:
-            ref_problem = f"reference {ref_label} cannot do this chain: {ref_support.reason}"
-        else:
-            model = reference.build_kinematics(scene.chain)
-            ref = (model.forward_kinematics(q), model.jacobian_world(q))
-    except Exception as err:  # noqa: BLE001 - reported in the rows
-        ref_problem, ref_status = f"reference {ref_label} failed: {error_text(err)}", FAILED
-    rows: list[ResultRow] = []
-    for engine in engines:
-        case = Case(scene.name, engine.name, "", math.nan, ref_label)
-        with warnings_into_rows(rows):
-            rows += _kinematics_case(scene, engine, case, q, ref, (ref_problem, ref_status), repeats,
-                                     engine.name == reference.name)
-        progress(engine.name, "")
-    return rows
-
-
-def _kinematics_case(scene: KinematicsScene, engine: Engine, case: Case, q: np.ndarray, ref, ref_problem: tuple[str, str],
-                     repeats: int, is_reference: bool) -> list[ResultRow]:
-    """Rows of one engine's FK and Jacobian at configurations ``q`` against ``ref`` = (poses, Jacobians) or None."""
-    try:
-        support = engine.supports_kinematics(scene.chain)
-        if not support.ok:
-            return case.rows(KINEMATICS_METRICS, NOT_AVAILABLE, support.reason)
-        model = engine.build_kinematics(scene.chain)
-        fk_seconds, poses = best_of(lambda: model.forward_kinematics(q), repeats)
-        jac_seconds, jac = best_of(lambda: model.jacobian_world(q), repeats)
-    except Exception as err:  # noqa: BLE001 - reported in the rows
-        return case.rows(KINEMATICS_METRICS, FAILED, error_text(err))
-    values = {"time_per_fk": Measured(fk_seconds / len(q), "s"), "time_per_jacobian": Measured(jac_seconds / len(q), "s")}
-    if not (np.all(np.isfinite(poses.position_world)) and np.all(np.isfinite(jac))):
-        return case.rows(KINEMATICS_METRICS, DIVERGED, "non-finite FK or Jacobian", values)
-    if ref is None:
-        problem, status = ref_problem
-        return case.partial_rows(KINEMATICS_METRICS, values, model.detail, status, problem)
-    values.update(kinematics_errors(poses, jac, *ref))
-    return case.rows(KINEMATICS_METRICS, OK, ("this is the reference; " if is_reference else "") + model.detail, values)
+def assemble_scene(scene, groups: list[CaseGroup],
+                   outcomes: list[list[CaseOutcome]]) -> tuple[list[ResultRow], list[SeriesRecord]]:
+    """A scene's rows and series in their stored order from every case's outcome (``outcomes[g][c]`` of
+    case c of group g), with what needs them all: the observed orders of a dynamics scene (after the
+    time steps' rows, before the stability limits), the FK agreement matrix of an IK scene."""
+    ladders: dict[tuple[str, str], _Ladder] = {}
+    for group, results in zip(groups, outcomes):
+        for spec, outcome in zip(group.cases, results):
+            if group.kind == DYNAMICS and spec.integrator != NO_INTEGRATOR:
+                ladder = ladders.setdefault((spec.engine, spec.integrator), _Ladder())
+                ladder.dts.append(group.dt)
+                ladder.cases.append(outcome)
+    rows = [row for group, results in zip(groups, outcomes) if group.kind != STABILITY
+            for outcome in results for row in outcome.rows]
+    if isinstance(scene, DynamicsScene) and len(scene.dts) > 1:
+        rows += _orders(scene, ladders, groups[0].reference_label)
+    rows += [row for group, results in zip(groups, outcomes) if group.kind == STABILITY
+             for outcome in results for row in outcome.rows]
+    series = [record for results in outcomes for outcome in results for record in outcome.series]
+    if isinstance(scene, IKScene):
+        series += ik_scene_series(scene, [outcome for results in outcomes for outcome in results])
+    return rows, series
 
 
 def run_scene(
     scene, engines: list[Engine], make_reference: Callable[[str], Engine], repeats: int = DEFAULT_REPEATS,
     series: list[SeriesRecord] | None = None, progress: Progress | None = None,
 ) -> list[ResultRow]:
-    """All rows of one scene on ``engines``, measured against ``make_reference(scene.reference)``.
+    """All rows of one scene on ``engines``, measured against ``make_reference(scene.reference)``, in this process.
 
     When ``series`` is a list, the scene's sampled series (:mod:`comparisons.series`) are appended to it;
-    ``progress(engine, integrator)`` is called after each case (:func:`count_cases` of them).
+    ``progress(engine, integrator)`` is called after each case.
     """
     progress = progress or _no_progress
-    if isinstance(scene, IKScene):
-        return run_ik_scene(scene, engines, make_reference, repeats, series, progress)
-    reference = make_reference(scene.reference)
-    if isinstance(scene, DynamicsScene):
-        return _dynamics(scene, engines, reference, repeats, series, progress)
-    return _kinematics(scene, engines, reference, repeats, progress)
+    by_name = {e.name: e for e in engines}
 
+    def engine_for(name: str) -> Engine:
+        if name not in by_name:
+            by_name[name] = make_reference(name)
+        return by_name[name]
 
-def count_cases(scene, engines: list[Engine]) -> int:
-    """How many times :func:`run_scene` calls ``progress`` for ``scene``: its cases, order fits aside."""
-    if isinstance(scene, IKScene):
-        return sum(len(engine.ik_solvers() or ("-",)) for engine in engines)
-    if isinstance(scene, DynamicsScene):
-        return len(scene.dts) * sum(len(_integrators(scene, engine)[0]) for engine in engines)
-    return len(engines)
+    groups = plan_scene(scene, engines, engine_for(scene.reference), repeats)
+    outcomes = []
+    for group in groups:
+        results = []
+        for index, outcome in run_group(group, engine_for):
+            results.append(outcome)
+            progress(group.cases[index].engine, group.cases[index].integrator)
+        outcomes.append(results)
+    rows, records = assemble_scene(scene, groups, outcomes)
+    if series is not None:
+        series += records
+    return rows
 
 
 def _no_progress(engine: str, integrator: str) -> None:

@@ -1,20 +1,22 @@
 """Scene files (TOML) -> :class:`core.scene.DynamicsScene` / :class:`core.scene.KinematicsScene`.
 
 Every value is checked; a bad one raises :class:`core.errors.SceneError` naming the file,
-the key path, what was wrong and what is allowed. The format is documented in
-``docs/scenes.md``.
+the key path, what was wrong and what is allowed. A file with a ``[sweep]`` is several scenes, one per
+variant (:mod:`comparisons.sweep`; :func:`load_scenes`). The format is documented in ``docs/scenes.md``.
 """
 
 from __future__ import annotations
 
 import math
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from simparity.comparisons.engines import ENGINE_NAMES, known_integrators
 from simparity.comparisons.scene_limits import DEFAULT_LIMITS, POSITION_TOLERANCE_OF_REACH, Limits, allowed_at_most
+from simparity.comparisons.sweep import SWEEP_TABLE, read_sweep
 from simparity.core.dh import chain_from_dh
 from simparity.core.errors import SceneError, echo, one_line
 from simparity.core.files import file_problem, read_toml
@@ -682,7 +684,12 @@ def _check_reference(top: _Reader, scene) -> None:
 
 
 def parse_scene(data: dict, source: str = "<scene>", limits: Limits = DEFAULT_LIMITS):
-    """Build a scene from parsed TOML ``data``; ``source`` names it in error messages."""
+    """Build a scene from parsed TOML ``data``; ``source`` names it in error messages. Data with a ``[sweep]``
+    is several scenes: :func:`parse_scenes`."""
+    if SWEEP_TABLE in data:
+        raise SceneError(source, SWEEP_TABLE, "the file sweeps keys: it is several scenes, not one",
+                         "load_scenes or parse_scenes (comparisons.scene_loader), library.load, simparity.load_scenes "
+                         "or simparity run FILE, which expand it into its variants")
     try:
         return _parse(data, source, limits)
     except SceneError as err:
@@ -714,7 +721,34 @@ def _parse(data: dict, source: str, limits: Limits):
     return scene
 
 
+def parse_scenes(data: dict, source: str = "<scene>", limits: Limits = DEFAULT_LIMITS) -> list:
+    """The scenes of parsed TOML ``data``: the one it describes, or the variants of its ``[sweep]`` in the
+    sweep's order. The file without its ``[sweep]`` must be a valid scene; each variant is checked like a file
+    written by hand with its values, and an error in one names the sweep key and value
+    (:meth:`comparisons.sweep.Sweep.refusal`)."""
+    if SWEEP_TABLE not in data:
+        return [parse_scene(data, source, limits)]
+    base_data = {key: value for key, value in data.items() if key != SWEEP_TABLE}
+    base = parse_scene(base_data, source, limits)
+    sweep = read_sweep(data[SWEEP_TABLE], base_data, source, base.name)
+    scenes = []
+    for name, variant, point in sweep.variants(base_data):
+        try:
+            scene = parse_scene(variant, source, limits)
+        except SceneError as err:
+            raise sweep.refusal(err, point) from None
+        scenes.append(replace(scene, name=name, sweep=point))
+    return scenes
+
+
+def load_scenes(path: str | Path, limits: Limits = DEFAULT_LIMITS) -> list:
+    """Read and check one scene file (a regular file of at most ``limits.max_file_bytes``): its scene, or the
+    variants of its ``[sweep]``."""
+    source = str(path)
+    return parse_scenes(read_toml(source, limits.max_file_bytes, "scene file"), source, limits)
+
+
 def load_scene(path: str | Path, limits: Limits = DEFAULT_LIMITS):
-    """Read and check one scene file (a regular file of at most ``limits.max_file_bytes``)."""
+    """Read and check one scene file without a ``[sweep]`` (a file with one: :func:`load_scenes`)."""
     source = str(path)
     return parse_scene(read_toml(source, limits.max_file_bytes, "scene file"), source, limits)

@@ -21,8 +21,10 @@ from simparity.core.results import (
     SCHEMA_VERSION,
     SERIES_COLUMNS,
     SERIES_FILE,
+    SWEEP_COLUMN,
     ResultRow,
     SeriesRecord,
+    sweep_column,
 )
 from simparity.core.scene import DynamicsScene, IKScene
 
@@ -75,7 +77,8 @@ def _variants(engine: Engine) -> dict[str, list[str]]:
 def _scene_info(scene) -> dict:
     """What a report needs of a scene beside its rows: what it is, where from, and for dynamics
     the number of bodies (per-call overhead), the error its schemes are ranked by and, with contact, the
-    planes, the requested restitution (body x plane), core's methods and the rest speed."""
+    planes, the requested restitution (body x plane), core's methods and the rest speed; for a variant of a
+    sweep, :class:`core.scene.SweepPoint` (base, index, count, values: {key: value} in the sweep's order)."""
     info = {"kind": scene.kind, "description": scene.description, "reference": scene.reference,
             "source": scene.source, "suites": list(scene.suites)}
     if isinstance(scene, DynamicsScene):
@@ -86,7 +89,24 @@ def _scene_info(scene) -> dict:
                                "methods": list(scene.contact.methods), "rest_speed": scene.contact.rest_speed}
     if isinstance(scene, IKScene):
         info |= {"position_tolerance": scene.position_tolerance}
+    if scene.sweep is not None:
+        info["sweep"] = {"base": scene.sweep.base, "index": scene.sweep.index, "count": scene.sweep.count,
+                         "values": dict(scene.sweep.values)}
     return info
+
+
+def sweep_cells(scenes: list) -> tuple[list[str], dict[str, dict[str, object]]]:
+    """(the columns a run's sweeps add to :data:`core.results.COLUMNS`, {scene name: {column: value}} of each
+    swept scene). No columns when no scene was swept; else :data:`core.results.SWEEP_COLUMN` (the base
+    scene's name), then one column per swept key in the order the scenes first sweep it."""
+    columns: list[str] = []
+    cells = {}
+    for scene in scenes:
+        if scene.sweep is None:
+            continue
+        cells[scene.name] = {SWEEP_COLUMN: scene.sweep.base} | {sweep_column(k): v for k, v in scene.sweep.values}
+        columns += [column for column in cells[scene.name] if column not in columns]
+    return columns, cells
 
 
 def _series_frame(series: list[SeriesRecord]) -> pd.DataFrame:
@@ -100,14 +120,16 @@ def _series_frame(series: list[SeriesRecord]) -> pd.DataFrame:
 
 class RunWriter:
     """Appends rows to ``results.csv`` and series to ``series.csv.gz`` as they are produced, so nothing
-    computed is lost."""
+    computed is lost. A run of swept scenes (``scenes``) has the sweep columns of :func:`sweep_cells` after the
+    fixed ones, filled from each row's scene."""
 
     def __init__(self, out_dir: Path, engines: list[Engine], command: str, scenes: list) -> None:
         self.out_dir = Path(out_dir)
         self.out_dir.mkdir(parents=True, exist_ok=True)
         self.results_path = self.out_dir / RESULTS_FILE
         self.series_path = self.out_dir / SERIES_FILE
-        pd.DataFrame(columns=list(COLUMNS)).to_csv(self.results_path, index=False)
+        self._sweep_columns, self._sweep_cells = sweep_cells(scenes)
+        pd.DataFrame(columns=list(COLUMNS) + self._sweep_columns).to_csv(self.results_path, index=False)
         pd.DataFrame(columns=list(SERIES_COLUMNS)).to_csv(self.series_path, index=False)
         info = {
             "schema_version": SCHEMA_VERSION,
@@ -125,6 +147,9 @@ class RunWriter:
 
     def append(self, rows: list[ResultRow], series: list[SeriesRecord] = ()) -> None:
         frame = pd.DataFrame([r.as_dict() for r in rows], columns=list(COLUMNS))
+        for column in self._sweep_columns:
+            # object cells: an int stays an int, a float is written as its shortest exact text, "" is no value
+            frame[column] = pd.Series([self._sweep_cells.get(r.scene, {}).get(column, "") for r in rows], dtype=object)
         frame.to_csv(self.results_path, mode="a", header=False, index=False, float_format="%.17g")
         if series:
             # Each append is one more gzip member; readers (gzip, pandas) read the members as one file.

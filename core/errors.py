@@ -78,6 +78,11 @@ class UnknownEngineError(SimparityError):
     """An engine name is not one simparity knows."""
 
 
+class PluginError(SimparityError):
+    """A user's engine (an installed plugin or a ``module:attr`` spec) raised while it was loaded, built or
+    asked what it offers, or broke the engine interface: its cases fail with this message."""
+
+
 class DivergedError(SimparityError):
     """A simulation became unstable (an engine reported it, or its state left the finite numbers)."""
 

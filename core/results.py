@@ -19,6 +19,22 @@ REPORT_FILE = "report.md"
 REPORT_HTML_FILE = "report.html"
 
 COLUMNS = ("scene", "engine", "integrator", "dt", "metric", "value", "unit", "reference", "status", "detail")
+"""The columns of every run. A run with a swept scene (a file's ``[sweep]``) has the sweep columns after
+them; a run without has exactly these."""
+
+SWEEP_COLUMN = "sweep"
+"""Sweep column: the name of the scene a variant was swept from (its file's ``[scene] name``); empty on rows
+of scenes without a sweep."""
+
+SWEEP_PREFIX = "sweep:"
+"""Sweep columns after :data:`SWEEP_COLUMN`, one per swept key: this prefix and the key's path as the
+``[sweep]`` table writes it (``sweep:contact.restitution``), holding the variant's value; empty on rows of
+scenes that do not sweep that key. No fixed column has a colon, so none can clash."""
+
+
+def sweep_column(key: str) -> str:
+    """The results column of swept key ``key``."""
+    return SWEEP_PREFIX + key
 
 OK, NOT_AVAILABLE, FAILED, DIVERGED = "ok", "n/a", "failed", "diverged"
 STATUSES = (OK, NOT_AVAILABLE, FAILED, DIVERGED)

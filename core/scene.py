@@ -393,6 +393,43 @@ class PointMasses:
 
 
 @dataclass(frozen=True)
+class SweepPoint:
+    """Where a scene sits in the ``[sweep]`` of its file: one variant of the scene the file declares
+    (``docs/scenes.md``, "Sweeps").
+
+    Attributes
+    ----------
+    base : str
+        The name the file gives the scene (``[scene] name``); the variant's own name is derived from it
+        and the values, for display only.
+    values : tuple of (str, int or float)
+        Each swept key (its path as the ``[sweep]`` table writes it, e.g. ``"body[ball].restitution"``)
+        with this variant's value, in the sweep's order. A value is the number written into the file, in
+        the file's ``length_unit``: an int for whole-number keys (seeds, counts), else a float.
+    index : int
+        The variant's position in the sweep's order, from 0.
+    count : int
+        Variants the file expands into.
+    """
+
+    base: str
+    values: tuple[tuple[str, int | float], ...]
+    index: int
+    count: int
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "values", tuple((str(k), v) for k, v in self.values))
+        if not 0 <= self.index < self.count:
+            raise SceneError("<code>", "sweep", f"variant index {self.index} of {self.count} variants",
+                             "an index from 0 to count - 1")
+
+    @property
+    def keys(self) -> tuple[str, ...]:
+        """The swept keys, in the sweep's order."""
+        return tuple(key for key, _ in self.values)
+
+
+@dataclass(frozen=True)
 class DynamicsScene:
     """Free rigid bodies under external forces, simulated from t = 0 to ``duration``.
 
@@ -418,6 +455,8 @@ class DynamicsScene:
         The built-in suites (:data:`SUITES`) the scene belongs to.
     contact : Contact or None
         Planes the bodies collide with; None: no contact (no engine is given any).
+    sweep : SweepPoint or None
+        For a variant of a file with a ``[sweep]``: its base scene and swept values; None otherwise.
     """
 
     name: str
@@ -432,6 +471,7 @@ class DynamicsScene:
     source: str = "<code>"
     suites: tuple[str, ...] = ("default",)
     contact: Contact | None = None
+    sweep: SweepPoint | None = None
     kind: str = field(default="dynamics", init=False)
 
     def n_steps(self, dt: float) -> int:
@@ -555,6 +595,8 @@ class KinematicsScene:
     source : str
     suites : tuple of str
         The built-in suites (:data:`SUITES`) the scene belongs to.
+    sweep : SweepPoint or None
+        For a variant of a file with a ``[sweep]``: its base scene and swept values; None otherwise.
     """
 
     name: str
@@ -565,6 +607,7 @@ class KinematicsScene:
     seed: int
     source: str = "<code>"
     suites: tuple[str, ...] = ("default",)
+    sweep: SweepPoint | None = None
     kind: str = field(default="kinematics", init=False)
 
     def configurations(self) -> np.ndarray:
@@ -610,6 +653,8 @@ class IKScene:
     source : str
     suites : tuple of str
         The built-in suites (:data:`SUITES`) the scene belongs to.
+    sweep : SweepPoint or None
+        For a variant of a file with a ``[sweep]``: its base scene and swept values; None otherwise.
     """
 
     name: str
@@ -626,6 +671,7 @@ class IKScene:
     hard_targets: tuple[str, ...] = ()
     source: str = "<code>"
     suites: tuple[str, ...] = ("default",)
+    sweep: SweepPoint | None = None
     kind: str = field(default="ik", init=False)
 
     def __post_init__(self) -> None:

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 
@@ -56,3 +57,15 @@ class Details:
 
 
 Block = Heading | Paragraph | Bullets | Table | Figure | Details
+
+
+def number(value: float) -> str:
+    """A number in a cell or a sentence: three significant digits; an em dash for no value."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "—"
+    return "0" if value == 0 else f"{value:.3g}"
+
+
+def scene_heading(scene: str, kind: str) -> Heading:
+    """A scene section's heading; the summary and the sweep sections link to its anchor."""
+    return Heading(2, f"{scene} ({kind})")

@@ -1,5 +1,6 @@
 """What a report says, as blocks (:mod:`reports.blocks`): the summary first, then per scene its figures,
-a compact table and (folded) the full one. Reads a stored run only; figures are drawn and saved here.
+a compact table and (folded) the full one; a sweep's variants are one row, line or section wherever the report
+lists scenes (:mod:`reports.sweep_sections`). Reads a stored run only; figures are drawn and saved here.
 """
 
 from __future__ import annotations
@@ -21,8 +22,19 @@ from simparity.core.results import (
     case_counts,
     case_status,
 )
-from simparity.reports import figures, summary
-from simparity.reports.blocks import Block, Bullets, Details, Figure, Heading, Paragraph, Table
+from simparity.reports import figures, summary, sweep_sections, sweep_summary, tables
+from simparity.reports.blocks import (
+    Block,
+    Bullets,
+    Details,
+    Figure,
+    Heading,
+    Paragraph,
+    Table,
+    number,
+    scene_heading,
+)
+from simparity.reports.sweep_summary import Sweep, merge_variants, union
 
 FIGURES_DIR = "figures"
 """Sub-folder of the run folder the figures are written to (SVG and PNG)."""
@@ -37,40 +49,6 @@ class ToleranceVerdict:
     violations: tuple[str, ...] = ()
 
 
-_DYNAMICS_COLUMNS = [
-    ("position_error_max", "position error max [m]"),
-    ("orientation_error_max", "orientation error max [rad]"),
-    ("velocity_error_max", "velocity error max [m/s]"),
-    ("angular_velocity_error_max", "angular velocity error max [rad/s]"),
-    ("energy_drift_max", "energy drift max (rel.)"),
-    ("angular_momentum_drift_max", "angular momentum drift max (rel.)"),
-    ("time_per_step", "time per step [s]"),
-    ("impact_time_error", "impact time error [s]"),
-    ("rebound_velocity_error", "rebound velocity error [m/s]"),
-    ("apex_height_error", "apex height error [m]"),
-    ("impacts_missed", "impacts missed"),
-    ("restitution_measured", "restitution measured"),
-    ("restitution_error", "restitution error"),
-    ("penetration_max", "penetration max [m]"),
-    ("tunnelled", "bodies tunnelled"),
-    ("energy_gain_max", "energy gained max (rel.)"),
-    ("rest_time_error", "rest time error [s]"),
-    ("stopping_distance", "stopping distance [m]"),
-    ("stopping_distance_error", "stopping distance error [m]"),
-]
-_IK_COLUMNS = [
-    ("solve_rate", "solve rate"),
-    ("position_residual_median", "position residual median [m]"),
-    ("position_residual_max", "position residual max [m]"),
-    ("orientation_residual_max", "orientation residual max [rad]"),
-    ("iterations_median", "iterations median"),
-    ("time_per_solve", "time per solve [s]"),
-    ("limit_violations", "solutions outside limits"),
-    ("start_rank_deficiency", "start pose rank deficiency"),
-    ("rest_distance_median", "distance to start median"),
-    ("cross_eval_solve_rate_min", "solve rate, worst engine's FK"),
-    ("cross_eval_disagreement_max", "FK disagreement max [m]"),
-]
 _IK_COMPACT = ("solve_rate", "position_residual_median", "iterations_median", "time_per_solve", "limit_violations",
                "cross_eval_solve_rate_min")
 _IK_PROTOCOL = (
@@ -81,19 +59,6 @@ _IK_PROTOCOL = (
     "solution is also put through every engine's forward kinematics (worst solve rate and largest "
     "disagreement shown), so no solver passes on its own kinematics alone."
 )
-_ORDER_COLUMNS = [
-    ("order_position", "order (position)"),
-    ("order_orientation", "order (orientation)"),
-    ("order_velocity", "order (velocity)"),
-    ("order_angular_velocity", "order (angular velocity)"),
-]
-_KINEMATICS_COLUMNS = [
-    ("position_error_max", "frame position error max [m]"),
-    ("orientation_error_max", "frame orientation error max [rad]"),
-    ("jacobian_error_max", "Jacobian error max"),
-    ("time_per_fk", "time per FK [s]"),
-    ("time_per_jacobian", "time per Jacobian [s]"),
-]
 _TIMING_METRICS = ("time_per_step", "time_per_fk", "time_per_solve")
 _DEFINITIONS = (
     "Statuses: `ok` measured; `n/a` not measured, with the reason: the engine cannot do what the scene asks, "
@@ -108,38 +73,6 @@ _DEFINITIONS = (
 )
 _HEADLINE_NAMES = {"position_error_max": ("position error max", "m"),
                    "orientation_error_max": ("orientation error max", "rad")}
-
-
-def number(value: float) -> str:
-    """Three significant digits; an em dash for no value."""
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "—"
-    return "0" if value == 0 else f"{value:.3g}"
-
-
-def _status(group: pd.DataFrame) -> str:
-    """'ok', or each non-ok status with the metrics it is about (none named when it covers them all) and why."""
-    bad = group[group["status"] != OK]
-    if bad.empty:
-        return OK
-    parts = [OK] if len(bad) < len(group) else []
-    for (status, detail), rows in bad.groupby(["status", "detail"], sort=False):
-        label = status if len(rows) == len(group) else f"{status} ({', '.join(rows['metric'])})"
-        parts.append(f"{label}: {detail}" if detail else label)
-    return " · ".join(parts)
-
-
-def _table(scene_rows: pd.DataFrame, columns, keys: list[str]) -> Table:
-    present = set(scene_rows["metric"])
-    columns = [(metric, label) for metric, label in columns if metric in present]
-    rows = []
-    for key, group in scene_rows.groupby(keys, sort=False, dropna=False):
-        key = key if isinstance(key, tuple) else (key,)
-        values = dict(zip(group["metric"], group["value"]))
-        cells = [number(float(v)) if name == "dt" else str(v) for name, v in zip(keys, key)]
-        cells += [number(values.get(metric, math.nan)) for metric, _ in columns]
-        rows.append(tuple(cells + [_status(group)]))
-    return Table(tuple(keys + [label for _, label in columns] + ["status"]), tuple(rows))
 
 
 def _notes(scene_rows: pd.DataFrame) -> list[Block]:
@@ -198,21 +131,26 @@ def _dynamics_verdicts(rows: pd.DataFrame) -> Table:
 
 
 def _verdict_line(name: str, rows: pd.DataFrame) -> str:
-    """One line per hard dynamics scene: how many cases earned each status, and which diverged."""
+    """One line per hard dynamics scene (or sweep: its variants' cases together): how many cases earned each
+    status, and which diverged."""
     per_dt = rows[rows["dt"].notna()]
-    statuses = per_dt.groupby(["engine", "integrator", "dt"], sort=False)["status"].agg(case_status)
+    statuses = per_dt.groupby(["scene", "engine", "integrator", "dt"], sort=False)["status"].agg(case_status)
     counts = statuses.value_counts()
-    diverged = sorted({f"{e} {i}" for (e, i, _), s in statuses.items() if s == "diverged"})
+    diverged = sorted({f"{e} {i}" for (_, e, i, _), s in statuses.items() if s == "diverged"})
     text = f"**{name}**: " + ", ".join(f"{s} {counts[s]}" for s in STATUSES if s in counts)
     return text + (f"; diverged: {', '.join(diverged)}" if diverged else "")
 
 
-def _hard_cases(table: pd.DataFrame, info: dict) -> list[Block]:
-    """The verdict every engine earned on each scene of the hard suite in the run."""
-    scenes = [name for name, about in info.get("scenes", {}).items() if "hard" in about.get("suites", ())]
-    scenes = [name for name in scenes if (table["scene"] == name).any()]
-    if not scenes:
+def _hard_cases(table: pd.DataFrame, info: dict, groups: dict[str, str]) -> list[Block]:
+    """The verdict every engine earned on each scene of the hard suite in the run; a sweep's variants (``groups``:
+    {variant: its sweep's label}) share one line, with no grid of their own (the sweep's section has one)."""
+    names = [name for name, about in info.get("scenes", {}).items() if "hard" in about.get("suites", ())]
+    names = [name for name in names if (table["scene"] == name).any()]
+    if not names:
         return []
+    table = table.assign(_group=table["scene"].map(lambda scene: groups.get(scene, scene)))
+    scenes = list(dict.fromkeys(groups.get(name, name) for name in names))
+    swept = set(groups.values())
     blocks: list[Block] = [
         Heading(2, "Hard cases"),
         Paragraph("The numerical-stability cases of the `hard` suite and the verdict each engine earned: a case is "
@@ -221,14 +159,14 @@ def _hard_cases(table: pd.DataFrame, info: dict) -> list[Block]:
                   "(`simparity check`).")]
     lines = []
     for name in scenes:
-        rows = table[table["scene"] == name]
+        rows = table[table["_group"] == name]
         if _kind(rows) == "ik":
             solved, total = _hard_solved(rows)
             lines.append(f"**{name}**: {solved} of {total} hard IK solves succeeded")
         else:
             lines.append(_verdict_line(name, rows))
     blocks.append(Bullets(tuple(lines)))
-    for name in scenes:
+    for name in (name for name in scenes if name not in swept):
         rows = table[table["scene"] == name]
         grid = _hard_table(rows) if _kind(rows) == "ik" else [_dynamics_verdicts(rows)]
         blocks.append(Details(f"{name}: every verdict", tuple(grid), markdown=False))
@@ -263,10 +201,18 @@ def _overhead_mark(engine: str, about: dict) -> str:
 
 class _Builder:
     def __init__(self, table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: ToleranceVerdict | None,
-                 figure_dir: Path, writer: figures.FigureWriter) -> None:
+                 figure_dir: Path, writer: figures.FigureWriter, sweeps: list[Sweep]) -> None:
         self.table, self.info, self.series, self.verdict = table, info, series, verdict
         self.figure_dir, self.writer = figure_dir, writer
         self.svgs: dict[str, concurrent.futures.Future] = {}
+        self.sweeps = sweeps
+        self.sweep_of = {name: sweep for sweep in sweeps for name in sweep.variants}
+        self.groups = sweep_summary.groups(sweeps)
+        self.counts = sweep_summary.counts(sweeps)
+
+    def listed(self, scene: str) -> bool:
+        """Whether ``scene`` has a section of its own: a scene outside a sweep, or a variant the sweep shows."""
+        return scene not in self.sweep_of or scene in self.sweep_of[scene].shown
 
     def about(self, scene: str) -> dict:
         return self.info.get("scenes", {}).get(scene, {})
@@ -281,20 +227,25 @@ class _Builder:
 
     def summary(self) -> list[Block]:
         blocks: list[Block] = [Heading(2, "Summary")]
-        dyn_rows, ik_rows = [], []
+        dyn_rows, ik_rows, swept = [], [], set()
         for scene, rows in self.table.groupby("scene", sort=False):
             kind, about = _kind(rows), self.about(scene)
-            if kind == "dynamics":
+            if scene in self.sweep_of:
+                sweep = self.sweep_of[scene]
+                if sweep.base not in swept and kind in ("dynamics", "ik"):
+                    (dyn_rows if kind == "dynamics" else ik_rows).append(_sweep_row(sweep))
+                swept.add(sweep.base)
+            elif kind == "dynamics":
                 headline = _headline(about)
                 name, unit = _HEADLINE_NAMES[headline]
                 cases = summary.dynamics_cases(rows, headline)
-                cells = [f"[{scene}](#{_scene_heading(scene, kind).anchor})", f"{name} [{unit}] vs `{rows['reference'].iloc[0]}`"]
+                cells = [f"[{scene}](#{scene_heading(scene, kind).anchor})", f"{name} [{unit}] vs `{rows['reference'].iloc[0]}`"]
                 cells += [_scheme(summary.cheapest_within(cases, b), unit) for b in summary.ERROR_BUDGETS]
                 cells += [_scheme(summary.most_accurate_within(cases, b), unit) for b in summary.TIME_BUDGETS]
                 dyn_rows.append(tuple(cells))
             elif kind == "ik":
                 best, fastest = summary.best_ik(summary.ik_solvers(rows[~rows["metric"].str.startswith("hard_")]))
-                ik_rows.append((f"[{scene}](#{_scene_heading(scene, kind).anchor})", _solver(best), _solver(fastest)))
+                ik_rows.append((f"[{scene}](#{scene_heading(scene, kind).anchor})", _solver(best), _solver(fastest)))
         if dyn_rows:
             blocks += [
                 Heading(3, "Which integrator for this scene?"),
@@ -306,6 +257,7 @@ class _Builder:
                           "\"none\": no scheme run reached it."),
                 Table(("scene", "error (reference)") + tuple(f"error ≤ {b:g}" for b in summary.ERROR_BUDGETS)
                       + tuple(f"most accurate at ≤ {b:g} s/s" for b in summary.TIME_BUDGETS), tuple(dyn_rows)),
+                *([_SWEEP_ROWS_DYNAMICS] if any(s.kind == "dynamics" for s in self.sweeps) else []),
                 Paragraph("Each dynamics scene's section below has its work-precision, convergence and drift figures "
                           "and, per engine × integrator, the time step of least error with its cost and time per "
                           "step, the observed order of that error (theory in brackets) and the status of its time "
@@ -321,24 +273,41 @@ class _Builder:
             blocks += [Heading(3, "Which IK solver?"),
                        Paragraph(f"Best solve rate (the faster on a tie) and the fastest solver at ≥ "
                                  f"{summary.SOLVED_ENOUGH:.0%} solve rate, on the scene's random targets."),
-                       Table(("scene", "best solve rate", f"fastest at ≥ {summary.SOLVED_ENOUGH:.0%}"), tuple(ik_rows))]
+                       Table(("scene", "best solve rate", f"fastest at ≥ {summary.SOLVED_ENOUGH:.0%}"),
+                             tuple(ik_rows)),
+                       *([_SWEEP_ROWS_IK] if any(s.kind == "ik" for s in self.sweeps) else [])]
         return blocks + self.findings() + self.unresolved()
+
+    def merged(self, frame: pd.DataFrame, keys: list[str], **aggregations) -> pd.DataFrame:
+        """``frame`` with each sweep's variants merged (:func:`reports.sweep_summary.merge_variants`); as it is in a
+        run without a sweep."""
+        return merge_variants(frame, self.groups, keys, **aggregations) if self.groups else frame
+
+    def in_variants(self, row: pd.Series, lead: str = " ") -> str:
+        """"in K of N variants" after ``lead`` for a row standing for a sweep's variants; nothing for a scene of its
+        own."""
+        count = self.counts.get(row["scene"])
+        return f"{lead}in {row['variants']} of {count} variants" if count else ""
 
     def findings(self) -> list[Block]:
         items = []
-        for scene, g in summary.energy_gains(self.series).groupby("scene", sort=False):
-            cases = ", ".join(f"{r['engine']} {r['integrator']} +{number(r['gain_max'])} (dt "
-                              f"{', '.join(f'{d:g}' for d in r['dts'])})" for _, r in g.iterrows())
+        gains = self.merged(summary.energy_gains(self.series), ["engine", "integrator"],
+                            gain_max=("gain_max", "max"), dts=("dts", union))
+        for scene, g in gains.groupby("scene", sort=False):
+            cases = ", ".join(f"{r['engine']} {r['integrator']} +{number(r['gain_max'])} (dt {_dts(r)}"
+                              f"{self.in_variants(r, '; ')})" for _, r in g.iterrows())
             items.append(f"**energy gained** in {scene} (conserves energy; largest (E - E(0)) / E(0) per scheme): "
                          + cases)
-        for (scene, metric), g in summary.contact_flags(self.table).groupby(["scene", "metric"], sort=False):
+        flags = self.merged(summary.contact_flags(self.table), ["metric", "engine", "integrator"],
+                            value_max=("value_max", "max"), dts=("dts", union))
+        for (scene, metric), g in flags.groupby(["scene", "metric"], sort=False):
             what = ("**energy gained at an impact**" if metric == "energy_gain_max" else "**tunnelling**")
-            cases = ", ".join(f"{r['engine']} {r['integrator']} {number(r['value_max'])} (dt "
-                              f"{', '.join(f'{d:g}' for d in r['dts'])})" for _, r in g.iterrows())
+            cases = ", ".join(f"{r['engine']} {r['integrator']} {number(r['value_max'])} (dt {_dts(r)}"
+                              f"{self.in_variants(r, '; ')})" for _, r in g.iterrows())
             items.append(f"{what} in {scene} (`{metric}`): " + cases)
-        for _, s in summary.saturated(self.table).iterrows():
-            items.append(f"**saturated**: {s['scene']} `{s['metric']}` in {s['n_cases']} cases (n/a: the error "
-                         "lost all meaning there)")
+        for _, s in self.merged(summary.saturated(self.table), ["metric"], n_cases=("n_cases", "sum")).iterrows():
+            items.append(f"**saturated**: {s['scene']} `{s['metric']}` in {s['n_cases']} cases{self.in_variants(s)} "
+                         "(n/a: the error lost all meaning there)")
         blocks: list[Block] = [Heading(3, "Flagged findings")]
         verdict = self.verdict
         unbounded = f"; {verdict.unchecked} without a bound, so not held to anything" if verdict and verdict.unchecked else ""
@@ -362,10 +331,12 @@ class _Builder:
         cases = summary.unresolved_cases(self.table)
         if cases.empty:
             return [Heading(3, "Cases without a result"), Paragraph("None: every case was measured.")]
+        cases = self.merged(cases, ["status", "order_fit", "engine", "integrator", "reason"],
+                            n_cases=("n_cases", "sum"), dts=("dts", union))
 
         def label(c) -> str:
             dts = f" (dt {', '.join(f'{dt:g}' for dt in c['dts'])})" if c["dts"] else ""
-            return f"{c['engine']} {c['integrator']}".strip() + dts
+            return f"{c['engine']} {c['integrator']}".strip() + dts + self.in_variants(c)
 
         # Failed and diverged cases get a line per scene, each case with its reason; n/a cases (the engine
         # cannot, or nothing to fit) share one line per kind, grouped by reason.
@@ -385,10 +356,17 @@ class _Builder:
     # -- scenes --------------------------------------------------------------------------------
 
     def introduction(self, scene: str, rows: pd.DataFrame) -> str:
-        """What the scene is, its reference and file, and how its hard IK targets fared."""
+        """What the scene is (a sweep's variant: its values), its reference and file, and how its hard IK targets
+        fared."""
         about = self.about(scene)
         solved, total = _hard_solved(rows)
+        sweep = about.get("sweep")
+        shown = (f" ({sweep_sections.roles(self.sweep_of[scene], scene)})"
+                 if scene in self.sweep_of and scene in self.sweep_of[scene].shown else "")
         return ((f"{about['description']} " if about.get("description") else "")
+                + (f"Variant {sweep['index'] + 1} of {sweep['count']} of the [sweep of {sweep['base']}]"
+                   f"(#{sweep_sections.heading(sweep['base']).anchor}){shown}: "
+                   + ", ".join(f"`{key}` = {value}" for key, value in sweep["values"].items()) + ". " if sweep else "")
                 + f"Reference: `{rows['reference'].iloc[0]}`."
                 + (f" Scene file: `{about['source']}`." if about.get("source") else "")
                 + (f" Hard targets: {solved} of {total} solves succeeded (each solver's verdict per target: the "
@@ -398,7 +376,7 @@ class _Builder:
         """The section of a dynamics or IK scene."""
         kind, about = _kind(rows), self.about(scene)
         reference = rows["reference"].iloc[0]
-        blocks: list[Block] = [_scene_heading(scene, kind), Paragraph(self.introduction(scene, rows))]
+        blocks: list[Block] = [scene_heading(scene, kind), Paragraph(self.introduction(scene, rows))]
         series = self.series[self.series["scene"] == scene]
         if kind == "dynamics":
             blocks += self.dynamics(scene, rows, about, reference, series)
@@ -412,7 +390,7 @@ class _Builder:
         return [Heading(2, "Kinematics"),
                 Bullets(tuple(f"**{scene}**: {self.introduction(scene, rows[rows['scene'] == scene])}"
                               for scene in scenes)),
-                _table(rows, _KINEMATICS_COLUMNS, ["scene", "engine"])] + _notes(rows)
+                tables.metric_table(rows, tables.KINEMATICS_COLUMNS, ["scene", "engine"])] + _notes(rows)
 
     def dynamics(self, scene, rows, about, reference, series) -> list[Block]:
         headline = _headline(about)
@@ -445,12 +423,14 @@ class _Builder:
                           "order (theory)", "time steps"),
                          tuple(_scheme_row(engine, scheme, members) for (engine, scheme), members in per_scheme.items()))]
 
-        full = [_table(rows[rows["dt"].notna()], _DYNAMICS_COLUMNS, ["engine", "integrator", "dt"])]
+        full = [tables.metric_table(rows[rows["dt"].notna()], tables.DYNAMICS_COLUMNS,
+                                    ["engine", "integrator", "dt"])]
         orders = rows[rows["dt"].isna()]
         if not orders.empty:
             full += [Paragraph("Observed order of convergence: slope of log(error max) against log(dt) over the finest "
                                "time steps whose local slopes agree; errors at the rounding floor or saturated are "
-                               "left out."), _table(orders, _ORDER_COLUMNS, ["engine", "integrator"])] + _fits(orders)
+                               "left out."),
+                     tables.metric_table(orders, tables.ORDER_COLUMNS, ["engine", "integrator"])] + _fits(orders)
         return blocks + [Details(f"{scene}: every engine × integrator × dt", tuple(full), markdown=False)]
 
     def contact(self, scene, rows, about, reference, series) -> list[Block]:
@@ -498,11 +478,12 @@ class _Builder:
                               "Cross-engine FK agreement on every solution [m].")
         plain = rows[~rows["metric"].str.startswith("hard_")].rename(columns={"integrator": "solver"})
         measured = plain.groupby(["engine", "solver"], sort=False)["status"].transform(lambda s: (s != NOT_AVAILABLE).any())
-        compact = [c for c in _IK_COLUMNS if c[0] in _IK_COMPACT]
-        blocks.append(_table(plain[measured], compact, ["engine", "solver"]))
+        compact = [c for c in tables.IK_COLUMNS if c[0] in _IK_COMPACT]
+        blocks.append(tables.metric_table(plain[measured], compact, ["engine", "solver"]))
         hard = _hard_table(rows)
         return blocks + [Details(f"{scene}: every metric and hard target",
-                                 (_table(plain, _IK_COLUMNS, ["engine", "solver"]), *hard), markdown=False)]
+                                 (tables.metric_table(plain, tables.IK_COLUMNS, ["engine", "solver"]), *hard),
+                                 markdown=False)]
 
 
 def _scheme_row(engine: str, scheme: str, members: list[tuple[str, tuple[str, ...]]]) -> tuple[str, ...]:
@@ -516,15 +497,39 @@ def _scheme_row(engine: str, scheme: str, members: list[tuple[str, tuple[str, ..
             *(column[0] if len(set(column)) == 1 else " / ".join(column) for column in zip(*cells)))
 
 
+_SWEEP_ROWS_DYNAMICS = Paragraph(
+    "A sweep has one row, linked to its section: each engine × integrator × dt is ranked by its worst variant (its "
+    "error the largest over the variants, its cost the median), and a case that is not ok in every variant is not "
+    "ranked.")
+_SWEEP_ROWS_IK = Paragraph(
+    "A sweep has one row, linked to its section: each solver is ranked by its lowest solve rate over the variants and "
+    "its median time per solve, and a solver not measured in every variant is not ranked.")
+
+
+def _sweep_row(sweep: Sweep) -> tuple[str, ...]:
+    """A sweep's row of the summary's table for its kind: its schemes judged by their worst variant."""
+    link = (f"[{sweep_summary.label(sweep.base)}](#{sweep_sections.heading(sweep.base).anchor}) "
+            f"({len(sweep.variants)} variants)")
+    ranked = sweep.across[sweep.across["status"] == OK]
+    if sweep.kind == "ik":
+        best, fastest = summary.best_ik(ranked.rename(columns={"value": "solve_rate", "cost": "time_per_solve"}))
+        return link, _solver(best), _solver(fastest)
+    name, unit = _HEADLINE_NAMES[sweep.metric]
+    cases = ranked.rename(columns={"value": "error"})
+    return ((link, f"{name} [{unit}] vs `{sweep.reference}`")
+            + tuple(_scheme(summary.cheapest_within(cases, b), unit) for b in summary.ERROR_BUDGETS)
+            + tuple(_scheme(summary.most_accurate_within(cases, b), unit) for b in summary.TIME_BUDGETS))
+
+
+def _dts(row: pd.Series) -> str:
+    """The time steps of a flagged row, as the findings list them."""
+    return ", ".join(f"{d:g}" for d in row["dts"])
+
+
 def _solver(row: pd.Series | None) -> str:
     if row is None:
         return "none"
     return f"{row['engine']} {row['integrator']}: {row['solve_rate']:.1%} at {number(row['time_per_solve'])} s"
-
-
-def _scene_heading(scene: str, kind: str) -> Heading:
-    """A scene section's heading; the summary links to its anchor."""
-    return Heading(2, f"{scene} ({kind})")
 
 
 def build(table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: ToleranceVerdict | None,
@@ -532,7 +537,8 @@ def build(table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: Tolera
     """(the report's blocks, the SVG text of each figure by name); figures are written to
     ``run_dir/figures``, on one process per CPU. ``verdict``: the run held to tolerances, None if it was not."""
     with figures.FigureWriter() as writer:
-        builder = _Builder(table, info, series, verdict, Path(run_dir) / FIGURES_DIR, writer)
+        builder = _Builder(table, info, series, verdict, Path(run_dir) / FIGURES_DIR, writer,
+                           sweep_summary.sweeps(table, info))
         blocks = _blocks(builder, table, info)
         svgs = {name: future.result() for name, future in builder.svgs.items()}
     return blocks, svgs
@@ -557,12 +563,13 @@ def _blocks(builder: _Builder, table: pd.DataFrame, info: dict) -> list[Block]:
                   "series: `series.csv.gz`."),
     ]
     blocks += builder.summary()
-    blocks += _hard_cases(table, info)
+    blocks += _hard_cases(table, info, builder.groups)
     blocks += [Details("Definitions", (Paragraph(_DEFINITIONS), Paragraph(_IK_PROTOCOL)))]
+    blocks += sweep_sections.sections(builder.sweeps, builder.figure, info.get("theoretical_orders", {}))
     kinds = {scene: _kind(rows) for scene, rows in table.groupby("scene", sort=False)}
     for scene, rows in table.groupby("scene", sort=False):
-        blocks += builder.scene(scene, rows) if kinds[scene] != "kinematics" else []
-    kinematics = table[table["scene"].map(kinds) == "kinematics"]
+        blocks += builder.scene(scene, rows) if kinds[scene] != "kinematics" and builder.listed(scene) else []
+    kinematics = table[(table["scene"].map(kinds) == "kinematics") & ~table["scene"].isin(builder.sweep_of)]
     if not kinematics.empty:
         blocks += builder.kinematics(kinematics)
     return blocks

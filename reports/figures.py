@@ -1,8 +1,8 @@
 """The report's figures, drawn with matplotlib (headless ``Agg``) from a stored run's rows and series.
 
-Each ``*_figure`` function returns a matplotlib Figure, or None when the run holds nothing to draw;
-:func:`save` writes it as SVG and PNG. Every axis names its quantity and unit, every title the
-reference the errors are measured against.
+Each ``*_figure`` function returns a matplotlib Figure, laid out by :mod:`reports.figure_layout`, or None when the
+run holds nothing to draw; :func:`save` writes it as SVG and PNG. Every axis names its quantity and unit, every
+title the reference the errors are measured against.
 """
 
 from __future__ import annotations
@@ -23,6 +23,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from simparity.core.results import SWEEP_PREFIX  # noqa: E402
+from simparity.reports.figure_layout import finish, legend, title  # noqa: E402
 from simparity.reports.summary import ERROR_BUDGETS  # noqa: E402
 
 _ENGINE_MARKERS = {"core": "o", "mujoco": "s", "pybullet": "^", "pinocchio": "D"}
@@ -32,20 +34,20 @@ _DRIFT_PANELS = [("energy_change", "|E(t) - E(0)| / |E(0)|"), ("angular_momentum
                  ("position_error", "position error [m]"), ("orientation_error", "orientation error [rad]")]
 _COLORS = plt.get_cmap("tab20").colors + plt.get_cmap("tab20b").colors
 """40 distinct colours: a scene's schemes (up to ~25 with core's orientation updates) each get their own."""
-_TITLE = {"loc": "left", "fontsize": 10}
-"""Titles start at the axes' left edge, so a long one runs over the legend's side, never off the figure."""
 _WIDTH = 9.0
 """[in] Figure width: a report column at 100 dpi."""
+_PANEL_GAP = 0.12
+"""[in] Between panels stacked on one time or swept axis: their x tick labels show on the lowest one only."""
+_SIDE_BY_SIDE_GAP = 0.95
+"""[in] Between panels side by side: room for the right one's y tick labels and y label."""
+_MATRIX_MARGINS = {"left": 0.9, "right": 1.0, "top": 0.3}
+"""[in] The FK matrix: engine names on the left, the colour bar with its ticks and label on the right."""
 
 
 def _style(index: int, engine: str) -> dict:
     colors = _COLORS
     return {"color": colors[index % len(colors)], "marker": _ENGINE_MARKERS.get(engine, "x"), "markersize": 4,
             "linewidth": 1.2}
-
-
-def _legend(ax) -> None:
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, frameon=False)
 
 
 def _positive(values) -> np.ndarray:
@@ -69,11 +71,10 @@ def work_precision_figure(scene: str, cases: pd.DataFrame, headline: str, refere
         ax.axvline(budget, color="0.6", linestyle=":", linewidth=0.8)
     ax.set(xscale="log", yscale="log", xlabel=_HEADLINE_LABELS[headline],
            ylabel="compute per simulated second [s/s]")
-    ax.set_title(f"{scene}: work against precision (one point per dt; error against {reference})", **_TITLE)
+    title(ax, f"{scene}: work against precision (one point per dt; error against {reference})")
     ax.grid(True, which="major", alpha=0.3)
-    _legend(ax)
-    fig.tight_layout()
-    return fig
+    legend(ax)
+    return finish(fig)
 
 
 def convergence_figure(scene: str, cases: pd.DataFrame, headline: str, reference: str,
@@ -97,11 +98,10 @@ def convergence_figure(scene: str, cases: pd.DataFrame, headline: str, reference
             dts = np.array([g["dt"].iloc[0], g["dt"].iloc[-1]])
             ax.plot(dts, e0 * (dts / dt0) ** p, linestyle="--", linewidth=0.7, color=style["color"])
     ax.set(xscale="log", yscale="log", xlabel="time step dt [s]", ylabel=_HEADLINE_LABELS[headline])
-    ax.set_title(f"{scene}: convergence against {reference} (dashed: theoretical slope)", **_TITLE)
+    title(ax, f"{scene}: convergence against {reference} (dashed: theoretical slope)")
     ax.grid(True, which="major", alpha=0.3)
-    _legend(ax)
-    fig.tight_layout()
-    return fig
+    legend(ax)
+    return finish(fig)
 
 
 def drift_figure(scene: str, series: pd.DataFrame, reference: str):
@@ -124,12 +124,10 @@ def drift_figure(scene: str, series: pd.DataFrame, reference: str):
                         **(_style(i, engine) | {"marker": None}))
         ax.set(yscale="log", ylabel=label)
         ax.grid(True, which="major", alpha=0.3)
-    axes[0, 0].set_title(f"{scene}: drift and error against time at dt = {dt:g} s (errors against {reference})",
-                         **_TITLE)
+    title(axes[0, 0], f"{scene}: drift and error against time at dt = {dt:g} s (errors against {reference})")
     axes[-1, 0].set_xlabel("time [s]")
-    _legend(axes[0, 0])
-    fig.tight_layout()
-    return fig
+    legend(axes[0, 0])
+    return finish(fig, row_gap=_PANEL_GAP)
 
 
 def contact_height_figure(scene: str, series: pd.DataFrame, reference: str):
@@ -147,10 +145,9 @@ def contact_height_figure(scene: str, series: pd.DataFrame, reference: str):
     ax.axhline(0.0, color="black", linewidth=0.8)
     ax.set(xlabel="time [s]", ylabel="lowest point above the plane [m]")
     ax.grid(True, which="major", alpha=0.3)
-    ax.set_title(f"{scene}: height of the lowest point at dt = {dt:g} s (reference {reference})", **_TITLE)
-    _legend(ax)
-    fig.tight_layout()
-    return fig
+    title(ax, f"{scene}: height of the lowest point at dt = {dt:g} s (reference {reference})")
+    legend(ax)
+    return finish(fig)
 
 
 def ik_rate_figure(scene: str, solvers: pd.DataFrame, reference: str):
@@ -163,11 +160,10 @@ def ik_rate_figure(scene: str, solvers: pd.DataFrame, reference: str):
         ax.plot([r["time_per_solve"]], [r["solve_rate"]], linestyle="none",
                 label=f"{r['engine']} {r['integrator']}", **_style(i, r["engine"]) | {"markersize": 7})
     ax.set(xscale="log", xlabel="time per solve [s]", ylabel="solve rate", ylim=(-0.03, 1.03))
-    ax.set_title(f"{scene}: solve rate against time per solve (targets from {reference})", **_TITLE)
+    title(ax, f"{scene}: solve rate against time per solve (targets from {reference})")
     ax.grid(True, alpha=0.3)
-    _legend(ax)
-    fig.tight_layout()
-    return fig
+    legend(ax)
+    return finish(fig)
 
 
 def ik_distribution_figure(scene: str, series: pd.DataFrame, position_tolerance: float | None):
@@ -185,10 +181,9 @@ def ik_distribution_figure(scene: str, series: pd.DataFrame, position_tolerance:
             ax.axvline(position_tolerance, color="0.3", linestyle=":", linewidth=0.9, label="scene tolerance")
         ax.set(xscale="log", xlabel=label, ylabel="fraction of targets at or below", ylim=(0, 1.02))
         ax.grid(True, alpha=0.3)
-    axes[0, 0].set_title(f"{scene}: distributions over the random targets", **_TITLE)
-    _legend(axes[0, -1])
-    fig.tight_layout()
-    return fig
+    title(axes[0, 0], f"{scene}: distributions over the random targets")
+    legend(axes[0, -1])
+    return finish(fig, column_gap=_SIDE_BY_SIDE_GAP)
 
 
 def fk_matrix_figure(scene: str, series: pd.DataFrame):
@@ -211,8 +206,64 @@ def fk_matrix_figure(scene: str, series: pd.DataFrame):
     ax.set_yticks(range(len(names)), names)
     fig.colorbar(image, ax=ax, label="log10 distance [m]")
     ax.set_title(f"{scene}: FK agreement, largest distance [m]", fontsize=9)
-    fig.tight_layout()
-    return fig
+    return finish(fig, margins=_MATRIX_MARGINS)
+
+
+def sweep_work_precision_figure(base: str, across: pd.DataFrame, label: str, reference: str, variants: int):
+    """Work against precision over a sweep's variants: per engine x integrator one point per dt at its worst
+    variant's error (x, log) and its median cost over the variants (y, log), a band from there to its best
+    variant's error, the error budgets of the summary dotted; None when no scheme was ok in every variant.
+
+    ``across``: :func:`reports.sweep_summary.across` of a dynamics sweep's cases (value: the error)."""
+    measured = across[(across["status"] == "ok") & (across["value"] > 0) & (across["cost"] > 0)]
+    if measured.empty:
+        return None
+    fig, ax = plt.subplots(figsize=(_WIDTH, 4.8))
+    for i, ((engine, integrator), g) in enumerate(measured.groupby(["engine", "integrator"], sort=False)):
+        g = g.sort_values("dt")
+        style = _style(i, engine)
+        ax.plot(g["value"], g["cost"], label=f"{engine} {integrator}", **style)
+        ax.hlines(g["cost"], _positive(g["best"]), g["value"], color=style["color"], linewidth=4, alpha=0.3)
+    for budget in ERROR_BUDGETS:
+        ax.axvline(budget, color="0.6", linestyle=":", linewidth=0.8)
+    ax.set(xscale="log", yscale="log", xlabel=label, ylabel="compute per simulated second, median [s/s]")
+    title(ax, f"{base}: work against precision over {variants} variants (worst variant; band to the best; error "
+              f"against {reference})")
+    ax.grid(True, which="major", alpha=0.3)
+    legend(ax)
+    return finish(fig)
+
+
+def sweep_figure(base: str, cases: pd.DataFrame, x: str, panels: list[str], label: str, reference: str):
+    """A metric (y) against the last swept key (x), one line per engine x integrator, one panel per combination
+    of ``panels`` (the other swept keys, and dt) in the order they come; None when nothing was measured.
+
+    ``cases``: :func:`reports.sweep_sections.sweep_cases` (columns engine, integrator, the keys, status, value)."""
+    measured = cases[(cases["status"] == "ok") & cases["value"].notna()]
+    if measured.empty:
+        return None
+    groups = list(measured.groupby(panels, sort=False)) if panels else [((), measured)]
+    xs = measured[x].astype(float)
+    log_x = bool((xs > 0).all() and xs.max() >= 10 * xs.min())
+    log_y = bool((measured["value"] > 0).all())
+    schemes = list(dict.fromkeys(zip(measured["engine"], measured["integrator"])))
+    fig, axes = plt.subplots(len(groups), 1, figsize=(_WIDTH, 2.4 * len(groups) + 0.8), sharex=True, squeeze=False)
+    for ax, (key, g) in zip(axes[:, 0], groups):
+        for i, (engine, integrator) in enumerate(schemes):
+            line = g[(g["engine"] == engine) & (g["integrator"] == integrator)].sort_values(x)
+            if not line.empty:
+                ax.plot(line[x].astype(float), line["value"], label=f"{engine} {integrator}", **_style(i, engine))
+        at = ", ".join(f"{name.removeprefix(SWEEP_PREFIX)} = {float(v):g}" + (" s" if name == "dt" else "")
+                       for name, v in zip(panels, key if isinstance(key, tuple) else (key,)))
+        if at:
+            ax.text(0.99, 0.96, at, transform=ax.transAxes, ha="right", va="top", fontsize=8,
+                    bbox={"facecolor": "white", "edgecolor": "0.8", "pad": 2})
+        ax.set(yscale="log" if log_y else "linear", ylabel=label)
+        ax.grid(True, which="major", alpha=0.3)
+    title(axes[0, 0], f"{base}: {label} against {x.removeprefix(SWEEP_PREFIX)} (against {reference})")
+    axes[-1, 0].set(xlabel=x.removeprefix(SWEEP_PREFIX), xscale="log" if log_x else "linear")
+    legend(axes[0, 0])
+    return finish(fig, row_gap=_PANEL_GAP)
 
 
 def save(fig, folder: Path, name: str) -> str:
@@ -232,9 +283,10 @@ def _save_pickled(pickled: bytes, folder: Path, name: str) -> str:
 
 
 class FigureWriter:
-    """Writes figures on one process per CPU while the report goes on (the drawing is most of a report's
-    time: measured 28 s of 30 for the default suite's 51 figures on one CPU). Use as a context manager;
-    :meth:`submit` returns a future of :func:`save`'s SVG text. One CPU: written at once, in this process."""
+    """Writes figures on one process per CPU while the report goes on (saving, which draws each figure twice, as
+    SVG and PNG, is most of a report's time: 12 s of 17 s for the default suite's 51 figures on one CPU). Use as a
+    context manager; :meth:`submit` returns a future of :func:`save`'s SVG text. One CPU: written at once, in this
+    process."""
 
     def __init__(self, workers: int | None = None) -> None:
         self._workers = max(1, os.cpu_count() or 1) if workers is None else workers

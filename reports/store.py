@@ -3,12 +3,23 @@
 from __future__ import annotations
 
 import json
+import math
+import re
 from pathlib import Path
 
 import pandas as pd
 
 from simparity.core.errors import ResultsError, one_line
-from simparity.core.results import COLUMNS, RESULTS_FILE, RUN_INFO_FILE, SCHEMA_VERSION, SERIES_COLUMNS, SERIES_FILE
+from simparity.core.results import (
+    COLUMNS,
+    RESULTS_FILE,
+    RUN_INFO_FILE,
+    SCHEMA_VERSION,
+    SERIES_COLUMNS,
+    SERIES_FILE,
+    SWEEP_COLUMN,
+    SWEEP_PREFIX,
+)
 
 
 # pandas < 3 parses floats inexactly unless asked; pandas 3 is exact and deprecates the option.
@@ -16,7 +27,11 @@ _EXACT_FLOATS = {"float_precision": "round_trip"} if int(pd.__version__.split(".
 
 
 def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
-    """(results table, run information) of a stored run; raises ResultsError if unusable."""
+    """(results table, run information) of a stored run; raises ResultsError if unusable.
+
+    The table has :data:`core.results.COLUMNS` (``dt`` and ``value`` float64) and, for a run of swept scenes,
+    the sweep columns: ``sweep`` (text, empty for scenes without a sweep) and each ``sweep:KEY`` as numbers
+    (Int64 for whole-number keys, else float64; missing for rows of scenes that do not sweep the key)."""
     run_dir = Path(run_dir)
     results, info = run_dir / RESULTS_FILE, run_dir / RUN_INFO_FILE
     for path in (results, info):
@@ -25,10 +40,13 @@ def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
                                f"{RESULTS_FILE} and {RUN_INFO_FILE})")
     try:
         meta = json.loads(info.read_text(encoding="utf-8"))
+        swept = [c for c in pd.read_csv(results, nrows=0).columns if c == SWEEP_COLUMN or c.startswith(SWEEP_PREFIX)]
         # keep_default_na=False: pandas would read the status "n/a" as missing.
-        table = pd.read_csv(results, keep_default_na=False, **_EXACT_FLOATS,
+        table = pd.read_csv(results, keep_default_na=False, **_EXACT_FLOATS, dtype={c: str for c in swept},
                             na_values={"value": ["", "nan", "NaN"], "dt": ["", "nan", "NaN"]})
-    except (json.JSONDecodeError, pd.errors.ParserError, UnicodeDecodeError) as err:
+        for column in (c for c in swept if c != SWEEP_COLUMN):
+            table[column] = _swept_values(table[column])
+    except (json.JSONDecodeError, pd.errors.ParserError, UnicodeDecodeError, ValueError) as err:
         raise ResultsError(f"{one_line(run_dir)}: unreadable stored run: {one_line(err)} (allowed: a folder written by "
                            "'simparity run')") from None
     if meta.get("schema_version") != SCHEMA_VERSION:
@@ -38,6 +56,18 @@ def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
     if missing:
         raise ResultsError(f"{results}: missing columns {missing} (allowed: a results.csv with {', '.join(COLUMNS)})")
     return table, meta
+
+
+_WHOLE = re.compile(r"-?[0-9]+")
+
+
+def _swept_values(column: pd.Series) -> pd.Series:
+    """A sweep column's text as numbers: Int64 when every value given is whole (a seed, a count), else float64
+    (read by Python's float, exact); an empty cell (a row of a scene that does not sweep the key) is missing."""
+    given = column[column != ""]
+    if given.map(lambda text: _WHOLE.fullmatch(text) is not None).all():
+        return pd.Series([int(text) if text else pd.NA for text in column], index=column.index, dtype="Int64")
+    return pd.Series([float(text) if text else math.nan for text in column], index=column.index, dtype=float)
 
 
 def read_series(run_dir: str | Path) -> pd.DataFrame:

@@ -34,13 +34,14 @@ OVERHEAD_DOMINATED_BODIES = 100
 
 
 def dynamics_cases(rows: pd.DataFrame, headline: str) -> pd.DataFrame:
-    """One row per engine x integrator x dt of a dynamics scene, ground truths and the scene's reference scheme
-    (core backup where core is the reference) left out: a scheme measured against itself ranks nothing.
+    """One row per scene x engine x integrator x dt of dynamics scenes (one scene, or a sweep's variants), ground
+    truths and the scene's reference scheme (core backup where core is the reference) left out: a scheme measured
+    against itself ranks nothing.
 
-    Columns: engine, integrator, dt [s], status (the case's), error (the headline metric where it
+    Columns: scene, engine, integrator, dt [s], status (the case's), error (the headline metric where it
     was measured, else NaN), time_per_step [s] and cost [s of compute per simulated second].
     """
-    keys = ["engine", "integrator", "dt"]
+    keys = ["scene", "engine", "integrator", "dt"]
     per_dt = rows[rows["dt"].notna() & ~rows["engine"].isin(GROUND_TRUTH_ENGINES)
                   & (rows["engine"] + ":" + rows["integrator"] != rows["reference"])]
     cases = per_dt.groupby(keys, sort=False)["status"].agg(case_status).rename("status").reset_index()
@@ -49,7 +50,7 @@ def dynamics_cases(rows: pd.DataFrame, headline: str) -> pd.DataFrame:
     cases = cases.merge(values.reindex(columns=[headline, "time_per_step"]).reset_index(), on=keys, how="left")
     cases = cases.rename(columns={headline: "error"})
     cases["cost"] = cases["time_per_step"] / cases["dt"]
-    return cases[["engine", "integrator", "dt", "status", "error", "time_per_step", "cost"]]
+    return cases[["scene", "engine", "integrator", "dt", "status", "error", "time_per_step", "cost"]]
 
 
 def _measured(cases: pd.DataFrame) -> pd.DataFrame:
@@ -82,9 +83,13 @@ def best_per_scheme(cases: pd.DataFrame) -> pd.DataFrame:
     return summary.merge(best[keys + ["dt", "error", "cost", "time_per_step"]], on=keys, how="left")
 
 
+ORDER_METRICS = {"position_error_max": "order_position", "orientation_error_max": "order_orientation"}
+"""The row holding the observed order of convergence of each headline error."""
+
+
 def orders(rows: pd.DataFrame, headline: str) -> dict[tuple[str, str], float]:
     """Observed order of the headline error per (engine, integrator), where it was fitted."""
-    metric = {"position_error_max": "order_position", "orientation_error_max": "order_orientation"}[headline]
+    metric = ORDER_METRICS[headline]
     fitted = rows[rows["dt"].isna() & (rows["metric"] == metric) & (rows["status"] == OK)]
     return {(r["engine"], r["integrator"]): float(r["value"]) for _, r in fitted.iterrows()}
 

@@ -1,17 +1,20 @@
-"""Scene builders shared by the tests (seeded generators take an explicit rng)."""
+"""Scene builders and run helpers shared by the tests (seeded generators take an explicit rng)."""
 
 from __future__ import annotations
 
-import numpy as np
-
 import dataclasses
+import math
 import os
+
+import numpy as np
 
 import pybullet_data
 
 from simparity.core.ik.result import LIMIT_TOLERANCE
 from simparity.comparisons.engines import make_engine
 from simparity.comparisons.library import builtin_paths
+from simparity.comparisons.profiles import apply_profile
+from simparity.comparisons.runner import run_group
 from simparity.comparisons.scene_loader import load_scene
 from simparity.core.ik.jacobian_solvers import IKOptions
 from simparity.core.ik.reach import reach_upper_bound
@@ -137,3 +140,75 @@ def reached_rate(result) -> float:
     outside = result.reason == "outside_limits"
     assert np.all(result.limit_violation[outside] > LIMIT_TOLERANCE)
     return float(np.mean(result.success | outside))
+
+
+RUN_ENGINES = ("core", "analytic", "mujoco", "pybullet", "pinocchio")
+MIXED_SCENES = ("lecture-projectile", "ball-bounce-k05", "dzhanibekov", "ur5-kinematics", "lecture-2link-ik")
+"""A dynamics scene with an analytic truth, one with contact (stability limits too), one with a tight
+reference and observed orders, a kinematics scene and an IK scene with hard targets."""
+
+TIMING_PREFIX = "time_"
+"""Metrics that are wall times: they differ between any two runs; every other value must not."""
+
+
+def quick_scenes(names=MIXED_SCENES):
+    """Built-in scenes in the quick profile."""
+    return apply_profile([builtin(n) for n in names], "quick")
+
+
+def built_engines(names=RUN_ENGINES):
+    return [make_engine(n) for n in names]
+
+
+def comparable(results) -> list[tuple]:
+    """Every row's non-timing content, floats by their exact bits (repr), and every series point."""
+    out = []
+    for scene, rows, series in results:
+        for r in rows:
+            value = "timing" if r.metric.startswith(TIMING_PREFIX) else repr(r.value)
+            out.append((r.scene, r.engine, r.integrator, repr(r.dt), r.metric, value, r.unit, r.reference, r.status,
+                        r.detail))
+        for s in series:
+            out.append((s.scene, s.engine, s.integrator, repr(s.dt), s.quantity, s.x.tobytes(), s.value.tobytes()))
+    return out
+
+
+class InProcess:
+    """An executor running every group in this process, counting the cases it ran; it can stop (as Ctrl-C
+    would) after ``stop_after`` cases."""
+
+    def __init__(self, stop_after: float = math.inf) -> None:
+        self.ran, self.stop_after, self.jobs = 0, stop_after, []
+
+    def run(self, jobs):
+        self.jobs = list(jobs)
+        for job in jobs:
+            for index, outcome in run_group(job.group, make_engine, skip=frozenset(job.skip)):
+                if self.ran >= self.stop_after:
+                    raise KeyboardInterrupt
+                self.ran += 1
+                yield job.key, index, outcome
+
+    def close(self) -> None:
+        return None
+
+
+THROWN_BALL = """
+[scene]
+name = "throw"
+kind = "dynamics"
+reference = "analytic"
+[world]
+gravity_world = [0.0, 0.0, -9.81]
+[[body]]
+name = "ball"
+mass = 1.0
+inertia_body_diagonal = [0.1, 0.1, 0.1]
+position_world = [0.0, 0.0, 10.0]
+velocity_world = [1.0, 0.0, 0.0]
+[simulation]
+duration = 1.0
+dt = [0.01, 0.005]
+integrators = ["rk4"]
+"""
+"""A ball thrown under gravity for 1 s at two time steps, RK4 only: a scene of milliseconds per case."""

@@ -100,3 +100,14 @@ def test_project_modules_are_imported_through_the_namespace(layer):
     for path in _modules(layer):
         bare = [n for n in _imports(path) if n.split(".")[0] in LAYERS]
         assert not bare, f"{path.relative_to(ROOT)} imports {bare} outside the simparity namespace"
+
+
+EXAMPLE_PLUGIN = ROOT / "examples" / "plugin-engine" / "src"
+"""The plugin engine users copy (docs/plugins.md)."""
+
+
+@pytest.mark.parametrize("path", sorted(EXAMPLE_PLUGIN.rglob("*.py")), ids=lambda p: p.name)
+def test_the_example_plugin_imports_only_the_data_model_of_core(path):
+    """Like a reference: a user's engine built on core's methods would agree with their bugs."""
+    borrowed = _project_modules(_imports(path)) - DATA_MODEL - {"simparity.core"}
+    assert not borrowed, f"{path.name} imports {sorted(borrowed)}; allowed: {sorted(DATA_MODEL)}"

@@ -10,10 +10,15 @@ from simparity.comparisons.check import BASELINE_RELATIVE, check_table, compare_
 from simparity.comparisons.engines import make_engine
 from simparity.comparisons.profiles import quick
 from simparity.comparisons.runner import run_scene
+from simparity.comparisons.scene_loader import parse_scenes
+from simparity.comparisons.store import RunWriter
 from simparity.comparisons.tolerances import load_tolerances
 from simparity.core import quaternion_integrators
+from simparity.core.files import tomllib
 from simparity.core.results import COLUMNS, ResultRow
+from simparity.reports.store import read_run
 from tests.helpers import builtin
+from tests.test_scene_loader import VALID_DYNAMICS
 
 
 def _table(rows):
@@ -93,3 +98,19 @@ def test_a_degraded_rk4_fails_the_shipped_tolerances(monkeypatch):
     monkeypatch.setitem(quaternion_integrators.TABLEAUX, "rk4", (a, [1 / 6, 1 / 6, 1 / 2, 1 / 6], c))
     bad = check_table(_table(run_scene(scene, [make_engine("core")], make_engine, repeats=0)), bounds)
     assert not bad.passed and any(v.metric == "order_orientation" for v in bad.violations)
+
+
+def test_a_run_with_sweep_columns_is_checked_and_compared_like_any_other(bounds, tmp_path):
+    """The gate reads the fixed columns: a swept run's extra columns change no verdict, and a run stored before
+    sweeps (fixed columns only) is its baseline without a move."""
+    variants = parse_scenes(tomllib.loads(VALID_DYNAMICS + '[sweep]\n"body[ball].mass" = [1.0, 2.0]\n'))
+    rows = [dataclasses.replace(_row(value=value), scene=scene.name) for scene in variants for value in (4.02, 2.9)]
+    RunWriter(tmp_path / "new", [], "simparity run", variants).append(rows)
+    RunWriter(tmp_path / "old", [], "simparity run", []).append(rows)
+    new, old = read_run(tmp_path / "new")[0], read_run(tmp_path / "old")[0]
+    assert "sweep:body[ball].mass" in new.columns and tuple(old.columns) == COLUMNS
+    verdict = check_table(new, bounds)
+    lines = [v.line() for v in verdict.violations]
+    assert (verdict.checked, len(lines)) == (4, 2) and lines == [v.line() for v in check_table(old, bounds).violations]
+    diff = compare_with_baseline(new, old)
+    assert not (diff.moved or diff.missing or diff.new)

@@ -23,11 +23,13 @@ def _run(argv):
 
 
 def test_list_names_every_builtin_scene():
-    """'simparity list' prints one line per built-in scene, starting with its name."""
+    """'simparity list' prints one line per built-in scene, starting with its name; a file with a sweep, one line
+    per variant in the sweep's order."""
     code, text = _run(["list"])
     lines = text.strip().splitlines()
     assert code == EXIT_OK
-    assert [line.split()[0] for line in lines] == sorted(builtin_paths())
+    variants = {"restitution-sweep": [f"restitution-sweep_restitution-{k}" for k in ("0.3", "0.5", "0.7", "0.9")]}
+    assert [line.split()[0] for line in lines] == [v for name in sorted(builtin_paths()) for v in variants.get(name, [name])]
 
 
 @pytest.mark.parametrize("suite", [None, "default", "hard"])
@@ -35,8 +37,13 @@ def test_run_without_scenes_runs_a_whole_builtin_suite(tmp_path, monkeypatch, su
     """No scene argument means every built-in scene of the suite (default: "default"), each once, on
     the default engines; a scene file lists its suites."""
     seen = []
-    monkeypatch.setattr("simparity.comparisons.parallel.run_scene", lambda scene, engines, *a, **k: seen.append(
-        (scene.name, tuple(e.name for e in engines))) or [])
+
+    def run_scenes(scenes, engines, *args, **kwargs):
+        for scene in scenes:
+            seen.append((scene.name, tuple(e.name for e in engines)))
+            yield scene, [], []
+
+    monkeypatch.setattr("simparity.comparisons.cli.run_scenes", run_scenes)
     code, _ = _run(["run", "--out", str(tmp_path), "--jobs", "1"] + (["--suite", suite] if suite else []))
     assert code == EXIT_OK
     wanted = suite or "default"

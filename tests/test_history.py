@@ -16,7 +16,7 @@ from simparity.comparisons.history import (
     run_table,
     runs,
 )
-from simparity.core.results import COLUMNS, ResultRow
+from simparity.core.results import COLUMNS, SWEEP_COLUMN, ResultRow, sweep_column
 
 INFO = {"created_utc": "2026-11-22T10:00:00+00:00", "git_commit": "abc", "command": "simparity run",
         "machine": {"cpu_count": 2}, "engine_versions": {"core": "1"}}
@@ -74,3 +74,11 @@ def test_two_processes_writing_at_once_lose_nothing(tmp_path):
     recorded = runs(db)
     assert len(recorded) == 40 and recorded["id"].is_unique
     assert all(len(run_table(db, int(i))) == 2 for i in recorded["id"])
+
+
+def test_a_run_with_sweep_columns_is_recorded_in_the_fixed_columns(tmp_path):
+    """The history keeps the fixed columns of any run (a variant's values are in its name and its run.json)."""
+    swept = _table(1e-6).assign(**{SWEEP_COLUMN: "drop", sweep_column("body[ball].mass"): 2.0})
+    run = record_run(tmp_path / "h.sqlite", tmp_path / "r", INFO, swept)
+    table = run_table(tmp_path / "h.sqlite", run)
+    assert tuple(table.columns) == COLUMNS and table["value"].iloc[0] == 1e-6

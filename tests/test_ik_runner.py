@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.engines import DEFAULT_ENGINES, make_engine
-from simparity.comparisons.ik_runner import IK_METRICS, run_ik_scene
+from simparity.comparisons.ik_runner import IK_METRICS
+from simparity.comparisons.runner import run_scene
 from simparity.comparisons.ik_targets import random_targets
 from simparity.core.ik.jacobian_solvers import IKOptions
 from simparity.core.results import FAILED, NOT_AVAILABLE, OK
@@ -21,7 +22,7 @@ REQUIRED_IIWA_SOLVE_RATE = 0.995
 def iiwa_rows():
     """All engines on the built-in iiwa scene, 40 random targets (the hard targets in full)."""
     scene = dataclasses.replace(builtin("iiwa-ik"), n_targets=40)
-    return run_ik_scene(scene, [make_engine(name) for name in DEFAULT_ENGINES], make_engine, repeats=1)
+    return run_scene(scene, [make_engine(name) for name in DEFAULT_ENGINES], make_engine, repeats=1)
 
 
 def test_every_engine_and_solver_has_every_metric(iiwa_rows):
@@ -70,7 +71,7 @@ def test_core_solves_the_iiwa_criterion():
 def test_analytic_two_link_beside_the_iterative_solvers():
     """On the lecture's 2-link arm the analytic solver solves every reachable target; others are measured."""
     scene = dataclasses.replace(builtin("lecture-2link-ik"), n_targets=60)
-    rows = run_ik_scene(scene, [make_engine("analytic"), make_engine("core")], make_engine, repeats=1)
+    rows = run_scene(scene, [make_engine("analytic"), make_engine("core")], make_engine, repeats=1)
     rate = {(r.engine, r.integrator): r.value for r in rows if r.metric == "solve_rate" and r.status == OK}
     assert rate[("analytic", "two_link")] == 1.0
     assert 0 < rate[("core", "damped_least_squares")] <= 1.0
@@ -89,7 +90,7 @@ def test_a_failing_solver_still_reports_every_hard_target():
             raise RuntimeError("no solver today")
 
     scene = dataclasses.replace(builtin("iiwa-ik"), n_targets=5)
-    rows = run_ik_scene(scene, [_Broken()], make_engine, repeats=1)
+    rows = run_scene(scene, [_Broken()], make_engine, repeats=1)
     dls = [r for r in rows if r.integrator == "damped_least_squares"]
     assert {r.metric for r in dls} >= set(IK_METRICS) | {f"hard_{h}" for h in scene.hard_targets}
     assert {r.status for r in dls} == {FAILED} and all("no solver today" in r.detail for r in dls)
@@ -98,7 +99,7 @@ def test_a_failing_solver_still_reports_every_hard_target():
 def test_float32_judge_does_not_fail_double_precision_solutions():
     """A solution within tolerance in double is granted by every judge, PyBullet's float32 FK included."""
     scene = dataclasses.replace(builtin("lecture-2link-ik"), n_targets=40)
-    rows = run_ik_scene(scene, [make_engine("analytic"), make_engine("pybullet"), make_engine("core")], make_engine,
+    rows = run_scene(scene, [make_engine("analytic"), make_engine("pybullet"), make_engine("core")], make_engine,
                         repeats=1)
     cross = {r.integrator: r.value for r in rows if r.metric == "cross_eval_solve_rate_min"}
     own = {r.integrator: r.value for r in rows if r.metric == "solve_rate"}
@@ -110,7 +111,7 @@ def test_unavailable_engine_says_why_in_ik_scenes():
     from simparity.comparisons.engines import UnavailableEngine
 
     scene = dataclasses.replace(builtin("lecture-2link-ik"), n_targets=5)
-    rows = run_ik_scene(scene, [UnavailableEngine("mujoco", "No module named 'mujoco'")], make_engine, repeats=1)
+    rows = run_scene(scene, [UnavailableEngine("mujoco", "No module named 'mujoco'")], make_engine, repeats=1)
     assert rows and all(r.status == NOT_AVAILABLE and "not importable" in r.detail for r in rows)
 
 

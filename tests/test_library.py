@@ -12,15 +12,16 @@ import pytest
 
 from simparity.comparisons import library
 from simparity.comparisons.check import check_table
+from simparity.comparisons.describe import describe
 from simparity.comparisons.engines import make_engine
 from simparity.comparisons.profiles import quick
 from simparity.comparisons.scene_loader import EXAMPLE_ROBOT_DATA_PREFIX
 from simparity.comparisons.runner import run_scene
 from simparity.comparisons.tolerances import load_tolerances
-from simparity.core.errors import SceneError, SimparityError
+from simparity.core.errors import SceneError, SimparityError, UnknownSceneError
 from simparity.core.files import tomllib
 from simparity.core.results import COLUMNS, DIVERGED, OK, ResultRow
-from simparity.core.scene import DynamicsScene, IKScene
+from simparity.core.scene import DynamicsScene, IKScene, SweepPoint
 from tests.helpers import builtin
 
 MIN_HARD_CASES = 20
@@ -39,7 +40,41 @@ def test_default_suite_is_every_scene_marked_default_and_hard_is_its_own():
     assert "lecture-projectile" in default and "lecture-projectile" not in hard
     assert "hard-stiff-drag" in hard and "hard-stiff-drag" not in default
     assert "fast-spinner" in default & hard
-    assert default | hard | contact | bench == set(library.builtin_paths())
+    assert default | hard | contact | bench == {s.name for s in library.load(list(library.builtin_paths()))}
+    files = {s.sweep.base if s.sweep else s.name for name in ("default", "hard", "contact", "bench")
+             for s in library.suite(name)}   # a sweep's variants are named after their file's scene
+    assert files == set(library.builtin_paths())
+
+
+RESTITUTION_SWEEP = ["restitution-sweep_restitution-0.3", "restitution-sweep_restitution-0.5",
+                     "restitution-sweep_restitution-0.7", "restitution-sweep_restitution-0.9"]
+"""The variants of the built-in example sweep, written out from its file's range (0.3 to 0.9 in 4 values)."""
+
+
+def test_a_file_with_a_sweep_loads_as_its_variants_in_the_sweeps_order():
+    """Issue #12: one file, one scene per swept value, in the sweep's order and where the file was named."""
+    loaded = library.load(["wind", "restitution-sweep", "dzhanibekov"])
+    assert [s.name for s in loaded] == ["wind"] + RESTITUTION_SWEEP + ["dzhanibekov"]
+    variants = loaded[1:5]
+    assert [s.sweep.values for s in variants] == [(("contact.restitution", k),) for k in (0.3, 0.5, 0.7, 0.9)]
+    assert [float(s.contact.restitution[0, 0]) for s in variants] == [0.3, 0.5, 0.7, 0.9]
+    assert [s.name for s in library.load([str(library.builtin_paths()["restitution-sweep"])])] == RESTITUTION_SWEEP
+
+
+def test_a_built_in_variant_is_found_by_the_name_simparity_list_shows():
+    (variant,) = library.load(["restitution-sweep_restitution-0.7"])
+    assert variant.sweep == SweepPoint("restitution-sweep", (("contact.restitution", 0.7),), 2, 4)
+    assert ("variant 3 of 4 of the sweep of restitution-sweep: contact.restitution = 0.7 (as written in the file)"
+            in describe(variant).splitlines())   # what `simparity show` prints
+    with pytest.raises(UnknownSceneError, match="neither a built-in scene nor a scene file"):
+        library.load(["restitution-sweep_restitution-0.8"])
+
+
+def test_the_example_sweep_is_in_the_contact_suite_only():
+    """Not in the default suite: it must not slow `simparity run`."""
+    contact = [s.name for s in library.suite("contact")]
+    assert [n for n in contact if n.startswith("restitution-sweep")] == RESTITUTION_SWEEP
+    assert not any(s.sweep for s in library.suite("default"))
 
 
 def test_the_bench_suite_is_the_three_arms_with_10000_targets_each():

@@ -1,10 +1,15 @@
 """Scene files: every built-in scene loads; every kind of bad input is rejected with file, key and reason."""
 
+import dataclasses
+import re
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from simparity.comparisons.library import builtin_paths
-from simparity.comparisons.scene_loader import LENGTH_UNITS, load_scene, parse_scene
+from simparity.comparisons.describe import describe
+from simparity.comparisons.scene_loader import LENGTH_UNITS, load_scene, load_scenes, parse_scene, parse_scenes
 from simparity.core.files import tomllib
 from simparity.core.errors import SceneError
 
@@ -198,9 +203,9 @@ def test_absent_forces_stay_absent():
 
 @pytest.mark.parametrize("name", sorted(builtin_paths()))
 def test_every_builtin_scene_loads(name):
-    """The built-in library is valid: every file loads and names itself after its file."""
-    scene = load_scene(builtin_paths()[name])
-    assert scene.name == name
+    """The built-in library is valid: every file loads and names itself after its file (a sweep: its base)."""
+    scenes = load_scenes(builtin_paths()[name])
+    assert [s.sweep.base if s.sweep else s.name for s in scenes] == [name] * len(scenes)
 
 
 HAND_EXACT = 1e-15
@@ -355,3 +360,117 @@ def test_contact_keys_without_a_plane_are_rejected(tmp_path):
     with pytest.raises(SceneError) as caught:
         load_scene(_write(tmp_path, text))
     assert caught.value.key == "body[0].restitution" and "no [[plane]]" in str(caught.value)
+
+
+# --- sweeps --------------------------------------------------------------------------------------------
+
+SWEPT = VALID_DYNAMICS + """
+[sweep]
+"body[ball].velocity_world[0]" = [1.0, 2.0]
+"simulation.dt" = {start = 0.01, stop = 0.04, num = 2}
+"""
+
+DOCS = Path(__file__).resolve().parents[1] / "docs" / "scenes.md"
+
+
+def test_a_sweep_expands_into_variants_in_the_sweeps_order():
+    scenes = parse_scenes(tomllib.loads(SWEPT), "swept.toml")
+    assert [s.name for s in scenes] == ["drop_velocity_world.0-1.0_dt-0.01", "drop_velocity_world.0-1.0_dt-0.04",
+                                        "drop_velocity_world.0-2.0_dt-0.01", "drop_velocity_world.0-2.0_dt-0.04"]
+    assert [s.sweep.values for s in scenes] == [
+        (("body[ball].velocity_world[0]", 1.0), ("simulation.dt", 0.01)),
+        (("body[ball].velocity_world[0]", 1.0), ("simulation.dt", 0.04)),
+        (("body[ball].velocity_world[0]", 2.0), ("simulation.dt", 0.01)),
+        (("body[ball].velocity_world[0]", 2.0), ("simulation.dt", 0.04))]
+    assert {(s.sweep.base, s.sweep.count) for s in scenes} == {("drop", 4)} and [s.sweep.index for s in scenes] == [0, 1, 2, 3]
+    assert [s.dts for s in scenes] == [(0.01,), (0.04,), (0.01,), (0.04,)]
+    assert [s.bodies[0].velocity_world[0] for s in scenes] == [1.0, 1.0, 2.0, 2.0]
+
+
+def test_a_variant_is_the_scene_written_by_hand_with_its_values():
+    """The variant loads exactly as the file with those values typed in (only its name and sweep differ)."""
+    variant = parse_scenes(tomllib.loads(SWEPT))[3]
+    by_hand = parse_scene(tomllib.loads(VALID_DYNAMICS.replace("velocity_world = [1.0, 0.0, 0.0]",
+                                                               "velocity_world = [2.0, 0.0, 0.0]")
+                                        .replace("dt = [0.01]", "dt = [0.04]")))
+    assert describe(dataclasses.replace(variant, name="drop", sweep=None)) == describe(by_hand)
+    assert parse_scenes(tomllib.loads(VALID_DYNAMICS))[0].sweep is None
+
+
+def test_sweep_values_are_as_written_in_the_files_length_unit():
+    text = VALID_DYNAMICS.replace('reference = "analytic"', 'reference = "analytic"\nlength_unit = "cm"').replace(
+        'name = "ball"', 'name = "ball"\nposition_world = [0.0, 0.0, 50.0]') + '[sweep]\n"body[0].position_world[2]" = [50, 100]\n'
+    scenes = parse_scenes(tomllib.loads(text))
+    assert [s.sweep.values[0][1] for s in scenes] == [50.0, 100.0]
+    assert [s.bodies[0].position_world[2] for s in scenes] == [pytest.approx(0.5, rel=HAND_EXACT),
+                                                              pytest.approx(1.0, rel=HAND_EXACT)]
+
+
+def test_ik_and_kinematics_scenes_sweep_their_seeds_and_chain():
+    ik = VALID_KINEMATICS.replace('kind = "kinematics"', 'kind = "ik"').replace(
+        "[chain]", "[targets]\ncount = 5\nseed = 0\n[chain]") + '[sweep]\n"targets.seed" = {start = 0, stop = 2, num = 3}\n'
+    seeds = parse_scenes(tomllib.loads(ik))
+    assert [s.seed for s in seeds] == [0, 1, 2] and all(type(s.sweep.values[0][1]) is int for s in seeds)
+    assert not np.array_equal(seeds[0].configurations(), seeds[1].configurations())
+    arm = VALID_KINEMATICS.replace('axis = [0.0, 0.0, 1.0]', 'axis = [0.0, 0.0, 1.0]\norigin_xyz = [0.5, 0.0, 0.0]') + (
+        '[sweep]\n"chain.joint[j1].origin_xyz[0]" = [0.25, 0.75]\n"chain.joint[j1].upper" = [0.5]\n')
+    arms = parse_scenes(tomllib.loads(arm))
+    assert [s.chain.joints[0].origin_xyz[0] for s in arms] == [0.25, 0.75] and {s.chain.joints[0].upper for s in arms} == {0.5}
+    assert {s.chain.name for s in arms} == {"arm"}   # the chain keeps the file's name
+
+
+def test_a_file_with_a_sweep_is_not_one_scene(tmp_path):
+    with pytest.raises(SceneError, match=r"sweep: the file sweeps keys: it is several scenes.*load_scenes"):
+        load_scene(_write(tmp_path, SWEPT))
+    assert len(load_scenes(_write(tmp_path, SWEPT))) == 4
+
+
+@pytest.mark.parametrize("sweep, key, words", [
+    ('"body[ball].velocity_world[0]" = [1.0, 1e7]', "sweep.body[ball].velocity_world[0]",
+     "10000000.0 (variant 2 of 2): body[0].velocity_world[0]: 1e+07 is outside the physical range"),
+    ('"body[ball].mass" = [1.0, -2.0]', "sweep.body[ball].mass", "-2.0 (variant 2 of 2): body[0].mass: -2.0 is not positive"),
+    ('"simulation.dt" = [0.01, 0.3]', "sweep.simulation.dt", "0.3 (variant 2 of 2): simulation.dt[0]: duration 1 s is not"),
+    ('"simulation.dt[0]" = [0.5]\n"simulation.duration" = [1.0, 1.25]', "sweep.simulation.dt[0]",   # the key named
+     "0.5 (variant 2 of 2, with simulation.duration = 1.25): simulation.dt[0]: duration 1.25 s is not a whole number"),
+    ('"body[ball].inertia_body_diagonal[2]" = [0.3]', "sweep.body[ball].inertia_body_diagonal[2]",
+     "0.3 (variant 1 of 1): body[0].inertia_body_diagonal: inertia violates the triangle inequality"),
+    ('"plane[floor].coefficients[3]" = [1.0, -1.0]\n"body[ball].mass" = [1.5]', "sweep",   # the plane moved onto the ball
+     "variant 2 of 2 (plane[floor].coefficients[3] = -1.0, body[ball].mass = 1.5): body[0].position_world: body 'ball' "
+     "starts 1 m inside plane 'floor'"),
+])
+def test_a_variant_the_loader_refuses_names_the_sweep_key_and_value(tmp_path, sweep, key, words):
+    plane = '[[plane]]\nname = "floor"\ncoefficients = [0.0, 0.0, 1.0, 1.0]\n' if "plane" in sweep else ""
+    path = _write(tmp_path, VALID_DYNAMICS + plane + "[sweep]\n" + sweep + "\n")
+    with pytest.raises(SceneError) as caught:
+        load_scenes(path)
+    assert caught.value.source == str(path) and caught.value.key == key
+    assert words in caught.value.problem and caught.value.allowed
+
+
+def test_the_file_without_its_sweep_must_be_a_scene(tmp_path):
+    """An error of the file itself names its own key, as in a file without a sweep."""
+    path = _write(tmp_path, SWEPT.replace("mass = 1.5", "mass = -1.5"))
+    with pytest.raises(SceneError) as caught:
+        load_scenes(path)
+    assert caught.value.key == "body[0].mass"
+
+
+def _docs_section() -> str:
+    return DOCS.read_text(encoding="utf-8").split("## Sweeps", 1)[1].split("\n## ", 1)[0]
+
+
+def test_the_documented_sweep_expands_as_documented():
+    """docs/scenes.md's example gives the variants its table lists, and its error is the one it prints."""
+    text = re.search(r"```toml\n(.*?)```", _docs_section(), flags=re.S).group(1)
+    scenes = parse_scenes(tomllib.loads(text), "bounce.toml")
+    names = [s.name for s in scenes]
+    assert len(names) == 8 and names[:3] + names[-1:] == [
+        "bounce_restitution-0.3_velocity_world.0-0.0", "bounce_restitution-0.3_velocity_world.0-1.0",
+        "bounce_restitution-0.5_velocity_world.0-0.0", "bounce_restitution-0.9_velocity_world.0-1.0"]
+    for name in names[:3] + names[-1:]:
+        assert f"| `{name}` |" in _docs_section()
+    assert [s.contact.restitution[0, 0] for s in scenes[::2]] == [0.3, 0.5, 0.7, 0.9]
+    bad = text.split("[sweep]")[0] + '[sweep]\n"contact.restitution" = [0.5, 0.8, 1.5]\n'
+    with pytest.raises(SceneError) as caught:
+        parse_scenes(tomllib.loads(bad), "bounce.toml")
+    assert f"simparity: error: {caught.value}" in _docs_section()

@@ -6,11 +6,14 @@ import math
 import pytest
 
 from simparity.comparisons.engines import make_engine
+from simparity.comparisons.scene_loader import parse_scenes
 from simparity.comparisons.store import RunWriter
 from simparity.core.errors import ResultsError
-from simparity.core.results import ResultRow
+from simparity.core.files import tomllib
+from simparity.core.results import COLUMNS, RESULTS_FILE, ResultRow
 from simparity.reports.store import read_run
 from tests.helpers import builtin
+from tests.test_scene_loader import VALID_DYNAMICS, VALID_KINEMATICS
 
 
 def test_rows_round_trip_with_full_precision(tmp_path):
@@ -41,4 +44,54 @@ def test_bad_run_folders_raise_results_error(tmp_path):
     info["schema_version"] = 99
     (tmp_path / "run.json").write_text(json.dumps(info))
     with pytest.raises(ResultsError, match="schema_version 99"):
+        read_run(tmp_path)
+
+
+def _row(scene: str) -> ResultRow:
+    return ResultRow(scene, "core", "rk4", 0.01, "position_error_max", 1e-3, "m", "analytic:exact", "ok")
+
+
+def _swept_scenes() -> list:
+    """Two dynamics variants (a float key), a scene without a sweep, two IK variants (a seed up to 2^63 - 1)."""
+    dynamics = parse_scenes(tomllib.loads(VALID_DYNAMICS + '[sweep]\n"body[ball].mass" = [1.0, 0.30000000000000004]\n'))
+    ik = VALID_KINEMATICS.replace('kind = "kinematics"', 'kind = "ik"').replace("[chain]", "[targets]\nseed = 0\n[chain]")
+    ik = parse_scenes(tomllib.loads(ik + '[sweep]\n"targets.seed" = [3, 9223372036854775807]\n'))
+    return dynamics + [builtin("lecture-projectile")] + ik
+
+
+def test_a_run_of_swept_scenes_has_a_column_per_swept_key(tmp_path):
+    """Issue #12: `sweep` (the base scene) and `sweep:KEY` per swept key after the fixed columns, read back exactly
+    and typed (a seed stays a whole number), empty where a scene does not sweep the key; run.json has the sweep."""
+    scenes = _swept_scenes()
+    writer = RunWriter(tmp_path, [], "simparity run", scenes)
+    writer.append([_row(s.name) for s in scenes[3:]])          # rows arrive in any order
+    writer.append([_row(s.name) for s in scenes[:3]] + [_row("not-in-the-run")])
+    table, info = read_run(tmp_path)
+    assert list(table.columns) == list(COLUMNS) + ["sweep", "sweep:body[ball].mass", "sweep:targets.seed"]
+    assert list(table["scene"]) == ["arm_seed-3", "arm_seed-9223372036854775807", "drop_mass-1.0",
+                                    "drop_mass-0.30000000000000004", "lecture-projectile", "not-in-the-run"]
+    assert list(table["sweep"]) == ["arm", "arm", "drop", "drop", "", ""]
+    mass = table["sweep:body[ball].mass"]
+    assert mass.dtype == float and list(mass[2:4]) == [1.0, 0.1 + 0.2] and mass.isna().sum() == 4
+    seed = table["sweep:targets.seed"]
+    assert str(seed.dtype) == "Int64" and list(seed[:2]) == [3, 2**63 - 1] and seed.isna().sum() == 4
+    assert info["scenes"]["drop_mass-0.30000000000000004"]["sweep"] == {
+        "base": "drop", "index": 1, "count": 2, "values": {"body[ball].mass": 0.1 + 0.2}}
+    assert "sweep" not in info["scenes"]["lecture-projectile"]
+
+
+def test_a_run_without_sweeps_keeps_exactly_the_fixed_columns(tmp_path):
+    writer = RunWriter(tmp_path, [], "simparity run", [builtin("lecture-projectile")])
+    writer.append([_row("lecture-projectile")])
+    assert (tmp_path / RESULTS_FILE).read_text(encoding="utf-8").splitlines()[0] == ",".join(COLUMNS)
+    table, _ = read_run(tmp_path)
+    assert tuple(table.columns) == COLUMNS
+
+
+def test_a_damaged_sweep_column_is_a_results_error(tmp_path):
+    writer = RunWriter(tmp_path, [], "simparity run", _swept_scenes()[:2])
+    writer.append([_row("drop_mass-1.0")])
+    path = tmp_path / RESULTS_FILE
+    path.write_text(path.read_text(encoding="utf-8").replace(",drop,1.0", ",drop,heavy"), encoding="utf-8")
+    with pytest.raises(ResultsError, match="unreadable stored run"):
         read_run(tmp_path)

@@ -1,0 +1,89 @@
+"""Running case groups on a Dask distributed cluster (``simparity run --executor dask``).
+
+Each group is one Dask task. On the Dask worker the task runs its group in an
+:class:`~comparisons.isolation.IsolatedPool` of one worker process, kept for the worker's next
+tasks, so a case that crashes, hangs or exhausts memory fails alone there exactly as it does
+locally, and the Dask worker lives on. Without a scheduler address a ``LocalCluster`` is started on
+the loopback interface with one single-threaded worker process per job. Outcomes stream back group
+by group as tasks finish; a group whose Dask worker is lost for good (Dask retries it elsewhere
+first) fails with that cause.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Iterator
+
+from simparity.comparisons.cases import CaseGroup, CaseOutcome
+from simparity.comparisons.isolation import CaseLimits, IsolatedPool, Job
+from simparity.comparisons.runner import failed_outcome
+from simparity.core.errors import SimparityError, one_line
+
+CONNECT_SECONDS = 30
+"""How long to wait for the scheduler at --scheduler before giving up."""
+
+_pools = threading.local()
+"""Each Dask worker thread's pool of one worker process, kept between tasks."""
+
+
+def run_group_task(group: CaseGroup, skip: frozenset[int], limits: CaseLimits) -> list[tuple[int, CaseOutcome]]:
+    """The Dask task: every case of ``group`` but ``skip``, run in this Dask worker's isolated process."""
+    pool = getattr(_pools, "pool", None)
+    if pool is None or pool.limits != limits:
+        if pool is not None:
+            pool.close()
+        pool = _pools.pool = IsolatedPool(1, limits)
+    return [(index, outcome) for _, index, outcome in pool.run([Job(0, group, set(skip))])]
+
+
+class DaskExecutor:
+    """Case groups as tasks on the cluster at ``scheduler`` (address), or on a new ``LocalCluster`` of
+    ``workers`` processes when it is None."""
+
+    def __init__(self, scheduler: str | None, workers: int, limits: CaseLimits) -> None:
+        try:
+            import distributed
+        except ImportError as err:
+            raise SimparityError(f"--executor dask: Dask is not installed here ({one_line(err)}) (allowed: pip install "
+                                 "'simparity[dask]', or --executor local)") from None
+        self.limits = limits
+        self._cluster = None
+        try:
+            if scheduler is None:
+                self._cluster = distributed.LocalCluster(
+                    n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                    dashboard_address=":0", memory_limit=0, silence_logs=50)
+                self.client = distributed.Client(self._cluster)
+            else:
+                self.client = distributed.Client(scheduler, timeout=CONNECT_SECONDS)
+        except (OSError, TimeoutError, ValueError) as err:
+            self.close()
+            raise SimparityError(f"--scheduler {one_line(scheduler)}: cannot reach a Dask scheduler: {one_line(err)} "
+                                 "(allowed: the address a running 'dask scheduler' prints, e.g. "
+                                 "tcp://10.0.0.5:8786)") from None
+
+    def run(self, jobs: list[Job]) -> Iterator[tuple[object, int, CaseOutcome]]:
+        import distributed
+
+        futures = {}
+        for rank, job in enumerate(jobs):  # the costliest first: Dask runs higher priorities first
+            future = self.client.submit(run_group_task, job.group, frozenset(job.skip), self.limits,
+                                        pure=False, priority=len(jobs) - rank)
+            futures[future] = job
+        for future in distributed.as_completed(futures):
+            job = futures[future]
+            try:
+                results = future.result()
+            except Exception as err:  # noqa: BLE001 - the task's worker was lost for good
+                cause = f"crashed: the Dask task was lost: {type(err).__name__}: {one_line(err)}"
+                results = [(i, failed_outcome(job.group, job.group.cases[i], cause))
+                           for i in range(len(job.group.cases)) if i not in job.skip]
+            for index, outcome in results:
+                yield job.key, index, outcome
+
+    def close(self) -> None:
+        client = getattr(self, "client", None)
+        if client is not None:
+            client.close()
+        if self._cluster is not None:
+            self._cluster.close()

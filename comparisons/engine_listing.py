@@ -1,0 +1,59 @@
+"""``simparity engines``: every engine, built-in and plugin, one line each with what it offers.
+
+A line names the engine, where it comes from (built-in, or the plugin's distribution and entry point),
+its version and what it supports: dynamics integrators, IK solvers, and kinematics (yes or no, asked
+with a one-joint revolute chain, which every engine that does kinematics at all can do). An engine
+that cannot run says why (``n/a: ...`` when its library does not import, ``failed: ...`` when its code
+raised); a plugin that is not used (shadowed, a bad name) says that instead.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simparity.comparisons.engines import ENGINE_NAMES, make_engine
+from simparity.comparisons.placeholder_engines import BrokenEngine, UnavailableEngine
+from simparity.comparisons.plugins import discover
+from simparity.comparisons.rows import error_text
+from simparity.core.engine import Engine
+from simparity.core.errors import one_line
+from simparity.core.scene import Chain, Joint
+
+PROBE_CHAIN = Chain("probe", (Joint("joint", "revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.eye(3)),),
+                    end_effector_xyz=np.array([1.0, 0.0, 0.0]))
+"""One revolute joint about z and a 1 m link: the chain an engine's kinematics support is asked about."""
+
+DETAIL_LIMIT = 600
+"""Characters of a reason printed (an import error can be long): the line stays readable."""
+
+
+def engine_lines() -> list[str]:
+    """One line per engine: the built-ins, then every plugin found (used or not), then why the search for
+    plugins failed if it did."""
+    discovery = discover(ENGINE_NAMES)
+    entries = [(name, "built-in", "") for name in ENGINE_NAMES]
+    entries += [(one_line(p.name), f"plugin {one_line(p.name)} = {one_line(p.target)} from {one_line(p.distribution)}",
+                 p.problem) for p in discovery.plugins]
+    width = max(len(name) for name, _, _ in entries)
+    lines = [f"{name:<{width}}  {origin}; " + (f"not used: {problem}" if problem else _offers(make_engine(name)))
+             for name, origin, problem in entries]
+    if discovery.error:
+        lines.append(f"plugins not searched: {discovery.error}")
+    return lines
+
+
+def _offers(engine: Engine) -> str:
+    """``version V; dynamics: ...; IK: ...; kinematics: yes|no``, or why the engine cannot run."""
+    if isinstance(engine, UnavailableEngine):
+        return f"n/a: {one_line(engine.reason, DETAIL_LIMIT)}"
+    if isinstance(engine, BrokenEngine):
+        return f"failed: {one_line(engine.reason, DETAIL_LIMIT)}"
+    return (f"version {engine.version()}; dynamics: {', '.join(engine.integrators()) or 'none'}; "
+            f"IK: {', '.join(engine.ik_solvers()) or 'none'}; kinematics: {_kinematics(engine)}")
+
+
+def _kinematics(engine: Engine) -> str:
+    try:
+        return "yes" if engine.supports_kinematics(PROBE_CHAIN).ok else "no"
+    except Exception as err:  # noqa: BLE001 - a user's engine: say what it raised
+        return f"unknown ({one_line(error_text(err))})"

@@ -1,0 +1,87 @@
+"""Engines that stand in for one that cannot run, so that every scene still gets its rows, with the reason.
+
+:class:`UnavailableEngine` stands in for an engine whose library will not import here (MuJoCo not
+installed, a plugin's missing dependency): ``n/a`` rows, as for any scene an engine cannot do.
+:class:`BrokenEngine` stands in for a user's engine whose own code raised while it was loaded or
+built, or that broke the interface: ``failed`` rows, which fail ``simparity run`` (exit 1) and the
+CI gate like any other failure.
+"""
+
+from __future__ import annotations
+
+from simparity.core.engine import Engine, KinematicsModel, Simulation, Support
+from simparity.core.errors import PluginError, SimparityError
+
+class UnavailableEngine(Engine):
+    """An engine whose library failed to import: every scene gets n/a with the import error.
+
+    Attributes
+    ----------
+    reason : str
+        ``<name> is not importable here: <error>``, the detail of every row.
+    """
+
+    def __init__(self, name: str, error: str) -> None:
+        self.name = name
+        self.reason = f"{name} is not importable here: {error}"
+
+    def version(self) -> str:
+        return "unavailable"
+
+    def integrators(self) -> tuple[str, ...]:
+        return ()
+
+    def supports_dynamics(self, scene, integrator: str) -> Support:
+        return Support.no(self.reason)
+
+    def build_dynamics(self, scene, integrator: str, dt: float) -> Simulation:
+        raise SimparityError(self.reason)
+
+    def supports_kinematics(self, chain) -> Support:
+        return Support.no(self.reason)
+
+    def build_kinematics(self, chain) -> KinematicsModel:
+        raise SimparityError(self.reason)
+
+    def supports_ik(self, chain, solver: str, position_only: bool) -> Support:
+        return Support.no(self.reason)
+
+
+class BrokenEngine(Engine):
+    """A user's engine that raised while it was loaded or built, or broke the interface: every case of every
+    scene fails with that error.
+
+    Attributes
+    ----------
+    reason : str
+        What went wrong, the detail of every row.
+    """
+
+    def __init__(self, name: str, reason: str) -> None:
+        self.name = name
+        self.reason = f"{name} is broken: {reason}"
+
+    def version(self) -> str:
+        return "broken"
+
+    def integrators(self) -> tuple[str, ...]:
+        return ()
+
+    def scene_integrators(self, scene) -> tuple[str, ...]:
+        """Raises: the runner turns the scene's one case into failed rows with the reason."""
+        raise PluginError(self.reason)
+
+    def supports_dynamics(self, scene, integrator: str) -> Support:
+        raise PluginError(self.reason)
+
+    def build_dynamics(self, scene, integrator: str, dt: float) -> Simulation:
+        raise PluginError(self.reason)
+
+    def supports_kinematics(self, chain) -> Support:
+        raise PluginError(self.reason)
+
+    def build_kinematics(self, chain) -> KinematicsModel:
+        raise PluginError(self.reason)
+
+    def supports_ik(self, chain, solver: str, position_only: bool) -> Support:
+        raise PluginError(self.reason)

@@ -1,0 +1,92 @@
+"""Issue #12: ``--executor dask`` runs the cases on a Dask distributed cluster (here a LocalCluster of two
+workers on the loopback interface) and gives results identical to the local executor."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+
+from simparity.comparisons import dask_executor
+from simparity.comparisons.cli import main
+from simparity.comparisons.dask_executor import DaskExecutor
+from simparity.comparisons.engines import make_engine
+from simparity.comparisons.execution import run_scenes
+from simparity.comparisons import library
+from simparity.comparisons.isolation import CaseLimits, IsolatedPool
+from simparity.core.results import RESULTS_FILE
+from tests.helpers import THROWN_BALL, InProcess, built_engines, comparable, quick_scenes
+
+WORKERS = 2
+
+
+@pytest.fixture(scope="module")
+def dask():
+    executor = DaskExecutor(None, WORKERS, CaseLimits.default(WORKERS))
+    yield executor
+    executor.close()
+
+
+def test_a_local_dask_cluster_gives_the_results_of_this_process(dask):
+    scenes = quick_scenes()
+    expected = list(run_scenes(scenes, built_engines(), make_engine, 0, InProcess()))
+    got = list(run_scenes(scenes, built_engines(), make_engine, 0, dask))
+    assert [s.name for s, _, _ in got] == [s.name for s in scenes]
+    assert comparable(got) == comparable(expected)
+    assert len(dask.client.scheduler_info()["workers"]) == WORKERS
+    assert all(address.startswith("tcp://127.0.0.1:") for address in dask.client.scheduler_info()["workers"])
+
+
+def test_a_crash_on_a_dask_worker_fails_its_case_alone(dask):
+    scenes = quick_scenes(("lecture-projectile",))
+    engines = built_engines(("core",)) + [make_engine("tests.hostile_engines:SegfaultingEngine")]
+    specs = {"segfaulting": "tests.hostile_engines:SegfaultingEngine"}
+    [(_, rows, _)] = run_scenes(scenes, engines, make_engine, 0, dask, specs=specs)
+    by_engine = {e: {r.status for r in rows if r.engine == e and r.dt == r.dt} for e in ("core", "segfaulting")}
+    assert by_engine["core"] == {"ok", "n/a"} and by_engine["segfaulting"] <= {"failed", "n/a"}
+    failed = [r for r in rows if r.engine == "segfaulting" and r.status == "failed"]
+    assert failed and all("SIGSEGV" in r.detail for r in failed)  # n/a: integrators it refuses before running
+
+
+def test_the_cli_runs_on_dask_and_writes_the_local_executor_results(tmp_path):
+    args = ["run", "lecture-projectile", "lecture-2link-ik", "--quick", "--jobs", str(WORKERS)]
+    assert main(args + ["--out", str(tmp_path / "local")]) == 0
+    assert main(args + ["--executor", "dask", "--out", str(tmp_path / "dask")]) == 0
+    tables = [pd.read_csv(tmp_path / name / RESULTS_FILE, dtype=str, keep_default_na=False) for name in ("local", "dask")]
+    for table in tables:
+        table.loc[table.metric.str.startswith("time_"), "value"] = "timing"
+    pd.testing.assert_frame_equal(*tables)
+
+
+def test_an_unreachable_scheduler_is_a_one_line_error(monkeypatch, tmp_path, capsys):
+    monkeypatch.setattr(dask_executor, "CONNECT_SECONDS", 2)
+    assert main(["run", "lecture-projectile", "--executor", "dask", "--scheduler", "tcp://127.0.0.1:9",
+                 "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot reach a Dask scheduler" in err
+
+
+def test_a_scheduler_without_dask_is_refused(tmp_path, capsys):
+    assert main(["run", "lecture-projectile", "--scheduler", "tcp://127.0.0.1:8786", "--out", str(tmp_path)]) == 2
+    assert "--executor dask" in capsys.readouterr().err
+
+
+SWEEP = THROWN_BALL + """
+[sweep]
+"body[ball].velocity_world[0]" = {start = 0.0, stop = 9.0, num = 10}
+"world.gravity_world[2]" = {start = -10.0, stop = -1.0, num = 10}
+"""
+
+
+def test_a_sweep_of_100_variants_on_two_dask_workers_gives_the_local_results(tmp_path, dask):
+    """Issue #12's done-when: 100 scene variants on a local Dask cluster of 2 workers give, bit for bit, the
+    results of the local executor's 2 worker processes."""
+    scene = tmp_path / "throw.toml"
+    scene.write_text(SWEEP, encoding="utf-8")
+    variants = library.load([str(scene)])
+    assert len(variants) == 100 and len({v.name for v in variants}) == 100
+    engines = built_engines(("core", "mujoco"))
+    with IsolatedPool(WORKERS, CaseLimits.default(WORKERS)) as pool:
+        local = list(run_scenes(variants, engines, make_engine, 0, pool))
+    on_dask = list(run_scenes(variants, engines, make_engine, 0, dask))
+    assert comparable(on_dask) == comparable(local)
+    assert [s.name for s, _, _ in on_dask] == [v.name for v in variants]

@@ -1,0 +1,70 @@
+"""Issue #12: a run's cases, wherever they execute, come back scene by scene in the suite's order, the same
+bit for bit whatever the executor and the number of workers; a resumed run recomputes nothing that finished."""
+
+from __future__ import annotations
+
+import pytest
+
+from simparity.comparisons.engines import make_engine
+from simparity.comparisons.execution import count_cases, estimated_cost, run_scenes
+from simparity.comparisons.isolation import CaseLimits, IsolatedPool
+from simparity.comparisons.journal import Journal
+from simparity.core.results import STATUSES, case_counts
+from tests.helpers import InProcess, built_engines, comparable, quick_scenes
+
+@pytest.fixture(scope="module")
+def in_process():
+    scenes = quick_scenes()
+    return scenes, list(run_scenes(scenes, built_engines(), make_engine, 0, InProcess()))
+
+
+def test_worker_processes_give_bit_identical_results_whatever_their_number(in_process):
+    """Determinism: one worker, two workers and this process agree on every non-timing value."""
+    scenes, expected = in_process
+    for workers in (1, 2):
+        with IsolatedPool(workers, CaseLimits.default(workers)) as pool:
+            got = list(run_scenes(scenes, built_engines(), make_engine, 0, pool))
+        assert [s.name for s, _, _ in got] == [s.name for s in scenes]
+        assert comparable(got) == comparable(expected), workers
+
+
+def test_every_case_is_heard_once_and_the_costliest_group_goes_first():
+    scenes = quick_scenes(("lecture-planar-arm", "lecture-projectile"))
+    heard = []
+    executor = InProcess()
+    results = list(run_scenes(scenes, built_engines(("core",)), make_engine, 0, executor,
+                              on_case=lambda *event: heard.append(event)))
+    assert [s.name for s, _, _ in results] == ["lecture-planar-arm", "lecture-projectile"]
+    assert len(heard) == sum(count_cases(scenes, built_engines(("core",)), make_engine))
+    costs = [estimated_cost(job.group) for job in executor.jobs]
+    assert costs == sorted(costs, reverse=True) and executor.jobs[0].group.scene.name == "lecture-projectile"
+
+
+def test_an_interrupted_run_resumes_without_recomputing_what_finished(tmp_path, in_process):
+    scenes, expected = in_process
+    total = sum(count_cases(scenes, built_engines(), make_engine))
+    first = InProcess(stop_after=total // 2)
+    handed_back = []
+    with pytest.raises(KeyboardInterrupt):
+        for item in run_scenes(scenes, built_engines(), make_engine, 0, first, Journal(tmp_path)):
+            handed_back.append(item)
+    assert len(Journal(tmp_path)) == total // 2
+    # every finished case reached the caller before the interruption did, complete scenes whole
+    assert sum(case_counts(rows)[s] for _, rows, _ in handed_back for s in STATUSES) == total // 2
+    second = InProcess()
+    resumed = list(run_scenes(scenes, built_engines(), make_engine, 0, second, Journal(tmp_path)))
+    assert second.ran == total - total // 2  # nothing that finished ran again
+    assert comparable(resumed) == comparable(expected)
+
+
+def test_a_changed_scene_or_engine_version_is_computed_again(tmp_path, monkeypatch):
+    scenes = quick_scenes(("lecture-projectile",))
+    list(run_scenes(scenes, built_engines(("core",)), make_engine, 0, InProcess(), Journal(tmp_path)))
+    again = InProcess()
+    list(run_scenes(scenes, built_engines(("core",)), make_engine, 0, again, Journal(tmp_path)))
+    assert again.ran == 0
+    engines = built_engines(("core",))
+    monkeypatch.setattr(type(engines[0]), "version", lambda self: "another")
+    newer = InProcess()
+    list(run_scenes(scenes, engines, make_engine, 0, newer, Journal(tmp_path)))
+    assert newer.ran == count_cases(scenes, engines, make_engine)[0]

@@ -1,0 +1,124 @@
+"""Issue #12: ``simparity run --resume DIR``. A run killed halfway and resumed writes the same results.csv as
+an uninterrupted run; finished cases are kept, cases that did not finish are tried again."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pandas as pd
+import pytest
+
+from simparity.comparisons.cases import CaseKey, CaseOutcome
+from simparity.comparisons.cli import main
+from simparity.comparisons.engines import make_engine
+from simparity.comparisons.execution import count_cases, run_scenes
+from simparity.comparisons.journal import CASES_FOLDER, Journal, run_lock
+from simparity.comparisons.profiles import apply_profile
+from simparity.core.results import RESULTS_FILE
+from tests.helpers import InProcess, builtin
+
+SCENES = ("lecture-projectile", "dzhanibekov", "ball-bounce-k05", "lecture-2link-ik")
+KILL_WAIT_SECONDS = 240
+"""How long the test waits for half the cases to finish before it gives up (they take ~10 s on 2 cores)."""
+
+
+def _command(out) -> list[str]:
+    return [sys.executable, "-m", "simparity.comparisons.cli", "run", *SCENES, "--quick", "--jobs", "2", "--out",
+            str(out)]
+
+
+def _table(run_dir) -> pd.DataFrame:
+    """results.csv as text, the wall times blanked (they differ between any two runs)."""
+    table = pd.read_csv(run_dir / RESULTS_FILE, dtype=str, keep_default_na=False)
+    table.loc[table.metric.str.startswith("time_"), "value"] = "timing"
+    return table
+
+
+def test_a_run_killed_halfway_and_resumed_writes_the_same_results(tmp_path):
+    total = sum(count_cases(apply_profile([builtin(n) for n in SCENES], "quick"),
+                            [make_engine(n) for n in ("core", "analytic", "mujoco", "pybullet", "pinocchio")],
+                            make_engine))
+    whole, killed = tmp_path / "whole", tmp_path / "killed"
+    subprocess.run(_command(whole), check=True, capture_output=True)
+    run = subprocess.Popen(_command(killed), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + KILL_WAIT_SECONDS
+    while len(list((killed / CASES_FOLDER).glob("*.pickle"))) < total // 2 and time.monotonic() < deadline:
+        time.sleep(0.05)
+    os.kill(run.pid, signal.SIGKILL)  # no chance to clean up: a lost node, the OOM killer
+    run.wait()
+    finished = len(Journal(killed))
+    assert total // 2 <= finished < total
+    resumed = subprocess.run([sys.executable, "-m", "simparity.comparisons.cli", "run", "--resume", str(killed)],
+                             capture_output=True, text=True)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"resuming {finished} finished cases" in resumed.stdout
+    pd.testing.assert_frame_equal(_table(killed), _table(whole))
+
+
+def test_resume_refuses_a_folder_without_a_run_and_options_that_change_it(tmp_path, capsys):
+    assert main(["run", "--resume", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "resume.json" in err
+    assert main(["run", "lecture-projectile", "--resume", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "SCENE" in err and "allowed with --resume" in err
+    (tmp_path / "resume.json").write_text("{not json", encoding="utf-8")
+    assert main(["run", "--resume", str(tmp_path)]) == 2
+    assert "unreadable" in capsys.readouterr().err
+
+
+def test_unfinished_and_unreadable_cases_are_computed_again(tmp_path):
+    journal = Journal(tmp_path)
+    key = CaseKey("hash", "core", "1.0", "rk4", 0.01, "dynamics")
+    journal.save(key, CaseOutcome([], harness_failure=True))
+    assert journal.load(key) is None and len(journal) == 0
+    journal.save(key, CaseOutcome([]))
+    assert journal.load(key) == CaseOutcome([])
+    (tmp_path / CASES_FOLDER / f"{key.digest()}.pickle").write_bytes(b"truncated")
+    assert journal.load(key) is None
+    other = CaseKey("hash", "core", "1.1", "rk4", 0.01, "dynamics")
+    assert other.digest() != key.digest()
+
+
+@pytest.mark.parametrize("dt", [0.01, float("nan")])
+def test_a_key_digest_is_a_file_name(dt):
+    digest = CaseKey("h", "a/b", "v", "rk4", dt, "dynamics").digest()
+    assert len(digest) == 64 and all(c in "0123456789abcdef" for c in digest)
+
+
+def _interrupted(run_dir) -> int:
+    """Leave in ``run_dir`` the kept cases an interrupted run of lecture-projectile on core leaves, each claiming a
+    detail no engine writes; returns how many there are."""
+    scenes = apply_profile([builtin("lecture-projectile")], "quick")
+    list(run_scenes(scenes, [make_engine("core")], make_engine, 0, InProcess(), Journal(run_dir)))
+    journal, planted = Journal(run_dir), 0
+    for path in (run_dir / CASES_FOLDER).glob("*.pickle"):
+        key, outcome = pd.read_pickle(path)
+        outcome.rows = [dataclasses.replace(r, detail="planted") for r in outcome.rows]
+        journal.save(key, outcome)
+        planted += 1
+    return planted
+
+
+def test_a_forced_new_run_reuses_nothing_a_run_left_and_a_finished_run_keeps_no_cases(tmp_path):
+    argv = ["run", "lecture-projectile", "--quick", "--engines", "core", "--jobs", "1", "--out", str(tmp_path)]
+    assert main(argv) == 0
+    assert not (tmp_path / CASES_FOLDER).exists()  # finished, every case done: they are in results.csv
+    assert _interrupted(tmp_path) > 0
+    assert main(argv + ["--force"]) == 0
+    assert "planted" not in (tmp_path / RESULTS_FILE).read_text(encoding="utf-8")
+    _interrupted(tmp_path)
+    assert main(["run", "--resume", str(tmp_path)]) == 0  # a resumed run, by contrast, keeps what it finds
+    assert "planted" in (tmp_path / RESULTS_FILE).read_text(encoding="utf-8")
+
+
+def test_a_folder_being_written_by_another_run_is_refused(tmp_path, capsys):
+    with run_lock(tmp_path):  # as another run would hold it
+        assert main(["run", "lecture-projectile", "--out", str(tmp_path), "--force"]) == 2
+    err = capsys.readouterr().err
+    assert "another simparity run is writing this folder" in err and err.count("\n") == 1
