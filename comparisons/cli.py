@@ -25,7 +25,8 @@ from simparity.comparisons.engines import DEFAULT_ENGINES, allowed_engines, chec
 from simparity.comparisons.history import history_path, latest_before, metric_history, record_run, run_table
 from simparity.comparisons.execution import count_cases, default_jobs, run_scenes
 from simparity.comparisons.isolation import DEFAULT_CASE_SECONDS, GIB, CaseLimits, IsolatedPool
-from simparity.comparisons.journal import Journal, read_request, run_lock, write_request
+from simparity.comparisons.journal import CASES_FOLDER, Journal, read_request, run_lock, write_request
+from simparity.comparisons.placeholder_engines import BrokenEngine, UnavailableEngine
 from simparity.comparisons.profiles import apply_profile
 from simparity.comparisons.progress import ProgressBar
 from simparity.comparisons.runner import DEFAULT_REPEATS
@@ -44,6 +45,8 @@ from simparity.reports.store import read_run
 EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
 EXPORTABLE = ("mujoco", "pybullet", "pinocchio")
 EXECUTORS = ("local", "dask")
+MAX_JOBS = 256
+"""Worker processes at most: each is a Python process of ~250 MiB with the engines loaded."""
 MEMORY_HELP = "80%% of this machine's memory shared between the workers, at least 1 GiB"
 RESUMED_OPTIONS = ("scenes", "suite", "engines", "out", "force", "quick", "repeats", "max_steps", "max_samples",
                    "max_joints")
@@ -255,6 +258,10 @@ def _resumed(args) -> None:
                              "(allowed with --resume: --jobs, --executor, --scheduler, --case-timeout, --case-memory, "
                              "--check and its options, --history)")
     request = read_request(args.resume)
+    if not (args.resume / CASES_FOLDER).is_dir():
+        raise SimparityError(f"--resume {one_line(args.resume)}: that run finished (every case is in its "
+                             f"{RESULTS_FILE}); nothing to resume (allowed: the folder of a run that did not finish; "
+                             "'simparity report DIR' re-renders a finished one)")
     try:
         for name in RESUMED_OPTIONS:
             if name not in ("out", "force"):
@@ -296,6 +303,8 @@ def cmd_run(args, out) -> int:
                         ("--max-joints", args.max_joints), ("--jobs", jobs)):
         if value < 1:
             raise SimparityError(f"{flag} {value}: out of range (allowed: a whole number >= 1)")
+    if jobs > MAX_JOBS:
+        raise SimparityError(f"--jobs {jobs}: out of range (allowed: 1 to {MAX_JOBS})")
     if args.scheduler is not None and args.executor != "dask":
         raise SimparityError(f"--scheduler {one_line(args.scheduler)} without --executor dask (allowed: add --executor "
                              "dask, or drop --scheduler)")
@@ -309,6 +318,13 @@ def cmd_run(args, out) -> int:
     scenes = apply_profile(chosen, "quick" if args.quick else "full")
     bounds = load_tolerances(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
     engines = [make_engine(n) for n in names]
+    _check_distinct(engines, names, scenes)
+    if args.resume is not None:
+        stand_ins = [n for n, e in zip(names, engines) if isinstance(e, (UnavailableEngine, BrokenEngine))]
+        if stand_ins:  # its kept cases would be replaced by n/a or failed rows
+            raise SimparityError(f"--resume {one_line(args.resume)}: engine(s) {one_line(', '.join(stand_ins))} of "
+                                 "that run cannot be built here (allowed: resume where the run's engines import, e.g. "
+                                 "from the folder a module:Class engine was found in)")
     out_dir = _out_dir(args)
     try:
         out_dir.mkdir(parents=True, exist_ok=True)
@@ -328,6 +344,22 @@ def cmd_run(args, out) -> int:
                         dict(zip((e.name for e in engines), names)))
         finally:  # what the run cost, also when it was interrupted or stopped by an error
             print(resource_line(time.perf_counter() - start), file=out, flush=True)
+
+
+def _check_distinct(engines, names: tuple[str, ...], scenes) -> None:
+    """Refuse two engines or two scenes of one name: their rows would be indistinguishable."""
+    seen: dict[str, str] = {}
+    for engine, name in zip(engines, names):
+        if engine.name in seen:
+            raise SimparityError(f"--engines: {one_line(seen[engine.name])} and {one_line(name)} are both named "
+                                 f"{one_line(engine.name)} (allowed: engines of distinct names)")
+        seen[engine.name] = name
+    files: dict[str, str] = {}
+    for scene in scenes:
+        if scene.name in files:
+            raise SimparityError(f"{one_line(scene.source or scene.name)}: a second scene named {one_line(scene.name)} "
+                                 f"(the first from {one_line(files[scene.name])}) (allowed: scenes of distinct names)")
+        files[scene.name] = scene.source or scene.name
 
 
 def _executor(args, jobs: int, limits: CaseLimits):

@@ -45,6 +45,10 @@ BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THR
 """Set to 1 in every worker: each worker is one CPU, many small matrix products gain nothing from BLAS
 threads, and results do not depend on how many threads summed them."""
 
+EXIT_GRACE_SECONDS = 1.0
+"""How long a worker whose pipe closed is given to exit by itself before it is killed (a Python exception or
+``sys.exit`` takes milliseconds; killing it at once would report signal 9 instead of its exit code)."""
+
 STDERR_TAIL_BYTES = 64 * 1024
 """How much of a dead worker's standard error is read for the cause of its death."""
 
@@ -125,8 +129,11 @@ class _Worker:
         self.outbox.send((job.group, frozenset(job.skip), job.reference_failure))
 
     def kill(self) -> int:
-        """Kill the process (if alive) and return its exit code."""
-        if self.process.poll() is None:
+        """Kill the process (if alive after a moment to exit by itself: its own exit code says more) and return
+        its exit code."""
+        try:
+            self.process.wait(timeout=EXIT_GRACE_SECONDS)
+        except subprocess.TimeoutExpired:
             self.process.kill()
         code = self.process.wait()
         for end in (self.inbox, self.outbox):
@@ -154,12 +161,12 @@ def death_cause(code: int, stderr: str) -> str:
     else:
         cause = f"crashed: the worker exited with code {code}"
     lines = [line.strip() for line in stderr.splitlines() if line.strip()]
-    where = next((line for line in lines if line.startswith("File ")), "")
-    last = lines[-1] if lines else ""
-    if where:
-        cause += f", in {where}"
-    elif last:
-        cause += f": {last[:300]}"
+    frames = [line for line in lines if line.startswith("File ")]
+    faulthandler_stack = any(line.startswith(("Current thread", "Thread 0x")) for line in lines)
+    if faulthandler_stack and frames:  # most recent call first
+        cause += f", in {frames[0]}"
+    elif lines:  # a Python traceback: its last line is the error
+        cause += f": {lines[-1][:300]}" + (f" ({frames[-1][:200]})" if frames else "")
     return cause
 
 
@@ -216,6 +223,10 @@ class IsolatedPool:
             worker.job = None
 
     def _enforce_limits(self, worker: _Worker, pending) -> Iterator[tuple[object, int, CaseOutcome]]:
+        if worker.process.poll() is not None:  # died, its pipe held open by a child it forked
+            code = worker.kill()
+            yield from self._replace(worker, death_cause(code, worker.stderr_tail()), pending)
+            return
         elapsed = time.monotonic() - worker.since
         if elapsed > self.limits.seconds:
             worker.kill()
@@ -225,8 +236,8 @@ class IsolatedPool:
         rss = resident_bytes(worker.process.pid)
         if rss > self.limits.memory_bytes:
             worker.kill()
-            yield from self._replace(worker, f"out of memory: the worker's resident memory reached {rss / GIB:.2f} "
-                                     f"GiB, over the per-case limit of {self.limits.memory_bytes / GIB:.2f} GiB; the "
+            yield from self._replace(worker, f"out of memory: the worker's resident memory reached {rss / GIB:.3g} "
+                                     f"GiB, over the per-case limit of {self.limits.memory_bytes / GIB:.3g} GiB; the "
                                      "worker was killed", pending)
 
     def _replace(self, worker: _Worker, cause: str, pending: collections.deque) -> Iterator[tuple[object, int, CaseOutcome]]:

@@ -218,6 +218,15 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
         return _CaseResult(case.rows(metrics, DIVERGED, str(err)))
     except Exception as err:  # noqa: BLE001 - reported in the rows
         return _CaseResult(case.rows(metrics, FAILED, error_text(err)))
+    try:
+        return _measured_case(scene, sim, case, metrics, n, traj, seconds, ref_traj, ref_problem, is_reference, series)
+    except Exception as err:  # noqa: BLE001 - a user's engine returned what cannot be measured
+        return _CaseResult(case.rows(metrics, FAILED, f"its trajectory cannot be measured: {error_text(err)}"))
+
+
+def _measured_case(scene, sim, case: Case, metrics: dict, n: int, traj, seconds: float, ref_traj,
+                   ref_problem: tuple[str, str], is_reference: bool, series: list[SeriesRecord]) -> _CaseResult:
+    """The rows of a case whose simulation ran: ``traj`` measured against ``ref_traj``."""
     values = {"time_per_step": Measured(seconds / n, "s")}
     with np.errstate(all="ignore"):
         blown, reading = blow_up(scene, traj)

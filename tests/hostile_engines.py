@@ -37,6 +37,11 @@ class _Hog(Simulation):
             blocks.append(np.ones(ALLOCATION_BYTES // 8))
 
 
+class _Malformed(Simulation):
+    def run(self, n_steps: int):
+        return {"not": "a trajectory"}
+
+
 class _Misbehaving(InHouseEngine):
     simulation: type[Simulation]
 
@@ -57,3 +62,12 @@ class HangingEngine(_Misbehaving):
 class HoggingEngine(_Misbehaving):
     name = "hogging"
     simulation = _Hog
+
+
+class HangingTwin(HangingEngine):
+    """Another engine called ``hanging``: a run may not have two engines of one name."""
+
+
+class MalformedEngine(_Misbehaving):
+    name = "malformed"
+    simulation = _Malformed

@@ -8,6 +8,7 @@ import pytest
 
 from simparity.comparisons.cli import main
 from simparity.comparisons.isolation import death_cause
+from simparity.comparisons.library import builtin_paths
 from tests.helpers import THROWN_BALL
 
 HANGING = ("tests.hostile_engines:HangingEngine", "hung: no result within the per-case time limit of 5 s")
@@ -72,3 +73,30 @@ def test_limits_out_of_range_are_one_line_errors(option, value, capsys, tmp_path
     assert main(["run", "lecture-projectile", option, value, "--out", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and option in err and "allowed" in err
+
+
+def test_a_trajectory_that_cannot_be_measured_fails_with_the_error_not_as_a_crash(tmp_path):
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    assert main(["run", str(scene), "--engines", "core,tests.hostile_engines:MalformedEngine", "--repeats", "0",
+                 "--jobs", "1", "--out", str(tmp_path / "run")]) == 1
+    table = pd.read_csv(tmp_path / "run" / "results.csv")
+    rows = table[(table.engine == "malformed") & table.dt.notna()]
+    assert set(rows.status) == {"failed"}
+    assert rows.detail.str.contains("its trajectory cannot be measured: AttributeError", regex=False).all()
+
+
+def test_two_engines_or_two_scenes_of_one_name_are_refused(tmp_path, capsys):
+    twins = "tests.hostile_engines:HangingEngine,tests.hostile_engines:HangingTwin"
+    assert main(["run", "lecture-projectile", "--engines", twins, "--out", str(tmp_path / "a")]) == 2
+    assert "are both named hanging" in capsys.readouterr().err
+    copy = tmp_path / "wind.toml"
+    copy.write_text(builtin_paths()["wind"].read_text(encoding="utf-8"), encoding="utf-8")
+    assert main(["run", "wind", str(copy), "--out", str(tmp_path / "b")]) == 2
+    err = capsys.readouterr().err
+    assert "a second scene named wind" in err and err.count("\n") == 1
+
+
+def test_the_cause_of_an_exit_is_the_exit_code_and_the_error():
+    stderr = 'Traceback (most recent call last):\n  File "/a.py", line 1, in main\n  File "/b.py", line 9, in f\nKeyError: 3\n'
+    assert death_cause(1, stderr) == 'crashed: the worker exited with code 1: KeyError: 3 (File "/b.py", line 9, in f)'

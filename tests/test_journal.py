@@ -122,3 +122,11 @@ def test_a_folder_being_written_by_another_run_is_refused(tmp_path, capsys):
         assert main(["run", "lecture-projectile", "--out", str(tmp_path), "--force"]) == 2
     err = capsys.readouterr().err
     assert "another simparity run is writing this folder" in err and err.count("\n") == 1
+
+
+def test_a_finished_run_is_not_resumed(tmp_path, capsys):
+    assert main(["run", "lecture-projectile", "--quick", "--engines", "core", "--jobs", "1", "--out", str(tmp_path)]) == 0
+    capsys.readouterr()
+    assert main(["run", "--resume", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "that run finished" in err and err.count("\n") == 1
