@@ -23,6 +23,7 @@ from typing import Iterator
 
 from simparity.comparisons.cases import CaseGroup, CaseOutcome
 from simparity.comparisons.runner import failed_outcome
+from simparity.comparisons.timing import status_bytes
 
 GIB = 1024 ** 3
 
@@ -81,18 +82,6 @@ def worker_environment() -> dict[str, str]:
     return env
 
 
-def resident_bytes(pid: int) -> int:
-    """Resident memory of process ``pid`` [bytes] (VmRSS); 0 when it cannot be read."""
-    try:
-        with open(f"/proc/{pid}/status", encoding="ascii") as status:
-            for line in status:
-                if line.startswith("VmRSS:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError):
-        return 0
-    return 0
-
-
 @dataclass
 class Job:
     """A group to run: ``key`` names it to the caller; ``skip`` are its cases already done."""
@@ -128,11 +117,10 @@ class _Worker:
         self.job, self.phase, self.since = job, None, time.monotonic()
         self.outbox.send((job.group, frozenset(job.skip), job.reference_failure))
 
-    def kill(self) -> int:
-        """Kill the process (if alive after a moment to exit by itself: its own exit code says more) and return
-        its exit code."""
+    def kill(self, grace_seconds: float = 0.0) -> int:
+        """Kill the process (if still alive after ``grace_seconds`` to exit by itself) and return its exit code."""
         try:
-            self.process.wait(timeout=EXIT_GRACE_SECONDS)
+            self.process.wait(timeout=grace_seconds)
         except subprocess.TimeoutExpired:
             self.process.kill()
         code = self.process.wait()
@@ -209,8 +197,8 @@ class IsolatedPool:
     def _receive(self, worker: _Worker, pending: collections.deque) -> Iterator[tuple[object, int, CaseOutcome]]:
         try:
             message = worker.inbox.recv()
-        except (EOFError, OSError):
-            code = worker.kill()
+        except (EOFError, OSError):  # the worker is exiting: its own exit code says more than a kill's
+            code = worker.kill(EXIT_GRACE_SECONDS)
             yield from self._replace(worker, death_cause(code, worker.stderr_tail()), pending)
             return
         job = worker.job
@@ -233,7 +221,7 @@ class IsolatedPool:
             yield from self._replace(worker, f"hung: no result within the per-case time limit of "
                                      f"{self.limits.seconds:g} s; the worker was killed", pending)
             return
-        rss = resident_bytes(worker.process.pid)
+        rss = status_bytes("VmRSS", worker.process.pid) or 0
         if rss > self.limits.memory_bytes:
             worker.kill()
             yield from self._replace(worker, f"out of memory: the worker's resident memory reached {rss / GIB:.3g} "

@@ -70,20 +70,6 @@ DEFAULT_REPEATS = 3
 
 
 @dataclass
-class _CaseResult:
-    """One dynamics case: its rows, and what the order fits need from it.
-
-    ``errors`` are the raw error values (saturated ones included), ``floors`` their rounding
-    floors; both empty when nothing was measured.
-    """
-
-    rows: list[ResultRow]
-    errors: dict[str, float] = field(default_factory=dict)
-    floors: dict[str, float] = field(default_factory=dict)
-    integrates_rotation: bool = True
-
-
-@dataclass
 class _Ladder:
     """The cases of one engine x integrator over the scene's time steps, for the order fits."""
 
@@ -117,7 +103,9 @@ def _dynamics_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart, 
     n = scene.n_steps(dt)
     metrics = dynamics_metrics(scene)
     on_start(None)
-    ref_traj, ref_problem = _reference_trajectory(scene, engine_for(scene.reference), dt, group.reference_label,
+    reference = engine_for(scene.reference)
+    ref_integrator = reference.scene_integrators(scene)[0]
+    ref_traj, ref_problem = _reference_trajectory(scene, reference, ref_integrator, dt, group.reference_label,
                                                   reference_failure)
     for index, spec in enumerate(group.cases):
         if index in skip:
@@ -129,13 +117,13 @@ def _dynamics_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart, 
             yield index, CaseOutcome(_no_integrator_rows(scene, engine, case, metrics))
             continue
         rows: list[ResultRow] = []
-        series: list[SeriesRecord] = []
-        is_reference = group.reference_label == f"{spec.engine}:{spec.integrator}"
+        is_reference = (spec.engine, spec.integrator) == (reference.name, ref_integrator)
         with warnings_into_rows(rows):
-            result = _dynamics_case(scene, engine, case, metrics, n, ref_traj, ref_problem, group.repeats,
-                                    is_reference, series)
-            rows += result.rows
-        yield index, CaseOutcome(rows, series, result.errors, result.floors, result.integrates_rotation)
+            outcome = _dynamics_case(scene, engine, case, metrics, n, ref_traj, ref_problem, group.repeats,
+                                     is_reference)
+            rows += outcome.rows
+        outcome.rows = rows
+        yield index, outcome
 
 
 def _no_integrator_rows(scene: DynamicsScene, engine: Engine, case: Case, metrics: dict) -> list[ResultRow]:
@@ -152,12 +140,12 @@ def _no_integrator_rows(scene: DynamicsScene, engine: Engine, case: Case, metric
     return case.rows(metrics, NOT_AVAILABLE, reason)
 
 
-def _reference_trajectory(scene: DynamicsScene, reference: Engine, dt: float, label: str,
+def _reference_trajectory(scene: DynamicsScene, reference: Engine, integrator: str, dt: float, label: str,
                           reference_failure: str) -> tuple[object, tuple[str, str]]:
-    """(the reference trajectory at ``dt`` or None, (why there is none, the status that gives))."""
+    """(the reference trajectory at ``dt`` or None, (why there is none, the status that gives)); ``label`` names
+    the reference in the reasons."""
     if reference_failure:
         return None, (f"reference {label} failed: {reference_failure}", FAILED)
-    integrator = label.split(":", 1)[1]
     try:
         support = reference.supports_dynamics(scene, integrator)
     except Exception as err:  # noqa: BLE001 - reported in the rows
@@ -201,55 +189,56 @@ def _stability_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart,
 
 
 def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref_traj, ref_problem: tuple[str, str],
-                   repeats: int, is_reference: bool, series: list[SeriesRecord]) -> _CaseResult:
-    """One case; ``ref_problem`` is (why there is no reference trajectory, the status that gives).
-    The case's sampled series are appended to ``series``."""
+                   repeats: int, is_reference: bool) -> CaseOutcome:
+    """One case; ``ref_problem`` is (why there is no reference trajectory, the status that gives). The outcome's
+    ``errors`` are the raw error values (saturated ones included), ``floors`` their rounding floors, for the order
+    fits; both empty when nothing was measured."""
     try:
         support = engine.supports_dynamics(scene, case.integrator)
     except Exception as err:  # noqa: BLE001 - reported in the rows
-        return _CaseResult(case.rows(metrics, FAILED, error_text(err)))
+        return CaseOutcome(case.rows(metrics, FAILED, error_text(err)))
     if not support.ok:
-        return _CaseResult(case.rows(metrics, NOT_AVAILABLE, support.reason))
+        return CaseOutcome(case.rows(metrics, NOT_AVAILABLE, support.reason))
     try:
         sim = engine.build_dynamics(scene, case.integrator, case.dt)
         with np.errstate(all="ignore"):  # a diverging run overflows; it is reported as diverged
             seconds, traj = best_of(lambda: sim.run(n), repeats)
     except DivergedError as err:
-        return _CaseResult(case.rows(metrics, DIVERGED, str(err)))
+        return CaseOutcome(case.rows(metrics, DIVERGED, str(err)))
     except Exception as err:  # noqa: BLE001 - reported in the rows
-        return _CaseResult(case.rows(metrics, FAILED, error_text(err)))
+        return CaseOutcome(case.rows(metrics, FAILED, error_text(err)))
     try:
-        return _measured_case(scene, sim, case, metrics, n, traj, seconds, ref_traj, ref_problem, is_reference, series)
+        return _measured_case(scene, sim, case, metrics, n, traj, seconds, ref_traj, ref_problem, is_reference)
     except Exception as err:  # noqa: BLE001 - a user's engine returned what cannot be measured
-        return _CaseResult(case.rows(metrics, FAILED, f"its trajectory cannot be measured: {error_text(err)}"))
+        return CaseOutcome(case.rows(metrics, FAILED, f"its trajectory cannot be measured: {error_text(err)}"))
 
 
 def _measured_case(scene, sim, case: Case, metrics: dict, n: int, traj, seconds: float, ref_traj,
-                   ref_problem: tuple[str, str], is_reference: bool, series: list[SeriesRecord]) -> _CaseResult:
+                   ref_problem: tuple[str, str], is_reference: bool) -> CaseOutcome:
     """The rows of a case whose simulation ran: ``traj`` measured against ``ref_traj``."""
     values = {"time_per_step": Measured(seconds / n, "s")}
     with np.errstate(all="ignore"):
         blown, reading = blow_up(scene, traj)
         if blown:
-            return _CaseResult(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values),
+            return CaseOutcome(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values),
                                integrates_rotation=sim.integrates_rotation)
         changes = conserved_changes(scene, traj)
         values.update(drifts(scene, traj, changes))
         heights = None if reading is None else reading.distance[:, 0].min(axis=-1)
-        series += dynamics_series(case, traj, ref_traj, changes, heights)
+        series = dynamics_series(case, traj, ref_traj, changes, heights)
         floors = rounding_floors(scene, traj, n)
         if ref_traj is None:
             if reading is not None:
                 values.update(contact_metrics(scene, traj, None, reading))
             problem, status = ref_problem
-            return _CaseResult(case.partial_rows(metrics, values, sim.detail, status, problem), {}, floors,
-                               sim.integrates_rotation)
+            return CaseOutcome(case.partial_rows(metrics, values, sim.detail, status, problem), series, floors=floors,
+                               integrates_rotation=sim.integrates_rotation)
         values.update(trajectory_errors(traj, ref_traj))
         if reading is not None:
             values.update(contact_metrics(scene, traj, ref_traj, reading))
     detail = ("this is the reference; " if is_reference else "") + sim.detail
-    return _CaseResult(case.rows(metrics, OK, detail, values), {m: v.value for m, v in values.items()}, floors,
-                       sim.integrates_rotation)
+    return CaseOutcome(case.rows(metrics, OK, detail, values), series, {m: v.value for m, v in values.items()},
+                       floors, sim.integrates_rotation)
 
 
 def _kinematics_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart, skip: frozenset[int],

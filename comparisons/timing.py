@@ -42,18 +42,23 @@ def best_of(fn: Callable[[], T], repeats: int) -> tuple[float, T]:
     return best, result
 
 
-def _high_water_mark_bytes() -> int | None:
-    """This process's peak resident memory from Linux's /proc (VmHWM), None elsewhere. Unlike ru_maxrss, it
-    starts afresh at exec: a process started by a large one (a benchmark, a test run) does not report its
-    parent's size."""
+def status_bytes(field: str, pid: int | str = "self") -> int | None:
+    """A memory field of a process from Linux's /proc (``VmHWM``, ``VmRSS``, ...) [bytes]; None when it cannot be
+    read (not Linux, the process is gone)."""
     try:
-        with open("/proc/self/status", encoding="ascii") as status:
+        with open(f"/proc/{pid}/status", encoding="ascii") as status:
             for line in status:
-                if line.startswith("VmHWM:"):
+                if line.startswith(f"{field}:"):
                     return int(line.split()[1]) * 1024
     except (OSError, ValueError):
         return None
     return None
+
+
+def _high_water_mark_bytes() -> int | None:
+    """This process's peak resident memory (VmHWM), None elsewhere. Unlike ru_maxrss, it starts afresh at exec: a
+    process started by a large one (a benchmark, a test run) does not report its parent's size."""
+    return status_bytes("VmHWM")
 
 
 def peak_memory_bytes() -> tuple[int, int]:

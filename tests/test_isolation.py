@@ -7,7 +7,7 @@ import pandas as pd
 import pytest
 
 from simparity.comparisons.cli import main
-from simparity.comparisons.isolation import death_cause
+from simparity.comparisons.isolation import BLAS_THREAD_VARIABLES, death_cause, worker_environment
 from simparity.comparisons.library import builtin_paths
 from tests.helpers import THROWN_BALL
 
@@ -100,3 +100,10 @@ def test_two_engines_or_two_scenes_of_one_name_are_refused(tmp_path, capsys):
 def test_the_cause_of_an_exit_is_the_exit_code_and_the_error():
     stderr = 'Traceback (most recent call last):\n  File "/a.py", line 1, in main\n  File "/b.py", line 9, in f\nKeyError: 3\n'
     assert death_cause(1, stderr) == 'crashed: the worker exited with code 1: KeyError: 3 (File "/b.py", line 9, in f)'
+
+
+def test_workers_use_one_blas_thread_whatever_the_user_set(monkeypatch):
+    """Determinism across worker counts rests on it: a sum split over BLAS threads rounds differently."""
+    monkeypatch.setenv("OPENBLAS_NUM_THREADS", "8")
+    env = worker_environment()
+    assert all(env[variable] == "1" for variable in BLAS_THREAD_VARIABLES)

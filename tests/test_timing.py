@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simparity.comparisons.timing import peak_memory_bytes, resource_line
+from simparity.comparisons.timing import peak_memory_bytes, resource_line, status_bytes
 
 PARENT_BYTES = 300 * 2**20
 """Resident memory the test process takes before starting a child."""
@@ -26,3 +26,8 @@ def test_a_process_started_by_a_large_one_reports_its_own_peak():
 
 def test_the_resource_line_names_wall_time_and_peak_memory():
     assert resource_line(12.345).startswith("wall time 12.3 s; peak memory ")
+
+
+def test_a_process_memory_field_is_read_in_bytes_or_none():
+    assert status_bytes("VmRSS") > 10 * 1024 ** 2  # this Python with NumPy holds more than 10 MiB
+    assert status_bytes("VmRSS", pid=2 ** 31) is None  # no such process
