@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from simparity.comparisons.placeholder_engines import StandInEngine
 from simparity.core.engine import Engine
 from simparity.core.results import ResultRow, SeriesRecord
 from simparity.core.scene import PENALTY_PREFIX, DynamicsScene, IKScene
@@ -64,6 +65,9 @@ class CaseGroup:
         Timed repeats per case.
     reference_label : str
         The reference named in the rows (``engine:integrator``).
+    stand_ins : tuple of StandInEngine
+        The run's engines that cannot run (:mod:`comparisons.placeholder_engines`): a worker uses them as they
+        are instead of building the engine again.
     """
 
     scene: object
@@ -74,6 +78,7 @@ class CaseGroup:
     engines: tuple[tuple[str, str], ...]
     repeats: int
     reference_label: str
+    stand_ins: tuple[StandInEngine, ...] = ()
 
     @property
     def engine_names(self) -> tuple[str, ...]:
@@ -206,10 +211,11 @@ def plan_scene(scene, engines: list[Engine], reference: Engine, repeats: int,
     ``reference``, in the order their rows are stored; ``specs`` maps engine names to what they were built
     from when that is not the name."""
     names = tuple((e.name, (specs or {}).get(e.name, e.name)) for e in engines)
+    stand_ins = tuple(e for e in engines if isinstance(e, StandInEngine))
     digest = scene_hash(scene)
 
     def group(kind: str, dt: float, cases: list[CaseSpec], label: str) -> CaseGroup:
-        return CaseGroup(scene, digest, kind, dt, tuple(cases), names, repeats, label)
+        return CaseGroup(scene, digest, kind, dt, tuple(cases), names, repeats, label, stand_ins)
 
     if isinstance(scene, IKScene):
         cases = [CaseSpec(e.name, s) for e in engines for s in _solvers(e) or (NO_INTEGRATOR,)]

@@ -21,7 +21,15 @@ from simparity.comparisons import library
 from simparity.comparisons.check import BASELINE_RELATIVE, CheckResult, check_table, compare_with_baseline
 from simparity.comparisons.check_output import junit_xml, summary_markdown
 from simparity.comparisons.describe import describe
-from simparity.comparisons.engines import DEFAULT_ENGINES, allowed_engines, check_engine_names, make_engine
+from simparity.comparisons.console import EXIT_INTERRUPTED
+from simparity.comparisons.engines import (
+    DEFAULT_ENGINES,
+    allowed_engines,
+    check_engine_names,
+    describe_engines,
+    include_specs,
+    make_engine,
+)
 from simparity.comparisons.history import history_path, latest_before, metric_history, record_run, run_table
 from simparity.comparisons.execution import count_cases, default_jobs, run_scenes
 from simparity.comparisons.isolation import DEFAULT_CASE_SECONDS, GIB, CaseLimits, IsolatedPool
@@ -42,12 +50,13 @@ from simparity.reports.content import ToleranceVerdict
 from simparity.reports.render import write_report
 from simparity.reports.store import read_run
 
-EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE, EXIT_INTERRUPTED = 0, 1, 2, 130
+EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE = 0, 1, 2
 EXPORTABLE = ("mujoco", "pybullet", "pinocchio")
 EXECUTORS = ("local", "dask")
 MAX_JOBS = 256
 """Worker processes at most: each is a Python process of ~250 MiB with the engines loaded."""
-MEMORY_HELP = "80%% of this machine's memory shared between the workers, at least 1 GiB"
+MEMORY_HELP = ("80%% of the memory of the machine a case runs on, shared between its workers (on Dask: a worker's own "
+               "memory limit shared between its threads, if it has one), at least 1 GiB")
 RESUMED_OPTIONS = ("scenes", "suite", "engines", "out", "force", "quick", "repeats", "max_steps", "max_samples",
                    "max_joints")
 """What a resumed run takes from the run it resumes (``resume.json``), never from the command line."""
@@ -280,12 +289,11 @@ def _request(args, names: tuple[str, ...], repeats: int) -> dict:
 
 
 def _limits(args, jobs: int) -> CaseLimits:
-    """The per-case limits from --case-timeout and --case-memory (default: a share of this machine)."""
+    """The per-case limits from --case-timeout and --case-memory (default: a share of the machine a case runs on)."""
     if not (math.isfinite(args.case_timeout) and args.case_timeout > 0):
         raise SimparityError(f"--case-timeout {args.case_timeout}: out of range (allowed: a number of seconds > 0)")
-    limits = CaseLimits.default(jobs)
-    if args.case_memory is None:
-        return CaseLimits(args.case_timeout, limits.memory_bytes)
+    if args.case_memory is None:  # on Dask, each node's own default
+        return CaseLimits(args.case_timeout, CaseLimits.default(jobs).memory_bytes if args.executor == "local" else None)
     if not (math.isfinite(args.case_memory) and 0 < args.case_memory <= 1e6):
         raise SimparityError(f"--case-memory {args.case_memory}: out of range (allowed: GiB > 0, up to 1e6)")
     return CaseLimits(args.case_timeout, int(args.case_memory * GIB))
@@ -310,6 +318,7 @@ def cmd_run(args, out) -> int:
                              "dask, or drop --scheduler)")
     limits = _limits(args, jobs)
     names = check_engine_names(args.engines)
+    include_specs(names)
     run_limits = Limits(max_steps=args.max_steps, max_samples=args.max_samples, max_joints=args.max_joints)
     if args.scenes and args.suite:
         raise SimparityError(f"--suite {args.suite} with scenes named: give one (allowed: scene names or files, "
@@ -317,7 +326,7 @@ def cmd_run(args, out) -> int:
     chosen = library.load(args.scenes, run_limits) if args.scenes else library.suite(args.suite or "default", run_limits)
     scenes = apply_profile(chosen, "quick" if args.quick else "full")
     bounds = load_tolerances(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
-    engines = [make_engine(n) for n in names]
+    engines = describe_engines(names, scenes)
     _check_distinct(engines, names, scenes)
     if args.resume is not None:
         stand_ins = [n for n, e in zip(names, engines) if isinstance(e, (UnavailableEngine, BrokenEngine))]
@@ -326,12 +335,8 @@ def cmd_run(args, out) -> int:
                                  "that run cannot be built here (allowed: resume where the run's engines import, e.g. "
                                  "from the folder a module:Class engine was found in)")
     out_dir = _out_dir(args)
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-    except (OSError, ValueError) as err:  # ValueError: a NUL byte in the name
-        raise SimparityError(f"--out {one_line(out_dir)}: cannot create the folder: {getattr(err, 'strerror', None) or err} "
-                             "(allowed: a folder you can write)") from None
-    with run_lock(out_dir):
+    executor = _executor(args, jobs, limits)  # an unreachable scheduler is an error before a folder is made
+    with contextlib.closing(executor), run_lock(_made(out_dir)):
         if args.resume is None:  # a new run: nothing of a run --force replaces is reused
             write_request(out_dir, _request(args, names, repeats))
             Journal(out_dir).clear()
@@ -340,10 +345,20 @@ def cmd_run(args, out) -> int:
         print(f"{_cost(scenes)}; {len(names)} engines; {where}" + (" (quick profile)" if args.quick else "")
               + (f"; resuming {len(Journal(out_dir))} finished cases" if args.resume else ""), file=out, flush=True)
         try:
-            return _run(args, out, scenes, engines, repeats, _executor(args, jobs, limits), bounds, out_dir,
+            return _run(args, out, scenes, engines, repeats, executor, bounds, out_dir,
                         dict(zip((e.name for e in engines), names)))
         finally:  # what the run cost, also when it was interrupted or stopped by an error
             print(resource_line(time.perf_counter() - start), file=out, flush=True)
+
+
+def _made(out_dir: Path) -> Path:
+    """``out_dir``, created if it is not there."""
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except (OSError, ValueError) as err:  # ValueError: a NUL byte in the name
+        raise SimparityError(f"--out {one_line(out_dir)}: cannot create the folder: {getattr(err, 'strerror', None) or err} "
+                             "(allowed: a folder you can write)") from None
+    return out_dir
 
 
 def _check_distinct(engines, names: tuple[str, ...], scenes) -> None:
@@ -386,7 +401,7 @@ def _run(args, out, scenes, engines, repeats: int, executor, bounds, out_dir: Pa
     failed = 0
     journal = Journal(out_dir)
     try:
-        with contextlib.closing(executor):
+        with contextlib.closing(executor):  # the workers stop as soon as the cases do, before the report
             results = run_scenes(scenes, engines, make_engine, repeats, executor, journal,
                                  bar.case_done if bar.active else None, specs)
             for k, (scene, rows, series) in enumerate(results):
@@ -545,6 +560,9 @@ def main(argv: list[str] | None = None, out=None) -> int:
     except SimparityError as err:
         print(f"simparity: error: {one_line(err, MESSAGE_LIMIT)}", file=sys.stderr)
         return EXIT_USAGE
+    except KeyboardInterrupt:  # Ctrl-C outside a run's cases (start-up, a report): one line, not a traceback
+        print("simparity: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except BrokenPipeError:  # the reader went away (`simparity list | head`): stop quietly, like Unix tools
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_OK

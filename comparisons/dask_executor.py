@@ -4,36 +4,71 @@ Each group is one Dask task. On the Dask worker the task runs its group in an
 :class:`~comparisons.isolation.IsolatedPool` of one worker process, kept for the worker's next
 tasks, so a case that crashes, hangs or exhausts memory fails alone there exactly as it does
 locally, and the Dask worker lives on. Without a scheduler address a ``LocalCluster`` is started on
-the loopback interface with one single-threaded worker process per job. Outcomes stream back group
+the loopback interface with one single-threaded worker process per job. Without --case-memory, each case's
+memory limit is the default of the machine it runs on (:func:`node_memory_bytes`), not of this one. Outcomes stream back group
 by group as tasks finish; a group whose Dask worker is lost for good (Dask retries it elsewhere
 first) fails with that cause.
 """
 
 from __future__ import annotations
 
+import os
+import socket
 import threading
 from typing import Iterator
 
 from simparity.comparisons.cases import CaseGroup, CaseOutcome
-from simparity.comparisons.isolation import CaseLimits, IsolatedPool, Job
+from simparity.comparisons.isolation import MIN_MEMORY_BYTES, CaseLimits, IsolatedPool, Job
 from simparity.comparisons.runner import failed_outcome
 from simparity.core.errors import SimparityError, one_line
 
 CONNECT_SECONDS = 30
-"""How long to wait for the scheduler at --scheduler before giving up."""
+"""How long to wait for the scheduler at --scheduler to answer, once its port accepts connections."""
+
+REACH_SECONDS = 5
+"""How long to wait for the scheduler's port to accept a connection: a refused or unresolvable address fails at
+once, an unanswered one (a firewall dropping packets) after this."""
 
 _pools = threading.local()
 """Each Dask worker thread's pool of one worker process, kept between tasks."""
 
 
 def run_group_task(group: CaseGroup, skip: frozenset[int], limits: CaseLimits) -> list[tuple[int, CaseOutcome]]:
-    """The Dask task: every case of ``group`` but ``skip``, run in this Dask worker's isolated process."""
+    """The Dask task: every case of ``group`` but ``skip``, run in this Dask worker's isolated process, under
+    ``limits`` (a memory limit of None: :func:`node_memory_bytes`)."""
+    if limits.memory_bytes is None:
+        limits = CaseLimits(limits.seconds, node_memory_bytes())
     pool = getattr(_pools, "pool", None)
     if pool is None or pool.limits != limits:
         if pool is not None:
             pool.close()
         pool = _pools.pool = IsolatedPool(1, limits)
     return [(index, outcome) for _, index, outcome in pool.run([Job(0, group, set(skip))])]
+
+
+def _reach(address: str) -> None:
+    """Raise OSError or ValueError unless something accepts connections at the scheduler's ``address`` (before
+    Dask's client, which retries a refused connection for its whole timeout)."""
+    from distributed.comm.addressing import get_address_host_port, normalize_address
+
+    host, port = get_address_host_port(normalize_address(address))
+    socket.create_connection((host, port), timeout=REACH_SECONDS).close()
+
+
+def node_memory_bytes() -> int:
+    """The per-case memory limit by default on the machine a Dask worker runs on: the worker's own memory limit
+    shared between its threads (each runs one case at a time), or, when it has none, the local default for one
+    case per CPU of that machine."""
+    import distributed
+
+    try:
+        worker = distributed.get_worker()
+        limit, threads = worker.memory_manager.memory_limit, worker.state.nthreads
+    except (ValueError, AttributeError):  # not on a worker, or a Dask without these: the machine's share
+        limit, threads = None, 1
+    if limit:
+        return max(MIN_MEMORY_BYTES, int(limit) // max(1, threads))
+    return CaseLimits.default(os.cpu_count() or 1).memory_bytes
 
 
 class DaskExecutor:
@@ -55,6 +90,7 @@ class DaskExecutor:
                     dashboard_address=":0", memory_limit=0, silence_logs=50)
                 self.client = distributed.Client(self._cluster)
             else:
+                _reach(scheduler)
                 self.client = distributed.Client(scheduler, timeout=CONNECT_SECONDS)
         except (OSError, TimeoutError, ValueError) as err:
             self.close()
@@ -82,8 +118,10 @@ class DaskExecutor:
                 yield job.key, index, outcome
 
     def close(self) -> None:
-        client = getattr(self, "client", None)
+        """Disconnect, and stop the LocalCluster if this started one (again: nothing)."""
+        client, self.client = getattr(self, "client", None), None
         if client is not None:
             client.close()
-        if self._cluster is not None:
-            self._cluster.close()
+        cluster, self._cluster = self._cluster, None
+        if cluster is not None:
+            cluster.close()

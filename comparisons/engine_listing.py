@@ -9,19 +9,13 @@ raised); a plugin that is not used (shadowed, a bad name) says that instead.
 
 from __future__ import annotations
 
-import numpy as np
-
-from simparity.comparisons.engines import ENGINE_NAMES, make_engine
+from simparity.comparisons.engine_probe import PROBE_CHAIN
+from simparity.comparisons.engines import ENGINE_NAMES, describe_engines
 from simparity.comparisons.placeholder_engines import BrokenEngine, UnavailableEngine
 from simparity.comparisons.plugins import discover
 from simparity.comparisons.rows import error_text
 from simparity.core.engine import Engine
 from simparity.core.errors import one_line
-from simparity.core.scene import Chain, Joint
-
-PROBE_CHAIN = Chain("probe", (Joint("joint", "revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.eye(3)),),
-                    end_effector_xyz=np.array([1.0, 0.0, 0.0]))
-"""One revolute joint about z and a 1 m link: the chain an engine's kinematics support is asked about."""
 
 DETAIL_LIMIT = 600
 """Characters of a reason printed (an import error can be long): the line stays readable."""
@@ -35,7 +29,9 @@ def engine_lines() -> list[str]:
     entries += [(one_line(p.name), f"plugin {one_line(p.name)} = {one_line(p.target)} from {one_line(p.distribution)}",
                  p.problem) for p in discovery.plugins]
     width = max(len(name) for name, _, _ in entries)
-    lines = [f"{name:<{width}}  {origin}; " + (f"not used: {problem}" if problem else _offers(make_engine(name)))
+    used = [name for name, _, problem in entries if not problem]
+    engines = dict(zip(used, describe_engines(used)))
+    lines = [f"{name:<{width}}  {origin}; " + (f"not used: {problem}" if problem else _offers(engines[name]))
              for name, origin, problem in entries]
     if discovery.error:
         lines.append(f"plugins not searched: {discovery.error}")

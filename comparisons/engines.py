@@ -71,11 +71,35 @@ def make_engine(name: str) -> Engine:
     return load_engine(name, taken=frozenset(ENGINE_NAMES) | frozenset(plugins))
 
 
+def describe_engines(names, scenes=()) -> list[Engine]:
+    """The engines called ``names`` as simparity itself may hold them: a built-in built here, a plugin or spec
+    described by a process of its own, asked about ``scenes`` (:mod:`comparisons.engine_probe`): a user's code
+    never runs in this process, so one that crashes or hangs there cannot take simparity down."""
+    from simparity.comparisons.engine_probe import probe_engines  # it starts processes: only when asked
+
+    names = check_engine_names(names)
+    outside = [n for n in names if n not in _ENGINES]
+    probed = probe_engines(outside, scenes) if outside else {}
+    return [probed[n] if n in probed else make_engine(n) for n in names]
+
+
+_RUN_SPECS: list[str] = []
+"""The ``module:attr`` engines of this run (:func:`include_specs`): their integrators may be named in scene files."""
+
+
+def include_specs(names) -> None:
+    """Let the integrators of the spec engines among ``names`` (``--engines``) be named in scene files."""
+    specs = [n for n in names if is_spec(n) and n not in _RUN_SPECS]
+    if specs:
+        _RUN_SPECS.extend(specs)
+        known_integrators.cache_clear()
+
+
 @functools.lru_cache(maxsize=1)
 def known_integrators() -> tuple[str, ...]:
-    """Every integrator name some engine offers, built-in or plugin (for checking scene files). Cached: each
-    engine is built once per process; a plugin that cannot run offers none."""
+    """Every integrator name some engine offers: a built-in, an installed plugin or a spec engine of this run
+    (for checking scene files). Cached; a plugin that cannot run offers none."""
     names = {}
-    for engine in ENGINE_NAMES + plugin_names():
-        names.update(dict.fromkeys(make_engine(engine).integrators()))
+    for engine in describe_engines(ENGINE_NAMES + plugin_names() + tuple(_RUN_SPECS)):
+        names.update(dict.fromkeys(engine.integrators()))
     return tuple(names)

@@ -19,7 +19,8 @@ Per engine x solver (the ``integrator`` column holds the solver; ``dt`` is NaN):
 from __future__ import annotations
 
 import math
-from typing import Callable, Iterator
+from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 
@@ -180,33 +181,48 @@ def _distributions(case: Case, result: IKResult) -> list[SeriesRecord]:
             + ([quantiles(case, "iterations", "1", iterations)] if iterations.size else []))
 
 
-def _case_outcome(scene: IKScene, engine: Engine, case: Case, options: IKTolerances, random: Targets,
-                  hard: list[Targets], judges: dict[str, KinematicsModel], repeats: int) -> CaseOutcome:
+@dataclass(frozen=True)
+class _Solve:
+    """A solver's answers: on the random targets (timed, ``seconds``), on each hard target, and its model's
+    detail; or, when it could not solve, ``status`` and ``problem`` say why."""
+
+    result: IKResult | None = None
+    hard: list[IKResult] = field(default_factory=list)
+    seconds: float = math.nan
+    detail: str = ""
+    status: str = OK
+    problem: str = ""
+
+
+def _solved(scene: IKScene, engine: Engine, solver: str, random: Targets, hard: list[Targets], repeats: int) -> _Solve:
+    """``solver`` of ``engine`` on the targets, or why it cannot solve them."""
     try:
-        support = engine.supports_ik(scene.chain, case.integrator, scene.target_kind == "position")
+        support = engine.supports_ik(scene.chain, solver, scene.target_kind == "position")
     except Exception as err:  # noqa: BLE001 - reported in the rows
-        problem = error_text(err)
-        return CaseOutcome(case.rows(IK_METRICS, FAILED, problem)
-                           + _hard_rows(case, hard, [None] * len(hard), FAILED, problem))
+        return _Solve(status=FAILED, problem=error_text(err))
     if not support.ok:
-        return CaseOutcome(case.rows(IK_METRICS, NOT_AVAILABLE, support.reason)
-                           + _hard_rows(case, hard, [None] * len(hard), NOT_AVAILABLE, support.reason))
+        return _Solve(status=NOT_AVAILABLE, problem=support.reason)
     try:
-        model = engine.build_ik(scene.chain, case.integrator, options)
+        model = engine.build_ik(scene.chain, solver, _options(scene))
         seconds, result = best_of(lambda: _solve(model, random, scene.q_start), repeats)
-        hard_results = _solve_each(model, hard, scene.q_start)
+        return _Solve(result, _solve_each(model, hard, scene.q_start), seconds, model.detail)
     except Exception as err:  # noqa: BLE001 - reported in the rows
-        problem = error_text(err)
-        return CaseOutcome(case.rows(IK_METRICS, FAILED, problem)
-                           + _hard_rows(case, hard, [None] * len(hard), FAILED, problem))
-    values = {m: Measured(v, IK_METRICS[m]) for m, v in _summary(result, scene.q_start, seconds).items()}
-    agreement, ends = _cross_evaluation(scene, random, result.q, judges)
+        return _Solve(status=FAILED, problem=error_text(err))
+
+
+def _case_outcome(scene: IKScene, engine: Engine, case: Case, solved: _Solve, random: Targets, hard: list[Targets],
+                  judges: dict[str, KinematicsModel]) -> CaseOutcome:
+    if solved.result is None:
+        return CaseOutcome(case.rows(IK_METRICS, solved.status, solved.problem)
+                           + _hard_rows(case, hard, [None] * len(hard), solved.status, solved.problem))
+    values = {m: Measured(v, IK_METRICS[m]) for m, v in _summary(solved.result, scene.q_start, solved.seconds).items()}
+    agreement, ends = _cross_evaluation(scene, random, solved.result.q, judges)
     values.update({m: Measured(v, IK_METRICS[m]) for m, v in agreement.items()})
     if engine.name in judges:
         values["start_rank_deficiency"] = start_rank_deficiency(scene, judges[engine.name])
-    rows = (case.rows(IK_METRICS, OK, f"{model.detail}; {random.note}", values)
-            + _hard_rows(case, hard, hard_results, OK, ""))
-    return CaseOutcome(rows, _distributions(case, result), ends=ends, reference_label=case.reference)
+    rows = (case.rows(IK_METRICS, OK, f"{solved.detail}; {random.note}", values)
+            + _hard_rows(case, hard, solved.hard, OK, ""))
+    return CaseOutcome(rows, _distributions(case, solved.result), ends=ends, reference_label=case.reference)
 
 
 def _skipped(scene: IKScene) -> dict[str, str]:
@@ -220,49 +236,61 @@ def _options(scene: IKScene) -> IKTolerances:
                         max_iterations=scene.max_iterations)
 
 
-def run_ik_group(group: CaseGroup, engine_for: Callable[[str], Engine], on_start: Callable[[int | None], None],
-                 skip: frozenset[int], reference_failure: str) -> Iterator[tuple[int, CaseOutcome]]:
-    """(index, outcome) of every case of an IK group but those in ``skip``: the reference engine's FK
-    generates the targets, every engine of the run that can build the chain judges the solutions.
-    ``reference_failure``: why the targets are not to be made again (it took the worker down)."""
+@dataclass(frozen=True)
+class IKShared:
+    """What the cases of an IK group share: the targets (None when the reference cannot make them) or
+    (the status, the reason) of why there are none."""
+
+    random: Targets | None
+    hard: list[Targets]
+    problem: tuple[str, str]
+
+
+def prepare_ik(group: CaseGroup, engine_for: Callable[[str], Engine], reference_failure: str) -> IKShared:
+    """The targets of an IK group, made with the reference engine's FK. ``reference_failure``: why they are
+    not to be made again (it took the worker down)."""
     scene = group.scene
-    on_start(None)
-    fk, status, reason = None, FAILED, f"failed: {reference_failure}"
-    if not reference_failure:
-        status, reason = NOT_AVAILABLE, ""
-        try:
-            support = engine_for(scene.reference).supports_kinematics(scene.chain)
-            reason = support.reason
-            if support.ok:
-                fk = engine_for(scene.reference).build_kinematics(scene.chain)
-        except Exception as err:  # noqa: BLE001 - reported in the rows
-            status, reason = FAILED, f"failed: {error_text(err)}"
-    skipped = _skipped(scene)
-    if fk is None:
-        problem = f"reference {scene.reference} cannot make the targets: {reason}"
-        for index, spec in enumerate(group.cases):
-            if index not in skip:
-                case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label)
-                yield index, CaseOutcome(case.rows(IK_METRICS, status, problem))
-        return
-    random = random_targets(scene, fk)
-    hard = [hard_target(scene, name, fk) for name in scene.hard_targets
-            if not (scene.target_kind == "position" and name in ORIENTATION_ONLY)]
-    judges = _judges(scene, [engine_for(name) for name in group.engine_names])
-    label = f"{scene.reference}:fk (targets); cross-evaluated by {', '.join(judges)}"
-    for index, spec in enumerate(group.cases):
-        if index in skip:
-            continue
-        on_start(index)
+    if reference_failure:
+        return IKShared(None, [], (FAILED, _no_targets(scene, f"failed: {reference_failure}")))
+    try:
+        reference = engine_for(scene.reference)
+        support = reference.supports_kinematics(scene.chain)
+        if not support.ok:
+            return IKShared(None, [], (NOT_AVAILABLE, _no_targets(scene, support.reason)))
+        fk = reference.build_kinematics(scene.chain)
+        random = random_targets(scene, fk)
+        hard = [hard_target(scene, name, fk) for name in scene.hard_targets
+                if not (scene.target_kind == "position" and name in ORIENTATION_ONLY)]
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        return IKShared(None, [], (FAILED, _no_targets(scene, f"failed: {error_text(err)}")))
+    return IKShared(random, hard, ("", ""))
+
+
+def _no_targets(scene: IKScene, reason: str) -> str:
+    return f"reference {scene.reference} cannot make the targets: {reason}"
+
+
+def ik_case(group: CaseGroup, shared: IKShared, index: int, engine_for: Callable[[str], Engine]) -> CaseOutcome:
+    """One engine x solver of an IK group on the shared targets; every engine of the run that can build the
+    chain judges its solutions. The judges are built here, after the solve, so no other engine's code has run
+    in this process before the solver's."""
+    scene, spec = group.scene, group.cases[index]
+    if shared.random is None:
+        status, problem = shared.problem
+        case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label)
+        return CaseOutcome(case.rows(IK_METRICS, status, problem))
+    rows: list[ResultRow] = []
+    with warnings_into_rows(rows):
+        engine = engine_for(spec.engine)
+        solved = _solved(scene, engine, spec.integrator, shared.random, shared.hard, group.repeats)
+        judges = _judges(scene, [engine_for(name) for name in group.engine_names])
+        label = f"{scene.reference}:fk (targets); cross-evaluated by {', '.join(judges)}"
         case = Case(scene.name, spec.engine, spec.integrator, math.nan, label)
-        rows: list[ResultRow] = []
-        with warnings_into_rows(rows):
-            outcome = _case_outcome(scene, engine_for(spec.engine), case, _options(scene), random, hard, judges,
-                                    group.repeats)
-            rows += outcome.rows
-        outcome.rows = rows + case.rows(skipped, NOT_AVAILABLE, "position-only scene: no orientation to target")
-        outcome.reference_label = label
-        yield index, outcome
+        outcome = _case_outcome(scene, engine, case, solved, shared.random, shared.hard, judges)
+        rows += outcome.rows
+    outcome.rows = rows + case.rows(_skipped(scene), NOT_AVAILABLE, "position-only scene: no orientation to target")
+    outcome.reference_label = label
+    return outcome
 
 
 def failed_ik_outcome(group: CaseGroup, spec: CaseSpec, cause: str) -> CaseOutcome:

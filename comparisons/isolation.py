@@ -61,10 +61,11 @@ def physical_memory_bytes() -> int:
 
 @dataclass(frozen=True)
 class CaseLimits:
-    """What one case may take: wall time [s] and resident memory of its worker [bytes]."""
+    """What one case may take: wall time [s] and resident memory of its worker [bytes]; None: the default of the
+    machine that runs it, resolved there (a Dask node's, :func:`comparisons.dask_executor.node_memory_bytes`)."""
 
     seconds: float
-    memory_bytes: int
+    memory_bytes: int | None
 
     @classmethod
     def default(cls, workers: int) -> "CaseLimits":
@@ -110,11 +111,12 @@ class _Worker:
         self.inbox = Connection(parent_reads, writable=False)
         self.job: Job | None = None
         self.phase: int | None = None
+        self.phase_pid = self.process.pid
         self.since = time.monotonic()
 
     def start(self, job: Job) -> None:
         self.stderr.truncate(0)
-        self.job, self.phase, self.since = job, None, time.monotonic()
+        self.job, self.phase, self.phase_pid, self.since = job, None, self.process.pid, time.monotonic()
         self.outbox.send((job.group, frozenset(job.skip), job.reference_failure))
 
     def kill(self, grace_seconds: float = 0.0) -> int:
@@ -122,7 +124,11 @@ class _Worker:
         try:
             self.process.wait(timeout=grace_seconds)
         except subprocess.TimeoutExpired:
-            self.process.kill()
+            pass
+        try:  # the worker's session: it, the child running a case and anything they forked
+            os.killpg(self.process.pid, signal.SIGKILL)
+        except (ProcessLookupError, PermissionError):
+            pass
         code = self.process.wait()
         for end in (self.inbox, self.outbox):
             end.close()
@@ -139,15 +145,15 @@ class _Worker:
         self.stderr.close()
 
 
-def death_cause(code: int, stderr: str) -> str:
-    """Why a worker died, from its exit code and the end of its standard error (faulthandler's stack)."""
+def death_cause(code: int, stderr: str, process: str = "the worker") -> str:
+    """Why ``process`` died, from its exit code and the end of its standard error (faulthandler's stack)."""
     if code < 0:
         name = signal.Signals(-code).name if -code in signal.valid_signals() else f"signal {-code}"
-        cause = f"crashed: the worker was killed by signal {-code} ({name})"
+        cause = f"crashed: {process} was killed by signal {-code} ({name})"
         if -code == signal.SIGKILL:
             cause += " (the system's out-of-memory killer, or another process)"
     else:
-        cause = f"crashed: the worker exited with code {code}"
+        cause = f"crashed: {process} exited with code {code}" + (" before its cases finished" if code == 0 else "")
     lines = [line.strip() for line in stderr.splitlines() if line.strip()]
     frames = [line for line in lines if line.startswith("File ")]
     faulthandler_stack = any(line.startswith(("Current thread", "Thread 0x")) for line in lines)
@@ -203,7 +209,12 @@ class IsolatedPool:
             return
         job = worker.job
         if message[0] == "start":
-            worker.phase, worker.since = message[1], time.monotonic()
+            worker.phase, worker.phase_pid, worker.since = message[1], message[2], time.monotonic()
+        elif message[0] == "crashed":  # the child running the cases of one engine died; the worker lives on
+            cause = death_cause(message[1], worker.stderr_tail(), "the case's process")
+            worker.phase = message[2] if worker.phase is None else worker.phase
+            yield from self._fail_phase(worker, cause, pending)
+            worker.job = None
         elif message[0] == "done":
             job.skip.add(message[1])
             yield job.key, message[1], message[2]
@@ -221,7 +232,7 @@ class IsolatedPool:
             yield from self._replace(worker, f"hung: no result within the per-case time limit of "
                                      f"{self.limits.seconds:g} s; the worker was killed", pending)
             return
-        rss = status_bytes("VmRSS", worker.process.pid) or 0
+        rss = status_bytes("VmRSS", worker.phase_pid) or 0
         if rss > self.limits.memory_bytes:
             worker.kill()
             yield from self._replace(worker, f"out of memory: the worker's resident memory reached {rss / GIB:.3g} "
@@ -231,9 +242,14 @@ class IsolatedPool:
     def _replace(self, worker: _Worker, cause: str, pending: collections.deque) -> Iterator[tuple[object, int, CaseOutcome]]:
         """A new process in ``worker``'s place; the case it ran fails with ``cause``, the rest of its job goes
         first in the queue."""
-        job, phase = worker.job, worker.phase
         worker.stderr.close()
         self._workers[self._workers.index(worker)] = _Worker()
+        yield from self._fail_phase(worker, cause, pending)
+
+    def _fail_phase(self, worker: _Worker, cause: str, pending: collections.deque) -> Iterator[tuple[object, int, CaseOutcome]]:
+        """The case ``worker`` was running fails with ``cause`` (its shared part: the group's cases run again
+        without it); the rest of its job goes first in the queue."""
+        job, phase = worker.job, worker.phase
         if phase is None and not job.reference_failure:
             job.reference_failure = cause  # its cases run again, without it
         else:
@@ -245,8 +261,10 @@ class IsolatedPool:
             pending.appendleft(job)
 
     def close(self) -> None:
+        """Stop every worker (again: nothing)."""
         for worker in self._workers:
             worker.close()
+        self._workers = []
 
     def __enter__(self) -> "IsolatedPool":
         return self

@@ -2,7 +2,8 @@
 
 Each finished case is one file ``cases/<key digest>.pickle`` in the run's folder (written to a
 temporary name and renamed, so a kill leaves no half-written case), holding its :class:`CaseKey`
-and :class:`CaseOutcome`. A case that did not finish (its worker crashed, hung or ran out of memory)
+and :class:`CaseOutcome`; reading one rebuilds only simparity's data types and NumPy arrays, never
+runs code a file names. A case that did not finish (its worker crashed, hung or ran out of memory)
 is not kept: a resumed run tries it again. ``resume.json`` holds what the run was asked to do. A run that
 finishes with every case done removes its kept cases (they are in ``results.csv``; ~15 MB for the default
 suite).
@@ -11,6 +12,8 @@ suite).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
+import enum
 import fcntl
 import json
 import os
@@ -23,6 +26,30 @@ from simparity.core.errors import SimparityError, one_line
 CASES_FOLDER = "cases"
 RESUME_FILE = "resume.json"
 LOCK_FILE = ".lock"
+
+
+NUMPY_GLOBALS = frozenset({
+    ("numpy", "ndarray"), ("numpy", "dtype"),
+    ("numpy._core.multiarray", "_reconstruct"), ("numpy.core.multiarray", "_reconstruct"),
+    ("numpy._core.multiarray", "scalar"), ("numpy.core.multiarray", "scalar"),
+    ("numpy._core.numeric", "_frombuffer"), ("numpy.core.numeric", "_frombuffer"),
+})
+"""What NumPy's arrays, dtypes and scalars are rebuilt from (NumPy 2 names, and 1.x's)."""
+
+
+class _CaseUnpickler(pickle.Unpickler):
+    """Reads a kept case and nothing else: simparity's dataclasses and enums (their constructors only store
+    values) and NumPy's arrays. Any other global a file names (``os.system``, a simparity function) is
+    refused, so a tampered or foreign case file is computed again instead of running code."""
+
+    def find_class(self, module: str, name: str):
+        if (module, name) in NUMPY_GLOBALS:
+            return super().find_class(module, name)
+        if module.startswith("simparity.") and "." not in name:
+            found = super().find_class(module, name)
+            if isinstance(found, type) and (dataclasses.is_dataclass(found) or issubclass(found, enum.Enum)):
+                return found
+        raise pickle.UnpicklingError(f"{module}.{name} is not part of a kept case")
 
 
 class Journal:
@@ -41,10 +68,11 @@ class Journal:
         """The outcome stored under ``key``, or None (never stored, or unreadable: computed again)."""
         try:
             with open(self._path(key), "rb") as handle:
-                stored_key, outcome = pickle.load(handle)
-        except (OSError, EOFError, pickle.UnpicklingError, ValueError, TypeError, AttributeError):
+                stored_key, outcome = _CaseUnpickler(handle).load()
+        except (OSError, EOFError, pickle.UnpicklingError, ValueError, TypeError, AttributeError, KeyError,
+                IndexError, ImportError):
             return None
-        return outcome if stored_key == key else None
+        return outcome if stored_key == key and isinstance(outcome, CaseOutcome) else None
 
     def save(self, key: CaseKey, outcome: CaseOutcome) -> None:
         """Keep a finished case (not one that did not finish: a resumed run tries it again)."""

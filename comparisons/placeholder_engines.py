@@ -12,7 +12,21 @@ from __future__ import annotations
 from simparity.core.engine import Engine, KinematicsModel, Simulation, Support
 from simparity.core.errors import PluginError, SimparityError
 
-class UnavailableEngine(Engine):
+class StandInEngine(Engine):
+    """An engine standing in for one that cannot run: the run's workers use it as it is, never building the
+    engine it stands in for again (a plugin that hung or crashed while it was described would do so again in
+    every case).
+
+    Attributes
+    ----------
+    reason : str
+        Why the engine cannot run, the detail of every row.
+    """
+
+    reason: str
+
+
+class UnavailableEngine(StandInEngine):
     """An engine whose library failed to import: every scene gets n/a with the import error.
 
     Attributes
@@ -47,7 +61,7 @@ class UnavailableEngine(Engine):
         return Support.no(self.reason)
 
 
-class BrokenEngine(Engine):
+class BrokenEngine(StandInEngine):
     """A user's engine that raised while it was loaded or built, or broke the interface: every case of every
     scene fails with that error.
 

@@ -32,7 +32,7 @@ from simparity.comparisons.cases import (
 )
 from simparity.comparisons.contact_metrics import contact_metrics
 from simparity.comparisons.divergence import blow_up
-from simparity.comparisons.ik_runner import failed_ik_outcome, ik_scene_series, run_ik_group
+from simparity.comparisons.ik_runner import failed_ik_outcome, ik_case, ik_scene_series, prepare_ik
 from simparity.comparisons.metrics import (
     KINEMATICS_METRICS,
     ORDER_METRICS,
@@ -55,6 +55,7 @@ from simparity.core.engine import Engine, Support
 from simparity.core.errors import DivergedError
 from simparity.core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
 from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
+from simparity.core.trajectory import Trajectory
 
 Progress = Callable[[str, str], None]
 """Called with (engine, integrator or solver) after each case of a scene."""
@@ -67,6 +68,11 @@ OnStart = Callable[[int | None], None]
 
 DEFAULT_REPEATS = 3
 """Timed repeats per measurement (the minimum is kept), after one warm-up run."""
+
+TIME_GRID_TOLERANCE = 1e-3
+"""How far [steps] a trajectory's sample time may be from k * dt: a clock kept as t += dt drifts at most
+~n^2 eps steps (1e-4 at the 10^6 steps a scene may have); a sample a thousandth of a step off is on another
+grid, and every error measured against the reference's samples would be wrong."""
 
 
 @dataclass
@@ -85,45 +91,75 @@ def _ignore_start(index: int | None) -> None:
     return None
 
 
+@dataclass(frozen=True)
+class _Kind:
+    """How a kind of group runs: ``prepare(group, engine_for, reference_failure)`` computes what its cases share
+    (the reference), ``case(group, shared, index, engine_for)`` one case's outcome."""
+
+    prepare: Callable
+    case: Callable
+
+
+def prepare_group(group: CaseGroup, engine_for: EngineFor, reference_failure: str = "") -> object:
+    """What the cases of ``group`` share (its reference trajectory, FK or targets), computed once.
+
+    ``reference_failure``, when given, is why it is not to be computed again (it took its worker down): the
+    cases run without it.
+    """
+    return _KINDS[group.kind].prepare(group, engine_for, reference_failure)
+
+
+def run_case(group: CaseGroup, shared: object, index: int, engine_for: EngineFor) -> CaseOutcome:
+    """The outcome of case ``index`` of ``group``, given what :func:`prepare_group` computed."""
+    return _KINDS[group.kind].case(group, shared, index, engine_for)
+
+
 def run_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart = _ignore_start,
               skip: frozenset[int] = frozenset(), reference_failure: str = "") -> Iterator[tuple[int, CaseOutcome]]:
-    """(index, outcome) of every case of ``group`` but those in ``skip``, as each finishes.
-
-    ``reference_failure``, when given, is why the group's shared part (reference trajectory, FK,
-    targets) is not to be computed again (it took its worker down): the cases run without it.
-    """
-    runner = {DYNAMICS: _dynamics_group, STABILITY: _stability_group, KINEMATICS: _kinematics_group,
-              IK: run_ik_group}[group.kind]
-    yield from runner(group, engine_for, on_start, skip, reference_failure)
-
-
-def _dynamics_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart, skip: frozenset[int],
-                    reference_failure: str) -> Iterator[tuple[int, CaseOutcome]]:
-    scene, dt = group.scene, group.dt
-    n = scene.n_steps(dt)
-    metrics = dynamics_metrics(scene)
+    """(index, outcome) of every case of ``group`` but those in ``skip``, as each finishes, in this process."""
     on_start(None)
+    shared = prepare_group(group, engine_for, reference_failure)
+    for index in range(len(group.cases)):
+        if index not in skip:
+            on_start(index)
+            yield index, run_case(group, shared, index, engine_for)
+
+
+@dataclass(frozen=True)
+class _DynamicsShared:
+    """What the cases of a dynamics group share: the reference, its trajectory at the group's dt (None when
+    there is none) and (why there is none, the status that gives)."""
+
+    reference: str
+    integrator: str
+    trajectory: object
+    problem: tuple[str, str]
+
+
+def _prepare_dynamics(group: CaseGroup, engine_for: EngineFor, reference_failure: str) -> _DynamicsShared:
+    scene = group.scene
     reference = engine_for(scene.reference)
-    ref_integrator = reference.scene_integrators(scene)[0]
-    ref_traj, ref_problem = _reference_trajectory(scene, reference, ref_integrator, dt, group.reference_label,
-                                                  reference_failure)
-    for index, spec in enumerate(group.cases):
-        if index in skip:
-            continue
-        on_start(index)
-        engine = engine_for(spec.engine)
-        case = Case(scene.name, spec.engine, spec.integrator, dt, group.reference_label)
-        if spec.integrator == NO_INTEGRATOR:
-            yield index, CaseOutcome(_no_integrator_rows(scene, engine, case, metrics))
-            continue
-        rows: list[ResultRow] = []
-        is_reference = (spec.engine, spec.integrator) == (reference.name, ref_integrator)
-        with warnings_into_rows(rows):
-            outcome = _dynamics_case(scene, engine, case, metrics, n, ref_traj, ref_problem, group.repeats,
-                                     is_reference)
-            rows += outcome.rows
-        outcome.rows = rows
-        yield index, outcome
+    integrator = reference.scene_integrators(scene)[0]
+    traj, problem = _reference_trajectory(scene, reference, integrator, group.dt, group.reference_label,
+                                          reference_failure)
+    return _DynamicsShared(reference.name, integrator, traj, problem)
+
+
+def _dynamics_case_at(group: CaseGroup, shared: _DynamicsShared, index: int, engine_for: EngineFor) -> CaseOutcome:
+    scene, dt, spec = group.scene, group.dt, group.cases[index]
+    metrics = dynamics_metrics(scene)
+    engine = engine_for(spec.engine)
+    case = Case(scene.name, spec.engine, spec.integrator, dt, group.reference_label)
+    if spec.integrator == NO_INTEGRATOR:
+        return CaseOutcome(_no_integrator_rows(scene, engine, case, metrics))
+    rows: list[ResultRow] = []
+    is_reference = (spec.engine, spec.integrator) == (shared.reference, shared.integrator)
+    with warnings_into_rows(rows):
+        outcome = _dynamics_case(scene, engine, case, metrics, scene.n_steps(dt), shared.trajectory, shared.problem,
+                                 group.repeats, is_reference)
+        rows += outcome.rows
+    outcome.rows = rows
+    return outcome
 
 
 def _no_integrator_rows(scene: DynamicsScene, engine: Engine, case: Case, metrics: dict) -> list[ResultRow]:
@@ -162,30 +198,29 @@ def _reference_trajectory(scene: DynamicsScene, reference: Engine, integrator: s
     return traj, ("", NOT_AVAILABLE)
 
 
-def _stability_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart, skip: frozenset[int],
-                     reference_failure: str) -> Iterator[tuple[int, CaseOutcome]]:
-    """The measured stability limit of every penalty-method integrator of the group (:mod:`comparisons.stability`)."""
-    scene = group.scene
-    on_start(None)
-    for index, spec in enumerate(group.cases):
-        if index in skip:
-            continue
-        on_start(index)
-        engine = engine_for(spec.engine)
-        case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label)
-        rows: list[ResultRow] = []
-        with warnings_into_rows(rows):
-            try:
-                support = engine.supports_dynamics(scene, spec.integrator)
-                if not support.ok:
-                    rows += case.rows(STABILITY_METRICS, NOT_AVAILABLE, support.reason)
-                else:
-                    limit = stable_dt_max(scene, engine, spec.integrator)
-                    rows += case.rows(STABILITY_METRICS, OK, f"measured by bisection on {scene.name}",
-                                      {"stable_dt_max": limit})
-            except Exception as err:  # noqa: BLE001 - reported in the rows
-                rows += case.rows(STABILITY_METRICS, FAILED, error_text(err))
-        yield index, CaseOutcome(rows)
+def _prepare_nothing(group: CaseGroup, engine_for: EngineFor, reference_failure: str) -> None:
+    """The stability limits share nothing: each case bisects on its own."""
+    return None
+
+
+def _stability_case_at(group: CaseGroup, shared: None, index: int, engine_for: EngineFor) -> CaseOutcome:
+    """The measured stability limit of one penalty-method integrator (:mod:`comparisons.stability`)."""
+    scene, spec = group.scene, group.cases[index]
+    engine = engine_for(spec.engine)
+    case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label)
+    rows: list[ResultRow] = []
+    with warnings_into_rows(rows):
+        try:
+            support = engine.supports_dynamics(scene, spec.integrator)
+            if not support.ok:
+                rows += case.rows(STABILITY_METRICS, NOT_AVAILABLE, support.reason)
+            else:
+                limit = stable_dt_max(scene, engine, spec.integrator)
+                rows += case.rows(STABILITY_METRICS, OK, f"measured by bisection on {scene.name}",
+                                  {"stable_dt_max": limit})
+        except Exception as err:  # noqa: BLE001 - reported in the rows
+            rows += case.rows(STABILITY_METRICS, FAILED, error_text(err))
+    return CaseOutcome(rows)
 
 
 def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref_traj, ref_problem: tuple[str, str],
@@ -208,9 +243,32 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
     except Exception as err:  # noqa: BLE001 - reported in the rows
         return CaseOutcome(case.rows(metrics, FAILED, error_text(err)))
     try:
+        problem = sampling_problem(scene, traj, n, case.dt)
+        if problem:
+            return CaseOutcome(case.rows(metrics, FAILED, f"its trajectory does not sample the scene: {problem}"))
         return _measured_case(scene, sim, case, metrics, n, traj, seconds, ref_traj, ref_problem, is_reference)
     except Exception as err:  # noqa: BLE001 - a user's engine returned what cannot be measured
         return CaseOutcome(case.rows(metrics, FAILED, f"its trajectory cannot be measured: {error_text(err)}"))
+
+
+def sampling_problem(scene: DynamicsScene, traj, n: int, dt: float) -> str:
+    """What is wrong with ``traj`` as the samples of ``n`` steps of ``dt`` of ``scene`` ("" when nothing): a
+    Trajectory of n + 1 samples of every body, at times k * dt (within :data:`TIME_GRID_TOLERANCE` steps)."""
+    if not isinstance(traj, Trajectory):
+        return f"run() returned a {type(traj).__name__} (allowed: a simparity.core.trajectory.Trajectory)"
+    times = np.asarray(traj.times)
+    if times.shape != (n + 1,):
+        return f"its times have shape {times.shape} (expected ({n + 1},): the initial state and {n} steps)"
+    if traj.n_bodies != len(scene.bodies):
+        return f"it has {traj.n_bodies} bodies (the scene has {len(scene.bodies)})"
+    with np.errstate(all="ignore"):
+        off = np.abs(times - np.arange(n + 1) * dt) / dt
+    bad = np.flatnonzero(~(off <= TIME_GRID_TOLERANCE))
+    if bad.size:
+        k = int(bad[0])
+        return (f"sample {k} is at t = {float(times[k]):.9g} s (expected {k * dt:.9g} s, k * dt within "
+                f"{TIME_GRID_TOLERANCE:g} steps)")
+    return ""
 
 
 def _measured_case(scene, sim, case: Case, metrics: dict, n: int, traj, seconds: float, ref_traj,
@@ -241,36 +299,41 @@ def _measured_case(scene, sim, case: Case, metrics: dict, n: int, traj, seconds:
                        floors, sim.integrates_rotation)
 
 
-def _kinematics_group(group: CaseGroup, engine_for: EngineFor, on_start: OnStart, skip: frozenset[int],
-                      reference_failure: str) -> Iterator[tuple[int, CaseOutcome]]:
-    scene = group.scene
+@dataclass(frozen=True)
+class _KinematicsShared:
+    """The configurations of a kinematics group, the reference's (poses, Jacobians) there (None when there
+    are none) and (why there are none, the status that gives)."""
+
+    q: np.ndarray
+    reference: tuple | None
+    problem: tuple[str, str]
+
+
+def _prepare_kinematics(group: CaseGroup, engine_for: EngineFor, reference_failure: str) -> _KinematicsShared:
+    scene, label = group.scene, group.reference_label
     q = scene.configurations()
-    ref_label = group.reference_label
-    ref, ref_problem, ref_status = None, "", NOT_AVAILABLE
-    on_start(None)
     if reference_failure:
-        ref_problem, ref_status = f"reference {ref_label} failed: {reference_failure}", FAILED
-    else:
-        try:
-            reference = engine_for(scene.reference)
-            ref_support = reference.supports_kinematics(scene.chain)
-            if not ref_support.ok:
-                ref_problem = f"reference {ref_label} cannot do this chain: {ref_support.reason}"
-            else:
-                model = reference.build_kinematics(scene.chain)
-                ref = (model.forward_kinematics(q), model.jacobian_world(q))
-        except Exception as err:  # noqa: BLE001 - reported in the rows
-            ref_problem, ref_status = f"reference {ref_label} failed: {error_text(err)}", FAILED
-    for index, spec in enumerate(group.cases):
-        if index in skip:
-            continue
-        on_start(index)
-        case = Case(scene.name, spec.engine, "", math.nan, ref_label)
-        rows: list[ResultRow] = []
-        with warnings_into_rows(rows):
-            rows += _kinematics_case(scene, engine_for(spec.engine), case, q, ref, (ref_problem, ref_status),
-                                     group.repeats, spec.engine == scene.reference)
-        yield index, CaseOutcome(rows)
+        return _KinematicsShared(q, None, (f"reference {label} failed: {reference_failure}", FAILED))
+    try:
+        reference = engine_for(scene.reference)
+        support = reference.supports_kinematics(scene.chain)
+        if not support.ok:
+            return _KinematicsShared(q, None, (f"reference {label} cannot do this chain: {support.reason}",
+                                               NOT_AVAILABLE))
+        model = reference.build_kinematics(scene.chain)
+        return _KinematicsShared(q, (model.forward_kinematics(q), model.jacobian_world(q)), ("", NOT_AVAILABLE))
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        return _KinematicsShared(q, None, (f"reference {label} failed: {error_text(err)}", FAILED))
+
+
+def _kinematics_case_at(group: CaseGroup, shared: _KinematicsShared, index: int, engine_for: EngineFor) -> CaseOutcome:
+    scene, spec = group.scene, group.cases[index]
+    case = Case(scene.name, spec.engine, "", math.nan, group.reference_label)
+    rows: list[ResultRow] = []
+    with warnings_into_rows(rows):
+        rows += _kinematics_case(scene, engine_for(spec.engine), case, shared.q, shared.reference, shared.problem,
+                                 group.repeats, spec.engine == scene.reference)
+    return CaseOutcome(rows)
 
 
 def _kinematics_case(scene: KinematicsScene, engine: Engine, case: Case, q: np.ndarray, ref, ref_problem: tuple[str, str],
@@ -316,6 +379,10 @@ def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_l
                                             [c.floors.get(source, 0.0) for c in ladder.cases], saturation)
         rows += case.rows(ORDER_METRICS, OK, f"against {ref_label}", values)
     return rows
+
+
+_KINDS = {DYNAMICS: _Kind(_prepare_dynamics, _dynamics_case_at), STABILITY: _Kind(_prepare_nothing, _stability_case_at),
+          KINEMATICS: _Kind(_prepare_kinematics, _kinematics_case_at), IK: _Kind(prepare_ik, ik_case)}
 
 
 def failed_outcome(group: CaseGroup, spec: CaseSpec, cause: str) -> CaseOutcome:

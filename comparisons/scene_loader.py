@@ -93,8 +93,11 @@ class _Reader:
         return value
 
     def text(self, key: str, default: str) -> str:
-        """Free text for people (a description): one line of printable characters (:mod:`core.names`)."""
-        value = self.string(key, default)
+        """Free text for people (a description): one line of printable characters (:mod:`core.names`); ``default``
+        when the key is absent."""
+        if not self.has(key):
+            return default
+        value = self.string(key)
         problem = text_problem(value)
         if problem:
             raise self.fail(key, problem, TEXT_RULE)
@@ -705,7 +708,7 @@ def _parse(data: dict, source: str, limits: Limits):
     unit = s.string("length_unit", "m", choices=tuple(LENGTH_UNITS))
     kind = s.string("kind", choices=KINDS)
     head = dict(
-        name=s.name("name"), description=s.text("description", "-"),
+        name=s.name("name"), description=s.text("description", ""),
         reference=s.string("reference", choices=ENGINE_NAMES), source=source,
         suites=s.strings("suites", SUITES, "there is no suite {}") if s.has("suites") else ("default",),
     )

@@ -13,6 +13,7 @@ import math
 import multiprocessing
 import os
 import pickle
+import signal
 from pathlib import Path
 
 import matplotlib
@@ -23,6 +24,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from simparity.core.processes import die_with_parent  # noqa: E402
 from simparity.core.results import SWEEP_PREFIX  # noqa: E402
 from simparity.reports.figure_layout import finish, legend, title  # noqa: E402
 from simparity.reports.summary import ERROR_BUDGETS  # noqa: E402
@@ -282,6 +284,12 @@ def _save_pickled(pickled: bytes, folder: Path, name: str) -> str:
     return save(pickle.loads(pickled), folder, name)
 
 
+def _figure_worker(parent: int) -> None:
+    """A figure process: Ctrl-C is its parent's to handle (no traceback of its own), and it dies with its parent."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    die_with_parent(parent)
+
+
 class FigureWriter:
     """Writes figures on one process per CPU while the report goes on (saving, which draws each figure twice, as
     SVG and PNG, is most of a report's time: 12 s of 17 s for the default suite's 51 figures on one CPU). Use as a
@@ -295,7 +303,8 @@ class FigureWriter:
     def __enter__(self) -> "FigureWriter":
         if self._workers > 1:
             self._pool = concurrent.futures.ProcessPoolExecutor(
-                self._workers, mp_context=multiprocessing.get_context("spawn"))
+                self._workers, mp_context=multiprocessing.get_context("spawn"), initializer=_figure_worker,
+                initargs=(os.getpid(),))
         return self
 
     def __exit__(self, *exc) -> None:

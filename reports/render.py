@@ -6,10 +6,22 @@ from __future__ import annotations
 from pathlib import Path
 
 from simparity.core.results import REPORT_FILE, REPORT_HTML_FILE
-from simparity.reports.content import ToleranceVerdict, build
+from simparity.reports.content import FIGURES_DIR, ToleranceVerdict, build
 from simparity.reports.html import to_html
 from simparity.reports.markdown import to_markdown
 from simparity.reports.store import read_run, read_series
+
+
+FIGURE_SUFFIXES = (".svg", ".png")
+"""What a figure is written as (:func:`reports.figures.save`)."""
+
+
+def _remove_stale_figures(folder: Path, drawn: set[str]) -> None:
+    """Delete the figures in ``folder`` an earlier rendering wrote that this one did not (``drawn``: names)."""
+    if folder.is_dir():
+        for path in folder.iterdir():
+            if path.suffix in FIGURE_SUFFIXES and path.stem not in drawn and path.is_file():
+                path.unlink()
 
 
 def write_report(run_dir: str | Path, verdict: ToleranceVerdict | None = None) -> tuple[Path, Path]:
@@ -19,6 +31,7 @@ def write_report(run_dir: str | Path, verdict: ToleranceVerdict | None = None) -
     run_dir = Path(run_dir)
     table, info = read_run(run_dir)
     blocks, svgs = build(table, info, read_series(run_dir), verdict, run_dir)
+    _remove_stale_figures(run_dir / FIGURES_DIR, set(svgs))
     markdown, page = run_dir / REPORT_FILE, run_dir / REPORT_HTML_FILE
     markdown.write_text(to_markdown(blocks), encoding="utf-8")
     page.write_text(to_html(blocks, svgs, f"simparity report {info.get('created_utc', '')}".strip()), encoding="utf-8")

@@ -8,6 +8,7 @@ named by spec in ``--engines``: ``tests.hostile_engines:SegfaultingEngine``.
 from __future__ import annotations
 
 import ctypes
+import os
 import time
 
 import numpy as np
@@ -71,3 +72,58 @@ class HangingTwin(HangingEngine):
 class MalformedEngine(_Misbehaving):
     name = "malformed"
     simulation = _Malformed
+
+
+FE_UPWARD = 0x800
+"""glibc's x86-64 value of FE_UPWARD (fenv.h): every later floating-point operation of the process rounds up."""
+
+
+class RoundingEngine(InHouseEngine):
+    """Core's engine that first switches its process's FPU to round upward (a legitimate library can do this and
+    forget to restore it): results computed after it in the same process would change in their last bits."""
+
+    name = "rounding"
+
+    def build_dynamics(self, scene, integrator: str, dt: float) -> Simulation:
+        ctypes.CDLL("libm.so.6").fesetround(FE_UPWARD)
+        return super().build_dynamics(scene, integrator, dt)
+
+
+class _Exit(Simulation):
+    def run(self, n_steps: int):
+        os._exit(0)
+
+
+class ExitingEngine(_Misbehaving):
+    """Ends its process with exit code 0 in the middle of a case, as if all were well."""
+
+    name = "exiting"
+    simulation = _Exit
+
+
+class SegfaultOnConstruction(InHouseEngine):
+    """Segfaults as it is constructed: before any case, where simparity itself would build it."""
+
+    name = "segfault-on-construction"
+
+    def __init__(self) -> None:
+        ctypes.string_at(0)
+
+
+class ExitInVersion(InHouseEngine):
+    """Ends its process (code 3) when asked its version."""
+
+    name = "exit-in-version"
+
+    def version(self) -> str:
+        os._exit(3)
+
+
+class HangInIntegrators(InHouseEngine):
+    """Never answers which integrators it offers."""
+
+    name = "hang-in-integrators"
+
+    def integrators(self):
+        while True:
+            time.sleep(3600)

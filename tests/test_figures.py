@@ -1,6 +1,11 @@
 """The report's figures (reports/figures.py), drawn from hand-made cases: laid out once with no layout engine left
 (a save draws once), log ticks without mathtext, and the sweep's figures."""
 
+import os
+import subprocess
+import sys
+import time
+
 import pandas as pd
 
 from simparity.reports import figures
@@ -52,3 +57,39 @@ def test_the_sweep_figure_draws_a_panel_per_combination_it_is_given():
     assert len(fig.axes) == 2 and fig.get_layout_engine() is None
     figures.plt.close(fig)
     assert figures.sweep_figure("b", cases.assign(status="n/a"), "x", ["y"], "error [m]", REFERENCE) is None
+
+
+ORPHAN_SECONDS = 10.0
+"""How long the figure processes of a killed report may take to go: the kernel signals them at once."""
+
+KILLED_WRITER = """
+import os, signal, sys
+from pathlib import Path
+import matplotlib.pyplot as plt
+from simparity.reports.figures import FigureWriter
+with FigureWriter(2) as writer:
+    writer.submit(plt.figure(), Path(sys.argv[1]), "first").result()  # the pool's processes are up
+    print(" ".join(str(pid) for pid in writer._pool._processes), flush=True)
+    os.kill(os.getpid(), signal.SIGKILL)
+"""
+
+
+def _alive(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/status", encoding="utf-8") as f:
+            return not any(line.startswith("State:") and "Z" in line for line in f)
+    except FileNotFoundError:
+        return False
+
+
+def test_the_figure_processes_of_a_killed_report_do_not_outlive_it(tmp_path):
+    """SIGKILL while figures are written (a CI job cancelled): the pool's processes end with their parent."""
+    done = subprocess.run([sys.executable, "-c", KILLED_WRITER, str(tmp_path)], capture_output=True, text=True,
+                          timeout=120)
+    pids = [int(p) for p in done.stdout.split()]
+    assert done.returncode == -9 and len(pids) >= 1, done.stderr
+    deadline = time.monotonic() + ORPHAN_SECONDS
+    while any(_alive(p) for p in pids) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(_alive(p) for p in pids)
+    assert os.path.exists(tmp_path / "first.svg")

@@ -60,6 +60,35 @@ def test_a_hang_fails_alone(tmp_path):
     _run(tmp_path, {"hanging": HANGING}, HANG_SECONDS)
 
 
+def _core_values(tmp_path, engines: str, name: str) -> pd.DataFrame:
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    main(["run", str(scene), "--engines", engines, "--repeats", "0", "--jobs", "1", "--out", str(tmp_path / name)])
+    table = pd.read_csv(tmp_path / name / "results.csv")
+    rows = table[(table.engine == "core") & ~table.metric.str.startswith("time_")]
+    return rows[["integrator", "dt", "metric", "status", "value"]].reset_index(drop=True)
+
+
+def test_an_engine_that_changes_its_process_cannot_change_another_engines_results(tmp_path):
+    """The rounding engine switches the FPU to round upward before its cases; core's cases and the reference,
+    run after it by the same single worker, are bit-identical to a run without it: each engine's cases run in
+    a process of their own, forked from a worker no engine's code ran in."""
+    alone = _core_values(tmp_path, "core", "alone")
+    beside = _core_values(tmp_path, "tests.hostile_engines:RoundingEngine,core", "beside")
+    assert len(alone) > 10 and alone["status"].eq("ok").any()
+    pd.testing.assert_frame_equal(alone, beside, check_exact=True)
+
+
+def test_an_engine_that_ends_its_process_quietly_fails_its_case(tmp_path):
+    """os._exit(0) in the middle of a case: failed rows saying so; core, after it in the same worker, completes."""
+    table = _first_then_core(tmp_path, "tests.hostile_engines:ExitingEngine")
+    exiting = table[(table.engine == "exiting") & table.dt.notna()]
+    assert set(exiting.status) == {"failed"}
+    assert exiting.detail.str.contains("the case's process exited with code 0 before its cases finished").all()
+    core = table[(table.engine == "core") & (table.metric == "position_error_max")]
+    assert set(core.status) == {"ok"} and len(core) >= 2
+
+
 def test_the_cause_of_a_death_names_the_signal_and_where():
     stderr = 'Fatal Python error: Segmentation fault\n\nCurrent thread 0x1 (most recent call first):\n  File "/x/eng.py", line 7 in run\n'
     assert death_cause(-11, stderr) == 'crashed: the worker was killed by signal 11 (SIGSEGV), in File "/x/eng.py", line 7 in run'
@@ -75,15 +104,20 @@ def test_limits_out_of_range_are_one_line_errors(option, value, capsys, tmp_path
     assert err.count("\n") == 1 and option in err and "allowed" in err
 
 
-def test_a_trajectory_that_cannot_be_measured_fails_with_the_error_not_as_a_crash(tmp_path):
+def _first_then_core(tmp_path, spec: str) -> pd.DataFrame:
+    """The results of the tiny scene on ``spec`` then core, by one worker (exit 1: the first's cases fail)."""
     scene = tmp_path / "throw.toml"
     scene.write_text(THROWN_BALL, encoding="utf-8")
-    assert main(["run", str(scene), "--engines", "core,tests.hostile_engines:MalformedEngine", "--repeats", "0",
-                 "--jobs", "1", "--out", str(tmp_path / "run")]) == 1
-    table = pd.read_csv(tmp_path / "run" / "results.csv")
+    assert main(["run", str(scene), "--engines", f"{spec},core", "--repeats", "0", "--jobs", "1",
+                 "--out", str(tmp_path / "run")]) == 1
+    return pd.read_csv(tmp_path / "run" / "results.csv")
+
+
+def test_a_trajectory_that_cannot_be_measured_fails_with_the_error_not_as_a_crash(tmp_path):
+    table = _first_then_core(tmp_path, "tests.hostile_engines:MalformedEngine")
     rows = table[(table.engine == "malformed") & table.dt.notna()]
     assert set(rows.status) == {"failed"}
-    assert rows.detail.str.contains("its trajectory cannot be measured: AttributeError", regex=False).all()
+    assert rows.detail.str.contains("its trajectory does not sample the scene: run() returned a dict", regex=False).all()
 
 
 def test_two_engines_or_two_scenes_of_one_name_are_refused(tmp_path, capsys):

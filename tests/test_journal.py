@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import pickle
 import signal
 import subprocess
 import sys
@@ -83,6 +84,29 @@ def test_unfinished_and_unreadable_cases_are_computed_again(tmp_path):
     assert journal.load(key) is None
     other = CaseKey("hash", "core", "1.1", "rk4", 0.01, "dynamics")
     assert other.digest() != key.digest()
+
+
+class _Planted:
+    """What a tampered case file holds: unpickling it would call ``os.system`` (or a simparity function)."""
+
+    def __init__(self, call, *args) -> None:
+        self.call, self.args = call, args
+
+    def __reduce__(self):
+        return self.call, self.args
+
+
+@pytest.mark.parametrize("call", [os.system, main])
+def test_a_case_file_that_names_code_is_computed_again_and_never_runs_it(tmp_path, call):
+    """--resume reads only simparity's data types and NumPy arrays: a file naming os.system or simparity's own CLI
+    is refused (the case is computed again) and the planted command never runs."""
+    journal = Journal(tmp_path)
+    key = CaseKey("hash", "core", "1.0", "rk4", 0.01, "dynamics")
+    witness = tmp_path / "ran"
+    payload = f"touch {witness}" if call is os.system else ["list", "--out", str(witness)]
+    (tmp_path / CASES_FOLDER / f"{key.digest()}.pickle").write_bytes(pickle.dumps((key, _Planted(call, payload))))
+    assert journal.load(key) is None
+    assert not witness.exists()
 
 
 @pytest.mark.parametrize("dt", [0.01, float("nan")])

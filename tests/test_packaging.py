@@ -21,4 +21,4 @@ def test_the_wheel_holds_only_the_simparity_namespace(tmp_path):
     assert "simparity/comparisons/scenes/dzhanibekov.toml" in names
     assert not any(n.startswith("simparity/tests/") or n.startswith("simparity/benchmarks/") for n in names)
     entry_points = next(n for n in names if n.endswith("entry_points.txt"))
-    assert "simparity = simparity.comparisons.cli:main" in zipfile.ZipFile(wheel).read(entry_points).decode()
+    assert "simparity = simparity.comparisons.console:main" in zipfile.ZipFile(wheel).read(entry_points).decode()

@@ -128,6 +128,21 @@ def test_report_regenerates_a_copied_run_with_no_engine_importable(run_dir, tmp_
     assert (copy / REPORT_HTML_FILE).stat().st_size > MIN_PAGE_BYTES
 
 
+def test_report_removes_the_figures_an_earlier_rendering_left(run_dir, tmp_path):
+    """A figure no longer drawn (its scene's rows removed from results.csv) does not outlive the re-rendering; every
+    figure the report links is there, and a file that is not a figure is left alone."""
+    copy = tmp_path / "copied"
+    shutil.copytree(run_dir, copy)
+    table = pd.read_csv(copy / "results.csv")
+    table[table.scene != "dzhanibekov"].to_csv(copy / "results.csv", index=False)
+    (copy / "figures" / "notes.txt").write_text("mine", encoding="utf-8")
+    assert main(["report", str(copy)]) == 0
+    left = {p.name for p in (copy / "figures").iterdir()}
+    assert not any(name.startswith("dzhanibekov-") for name in left) and "notes.txt" in left
+    linked = set(re.findall(r"\]\(figures/([^)]+\.svg)\)", (copy / REPORT_FILE).read_text()))
+    assert linked and linked <= left
+
+
 def _findings(verdict, tmp_path) -> str:
     rows = [ResultRow("s", "core", "rk4", 0.01, metric, 1e-6, "rad", "analytic:exact", "ok")
             for metric in ("orientation_error_max", "time_per_step")]

@@ -25,8 +25,8 @@ class _Crashing(InHouseEngine):
         raise RuntimeError("boom")
 
 
-def _tampered(name: str, field: str, value: float):
-    """An in-house engine (rk4 only) whose trajectories get ``field`` at the last sample set to ``value``."""
+def _rewritten(rewrite, name: str = "rewritten"):
+    """An in-house engine (rk4 only) whose trajectories are ``rewrite(trajectory)`` instead of their own."""
 
     class _Engine(InHouseEngine):
         def integrators(self):
@@ -39,17 +39,24 @@ def _tampered(name: str, field: str, value: float):
                 detail = "test"
 
                 def run(self, n):
-                    traj = sim.run(n)
-                    values = {f: getattr(traj, f) for f in ("position_world", "quat_wxyz", "velocity_world",
-                                                           "angular_velocity_world")}
-                    values[field] = values[field].copy()
-                    values[field][-1] = value
-                    return type(traj)(traj.times, **values)
+                    return rewrite(sim.run(n))
 
             return _Sim()
 
     _Engine.name = name
     return _Engine()
+
+
+def _tampered(name: str, field: str, value: float):
+    """An in-house engine (rk4 only) whose trajectories get ``field`` at the last sample set to ``value``."""
+
+    def rewrite(traj):
+        values = {f: np.array(getattr(traj, f)) for f in ("position_world", "quat_wxyz", "velocity_world",
+                                                          "angular_velocity_world")}
+        values[field][-1] = value
+        return type(traj)(traj.times, **values)
+
+    return _rewritten(rewrite, name)
 
 
 class _Refusing(InHouseEngine):
@@ -135,6 +142,28 @@ def test_finite_blow_up_is_diverged_by_the_runner_bound():
     rows = run_scene(scene, [_tampered("exploding", "velocity_world", 1e12)], make_engine, repeats=1)
     assert {r.status for r in rows if not math.isnan(r.dt)} == {DIVERGED}
     assert "speed of point reached" in rows[0].detail and "its forces allow" in rows[0].detail
+
+
+def _retimed(times_of):
+    return lambda traj: dataclasses.replace(traj, times=times_of(np.array(traj.times)))
+
+
+@pytest.mark.parametrize("rewrite, problem", [
+    (_retimed(lambda t: np.where(np.arange(len(t)) == 3, np.nan, t)), "sample 3 is at t = nan"),
+    (_retimed(lambda t: t * 2.0), "sample 1 is at t = "),
+    (_retimed(lambda t: t + 0.5 * (t[1] - t[0])), "sample 0 is at t = "),
+    (lambda traj: type(traj)(*(np.array(getattr(traj, f.name))[1:] for f in dataclasses.fields(traj))),
+     "its times have shape (180,) (expected (181,): the initial state and 180 steps)"),
+])
+def test_a_trajectory_off_the_time_grid_fails_instead_of_being_measured(rewrite, problem):
+    """Samples that are not at k * dt (NaN, twice the step, half a step late, the initial state left out) would be
+    compared with the reference's samples at other times: every case fails, naming the first bad sample."""
+    scene = builtin("lecture-projectile")
+    rows = run_scene(scene, [_rewritten(rewrite)], make_engine, repeats=1)
+    cases = [r for r in rows if not math.isnan(r.dt)]
+    assert cases and {r.status for r in cases} == {FAILED}
+    assert all("does not sample the scene" in r.detail for r in cases)
+    assert problem in cases[0].detail
 
 
 def test_energy_drift_without_energy_is_not_available():

@@ -154,6 +154,7 @@ def test_valid_scenes_load_with_defaults_and_units(tmp_path):
     """Defaults fill in (identity orientation, zero velocities, 100 configurations); lengths are scaled to metres."""
     scene = load_scene(_write(tmp_path, VALID_DYNAMICS))
     body = scene.bodies[0]
+    assert scene.description == ""  # none given: nothing (a "-" rendered as a Markdown bullet in the report)
     np.testing.assert_array_equal(body.quat_wxyz, [1, 0, 0, 0])
     np.testing.assert_array_equal(body.angular_velocity_world, [0, 0, 0])
     assert scene.n_steps(scene.dts[0]) == 100

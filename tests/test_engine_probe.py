@@ -1,0 +1,96 @@
+"""A user's engine is built and described in a process of its own: one that crashes, exits or hangs as it is
+constructed or asked about itself becomes a broken engine naming the cause, and simparity goes on."""
+
+from __future__ import annotations
+
+import time
+
+import pandas as pd
+import pytest
+
+from simparity.comparisons import engine_probe
+from simparity.comparisons.cli import main
+from simparity.comparisons.engine_probe import PROBE_CHAIN, DescribedEngine, probe_engines
+from simparity.comparisons.placeholder_engines import BrokenEngine, UnavailableEngine
+from simparity.core.inhouse import InHouseEngine
+from tests.helpers import THROWN_BALL, builtin
+
+CORE_SPEC = "simparity.core.inhouse:InHouseEngine"
+"""Core named by its spec: a plugin whose integrators differ by scene (contact or not)."""
+
+SHORT_PROBE_SECONDS = 5.0
+"""The hanging engine's limit in these tests: a probe's start and imports take ~1-2 s under load."""
+
+RUN_SECONDS = 90.0
+"""A run of the tiny scene on core takes ~5 s, ~30 s on a loaded machine; far under the 900 s a hung case would
+take."""
+
+
+def test_a_probe_describes_an_engine_as_it_describes_itself():
+    scenes = [builtin("lecture-projectile"), builtin("ball-bounce-k05")]
+    described = probe_engines([CORE_SPEC], scenes)[CORE_SPEC]
+    real = InHouseEngine()
+    assert isinstance(described, DescribedEngine)
+    assert described.name == CORE_SPEC and described.version() == real.version()  # "core" is the built-in's
+    assert described.integrators() == real.integrators() and described.ik_solvers() == real.ik_solvers()
+    for integrator in real.integrators():
+        assert described.theoretical_order(integrator) == real.theoretical_order(integrator)
+        assert described.integrator_variant(integrator) == real.integrator_variant(integrator)
+    for scene in scenes:  # contact methods on the bouncing ball, free-body integrators on the projectile
+        assert described.scene_integrators(scene) == real.scene_integrators(scene)
+    assert described.scene_integrators(scenes[0]) != described.scene_integrators(scenes[1])
+    assert described.supports_kinematics(PROBE_CHAIN).ok
+
+
+def test_a_crash_or_an_exit_while_building_or_describing_is_a_broken_engine():
+    found = probe_engines(["tests.hostile_engines:SegfaultOnConstruction", "tests.hostile_engines:ExitInVersion",
+                           "no_such_module_here:Engine"])
+    segfault = found["tests.hostile_engines:SegfaultOnConstruction"]
+    assert isinstance(segfault, BrokenEngine) and "killed by signal 11 (SIGSEGV)" in segfault.reason
+    assert "in File" in segfault.reason  # where, from the faulthandler's stack
+    exits = found["tests.hostile_engines:ExitInVersion"]
+    assert isinstance(exits, BrokenEngine) and "exited with code 3" in exits.reason
+    assert isinstance(found["no_such_module_here:Engine"], UnavailableEngine)
+
+
+def test_a_hang_while_describing_is_a_broken_engine_within_the_limit(monkeypatch):
+    monkeypatch.setattr(engine_probe, "PROBE_SECONDS", SHORT_PROBE_SECONDS)
+    hung = probe_engines(["tests.hostile_engines:HangInIntegrators"])["tests.hostile_engines:HangInIntegrators"]
+    assert isinstance(hung, BrokenEngine) and f"took more than {SHORT_PROBE_SECONDS:g} s" in hung.reason
+
+
+def test_a_run_goes_on_when_an_engine_crashes_as_it_is_built(tmp_path, monkeypatch):
+    """Before, the segfault in the constructor killed `simparity run` itself; now its cases fail, core's complete."""
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    engines = "core,tests.hostile_engines:SegfaultOnConstruction,tests.hostile_engines:ExitInVersion"
+    assert main(["run", str(scene), "--engines", engines, "--repeats", "0", "--jobs", "1",
+                 "--out", str(tmp_path / "run")]) == 1
+    table = pd.read_csv(tmp_path / "run" / "results.csv")
+    for spec, cause in (("tests.hostile_engines:SegfaultOnConstruction", "SIGSEGV"),
+                        ("tests.hostile_engines:ExitInVersion", "exited with code 3")):
+        rows = table[table.engine == spec]
+        assert len(rows) and set(rows.status) == {"failed"} and rows.detail.str.contains(cause).all(), spec
+    core = table[(table.engine == "core") & (table.metric == "position_error_max")]
+    assert len(core) >= 2 and set(core.status) == {"ok"}
+
+
+def test_an_engine_that_hung_while_described_is_not_built_again_by_the_cases(tmp_path, monkeypatch):
+    """Its cases fail at once with the probe's cause, instead of each hanging to the 900 s case limit."""
+    monkeypatch.setattr(engine_probe, "PROBE_SECONDS", SHORT_PROBE_SECONDS)
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    start = time.monotonic()
+    assert main(["run", str(scene), "--engines", "core,tests.hostile_engines:HangInIntegrators", "--repeats", "0",
+                 "--jobs", "1", "--out", str(tmp_path / "run")]) == 1
+    assert time.monotonic() - start < RUN_SECONDS
+    table = pd.read_csv(tmp_path / "run" / "results.csv")
+    rows = table[table.engine == "tests.hostile_engines:HangInIntegrators"]
+    assert len(rows) and set(rows.status) == {"failed"}
+    assert rows.detail.str.contains(f"took more than {SHORT_PROBE_SECONDS:g} s", regex=False).all()
+
+
+def test_a_described_engine_runs_nothing():
+    described = probe_engines([CORE_SPEC])[CORE_SPEC]
+    with pytest.raises(Exception, match="described, not built"):
+        described.build_dynamics(builtin("lecture-projectile"), "rk4", 0.01)
