@@ -27,8 +27,8 @@ from simparity.comparisons.engines import (
     allowed_engines,
     check_engine_names,
     describe_engines,
-    include_specs,
     make_engine,
+    use_specs,
 )
 from simparity.comparisons.history import history_path, latest_before, metric_history, record_run, run_table
 from simparity.comparisons.execution import count_cases, default_jobs, run_scenes
@@ -318,7 +318,7 @@ def cmd_run(args, out) -> int:
                              "dask, or drop --scheduler)")
     limits = _limits(args, jobs)
     names = check_engine_names(args.engines)
-    include_specs(names)
+    use_specs(names)
     run_limits = Limits(max_steps=args.max_steps, max_samples=args.max_samples, max_joints=args.max_joints)
     if args.scenes and args.suite:
         raise SimparityError(f"--suite {args.suite} with scenes named: give one (allowed: scene names or files, "
@@ -556,6 +556,7 @@ def main(argv: list[str] | None = None, out=None) -> int:
     out = out or sys.stdout
     try:
         args = build_parser().parse_args(argv)
+        use_specs(())  # until `run` names its engines: none of an earlier command's
         return _COMMANDS[args.command](args, out)
     except SimparityError as err:
         print(f"simparity: error: {one_line(err, MESSAGE_LIMIT)}", file=sys.stderr)

@@ -27,7 +27,7 @@ import numpy as np
 from simparity.comparisons.cases import scene_hash
 from simparity.comparisons.engines import make_engine
 from simparity.comparisons.isolation import death_cause, worker_environment
-from simparity.comparisons.placeholder_engines import BrokenEngine, UnavailableEngine
+from simparity.comparisons.placeholder_engines import BrokenEngine, StandInEngine
 from simparity.comparisons.rows import error_text
 from simparity.comparisons.timing import status_bytes
 from simparity.core.engine import Engine, KinematicsModel, Simulation, Support
@@ -152,7 +152,7 @@ def describe(engine: Engine, scenes: list) -> EngineDescription:
 def probe_engines(names: list[str], scenes: list = ()) -> dict[str, Engine]:
     """Each of ``names`` (a plugin's name or a spec ``module:attr``) described in a process of its own, all at
     once: a :class:`DescribedEngine`, or the engine standing in for one that cannot run (an
-    :class:`UnavailableEngine` when it does not import, a :class:`BrokenEngine` naming what went wrong: an
+    ``UnavailableEngine`` when it does not import, a :class:`BrokenEngine` naming what went wrong: an
     error, a crash, a hang, a memory blow-up)."""
     probes = {name: _Probe(name, list(scenes)) for name in names}
     try:
@@ -174,20 +174,22 @@ def _memory_limit() -> int:
 
 
 class _Probe:
-    """One probe process: the request and answer files, its standard error, why it was stopped ("" if not)."""
+    """One probe process: its request (on its standard input), the file it answers in (an inherited descriptor),
+    its standard error, why it was stopped ("" if not). Every file is anonymous: a killed run leaves none."""
 
     def __init__(self, name: str, scenes: list) -> None:
         self.name = name
-        self.folder = tempfile.TemporaryDirectory(prefix="simparity-probe-")
-        request, self.answer = os.path.join(self.folder.name, "request"), os.path.join(self.folder.name, "answer")
-        with open(request, "wb") as f:
-            pickle.dump((name, scenes), f)
-        self.stderr = tempfile.TemporaryFile()
+        request = tempfile.TemporaryFile()
+        pickle.dump((name, scenes), request)
+        request.seek(0)
+        self.answer, self.stderr = tempfile.TemporaryFile(), tempfile.TemporaryFile()
         self.stopped = ""
-        self.process = subprocess.Popen(
-            [sys.executable, "-m", "simparity.comparisons.engine_probe", request, self.answer, str(os.getpid())],
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=self.stderr, env=worker_environment(),
-            start_new_session=True, cwd=os.getcwd())
+        with request:
+            self.process = subprocess.Popen(
+                [sys.executable, "-m", "simparity.comparisons.engine_probe", str(self.answer.fileno()),
+                 str(os.getpid())],
+                stdin=request, stdout=subprocess.DEVNULL, stderr=self.stderr, pass_fds=(self.answer.fileno(),),
+                env=worker_environment(), start_new_session=True)
 
     def enforce(self, deadline: float) -> None:
         """Kill the probe if it is past the deadline or its memory limit."""
@@ -209,9 +211,9 @@ class _Probe:
 
     def result(self) -> Engine:
         code = self.process.wait()
-        if not self.stopped and code == 0 and os.path.exists(self.answer):
-            with open(self.answer, "rb") as f:
-                kind, value = pickle.load(f)
+        self.answer.seek(0)
+        if not self.stopped and code == 0 and (answer := self.answer.read()):
+            kind, value = pickle.loads(answer)
             if kind == "described":
                 return DescribedEngine(value)
             return value
@@ -225,28 +227,26 @@ class _Probe:
         if self.process.poll() is None:
             self.kill()
         self.stderr.close()
-        self.folder.cleanup()
+        self.answer.close()
 
 
 def main(argv: list[str]) -> int:
-    """The probe process: build engine ``argv[1]``'s request, write its description (or stand-in) to ``argv[2]``."""
-    die_with_parent(int(argv[3]))
+    """The probe process: build the engine its standard input names, write its description (or stand-in) to the
+    descriptor ``argv[1]``; ``argv[2]`` is the parent's pid."""
+    die_with_parent(int(argv[2]))
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     faulthandler.enable()
-    with open(argv[1], "rb") as f:
-        name, scenes = pickle.load(f)
+    name, scenes = pickle.load(sys.stdin.buffer)
     engine = make_engine(name)
-    if isinstance(engine, (UnavailableEngine, BrokenEngine)):
+    if isinstance(engine, StandInEngine):
         answer = ("stand-in", engine)
     else:
         try:
             answer = ("described", describe(engine, scenes))
         except (Exception, SystemExit) as err:  # noqa: BLE001 - a user's code
             answer = ("stand-in", BrokenEngine(name, f"describing it raised {one_line(error_text(err))}"))
-    with open(argv[2] + ".part", "wb") as f:
+    with os.fdopen(int(argv[1]), "wb") as f:
         pickle.dump(answer, f)
-    os.replace(argv[2] + ".part", argv[2])
-    sys.stdout.flush()
     os._exit(0)  # no interpreter shutdown: a user's atexit or finaliser cannot change the answer
 
 

@@ -84,14 +84,16 @@ def describe_engines(names, scenes=()) -> list[Engine]:
 
 
 _RUN_SPECS: list[str] = []
-"""The ``module:attr`` engines of this run (:func:`include_specs`): their integrators may be named in scene files."""
+"""The ``module:attr`` engines of the command running (:func:`use_specs`): their integrators may be named in scene
+files."""
 
 
-def include_specs(names) -> None:
-    """Let the integrators of the spec engines among ``names`` (``--engines``) be named in scene files."""
-    specs = [n for n in names if is_spec(n) and n not in _RUN_SPECS]
-    if specs:
-        _RUN_SPECS.extend(specs)
+def use_specs(names) -> None:
+    """Let the integrators of the spec engines among ``names`` (``--engines``; () for none) be named in scene
+    files, instead of those of the command before."""
+    specs = [n for n in dict.fromkeys(names) if is_spec(n)]
+    if specs != _RUN_SPECS:
+        _RUN_SPECS[:] = specs
         known_integrators.cache_clear()
 
 

@@ -207,6 +207,11 @@ class IsolatedPool:
             code = worker.kill(EXIT_GRACE_SECONDS)
             yield from self._replace(worker, death_cause(code, worker.stderr_tail()), pending)
             return
+        except Exception as err:  # noqa: BLE001 - bytes that are no message: something else wrote to the pipe
+            worker.kill()
+            yield from self._replace(worker, f"crashed: the case's process wrote what is not a message to its pipe "
+                                     f"({type(err).__name__}); the worker was killed", pending)
+            return
         job = worker.job
         if message[0] == "start":
             worker.phase, worker.phase_pid, worker.since = message[1], message[2], time.monotonic()
