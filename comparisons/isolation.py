@@ -15,6 +15,7 @@ import os
 import signal
 import subprocess
 import sys
+import sysconfig
 import tempfile
 import time
 from dataclasses import dataclass, field
@@ -159,9 +160,19 @@ def death_cause(code: int, stderr: str, process: str = "the worker") -> str:
     faulthandler_stack = any(line.startswith(("Current thread", "Thread 0x")) for line in lines)
     if faulthandler_stack and frames:  # most recent call first
         cause += f", in {frames[0]}"
+        own = next((f for f in frames if not _in_stdlib(f)), frames[0])
+        if own != frames[0]:  # the crash is in the standard library (ctypes): say whose code called it
+            cause += f", called from {own}"
     elif lines:  # a Python traceback: its last line is the error
         cause += f": {lines[-1][:300]}" + (f" ({frames[-1][:200]})" if frames else "")
     return cause
+
+
+def _in_stdlib(frame: str) -> bool:
+    """True when a faulthandler frame line (``File "path", line N in name``) is in Python's standard library."""
+    path = frame.split('"')[1] if frame.count('"') >= 2 else ""
+    stdlib = sysconfig.get_paths()["stdlib"]
+    return path.startswith(stdlib + os.sep) and "site-packages" not in path
 
 
 class IsolatedPool:

@@ -3,6 +3,8 @@ or allocates without bound becomes failed rows naming the cause, and every other
 
 from __future__ import annotations
 
+import sysconfig
+
 import pandas as pd
 import pytest
 
@@ -92,6 +94,11 @@ def test_an_engine_that_ends_its_process_quietly_fails_its_case(tmp_path):
 def test_the_cause_of_a_death_names_the_signal_and_where():
     stderr = 'Fatal Python error: Segmentation fault\n\nCurrent thread 0x1 (most recent call first):\n  File "/x/eng.py", line 7 in run\n'
     assert death_cause(-11, stderr) == 'crashed: the worker was killed by signal 11 (SIGSEGV), in File "/x/eng.py", line 7 in run'
+    ctypes_frame = f'File "{sysconfig.get_paths()["stdlib"]}/ctypes/__init__.py", line 519 in string_at'
+    in_ctypes = f'Fatal Python error: Segmentation fault\n\nCurrent thread 0x1 (most recent call first):\n  {ctypes_frame}\n  File "/x/eng.py", line 7 in run\n'
+    assert death_cause(-11, in_ctypes, "the case's process") == (
+        f"crashed: the case's process was killed by signal 11 (SIGSEGV), in {ctypes_frame}, called from File "
+        '"/x/eng.py", line 7 in run')
     assert "out-of-memory killer" in death_cause(-9, "")
     assert death_cause(1, "Traceback ...\nValueError: bad\n") == "crashed: the worker exited with code 1: ValueError: bad"
 
