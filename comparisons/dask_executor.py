@@ -5,16 +5,23 @@ Each group is one Dask task. On the Dask worker the task runs its group in an
 tasks, so a case that crashes, hangs or exhausts memory fails alone there exactly as it does
 locally, and the Dask worker lives on. Without a scheduler address a ``LocalCluster`` is started on
 the loopback interface with one single-threaded worker process per job. Without --case-memory, each case's
-memory limit is the default of the machine it runs on (:func:`node_memory_bytes`), not of this one. Outcomes stream back group
-by group as tasks finish; a group whose Dask worker is lost for good (Dask retries it elsewhere
-first) fails with that cause.
+memory limit is the default of the machine it runs on (:func:`node_memory_bytes`), not of this one.
+
+Outcomes stream back case by case, as on the local executor: the task puts each finished case on a Dask
+``Queue`` of the run, so the progress bar moves and the journal keeps every finished case while its group is
+still running (an interrupted run resumes without computing it again). A group whose Dask worker is lost
+is retried elsewhere by Dask; a case it sends twice is taken once, and the cases of a group lost for good
+that never came back fail with that cause.
 """
 
 from __future__ import annotations
 
 import os
+import pickle
 import socket
 import threading
+import time
+import uuid
 from typing import Iterator
 
 from simparity.comparisons.cases import CaseGroup, CaseOutcome
@@ -25,6 +32,9 @@ from simparity.core.errors import SimparityError, one_line
 CONNECT_SECONDS = 30
 """How long to wait for the scheduler at --scheduler to answer, once its port accepts connections."""
 
+POLL_SECONDS = 0.05
+"""How often the run's queue and tasks are looked at when nothing arrived: a finished case waits at most this long."""
+
 REACH_SECONDS = 5
 """How long to wait for the scheduler's port to accept a connection: a refused or unresolvable address fails at
 once, an unanswered one (a firewall dropping packets) after this."""
@@ -33,9 +43,12 @@ _pools = threading.local()
 """Each Dask worker thread's pool of one worker process, kept between tasks."""
 
 
-def run_group_task(group: CaseGroup, skip: frozenset[int], limits: CaseLimits) -> list[tuple[int, CaseOutcome]]:
+def run_group_task(group: CaseGroup, skip: frozenset[int], limits: CaseLimits, queue: str, rank: int) -> None:
     """The Dask task: every case of ``group`` but ``skip``, run in this Dask worker's isolated process, under
-    ``limits`` (a memory limit of None: :func:`node_memory_bytes`)."""
+    ``limits`` (a memory limit of None: :func:`node_memory_bytes`); each outcome is put on the Dask queue named
+    ``queue`` as it finishes, pickled with the job's ``rank``: ``(rank, case index, outcome)``."""
+    import distributed
+
     if limits.memory_bytes is None:
         limits = CaseLimits(limits.seconds, node_memory_bytes())
     pool = getattr(_pools, "pool", None)
@@ -43,7 +56,9 @@ def run_group_task(group: CaseGroup, skip: frozenset[int], limits: CaseLimits) -
         if pool is not None:
             pool.close()
         pool = _pools.pool = IsolatedPool(1, limits)
-    return [(index, outcome) for _, index, outcome in pool.run([Job(0, group, set(skip))])]
+    outbox = distributed.Queue(queue)
+    for _, index, outcome in pool.run([Job(0, group, set(skip))]):
+        outbox.put(pickle.dumps((rank, index, outcome), protocol=pickle.HIGHEST_PROTOCOL))
 
 
 def _reach(address: str) -> None:
@@ -101,21 +116,42 @@ class DaskExecutor:
     def run(self, jobs: list[Job]) -> Iterator[tuple[object, int, CaseOutcome]]:
         import distributed
 
+        queue = distributed.Queue(f"simparity-{uuid.uuid4().hex}", client=self.client)
         futures = {}
         for rank, job in enumerate(jobs):  # the costliest first: Dask runs higher priorities first
-            future = self.client.submit(run_group_task, job.group, frozenset(job.skip), self.limits,
-                                        pure=False, priority=len(jobs) - rank)
-            futures[future] = job
-        for future in distributed.as_completed(futures):
-            job = futures[future]
-            try:
-                results = future.result()
-            except Exception as err:  # noqa: BLE001 - the task's worker was lost for good
-                cause = f"crashed: the Dask task was lost: {type(err).__name__}: {one_line(err)}"
-                results = [(i, failed_outcome(job.group, job.group.cases[i], cause))
-                           for i in range(len(job.group.cases)) if i not in job.skip]
-            for index, outcome in results:
-                yield job.key, index, outcome
+            future = self.client.submit(run_group_task, job.group, frozenset(job.skip), self.limits, queue.name,
+                                        rank, pure=False, priority=len(jobs) - rank)
+            futures[future] = rank
+        received: list[set[int]] = [set(job.skip) for job in jobs]
+        pending = set(futures)
+        try:
+            while pending:
+                finished = {future for future in pending if future.done()}  # before the queue: their cases are on it
+                messages = queue.get(batch=True)
+                for rank, index, outcome in map(pickle.loads, messages):
+                    if index not in received[rank]:  # a retried group sends its cases again
+                        received[rank].add(index)
+                        yield jobs[rank].key, index, outcome
+                for future in finished:
+                    yield from self._lost(jobs[futures[future]], received[futures[future]], future)
+                pending -= finished
+                if not messages and not finished:
+                    time.sleep(POLL_SECONDS)
+        finally:
+            queue.close()
+
+    @staticmethod
+    def _lost(job: Job, received: set[int], future) -> Iterator[tuple[object, int, CaseOutcome]]:
+        """Failed outcomes of the cases of ``job`` that never came back from its finished ``future``."""
+        missing = [i for i in range(len(job.group.cases)) if i not in received]
+        if not missing:
+            return
+        error = future.exception() if future.status == "error" else None
+        cause = ("crashed: the Dask task was lost: " + (f"{type(error).__name__}: {one_line(error)}" if error is not None
+                                                        else f"it ended ({future.status}) before its cases came back"))
+        for index in missing:
+            received.add(index)
+            yield job.key, index, failed_outcome(job.group, job.group.cases[index], cause)
 
     def close(self) -> None:
         """Disconnect, and stop the LocalCluster if this started one (again: nothing)."""

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import ctypes
 import os
+import signal
 import time
 
 import numpy as np
@@ -99,6 +100,23 @@ class ExitingEngine(_Misbehaving):
 
     name = "exiting"
     simulation = _Exit
+
+
+class _KillHost(Simulation):
+    def run(self, n_steps: int):
+        worker = os.getppid()  # the case worker; its parent is the process that started it (a Dask worker)
+        with open(f"/proc/{worker}/stat", encoding="ascii") as stat:
+            host = int(stat.read().rsplit(")", 1)[1].split()[1])
+        os.kill(host, signal.SIGKILL)
+        while True:
+            time.sleep(3600)
+
+
+class HostKillingEngine(_Misbehaving):
+    """Kills the process that started its case's worker, as a lost node would lose it: on Dask, the Dask worker."""
+
+    name = "host-killing"
+    simulation = _KillHost
 
 
 class SegfaultOnConstruction(InHouseEngine):

@@ -98,3 +98,48 @@ def test_a_sweep_of_100_variants_on_two_dask_workers_gives_the_local_results(tmp
     on_dask = list(run_scenes(variants, engines, make_engine, 0, dask))
     assert comparable(on_dask) == comparable(local)
     assert [s.name for s, _, _ in on_dask] == [v.name for v in variants]
+
+
+STREAM_LIMIT_SECONDS = 6.0
+"""The per-case time limit of the streaming test: the hanging case fails this long after it starts."""
+
+
+def test_cases_stream_back_one_by_one_while_their_group_still_runs(tmp_path, dask):
+    """A finished case comes back (and is journaled) while a later case of its group still runs: core's case
+    arrives a good part of the time limit before the hanging engine's case of the same group fails (sent
+    group by group, both would arrive together)."""
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL.replace("dt = [0.01, 0.005]", "dt = [0.01]"), encoding="utf-8")
+    engines = built_engines(("core",)) + [make_engine("tests.hostile_engines:HangingEngine")]
+    specs = {"hanging": "tests.hostile_engines:HangingEngine"}
+    arrivals = {}
+    kept, dask.limits = dask.limits, CaseLimits(STREAM_LIMIT_SECONDS, None)
+    try:
+        [(_, rows, _)] = run_scenes(library.load([str(scene)]), engines, make_engine, 0, dask, specs=specs,
+                                    on_case=lambda s, engine, i: arrivals.setdefault(engine, time.monotonic()))
+    finally:
+        dask.limits = kept
+    assert {r.status for r in rows if r.engine == "core"} == {"ok"}
+    assert all(r.status == "failed" and r.detail.startswith("hung:") for r in rows if r.engine == "hanging")
+    assert arrivals["hanging"] - arrivals["core"] > STREAM_LIMIT_SECONDS / 2
+
+
+def test_a_group_lost_for_good_fails_only_the_cases_that_never_came_back(tmp_path):
+    """A lost node (here: a case kills its Dask worker, and the cluster allows no retry) fails the cases of its
+    group that were not back yet, with the cause; the cases already back keep their results."""
+    import dask.config
+    import distributed  # noqa: F401 - its defaults loaded before the setting below (unset, it would drop them all)
+
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL.replace("dt = [0.01, 0.005]", "dt = [0.01]"), encoding="utf-8")
+    engines = built_engines(("core",)) + [make_engine("tests.hostile_engines:HostKillingEngine")]
+    specs = {"host-killing": "tests.hostile_engines:HostKillingEngine"}
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        executor = DaskExecutor(None, 1, CaseLimits.default(1))
+    try:
+        [(_, rows, _)] = run_scenes(library.load([str(scene)]), engines, make_engine, 0, executor, specs=specs)
+    finally:
+        executor.close()
+    assert {r.status for r in rows if r.engine == "core"} == {"ok"}
+    lost = [r for r in rows if r.engine == "host-killing"]
+    assert lost and all(r.status == "failed" and "the Dask task was lost: KilledWorker" in r.detail for r in lost)
