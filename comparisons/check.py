@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from simparity.comparisons.tolerances import Bound, bound_for
-from simparity.core.results import OK
+from simparity.core.results import DIMENSIONLESS, OK
 
 CASE_KEYS = ("scene", "engine", "integrator", "dt")
 ROW_KEYS = CASE_KEYS + ("metric",)
@@ -82,7 +82,8 @@ def _judge(bound: Bound, row) -> tuple[str, str] | None:
         return None
     low, high = bound.limits(dt)
     if not (low <= value <= high):
-        return f"{value:.4g} {row['unit']}".strip(), bound.describe(dt)
+        unit = "" if row["unit"] == DIMENSIONLESS else f" {row['unit']}"
+        return f"{value:.4g}{unit}", bound.describe(dt)
     return None
 
 

@@ -42,6 +42,9 @@ STATUSES = (OK, NOT_AVAILABLE, FAILED, DIVERGED)
 failed: the engine or adapter raised (detail has the error). diverged: the run produced
 non-finite values."""
 
+DIMENSIONLESS = "1"
+"""The unit of a dimensionless metric (a ratio, a drift, an order), as SI writes it."""
+
 
 @dataclass(frozen=True)
 class ResultRow:

@@ -56,7 +56,7 @@ def test_rows_inside_pass_outside_fail_with_a_one_line_reason(bounds):
     result = check_table(_table([_row(value=4.02), _row(metric="order_velocity", value=2.9)]), bounds)
     assert result.checked == 2 and len(result.violations) == 1
     line = result.violations[0].line()
-    assert line == "s core rk4 order_velocity: 2.9 1, bound in [3.5, 4.5] (fourth order)"
+    assert line == "s core rk4 order_velocity: 2.9, bound in [3.5, 4.5] (fourth order)"
 
 
 def test_a_bounded_metric_that_went_n_a_is_a_violation_not_a_pass(bounds):

@@ -7,7 +7,7 @@ from simparity.comparisons.check_output import junit_xml, summary_markdown
 
 
 def _result():
-    broken = Violation("s", "core", "rk4", 0.01, "order_position", "2.9 1", "in [3.5, 4.5]", "fourth order")
+    broken = Violation("s", "core", "rk4", 0.01, "order_position", "2.9", "in [3.5, 4.5]", "fourth order")
     return CheckResult(checked=3, unchecked=1, violations=[broken],
                        cases={("s", "core", "rk4", 0.01): [broken], ("s", "mujoco", "rk4", 0.01): [],
                               ("k", "core", "", "nan"): []})
@@ -21,12 +21,12 @@ def test_junit_has_one_test_case_per_case_and_failures_with_their_violations(tmp
     assert len(cases) == 4  # three cases and the baseline
     failed = {(c.classname, c.name): c for c in cases if not c.is_passed}
     assert set(failed) == {("s", "core rk4 dt=0.01"), ("baseline", "unchanged since the baseline")}
-    assert "order_position: 2.9 1, bound in [3.5, 4.5] (fourth order)" in failed[("s", "core rk4 dt=0.01")].result[0].text
+    assert "order_position: 2.9, bound in [3.5, 4.5] (fourth order)" in failed[("s", "core rk4 dt=0.01")].result[0].text
     assert ("k", "core -") in {(c.classname, c.name) for c in cases}
 
 
 def test_summary_names_the_verdict_and_each_violation():
     text = summary_markdown(_result())
     assert text.startswith("## simparity check: failed")
-    assert "| s | core | rk4 | 0.01 | order_position | 2.9 1 | in [3.5, 4.5] | fourth order |" in text
+    assert "| s | core | rk4 | 0.01 | order_position | 2.9 | in [3.5, 4.5] | fourth order |" in text
     assert summary_markdown(CheckResult(checked=1)).startswith("## simparity check: passed")
