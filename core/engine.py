@@ -188,8 +188,9 @@ class Engine(abc.ABC):
         """Whether :meth:`build_ik` can build ``solver`` for ``chain`` and this kind of target."""
         if solver in self.ik_solvers():
             return Support.yes()
-        offered = ", ".join(self.ik_solvers()) or "none"
-        return Support.no(f"{self.name} has no IK solver '{solver}' (offers: {offered})")
+        if not self.ik_solvers():
+            return Support.no(f"{self.name} offers no IK solver")
+        return Support.no(f"{self.name} has no IK solver '{solver}' (offers: {', '.join(self.ik_solvers())})")
 
     def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
         """Build ``solver`` for ``chain`` with the scene's tolerances and iteration cap (not timed)."""

@@ -115,6 +115,13 @@ def test_unavailable_engine_says_why_in_ik_scenes():
     assert rows and all(r.status == NOT_AVAILABLE and "not importable" in r.detail for r in rows)
 
 
+def test_an_engine_without_ik_solvers_says_so_in_ik_scenes():
+    """A dynamics-only engine (here: the tight reference) gets n/a IK rows saying it offers no IK solver."""
+    scene = dataclasses.replace(builtin("lecture-2link-ik"), n_targets=5)
+    rows = run_scene(scene, [make_engine("tight")], make_engine, repeats=1)
+    assert rows and all(r.status == NOT_AVAILABLE and r.detail == "tight offers no IK solver" for r in rows)
+
+
 def test_singular_start_pose_is_reported():
     """The planar 2-link arm stretched straight (q = 0) loses a direction of motion there: the start pose is
     reported singular (rank deficiency 1); bent (q2 = 1 rad) it is regular."""
