@@ -151,9 +151,8 @@ def describe(engine: Engine, scenes: list) -> EngineDescription:
 
 def probe_engines(names: list[str], scenes: list = ()) -> dict[str, Engine]:
     """Each of ``names`` (a plugin's name or a spec ``module:attr``) described in a process of its own, all at
-    once: a :class:`DescribedEngine`, or the engine standing in for one that cannot run (an
-    ``UnavailableEngine`` when it does not import, a :class:`BrokenEngine` naming what went wrong: an
-    error, a crash, a hang, a memory blow-up)."""
+    once: a :class:`DescribedEngine`, or a :class:`BrokenEngine` standing in for one that cannot run, naming
+    what went wrong: it does not import, an error, a crash, a hang, a memory blow-up."""
     probes = {name: _Probe(name, list(scenes)) for name in names}
     try:
         deadline = time.monotonic() + PROBE_SECONDS

@@ -1,10 +1,11 @@
 """Engines that stand in for one that cannot run, so that every scene still gets its rows, with the reason.
 
-:class:`UnavailableEngine` stands in for an engine whose library will not import here (MuJoCo not
-installed, a plugin's missing dependency): ``n/a`` rows, as for any scene an engine cannot do.
-:class:`BrokenEngine` stands in for a user's engine whose own code raised while it was loaded or
-built, or that broke the interface: ``failed`` rows, which fail ``simparity run`` (exit 1) and the
-CI gate like any other failure.
+:class:`UnavailableEngine` stands in for a built-in engine whose library will not import here (MuJoCo
+not installed): ``n/a`` rows, as for any scene an engine cannot do.
+:class:`BrokenEngine` stands in for a user's engine that does not import (a typo in its module, a
+missing dependency), whose own code raised while it was loaded or built, or that broke the interface:
+``failed`` rows, which fail ``simparity run`` (exit 1) and the CI gate like any other failure: an
+engine the user asked for that never ran must not pass.
 """
 
 from __future__ import annotations

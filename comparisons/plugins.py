@@ -22,7 +22,7 @@ import sys
 from dataclasses import dataclass
 from importlib import metadata
 
-from simparity.comparisons.placeholder_engines import BrokenEngine, UnavailableEngine
+from simparity.comparisons.placeholder_engines import BrokenEngine
 from simparity.comparisons.rows import error_text
 from simparity.core.engine import Engine
 from simparity.core.errors import PluginError, echo, one_line
@@ -120,8 +120,9 @@ def load_engine(target: str, name: str | None = None, taken: frozenset[str] = fr
     ``name``: what the engine is called (a plugin's entry-point name). None (a spec): its own ``name``
     unless that is empty, not an engine name (:data:`ENGINE_NAME`) or in ``taken`` (a built-in's or a
     plugin's), then ``target`` itself. A spec's module is looked for on the import path, then in the
-    current folder. Returns the engine, an :class:`UnavailableEngine` when its module does not import,
-    or a :class:`BrokenEngine` when its code raised or broke the interface.
+    current folder. Returns the engine, or a :class:`BrokenEngine` when it does not import (a typo in its
+    module, a missing dependency: the user asked for it, so its rows fail rather than pass the gate as n/a),
+    its code raised or it broke the interface.
     """
     label = name or target
     if name is None and os.getcwd() not in sys.path:
@@ -129,7 +130,7 @@ def load_engine(target: str, name: str | None = None, taken: frozenset[str] = fr
     try:
         engine = _instantiate(metadata.EntryPoint(label, target, ENTRY_POINT_GROUP).load(), target)
     except ImportError as err:  # where: always the import machinery, so not said
-        return UnavailableEngine(label, f"{target}: {one_line(f'{type(err).__name__}: {err}')}")
+        return BrokenEngine(label, f"{target} does not import here: {one_line(f'{type(err).__name__}: {err}')}")
     except (Exception, SystemExit) as err:  # noqa: BLE001 - a user's code: its cases fail with the error
         return BrokenEngine(label, f"importing or constructing {target} raised {one_line(error_text(err))}")
     try:
@@ -145,11 +146,11 @@ def load_engine(target: str, name: str | None = None, taken: frozenset[str] = fr
 def _instantiate(found: object, target: str) -> Engine:
     """An engine from what an entry point loaded: an Engine subclass, or a callable returning an Engine."""
     if not callable(found):
-        raise PluginError(f"{target} is a {type(found).__name__} (allowed: an Engine subclass or a zero-argument "
+        raise PluginError(f"{target} is a value of type {type(found).__name__} (allowed: an Engine subclass or a zero-argument "
                           "callable returning an Engine)")
     engine = found()
     if not isinstance(engine, Engine):
-        raise PluginError(f"{target}() returned a {type(engine).__name__}, not a simparity.core.engine.Engine")
+        raise PluginError(f"{target}() returned a value of type {type(engine).__name__}, not a simparity.core.engine.Engine")
     return engine
 
 

@@ -255,7 +255,7 @@ def sampling_problem(scene: DynamicsScene, traj, n: int, dt: float) -> str:
     """What is wrong with ``traj`` as the samples of ``n`` steps of ``dt`` of ``scene`` ("" when nothing): a
     Trajectory of n + 1 samples of every body, at times k * dt (within :data:`TIME_GRID_TOLERANCE` steps)."""
     if not isinstance(traj, Trajectory):
-        return f"run() returned a {type(traj).__name__} (allowed: a simparity.core.trajectory.Trajectory)"
+        return f"run() returned a value of type {type(traj).__name__} (allowed: a simparity.core.trajectory.Trajectory)"
     times = np.asarray(traj.times)
     if times.shape != (n + 1,):
         return f"its times have shape {times.shape} (expected ({n + 1},): the initial state and {n} steps)"

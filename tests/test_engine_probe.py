@@ -11,7 +11,7 @@ import pytest
 from simparity.comparisons import engine_probe
 from simparity.comparisons.cli import main
 from simparity.comparisons.engine_probe import PROBE_CHAIN, DescribedEngine, probe_engines
-from simparity.comparisons.placeholder_engines import BrokenEngine, UnavailableEngine
+from simparity.comparisons.placeholder_engines import BrokenEngine
 from simparity.core.engine import Engine, Support
 from simparity.core.inhouse import InHouseEngine
 from tests.helpers import THROWN_BALL, builtin
@@ -51,7 +51,8 @@ def test_a_crash_or_an_exit_while_building_or_describing_is_a_broken_engine():
     assert "in File" in segfault.reason  # where, from the faulthandler's stack
     exits = found["tests.hostile_engines:ExitInVersion"]
     assert isinstance(exits, BrokenEngine) and "exited with code 3" in exits.reason
-    assert isinstance(found["no_such_module_here:Engine"], UnavailableEngine)
+    missing = found["no_such_module_here:Engine"]
+    assert isinstance(missing, BrokenEngine) and "does not import here: ModuleNotFoundError" in missing.reason
 
 
 def test_a_hang_while_describing_is_a_broken_engine_within_the_limit(monkeypatch):

@@ -225,17 +225,26 @@ def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_
 
 # --- Plugins that cannot run ----------------------------------------------------------------------------------------
 
-def test_a_plugin_that_fails_to_import_gives_na_rows_with_the_import_error(site, scene_file):
+def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site, scene_file):
+    """Asked for and never run, it must not pass the gate as n/a: its rows fail, naming the import error."""
     site.install({"ghost": "no_such_module_for_simparity_tests:Engine"})
     dynamics = run_scene(load_scene(str(scene_file)), engines=["core", "ghost"], repeats=0)
     kinematics = run_scene("lecture-planar-arm", engines=["core", "ghost"], repeats=0)
     for table in (dynamics, kinematics):
         ghost = _rows(table, "ghost")
-        assert len(ghost) and set(ghost.status) == {NOT_AVAILABLE}
         cases = ghost[~ghost.metric.str.startswith("order_")]  # an order over cases that never ran: n/a, "too few"
-        assert cases.detail.str.contains("ghost is not importable here: no_such_module_for_simparity_tests:Engine: "
-                                         "ModuleNotFoundError", regex=False).all()
+        assert len(cases) and set(cases.status) == {FAILED}
+        assert cases.detail.str.contains("ghost is broken: no_such_module_for_simparity_tests:Engine does not import "
+                                         "here: ModuleNotFoundError", regex=False).all()
         assert OK in set(_rows(table, "core").status)
+
+
+def test_a_mistyped_spec_module_fails_the_run_and_the_gate(tmp_path, capsys):
+    out = tmp_path / "run"
+    code = main(["run", "lecture-projectile", "--quick", "--engines", "core,no_such_module_for_simparity_tests:X",
+                 "--out", str(out), "--check"])
+    assert code == EXIT_FAILED_CASES
+    assert "check FAILED" in capsys.readouterr().out
 
 
 def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(site, scene_file, tmp_path):
@@ -257,7 +266,7 @@ def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(si
     ("NoVersion", "version() raised RuntimeError: no version here"),
     ("ListedIntegrators", "integrators() returned ['rk4'] (allowed: a tuple of str)"),
     ("RaisingOrder", "theoretical_order('rk4') raised KeyError: 'rk4'"),
-    ("NotAnEngine", "plugin_engines_b:NotAnEngine() returned a NotAnEngine, not a simparity.core.engine.Engine"),
+    ("NotAnEngine", "plugin_engines_b:NotAnEngine() returned a value of type NotAnEngine, not a simparity.core.engine.Engine"),
     ("NoSuchClass", "AttributeError"),
 ])
 def test_an_engine_that_breaks_the_interface_fails_its_rows_with_the_reason(site, scene_file, attr, reason):
@@ -316,7 +325,8 @@ def test_a_built_in_name_wins_over_a_plugin_and_simparity_engines_lists_every_st
     assert [line.split()[0] for line in listed if "  built-in; " in line] == list(ENGINE_NAMES)
     assert "not used: shadowed by the built-in engine core" in lines["core"] and origin in lines["core"]
     assert origin in lines["exploding"] and "failed: " in lines["exploding"] and "boom in the constructor" in lines["exploding"]
-    assert origin in lines["ghost"] and "n/a: ghost is not importable here" in lines["ghost"]
+    assert origin in lines["ghost"] and "failed: ghost is broken: no_such_module_for_simparity_tests:Engine does not " \
+        "import here" in lines["ghost"]
     assert "not used: the name 'two,names' is not an engine name" in lines["two,names"]
     assert "version numpy" in lines["renamed"] and "kinematics: yes" in lines["renamed"]
 
