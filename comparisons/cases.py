@@ -144,8 +144,10 @@ def case_key(group: CaseGroup, spec: CaseSpec, versions: dict[str, str]) -> Case
 
 
 def scene_hash(scene) -> str:
-    """SHA-256 of a scene's content: every field of its dataclasses, arrays by dtype, shape and bytes,
-    floats exactly. The same scene loaded twice, in any process, hashes the same."""
+    """SHA-256 of a scene's content: every field of its dataclasses that takes part in their equality (not
+    ``compare=False`` ones, such as the file a scene was read from: the same file by a relative or an absolute
+    path, or moved, is the same scene), arrays by dtype, shape and bytes, floats exactly. The same scene
+    loaded twice, in any process, hashes the same."""
     digest = hashlib.sha256()
     _feed(digest, scene)
     return digest.hexdigest()
@@ -155,7 +157,7 @@ def _feed(digest, value) -> None:
     """Feed ``value`` to ``digest`` with its type, so different structures never give the same bytes."""
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         digest.update(f"<{type(value).__qualname__}".encode())
-        for f in dataclasses.fields(value):
+        for f in (f for f in dataclasses.fields(value) if f.compare):
             digest.update(f.name.encode() + b"=")
             _feed(digest, getattr(value, f.name))
         digest.update(b">")

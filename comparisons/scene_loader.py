@@ -538,7 +538,7 @@ def _urdf_path(c: _Reader) -> Path:
         if not os.path.realpath(path).startswith(os.path.realpath(root) + os.sep):
             raise c.fail("urdf", f"{echo(text)} leaves the {prefix[:-1]} package", _WHERE_URDF)
     else:
-        path = Path(text) if Path(text).is_absolute() else Path(c.source).parent / text
+        path = Path(os.path.abspath(Path(c.source).parent / text))  # absolute: the same file however the scene was named
     problem = file_problem(path, "URDF file")
     if problem:
         raise c.fail("urdf", f"{problem}: {one_line(path)}", _WHERE_URDF)

@@ -450,7 +450,8 @@ class DynamicsScene:
     length_unit : str
         The unit the scene file was written in (values here are already in metres).
     source : str
-        File the scene came from, or ``"<code>"``.
+        File the scene came from, or ``"<code>"``: where, not what; not part of the scene's equality or
+        content hash.
     suites : tuple of str
         The built-in suites (:data:`SUITES`) the scene belongs to.
     contact : Contact or None
@@ -468,7 +469,7 @@ class DynamicsScene:
     dts: tuple[float, ...]
     integrators: tuple[str, ...] = ()
     length_unit: str = "m"
-    source: str = "<code>"
+    source: str = field(default="<code>", compare=False)
     suites: tuple[str, ...] = ("default",)
     contact: Contact | None = None
     sweep: SweepPoint | None = None
@@ -605,7 +606,7 @@ class KinematicsScene:
     chain: Chain
     n_configurations: int
     seed: int
-    source: str = "<code>"
+    source: str = field(default="<code>", compare=False)
     suites: tuple[str, ...] = ("default",)
     sweep: SweepPoint | None = None
     kind: str = field(default="kinematics", init=False)
@@ -669,7 +670,7 @@ class IKScene:
     orientation_tolerance: float
     max_iterations: int
     hard_targets: tuple[str, ...] = ()
-    source: str = "<code>"
+    source: str = field(default="<code>", compare=False)
     suites: tuple[str, ...] = ("default",)
     sweep: SweepPoint | None = None
     kind: str = field(default="ik", init=False)

@@ -5,8 +5,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,6 +16,7 @@ import pytest
 from simparity.comparisons.cases import DYNAMICS, IK, KINEMATICS, NO_INTEGRATOR, STABILITY, plan_scene, scene_hash
 from simparity.comparisons.engines import make_engine
 from simparity.comparisons.library import builtin_paths
+from simparity.comparisons.scene_loader import load_scene
 from tests.helpers import builtin
 
 
@@ -34,6 +37,26 @@ def test_any_changed_value_changes_the_hash():
                 dataclasses.replace(scene, dts=scene.dts[:-1])]
     hashes = {scene_hash(s) for s in variants} | {scene_hash(scene)}
     assert len(hashes) == len(variants) + 1
+
+
+def test_the_same_file_by_a_relative_or_absolute_path_or_moved_hashes_the_same(tmp_path, monkeypatch):
+    """A scene's hash is its content, not where it was read from: a run started with a relative path and
+    resumed (which names it absolutely) keeps every finished case. Its URDF is named absolutely either way."""
+    import pybullet_data
+
+    for folder in ("a", "b"):
+        (tmp_path / folder).mkdir()
+        shutil.copy(builtin_paths()["lecture-projectile"], tmp_path / folder / "scene.toml")
+        shutil.copy(Path(pybullet_data.getDataPath()) / "kuka_iiwa" / "model.urdf", tmp_path / folder / "arm.urdf")
+        (tmp_path / folder / "arm.toml").write_text('[scene]\nname = "arm"\nkind = "kinematics"\nreference = '
+                                                   '"pinocchio"\n[chain]\nurdf = "arm.urdf"\n', encoding="utf-8")
+    monkeypatch.chdir(tmp_path)
+    for name in ("scene.toml", "arm.toml"):
+        relative, absolute = load_scene(f"a/{name}"), load_scene(str(tmp_path / "a" / name))
+        assert relative.source != absolute.source and scene_hash(relative) == scene_hash(absolute)
+    arms = [load_scene("a/arm.toml"), load_scene(str(tmp_path / "a" / "arm.toml"))]
+    assert arms[0].chain.urdf_path == arms[1].chain.urdf_path == str(tmp_path / "a" / "arm.urdf")
+    assert scene_hash(load_scene("a/scene.toml")) == scene_hash(load_scene("b/scene.toml"))  # moved: the same
 
 
 def test_a_dynamics_scene_is_a_group_per_time_step_then_the_stability_limits():
