@@ -16,6 +16,7 @@ that never came back fail with that cause.
 
 from __future__ import annotations
 
+import asyncio
 import os
 import pickle
 import socket
@@ -38,6 +39,10 @@ POLL_SECONDS = 0.05
 REACH_SECONDS = 5
 """How long to wait for the scheduler's port to accept a connection: a refused or unresolvable address fails at
 once, an unanswered one (a firewall dropping packets) after this."""
+
+IDENTIFY_SECONDS = 10
+"""How long a server at --scheduler has to say that it is a Dask scheduler (a scheduler answers in milliseconds;
+a web server, the dashboard's port given by mistake, never does)."""
 
 _pools = threading.local()
 """Each Dask worker thread's pool of one worker process, kept between tasks."""
@@ -62,12 +67,35 @@ def run_group_task(group: CaseGroup, skip: frozenset[int], limits: CaseLimits, q
 
 
 def _reach(address: str) -> None:
-    """Raise OSError or ValueError unless something accepts connections at the scheduler's ``address`` (before
-    Dask's client, which retries a refused connection for its whole timeout)."""
+    """Raise OSError or ValueError unless a Dask scheduler answers at ``address`` (before Dask's client, which
+    retries a refused connection for its whole timeout and waits on a service that is not Dask for ever): its
+    port accepts connections within :data:`REACH_SECONDS`, and it says it is a scheduler within
+    :data:`IDENTIFY_SECONDS`."""
     from distributed.comm.addressing import get_address_host_port, normalize_address
 
     host, port = get_address_host_port(normalize_address(address))
     socket.create_connection((host, port), timeout=REACH_SECONDS).close()
+    try:
+        identity = asyncio.run(asyncio.wait_for(_identity(address), IDENTIFY_SECONDS))
+    except (asyncio.TimeoutError, TimeoutError):
+        raise OSError(f"something listens there but gave no Dask answer within {IDENTIFY_SECONDS:g} s") from None
+    except Exception as err:  # noqa: BLE001 - whatever a service that is not Dask makes Dask's protocol raise
+        raise OSError(f"something listens there but does not speak Dask's protocol ({type(err).__name__})") from None
+    kind = identity.get("type") if isinstance(identity, dict) else None
+    if kind != "Scheduler":
+        raise OSError(f"a Dask {kind or 'process'} answers there, not a scheduler")
+
+
+async def _identity(address: str) -> object:
+    """What the Dask server at ``address`` says it is (its ``identity``)."""
+    from distributed.core import rpc
+    from distributed.security import Security
+
+    server = rpc(address, timeout=REACH_SECONDS, connection_args=Security().get_connection_args("client"))
+    try:
+        return await server.identity()
+    finally:
+        await server.close_rpc()
 
 
 def node_memory_bytes() -> int:

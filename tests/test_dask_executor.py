@@ -3,17 +3,21 @@ workers on the loopback interface) and gives results identical to the local exec
 
 from __future__ import annotations
 
+import socketserver
+import threading
 import time
 
 import pandas as pd
 import pytest
 
 from simparity.comparisons.cli import main
+from simparity.comparisons import dask_executor
 from simparity.comparisons.dask_executor import DaskExecutor
 from simparity.comparisons.engines import make_engine
 from simparity.comparisons.execution import run_scenes
 from simparity.comparisons import library
 from simparity.comparisons.isolation import CaseLimits, IsolatedPool
+from simparity.core.errors import SimparityError
 from simparity.core.results import RESULTS_FILE
 from tests.helpers import THROWN_BALL, InProcess, built_engines, comparable, quick_scenes
 
@@ -61,6 +65,9 @@ def test_the_cli_runs_on_dask_and_writes_the_local_executor_results(tmp_path):
 UNREACHABLE_SECONDS = 10.0
 """A refused connection fails at once; this allows for the imports of a loaded machine (before: Dask's 30 s)."""
 
+SHORT_IDENTIFY_SECONDS = 2.0
+"""How long the tests give a server to say it is a Dask scheduler (a scheduler answers in milliseconds)."""
+
 
 @pytest.mark.parametrize("address", ["tcp://127.0.0.1:9", "127.0.0.1:9", "no-port-here"])
 def test_an_unreachable_scheduler_is_a_one_line_error_at_once_and_makes_no_folder(tmp_path, capsys, address):
@@ -71,6 +78,51 @@ def test_an_unreachable_scheduler_is_a_one_line_error_at_once_and_makes_no_folde
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "cannot reach a Dask scheduler" in err
     assert not out.exists()
+
+
+class _NotDask(socketserver.BaseRequestHandler):
+    """A service that is not Dask: a banner (as SSH sends), or silence until the client speaks HTTP."""
+
+    banner = b""
+
+    def handle(self) -> None:
+        if self.banner:
+            self.request.sendall(self.banner)
+        else:
+            self.request.recv(1 << 16)
+            time.sleep(UNREACHABLE_SECONDS)  # a web server waiting for the rest of a request
+
+
+@pytest.mark.parametrize("banner", [b"SSH-2.0-OpenSSH_9.6 not dask\r\n" * 4, b""])
+def test_a_service_that_is_not_dask_at_the_scheduler_address_is_a_one_line_error(tmp_path, capsys, monkeypatch,
+                                                                                   banner):
+    """Dask's own client raised a MemoryError from the banner's bytes read as a frame length, and waited for ever
+    on a silent server (a web server: the dashboard's port given by mistake)."""
+    monkeypatch.setattr(dask_executor, "IDENTIFY_SECONDS", SHORT_IDENTIFY_SECONDS)
+    handler = type("Handler", (_NotDask,), {"banner": banner})
+    with socketserver.ThreadingTCPServer(("127.0.0.1", 0), handler) as server:
+        threading.Thread(target=server.serve_forever, daemon=True).start()
+        out = tmp_path / "run"
+        address = f"tcp://127.0.0.1:{server.server_address[1]}"
+        start = time.monotonic()
+        assert main(["run", "lecture-projectile", "--executor", "dask", "--scheduler", address, "--out", str(out)]) == 2
+        assert time.monotonic() - start < UNREACHABLE_SECONDS
+        server.shutdown()
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot reach a Dask scheduler: something listens there but" in err
+    assert not out.exists()
+
+
+def test_a_running_scheduler_is_reached_and_a_worker_address_is_refused(dask):
+    """A real cluster's scheduler, named by its address, takes the run (and its memory limits are its nodes')."""
+    scheduler = DaskExecutor(dask.client.scheduler.address, WORKERS, CaseLimits(60.0, None))
+    try:
+        assert scheduler.client.scheduler_info()["workers"].keys() == dask.client.scheduler_info()["workers"].keys()
+    finally:
+        scheduler.close()
+    worker = next(iter(dask.client.scheduler_info()["workers"]))
+    with pytest.raises(SimparityError, match="a Dask Worker answers there, not a scheduler"):
+        DaskExecutor(worker, WORKERS, CaseLimits(60.0, None))
 
 
 def test_a_scheduler_without_dask_is_refused(tmp_path, capsys):
