@@ -28,7 +28,7 @@ from simparity.comparisons.engines import (
     check_engine_names,
     describe_engines,
     make_engine,
-    use_specs,
+    use_engines,
 )
 from simparity.comparisons.history import history_path, latest_before, metric_history, record_run, run_table
 from simparity.comparisons.execution import count_cases, default_jobs, run_scenes
@@ -318,7 +318,7 @@ def cmd_run(args, out) -> int:
                              "dask, or drop --scheduler)")
     limits = _limits(args, jobs)
     names = check_engine_names(args.engines)
-    use_specs(names)
+    use_engines(names)
     run_limits = Limits(max_steps=args.max_steps, max_samples=args.max_samples, max_joints=args.max_joints)
     if args.scenes and args.suite:
         raise SimparityError(f"--suite {args.suite} with scenes named: give one (allowed: scene names or files, "
@@ -556,7 +556,7 @@ def main(argv: list[str] | None = None, out=None) -> int:
     out = out or sys.stdout
     try:
         args = build_parser().parse_args(argv)
-        use_specs(())  # until `run` names its engines: none of an earlier command's
+        use_engines(())  # until `run` names its engines
         return _COMMANDS[args.command](args, out)
     except SimparityError as err:
         print(f"simparity: error: {one_line(err, MESSAGE_LIMIT)}", file=sys.stderr)
@@ -567,6 +567,8 @@ def main(argv: list[str] | None = None, out=None) -> int:
     except BrokenPipeError:  # the reader went away (`simparity list | head`): stop quietly, like Unix tools
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_OK
+    finally:
+        use_engines(())  # the command's engines end with it: none reaches the next command or a run_scene call
 
 
 if __name__ == "__main__":  # pragma: no cover

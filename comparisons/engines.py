@@ -83,25 +83,38 @@ def describe_engines(names, scenes=()) -> list[Engine]:
     return [probed[n] if n in probed else make_engine(n) for n in names]
 
 
-_RUN_SPECS: list[str] = []
-"""The ``module:attr`` engines of the command running (:func:`use_specs`): their integrators may be named in scene
-files."""
+_RUN_ENGINES: list[str] = []
+"""The user's engines (installed plugins and ``module:attr`` specs) of the command running (:func:`use_engines`):
+their integrators may be named in scene files, and the quick profile runs them."""
 
 
-def use_specs(names) -> None:
-    """Let the integrators of the spec engines among ``names`` (``--engines``; () for none) be named in scene
+def use_engines(names) -> None:
+    """Let the integrators of the user's engines among ``names`` (``--engines``; () for none) be named in scene
     files, instead of those of the command before."""
-    specs = [n for n in dict.fromkeys(names) if is_spec(n)]
-    if specs != _RUN_SPECS:
-        _RUN_SPECS[:] = specs
+    users = [n for n in dict.fromkeys(names) if n not in _ENGINES]
+    if users != _RUN_ENGINES:
+        _RUN_ENGINES[:] = users
         known_integrators.cache_clear()
+        installed_integrators.cache_clear()
 
 
 @functools.lru_cache(maxsize=1)
 def known_integrators() -> tuple[str, ...]:
-    """Every integrator name some engine offers: a built-in, an installed plugin or a spec engine of this run
-    (for checking scene files). Cached; a plugin that cannot run offers none."""
+    """Every integrator name the built-ins and the user's engines of this run offer. Cached; an engine that
+    cannot run offers none. Installed plugins the run does not name are not asked (each is a process of its
+    own, up to a minute for a slow one): see :func:`installed_integrators`."""
+    return _integrator_names(ENGINE_NAMES + tuple(_RUN_ENGINES))
+
+
+@functools.lru_cache(maxsize=1)
+def installed_integrators() -> tuple[str, ...]:
+    """:func:`known_integrators` and every installed plugin's, for a scene file that names an integrator the
+    run's engines do not offer. Cached."""
+    return _integrator_names(ENGINE_NAMES + plugin_names() + tuple(_RUN_ENGINES))
+
+
+def _integrator_names(engines: tuple[str, ...]) -> tuple[str, ...]:
     names = {}
-    for engine in describe_engines(ENGINE_NAMES + plugin_names() + tuple(_RUN_SPECS)):
+    for engine in describe_engines(engines):
         names.update(dict.fromkeys(engine.integrators()))
     return tuple(names)

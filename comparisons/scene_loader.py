@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simparity.comparisons.engines import ENGINE_NAMES, known_integrators
+from simparity.comparisons.engines import ENGINE_NAMES, installed_integrators, known_integrators
 from simparity.comparisons.scene_limits import DEFAULT_LIMITS, POSITION_TOLERANCE_OF_REACH, Limits, allowed_at_most
 from simparity.comparisons.sweep import SWEEP_TABLE, read_sweep
 from simparity.core.dh import chain_from_dh
@@ -465,9 +465,18 @@ def _dynamics(top: _Reader, head: dict) -> DynamicsScene:
     if sim.has("dt") == sim.has("rate_hz"):
         raise sim.fail("dt", "give exactly one of dt and rate_hz", "dt = [time steps in s] or rate_hz = [steps per s]")
     dts = _ladder(sim, duration, len(bodies))
-    integrators = sim.strings("integrators", known_integrators(), "no engine has an integrator {}") if sim.has("integrators") else ()
+    integrators = _integrators(sim) if sim.has("integrators") else ()
     return DynamicsScene(bodies=bodies, forces=forces, duration=duration, dts=dts, integrators=integrators,
                          contact=contact, **head)
+
+
+def _integrators(sim: _Reader) -> tuple[str, ...]:
+    """The integrators a scene names, each offered by some engine: a built-in or one of the run's, else an
+    installed plugin (asked only then)."""
+    named, choices = sim.table["integrators"], known_integrators()
+    if isinstance(named, list) and any(isinstance(n, str) and n not in choices for n in named):
+        choices = installed_integrators()
+    return sim.strings("integrators", choices, "no engine has an integrator {}")
 
 
 def _ladder(sim: _Reader, duration: float, n_bodies: int) -> tuple[float, ...]:

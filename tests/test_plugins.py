@@ -20,7 +20,8 @@ import pytest
 from simparity import load_scene, run_scene
 from simparity.comparisons import plugins
 from simparity.comparisons.cli import EXIT_FAILED_CASES, EXIT_OK, EXIT_USAGE, main
-from simparity.comparisons.engines import ENGINE_NAMES, check_engine_names, known_integrators, make_engine
+from simparity.comparisons.engines import (ENGINE_NAMES, check_engine_names, installed_integrators, known_integrators,
+                                           make_engine)
 from simparity.core.errors import UnknownEngineError
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.results import FAILED, NOT_AVAILABLE, OK
@@ -141,6 +142,7 @@ class _Site:
 def _forget_plugins() -> None:
     plugins.discover.cache_clear()
     known_integrators.cache_clear()
+    installed_integrators.cache_clear()
 
 
 @pytest.fixture
@@ -362,3 +364,24 @@ def test_a_scene_file_may_name_a_plugin_s_integrator(site, tmp_path):
     path = tmp_path / "leap.toml"
     path.write_text(SCENE.replace('integrators = ["rk4"]', 'integrators = ["leapfrog_demo"]'), encoding="utf-8")
     assert load_scene(str(path)).integrators == ("leapfrog_demo",)
+
+
+def test_an_installed_plugin_a_run_does_not_name_is_never_asked(site, scene_file, tmp_path, monkeypatch):
+    """Describing a plugin takes a process of its own (a slow one: up to the probe's minute): a run, a scene file
+    or the quick profile that does not need it never asks; a run naming it asks it alone, once per command
+    for the scene files and once for the run."""
+    from simparity.comparisons import engine_probe
+
+    site.install({"leap": "plugin_engines_h:Leapfrog", "other": "plugin_engines_h:Renamed"}, "plugin_engines_h")
+    asked = []
+    real = engine_probe.probe_engines
+    monkeypatch.setattr(engine_probe, "probe_engines", lambda names, scenes=(): asked.append(list(names)) or
+                        real(names, scenes))
+    assert main(["run", str(scene_file), "--quick", "--engines", "core", "--out", str(tmp_path / "a")]) == EXIT_OK
+    assert main(["list"], out=io.StringIO()) == EXIT_OK
+    assert asked == []
+    leap = tmp_path / "leap.toml"
+    leap.write_text(SCENE.replace('integrators = ["rk4"]', 'integrators = ["rk4", "leapfrog_demo"]'), encoding="utf-8")
+    code = main(["run", str(leap), "--quick", "--engines", "core,leap", "--out", str(tmp_path / "b")])
+    assert code != EXIT_USAGE  # the scene file was accepted (the demo integrator's own cases may fail)
+    assert asked and all(names == ["leap"] for names in asked)
