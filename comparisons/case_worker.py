@@ -22,7 +22,7 @@ from simparity.comparisons.cases import CaseGroup
 from simparity.comparisons.engines import ENGINE_NAMES, make_engine
 from simparity.comparisons.runner import prepare_group, run_case
 from simparity.core.engine import Engine
-from simparity.core.processes import die_with_parent
+from simparity.core.processes import die_with_parent, kill_group
 
 def serve(inbox: Connection, outbox: Connection) -> None:
     """Run every group sent on ``inbox`` until it closes, reporting on ``outbox``.
@@ -73,13 +73,16 @@ def _by_engine(group: CaseGroup, skip: frozenset[int]) -> list[tuple[str, list[i
 def _run_in_child(group: CaseGroup, shared: object, indices: list[int], trusted: dict[str, Engine],
                   outbox: Connection) -> int | None:
     """Run cases ``indices`` of one engine in a child process forked from this one; None when it finished
-    them all, else its exit status as a code (negative: the signal that killed it)."""
+    them all, else its exit status as a code (negative: the signal that killed it). The child leads a process
+    group of its own, killed when it ends: nothing the engine started outlives its cases (short of a process
+    that leaves the group, ``setsid``)."""
     finished_read, finished_write = os.pipe()
     pid = os.fork()
     if pid == 0:  # the child: report straight to the parent, never return into the loop above
         code = 1
         try:
             os.close(finished_read)
+            os.setpgid(0, 0)
             die_with_parent(os.getppid())
             engines = dict(trusted) | {group.spec_of(e.name): e for e in group.stand_ins}
 
@@ -101,6 +104,7 @@ def _run_in_child(group: CaseGroup, shared: object, indices: list[int], trusted:
             os._exit(code)
     os.close(finished_write)
     _, status = os.waitpid(pid, 0)
+    kill_group(pid)  # what the engine started and left running
     os.set_blocking(finished_read, False)  # a grandchild may hold the write end open
     try:
         finished = os.read(finished_read, 1) == b"1"

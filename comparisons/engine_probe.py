@@ -32,7 +32,7 @@ from simparity.comparisons.rows import error_text
 from simparity.comparisons.timing import status_bytes
 from simparity.core.engine import Engine, KinematicsModel, Simulation, Support
 from simparity.core.errors import PluginError, one_line
-from simparity.core.processes import die_with_parent
+from simparity.core.processes import die_with_parent, kill_group
 from simparity.core.scene import Chain, Joint
 
 PROBE_SECONDS = 60.0
@@ -202,10 +202,7 @@ class _Probe:
             self.kill()
 
     def kill(self) -> None:
-        try:
-            os.killpg(self.process.pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
+        kill_group(self.process.pid)
         self.process.wait()
 
     def result(self) -> Engine:

@@ -25,6 +25,7 @@ from typing import Iterator
 from simparity.comparisons.cases import CaseGroup, CaseOutcome
 from simparity.comparisons.runner import failed_outcome
 from simparity.comparisons.timing import status_bytes
+from simparity.core.processes import kill_group
 
 GIB = 1024 ** 3
 
@@ -126,10 +127,9 @@ class _Worker:
             self.process.wait(timeout=grace_seconds)
         except subprocess.TimeoutExpired:
             pass
-        try:  # the worker's session: it, the child running a case and anything they forked
-            os.killpg(self.process.pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
+        kill_group(self.process.pid)  # the worker and what it forked, but the child running a case ...
+        if self.phase_pid != self.process.pid:
+            kill_group(self.phase_pid)  # ... which leads a group of its own (case_worker), with what it started
         code = self.process.wait()
         for end in (self.inbox, self.outbox):
             end.close()

@@ -19,3 +19,11 @@ def die_with_parent(parent: int) -> None:
         return
     if os.getppid() != parent:  # the parent died before the request took effect
         os._exit(1)
+
+
+def kill_group(group: int) -> None:
+    """SIGKILL every process of process group ``group`` (a pid that leads, or led, one); nothing if it is gone."""
+    try:
+        os.killpg(group, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass

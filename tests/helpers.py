@@ -5,6 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import time
 
 import numpy as np
 
@@ -212,3 +213,20 @@ dt = [0.01, 0.005]
 integrators = ["rk4"]
 """
 """A ball thrown under gravity for 1 s at two time steps, RK4 only: a scene of milliseconds per case."""
+
+
+LEFTOVER_SECONDS = 10.0
+"""How long the processes an engine left running may take to be killed once its cases are back (the worker
+kills them right after the case's process ends, which may be just after its last result arrived)."""
+
+
+def no_leftovers_within(seconds: float = LEFTOVER_SECONDS) -> bool:
+    """True once no process :class:`tests.hostile_engines.ForkingEngine` left running is alive, within ``seconds``."""
+    from tests.hostile_engines import leftovers
+
+    deadline = time.monotonic() + seconds
+    while leftovers():
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.1)
+    return True

@@ -10,6 +10,8 @@ from __future__ import annotations
 import ctypes
 import os
 import signal
+import subprocess
+import sys
 import time
 
 import numpy as np
@@ -117,6 +119,33 @@ class HostKillingEngine(_Misbehaving):
 
     name = "host-killing"
     simulation = _KillHost
+
+
+LEFTOVER_MARK = "simparity-test-leftover-process"
+"""On the command line of the process :class:`ForkingEngine` leaves running, to find it."""
+
+
+class ForkingEngine(InHouseEngine):
+    """Core's engine that starts a process in every case and leaves it running (a simulator's server, say)."""
+
+    name = "forking"
+
+    def build_dynamics(self, scene, integrator: str, dt: float) -> Simulation:
+        subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)", LEFTOVER_MARK])
+        return super().build_dynamics(scene, integrator, dt)
+
+
+def leftovers() -> list[int]:
+    """The pids of the processes :class:`ForkingEngine` left running."""
+    found = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            with open(f"/proc/{pid}/cmdline", "rb") as cmdline:
+                if LEFTOVER_MARK.encode() in cmdline.read():
+                    found.append(int(pid))
+        except OSError:  # gone meanwhile
+            pass
+    return found
 
 
 class SegfaultOnConstruction(InHouseEngine):

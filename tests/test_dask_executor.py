@@ -19,7 +19,7 @@ from simparity.comparisons import library
 from simparity.comparisons.isolation import CaseLimits, IsolatedPool
 from simparity.core.errors import SimparityError
 from simparity.core.results import RESULTS_FILE
-from tests.helpers import THROWN_BALL, InProcess, built_engines, comparable, quick_scenes
+from tests.helpers import THROWN_BALL, InProcess, built_engines, comparable, no_leftovers_within, quick_scenes
 
 WORKERS = 2
 
@@ -195,3 +195,15 @@ def test_a_group_lost_for_good_fails_only_the_cases_that_never_came_back(tmp_pat
     assert {r.status for r in rows if r.engine == "core"} == {"ok"}
     lost = [r for r in rows if r.engine == "host-killing"]
     assert lost and all(r.status == "failed" and "the Dask task was lost: KilledWorker" in r.detail for r in lost)
+
+
+def test_what_an_engine_starts_and_leaves_running_ends_with_its_cases_on_dask(tmp_path, dask):
+    """A Dask worker keeps its pool between tasks, so nothing closes it after a run: the processes an engine
+    started and left running are killed when its cases end (held-out test: they were orphaned)."""
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    engines = [make_engine("core"), make_engine("tests.hostile_engines:ForkingEngine")]
+    [(_, rows, _)] = run_scenes(library.load([str(scene)]), engines, make_engine, 0, dask,
+                                specs={"forking": "tests.hostile_engines:ForkingEngine"})
+    assert {r.status for r in rows if r.engine == "forking" and r.metric == "position_error_max"} == {"ok"}
+    assert no_leftovers_within()

@@ -9,9 +9,13 @@ import pandas as pd
 import pytest
 
 from simparity.comparisons.cli import main
-from simparity.comparisons.isolation import BLAS_THREAD_VARIABLES, death_cause, worker_environment
+from simparity.comparisons import library
+from simparity.comparisons.engines import make_engine
+from simparity.comparisons.execution import run_scenes
+from simparity.comparisons.isolation import (BLAS_THREAD_VARIABLES, CaseLimits, IsolatedPool, death_cause,
+                                            worker_environment)
 from simparity.comparisons.library import builtin_paths
-from tests.helpers import THROWN_BALL
+from tests.helpers import THROWN_BALL, no_leftovers_within
 
 HANGING = ("tests.hostile_engines:HangingEngine", "hung: no result within the per-case time limit of 5 s")
 CRASHING = {
@@ -148,3 +152,16 @@ def test_workers_use_one_blas_thread_whatever_the_user_set(monkeypatch):
     monkeypatch.setenv("OPENBLAS_NUM_THREADS", "8")
     env = worker_environment()
     assert all(env[variable] == "1" for variable in BLAS_THREAD_VARIABLES)
+
+
+def test_what_an_engine_starts_and_leaves_running_ends_with_its_cases(tmp_path):
+    """An engine that starts a process in every case and never stops it: the processes are killed when its
+    cases end, while the pool's workers live on (as a Dask worker's pool does between tasks)."""
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    engines = [make_engine("core"), make_engine("tests.hostile_engines:ForkingEngine")]
+    with IsolatedPool(2, CaseLimits.default(2)) as pool:
+        [(_, rows, _)] = run_scenes(library.load([str(scene)]), engines, make_engine, 0, pool,
+                                    specs={"forking": "tests.hostile_engines:ForkingEngine"})
+        assert {r.status for r in rows if r.engine == "forking" and r.metric == "position_error_max"} == {"ok"}
+        assert no_leftovers_within()
