@@ -370,11 +370,16 @@ def _check_distinct(engines, names: tuple[str, ...], scenes) -> None:
                                  f"{one_line(engine.name)} (allowed: engines of distinct names)")
         seen[engine.name] = name
     files: dict[str, str] = {}
+    sweeps: dict[str, str] = {}
     for scene in scenes:
         if scene.name in files:
             raise SimparityError(f"{one_line(scene.source or scene.name)}: a second scene named {one_line(scene.name)} "
                                  f"(the first from {one_line(files[scene.name])}) (allowed: scenes of distinct names)")
         files[scene.name] = scene.source or scene.name
+        if scene.sweep is not None and sweeps.setdefault(scene.sweep.base, scene.source) != scene.source:
+            raise SimparityError(f"{one_line(scene.source)}: a second sweep named {one_line(scene.sweep.base)} (the "
+                                 f"first from {one_line(sweeps[scene.sweep.base])}): the results and the report group a "
+                                 "sweep's variants by that name (allowed: sweeps of distinct [scene] names)")
 
 
 def _executor(args, jobs: int, limits: CaseLimits):

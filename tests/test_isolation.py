@@ -140,6 +140,12 @@ def test_two_engines_or_two_scenes_of_one_name_are_refused(tmp_path, capsys):
     assert main(["run", "wind", str(copy), "--out", str(tmp_path / "b")]) == 2
     err = capsys.readouterr().err
     assert "a second scene named wind" in err and err.count("\n") == 1
+    for key, values in (("body[ball].mass", "[1.0, 2.0]"), ("simulation.duration", "[0.5, 1.0]")):
+        (tmp_path / f"{key}.toml").write_text(THROWN_BALL + f'[sweep]\n"{key}" = {values}\n', encoding="utf-8")
+    assert main(["run", str(tmp_path / "body[ball].mass.toml"), str(tmp_path / "simulation.duration.toml"),
+                 "--out", str(tmp_path / "c")]) == 2  # variants of distinct names, but one sweep name: "throw"
+    err = capsys.readouterr().err
+    assert "a second sweep named throw" in err and err.count("\n") == 1
 
 
 def test_the_cause_of_an_exit_is_the_exit_code_and_the_error():
