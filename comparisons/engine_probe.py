@@ -195,9 +195,9 @@ class _Probe:
         if time.monotonic() > deadline:
             self.stopped = (f"hung: building and describing it took more than {PROBE_SECONDS:g} s; the process was "
                             "killed")
-        elif (rss := status_bytes("VmRSS", self.process.pid) or 0) > _memory_limit():
-            self.stopped = (f"out of memory: building and describing it took {rss / 1024 ** 3:.3g} GiB, over the "
-                            f"limit of {_memory_limit() / 1024 ** 3:.3g} GiB; the process was killed")
+        elif (status_bytes("VmRSS", self.process.pid) or 0) > _memory_limit():
+            self.stopped = (f"out of memory: building and describing it went past the limit of "
+                            f"{_memory_limit() / 1024 ** 3:.3g} GiB; the process was killed")
         if self.stopped:
             self.kill()
 

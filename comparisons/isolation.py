@@ -248,12 +248,11 @@ class IsolatedPool:
             yield from self._replace(worker, f"hung: no result within the per-case time limit of "
                                      f"{self.limits.seconds:g} s; the worker was killed", pending)
             return
-        rss = status_bytes("VmRSS", worker.phase_pid) or 0
-        if rss > self.limits.memory_bytes:
+        if (status_bytes("VmRSS", worker.phase_pid) or 0) > self.limits.memory_bytes:
             worker.kill()
-            yield from self._replace(worker, f"out of memory: the worker's resident memory reached {rss / GIB:.3g} "
-                                     f"GiB, over the per-case limit of {self.limits.memory_bytes / GIB:.3g} GiB; the "
-                                     "worker was killed", pending)
+            # not how far past: the memory at the instant it was looked at differs from run to run, the rows must not
+            yield from self._replace(worker, f"out of memory: the worker's resident memory went past the per-case "
+                                     f"limit of {self.limits.memory_bytes / GIB:.3g} GiB; the worker was killed", pending)
 
     def _replace(self, worker: _Worker, cause: str, pending: collections.deque) -> Iterator[tuple[object, int, CaseOutcome]]:
         """A new process in ``worker``'s place; the case it ran fails with ``cause``, the rest of its job goes

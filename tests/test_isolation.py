@@ -20,7 +20,8 @@ from tests.helpers import THROWN_BALL, no_leftovers_within
 HANGING = ("tests.hostile_engines:HangingEngine", "hung: no result within the per-case time limit of 5 s")
 CRASHING = {
     "segfaulting": ("tests.hostile_engines:SegfaultingEngine", "killed by signal 11 (SIGSEGV)"),
-    "hogging": ("tests.hostile_engines:HoggingEngine", "out of memory"),
+    "hogging": ("tests.hostile_engines:HoggingEngine", "out of memory: the worker's resident memory went past the "
+                "per-case limit of 1 GiB; the worker was killed"),  # exactly: rows are the same in every run
 }
 
 HANG_SECONDS = 5
