@@ -247,6 +247,10 @@ def _range(fail, spec: dict, integer: bool) -> tuple:
     values = [start] + inner + [stop]
     if not all(math.isfinite(v) for v in values):
         raise fail("", f"the steps from {start:g} to {stop:g} overflow", "a range whose steps are finite numbers")
+    if len(set(values)) < len(values):
+        raise fail("", f"{num} values from {value_text(start)} to {value_text(stop)} are too close to tell apart "
+                   f"at {RANGE_DIGITS} significant digits", f"a range whose values differ in the first {RANGE_DIGITS} "
+                   "digits, or a list of the values")
     if integer:
         fractional = next((v for v in values if v != round(v)), None)
         if fractional is not None:

@@ -166,6 +166,19 @@ def test_a_trajectory_off_the_time_grid_fails_instead_of_being_measured(rewrite,
     assert problem in cases[0].detail
 
 
+def test_a_trajectory_of_complex_values_fails_instead_of_losing_its_imaginary_part():
+    """NumPy casts complex to real with no more than a warning: a state with an imaginary part is refused."""
+    def complex_positions(traj):
+        values = {f.name: np.array(getattr(traj, f.name)) for f in dataclasses.fields(traj)}
+        values["position_world"] = values["position_world"] + 1e-3j
+        return type(traj)(**values)
+
+    rows = run_scene(builtin("lecture-projectile"), [_rewritten(complex_positions)], make_engine, repeats=1)
+    cases = [r for r in rows if not math.isnan(r.dt)]
+    assert cases and {r.status for r in cases} == {FAILED}
+    assert all("complex values where real ones (float64) are expected" in r.detail for r in cases)
+
+
 def test_energy_drift_without_energy_is_not_available():
     """A body dropped from rest at the potential's zero has E(0) = 0: drift is measured against its kinetic energy."""
     from dataclasses import replace
