@@ -561,7 +561,6 @@ def main(argv: list[str] | None = None, out=None) -> int:
     out = out or sys.stdout
     try:
         args = build_parser().parse_args(argv)
-        use_engines(())  # until `run` names its engines
         return _COMMANDS[args.command](args, out)
     except SimparityError as err:
         print(f"simparity: error: {one_line(err, MESSAGE_LIMIT)}", file=sys.stderr)

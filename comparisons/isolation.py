@@ -251,8 +251,9 @@ class IsolatedPool:
         if (status_bytes("VmRSS", worker.phase_pid) or 0) > self.limits.memory_bytes:
             worker.kill()
             # not how far past: the memory at the instant it was looked at differs from run to run, the rows must not
-            yield from self._replace(worker, f"out of memory: the worker's resident memory went past the per-case "
-                                     f"limit of {self.limits.memory_bytes / GIB:.3g} GiB; the worker was killed", pending)
+            cause = (f"out of memory: the worker's resident memory went past the per-case limit of "
+                     f"{self.limits.memory_bytes / GIB:.3g} GiB; the worker was killed")
+            yield from self._replace(worker, cause, pending)
 
     def _replace(self, worker: _Worker, cause: str, pending: collections.deque) -> Iterator[tuple[object, int, CaseOutcome]]:
         """A new process in ``worker``'s place; the case it ran fails with ``cause``, the rest of its job goes

@@ -146,11 +146,12 @@ def load_engine(target: str, name: str | None = None, taken: frozenset[str] = fr
 def _instantiate(found: object, target: str) -> Engine:
     """An engine from what an entry point loaded: an Engine subclass, or a callable returning an Engine."""
     if not callable(found):
-        raise PluginError(f"{target} is a value of type {type(found).__name__} (allowed: an Engine subclass or a zero-argument "
-                          "callable returning an Engine)")
+        raise PluginError(f"{target} is a value of type {type(found).__name__} (allowed: an Engine subclass or a "
+                          "zero-argument callable returning an Engine)")
     engine = found()
     if not isinstance(engine, Engine):
-        raise PluginError(f"{target}() returned a value of type {type(engine).__name__}, not a simparity.core.engine.Engine")
+        raise PluginError(f"{target}() returned a value of type {type(engine).__name__}, not a "
+                          "simparity.core.engine.Engine")
     return engine
 
 

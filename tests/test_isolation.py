@@ -129,7 +129,8 @@ def test_a_trajectory_that_cannot_be_measured_fails_with_the_error_not_as_a_cras
     table = _first_then_core(tmp_path, "tests.hostile_engines:MalformedEngine")
     rows = table[(table.engine == "malformed") & table.dt.notna()]
     assert set(rows.status) == {"failed"}
-    assert rows.detail.str.contains("its trajectory does not sample the scene: run() returned a value of type dict", regex=False).all()
+    assert rows.detail.str.contains("its trajectory does not sample the scene: run() returned a value of type dict",
+                                    regex=False).all()
 
 
 def test_two_engines_or_two_scenes_of_one_name_are_refused(tmp_path, capsys):

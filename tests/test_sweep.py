@@ -137,7 +137,8 @@ def test_an_index_naming_another_entry_is_ambiguous_but_the_entry_itself_is_not(
     ({"start": 0.0, "stop": 0.9, "num": 3, "spacing": "log"}, "reaches zero or below"),
     ({"start": -1.0, "stop": -0.1, "num": 3, "spacing": "log"}, "reaches zero or below"),
     ({"start": -1e308, "stop": 1e308, "num": 3}, "overflow"),
-    ({"start": 1, "stop": 1.0000000000001, "num": 3}, "3 values from 1.0 to 1.0000000000001 are too close to tell apart"),
+    ({"start": 1, "stop": 1.0000000000001, "num": 3},
+     "3 values from 1.0 to 1.0000000000001 are too close to tell apart"),
     ({"start": 0.1, "stop": 0.9, "num": 3, "step": 0.1}, "'step' is not a range key"),
     ({"start": "a", "stop": 0.9, "num": 3}, "range start: expected a number"),
     ({"restitution": [0.5]}, "TOML reads a bare dotted key"),   # [sweep] contact.restitution = [...], unquoted
