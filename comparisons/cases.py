@@ -99,11 +99,15 @@ class CaseOutcome:
     series : list of SeriesRecord
     errors, floors : dict
         A dynamics case's raw errors and their rounding floors, for the order fits.
+    saturation : dict
+        A dynamics case's saturation ratio of each error (>= 1: saturated; ``metrics.saturation_ratios``).
     integrates_rotation : bool
     ends : dict of str to ndarray
         An IK case's end-effector positions (N, 3) [m] of its solutions by each judge's FK.
     reference_label : str
         An IK case's label naming its judges (the agreement matrix's).
+    theoretical_order : int or None
+        A dynamics case's integrator's theoretical order, as its engine declares it (None: unknown).
     harness_failure : bool
         True when the case did not finish (its worker crashed, hung or ran out of memory): a resumed
         run computes it again.
@@ -117,6 +121,8 @@ class CaseOutcome:
     ends: dict[str, np.ndarray] = field(default_factory=dict)
     reference_label: str = ""
     harness_failure: bool = False
+    saturation: dict[str, float] = field(default_factory=dict)
+    theoretical_order: int | None = None
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from simparity.comparisons.tolerances import Bound, bound_for
-from simparity.core.results import DIMENSIONLESS, OK
+from simparity.core.results import ALARM_FLAGS, DIMENSIONLESS, NOT_AVAILABLE, OK
 
 CASE_KEYS = ("scene", "engine", "integrator", "dt")
 ROW_KEYS = CASE_KEYS + ("metric",)
@@ -73,7 +73,12 @@ class CheckResult:
 
 def _judge(bound: Bound, row) -> tuple[str, str] | None:
     """(what was found, the bound) when ``row`` breaks ``bound``, else None."""
-    status, value, dt = row["status"], float(row["value"]), float(row["dt"])
+    status, value, dt, flag = row["status"], float(row["value"]), float(row["dt"]), row.get("flag", "")
+    flag = flag if isinstance(flag, str) else ""  # a table without flags (read by pandas alone: NaN)
+    if flag in ALARM_FLAGS and flag not in bound.na_when:
+        return f"status {status}, flag {flag}; {row['detail']}"[:300], f"no {flag} flag"
+    if status == NOT_AVAILABLE and flag and flag in bound.na_when:
+        return None
     if status not in bound.statuses:
         allowed = " or ".join(bound.statuses)
         why = f"; {row['detail']}" if row["detail"] and status != OK else ""

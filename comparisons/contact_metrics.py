@@ -20,14 +20,21 @@ Definitions with their reasons are in docs/metrics.md ("Contact").
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
+from simparity.comparisons.body_scales import (
+    body_sizes,
+    lift_energies,
+    shape_points_body,
+    shape_reach,
+    touch_gaps,
+)
 from simparity.comparisons.invariants import kinetic_energy, potential_energy
 from simparity.comparisons.rows import Measured
+from simparity.core.results import NOTHING_TO_MEASURE
 from simparity.core.scene import DynamicsScene
 from simparity.core.trajectory import Trajectory
 from simparity.references.conventions import quat_wxyz_to_matrix
@@ -39,11 +46,18 @@ CONTACT_METRICS = {
     "impacts_missed": "1",
     "restitution_measured": "1",
     "restitution_error": "1",
+    "restitution_min": "1",
+    "restitution_median": "1",
+    "restitution_max": "1",
+    "energy_kept_min": "1",
+    "energy_kept_median": "1",
+    "energy_kept_max": "1",
     "energy_loss_error": "1",
     "penetration_max": "m",
     "tunnelled": "1",
     "energy_gain_max": "1",
     "rest_time_error": "s",
+    "rest_jitter": "m",
     "stopping_distance": "m",
     "stopping_distance_error": "m",
 }
@@ -53,12 +67,12 @@ IMPACTS_COMPARED = 10
 """Impacts compared with the reference's: the issue's first ten bounces; later ones are ever
 shorter (k^n) and fall below any sampling."""
 
-TOUCH_GAP = 1e-9
-"""[m] A sample whose support distance is at most this touches the plane: a body resting on it
-(distance 0 up to rounding of positions of order 1-100 m, ~1e-14) or pressed into it. Free flight
-samples of a falling body are farther: the closest a ballistic sample can come to an impact
-without touching is the body's speed times the sub-step left, which is this small only for
-impacts timed to 1e-9 s."""
+HOP_FRACTION = 0.01
+"""An episode is an impact only if the body falls into it from at least this fraction of its size (its impact
+speed at least sqrt(2 |g_n| HOP_FRACTION size)): lower hops are a soft contact's jitter or a sliding body's
+friction hops, not bounces (MuJoCo's block sliding at 2 m/s hops 0.1 mm, a thousandth of its size, at
+"restitutions" of 1.2-1.5; PyBullet's resting box jitters 0.1 mm). Relative to the body's size, so it moves
+with the scene's length unit; a body that rises less than a hundredth of its size off a plane rests on it."""
 
 JUMP_RTOL = 1e-9
 """An upward jump of the normal velocity within a step larger than this x (|v_n| + |g_n| dt) is
@@ -87,9 +101,12 @@ class Impacts:
         Support height of the apex after the impact [m]; 0 when the body stays, NaN without gravity
         toward the plane or when the run ends inside the episode.
     turning : (N,) ndarray of bool
-        The body turns around the impact (its points move by rotation faster than the scene's
-        rest speed at the sample before or after): the COM's normal velocity is then not the
-        contact point's, and the impact gives no restitution.
+        The body turns around the impact (its points move by rotation faster than the least impact
+        speed at the sample before or after): the COM's normal velocity is then not the contact
+        point's, and the impact gives no restitution.
+    before, after : (N,) ndarray of int
+        The free samples either side of the impact's episode (``after``: the last sample when the run
+        ends inside it).
     """
 
     time: np.ndarray
@@ -97,23 +114,23 @@ class Impacts:
     velocity_out: np.ndarray
     apex: np.ndarray
     turning: np.ndarray
+    before: np.ndarray
+    after: np.ndarray
 
     @property
     def measured(self) -> np.ndarray:
         """(N,) bool: the impact's outcome (a rebound, or staying: 0) is known."""
         return np.isfinite(self.velocity_out)
 
+    @property
+    def rebound_ratio(self) -> np.ndarray:
+        """(N,) v_out / |v_in|: the restitution of each impact (NaN where its outcome is unknown)."""
+        return self.velocity_out / -self.velocity_in
 
-def shape_points_body(shape) -> np.ndarray:
-    """(V, 3) the points of a shape that can be lowest or highest against a plane, relative to the COM in body
-    axes [m], written here from the shape's data (not core's): a box's 8 corners, the given points, the
-    centre of a point or a sphere (whose radius is added apart)."""
-    if shape.kind == "box":
-        signs = np.array(list(itertools.product((-1.0, 1.0), repeat=3)))
-        return shape.center_body + signs * shape.half_extents_body
-    if shape.kind == "points":
-        return np.asarray(shape.points_body, dtype=float)
-    return np.zeros((1, 3))
+    @property
+    def restituting(self) -> np.ndarray:
+        """(N,) bool: impacts that give a restitution (outcome known, the body does not turn)."""
+        return self.measured & ~self.turning
 
 
 def extreme_distances(scene: DynamicsScene, traj: Trajectory, rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -148,12 +165,12 @@ def _episodes(touch: np.ndarray, jump: np.ndarray) -> list[tuple[int, int]]:
 
 
 def episode_samples(times: np.ndarray, distance: np.ndarray, normal_velocity: np.ndarray, normal_gravity: float,
-                    nearest: np.ndarray | None = None) -> list[tuple[int, int]]:
+                    nearest: np.ndarray | None = None, touch_gap: float = 0.0) -> list[tuple[int, int]]:
     """(sample before, sample after) of every contact episode of one body against one plane (see
     :func:`impacts` for the arguments): the samples either side of a run of steps that touch the plane or
     in which the normal velocity jumps up."""
     dt = float(times[1] - times[0]) if len(times) > 1 else 0.0
-    touch = distance <= TOUCH_GAP
+    touch = distance <= touch_gap
     rise = np.diff(normal_velocity) - normal_gravity * dt
     jump = rise > JUMP_RTOL * (np.abs(normal_velocity[:-1]) + abs(normal_gravity) * dt)
     if nearest is not None:
@@ -163,12 +180,16 @@ def episode_samples(times: np.ndarray, distance: np.ndarray, normal_velocity: np
 
 def impacts(times: np.ndarray, distance: np.ndarray, normal_velocity: np.ndarray, normal_gravity: float,
             min_speed: float = 0.0, spin_speed: np.ndarray | None = None,
-            episodes: list[tuple[int, int]] | None = None) -> Impacts:
+            episodes: list[tuple[int, int]] | None = None, touch_gap: float = 0.0) -> Impacts:
     """The impact episodes of one body against one plane from its samples; episodes whose impact speed is
-    below ``min_speed`` [m/s] are settling, not impacts, and are left out. ``spin_speed`` (T,) [m/s]: how
-    fast the body's points move by its rotation (|omega| x its extent); an impact where it exceeds
+    below ``min_speed`` [m/s] are settling, jitter or hops, not impacts, and are left out. ``spin_speed`` (T,)
+    [m/s]: how fast the body's points move by its rotation (|omega| x its extent); an impact where it exceeds
     ``min_speed`` is marked turning. ``episodes``: :func:`episode_samples` of these samples when already
-    found (None: found here, every step counted).
+    found (None: found here, every step counted). ``touch_gap`` [m]: a support distance within which a sample
+    touches the plane.
+
+    An episode the run ends inside has an unknown outcome (NaN rebound and apex), unless the body is on the
+    plane and no longer moving along its normal faster than ``min_speed`` there: it stayed (a rebound of 0).
 
     Parameters
     ----------
@@ -182,53 +203,77 @@ def impacts(times: np.ndarray, distance: np.ndarray, normal_velocity: np.ndarray
         g . N [m/s^2].
     """
     g = -normal_gravity  # > 0 when gravity pulls toward the plane
-    touch = distance <= TOUCH_GAP
-    out: list[tuple[float, float, float, float, bool]] = []
+    touch = distance <= touch_gap
+    last = len(times) - 1
+    out: list[tuple[float, float, float, float, bool, int, int]] = []
     if episodes is None:
-        episodes = episode_samples(times, distance, normal_velocity, normal_gravity)
+        episodes = episode_samples(times, distance, normal_velocity, normal_gravity, touch_gap=touch_gap)
     for before, after in episodes:
         if touch[before] or normal_velocity[before] ** 2 + 2 * g * distance[before] < 0:
             continue  # starts in contact (a body placed on the plane): not an impact
         d, v = distance[before], normal_velocity[before]
         speed_in = math.sqrt(max(v * v + 2 * g * d, 0.0))
+        if speed_in < min_speed:
+            continue
         backed = (v + speed_in) / g if g > 0 else (d / -v if v < 0 else math.nan)
         v_out = apex = math.nan  # the run ends inside the episode: the rebound is unknown
         if not touch[after] and normal_velocity[after] > 0:
             d1, v1 = distance[after], normal_velocity[after]
             v_out = math.sqrt(max(v1 * v1 + 2 * g * d1, 0.0))
             apex = d1 + v1 * v1 / (2 * g) if g > 0 else math.nan
-        elif after < len(times) - 1 or touch[after]:
+        elif after < last or (touch[after] and abs(normal_velocity[after]) <= min_speed):
             v_out = apex = 0.0  # the body stayed on the plane: a rebound of 0, measured
-        if speed_in >= min_speed:
-            spin = 0.0 if spin_speed is None else max(spin_speed[before], spin_speed[after])
-            out.append((times[before] + backed, -speed_in, v_out, apex, spin > min_speed))
-    columns = np.array(out, dtype=float).reshape(-1, 5).T
-    return Impacts(*columns[:4], columns[4].astype(bool))
+        spin = 0.0 if spin_speed is None else max(spin_speed[before], spin_speed[after])
+        out.append((times[before] + backed, -speed_in, v_out, apex, spin > min_speed, before, after))
+    columns = np.array(out, dtype=float).reshape(-1, 7).T
+    return Impacts(*columns[:4], columns[4].astype(bool), columns[5].astype(int), columns[6].astype(int))
 
 
 @dataclass(frozen=True)
 class ContactReading:
-    """What a trajectory shows about contact, per body and plane."""
+    """What a trajectory shows about contact, per body and plane.
+
+    Attributes
+    ----------
+    impacts : dict of (body, plane) to Impacts
+    episodes : dict of (body, plane) to list of (int, int)
+        (sample before, sample after) of every contact episode.
+    distance, highest : (T, B, P) ndarray
+        Support distances [m], and the distances of the highest points (negative: wholly beyond the plane).
+    rest_time : (B,) ndarray
+        First sample time after which the body stays at rest [s]; NaN if never.
+    energy, kinetic : (T, B) ndarray
+        Kinetic + potential, kinetic [J].
+    energy_scale : (B,) ndarray
+        What energy gained at a contact is relative to [J]: the body's largest kinetic energy of the run, at
+        least the energy that lifts it by its own size (a body resting on a plane has no other).
+    energy_kept : dict of (body, plane) to (N,) ndarray
+        Per impact, the energy it keeps (:func:`_energy_kept`); NaN where the outcome is unknown.
+    touch_gap : (B,) ndarray
+        The support distance within which each body touches a plane [m].
+    """
 
     impacts: dict[tuple[int, int], Impacts]
-    episodes: dict[tuple[int, int], list[tuple[int, int]]]  # (sample before, sample after) of every contact episode
-    distance: np.ndarray  # (T, B, P) support distances [m]
-    highest: np.ndarray  # (T, B, P) distances of the highest points [m]; negative: wholly beyond the plane
-    rest_time: np.ndarray  # (B,) first sample time after which the body stays at rest [s]; NaN if never
-    energy: np.ndarray  # (T, B) kinetic + potential [J]
-    kinetic: np.ndarray  # (T, B) [J]
+    episodes: dict[tuple[int, int], list[tuple[int, int]]]
+    distance: np.ndarray
+    highest: np.ndarray
+    rest_time: np.ndarray
+    energy: np.ndarray
+    kinetic: np.ndarray
+    energy_scale: np.ndarray
+    energy_kept: dict[tuple[int, int], np.ndarray]
+    touch_gap: np.ndarray
 
-
-def _extents(scene: DynamicsScene) -> np.ndarray:
-    """(B,) the largest distance of a body's shape from its COM [m]."""
-    return np.array([np.linalg.norm(shape_points_body(s), axis=1).max() + s.radius for s in scene.contact.shapes])
+    def starts_on_plane(self) -> np.ndarray:
+        """(B,) bool: bodies that touch a plane at the first sample."""
+        return (np.abs(self.distance[0]) <= self.touch_gap[:, None]).any(axis=1)
 
 
 def _rest_times(scene: DynamicsScene, traj: Trajectory) -> np.ndarray:
     """(B,) the first sample time from which every later sample's speed (COM speed plus |omega| times
     the body's extent) is within the scene's rest speed; NaN where the body is still moving at the end."""
     speed = (np.linalg.norm(traj.velocity_world, axis=-1)
-             + np.linalg.norm(traj.angular_velocity_world, axis=-1) * _extents(scene))
+             + np.linalg.norm(traj.angular_velocity_world, axis=-1) * shape_reach(scene))
     moving = speed > scene.contact.rest_speed
     out = np.full(len(scene.bodies), math.nan)
     for b in range(len(scene.bodies)):
@@ -245,6 +290,51 @@ def _settling_speed(rest_speed: float, restitution: float) -> float:
     return rest_speed / restitution if restitution > 0 else rest_speed
 
 
+def least_impact_speeds(scene: DynamicsScene) -> np.ndarray:
+    """(B, P) [m/s] the slowest episode that counts as an impact of each body on each plane: the scene's
+    settling speed (:func:`_settling_speed`), or the speed of a fall from :data:`HOP_FRACTION` of the body's
+    size where that is faster."""
+    sizes = body_sizes(scene)
+    out = np.empty((len(scene.bodies), len(scene.contact.planes)))
+    for b in range(len(scene.bodies)):
+        for p in range(len(scene.contact.planes)):
+            hop = math.sqrt(2 * abs(_normal_gravity(scene, p)) * HOP_FRACTION * sizes[b])
+            out[b, p] = max(_settling_speed(scene.contact.rest_speed, scene.contact.restitution[b, p]), hop)
+    return out
+
+
+def _flight_peak(distance: np.ndarray, start: int, stop: int) -> int:
+    """The sample of a flight (samples ``start`` to ``stop``, both free) farthest from the plane: where no contact
+    can act, even one that acts before its body touches (a collision margin, a speculative contact)."""
+    return start + int(np.argmax(distance[start:stop + 1]))
+
+
+def _energy_kept(found: Impacts, episodes: list[tuple[int, int]], energy: np.ndarray, above: np.ndarray,
+                 distance: np.ndarray) -> np.ndarray:
+    """(N,) per impact, 1 + (the energy it gained) / (the body's energy above the plane before it), each read at
+    the peak of the flight before and after it (:func:`_flight_peak`; the sample after the impact when the body
+    stays on the plane): the energy kept, e.g. h_after / h_before for a ball bouncing straight up and down (a
+    turning body whose centre of mass drops further than its lowest point as it settles keeps at least 0). NaN
+    where the outcome is unknown.
+
+    ``energy`` (T,) kinetic + potential [J] (conserved in flight), ``above`` (T,) kinetic + m |g_n| height of the
+    support [J], ``distance`` (T,) support distances [m]; ``episodes`` all of the body's episodes on the plane."""
+    starts = [after for _, after in episodes]
+    ends = [before for before, _ in episodes]
+    last = len(distance) - 1
+    kept = np.full(len(found.time), math.nan)
+    for i, (before, after, known) in enumerate(zip(found.before, found.after, found.measured)):
+        if not known:
+            continue
+        k = ends.index(before)
+        peak_before = _flight_peak(distance, starts[k - 1] if k > 0 else 0, before)
+        stays = found.velocity_out[i] == 0
+        peak_after = after if stays else _flight_peak(distance, after, ends[k + 1] if k + 1 < len(ends) else last)
+        if above[peak_before] > 0:
+            kept[i] = max(0.0, 1 + (energy[peak_after] - energy[peak_before]) / above[peak_before])
+    return kept
+
+
 def read_contact(scene: DynamicsScene, traj: Trajectory) -> ContactReading:
     """Everything the contact metrics need from one trajectory."""
     rotation = quat_wxyz_to_matrix(traj.quat_wxyz)  # SciPy's
@@ -254,48 +344,81 @@ def read_contact(scene: DynamicsScene, traj: Trajectory) -> ContactReading:
     kinetic = kinetic_energy(mass, inertia, traj.velocity_world, traj.angular_velocity_world, rotation)
     potential = (np.zeros_like(kinetic) if scene.forces.gravity_world is None
                  else potential_energy(mass, scene.forces.gravity_world, traj.position_world))
-    found, episodes = {}, {}
-    restitution = scene.contact.restitution
-    spin = np.linalg.norm(traj.angular_velocity_world, axis=-1) * _extents(scene)
+    found, episodes, kept = {}, {}, {}
+    least = least_impact_speeds(scene)
+    gaps = touch_gaps(scene)
+    spin = np.linalg.norm(traj.angular_velocity_world, axis=-1) * shape_reach(scene)
     closest = np.minimum(distance[:-1], distance[1:]).argmin(axis=-1)  # (T - 1, B): each step's nearest plane
     for b in range(len(scene.bodies)):
         for p, plane in enumerate(scene.contact.planes):
             normal_velocity, g_n = traj.velocity_world[:, b] @ plane.normal_world, _normal_gravity(scene, p)
-            episodes[b, p] = episode_samples(traj.times, distance[:, b, p], normal_velocity, g_n, closest[:, b] == p)
-            found[b, p] = impacts(traj.times, distance[:, b, p], normal_velocity, g_n,
-                                  _settling_speed(scene.contact.rest_speed, restitution[b, p]), spin[:, b],
-                                  episodes[b, p])
-    return ContactReading(found, episodes, distance, highest, _rest_times(scene, traj), kinetic + potential, kinetic)
+            episodes[b, p] = episode_samples(traj.times, distance[:, b, p], normal_velocity, g_n, closest[:, b] == p,
+                                             gaps[b])
+            found[b, p] = impacts(traj.times, distance[:, b, p], normal_velocity, g_n, least[b, p], spin[:, b],
+                                  episodes[b, p], gaps[b])
+            above = kinetic[:, b] + mass[b] * abs(g_n) * np.maximum(distance[:, b, p], 0.0)
+            kept[b, p] = _energy_kept(found[b, p], episodes[b, p], kinetic[:, b] + potential[:, b], above,
+                                      distance[:, b, p])
+    scale = np.maximum(kinetic.max(axis=0), lift_energies(scene))
+    return ContactReading(found, episodes, distance, highest, _rest_times(scene, traj), kinetic + potential, kinetic,
+                          scale, kept, gaps)
 
 
-def _own_metrics(scene: DynamicsScene, reading: ContactReading, traj: Trajectory) -> dict[str, Measured]:
-    """Metrics that need no reference: restitution against the requested one, penetration, tunnelling,
-    energy gained, stopping distance."""
+def _nothing(unit: str, why: str) -> Measured:
+    """An n/a value because the run's physics offers nothing to measure (no impact, no motion)."""
+    return Measured(math.nan, unit, flag=NOTHING_TO_MEASURE, unmeasurable=why)
+
+
+def _spread(values: list[float], unit: str, what: str, why: str) -> tuple[Measured, Measured, Measured]:
+    """(min, median, max) of ``values`` over the run's impacts, or three n/a with ``why`` when there are none."""
+    if not values:
+        return _nothing(unit, why), _nothing(unit, why), _nothing(unit, why)
+    note = f"over {len(values)} impacts: {what}"
+    return tuple(Measured(float(f(values)), unit, note=note) for f in (np.min, np.median, np.max))
+
+
+def _restitution_metrics(scene: DynamicsScene, reading: ContactReading) -> dict[str, Measured]:
+    """Restitution at the first impact (against the requested k) and at every impact (min / median / max), and
+    the energy each impact keeps (min / median / max)."""
     out: dict[str, Measured] = {}
     worst, measured, requested = -1.0, math.nan, math.nan
-    turning = False
+    turning = any(found.turning.any() for found in reading.impacts.values())
+    ratios, kept = [], []
     for (b, p), found in reading.impacts.items():
-        known = found.measured & ~found.turning
-        turning |= bool(found.turning.any())
+        known = found.restituting
+        ratios += found.rebound_ratio[known].tolist()
+        kept += reading.energy_kept[b, p][found.measured].tolist()
         if known.any():
             k = float(scene.contact.restitution[b, p])
-            i = int(np.argmax(known))  # the body's first impact with a known outcome
-            e = float(found.velocity_out[i] / -found.velocity_in[i])
+            e = float(found.rebound_ratio[int(np.argmax(known))])  # the body's first impact with a known outcome
             if abs(e - k) > worst:
                 worst, measured, requested = abs(e - k), e, k
+    none = ("the body turns at its impacts: the COM's rebound is not the contact point's" if turning else
+            "no impact: nothing to measure restitution on")
     if worst < 0:
-        none = ("the body turns at its impacts: the COM's rebound is not the contact point's" if turning else
-                "no impact: nothing to measure restitution on")
-        for metric in ("restitution_measured", "restitution_error"):
-            out[metric] = Measured(math.nan, "1", unmeasurable=none)
+        out["restitution_measured"] = out["restitution_error"] = _nothing("1", none)
     else:
         note = f"first impact: measured {measured:.6g}, requested {requested:.6g}"
         out["restitution_measured"] = Measured(measured, "1", note=note)
         out["restitution_error"] = Measured(worst, "1", note=note)
+    requested_k = ", ".join(f"{k:g}" for k in sorted({float(k) for k in np.ravel(scene.contact.restitution)}))
+    out["restitution_min"], out["restitution_median"], out["restitution_max"] = _spread(
+        ratios, "1", f"v_out / |v_in| of each, requested {requested_k}", none)
+    out["energy_kept_min"], out["energy_kept_median"], out["energy_kept_max"] = _spread(
+        kept, "1", "the body's energy above the plane after each over before it (above 1: gained)",
+        "no impact with a known outcome: nothing to measure the energy kept on")
+    return out
+
+
+def _own_metrics(scene: DynamicsScene, reading: ContactReading, traj: Trajectory) -> dict[str, Measured]:
+    """Metrics that need no reference: restitution against the requested one, penetration, tunnelling,
+    energy gained, resting jitter, stopping distance."""
+    out = _restitution_metrics(scene, reading)
     out["penetration_max"] = Measured(float(max(0.0, -reading.distance.min())), "m")
     out["tunnelled"] = Measured(float(_tunnelled(scene, reading, traj).sum()), "1",
                                 note="bodies wholly beyond a plane at the end and still moving away from it")
     out["energy_gain_max"] = _energy_gain(reading)
+    out["rest_jitter"] = _rest_jitter(scene, reading, traj)
     out["stopping_distance"] = _stopping_distance(reading, traj)
     return out
 
@@ -312,12 +435,47 @@ def _tunnelled(scene: DynamicsScene, reading: ContactReading, traj: Trajectory) 
     return ((reading.highest[-1] < 0) & deepest & inward).any(axis=1)
 
 
+def resting_phases(scene: DynamicsScene, reading: ContactReading) -> list[tuple[int, int] | None]:
+    """Per body, (first sample, plane) of the final run of samples in which it rests on a plane, or None: its
+    energy above the plane it ends nearest (kinetic + m |g_n| height of its support) stays within that of a hop
+    of :data:`HOP_FRACTION` of its size, so it cannot rise off the plane by more than a hop."""
+    sizes, out = body_sizes(scene), []
+    for b, body in enumerate(scene.bodies):
+        p = int(np.argmin(reading.distance[-1, b]))
+        lift = body.mass * abs(_normal_gravity(scene, p))
+        above = reading.kinetic[:, b] + lift * np.maximum(reading.distance[:, b, p], 0.0)
+        resting = above <= lift * HOP_FRACTION * sizes[b]
+        if lift == 0 or not resting[-1]:
+            out.append(None)
+            continue
+        moving = np.flatnonzero(~resting)
+        out.append((int(moving[-1]) + 1 if moving.size else 0, p))
+    return out
+
+
+def _rest_jitter(scene: DynamicsScene, reading: ContactReading, traj: Trajectory) -> Measured:
+    """The largest peak-to-peak support distance [m] of a body over its final resting phase
+    (:func:`resting_phases`): 0 for a body held exactly on its plane, a soft contact's persistent jitter else."""
+    jitters, spans = [], []
+    for b, phase in enumerate(resting_phases(scene, reading)):
+        if phase is not None and phase[0] < len(traj.times) - 1:
+            start, p = phase
+            jitters.append(float(np.ptp(reading.distance[start:, b, p])))
+            spans.append(float(traj.times[-1] - traj.times[start]))
+    if not jitters:
+        return _nothing("m", "no body rests on a plane at the end of the run")
+    worst = int(np.argmax(jitters))
+    return Measured(jitters[worst], "m", note=f"peak-to-peak support distance over the last {spans[worst]:.3g} s, "
+                                              "in which the body rests")
+
+
 def contact_energy_gains(reading: ContactReading) -> np.ndarray:
     """(B,) the largest rise of kinetic + potential energy across a contact episode of each body (from the
-    sample before it to the sample after it), relative to the body's largest kinetic energy of the run; 0
-    where it has none. Contact and friction only take energy away; a free flight's own drift between
-    episodes is the integrator's, not the contact's, and is not counted."""
-    scale = reading.kinetic.max(axis=0)
+    sample before it to the sample after it), relative to the body's energy scale (its largest kinetic energy
+    of the run, at least the energy that lifts it by its own size); 0 where it has none. Contact and friction
+    only take energy away; a free flight's own drift between episodes is the integrator's, not the contact's,
+    and is not counted."""
+    scale = reading.energy_scale
     gains = np.zeros(reading.energy.shape[1])
     for (b, _), bounds in reading.episodes.items():
         if bounds and scale[b] > 0:
@@ -329,44 +487,80 @@ def contact_energy_gains(reading: ContactReading) -> np.ndarray:
 def _energy_gain(reading: ContactReading) -> Measured:
     """:func:`contact_energy_gains`, the worst body's."""
     if not any(reading.episodes.values()):
-        return Measured(math.nan, "1", unmeasurable="no contact: no energy to gain at one")
-    if not (reading.kinetic.max(axis=0) > 0).any():
-        return Measured(math.nan, "1", unmeasurable="no body moved: no energy to gain")
+        return _nothing("1", "no contact: no energy to gain at one")
+    if not (reading.energy_scale > 0).any():
+        return _nothing("1", "no body moved and none has weight: no energy to gain")
     gain = float(contact_energy_gains(reading).max())
     if gain <= ENERGY_GAIN_ROUNDING:
-        return Measured(0.0, "1", note=f"rises below {ENERGY_GAIN_ROUNDING:g} of the largest kinetic energy are "
-                        "rounding")
-    return Measured(gain, "1", note="across a contact episode, relative to the run's largest kinetic energy")
+        return Measured(0.0, "1", note=f"rises below {ENERGY_GAIN_ROUNDING:g} of the energy scale are rounding")
+    return Measured(gain, "1", note="across a contact episode, relative to the body's largest kinetic energy (at least "
+                                   "m |g| size)")
 
 
 UNSTABLE_ENERGY_GAIN = 0.1
-"""Energy gained across one contact above 10 % of the run's largest kinetic energy is a blow-up, not an
-error: a stable scheme errs by a few per cent of the impact's energy at the steps run here, while an
-unstable one multiplies the energy by a growing factor each oscillation of a contact spring."""
+"""Energy gained across one contact above 10 % of the body's energy scale is a blow-up, not an error: a
+stable scheme errs by a few per cent of the impact's energy at the steps run here, while an unstable one
+multiplies the energy by a growing factor each oscillation of a contact spring."""
+
+REBOUND_GAIN_TOLERANCE = 0.05
+"""An impact after which the body has more than (1 + 0.05)^2 of its energy above the plane (a rebound 5 %
+faster than the impact: 10 % of the impact's energy gained) gains energy beyond what a soft or penalty contact
+stores and gives back at one impact (MuJoCo and PyBullet show ~1e-4 of it). Read from the energy, not the COM's
+normal rebound: a turning body's rebound is not its contact point's, and a contact that acts on samples that
+look free (PyBullet's speculative contacts at coarse steps) makes the normal rebound read high while the energy
+is kept."""
+
+SUSTAINED_GAIN_IMPACTS = 3
+"""Successive impacts of one body on one plane that each gain more than :data:`REBOUND_GAIN_TOLERANCE` allows
+are a contact that pumps energy in (a penalty spring past its integrator's stability limit), not an error:
+diverged. One or two such impacts stay numbers (``energy_kept_max``, ``restitution_max``, ``energy_gain_max``):
+a grazing impact spread over steps of comparable gravity can gain once."""
+
+
+def sustained_gain(reading: ContactReading) -> tuple[int, int, int, list[float]]:
+    """(impacts, body, plane, the energy each kept) of the longest run of successive impacts of one body on one
+    plane each keeping more than (1 + :data:`REBOUND_GAIN_TOLERANCE`)^2 of the body's energy above the plane;
+    (0, -1, -1, []) when there is none."""
+    best: tuple[int, int, int, list[float]] = (0, -1, -1, [])
+    for (b, p), found in reading.impacts.items():
+        run: list[float] = []
+        for kept in reading.energy_kept[b, p][found.measured].tolist() + [0.0]:
+            if kept > (1 + REBOUND_GAIN_TOLERANCE) ** 2:
+                run.append(kept)
+                continue
+            if len(run) > best[0]:
+                best = (len(run), b, p, run)
+            run = []
+    return best
 
 
 def contact_blow_up(scene: DynamicsScene, reading: ContactReading) -> str:
-    """Why a run counts as diverged at a contact (energy gained beyond :data:`UNSTABLE_ENERGY_GAIN`), or ""."""
+    """Why a run counts as diverged at a contact, or "": energy gained across one contact beyond
+    :data:`UNSTABLE_ENERGY_GAIN`, or a gain sustained over :data:`SUSTAINED_GAIN_IMPACTS` successive impacts."""
     gains = contact_energy_gains(reading)
-    if gains.max(initial=0.0) <= UNSTABLE_ENERGY_GAIN:
-        return ""
-    b = int(np.argmax(gains))
-    return (f"energy of {scene.bodies[b].name} rose by {gains[b]:.3g} of its largest kinetic energy across a contact "
-            f"(limit {UNSTABLE_ENERGY_GAIN:.0%}: contact only takes energy away)")
+    if gains.max(initial=0.0) > UNSTABLE_ENERGY_GAIN:
+        b = int(np.argmax(gains))
+        return (f"energy of {scene.bodies[b].name} rose by {gains[b]:.3g} of its energy scale across a contact "
+                f"(limit {UNSTABLE_ENERGY_GAIN:.0%}: contact only takes energy away)")
+    count, b, p, kept = sustained_gain(reading)
+    if count >= SUSTAINED_GAIN_IMPACTS:
+        shown = ", ".join(f"{k:.3g}" for k in kept[:6]) + (", ..." if count > 6 else "")
+        return (f"{scene.bodies[b].name} gained energy at {count} successive impacts on {scene.contact.planes[p].name} "
+                f"(energy kept {shown} > (1 + {REBOUND_GAIN_TOLERANCE:g})^2: contact only takes energy away)")
+    return ""
 
 
 def _stops(reading: ContactReading, traj: Trajectory) -> np.ndarray:
     """(B,) how far each body that starts on a plane has moved when at rest at the end [m]: |x(end) - x(0)|;
     NaN for a body that does not start on a plane or is still moving at the end."""
-    starts_on = (np.abs(reading.distance[0]) <= TOUCH_GAP).any(axis=1)
     moved = np.linalg.norm(traj.position_world[-1] - traj.position_world[0], axis=-1)
-    return np.where(starts_on & ~np.isnan(reading.rest_time), moved, np.nan)
+    return np.where(reading.starts_on_plane() & ~np.isnan(reading.rest_time), moved, np.nan)
 
 
 def _stopping_distance(reading: ContactReading, traj: Trajectory) -> Measured:
     """The largest stopping distance [m] over bodies that start on a plane and come to rest (sliding)."""
-    if not (np.abs(reading.distance[0]) <= TOUCH_GAP).any():
-        return Measured(math.nan, "m", unmeasurable="no body starts on a plane: stopping distance is for sliding")
+    if not reading.starts_on_plane().any():
+        return _nothing("m", "no body starts on a plane: stopping distance is for sliding")
     stops = _stops(reading, traj)
     if np.isnan(stops).all():
         return Measured(math.nan, "m", unmeasurable="no sliding body is at rest at the end of the run")
@@ -395,6 +589,17 @@ def _compare(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs(a[both] - b[both]).max()) if both.any() else math.nan
 
 
+_UNKNOWN = {
+    "impact_time_error": "no impact time: neither body falls toward the plane at the impacts compared, or they "
+                         "fall in the first step, where both runs back them up from the same initial state",
+    "rebound_velocity_error": "the runs end inside the impacts compared: their rebounds are unknown",
+    "apex_height_error": "no apex: gravity does not pull the body back toward the plane (or the runs end in "
+                         "contact)",
+    "energy_loss_error": "the bodies turn at the impacts compared: the COM's rebound is not the contact point's",
+}
+"""Why an impact comparison has no value although both runs share impacts."""
+
+
 def contact_metrics(scene: DynamicsScene, traj: Trajectory, ref: Trajectory | None,
                     reading: ContactReading | None = None) -> dict[str, Measured]:
     """The contact metrics of ``traj`` (those comparing with a reference only when ``ref`` is given);
@@ -411,36 +616,35 @@ def contact_metrics(scene: DynamicsScene, traj: Trajectory, ref: Trajectory | No
         compared += n
         missed += max(0, n - len(got.time))
         m = min(n, len(got.time))
-        times.append(_compare(got.time[:m], expected.time[:m]))
+        backed_apart = (got.before[:m] > 0) | (expected.before[:m] > 0)  # not both from the initial state
+        times.append(_compare(got.time[:m][backed_apart], expected.time[:m][backed_apart]))
         rebounds.append(_compare(got.velocity_out[:m], expected.velocity_out[:m]))
         apexes.append(_compare(got.apex[:m], expected.apex[:m]))
         still = ~got.turning[:m] & ~expected.turning[:m]
-        energies.append(_compare((got.velocity_out[:m] / got.velocity_in[:m])[still] ** 2,
-                                 (expected.velocity_out[:m] / expected.velocity_in[:m])[still] ** 2))
+        energies.append(_compare(got.rebound_ratio[:m][still] ** 2, expected.rebound_ratio[:m][still] ** 2))
     note = f"over the reference's first {IMPACTS_COMPARED} impacts per body and plane ({compared} here)"
     shared = sum(min(len(truth.impacts[key].time), IMPACTS_COMPARED, len(got.time))
                  for key, got in reading.impacts.items())
-    unknown = {
-        "impact_time_error": "no impact time: neither body falls toward the plane at the impacts compared",
-        "rebound_velocity_error": "the runs end inside the impacts compared: their rebounds are unknown",
-        "apex_height_error": "no apex: gravity does not pull the body back toward the plane (or the runs end in "
-                             "contact)",
-        "energy_loss_error": "the bodies turn at the impacts compared: the COM's rebound is not the contact point's",
-    }
     for metric, values, unit in (("impact_time_error", times, "s"), ("rebound_velocity_error", rebounds, "m/s"),
                                  ("apex_height_error", apexes, "m"), ("energy_loss_error", energies, "1")):
         finite = [v for v in values if math.isfinite(v)]
-        why = (unknown[metric] if shared else "the reference has no impact" if not compared else
-               "this run has none of the reference's impacts (impacts_missed counts them)")
-        out[metric] = Measured(max(finite), unit, note=note) if finite else Measured(math.nan, unit, unmeasurable=why)
+        if finite:
+            out[metric] = Measured(max(finite), unit, note=note)
+        elif shared:
+            out[metric] = _nothing(unit, _UNKNOWN[metric])
+        elif compared:
+            out[metric] = Measured(math.nan, unit, unmeasurable=(
+                "this run has none of the reference's impacts (impacts_missed counts them)"))
+        else:
+            out[metric] = _nothing(unit, "the reference has no impact")
     out["impacts_missed"] = (Measured(float(missed), "1", note=note) if compared else
-                             Measured(math.nan, "1", unmeasurable="the reference has no impact"))
+                             _nothing("1", "the reference has no impact"))
     out["rest_time_error"] = _rest_time_error(reading.rest_time, truth.rest_time, float(traj.times[-1]))
-    if (np.abs(truth.distance[0]) <= TOUCH_GAP).any():
+    if truth.starts_on_plane().any():
         out["stopping_distance_error"] = _stopping_distance_error(reading, traj, truth, ref)
     else:
-        out["stopping_distance_error"] = Measured(math.nan, "m", unmeasurable=(
-            "no body starts on a plane in the reference: stopping distance is for sliding"))
+        out["stopping_distance_error"] = _nothing("m", "no body starts on a plane in the reference: stopping "
+                                                       "distance is for sliding")
     return out
 
 
@@ -450,7 +654,7 @@ def _rest_time_error(rest: np.ndarray, truth: np.ndarray, end: float) -> Measure
     lower bound is the value, and the note says so."""
     either = ~np.isnan(rest) | ~np.isnan(truth)
     if not either.any():
-        return Measured(math.nan, "s", unmeasurable="no body comes to rest in this run or the reference")
+        return _nothing("s", "no body comes to rest in this run or the reference")
     late = np.where(np.isnan(rest), end - truth, np.where(np.isnan(truth), end - rest, np.abs(rest - truth)))[either]
     mismatch = (np.isnan(rest) != np.isnan(truth))[either].any()
     note = ("a body rests in one run and still moves in the other: the error is at least this" if mismatch else

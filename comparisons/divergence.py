@@ -10,8 +10,9 @@ A run is diverged when, for some body,
   contact a plane's impulse can turn a body, and the bound is its energy budget instead:
   |omega| <= sqrt(2 (KE(0) + (m |g| + sum |f_i|) v_max t) / I_min);
 - a quantity the scene conserves grows by more than :data:`CONSERVED_GROWTH_LIMIT` of its
-  initial size: the energy (E - E(0) > limit x |E(0)|, when E(0) is not near zero; contact only
-  takes energy away, so this holds with contact too) or |L| (not with contact).
+  scale: the energy (E - E(0) > limit x the body's energy scale, KE(0) plus the largest drop of its
+  potential energy along the run, at least m |g| size: not |E(0)|, which depends on where the origin
+  is; contact only takes energy away, so this holds with contact too) or |L| (not with contact).
 
 Speeds are compared with :data:`DIVERGENCE_MARGIN` times their bound. Energies come from
 :mod:`comparisons.metrics`, rotations from SciPy; nothing here is in-house code.
@@ -21,9 +22,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from simparity.comparisons.body_scales import body_sizes, energy_scales
 from simparity.comparisons.contact_metrics import ContactReading, contact_blow_up, read_contact
 from simparity.comparisons.invariants import angular_momentum_world
-from simparity.comparisons.metrics import ENERGY_NEAR_ZERO, energies
+from simparity.comparisons.metrics import energies
 from simparity.core.scene import DynamicsScene
 from simparity.core.trajectory import Trajectory
 from simparity.references.conventions import quat_wxyz_to_matrix
@@ -38,8 +40,9 @@ CONSERVED_GROWTH_LIMIT = 1.0
 doubled) is divergence, not drift."""
 
 AT_REST = 1e-9
-"""[m/s or rad/s] Added to every speed bound: a body with no motion budget at all may still
-show rounding-level speeds."""
+"""Added to every speed bound, times the body's size over the run's duration (linear) or one over it
+(angular): a body with no motion budget at all may still show rounding-level speeds. Relative to the
+body's own scales, so that it scales with the scene's units."""
 
 
 def _speed_bounds(scene: DynamicsScene) -> tuple[np.ndarray, np.ndarray]:
@@ -76,14 +79,14 @@ def _speed_bounds(scene: DynamicsScene) -> tuple[np.ndarray, np.ndarray]:
 def _conserved_growth(scene: DynamicsScene, traj: Trajectory) -> str:
     if scene.forces.conserves_energy:
         energy, kinetic, potential = energies(scene, traj)
-        size = np.abs(energy[0])
-        meaningful = size >= ENERGY_NEAR_ZERO * (kinetic + np.abs(potential)).max(axis=0)
+        scale = energy_scales(scene, kinetic, potential)
         growth = (energy - energy[0]).max(axis=0)
-        grown = meaningful & (growth > CONSERVED_GROWTH_LIMIT * size)
+        grown = (scale > 0) & (growth > CONSERVED_GROWTH_LIMIT * scale)
         if grown.any():
-            b = int(np.argmax(np.where(grown, growth / np.where(size > 0, size, 1.0), -np.inf)))
-            return (f"energy of {scene.bodies[b].name} grew to {energy[:, b].max() / energy[0, b]:.3g} x E(0) "
-                    f"(conserved; limit {1 + CONSERVED_GROWTH_LIMIT:g} x)")
+            b = int(np.argmax(np.where(grown, growth / np.where(scale > 0, scale, 1.0), -np.inf)))
+            return (f"energy of {scene.bodies[b].name} rose by {growth[b] / scale[b]:.3g} x its energy scale "
+                    f"{scale[b]:.3g} J (KE(0) + the largest drop of its potential, at least m |g| size; conserved, "
+                    f"limit {CONSERVED_GROWTH_LIMIT:g} x)")
     if scene.forces.conserves_angular_momentum and scene.contact is None:
         inertia = np.stack([b.inertia_body for b in scene.bodies])
         size = np.linalg.norm(angular_momentum_world(
@@ -99,10 +102,12 @@ def _conserved_growth(scene: DynamicsScene, traj: Trajectory) -> str:
 def divergence(scene: DynamicsScene, traj: Trajectory) -> str:
     """Why a finite trajectory counts as diverged (see the module's bounds), or "" when it does not."""
     linear, angular = _speed_bounds(scene)
-    for quantity, values, bound in (("speed", traj.velocity_world, linear),
-                                    ("angular speed", traj.angular_velocity_world, angular)):
+    duration = max(scene.duration, np.finfo(float).tiny)
+    for quantity, values, bound, rounding in (
+            ("speed", traj.velocity_world, linear, AT_REST * body_sizes(scene) / duration),
+            ("angular speed", traj.angular_velocity_world, angular, AT_REST / duration)):
         peak = np.linalg.norm(values, axis=-1).max(axis=0)
-        limit = DIVERGENCE_MARGIN * bound + AT_REST
+        limit = DIVERGENCE_MARGIN * bound + rounding
         over = peak > limit
         if over.any():
             b = int(np.argmax(peak / limit))

@@ -42,7 +42,7 @@ CREATE TABLE IF NOT EXISTS runs (
 CREATE TABLE IF NOT EXISTS results (
     run_id INTEGER NOT NULL REFERENCES runs(id),
     scene TEXT, engine TEXT, integrator TEXT, dt REAL, metric TEXT,
-    value REAL, unit TEXT, reference TEXT, status TEXT, detail TEXT
+    value REAL, unit TEXT, reference TEXT, status TEXT, detail TEXT, flag TEXT
 );
 CREATE INDEX IF NOT EXISTS results_by_metric ON results (scene, engine, metric);
 """
@@ -61,9 +61,19 @@ def _connect(path: Path, create: bool) -> sqlite3.Connection:
             path.parent.mkdir(parents=True, exist_ok=True)
         connection = sqlite3.connect(path, timeout=LOCK_TIMEOUT)
         connection.executescript(_SCHEMA)
+        _add_missing_columns(connection)
         return connection
     except (sqlite3.Error, OSError) as err:
         raise HistoryError(f"{path}: run history unusable: {type(err).__name__}: {err} (allowed: an SQLite file simparity wrote, or a new path)") from None
+
+
+def _add_missing_columns(connection: sqlite3.Connection) -> None:
+    """Bring a database an older simparity wrote up to this one's columns: a results column it lacks (the
+    ``flag`` of schema 2) is added, empty for the runs recorded before."""
+    present = {row[1] for row in connection.execute("PRAGMA table_info(results)")}
+    for column in (c for c in COLUMNS if c not in present):
+        with connection:
+            connection.execute(f"ALTER TABLE results ADD COLUMN {column} TEXT DEFAULT ''")
 
 
 def record_run(path: Path, run_dir: Path, info: dict, table: pd.DataFrame) -> int:
@@ -79,7 +89,8 @@ def record_run(path: Path, run_dir: Path, info: dict, table: pd.DataFrame) -> in
             run_id = cursor.lastrowid
             records = [(run_id, *(None if pd.isna(v) else v for v in row))
                        for row in table[list(COLUMNS)].itertuples(index=False, name=None)]
-            connection.executemany(f"INSERT INTO results VALUES ({', '.join('?' * (len(COLUMNS) + 1))})", records)
+            connection.executemany(f"INSERT INTO results (run_id, {', '.join(COLUMNS)}) "
+                                   f"VALUES ({', '.join('?' * (len(COLUMNS) + 1))})", records)
         return run_id
     except (sqlite3.Error, OSError) as err:
         raise HistoryError(f"{path}: could not record the run: {type(err).__name__}: {err} (allowed: a writable SQLite file simparity wrote)") from None
@@ -108,6 +119,7 @@ def run_table(path: Path, run_id: int) -> pd.DataFrame:
     table = _query(path, f"SELECT {', '.join(COLUMNS)} FROM results WHERE run_id = ?", (run_id,))
     table["integrator"] = table["integrator"].fillna("")
     table["detail"] = table["detail"].fillna("")
+    table["flag"] = table["flag"].fillna("")
     return table.astype({"dt": float, "value": float})
 
 

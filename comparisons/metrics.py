@@ -15,9 +15,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from simparity.comparisons.body_scales import body_sizes, energy_scales
 from simparity.comparisons.contact_metrics import CONTACT_METRICS
 from simparity.comparisons.invariants import angular_momentum_world, kinetic_energy, potential_energy
 from simparity.comparisons.rows import Measured
+from simparity.core.results import (
+    BELOW_THEORY,
+    NOT_CONVERGING,
+    NOTHING_TO_MEASURE,
+    PRE_ASYMPTOTIC,
+    ROUNDING_FLOOR,
+    SATURATED,
+    SUPERCONVERGENT,
+)
 from simparity.core.scene import DynamicsScene
 from simparity.core.trajectory import FramePoses, Trajectory
 from simparity.references.conventions import quat_wxyz_angle, quat_wxyz_to_matrix, rotation_angle
@@ -63,14 +73,31 @@ past pi/2 it no longer grows with the true error. Such a value is n/a ("orientat
 and it is left out of order fits. (Frame errors of forward kinematics do not accumulate and
 are not saturated.)"""
 
-SATURATED_DRIFT = 1.0
-"""A relative drift above 100 % says the quantity has nothing left in common with its start,
-not how far it is off: n/a. (Growth that large is divergence: see comparisons.divergence.)"""
+SATURATED_FRACTION = 0.25
+"""A position, velocity or angular-velocity error at or above this fraction of its quantity's own scale
+(:func:`saturation_scales`) is saturated: the run is on another orbit, and the error no longer measures how
+far. Two states of one scale on unrelated orbits differ by about the scale itself (4/pi of it on average for
+vectors of one length in random directions), so an error of a quarter of it is as large as the quantity's
+variation; a scheme whose error is a third of |omega| (a torque-free box near its separatrix) has lost the
+orbit, which a rule of half the largest possible error (orientation's) would not see. Saturated errors are
+n/a with the scale in the detail, and are left out of order fits."""
 
-ENERGY_NEAR_ZERO = 1e-3
-"""|E(0)| below this fraction of the run's largest energy term (kinetic plus |potential|) is
-"near zero": dividing by it would turn rounding into drift. The drift is then relative to the
-run's largest kinetic energy, and the row says so."""
+NEAR_SATURATION = 0.1
+"""An order fit below :data:`MIN_CONSISTENT_ORDER` whose errors reach this fraction of saturation is read as
+saturating (errors that stop falling within a decade of the quantity's own scale are leaving the orbit); one
+whose errors stay below it does not converge (flag ``not-converging``)."""
+
+MIN_CONSISTENT_ORDER = 0.5
+"""A consistent scheme's error falls at least as dt^1: a clean fit below half of that is never an order of
+convergence (it is saturation, or the errors do not converge)."""
+
+THEORY_BAND = 0.5
+"""An observed order more than this away from the scheme's theoretical order is flagged (``superconvergent``
+above it, ``below-theory`` under it): half the gap between neighbouring integer orders."""
+
+SATURATED_DRIFT = 1.0
+"""A relative drift above 100 % of its scale says the quantity has nothing left in common with its start,
+not how far it is off: n/a. (Growth that large is divergence: see comparisons.divergence.)"""
 
 ROUNDING_FLOOR_FACTOR = 2.0
 """The rounding floor of an error after N steps is this x eps x (N + kappa) x the state's scale:
@@ -93,27 +120,128 @@ def _distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.linalg.norm(a - b, axis=-1)
 
 
-def _orientation_error(angle: float) -> Measured:
-    if angle >= SATURATED_ORIENTATION:
-        return Measured(angle, "rad", unmeasurable=(
+@dataclass(frozen=True)
+class SaturationScale:
+    """The scale an error metric is judged against for saturation, per body.
+
+    Attributes
+    ----------
+    value : (B,) ndarray
+        The scale [the metric's unit]: the largest of ``parts``.
+    parts : dict of str to (B,) ndarray
+        What it is the largest of, by name (the range of motion, the body's size, ...), for the detail.
+    unit : str
+    """
+
+    value: np.ndarray
+    parts: dict[str, np.ndarray]
+    unit: str
+
+    def text(self, body: int) -> str:
+        """``2.1 m/s = max(|v| 2.1, sqrt(2 KE/m) 0.9, size/T 0.01)`` for ``body``."""
+        parts = ", ".join(f"{name} {values[body]:.3g}" for name, values in self.parts.items())
+        return f"{self.value[body]:.3g} {self.unit} = max({parts})"
+
+
+def saturation_scales(scene: DynamicsScene, ref: Trajectory) -> dict[str, SaturationScale]:
+    """Per error metric, the scale of its own quantity over the reference trajectory, each with a physical
+    floor so it never collapses to zero (a box spinning in place has no range of motion, a body at rest no
+    speed), per body:
+
+    - position: max(range of motion max_t |x(t) - x(0)|, the body's size :func:`body_sizes`) [m];
+    - velocity: max(max_t |v|, sqrt(2 KE_max / m), position scale / T) [m/s], KE the whole kinetic energy
+      (a spinning body's points move though its COM does not);
+    - angular velocity: max(max_t |omega|, 1 / T) [rad/s] (a quarter of it is a quarter turn per run), and with
+      contact the velocity scale over the size (an impact can turn a body's speed into spin).
+
+    T is the run's duration. Every scale is invariant under a rigid motion of the scene and scales with its
+    units; the order of the bodies is theirs.
+    """
+    mass = np.array([b.mass for b in scene.bodies])
+    inertia = np.stack([b.inertia_body for b in scene.bodies])
+    duration = max(float(ref.times[-1] - ref.times[0]), np.finfo(float).tiny)
+    rotation = quat_wxyz_to_matrix(ref.quat_wxyz)
+    kinetic = kinetic_energy(mass, inertia, ref.velocity_world, ref.angular_velocity_world, rotation).max(axis=0)
+    travel = np.linalg.norm(ref.position_world - ref.position_world[:1], axis=-1).max(axis=0)
+    length = SaturationScale(np.maximum(travel, body_sizes(scene)), {"range of motion": travel,
+                                                                      "size": body_sizes(scene)}, "m")
+    speed = np.linalg.norm(ref.velocity_world, axis=-1).max(axis=0)
+    energy_speed = np.sqrt(2 * kinetic / mass)
+    velocity_parts = {"|v|": speed, "sqrt(2 KE/m)": energy_speed, "position scale/T": length.value / duration}
+    spin = np.linalg.norm(ref.angular_velocity_world, axis=-1).max(axis=0)
+    spin_parts = {"|omega|": spin, "1/T": np.full(len(mass), 1.0 / duration)}
+    if scene.contact is not None:  # an impact can turn a body's speed into spin
+        spin_parts["velocity scale/size"] = np.maximum.reduce(list(velocity_parts.values())) / body_sizes(scene)
+    velocity = SaturationScale(np.maximum.reduce(list(velocity_parts.values())), velocity_parts, "m/s")
+    angular = SaturationScale(np.maximum.reduce(list(spin_parts.values())), spin_parts, "rad/s")
+    return {"position_error_max": length, "position_error_final": length, "velocity_error_max": velocity,
+            "angular_velocity_error_max": angular}
+
+
+def _orientation_error(angles: np.ndarray) -> tuple[Measured, float]:
+    """(the orientation error of per-body maxima ``angles`` (B,) [rad], its saturation ratio)."""
+    angle = float(angles.max())
+    ratio = angle / SATURATED_ORIENTATION
+    if ratio >= 1:
+        return Measured(angle, "rad", flag=SATURATED, unmeasurable=(
             f"saturated: orientation error {angle:.3g} rad >= pi/2, the orientation is lost and the angle "
-            "no longer measures how far"))
-    return Measured(angle, "rad")
+            "no longer measures how far")), ratio
+    return Measured(angle, "rad"), ratio
 
 
-def trajectory_errors(traj: Trajectory, ref: Trajectory) -> dict[str, Measured]:
-    """Position, orientation (geodesic angle) and velocity errors of ``traj`` against ``ref``."""
+def _saturating_error(metric: str, errors: np.ndarray, scale: SaturationScale | None) -> tuple[Measured, float]:
+    """(the error of per-body maxima ``errors`` (B,), its saturation ratio: the largest error / (fraction x scale)
+    over bodies; 0 without a scale)."""
+    value, unit = float(errors.max()), scale.unit if scale is not None else ""
+    if scale is None:
+        return Measured(value, ""), 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratios = np.where(scale.value > 0, errors / (SATURATED_FRACTION * scale.value), 0.0)
+    body = int(np.argmax(ratios))
+    ratio = float(ratios[body])
+    if ratio >= 1:
+        return Measured(value, unit, flag=SATURATED, unmeasurable=(
+            f"saturated: {metric.replace('_', ' ').removesuffix(' max')} {errors[body]:.3g} {unit} >= "
+            f"{SATURATED_FRACTION:g} x the body's scale {scale.text(body)}: the run is on another orbit")), ratio
+    return Measured(value, unit), ratio
+
+
+_ERROR_UNITS = {"position_error_max": "m", "position_error_final": "m", "velocity_error_max": "m/s",
+                "angular_velocity_error_max": "rad/s"}
+
+
+def trajectory_errors(traj: Trajectory, ref: Trajectory,
+                      scales: dict[str, SaturationScale] | None = None) -> dict[str, Measured]:
+    """Position, orientation (geodesic angle) and velocity errors of ``traj`` against ``ref``, maxima over
+    bodies; with ``scales`` (:func:`saturation_scales`) an error at or above :data:`SATURATED_FRACTION` of its
+    body's scale is saturated (n/a, the scale in its reason). :func:`saturation_ratios` gives how near each is."""
+    return {metric: measured for metric, (measured, _) in _errors(traj, ref, scales).items()}
+
+
+def saturation_ratios(traj: Trajectory, ref: Trajectory, scales: dict[str, SaturationScale]) -> dict[str, float]:
+    """Per error metric, its largest error over the bodies' saturation thresholds (>= 1: saturated)."""
+    return {metric: ratio for metric, (_, ratio) in _errors(traj, ref, scales).items()}
+
+
+def _errors(traj: Trajectory, ref: Trajectory,
+            scales: dict[str, SaturationScale] | None) -> dict[str, tuple[Measured, float]]:
     if traj.position_world.shape != ref.position_world.shape:
         raise ValueError(f"trajectory shape {traj.position_world.shape} != reference {ref.position_world.shape}")
     position = _distance(traj.position_world, ref.position_world)
-    return {
-        "position_error_max": Measured(float(position.max()), "m"),
-        "position_error_final": Measured(float(position[-1].max()), "m"),
-        "orientation_error_max": _orientation_error(float(quat_wxyz_angle(traj.quat_wxyz, ref.quat_wxyz).max())),
-        "velocity_error_max": Measured(float(_distance(traj.velocity_world, ref.velocity_world).max()), "m/s"),
-        "angular_velocity_error_max": Measured(
-            float(_distance(traj.angular_velocity_world, ref.angular_velocity_world).max()), "rad/s"),
+    per_body = {
+        "position_error_max": position.max(axis=0),
+        "position_error_final": position[-1],
+        "velocity_error_max": _distance(traj.velocity_world, ref.velocity_world).max(axis=0),
+        "angular_velocity_error_max": _distance(traj.angular_velocity_world, ref.angular_velocity_world).max(axis=0),
     }
+    out = {}
+    for metric, errors in per_body.items():
+        measured, ratio = _saturating_error(metric, errors, None if scales is None else scales[metric])
+        out[metric] = (Measured(measured.value, _ERROR_UNITS[metric], measured.unmeasurable, flag=measured.flag),
+                       ratio)
+    out["orientation_error_max"] = _orientation_error(quat_wxyz_angle(traj.quat_wxyz, ref.quat_wxyz).max(axis=0))
+    return {m: out[m] for m in ("position_error_max", "position_error_final", "orientation_error_max",
+                                "velocity_error_max", "angular_velocity_error_max")}
 
 
 def kinematics_errors(poses: FramePoses, jacobian: np.ndarray, ref_poses: FramePoses,
@@ -158,26 +286,16 @@ def energies(scene: DynamicsScene, traj: Trajectory) -> tuple[np.ndarray, np.nda
     return kinetic + potential, kinetic, potential
 
 
-def energy_scale(kinetic: np.ndarray, potential: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(what energy drift is relative to, per body (B,); True where that is the fallback).
-
-    |E(0)|, or the largest kinetic energy of the run where |E(0)| is near zero
-    (:data:`ENERGY_NEAR_ZERO`)."""
-    energy0 = np.abs(kinetic[0] + potential[0])
-    magnitude = (kinetic + np.abs(potential)).max(axis=0)
-    fallback = energy0 < ENERGY_NEAR_ZERO * magnitude
-    return np.where(fallback, kinetic.max(axis=0), energy0), fallback
-
-
 def _relative_drift(change: np.ndarray, scale: np.ndarray, quantity: str) -> Measured:
     """Largest change / scale over bodies with a non-zero scale; change (T, B), scale (B,)."""
     measurable = scale > 0
     if not measurable.any():
-        return Measured(math.nan, "1", unmeasurable=f"nothing to measure {quantity} drift against: it is 0")
+        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE,
+                        unmeasurable=f"nothing to measure {quantity} drift against: it is 0")
     drift = float((change[:, measurable] / scale[measurable]).max())
     if drift > SATURATED_DRIFT:
-        return Measured(drift, "1", unmeasurable=(
-            f"saturated: {quantity} changed by {drift:.3g} x its initial size (> {SATURATED_DRIFT:.0%})"))
+        return Measured(drift, "1", flag=SATURATED, unmeasurable=(
+            f"saturated: {quantity} changed by {drift:.3g} x its scale (> {SATURATED_DRIFT:.0%})"))
     return Measured(drift, "1")
 
 
@@ -192,9 +310,7 @@ class ConservedChanges:
     energy : (T, B) ndarray or None
         E(t) - E(0) [J], signed.
     energy_scale : (B,) ndarray or None
-        What energy drift is relative to (:func:`energy_scale`).
-    energy_fallback : (B,) ndarray of bool or None
-        Where that scale is the fallback (|E(0)| near zero).
+        What energy drift is relative to (:func:`comparisons.body_scales.energy_scales`).
     angular_momentum : (T, B) ndarray or None
         |L(t) - L(0)| [kg m^2/s], L about the COM.
     angular_momentum_size : (B,) ndarray or None
@@ -203,7 +319,6 @@ class ConservedChanges:
 
     energy: np.ndarray | None = None
     energy_scale: np.ndarray | None = None
-    energy_fallback: np.ndarray | None = None
     angular_momentum: np.ndarray | None = None
     angular_momentum_size: np.ndarray | None = None
 
@@ -214,8 +329,7 @@ def conserved_changes(scene: DynamicsScene, traj: Trajectory) -> ConservedChange
     out = {}
     if "energy_drift_max" in wanted:
         energy, kinetic, potential = energies(scene, traj)
-        scale, fallback = energy_scale(kinetic, potential)
-        out |= {"energy": energy - energy[0], "energy_scale": scale, "energy_fallback": fallback}
+        out |= {"energy": energy - energy[0], "energy_scale": energy_scales(scene, kinetic, potential)}
     if "angular_momentum_drift_max" in wanted:
         inertia = np.stack([b.inertia_body for b in scene.bodies])
         momentum = angular_momentum_world(inertia, traj.angular_velocity_world, quat_wxyz_to_matrix(traj.quat_wxyz))
@@ -227,7 +341,9 @@ def conserved_changes(scene: DynamicsScene, traj: Trajectory) -> ConservedChange
 def drifts(scene: DynamicsScene, traj: Trajectory, changes: ConservedChanges | None = None) -> dict[str, Measured]:
     """Relative drifts of what the scene conserves, the worst body's:
 
-    - ``energy_drift_max`` = max_t |E(t) - E(0)| / |E(0)| (fallback: :func:`energy_scale`);
+    - ``energy_drift_max`` = max_t |E(t) - E(0)| / the body's energy scale
+      (:func:`comparisons.body_scales.energy_scales`: |E(0)| without gravity; with gravity not |E(0)|, which
+      depends on where the origin is, but the kinetic energy the body has to trade);
     - ``angular_momentum_drift_max`` = max_t |L(t) - L(0)| / |L(0)|, L about the COM.
 
     ``changes``: :func:`conserved_changes` of ``traj`` when already computed.
@@ -235,12 +351,7 @@ def drifts(scene: DynamicsScene, traj: Trajectory, changes: ConservedChanges | N
     changes = changes or conserved_changes(scene, traj)
     out = {}
     if changes.energy is not None:
-        scale = changes.energy_scale
-        drift = _relative_drift(np.abs(changes.energy), scale, "energy")
-        if changes.energy_fallback[scale > 0].any() and not drift.unmeasurable:
-            drift = Measured(drift.value, "1", note=(
-                f"relative to the run's largest kinetic energy: |E(0)| < {ENERGY_NEAR_ZERO:g} x its energies"))
-        out["energy_drift_max"] = drift
+        out["energy_drift_max"] = _relative_drift(np.abs(changes.energy), changes.energy_scale, "energy")
     if changes.angular_momentum is not None:
         out["angular_momentum_drift_max"] = _relative_drift(changes.angular_momentum, changes.angular_momentum_size,
                                                             "angular momentum")
@@ -272,7 +383,7 @@ def _local_slopes(dts: np.ndarray, errors: np.ndarray) -> np.ndarray:
     return np.diff(np.log(errors)) / np.diff(np.log(dts))
 
 
-def observed_order(dts, errors, floors=0.0, saturation: float = math.inf) -> Measured:
+def observed_order(dts, errors, floors=0.0, saturation=0.0, theory: int | None = None) -> Measured:
     """Observed order of convergence over a ladder of time steps, or why there is none.
 
     Parameters
@@ -284,49 +395,95 @@ def observed_order(dts, errors, floors=0.0, saturation: float = math.inf) -> Mea
     floors : float or (K,) array_like
         Rounding floor of each error (:func:`rounding_floors`); errors at or below it are rounding,
         not truncation, and are left out.
-    saturation : float
-        Errors at or above it are saturated and left out.
+    saturation : float or (K,) array_like
+        Saturation ratio of each error (:func:`saturation_ratios`; orientation: angle / (pi/2)); errors at
+        a ratio of 1 or more are saturated and left out.
+    theory : int or None
+        The scheme's theoretical order (None: unknown).
 
     The fit is a least-squares line of log(error) against log(dt) over the finest time steps
     whose local slopes agree with the finest pair's (:data:`ASYMPTOTIC_SLOPE_TOLERANCE`); at
     least :data:`MIN_FIT_POINTS` are needed. The note gives the range, the local slopes and the
-    largest log residual.
+    largest log residual. What the fit shows is typed in the flag (:data:`core.results.FLAGS`): n/a when
+    saturated, at the rounding floor, pre-asymptotic or not converging (a clean fit below
+    :data:`MIN_CONSISTENT_ORDER`: saturating when its errors reach :data:`NEAR_SATURATION` of saturation,
+    rounding when they stay within :data:`ROUNDING_MARGIN` of the floor, else ``not-converging``, an alarm);
+    ok but flagged ``superconvergent`` or ``below-theory`` more than :data:`THEORY_BAND` from ``theory``.
     """
     dts, errors = np.asarray(dts, dtype=float), np.asarray(errors, dtype=float)
     floors = np.broadcast_to(np.asarray(floors, dtype=float), dts.shape)
+    ratios = np.broadcast_to(np.asarray(saturation, dtype=float), dts.shape)
     order = np.argsort(dts)
-    dts, errors, floors = dts[order], errors[order], floors[order]
+    dts, errors, floors, ratios = dts[order], errors[order], floors[order], ratios[order]
     measured = np.isfinite(errors)
     at_floor = measured & (errors <= floors)
-    saturated = measured & (errors >= saturation)
+    saturated = measured & ~at_floor & (ratios >= 1)
     usable = measured & ~at_floor & ~saturated
     left_out = []
     if at_floor.any():
         left_out.append(f"{at_floor.sum()} at the rounding floor, error <= {floors[at_floor].max():.2g}: "
                         "exact up to rounding")
     if saturated.any():
-        left_out.append(f"{saturated.sum()} saturated (error >= {saturation:.3g})")
+        left_out.append(f"{saturated.sum()} saturated (error >= its saturation threshold)")
     if (~measured).any():
         left_out.append(f"{(~measured).sum()} without an error (not run, failed or diverged)")
     why = "; ".join(left_out)
     if usable.sum() < MIN_FIT_POINTS:
-        return Measured(math.nan, "1", unmeasurable=(
+        flag = (SATURATED if saturated.sum() >= max(at_floor.sum(), 1) else ROUNDING_FLOOR if at_floor.any()
+                else "")
+        return Measured(math.nan, "1", flag=flag, unmeasurable=(
             f"too few time steps above the rounding floor and below saturation: {usable.sum()} of {len(dts)}, "
             f"an order needs {MIN_FIT_POINTS}" + (f" ({why})" if why else "")))
-    x, y = dts[usable], errors[usable]
+    x, y, fit_floors, fit_ratios = dts[usable], errors[usable], floors[usable], ratios[usable]
     slopes = _local_slopes(x, y)
     agree = np.abs(slopes - slopes[0]) <= ASYMPTOTIC_SLOPE_TOLERANCE
     n_slopes = int(np.argmin(agree)) if not agree.all() else len(slopes)
     slope_text = ", ".join(f"{s:.3g}" for s in slopes)
     if n_slopes + 1 < MIN_FIT_POINTS:
-        return Measured(math.nan, "1", unmeasurable=(
+        return Measured(math.nan, "1", flag=PRE_ASYMPTOTIC, unmeasurable=(
             f"not in the asymptotic range: local slopes {slope_text} (finest first) differ by more than "
             f"{ASYMPTOTIC_SLOPE_TOLERANCE:g}; finer time steps are needed"))
-    lx, ly = np.log(x[: n_slopes + 1]), np.log(y[: n_slopes + 1])
+    fitted = slice(0, n_slopes + 1)
+    lx, ly = np.log(x[fitted]), np.log(y[fitted])
     slope, intercept = np.polyfit(lx, ly, 1)
     residual = float(np.max(np.abs(ly - (slope * lx + intercept))))
     note = (f"fit over dt {x[0]:.3g}..{x[n_slopes]:.3g} ({n_slopes + 1} of {len(dts)} time steps), "
             f"local slopes {slope_text} (finest first), max log residual {residual:.2g}")
     if why:
         note += f"; left out: {why}"
+    if slope < MIN_CONSISTENT_ORDER:
+        return _inconsistent_fit(float(slope), note, fit_ratios[fitted], y[fitted] / np.maximum(fit_floors[fitted],
+                                                                                                 np.finfo(float).tiny))
+    if theory is not None and slope > theory + THEORY_BAND:
+        return Measured(float(slope), "1", flag=SUPERCONVERGENT, note=(
+            f"superconvergent: {slope:.3g} > theory {theory} + {THEORY_BAND:g} (error terms cancel, or the steps "
+            f"are before the asymptotic range); {note}"))
+    if theory is not None and slope < theory - THEORY_BAND:
+        return Measured(float(slope), "1", flag=BELOW_THEORY, note=(
+            f"below theory: {slope:.3g} < theory {theory} - {THEORY_BAND:g}; {note}"))
     return Measured(float(slope), "1", note=note)
+
+
+ROUNDING_MARGIN = 100.0
+"""A clean fit below :data:`MIN_CONSISTENT_ORDER` whose errors all stay within this factor of their rounding
+floor is rounding (or the reference's own error, of the same size) that the floor's estimate did not cover,
+not a scheme that fails to converge."""
+
+
+def _inconsistent_fit(slope: float, note: str, ratios: np.ndarray, above_floor: np.ndarray) -> Measured:
+    """The n/a of a clean fit of order ``slope`` < :data:`MIN_CONSISTENT_ORDER`, with what its data supports:
+    saturating (``ratios``, the errors' saturation ratios, reach :data:`NEAR_SATURATION`), rounding (every
+    error within :data:`ROUNDING_MARGIN` of its floor, ``above_floor`` = error / floor) or not converging."""
+    head = f"the errors fall only as dt^{slope:.3g} (a consistent scheme's fall at least as dt^1)"
+    if ratios.max() >= NEAR_SATURATION:
+        return Measured(slope, "1", flag=SATURATED, unmeasurable=(
+            f"saturated: {head} within a decade of saturation (at {ratios.max():.2g} of it): the run is leaving "
+            f"the orbit; {note}"))
+    if above_floor.max() <= ROUNDING_MARGIN:
+        return Measured(slope, "1", flag=ROUNDING_FLOOR, unmeasurable=(
+            f"rounding: {head} within {ROUNDING_MARGIN:g} x the rounding floor (at most {above_floor.max():.3g} x "
+            f"it): rounding or the reference's own error; {note}"))
+    return Measured(slope, "1", flag=NOT_CONVERGING, unmeasurable=(
+        f"not converging: {head} far from saturation (at most {ratios.max():.2g} of it) and from the rounding "
+        f"floor: the scheme is inconsistent, or something dt does not control dominates (the reference's own "
+        f"error, a discontinuity); {note}"))

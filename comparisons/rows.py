@@ -28,12 +28,17 @@ class Measured:
     note : str
         How it was measured when that differs from the metric's definition (a fallback);
         it goes first in the row's detail.
+    flag : str
+        The row's typed qualifier (:data:`core.results.FLAGS`): why it is unmeasurable (saturated, at the
+        rounding floor, ...), or what an ok value shows beside theory (superconvergent, ...); "" for a plain
+        measurement.
     """
 
     value: float
     unit: str
     unmeasurable: str = ""
     note: str = ""
+    flag: str = ""
 
 
 @dataclass(frozen=True)
@@ -46,16 +51,17 @@ class Case:
     dt: float
     reference: str
 
-    def _row(self, metric: str, value: float, unit: str, status: str, detail: str) -> ResultRow:
+    def _row(self, metric: str, value: float, unit: str, status: str, detail: str, flag: str = "") -> ResultRow:
         return ResultRow(self.scene, self.engine, self.integrator, self.dt, metric, value, unit, self.reference,
-                         status, detail)
+                         status, detail, flag)
 
     def rows(self, metrics: dict[str, str], status: str, detail: str,
              values: dict[str, Measured] | None = None) -> list[ResultRow]:
         """One row per metric of ``metrics`` ({metric: unit}) with the case's ``status`` and ``detail``.
 
         In an ok case a metric without a finite value, or one marked unmeasurable, is ``n/a``
-        with its own reason only (the case's detail is on its ok rows).
+        with its own reason only (the case's detail is on its ok rows); a measured value's flag goes
+        into the row's ``flag`` (rows of a case that is not ok carry none: the case's status says all).
         """
         values = values or {}
         rows = []
@@ -64,12 +70,12 @@ class Case:
             if status != OK:
                 rows.append(self._row(metric, measured.value, unit, status, detail))
             elif measured.unmeasurable:
-                rows.append(self._row(metric, math.nan, unit, NOT_AVAILABLE, measured.unmeasurable))
+                rows.append(self._row(metric, math.nan, unit, NOT_AVAILABLE, measured.unmeasurable, measured.flag))
             elif not math.isfinite(measured.value):
                 rows.append(self._row(metric, math.nan, unit, NOT_AVAILABLE, f"nothing to measure {metric} against"))
             else:
                 note = f"{measured.note}; " if measured.note else ""
-                rows.append(self._row(metric, measured.value, unit, OK, note + detail))
+                rows.append(self._row(metric, measured.value, unit, OK, note + detail, measured.flag))
         return rows
 
     def partial_rows(self, metrics: dict[str, str], values: dict[str, Measured], detail: str, missing_status: str,

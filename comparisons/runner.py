@@ -38,13 +38,14 @@ from simparity.comparisons.metrics import (
     ORDER_METRICS,
     ORDER_SOURCES,
     ROTATIONAL_ORDERS,
-    SATURATED_ORIENTATION,
     conserved_changes,
     drifts,
     dynamics_metrics,
     kinematics_errors,
     observed_order,
     rounding_floors,
+    saturation_ratios,
+    saturation_scales,
     trajectory_errors,
 )
 from simparity.comparisons.rows import Case, Measured, error_text, warnings_into_rows
@@ -85,6 +86,12 @@ class _Ladder:
     @property
     def integrates_rotation(self) -> bool:
         return all(case.integrates_rotation for case in self.cases)
+
+    @property
+    def theory(self) -> int | None:
+        """The theoretical order the engine declares for the integrator (None unless its cases that say one agree)."""
+        orders = {case.theoretical_order for case in self.cases if case.theoretical_order is not None}
+        return orders.pop() if len(orders) == 1 else None
 
 
 def _ignore_start(index: int | None) -> None:
@@ -159,7 +166,18 @@ def _dynamics_case_at(group: CaseGroup, shared: _DynamicsShared, index: int, eng
                                  group.repeats, is_reference)
         rows += outcome.rows
     outcome.rows = rows
+    outcome.theoretical_order = _theory(engine, spec.integrator)
     return outcome
+
+
+def _theory(engine: Engine, integrator: str) -> int | None:
+    """The integrator's theoretical order as the engine declares it; None when it does not say (or fails to: a
+    user's engine whose other answers are its rows' business)."""
+    try:
+        order = engine.theoretical_order(integrator)
+    except Exception:  # noqa: BLE001 - a user's engine; its rows report what fails
+        return None
+    return order if isinstance(order, int) and not isinstance(order, bool) and order > 0 else None
 
 
 def _no_integrator_rows(scene: DynamicsScene, engine: Engine, case: Case, metrics: dict) -> list[ResultRow]:
@@ -291,12 +309,14 @@ def _measured_case(scene, sim, case: Case, metrics: dict, n: int, traj, seconds:
             problem, status = ref_problem
             return CaseOutcome(case.partial_rows(metrics, values, sim.detail, status, problem), series, floors=floors,
                                integrates_rotation=sim.integrates_rotation)
-        values.update(trajectory_errors(traj, ref_traj))
+        scales = saturation_scales(scene, ref_traj)
+        values.update(trajectory_errors(traj, ref_traj, scales))
+        saturation = saturation_ratios(traj, ref_traj, scales)
         if reading is not None:
             values.update(contact_metrics(scene, traj, ref_traj, reading))
     detail = ("this is the reference; " if is_reference else "") + sim.detail
     return CaseOutcome(case.rows(metrics, OK, detail, values), series, {m: v.value for m, v in values.items()},
-                       floors, sim.integrates_rotation)
+                       floors, sim.integrates_rotation, saturation=saturation)
 
 
 @dataclass(frozen=True)
@@ -374,9 +394,9 @@ def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_l
                 values[metric] = Measured(math.nan, "1", unmeasurable=(
                     "point-mass rule: the integrator does not move orientation, so it has no rotational order"))
                 continue
-            saturation = SATURATED_ORIENTATION if source == "orientation_error_max" else math.inf
             values[metric] = observed_order(ladder.dts, [c.errors.get(source, math.nan) for c in ladder.cases],
-                                            [c.floors.get(source, 0.0) for c in ladder.cases], saturation)
+                                            [c.floors.get(source, 0.0) for c in ladder.cases],
+                                            [c.saturation.get(source, 0.0) for c in ladder.cases], ladder.theory)
         rows += case.rows(ORDER_METRICS, OK, f"against {ref_label}", values)
     return rows
 

@@ -15,7 +15,11 @@ Kinds of bound (one table may combine them): ``max`` (value <= max), ``min`` (va
 ``expected`` with ``band`` (absolute, +-) or ``rel`` (relative to ``expected``), any of them scaled
 by dt^``dt_power`` (a scheme's known error, e.g. C dt^1 for Euler), and ``status`` (the statuses the
 row may have; default ``ok`` when a number is bounded, so a metric that went ``n/a`` is a
-violation, not a pass; ``status = "diverged"`` makes a blow-up the expected verdict).
+violation, not a pass; ``status = "diverged"`` makes a blow-up the expected verdict). ``na_when``
+lists the flags (``core.results.FLAGS``) with which an ``n/a`` row is the right answer although the
+bound wants a number (``na_when = ["nothing-to-measure"]``: a resting run has no energy to gain). A
+row flagged with an alarm (``not-converging``) breaks every bound whose ``na_when`` does not name it,
+whatever its status.
 
 A bound may name one time step (``dt``, in seconds) or ``dt = "*"`` (every time step, but not
 the order rows, which have none); without ``dt`` it holds for every row.
@@ -33,7 +37,7 @@ from pathlib import Path
 
 from simparity.core.errors import SceneError, ToleranceError
 from simparity.core.files import read_toml
-from simparity.core.results import OK, STATUSES
+from simparity.core.results import FLAGS, OK, STATUSES
 
 
 DEFAULT_TOLERANCES = Path(__file__).resolve().parent / "tolerances" / "default.toml"
@@ -41,7 +45,7 @@ DEFAULT_TOLERANCES = Path(__file__).resolve().parent / "tolerances" / "default.t
 
 MATCH_KEYS = ("scene", "engine", "integrator", "metric")
 NUMBER_KEYS = ("max", "min", "expected", "band", "rel", "dt_power")
-ALLOWED_KEYS = MATCH_KEYS + ("dt",) + NUMBER_KEYS + ("status", "reason")
+ALLOWED_KEYS = MATCH_KEYS + ("dt",) + NUMBER_KEYS + ("status", "na_when", "reason")
 DT_MATCH = 1e-9
 """Relative difference under which a bound's ``dt`` [s] names a row's time step."""
 
@@ -61,6 +65,9 @@ class Bound:
         See the module docstring; ``None`` where not given.
     statuses : tuple of str
         Statuses the row may have.
+    na_when : tuple of str
+        Flags with which an n/a row passes although ``statuses`` does not allow n/a; an alarm flag passes
+        only when named here.
     reason : str
         Why the bound is what it is.
     where : str
@@ -84,6 +91,7 @@ class Bound:
     reason: str
     where: str
     order: int
+    na_when: tuple[str, ...] = ()
 
     @property
     def specificity(self) -> int:
@@ -169,8 +177,14 @@ def _bound(source: str, index: int, table) -> Bound:
         if not statuses or any(s not in STATUSES for s in statuses):
             raise ToleranceError(source, f"{where}.status", f"{status!r:.60} is not a status or a list of them",
                                  ", ".join(STATUSES))
+    na_when = table.get("na_when", [])
+    if isinstance(na_when, str):
+        na_when = [na_when]
+    if not isinstance(na_when, list) or any(f not in FLAGS for f in na_when):
+        raise ToleranceError(source, f"{where}.na_when", f"{na_when!r:.60} is not a flag or a list of them",
+                             ", ".join(FLAGS))
     bound = Bound(**patterns, dt=dt, **numbers, statuses=statuses, reason=reason.strip(), where=f"{source}: {where}",
-                  order=index)
+                  order=index, na_when=tuple(na_when))
     if not bound.bounds_a_number and status is None:
         raise ToleranceError(source, where, "bounds nothing", "max, min, expected or status")
     return bound

@@ -12,13 +12,16 @@ import numpy as np
 
 from simparity.core.arrays import readonly
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+"""2: the ``flag`` column (:data:`FLAGS`). Version 1 runs, without it, are read with every flag empty."""
+READ_SCHEMA_VERSIONS = (1, 2)
+"""Stored runs this simparity reads."""
 RESULTS_FILE = "results.csv"
 RUN_INFO_FILE = "run.json"
 REPORT_FILE = "report.md"
 REPORT_HTML_FILE = "report.html"
 
-COLUMNS = ("scene", "engine", "integrator", "dt", "metric", "value", "unit", "reference", "status", "detail")
+COLUMNS = ("scene", "engine", "integrator", "dt", "metric", "value", "unit", "reference", "status", "detail", "flag")
 """The columns of every run. A run with a swept scene (a file's ``[sweep]``) has the sweep columns after
 them; a run without has exactly these."""
 
@@ -42,6 +45,31 @@ STATUSES = (OK, NOT_AVAILABLE, FAILED, DIVERGED)
 failed: the engine or adapter raised (detail has the error). diverged: the run produced
 non-finite values."""
 
+SATURATED, ROUNDING_FLOOR, PRE_ASYMPTOTIC, SUPERCONVERGENT, BELOW_THEORY, NOT_CONVERGING, NOTHING_TO_MEASURE = (
+    "saturated", "rounding-floor", "pre-asymptotic", "superconvergent", "below-theory", "not-converging",
+    "nothing-to-measure")
+FLAGS = {
+    SATURATED: "n/a: the error is as large as the quantity it measures (the run is on another orbit, or an "
+               "orientation is lost): it no longer measures how far; the detail names the scale",
+    ROUNDING_FLOOR: "n/a: the errors are at the rounding floor of the run (the scheme is exact up to rounding)",
+    PRE_ASYMPTOTIC: "n/a: an order whose local slopes disagree: the time steps are not in the asymptotic range",
+    SUPERCONVERGENT: "ok: a clean order fit above the scheme's theoretical order + 0.5 (error terms cancel, or "
+                     "the steps are before the asymptotic range); the detail gives the local slopes",
+    BELOW_THEORY: "ok: a clean order fit below the scheme's theoretical order - 0.5: the scheme is not the one it "
+                  "claims to be, or the steps are before the asymptotic range",
+    NOT_CONVERGING: "n/a, and an alarm: a clean fit of order below 0.5 on errors far from saturation: the errors do "
+                    "not fall with dt (the scheme is inconsistent, or something dt does not control dominates); "
+                    "the gate fails it unless a bound names it",
+    NOTHING_TO_MEASURE: "n/a: the physics of this run offers nothing to measure (no impact, no motion, a quantity "
+                        "that is 0)",
+}
+"""The typed qualifiers of a row (its ``flag`` column; empty for a plain measurement): why a row is n/a when the
+number would mean nothing, and what an ok order fit shows beside theory. The report's findings and the gate read
+them; nobody parses the detail."""
+
+ALARM_FLAGS = (NOT_CONVERGING,)
+"""Flags that are a violation of every bound that does not name them (``na_when``): n/a, but not an honest one."""
+
 DIMENSIONLESS = "1"
 """The unit of a dimensionless metric (a ratio, a drift, an order), as SI writes it."""
 
@@ -64,6 +92,7 @@ class ResultRow:
     reference: str
     status: str
     detail: str = ""
+    flag: str = ""
 
     def as_dict(self) -> dict:
         return asdict(self)

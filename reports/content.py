@@ -62,12 +62,13 @@ _IK_PROTOCOL = (
 _TIMING_METRICS = ("time_per_step", "time_per_fk", "time_per_solve")
 _DEFINITIONS = (
     "Statuses: `ok` measured; `n/a` not measured, with the reason: the engine cannot do what the scene asks, "
-    "or the metric means nothing here (an orientation error saturated at >= pi/2, a drift above 100 %, errors at "
-    "the rounding floor, too few time steps for an order, a point-mass rule that does not move orientation, "
-    "nothing to compare against); `diverged` non-finite, or faster than the scene's forces allow, or a conserved "
-    "quantity more than doubled; `failed` the engine raised. A status cell names the metrics it is about. "
-    "Energy drift is max |E(t) - E(0)| / |E(0)| (potential zero at the world origin; relative to the largest "
-    "kinetic energy when |E(0)| is near zero, and the row says so); angular momentum drift is "
+    "or the metric means nothing here (saturated: an orientation error at >= pi/2, another error at >= 1/4 of "
+    "its quantity's scale, a drift above 100 %; errors at the rounding floor; too few time steps or no asymptotic "
+    "range for an order; a point-mass rule that does not move orientation; nothing to compare against); `diverged` "
+    "non-finite, or faster than the scene's forces allow, or a conserved quantity more than doubled, or a contact "
+    "that gains energy; `failed` the engine raised. A status cell names the metrics it is about. "
+    "Energy drift is max |E(t) - E(0)| / the body's energy scale (KE(0) plus the largest drop of its potential "
+    "energy, at least m |g| size: not |E(0)|, which depends on where the origin is); angular momentum drift is "
     "max |L(t) - L(0)| / |L(0)|. Cost is compute per simulated second, time per step / dt. Definitions: "
     "docs/metrics.md."
 )
@@ -296,8 +297,8 @@ class _Builder:
         for scene, g in gains.groupby("scene", sort=False):
             cases = ", ".join(f"{r['engine']} {r['integrator']} +{number(r['gain_max'])} (dt {_dts(r)}"
                               f"{self.in_variants(r, '; ')})" for _, r in g.iterrows())
-            items.append(f"**energy gained** in {scene} (conserves energy; largest (E - E(0)) / E(0) per scheme): "
-                         + cases)
+            items.append(f"**energy gained** in {scene} (conserves energy; largest (E - E(0)) / the body's energy "
+                         "scale per scheme): " + cases)
         flags = self.merged(summary.contact_flags(self.table), ["metric", "engine", "integrator"],
                             value_max=("value_max", "max"), dts=("dts", union))
         for (scene, metric), g in flags.groupby(["scene", "metric"], sort=False):
@@ -308,6 +309,7 @@ class _Builder:
         for _, s in self.merged(summary.saturated(self.table), ["metric"], n_cases=("n_cases", "sum")).iterrows():
             items.append(f"**saturated**: {s['scene']} `{s['metric']}` in {s['n_cases']} cases{self.in_variants(s)} "
                          "(n/a: the error lost all meaning there)")
+        items += self.order_findings()
         blocks: list[Block] = [Heading(3, "Flagged findings")]
         verdict = self.verdict
         unbounded = f"; {verdict.unchecked} without a bound, so not held to anything" if verdict and verdict.unchecked else ""
@@ -326,6 +328,21 @@ class _Builder:
             blocks.append(Details(f"{len(verdict.violations)} metrics outside their bounds",
                                   (Bullets(tuple(f"`{v}`" for v in verdict.violations)),)))
         return blocks
+
+    def order_findings(self) -> list[str]:
+        """One line per scene x flag of order fits flagged as findings (:func:`reports.summary.order_findings`)."""
+        what = {"not-converging": "**orders that do not converge** (errors far from saturation and rounding that "
+                                  "do not fall with dt: an alarm)",
+                "below-theory": "**orders below theory** (clean fits more than 0.5 under the scheme's order)",
+                "superconvergent": "**superconvergent orders** (clean fits more than 0.5 above the scheme's order: "
+                                   "error terms cancel, or the steps are before the asymptotic range)",
+                "pre-asymptotic": "**orders not in the asymptotic range** (local slopes disagree: finer steps needed)"}
+        items = []
+        for (scene, flag), g in summary.order_findings(self.table).groupby(["scene", "flag"], sort=False):
+            cases = ", ".join(f"{r['engine']} {r['integrator']} "
+                              + "/".join(number(v) if v == v else "n/a" for v in r["values"]) for _, r in g.iterrows())
+            items.append(f"{what[flag]} in {scene}: {cases}")
+        return items
 
     def unresolved(self) -> list[Block]:
         cases = summary.unresolved_cases(self.table)

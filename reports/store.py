@@ -13,8 +13,8 @@ from simparity.core.errors import ResultsError, one_line
 from simparity.core.results import (
     COLUMNS,
     RESULTS_FILE,
+    READ_SCHEMA_VERSIONS,
     RUN_INFO_FILE,
-    SCHEMA_VERSION,
     SERIES_COLUMNS,
     SERIES_FILE,
     SWEEP_COLUMN,
@@ -49,9 +49,11 @@ def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
     except (json.JSONDecodeError, pd.errors.ParserError, UnicodeDecodeError, ValueError) as err:
         raise ResultsError(f"{one_line(run_dir)}: unreadable stored run: {one_line(err)} (allowed: a folder written by "
                            "'simparity run')") from None
-    if meta.get("schema_version") != SCHEMA_VERSION:
-        raise ResultsError(f"{info}: schema_version {meta.get('schema_version')!r:.20} (allowed: {SCHEMA_VERSION}, the "
-                           "version this simparity reads)")
+    if meta.get("schema_version") not in READ_SCHEMA_VERSIONS:
+        raise ResultsError(f"{info}: schema_version {meta.get('schema_version')!r:.20} (allowed: "
+                           f"{', '.join(map(str, READ_SCHEMA_VERSIONS))}, the versions this simparity reads)")
+    if "flag" not in table.columns:  # schema 1: written before rows carried a flag
+        table.insert(table.columns.get_loc("detail") + 1, "flag", "")
     missing = [c for c in COLUMNS if c not in table.columns]
     if missing:
         raise ResultsError(f"{results}: missing columns {missing} (allowed: a results.csv with {', '.join(COLUMNS)})")

@@ -9,7 +9,17 @@ import math
 
 import pandas as pd
 
-from simparity.core.results import GROUND_TRUTH_ENGINES, NOT_AVAILABLE, OK, case_status
+from simparity.core.results import (
+    BELOW_THEORY,
+    GROUND_TRUTH_ENGINES,
+    NOT_AVAILABLE,
+    NOT_CONVERGING,
+    OK,
+    PRE_ASYMPTOTIC,
+    SATURATED,
+    SUPERCONVERGENT,
+    case_status,
+)
 
 ERROR_BUDGETS = (1e-3, 1e-6, 1e-9)
 """Error budgets [the headline metric's unit] the summary finds the cheapest scheme for: a coarse
@@ -142,9 +152,26 @@ def energy_gains(series: pd.DataFrame) -> pd.DataFrame:
 
 
 def saturated(table: pd.DataFrame) -> pd.DataFrame:
-    """Per scene x metric, how many cases had the metric saturated (n/a: it lost all meaning)."""
-    rows = table[(table["status"] == NOT_AVAILABLE) & table["detail"].str.startswith("saturated")]
+    """Per scene x metric, how many cases had the metric saturated (n/a, flagged ``saturated``: it lost all
+    meaning), order fits left out (:func:`order_findings` has them)."""
+    rows = table[(table["flag"] == SATURATED) & table["dt"].notna()]
     return rows.groupby(["scene", "metric"], sort=False).size().rename("n_cases").reset_index()
+
+
+ORDER_FINDINGS = (NOT_CONVERGING, BELOW_THEORY, SUPERCONVERGENT, PRE_ASYMPTOTIC)
+"""Order fits a report lists as findings, by flag, in this order: errors that do not converge (an alarm),
+clean fits away from theory either way, fits whose time steps are not in the asymptotic range."""
+
+
+def order_findings(table: pd.DataFrame) -> pd.DataFrame:
+    """Order fits flagged with one of :data:`ORDER_FINDINGS`, ground truths left out: per scene x flag x engine x
+    integrator, the metrics (``order_position`` ...) and their values (NaN where n/a), with one detail."""
+    rows = table[table["dt"].isna() & table["flag"].isin(ORDER_FINDINGS) & ~table["engine"].isin(GROUND_TRUTH_ENGINES)]
+    grouped = rows.groupby(["scene", "flag", "engine", "integrator"], sort=False).agg(
+        metrics=("metric", list), values=("value", list), detail=("detail", "first"))
+    rank = {flag: i for i, flag in enumerate(ORDER_FINDINGS)}
+    out = grouped.reset_index()
+    return out.sort_values("flag", key=lambda c: c.map(rank), kind="stable").reset_index(drop=True)
 
 
 

@@ -114,3 +114,45 @@ def test_a_run_with_sweep_columns_is_checked_and_compared_like_any_other(bounds,
     assert (verdict.checked, len(lines)) == (4, 2) and lines == [v.line() for v in check_table(old, bounds).violations]
     diff = compare_with_baseline(new, old)
     assert not (diff.moved or diff.missing or diff.new)
+
+
+def test_a_bound_says_when_n_a_is_the_right_answer(tmp_path):
+    """A bound that wants a number passes an n/a row whose flag it names in na_when (a resting run has no energy
+    to gain), and fails an n/a row of another flag or none (the engine could not measure it)."""
+    path = tmp_path / "tol.toml"
+    path.write_text("""
+[[bound]]
+metric = "energy_gain_max"
+max = 0.0
+na_when = ["nothing-to-measure"]
+reason = "contact only takes energy away"
+""", encoding="utf-8")
+    bounds = load_tolerances(path)
+    resting = dataclasses.replace(_row("energy_gain_max", math.nan, "n/a"), flag="nothing-to-measure")
+    unmeasured = _row("energy_gain_max", math.nan, "n/a")
+    result = check_table(_table([resting, unmeasured]), bounds)
+    assert result.checked == 2 and len(result.violations) == 1 and result.violations[0].found.startswith("status n/a")
+
+
+def test_an_alarm_flag_fails_every_bound_that_does_not_name_it(bounds, tmp_path):
+    """An order that does not converge is n/a, which the catch-all allows; its alarm flag fails it anyway, unless
+    a bound names the flag in na_when."""
+    alarm = dataclasses.replace(_row("order_position", math.nan, "n/a", integrator="midpoint"), flag="not-converging")
+    result = check_table(_table([alarm]), bounds)
+    assert len(result.violations) == 1 and "not-converging" in result.violations[0].found
+    path = tmp_path / "tol.toml"
+    path.write_text("""
+[[bound]]
+metric = "order_*"
+status = ["ok", "n/a"]
+na_when = ["not-converging"]
+reason = "this scene's errors are dominated by its reference's own error"
+""", encoding="utf-8")
+    assert check_table(_table([alarm]), load_tolerances(path)).passed
+
+
+def test_na_when_names_flags_only(tmp_path):
+    path = tmp_path / "tol.toml"
+    path.write_text('[[bound]]\nmetric = "*"\nstatus = "ok"\nna_when = ["nothing"]\nreason = "r"\n', encoding="utf-8")
+    with pytest.raises(Exception, match="na_when"):
+        load_tolerances(path)

@@ -11,8 +11,10 @@ import pytest
 from simparity.comparisons.cli import EXIT_OK, EXIT_USAGE, main
 from simparity.comparisons.engines import DEFAULT_ENGINES
 from simparity.comparisons.library import builtin_paths
+from simparity.comparisons.profiles import quick
 from simparity.core.results import COLUMNS, NOT_AVAILABLE, OK, STATUSES
 from simparity.reports.store import read_run
+from tests.helpers import builtin
 from tests.test_scene_loader import BROKEN
 
 
@@ -211,8 +213,9 @@ def test_run_check_junit_summary_and_history(tmp_path, capsys):
     out = capsys.readouterr().out
     assert code == 1
     violations = [line for line in out.splitlines() if line.startswith("violation: ")]
-    assert len(violations) == 3 and all("rk4" in v and "tighter than rounding" in v for v in violations)
-    assert ET.parse(junit).getroot().get("failures") == "3"
+    steps = len(quick(builtin("lecture-projectile")).dts)  # one violation per time step of the quick profile
+    assert len(violations) == steps and all("rk4" in v and "tighter than rounding" in v for v in violations)
+    assert ET.parse(junit).getroot().get("failures") == str(steps)
     assert "## simparity check: failed" in summary.read_text(encoding="utf-8")
     second = tmp_path / "second"
     assert main(["run", "lecture-projectile", "--quick", "--engines", "core", "--out", str(second), "--jobs", "1"]) == 0

@@ -1,5 +1,6 @@
 """Contact metrics read from sampled trajectories built here by hand (a ball's exact bounce sequence)."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -115,8 +116,9 @@ def test_a_bouncier_run_shows_its_restitution_energy_gain_and_late_impacts():
     gaining = _trajectory(one_rebound, *_bounce_heights(one_rebound, 1.1))
     gain = contact_metrics(_scene(0.5), gaining, None)["energy_gain_max"].value
     # The impact adds (k^2 - 1) K1 (free flight conserves energy between the samples around it), relative
-    # to the largest kinetic energy among the samples.
-    largest = 0.5 * np.max(gaining.velocity_world[:, 0, 2] ** 2)
+    # to the body's energy scale: the largest kinetic energy among the samples, at least m |g| size (the
+    # 1 kg point of inertia 1 kg m^2 has the size sqrt(3 / 2) m).
+    largest = max(0.5 * np.max(gaining.velocity_world[:, 0, 2] ** 2), G * math.sqrt(1.5))
     assert gain == pytest.approx((1.1**2 - 1) * 0.5 * 2 * G * H / largest, rel=1e-9)
 
 
@@ -153,3 +155,109 @@ def test_a_turning_body_gives_no_restitution():
     values = contact_metrics(_scene(k, Shape("sphere", radius=0.1)), spinning, spinning)
     assert "turns" in values["restitution_measured"].unmeasurable
     assert values["impact_time_error"].value == 0.0
+
+
+def _gaining_bounces(times: np.ndarray, ratios: list[float]) -> tuple[np.ndarray, np.ndarray]:
+    """Height and velocity of the ball dropped from H whose n-th impact rebounds at ratios[n] x its impact speed
+    (then k = 0.5), written from the same textbook sequence as :func:`_bounce_heights`."""
+    t, speed, starts, speeds = math.sqrt(2 * H / G), math.sqrt(2 * G * H), [0.0], [0.0]
+    heights0 = [H]
+    for ratio in ratios + [0.5] * 20:
+        speed *= ratio
+        starts.append(t)
+        speeds.append(speed)
+        heights0.append(0.0)
+        t += 2 * speed / G
+    index = np.searchsorted(starts, times, side="right") - 1
+    tau = times - np.array(starts)[index]
+    v0, h0 = np.array(speeds)[index], np.array(heights0)[index]
+    return h0 + v0 * tau - G * tau * tau / 2, v0 - G * tau
+
+
+def test_a_sustained_gain_is_a_blow_up_and_a_single_one_a_number():
+    """After a nearly plastic first impact, three successive rebounds 20 % faster than their impacts (apexes
+    1.44 x higher each): each gain is small beside the first drop's energy, but together they are a contact that
+    pumps energy in: diverged, with the count; one such rebound stays a number (energy_kept_max 1.44)."""
+    from simparity.comparisons.contact_metrics import contact_blow_up, read_contact
+
+    times = np.arange(0, 6.0, 0.001)
+    pumping = _trajectory(times, *_gaining_bounces(times, [0.3, 1.2, 1.2, 1.2]))
+    scene = _scene(0.5)
+    assert "gained energy at 3 successive impacts" in contact_blow_up(scene, read_contact(scene, pumping))
+    once = _trajectory(times, *_gaining_bounces(times, [1.2]))
+    assert contact_blow_up(scene, read_contact(scene, once)) == ""
+    values = contact_metrics(scene, once, None)
+    assert values["energy_kept_max"].value == pytest.approx(1.44, rel=1e-6)
+    assert values["restitution_max"].value == pytest.approx(1.2, rel=1e-6)
+    assert values["restitution_min"].value == pytest.approx(0.5, rel=1e-6)
+
+
+def test_a_run_that_ends_inside_a_bounce_has_no_rebound():
+    """A ball 2 mm inside the floor and still sinking at 1 m/s at the last sample: its rebound is unknown, not 0
+    (it never ended); a ball resting on the floor at the end did stay (a rebound of 0)."""
+    dt = 0.001
+    times = np.arange(0, math.sqrt(2 * H / G) + 0.005, dt)
+    height, velocity = _bounce_heights(times, 0.5)
+    inside = times > math.sqrt(2 * H / G)
+    height = np.where(inside, -0.002, height)
+    velocity = np.where(inside, -1.0, velocity)
+    found = impacts(times, height, velocity, -G, min_speed=0.1)
+    assert len(found.time) == 1 and math.isnan(found.velocity_out[0])
+    values = contact_metrics(_scene(0.5), _trajectory(times, height, velocity),
+                             _trajectory(times, height, velocity))
+    assert values["rebound_velocity_error"].unmeasurable and math.isnan(values["rebound_velocity_error"].value)
+    resting = impacts(times, np.where(inside, 0.0, height), np.where(inside, 0.0, velocity), -G, min_speed=0.1)
+    assert resting.velocity_out[0] == 0.0
+
+
+def test_an_impact_in_the_first_step_has_no_time_error():
+    """A ball released 1 mm above the floor at 1 m/s down hits it within the first step: both runs back the
+    impact up from the same initial state, so the time error would be 0 by construction: n/a."""
+    dt, h0, v0 = 0.01, 1e-3, 1.0
+    times = np.arange(0, 0.08, dt)  # ends before the second impact
+    t1 = (-v0 + math.sqrt(v0 * v0 + 2 * G * h0)) / G
+    v1 = v0 + G * t1
+    tau = times - t1
+    height = np.where(times < t1, h0 - v0 * times - G * times**2 / 2, 0.5 * v1 * tau - G * tau**2 / 2)
+    velocity = np.where(times < t1, -v0 - G * times, 0.5 * v1 - G * tau)
+    run = _trajectory(times, height, velocity)
+    value = contact_metrics(_scene(0.5), run, run)["impact_time_error"]
+    assert value.unmeasurable and "first step" in value.unmeasurable and value.flag == "nothing-to-measure"
+
+
+def test_a_resting_body_jitters_without_diverging():
+    """A box resting on the floor that jitters 0.1 mm up and down at 5 cm/s: its energy rises across each
+    touch by a few 1e-4 of m |g| size, not of its own (tiny) kinetic energy: not a blow-up; the jitter is its
+    own metric (0.2 mm peak to peak)."""
+    from simparity.comparisons.contact_metrics import contact_blow_up, read_contact
+
+    times = np.arange(0, 2.0, 0.001)
+    half = np.array([0.1, 0.1, 0.05])
+    scene = _scene(0.5, Shape("box", half_extents_body=half))
+    lift = 1e-4 * np.abs(np.sin(times * 50))
+    box = _trajectory(times, 0.05 + lift, 5e-3 * np.cos(times * 50) * np.sign(np.sin(times * 50)))
+    reading = read_contact(scene, box)
+    assert contact_blow_up(scene, reading) == ""
+    values = contact_metrics(scene, box, None)
+    assert values["rest_jitter"].value == pytest.approx(1e-4, rel=1e-3)
+    assert values["energy_gain_max"].value < 1e-3
+
+
+def test_contact_verdicts_do_not_depend_on_where_the_origin_is():
+    """The same bounce with the floor and the ball 1 km higher: the same statuses and values (up to rounding of
+    positions of 1 km) and the same verdict on divergence."""
+    from simparity.comparisons.divergence import blow_up
+
+    times = np.arange(0, 1.2, 0.005)
+    height, velocity = _bounce_heights(times, 0.6)
+    truth = _trajectory(times, *_bounce_heights(times, 0.5))
+    here = contact_metrics(_scene(0.5), _trajectory(times, height, velocity), truth)
+    lifted_scene = dataclasses.replace(_scene(0.5), contact=dataclasses.replace(
+        _scene(0.5).contact, planes=(Plane((0, 0, 1), -1000.0, "floor"),)))
+    lifted_truth = _trajectory(times, truth.position_world[:, 0, 2] + 1000.0, truth.velocity_world[:, 0, 2])
+    there = contact_metrics(lifted_scene, _trajectory(times, height + 1000.0, velocity), lifted_truth)
+    for metric, value in here.items():
+        assert bool(value.unmeasurable) == bool(there[metric].unmeasurable), metric
+        if not value.unmeasurable:
+            assert there[metric].value == pytest.approx(value.value, rel=1e-9, abs=1e-9), metric
+    assert blow_up(_scene(0.5), truth)[0] == blow_up(lifted_scene, lifted_truth)[0] == ""

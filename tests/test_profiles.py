@@ -4,18 +4,25 @@ from simparity.comparisons.profiles import QUICK_LADDER, QUICK_MAX_STEPS, QUICK_
 from tests.helpers import builtin
 
 
-def test_dynamics_keep_the_coarsest_steps_and_a_whole_number_of_them():
+def test_contact_scenes_keep_their_coarsest_steps():
+    """A contact scene has no order to fit; its verdicts lie at its coarsest steps."""
+    bounce = builtin("lecture-bouncing-particle")
+    assert quick(bounce).dts == tuple(sorted(bounce.dts))[-QUICK_LADDER:]
+    assert quick(bounce).duration == bounce.duration  # 1,600 steps at the finest kept step
+
+
+def test_dynamics_keep_their_steps_and_a_whole_number_of_them():
     full = builtin("long-horizon")
     short = quick(builtin("dzhanibekov"))
     assert short.dts == (0.0025, 0.005, 0.01) and len(short.dts) == QUICK_LADDER
-    assert short.duration == QUICK_MAX_STEPS * 0.0025  # 1000 steps of the finest, 250 of the coarsest
+    assert short.duration == QUICK_MAX_STEPS * 0.0025  # 2,000 steps of the finest, 500 of the coarsest
     assert all(VARIANT_MARK not in i for i in short.integrators) and "rk4" in short.integrators
     assert quick(full).duration == QUICK_MAX_STEPS * full.dts[0] < full.duration
 
 
 def test_short_scenes_run_whole_and_samples_shrink():
     projectile = builtin("lecture-projectile")
-    assert quick(projectile).duration == projectile.duration  # 720 steps at the finest kept step
-    assert quick(projectile).dts == tuple(sorted(projectile.dts))[-QUICK_LADDER:]
+    assert quick(projectile).duration == projectile.duration  # 1,440 steps at the finest step
+    assert quick(projectile).dts == tuple(sorted(projectile.dts))  # no contact: the whole ladder, for its orders
     assert quick(builtin("iiwa-ik")).n_targets == QUICK_TARGETS
     assert apply_profile([projectile], "full") == [projectile]
