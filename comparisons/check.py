@@ -15,6 +15,9 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
+from simparity.comparisons.cross_check import CROSS_CHECK_FACTOR, SOLVE_RATE_FRACTION, cross_check
+from simparity.comparisons.violation import Violation, row_label
+from simparity.comparisons.engines import ENGINE_NAMES
 from simparity.comparisons.tolerances import Bound, bound_for
 from simparity.core.results import ALARM_FLAGS, DIMENSIONLESS, NOT_AVAILABLE, OK
 
@@ -28,30 +31,6 @@ BASELINE_RELATIVE = 1e-6
 """Default relative change of a metric since the baseline that counts as a move: far above the
 1e-15 a recompiled BLAS may shift a result by, far below any tolerance, so a change in numerics
 shows even when it stays inside its bound."""
-
-
-def row_label(scene: str, engine: str, integrator: str, dt: float, metric: str) -> str:
-    """One row named for a message: ``scene engine integrator [dt=...] metric`` (``-`` for no integrator)."""
-    at = "" if math.isnan(dt) else f" dt={dt:g}"
-    return f"{scene} {engine} {integrator or '-'}{at} {metric}"
-
-
-@dataclass(frozen=True)
-class Violation:
-    """One row outside its bound."""
-
-    scene: str
-    engine: str
-    integrator: str
-    dt: float
-    metric: str
-    found: str
-    bound: str
-    reason: str
-
-    def line(self) -> str:
-        return (f"{row_label(self.scene, self.engine, self.integrator, self.dt, self.metric)}: {self.found}, "
-                f"bound {self.bound} ({self.reason})")
 
 
 @dataclass
@@ -92,14 +71,17 @@ def _judge(bound: Bound, row) -> tuple[str, str] | None:
     return None
 
 
-def check_table(table: pd.DataFrame, bounds: list[Bound]) -> CheckResult:
-    """Hold every row of a results table to its most specific bound."""
+def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = True) -> CheckResult:
+    """Hold every row of a results table to its most specific bound, and (``cross_checked``) every user engine's
+    row to the built-in schemes of its kind (:mod:`comparisons.cross_check`)."""
     result = CheckResult()
     for row in table.to_dict("records"):
         key = tuple(row[k] for k in CASE_KEYS)
         key = key[:3] + ("nan" if math.isnan(float(key[3])) else float(key[3]),)
         result.cases.setdefault(key, [])
-        bound = bound_for(bounds, row["scene"], row["engine"], row["integrator"], row["metric"], float(row["dt"]))
+        scheme = row.get("scheme", "")
+        bound = bound_for(bounds, row["scene"], row["engine"], row["integrator"], row["metric"], float(row["dt"]),
+                          scheme if isinstance(scheme, str) else "")
         if bound is None:
             result.unchecked += 1
             continue
@@ -111,7 +93,61 @@ def check_table(table: pd.DataFrame, bounds: list[Bound]) -> CheckResult:
                                   found, text, bound.reason)
             result.violations.append(violation)
             result.cases[key].append(violation)
+    for violation in cross_check(table, ENGINE_NAMES) if cross_checked else ():
+        result.violations.append(violation)
+        result.cases.setdefault(_case_key(violation), []).append(violation)
     return result
+
+
+def _case_key(v: Violation) -> tuple:
+    return (v.scene, v.engine, v.integrator, "nan" if math.isnan(v.dt) else v.dt)
+
+
+@dataclass(frozen=True)
+class Applied:
+    """A bound and the rows of one scene it decides: what the gate holds an engine to there."""
+
+    scene: str
+    bound: Bound
+    metrics: tuple[str, ...]
+    rows: int
+
+
+def explain(table: pd.DataFrame, bounds: list[Bound], engine: str) -> list[Applied]:
+    """Per scene, every bound that decides one of ``engine``'s rows (the most specific that matches), with the
+    metrics it decides and how many rows, in the scene's order; rows no bound matches are left out (the check
+    counts them as without a bound)."""
+    decided: dict[tuple[str, str], tuple[Bound, dict[str, None], int]] = {}
+    for row in table[table["engine"] == engine].to_dict("records"):
+        scheme = row.get("scheme", "")
+        bound = bound_for(bounds, row["scene"], row["engine"], row["integrator"], row["metric"], float(row["dt"]),
+                          scheme if isinstance(scheme, str) else "")
+        if bound is None:
+            continue
+        key = (row["scene"], bound.where)
+        held, metrics, count = decided.get(key, (bound, {}, 0))
+        metrics[row["metric"]] = None
+        decided[key] = (held, metrics, count + 1)
+    return [Applied(scene, bound, tuple(metrics), count) for (scene, _), (bound, metrics, count) in decided.items()]
+
+
+def explain_lines(applied: list[Applied], builtin: bool) -> list[str]:
+    """One line per scene and bound: ``scene: file bound[i] holds N rows (metrics...) to the bound (reason)``, and
+    for an engine that is not ``builtin`` a last line on the cross-checks it is also held to."""
+    lines = []
+    for item in applied:
+        shown = ", ".join(item.metrics[:4]) + (f", ... ({len(item.metrics)} metrics)" if len(item.metrics) > 4 else "")
+        held = item.bound.describe(math.nan) if item.bound.bounds_a_number else "status " + " or ".join(
+            item.bound.statuses)
+        if item.bound.bounds_a_number and item.bound.dt_power is not None:
+            held += f" x dt^{item.bound.dt_power:g}"
+        where = item.bound.where.rsplit("/", 1)[-1]
+        lines.append(f"{item.scene}: {where} holds {item.rows} rows ({shown}) to {held} ({item.bound.reason})")
+    if not builtin:
+        lines.append("and every row to the built-in schemes of its kind in the same run (cross-checks: errors within "
+                     f"{CROSS_CHECK_FACTOR:g} x the largest built-in's, IK solve rates at least "
+                     f"{SOLVE_RATE_FRACTION:.0%} of the best built-in's, null-space terms that help; docs/check.md)")
+    return lines
 
 
 @dataclass

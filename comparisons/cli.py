@@ -18,12 +18,20 @@ import time
 from pathlib import Path
 
 from simparity.comparisons import library
-from simparity.comparisons.check import BASELINE_RELATIVE, CheckResult, check_table, compare_with_baseline
+from simparity.comparisons.check import (
+    BASELINE_RELATIVE,
+    CheckResult,
+    check_table,
+    compare_with_baseline,
+    explain,
+    explain_lines,
+)
 from simparity.comparisons.check_output import junit_xml, summary_markdown
 from simparity.comparisons.describe import describe
 from simparity.comparisons.console import EXIT_INTERRUPTED
 from simparity.comparisons.engines import (
     DEFAULT_ENGINES,
+    ENGINE_NAMES,
     allowed_engines,
     check_engine_names,
     describe_engines,
@@ -31,6 +39,7 @@ from simparity.comparisons.engines import (
     use_engines,
 )
 from simparity.comparisons.history import history_path, latest_before, metric_history, record_run, run_table
+from simparity.comparisons.invariance_run import invariance_rows
 from simparity.comparisons.execution import count_cases, default_jobs, run_scenes
 from simparity.comparisons.isolation import DEFAULT_CASE_SECONDS, GIB, CaseLimits, IsolatedPool
 from simparity.comparisons.journal import CASES_FOLDER, Journal, read_request, run_lock, write_request
@@ -42,6 +51,7 @@ from simparity.comparisons.scene_limits import DEFAULT_LIMITS, Limits
 from simparity.comparisons.store import DEFAULT_OUT_ROOT, RunWriter, default_out_dir
 from simparity.comparisons.timing import resource_line
 from simparity.comparisons.tolerances import DEFAULT_TOLERANCES, load_tolerances
+from simparity.comparisons.transforms import TRANSFORM_NAMES, fixed_transforms
 from simparity.core.errors import HistoryError, SimparityError, UsageError, one_line
 from simparity.core.ranges import RANGES
 from simparity.core.results import FAILED, RESULTS_FILE, RUN_INFO_FILE, case_counts
@@ -58,7 +68,7 @@ MAX_JOBS = 256
 MEMORY_HELP = ("80%% of the memory of the machine a case runs on, shared between its workers (on Dask: a worker's own "
                "memory limit shared between its threads, if it has one), at least 1 GiB")
 RESUMED_OPTIONS = ("scenes", "suite", "engines", "out", "force", "quick", "repeats", "max_steps", "max_samples",
-                   "max_joints")
+                   "max_joints", "transform")
 """What a resumed run takes from the run it resumes (``resume.json``), never from the command line."""
 MESSAGE_LIMIT = 1000
 """Characters of an error message printed: one line, whatever the input echoed into it."""
@@ -163,6 +173,11 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--max-joints", type=int, default=DEFAULT_LIMITS.max_joints, metavar="N",
                      help=f"refuse a chain or URDF file of more than N movable joints (default: "
                      f"{DEFAULT_LIMITS.max_joints:,})")
+    run.add_argument("--transform", type=_engine_list, default=(), metavar="NAME[,NAME]",
+                     help="also run every scene transformed (" + ", ".join(TRANSFORM_NAMES) + ": 2 km from the "
+                     "origin, turned with its gravity, its bodies reordered, its units rescaled, time in ms) and add "
+                     "each engine's invariance rows (invariance_ratio_NAME <= 1, invariance_status_changes_NAME = 0; "
+                     "docs/invariance.md); costs about two more runs per transform")
     run.add_argument("--check", action="store_true",
                      help="check the run against tolerances when it is done (exit 1 on a violation)")
     _add_check_options(run)
@@ -175,6 +190,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     check.add_argument("run_dir", nargs="?", type=Path, default=None, metavar="RUN_DIR",
                        help="a folder written by 'simparity run' (default: the latest run in the history)")
+    check.add_argument("--explain", default=None, metavar="ENGINE",
+                       help="print, per scene, every bound that holds ENGINE's rows (which rows, to what, and why) "
+                       "instead of checking; your engine is held to the bounds of its schemes' kinds")
     _add_check_options(check)
     _add_history_option(check)
 
@@ -273,7 +291,9 @@ def _resumed(args) -> None:
                              "'simparity report DIR' re-renders a finished one)")
     try:
         for name in RESUMED_OPTIONS:
-            if name not in ("out", "force"):
+            if name == "transform":  # runs requested before --transform existed had none
+                args.transform = tuple(request.get(name, ()))
+            elif name not in ("out", "force"):
                 setattr(args, name, request[name] if name != "engines" else tuple(request[name]))
     except (KeyError, TypeError) as err:
         raise SimparityError(f"--resume {one_line(args.resume)}: its request lacks {one_line(err)} (allowed: the "
@@ -285,7 +305,8 @@ def _request(args, names: tuple[str, ...], repeats: int) -> dict:
     """What this run is asked to do, for ``--resume``: scene files by absolute path, everything else as given."""
     scenes = [str(Path(a).resolve()) if Path(a).is_file() else a for a in args.scenes]
     return {"scenes": scenes, "suite": args.suite, "engines": list(names), "repeats": repeats, "quick": args.quick,
-            "max_steps": args.max_steps, "max_samples": args.max_samples, "max_joints": args.max_joints}
+            "max_steps": args.max_steps, "max_samples": args.max_samples, "max_joints": args.max_joints,
+            "transform": list(args.transform)}
 
 
 def _limits(args, jobs: int) -> CaseLimits:
@@ -317,6 +338,7 @@ def cmd_run(args, out) -> int:
         raise SimparityError(f"--scheduler {one_line(args.scheduler)} without --executor dask (allowed: add --executor "
                              "dask, or drop --scheduler)")
     limits = _limits(args, jobs)
+    transforms = fixed_transforms(args.transform) if args.transform else ()
     names = check_engine_names(args.engines)
     use_engines(names)
     run_limits = Limits(max_steps=args.max_steps, max_samples=args.max_samples, max_joints=args.max_joints)
@@ -346,7 +368,7 @@ def cmd_run(args, out) -> int:
               + (f"; resuming {len(Journal(out_dir))} finished cases" if args.resume else ""), file=out, flush=True)
         try:
             return _run(args, out, scenes, engines, repeats, executor, bounds, out_dir,
-                        dict(zip((e.name for e in engines), names)))
+                        dict(zip((e.name for e in engines), names)), transforms)
         finally:  # what the run cost, also when it was interrupted or stopped by an error
             print(resource_line(time.perf_counter() - start), file=out, flush=True)
 
@@ -399,7 +421,8 @@ def _cost(scenes) -> str:
             f"{targets:,} IK targets per solver")
 
 
-def _run(args, out, scenes, engines, repeats: int, executor, bounds, out_dir: Path, specs: dict[str, str]) -> int:
+def _run(args, out, scenes, engines, repeats: int, executor, bounds, out_dir: Path, specs: dict[str, str],
+         transforms=()) -> int:
     writer = RunWriter(out_dir, engines, " ".join(["simparity"] + sys.argv[1:]), scenes)
     sizes = count_cases(scenes, engines, make_engine)
     bar = ProgressBar(sum(sizes), sys.stderr)
@@ -409,6 +432,7 @@ def _run(args, out, scenes, engines, repeats: int, executor, bounds, out_dir: Pa
         with contextlib.closing(executor):  # the workers stop as soon as the cases do, before the report
             results = run_scenes(scenes, engines, make_engine, repeats, executor, journal,
                                  bar.case_done if bar.active else None, specs)
+            base_rows = []
             for k, (scene, rows, series) in enumerate(results):
                 writer.append(rows, series)
                 counts = case_counts(rows)
@@ -416,6 +440,13 @@ def _run(args, out, scenes, engines, repeats: int, executor, bounds, out_dir: Pa
                 bar.scene_done(sum(sizes[:k + 1]))
                 print(f"{scene.name}: {sum(counts.values())} cases ("
                       + ", ".join(f"{s} {c}" for s, c in counts.items() if c) + ")", file=out, flush=True)
+                base_rows.append(rows)
+            if transforms:
+                bar.clear()
+                for rows in invariance_rows(scenes, base_rows, transforms, engines, executor, journal, specs,
+                                            lambda line: print(line, file=out, flush=True)):
+                    writer.append(rows)
+                    failed += sum(1 for r in rows if r.status == FAILED)
     except KeyboardInterrupt:
         bar.clear()
         print(f"interrupted; results so far are in {writer.results_path}; finish the run with: simparity run "
@@ -504,7 +535,21 @@ def cmd_check(args, out) -> int:
     if run_dir is None:
         _, latest = latest_before(history_path(args.history))
         run_dir = Path(latest)
+    if args.explain is not None:
+        return _explain(run_dir, bounds, args.explain, out)
     return _check(run_dir, bounds, args, out)
+
+
+def _explain(run_dir: Path, bounds, engine: str, out) -> int:
+    """What the gate holds ``engine`` to in the run of ``run_dir``: one line per scene and bound."""
+    table, _ = read_run(run_dir)
+    engines = sorted(set(table["engine"]))
+    if engine not in engines:
+        raise SimparityError(f"--explain {one_line(engine)}: no rows of that engine in {one_line(run_dir)} (allowed: "
+                             f"{', '.join(engines)})")
+    lines = explain_lines(explain(table, bounds, engine), engine in ENGINE_NAMES)
+    print("\n".join(lines) if lines else f"no bound holds {engine}'s rows", file=out)
+    return EXIT_OK
 
 
 def cmd_history(args, out) -> int:

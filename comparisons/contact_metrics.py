@@ -393,7 +393,9 @@ def _restitution_metrics(scene: DynamicsScene, reading: ContactReading) -> dict[
             e = float(found.rebound_ratio[int(np.argmax(known))])  # the body's first impact with a known outcome
             if abs(e - k) > worst:
                 worst, measured, requested = abs(e - k), e, k
+    impacted = any(len(found.time) for found in reading.impacts.values())
     none = ("the body turns at its impacts: the COM's rebound is not the contact point's" if turning else
+            "the run ends inside its impact: the rebound is unknown" if impacted else
             "no impact: nothing to measure restitution on")
     if worst < 0:
         out["restitution_measured"] = out["restitution_error"] = _nothing("1", none)
@@ -595,7 +597,8 @@ _UNKNOWN = {
     "rebound_velocity_error": "the runs end inside the impacts compared: their rebounds are unknown",
     "apex_height_error": "no apex: gravity does not pull the body back toward the plane (or the runs end in "
                          "contact)",
-    "energy_loss_error": "the bodies turn at the impacts compared: the COM's rebound is not the contact point's",
+    "energy_loss_error": "the runs end inside the impacts compared (their rebounds are unknown), or the bodies turn "
+                         "at them (the COM's rebound is not the contact point's)",
 }
 """Why an impact comparison has no value although both runs share impacts."""
 

@@ -42,7 +42,7 @@ CREATE TABLE IF NOT EXISTS runs (
 CREATE TABLE IF NOT EXISTS results (
     run_id INTEGER NOT NULL REFERENCES runs(id),
     scene TEXT, engine TEXT, integrator TEXT, dt REAL, metric TEXT,
-    value REAL, unit TEXT, reference TEXT, status TEXT, detail TEXT, flag TEXT
+    value REAL, unit TEXT, reference TEXT, status TEXT, detail TEXT, flag TEXT, scheme TEXT
 );
 CREATE INDEX IF NOT EXISTS results_by_metric ON results (scene, engine, metric);
 """
@@ -69,7 +69,7 @@ def _connect(path: Path, create: bool) -> sqlite3.Connection:
 
 def _add_missing_columns(connection: sqlite3.Connection) -> None:
     """Bring a database an older simparity wrote up to this one's columns: a results column it lacks (the
-    ``flag`` of schema 2) is added, empty for the runs recorded before."""
+    ``flag`` and ``scheme`` of schema 2) is added, empty for the runs recorded before."""
     present = {row[1] for row in connection.execute("PRAGMA table_info(results)")}
     for column in (c for c in COLUMNS if c not in present):
         with connection:
@@ -119,7 +119,7 @@ def run_table(path: Path, run_id: int) -> pd.DataFrame:
     table = _query(path, f"SELECT {', '.join(COLUMNS)} FROM results WHERE run_id = ?", (run_id,))
     table["integrator"] = table["integrator"].fillna("")
     table["detail"] = table["detail"].fillna("")
-    table["flag"] = table["flag"].fillna("")
+    table[["flag", "scheme"]] = table[["flag", "scheme"]].fillna("")
     return table.astype({"dt": float, "value": float})
 
 

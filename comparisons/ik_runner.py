@@ -26,13 +26,21 @@ import numpy as np
 
 from simparity.comparisons.cases import CaseGroup, CaseOutcome, CaseSpec
 from simparity.comparisons.ik_targets import ORIENTATION_ONLY, Targets, hard_target, random_targets
-from simparity.comparisons.rows import Case, Measured, error_text, warnings_into_rows
+from simparity.comparisons.rows import Case, Measured, declared_scheme, error_text, warnings_into_rows
 from simparity.comparisons.series import disagreement_matrix, quantiles
 from simparity.comparisons.timing import best_of
 from simparity.core.engine import Engine, KinematicsModel
 from simparity.core.ik.problem import IKTolerances
 from simparity.core.ik.result import LIMIT_TOLERANCE, IKResult
-from simparity.core.results import FAILED, HARD_VERDICT_SUFFIXES, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
+from simparity.core.results import (
+    FAILED,
+    HARD_VERDICT_SUFFIXES,
+    NOT_AVAILABLE,
+    OK,
+    UNSOLVED,
+    ResultRow,
+    SeriesRecord,
+)
 from simparity.core.scene import IKScene
 from simparity.references.conventions import rotation_angle
 
@@ -47,6 +55,9 @@ IK_METRICS = {
     "limit_violations": "1",
     "rest_distance_median": "rad or m",
     "cross_eval_solve_rate_min": "1",
+    "unconfirmed_claims": "1",
+    "fk_departure_max": "m",
+    "jacobian_departure_max": "m/rad or 1",
     "cross_eval_disagreement_max": "m",
     "start_rank_deficiency": "1",
 }
@@ -71,13 +82,22 @@ def _summary(result: IKResult, q_start: np.ndarray, seconds: float) -> dict[str,
     }
 
 
-def _cross_evaluation(scene: IKScene, targets: Targets, q: np.ndarray,
-                      judges: dict[str, KinematicsModel]) -> tuple[dict[str, float], dict[str, np.ndarray]]:
-    """(solve rate by each judge's FK (lowest kept; a solution outside the joint limits is solved by
-    none) and the spread of their end-effector positions, each judge's end-effector positions (N, 3))."""
+def _cross_evaluation(scene: IKScene, targets: Targets, result: IKResult, judges: dict[str, KinematicsModel],
+                      reference_end: np.ndarray | None) -> tuple[dict[str, float], dict[str, np.ndarray]]:
+    """(the judges' verdicts on the solutions, each judge's end-effector positions (N, 3)).
+
+    Each judge puts the solutions through its own FK; a solution outside the joint limits is solved by none.
+    The verdicts: ``cross_eval_solve_rate_min``, the lowest solve rate a judge grants, over the judges whose FK
+    agrees with the reference's (``reference_end``, (N, 3); None: every judge): a judge whose FK departs from the
+    reference's by more than the position tolerance would grant or refuse solves on its own error, and blames
+    every solver for it; ``unconfirmed_claims``, the share of targets the solver claims solved that no judge
+    confirms; ``cross_eval_disagreement_max``, the spread of the judges' end-effector positions; and the
+    departure of every judge's FK from the reference's (``departure:<judge>`` [m])."""
+    q = result.q
     violation = np.maximum(np.maximum(scene.chain.lower - q, q - scene.chain.upper), 0.0)
     inside = np.max(violation, axis=1, initial=0.0) <= LIMIT_TOLERANCE
-    rates, ends = [], {}
+    rates, ends, out = [], {}, {}
+    confirmed = np.zeros(len(q), bool)
     for name, model in judges.items():
         frames = model.forward_kinematics(q)
         end, rotation = frames.position_world[:, -1], frames.rotation_world[:, -1]
@@ -87,11 +107,18 @@ def _cross_evaluation(scene: IKScene, targets: Targets, q: np.ndarray,
         if targets.rotation_world is not None:
             solved &= (rotation_angle(rotation, targets.rotation_world)
                        <= scene.orientation_tolerance + orientation_resolution)
-        rates.append(float(np.mean(solved)))
+        departure = 0.0 if reference_end is None else float(np.linalg.norm(end - reference_end, axis=1).max())
+        out[f"departure:{name}"] = departure
+        if departure <= scene.position_tolerance + position_resolution:
+            rates.append(float(np.mean(solved)))
+        confirmed |= solved
         ends[name] = end
     stacked = np.stack(list(ends.values()))
     spread = np.linalg.norm(stacked[:, None] - stacked[None, :], axis=-1).max() if len(ends) > 1 else 0.0
-    return {"cross_eval_solve_rate_min": min(rates), "cross_eval_disagreement_max": float(spread)}, ends
+    out |= {"cross_eval_solve_rate_min": min(rates) if rates else math.nan,
+            "unconfirmed_claims": float(np.mean(np.asarray(result.success, bool) & ~confirmed)),
+            "cross_eval_disagreement_max": float(spread)}
+    return out, ends
 
 
 def _task_jacobian(scene: IKScene, model: KinematicsModel, q: np.ndarray) -> np.ndarray:
@@ -211,18 +238,50 @@ def _solved(scene: IKScene, engine: Engine, solver: str, random: Targets, hard: 
 
 
 def _case_outcome(scene: IKScene, engine: Engine, case: Case, solved: _Solve, random: Targets, hard: list[Targets],
-                  judges: dict[str, KinematicsModel]) -> CaseOutcome:
+                  judges: dict[str, KinematicsModel], reference: KinematicsModel | None) -> CaseOutcome:
     if solved.result is None:
         return CaseOutcome(case.rows(IK_METRICS, solved.status, solved.problem)
                            + _hard_rows(case, hard, [None] * len(hard), solved.status, solved.problem))
     values = {m: Measured(v, IK_METRICS[m]) for m, v in _summary(solved.result, scene.q_start, solved.seconds).items()}
-    agreement, ends = _cross_evaluation(scene, random, solved.result.q, judges)
-    values.update({m: Measured(v, IK_METRICS[m]) for m, v in agreement.items()})
+    reference_end = None if reference is None else reference.forward_kinematics(solved.result.q).position_world[:, -1]
+    agreement, ends = _cross_evaluation(scene, random, solved.result, judges, reference_end)
+    values.update({m: Measured(v, IK_METRICS[m]) for m, v in agreement.items() if m in IK_METRICS})
+    values.update(_unsolved(values, solved.result))
+    values |= _own_kinematics(scene, engine, solved.result.q, agreement, judges.get(engine.name), reference)
     if engine.name in judges:
         values["start_rank_deficiency"] = start_rank_deficiency(scene, judges[engine.name])
     rows = (case.rows(IK_METRICS, OK, f"{solved.detail}; {random.note}", values)
             + _hard_rows(case, hard, solved.hard, OK, ""))
     return CaseOutcome(rows, _distributions(case, solved.result), ends=ends, reference_label=case.reference)
+
+
+def _own_kinematics(scene: IKScene, engine: Engine, q: np.ndarray, agreement: dict[str, float],
+                    own: KinematicsModel | None, reference: KinematicsModel | None) -> dict[str, Measured]:
+    """How far the solver's own engine's FK and Jacobian are from the reference's at the solutions it found:
+    ``fk_departure_max`` [m] (end effector) and ``jacobian_departure_max`` (largest entry of the end effector's
+    world Jacobian), so that an IK scene checks the kinematics its solver stands on, and a wrong one is blamed on
+    its engine."""
+    if own is None or reference is None:
+        why = (f"{engine.name} has no forward kinematics of this chain, or the reference {scene.reference} has none "
+               "to compare with")
+        return {m: Measured(math.nan, IK_METRICS[m], unmeasurable=why)
+                for m in ("fk_departure_max", "jacobian_departure_max")}
+    where = f"against {scene.reference}'s, at its solutions"
+    jacobian = float(np.abs(own.jacobian_world(q) - reference.jacobian_world(q)).max())
+    return {"fk_departure_max": Measured(agreement[f"departure:{engine.name}"], "m", note=where),
+            "jacobian_departure_max": Measured(jacobian, IK_METRICS["jacobian_departure_max"], note=where)}
+
+
+def _unsolved(values: dict[str, Measured], result: IKResult) -> dict[str, Measured]:
+    """The solve rates of ``values`` that are 0 on the reachable random targets, as n/a flagged ``unsolved``
+    with the residuals the solver stopped at: a rate of 0 says which stopping rule or cap the solver does not
+    meet, not how well it solves."""
+    residuals = (f"median residuals {np.median(result.position_residual):.3g} m, "
+                 f"{np.median(result.orientation_residual):.3g} rad")
+    return {metric: Measured(0.0, "1", flag=UNSOLVED, unmeasurable=(
+                f"unsolved: none of the reachable targets is solved within the tolerances ({residuals}); the "
+                f"solver stops before them, or never reaches them"))
+            for metric in ("solve_rate", "cross_eval_solve_rate_min") if values[metric].value == 0}
 
 
 def _skipped(scene: IKScene) -> dict[str, str]:
@@ -284,9 +343,11 @@ def ik_case(group: CaseGroup, shared: IKShared, index: int, engine_for: Callable
         engine = engine_for(spec.engine)
         solved = _solved(scene, engine, spec.integrator, shared.random, shared.hard, group.repeats)
         judges = _judges(scene, [engine_for(name) for name in group.engine_names])
+        reference = judges.get(scene.reference) or _judges(scene, [engine_for(scene.reference)]).get(scene.reference)
         label = f"{scene.reference}:fk (targets); cross-evaluated by {', '.join(judges)}"
-        case = Case(scene.name, spec.engine, spec.integrator, math.nan, label)
-        outcome = _case_outcome(scene, engine, case, solved, shared.random, shared.hard, judges)
+        case = Case(scene.name, spec.engine, spec.integrator, math.nan, label,
+                    declared_scheme(engine, spec.integrator, scene))
+        outcome = _case_outcome(scene, engine, case, solved, shared.random, shared.hard, judges, reference)
         rows += outcome.rows
     outcome.rows = rows + case.rows(_skipped(scene), NOT_AVAILABLE, "position-only scene: no orientation to target")
     outcome.reference_label = label

@@ -76,7 +76,9 @@ def _clip(scene: IKScene, q: np.ndarray) -> np.ndarray:
 
 
 def hard_target(scene: IKScene, name: str, fk: KinematicsModel) -> Targets:
-    """The hard target ``name`` of the scene (see the module docstring), poses by ``fk``."""
+    """The hard target ``name`` of the scene (see the module docstring), poses by ``fk``. Directions and
+    orientations are the first joint's frame's (the chain's base as the scene places it), never the world's, so
+    that the same chain turned in the world is asked the same targets."""
     chain, q0 = scene.chain, scene.q_start
     center, radius = reach_upper_bound(chain)
     if name == "stretched":
@@ -85,9 +87,10 @@ def hard_target(scene: IKScene, name: str, fk: KinematicsModel) -> Targets:
         position, rotation = _poses(scene, _clip(scene, q)[None], fk)
         note = "the zero (stretched) configuration with joint 1 at 0.5 rad: boundary, singular"
     elif name in ("beyond_reach", "at_base"):
-        direction = np.ones(3) / np.sqrt(3)
+        base = np.asarray(chain.joints[0].origin_rotation, dtype=float)  # the chain's base as placed in the world
+        direction = base @ (np.ones(3) / np.sqrt(3))
         position = (center + 1.5 * radius * direction if name == "beyond_reach" else center)[None]
-        rotation = None if scene.target_kind == "position" else np.eye(3)[None]
+        rotation = None if scene.target_kind == "position" else base[None]
         note = ("1.5 x the reach bound from joint 1: unreachable" if name == "beyond_reach"
                 else "joint 1's own position: unreachable or degenerate")
     elif name == "near_limits":

@@ -38,6 +38,7 @@ DYNAMICS_METRICS = {
     "orientation_error_max": "rad",
     "velocity_error_max": "m/s",
     "angular_velocity_error_max": "rad/s",
+    "quaternion_norm_deviation_max": "1",
     "time_per_step": "s",
 }
 DRIFT_METRICS = {"energy_drift_max": "1", "angular_momentum_drift_max": "1"}
@@ -62,6 +63,7 @@ KINEMATICS_METRICS = {
     "position_error_max": "m",
     "orientation_error_max": "rad",
     "jacobian_error_max": "m/rad or 1",
+    "rotation_orthonormality_deviation_max": "1",
     "time_per_fk": "s",
     "time_per_jacobian": "s",
 }
@@ -244,6 +246,22 @@ def _errors(traj: Trajectory, ref: Trajectory,
                                 "velocity_error_max", "angular_velocity_error_max")}
 
 
+def state_validity(traj: Trajectory) -> dict[str, Measured]:
+    """Whether the states an engine reports are states: ``quaternion_norm_deviation_max`` = max | |q| - 1 | over
+    samples and bodies (a unit quaternion up to rounding; an orientation that is not one is no rotation at all,
+    whatever its angle to the reference's)."""
+    norm = np.linalg.norm(np.asarray(traj.quat_wxyz, dtype=float), axis=-1)
+    return {"quaternion_norm_deviation_max": Measured(float(np.abs(norm - 1.0).max()), "1")}
+
+
+def frame_validity(poses: FramePoses) -> dict[str, Measured]:
+    """``rotation_orthonormality_deviation_max`` = max |R^T R - I| (entries) over configurations and frames: a
+    rotation matrix up to rounding."""
+    rotation = np.asarray(poses.rotation_world, dtype=float)
+    gram = np.einsum("...ji,...jk->...ik", rotation, rotation) - np.eye(3)
+    return {"rotation_orthonormality_deviation_max": Measured(float(np.abs(gram).max()), "1")}
+
+
 def kinematics_errors(poses: FramePoses, jacobian: np.ndarray, ref_poses: FramePoses,
                       ref_jacobian: np.ndarray) -> dict[str, Measured]:
     """Frame position, frame orientation and Jacobian errors against the reference's."""
@@ -377,6 +395,19 @@ def rounding_floors(scene: DynamicsScene, traj: Trajectory, n_steps: int) -> dic
     kappa = max(np.linalg.cond(b.inertia_body) for b in scene.bodies)
     unit_roundoff = ROUNDING_FLOOR_FACTOR * np.finfo(float).eps * (max(n_steps, 1) + kappa)
     return {metric: unit_roundoff * scale for metric, scale in scales.items()}
+
+
+def at_rounding_floor(errors: dict[str, Measured], floors: dict[str, float]) -> dict[str, Measured]:
+    """``errors`` with each measured error at or below its rounding floor (:func:`rounding_floors`; the final
+    position error has the position's) flagged ``rounding-floor``: still a number, but exact up to rounding, so
+    that nothing compares it as a truncation error (an order fit leaves it out, a cross-check skips it)."""
+    out = dict(errors)
+    for metric, measured in errors.items():
+        floor = floors.get(metric.replace("_final", "_max"))
+        if floor is not None and not measured.unmeasurable and measured.value <= floor:
+            out[metric] = Measured(measured.value, measured.unit, note=(
+                f"at the rounding floor ({floor:.2g}): exact up to rounding"), flag=ROUNDING_FLOOR)
+    return out
 
 
 def _local_slopes(dts: np.ndarray, errors: np.ndarray) -> np.ndarray:

@@ -5,7 +5,9 @@ of the order fits and of the hard cases' verdicts, the hard IK targets), but
 
 - a dynamics scene runs for at most :data:`QUICK_MAX_STEPS` of its finest kept time step (a whole
   number of the coarsest), with one orientation update per scheme (the default; the ``+matrix`` /
-  ``+expmap`` variants are left to the full run). Which time steps it keeps is chosen by what the
+  ``+expmap`` variants are left to the full run), except on a rotating scene of at most
+  :data:`QUICK_VARIANT_STEPS` steps, which runs every variant, so that CI exercises every orientation
+  update. Which time steps it keeps is chosen by what the
   scene's rows judge: a scene without contact keeps its whole ladder, so that its order fits find
   the asymptotic range in it (the finest steps whose local slopes agree, above the rounding floor;
   coarse steps alone saturate or sit before it, fine ones alone may reach the floor); a contact
@@ -21,6 +23,8 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+import numpy as np
+
 from simparity.comparisons.engines import known_integrators
 from simparity.core.scene import DynamicsScene, IKScene, KinematicsScene
 
@@ -29,6 +33,11 @@ QUICK_MAX_STEPS = 2000
 Dzhanibekov flip and the separatrix over 10-20 s, 10^5 and 10^6 steps) runs whole, so the hard
 cases show the verdict they show in the full run and the closed-form bounds hold for the whole
 horizon; a long horizon is cut to 2,000 steps, which keeps the suite near a minute on 2 cores."""
+
+QUICK_VARIANT_STEPS = 1000
+"""A rotating scene of at most this many steps at its finest kept step runs every orientation variant in the
+quick profile: the variants triple the cost of the rigid-body schemes, which a scene this short (the hard
+fast spinner, 400 steps) pays in seconds; every other scene leaves them to the full run."""
 
 QUICK_LADDER = 3
 """Time steps a contact scene keeps (its coarsest): as many as the full run's verdict bounds name."""
@@ -51,6 +60,11 @@ def _divides(duration: float, dt: float) -> bool:
     return abs(steps - round(steps)) <= 1e-9 * steps
 
 
+def _rotates(scene: DynamicsScene) -> bool:
+    """A body spins at the start or a force turns one: the orientation updates differ."""
+    return scene.forces.exerts_torque or any(bool(np.any(b.angular_velocity_world != 0)) for b in scene.bodies)
+
+
 def quick(scene):
     """The ``quick`` version of a scene (see the module docstring); scenes of other kinds unchanged."""
     if isinstance(scene, DynamicsScene):
@@ -61,8 +75,10 @@ def quick(scene):
         duration = max(1, math.floor(QUICK_MAX_STEPS * dts[-1] / coarsest + 1e-9)) * coarsest
         if duration >= scene.duration or not all(_divides(duration, dt) for dt in dts):
             duration = scene.duration
-        integrators = scene.integrators or tuple(i for i in known_integrators() if VARIANT_MARK not in i)
-        integrators = tuple(i for i in integrators if VARIANT_MARK not in i) or integrators
+        short = duration / dts[-1] <= QUICK_VARIANT_STEPS * (1 + 1e-9) and _rotates(scene)
+        integrators = scene.integrators if short else (
+            scene.integrators or tuple(i for i in known_integrators() if VARIANT_MARK not in i))
+        integrators = integrators if short else tuple(i for i in integrators if VARIANT_MARK not in i) or integrators
         return replace(scene, duration=duration, dts=tuple(sorted(dts)), integrators=integrators)
     if isinstance(scene, KinematicsScene):
         return replace(scene, n_configurations=min(scene.n_configurations, QUICK_SAMPLES))

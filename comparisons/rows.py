@@ -8,6 +8,7 @@ import traceback
 import warnings
 from dataclasses import dataclass, replace
 
+from simparity.core.engine import is_scheme_label
 from simparity.core.errors import PluginError
 from simparity.core.results import NOT_AVAILABLE, OK, ResultRow
 
@@ -43,17 +44,19 @@ class Measured:
 
 @dataclass(frozen=True)
 class Case:
-    """One scene x engine x integrator (or IK solver) x dt: the key its rows share."""
+    """One scene x engine x integrator (or IK solver) x dt: the key its rows share, and the kind of scheme the
+    engine declares (:func:`declared_scheme`)."""
 
     scene: str
     engine: str
     integrator: str
     dt: float
     reference: str
+    scheme: str = ""
 
     def _row(self, metric: str, value: float, unit: str, status: str, detail: str, flag: str = "") -> ResultRow:
         return ResultRow(self.scene, self.engine, self.integrator, self.dt, metric, value, unit, self.reference,
-                         status, detail, flag)
+                         status, detail, flag, self.scheme)
 
     def rows(self, metrics: dict[str, str], status: str, detail: str,
              values: dict[str, Measured] | None = None) -> list[ResultRow]:
@@ -84,6 +87,17 @@ class Case:
         measured = {m: u for m, u in metrics.items() if m in values}
         missing = {m: u for m, u in metrics.items() if m not in values}
         return self.rows(measured, OK, detail, values) + self.rows(missing, missing_status, missing_detail)
+
+
+def declared_scheme(engine, name: str, scene) -> str:
+    """The kind of scheme ``engine`` declares integrator or IK solver ``name`` to be on ``scene``
+    (``Engine.scheme``); "" when it does not say, or answers what the interface does not allow (a user's engine:
+    the gate then holds it only to the bounds for every scheme)."""
+    try:
+        label = engine.scheme(name, scene)
+    except Exception:  # noqa: BLE001 - a user's engine; its rows report what else fails
+        return ""
+    return label if isinstance(label, str) and is_scheme_label(label) else ""
 
 
 def error_text(err: BaseException) -> str:

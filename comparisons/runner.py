@@ -38,17 +38,20 @@ from simparity.comparisons.metrics import (
     ORDER_METRICS,
     ORDER_SOURCES,
     ROTATIONAL_ORDERS,
+    at_rounding_floor,
     conserved_changes,
     drifts,
     dynamics_metrics,
+    frame_validity,
     kinematics_errors,
     observed_order,
     rounding_floors,
     saturation_ratios,
     saturation_scales,
+    state_validity,
     trajectory_errors,
 )
-from simparity.comparisons.rows import Case, Measured, error_text, warnings_into_rows
+from simparity.comparisons.rows import Case, Measured, declared_scheme, error_text, warnings_into_rows
 from simparity.comparisons.series import dynamics_series
 from simparity.comparisons.stability import STABILITY_METRICS, stable_dt_max
 from simparity.comparisons.timing import best_of
@@ -86,6 +89,12 @@ class _Ladder:
     @property
     def integrates_rotation(self) -> bool:
         return all(case.integrates_rotation for case in self.cases)
+
+    @property
+    def scheme(self) -> str:
+        """The kind of scheme the engine declared for the integrator (its cases' rows'; "" when they disagree)."""
+        schemes = {row.scheme for case in self.cases for row in case.rows}
+        return schemes.pop() if len(schemes) == 1 else ""
 
     @property
     def theory(self) -> int | None:
@@ -156,7 +165,8 @@ def _dynamics_case_at(group: CaseGroup, shared: _DynamicsShared, index: int, eng
     scene, dt, spec = group.scene, group.dt, group.cases[index]
     metrics = dynamics_metrics(scene)
     engine = engine_for(spec.engine)
-    case = Case(scene.name, spec.engine, spec.integrator, dt, group.reference_label)
+    case = Case(scene.name, spec.engine, spec.integrator, dt, group.reference_label,
+                declared_scheme(engine, spec.integrator, scene))
     if spec.integrator == NO_INTEGRATOR:
         return CaseOutcome(_no_integrator_rows(scene, engine, case, metrics))
     rows: list[ResultRow] = []
@@ -225,7 +235,8 @@ def _stability_case_at(group: CaseGroup, shared: None, index: int, engine_for: E
     """The measured stability limit of one penalty-method integrator (:mod:`comparisons.stability`)."""
     scene, spec = group.scene, group.cases[index]
     engine = engine_for(spec.engine)
-    case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label)
+    case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label,
+                declared_scheme(engine, spec.integrator, scene))
     rows: list[ResultRow] = []
     with warnings_into_rows(rows):
         try:
@@ -299,7 +310,7 @@ def _measured_case(scene, sim, case: Case, metrics: dict, n: int, traj, seconds:
             return CaseOutcome(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values),
                                integrates_rotation=sim.integrates_rotation)
         changes = conserved_changes(scene, traj)
-        values.update(drifts(scene, traj, changes))
+        values.update(drifts(scene, traj, changes) | state_validity(traj))
         heights = None if reading is None else reading.distance[:, 0].min(axis=-1)
         series = dynamics_series(case, traj, ref_traj, changes, heights)
         floors = rounding_floors(scene, traj, n)
@@ -310,7 +321,7 @@ def _measured_case(scene, sim, case: Case, metrics: dict, n: int, traj, seconds:
             return CaseOutcome(case.partial_rows(metrics, values, sim.detail, status, problem), series, floors=floors,
                                integrates_rotation=sim.integrates_rotation)
         scales = saturation_scales(scene, ref_traj)
-        values.update(trajectory_errors(traj, ref_traj, scales))
+        values.update(at_rounding_floor(trajectory_errors(traj, ref_traj, scales), floors))
         saturation = saturation_ratios(traj, ref_traj, scales)
         if reading is not None:
             values.update(contact_metrics(scene, traj, ref_traj, reading))
@@ -369,6 +380,7 @@ def _kinematics_case(scene: KinematicsScene, engine: Engine, case: Case, q: np.n
     except Exception as err:  # noqa: BLE001 - reported in the rows
         return case.rows(KINEMATICS_METRICS, FAILED, error_text(err))
     values = {"time_per_fk": Measured(fk_seconds / len(q), "s"), "time_per_jacobian": Measured(jac_seconds / len(q), "s")}
+    values.update(frame_validity(poses))
     if not (np.all(np.isfinite(poses.position_world)) and np.all(np.isfinite(jac))):
         return case.rows(KINEMATICS_METRICS, DIVERGED, "non-finite FK or Jacobian", values)
     if ref is None:
@@ -382,7 +394,7 @@ def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_l
     """Observed orders of convergence per engine and integrator over the scene's time steps."""
     rows = []
     for (engine, integrator), ladder in ladders.items():
-        case = Case(scene.name, engine, integrator, math.nan, ref_label)
+        case = Case(scene.name, engine, integrator, math.nan, ref_label, ladder.scheme)
         values = {}
         for metric, source in ORDER_SOURCES.items():
             if scene.contact is not None:

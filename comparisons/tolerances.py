@@ -5,7 +5,8 @@ A tolerances file is TOML with one ``[[bound]]`` table per bound (format: ``docs
     [[bound]]
     scene = "*"                      # fnmatch patterns; "*" (the default) matches anything
     engine = "*"
-    integrator = "rk4*"
+    integrator = "*"
+    scheme = "rk4"                   # the kind of scheme the engine declares its integrator to be
     metric = "order_position"
     expected = 4.0                   # |value - expected| <= band
     band = 0.3
@@ -23,8 +24,12 @@ whatever its status.
 
 A bound may name one time step (``dt``, in seconds) or ``dt = "*"`` (every time step, but not
 the order rows, which have none); without ``dt`` it holds for every row.
+``scheme`` matches the kind of scheme the engine declares the row's integrator or IK solver to be
+(``core.engine.SCHEME_KINDS``; ``soft+*`` any time integrator under MuJoCo's soft contact; a list of
+patterns matches any of them): a bound keyed by scheme holds every engine's scheme of that kind, a
+user's plugin included, whatever it calls it.
 The most specific bound wins: a key written out exactly counts 2, a pattern other than ``*``
-counts 1, ``*`` counts 0, summed over scene, engine, integrator, metric and dt; among equally
+counts 1, ``*`` counts 0, summed over scene, engine, integrator, scheme, metric and dt; among equally
 specific bounds the later one in the file wins, so a file can be extended by appending.
 """
 
@@ -45,7 +50,7 @@ DEFAULT_TOLERANCES = Path(__file__).resolve().parent / "tolerances" / "default.t
 
 MATCH_KEYS = ("scene", "engine", "integrator", "metric")
 NUMBER_KEYS = ("max", "min", "expected", "band", "rel", "dt_power")
-ALLOWED_KEYS = MATCH_KEYS + ("dt",) + NUMBER_KEYS + ("status", "na_when", "reason")
+ALLOWED_KEYS = MATCH_KEYS + ("scheme", "dt") + NUMBER_KEYS + ("status", "na_when", "reason")
 DT_MATCH = 1e-9
 """Relative difference under which a bound's ``dt`` [s] names a row's time step."""
 
@@ -58,6 +63,8 @@ class Bound:
     ----------
     scene, engine, integrator, metric : str
         fnmatch patterns the row's fields must match.
+    scheme : tuple of str
+        fnmatch patterns of which the row's ``scheme`` column must match one.
     dt : float, "*" or None
         The time step [s] the bound is for; ``"*"``: every time step (the per-time-step rows, not
         the order rows, which have none); None: every row.
@@ -79,6 +86,7 @@ class Bound:
     scene: str
     engine: str
     integrator: str
+    scheme: tuple[str, ...]
     metric: str
     dt: float | str | None
     max: float | None
@@ -97,15 +105,19 @@ class Bound:
     def specificity(self) -> int:
         patterns = (self.scene, self.engine, self.integrator, self.metric)
         dt_weight = 0 if self.dt is None else 1 if self.dt == "*" else 2
-        return dt_weight + sum(0 if p == "*" else 1 if any(c in p for c in "*?[") else 2 for p in patterns)
+        scheme_weight = max(_weight(p) for p in self.scheme) if len(self.scheme) == 1 else min(
+            1, *(_weight(p) for p in self.scheme))
+        return dt_weight + scheme_weight + sum(_weight(p) for p in patterns)
 
-    def matches(self, scene: str, engine: str, integrator: str, metric: str, dt: float = math.nan) -> bool:
+    def matches(self, scene: str, engine: str, integrator: str, metric: str, dt: float = math.nan,
+                scheme: str = "") -> bool:
         if self.dt == "*" and math.isnan(dt):
             return False
         if isinstance(self.dt, float) and not abs(dt - self.dt) <= DT_MATCH * self.dt:
             return False
-        return all(fnmatch.fnmatchcase(value, pattern) for value, pattern in
-                   zip((scene, engine, integrator, metric), (self.scene, self.engine, self.integrator, self.metric)))
+        return any(fnmatch.fnmatchcase(scheme, p) for p in self.scheme) and all(
+            fnmatch.fnmatchcase(value, pattern) for value, pattern in
+            zip((scene, engine, integrator, metric), (self.scene, self.engine, self.integrator, self.metric)))
 
     @property
     def bounds_a_number(self) -> bool:
@@ -133,6 +145,11 @@ class Bound:
         return f"<= {high:.3g}" if self.max is not None else f">= {low:.3g}"
 
 
+def _weight(pattern: str) -> int:
+    """How specific one pattern is: 0 for ``*``, 1 for another pattern, 2 for a name written out."""
+    return 0 if pattern == "*" else 1 if any(c in pattern for c in "*?[") else 2
+
+
 def _number(source: str, key: str, value, non_negative: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ToleranceError(source, key, f"expected a finite number, got {value!r:.60}", "finite numbers")
@@ -155,6 +172,12 @@ def _bound(source: str, index: int, table) -> Bound:
             raise ToleranceError(source, f"{where}.{key}", f"expected a non-empty pattern, got {value!r:.60}",
                                  "a name or an fnmatch pattern such as rk4*")
         patterns[key] = value
+    scheme = table.get("scheme", "*")
+    schemes = (scheme,) if isinstance(scheme, str) else tuple(scheme) if isinstance(scheme, list) else ()
+    if not schemes or not all(isinstance(p, str) and p for p in schemes):
+        raise ToleranceError(source, f"{where}.scheme", f"expected a pattern or a list of them, got {scheme!r:.60}",
+                             "kinds of scheme (core.engine.SCHEME_KINDS) or fnmatch patterns such as soft+*")
+    patterns["scheme"] = schemes
     dt = table.get("dt")
     if dt is not None and dt != "*":
         dt = _number(source, f"{where}.dt", table["dt"])
@@ -207,7 +230,7 @@ def load_tolerances(path: str | Path = DEFAULT_TOLERANCES) -> list[Bound]:
 
 
 def bound_for(bounds: list[Bound], scene: str, engine: str, integrator: str, metric: str,
-              dt: float = math.nan) -> Bound | None:
+              dt: float = math.nan, scheme: str = "") -> Bound | None:
     """The most specific bound that matches (the later one on a tie), or None."""
-    matching = [b for b in bounds if b.matches(scene, engine, integrator, metric, dt)]
+    matching = [b for b in bounds if b.matches(scene, engine, integrator, metric, dt, scheme)]
     return max(matching, key=lambda b: (b.specificity, b.order)) if matching else None

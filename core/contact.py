@@ -173,6 +173,15 @@ class Bodies:
     forces: Forces
 
     @cached_property
+    def size(self) -> np.ndarray:
+        """(B,) each body's size [m]: its contact shape's reach from the COM (vertices and sphere radius), or its
+        radius of gyration sqrt(tr I / (2 m)) where that is larger (a point has no reach)."""
+        model = self.model
+        reach = np.max(np.linalg.norm(model.vertices_body, axis=-1), axis=1) + model.radius
+        gyration = np.sqrt(np.trace(self.props.inertia_body, axis1=1, axis2=2) / (2 * self.props.mass))
+        return np.maximum(reach, gyration)
+
+    @cached_property
     def external(self) -> Wrench:
         """The scene's forces on these bodies (:func:`core.forces.make_wrench`), built once per batch."""
         return make_wrench(self.forces, self.props)

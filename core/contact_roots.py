@@ -7,7 +7,8 @@ Two searches over n bodies with per-body horizons, each on a free flight ``fligh
   (:func:`core.collision.entry_time`), exact for a body whose contact points move with its COM under a
   constant force (a point, a sphere, a body that does not turn);
 - :func:`root_contact`: a bracketed root finder on f(s) = min over points of E + delta
-  (:data:`ROOT_OFFSET`) along the flight. The bracket ends at the end of the horizon if a point is inside
+  (:data:`ROOT_OFFSET_RTOL` of the body's size) along the flight. The bracket ends at the end of the horizon
+  if a point is inside
   there, else at the minimum of the points' cubic Hermite interpolants of E (from E and u.N at both ends)
   if a flight confirms it: this catches a corner that dips in and out within one step. Each iterate is
   the first root of the Hermite cubic of the point inside at the upper end, or the bracket's middle when
@@ -22,10 +23,12 @@ from simparity.core.collision import entry_time
 from simparity.core.contact import Bodies, take_state
 from simparity.core.rigid_body import State, velocities
 
-ROOT_OFFSET = 1e-12
-"""[m] delta: the root finder looks for the first instant a point is delta inside a plane (to within
-delta / 2), so that a point that has just bounced (E = 0, moving out) is not found again at once. The
-body is pushed back out after the response."""
+ROOT_OFFSET_RTOL = 1e-11
+"""delta, relative to the body's size: the root finder looks for the first instant a point is delta inside a
+plane (to within delta / 2), so that a point that has just bounced (E = 0, moving out) is not found again at
+once; the body is pushed back out after the response. 1e-12 m for a decimetre body, ~1e5 ulp of positions of
+order 1 m; relative to the size, so that the scene's length unit does not change where the root is found
+(an absolute delta moved core's back-up trajectories by 1e-8 m when the scene was rescaled)."""
 
 ROOT_TIME_TOLERANCE = 1e-13
 """Relative to the sub-step: a narrower bracket is taken as converged (~500 ulp)."""
@@ -116,11 +119,14 @@ def root_contact(flight, t: float, state: State, resting, distance, speed, horiz
         """E + delta of every point (n, P V) [m] after flying s (n,) [s], and their rates u.N (n, P V)."""
         _, dist, spd = distances(fl.bodies, fl(t, st, s), rest)
         dist = dist.reshape(len(s), -1)
-        return np.where(np.isfinite(dist), dist + ROOT_OFFSET, 1.0), spd.reshape(len(s), -1)
+        delta_fl = ROOT_OFFSET_RTOL * fl.bodies.size[:, None]
+        return np.where(np.isfinite(dist), dist + delta_fl, 1.0), spd.reshape(len(s), -1)
 
     n = len(horizon)
+    delta = ROOT_OFFSET_RTOL * flight.bodies.size[:, None]  # (n, 1) [m]
     time = np.full(n, np.inf)
-    g0, rate0 = np.where(np.isfinite(distance), distance + ROOT_OFFSET, 1.0).reshape(n, -1), speed.reshape(n, -1)
+    start = distance.reshape(n, -1)
+    g0, rate0 = np.where(np.isfinite(start), start + delta, 1.0), speed.reshape(n, -1)
     f0 = g0.min(axis=1)
     time[f0 <= 0.0] = 0.0
     g_end, rate_end = g(flight, state, resting, np.where(f0 > 0.0, horizon, 0.0))
@@ -149,8 +155,9 @@ def root_contact(flight, t: float, state: State, resting, distance, speed, horiz
     hi, g_hi, r_hi = hi[idx], g_hi[idx], r_hi[idx]
     side, kept = np.zeros(len(idx), dtype=int), np.zeros(len(idx), dtype=bool)
     width = ROOT_TIME_TOLERANCE * horizon[idx]
+    half = 0.5 * delta[idx, 0]
     for _ in range(MAX_ROOT_ITERATIONS):
-        work = (g_lo.min(axis=1) > 0.5 * ROOT_OFFSET) & (g_hi.min(axis=1) < -0.5 * ROOT_OFFSET) & (hi - lo > width)
+        work = (g_lo.min(axis=1) > half) & (g_hi.min(axis=1) < -half) & (hi - lo > width)
         if not work.any():
             break
         point = g_hi.argmin(axis=1)[:, None]
@@ -165,5 +172,5 @@ def root_contact(flight, t: float, state: State, resting, distance, speed, horiz
                           np.where(right[:, None], r_s, r_hi))
         lo, g_lo, r_lo = np.where(left, s, lo), np.where(left[:, None], g_s, g_lo), np.where(left[:, None], r_s, r_lo)
         side = np.where(right, 1, np.where(left, -1, side))
-    time[idx] = np.where(g_hi.min(axis=1) >= -0.5 * ROOT_OFFSET, hi, lo)
+    time[idx] = np.where(g_hi.min(axis=1) >= -half, hi, lo)
     return time

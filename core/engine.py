@@ -19,6 +19,50 @@ from simparity.core.scene import Chain, DynamicsScene, KinematicsScene
 from simparity.core.trajectory import FramePoses, Trajectory
 
 
+SCHEME_KINDS = {
+    # How a dynamics integrator steps a free body.
+    "explicit_euler": "explicit (forward) Euler: first order, gains energy on any oscillation or spin",
+    "semi_implicit_euler": "semi-implicit (symplectic) Euler: first order",
+    "engine_euler": "semi-implicit Euler with the orientation advanced by the exponential map, as engines step: "
+                    "first order",
+    "implicit_damping": "semi-implicit Euler with velocity-dependent forces taken implicitly (MuJoCo's "
+                              "implicit, implicitfast): first order, damps stiff drag and fast spins",
+    "midpoint": "the explicit midpoint rule (RK2): second order",
+    "average_velocity": "the lecture's average-velocity rule (Heun's method, RK2): second order",
+    "rk4": "classical fourth-order Runge-Kutta",
+    "taylor2": "the lecture's Taylor rule for a point: exact under constant acceleration",
+    "constant_velocity": "the lecture's rule for a point no force acts on",
+    "closed_form": "a closed-form solution (a truth, not a scheme)",
+    "adaptive": "an adaptive high-order solve at a tight tolerance (a truth, not a scheme)",
+    # How contact with a plane is treated (a contact scene's scheme is "<treatment>+<time integrator>").
+    "backup": "time backed up to each contact, the response there (exact for ballistic flight)",
+    "act_after": "the kinematic response after the step in which the contact happened, with push-out",
+    "penalty": "a spring-damper force on penetration, integrated by a time integrator",
+    "soft": "a soft constraint (MuJoCo's solref/solimp), with no restitution coefficient",
+    "impulse": "velocity-level impulses with restitution and position correction (Bullet)",
+    # How an IK solver steps.
+    "jacobian_inverse": "Newton steps with J^-1 (square, invertible Jacobians only)",
+    "pseudo_inverse": "Newton steps with the Moore-Penrose pseudo-inverse of J",
+    "transpose": "gradient steps along J^T e",
+    "damped_least_squares": "damped least squares (Levenberg-Marquardt) steps",
+    "nullspace": "a secondary objective projected into J's null space (after a '+')",
+    "restarts": "restarts from random configurations when a solve stalls (after a '+')",
+    "limits": "keeps the joints within their limits at every iteration (after a '+')",
+}
+"""The kinds of scheme the CI gate keys its bounds by (``scheme`` in a tolerances file), whatever the engine
+calls its integrators: an engine's :meth:`Engine.scheme` answers with these names, joined by ``+`` where a
+kind is modified (``damped_least_squares+nullspace``) or a contact treatment drives a time integrator
+(``penalty+rk4``, ``soft+rk4``). "" is an engine that does not say, which only the bounds for every scheme
+hold."""
+
+CONTACT_TREATMENTS = ("backup", "act_after", "penalty", "soft", "impulse")
+
+
+def is_scheme_label(label: str) -> bool:
+    """Whether ``label`` is "" or kinds of :data:`SCHEME_KINDS` joined by ``+``."""
+    return label == "" or all(part in SCHEME_KINDS for part in label.split("+"))
+
+
 @dataclass(frozen=True)
 class Support:
     """Whether an engine can do what a scene asks, and why not when it cannot."""
@@ -173,6 +217,21 @@ class Engine(abc.ABC):
         """Global order of accuracy the integrator has in theory (None: unknown, or it depends on the
         scene). Reports draw it beside the observed order."""
         return None
+
+    def scheme(self, integrator: str, scene) -> str:
+        """What kind of scheme ``integrator`` (an IK solver on an IK scene) is on ``scene``, in the names of
+        :data:`SCHEME_KINDS` (``rk4``, ``penalty+rk4``, ``damped_least_squares+nullspace``); "" when unknown.
+        The CI gate holds every engine's scheme of a kind to that kind's bounds.
+
+        By default an integrator named as a kind is of that kind (its variant, after the first ``+`` of
+        :meth:`integrator_variant`, left out), and on a contact scene ``penalty_<kind>`` is ``penalty+<kind>``:
+        an engine that names its integrators and solvers after what they are needs nothing more."""
+        name = integrator
+        if isinstance(scene, DynamicsScene):
+            name = self.integrator_variant(integrator)[0]
+            if scene.contact is not None and name.startswith("penalty_"):
+                name = "penalty+" + name.removeprefix("penalty_")
+        return name if is_scheme_label(name) else ""
 
     def integrator_variant(self, integrator: str) -> tuple[str, str]:
         """(scheme, variant) of an integrator: integrators that differ only in a variant of one scheme

@@ -97,3 +97,13 @@ class ToleranceError(SceneError):
 
 class HistoryError(SimparityError):
     """The run history database cannot be read or written (the CSV results are unaffected)."""
+
+
+class TransformError(SceneError):
+    """A metamorphic transform (``comparisons.transforms``) is invalid, or cannot be applied to a scene: the
+    scene's data cannot express the transformed physics (file or ``<code>``, the transform's key, why)."""
+
+
+class UnitError(SimparityError):
+    """A metric's unit string is not one simparity can convert between unit systems (unknown, or a mix of
+    dimensions the transform scales differently): its value is never converted by a guessed factor."""

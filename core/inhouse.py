@@ -21,7 +21,7 @@ from simparity.core.contact_act_after import GAUSS_SEIDEL_PASSES, ActAfterSteppe
 from simparity.core.contact_backup import FREE, MAX_EVENTS_PER_STEP, BackupStepper
 from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
 from simparity.core.forces import make_wrench
-from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik
+from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik, task_basis
 from simparity.core.ik.problem import IKTolerances
 from simparity.core.ik.restarts import Restarts, solve_ik_with_restarts
 from simparity.core.ik.result import IKResult
@@ -30,7 +30,7 @@ from simparity.core.quaternion_integrators import PackedBodies, make_packed_step
 from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.rigid_body import MassProperties, State, initial_state, velocities
 from simparity.core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
-from simparity.core.scene import PENALTY_PREFIX, Chain, DynamicsScene
+from simparity.core.scene import PENALTY_PREFIX, Chain, DynamicsScene, IKScene
 from simparity.core.trajectory import FramePoses, Trajectory
 
 _DEFAULT_ORIENTATION = "quaternion"
@@ -325,9 +325,18 @@ class InHouseEngine(Engine):
     def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
         named = super().supports_ik(chain, solver, position_only)
         task = 3 if position_only else 6
-        if named.ok and solver == "jacobian_inverse" and chain.n_joints != task:
-            return Support.no(f"the Jacobian inverse needs a square Jacobian; this one is {task} x {chain.n_joints}")
+        if named.ok and solver == "jacobian_inverse":
+            moves = task_basis(chain, task).shape[1]
+            if moves != chain.n_joints:
+                return Support.no(f"the Jacobian inverse needs a square, invertible Jacobian; the chain moves in "
+                                  f"{moves} of the target's {task} directions with {chain.n_joints} joints")
         return named
+
+    def scheme(self, integrator: str, scene) -> str:
+        """What the engine's default says (core names its methods after what they are), and every in-house IK
+        solver keeps the joints within their limits every iteration: ``+limits``."""
+        kind = super().scheme(integrator, scene)
+        return f"{kind}+limits" if kind and isinstance(scene, IKScene) else kind
 
     def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
         # The scene's tolerances and cap; the in-house settings keep their defaults unless given.

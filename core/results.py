@@ -13,7 +13,8 @@ import numpy as np
 from simparity.core.arrays import readonly
 
 SCHEMA_VERSION = 2
-"""2: the ``flag`` column (:data:`FLAGS`). Version 1 runs, without it, are read with every flag empty."""
+"""2: the ``flag`` column (:data:`FLAGS`) and the ``scheme`` column (the kind of scheme of the row's integrator or
+solver, ``core.engine.SCHEME_KINDS``). Version 1 runs, without them, are read with both empty."""
 READ_SCHEMA_VERSIONS = (1, 2)
 """Stored runs this simparity reads."""
 RESULTS_FILE = "results.csv"
@@ -21,7 +22,8 @@ RUN_INFO_FILE = "run.json"
 REPORT_FILE = "report.md"
 REPORT_HTML_FILE = "report.html"
 
-COLUMNS = ("scene", "engine", "integrator", "dt", "metric", "value", "unit", "reference", "status", "detail", "flag")
+COLUMNS = ("scene", "engine", "integrator", "dt", "metric", "value", "unit", "reference", "status", "detail", "flag",
+           "scheme")
 """The columns of every run. A run with a swept scene (a file's ``[sweep]``) has the sweep columns after
 them; a run without has exactly these."""
 
@@ -48,10 +50,12 @@ non-finite values."""
 SATURATED, ROUNDING_FLOOR, PRE_ASYMPTOTIC, SUPERCONVERGENT, BELOW_THEORY, NOT_CONVERGING, NOTHING_TO_MEASURE = (
     "saturated", "rounding-floor", "pre-asymptotic", "superconvergent", "below-theory", "not-converging",
     "nothing-to-measure")
+UNSOLVED = "unsolved"
 FLAGS = {
     SATURATED: "n/a: the error is as large as the quantity it measures (the run is on another orbit, or an "
                "orientation is lost): it no longer measures how far; the detail names the scale",
-    ROUNDING_FLOOR: "n/a: the errors are at the rounding floor of the run (the scheme is exact up to rounding)",
+    ROUNDING_FLOOR: "an error at the rounding floor of its run (ok: a number, exact up to rounding), or an order fit "
+                    "of such errors (n/a)",
     PRE_ASYMPTOTIC: "n/a: an order whose local slopes disagree: the time steps are not in the asymptotic range",
     SUPERCONVERGENT: "ok: a clean order fit above the scheme's theoretical order + 0.5 (error terms cancel, or "
                      "the steps are before the asymptotic range); the detail gives the local slopes",
@@ -62,6 +66,8 @@ FLAGS = {
                     "the gate fails it unless a bound names it",
     NOTHING_TO_MEASURE: "n/a: the physics of this run offers nothing to measure (no impact, no motion, a quantity "
                         "that is 0)",
+    UNSOLVED: "n/a: an IK solver that solves none of the scene's reachable targets: a rate of 0 measures a stopping "
+              "rule or a cap it does not meet, not how well it solves (the detail gives its median residuals)",
 }
 """The typed qualifiers of a row (its ``flag`` column; empty for a plain measurement): why a row is n/a when the
 number would mean nothing, and what an ok order fit shows beside theory. The report's findings and the gate read
@@ -79,7 +85,9 @@ class ResultRow:
     """One measurement (or the reason there is none).
 
     ``dt`` is NaN and ``integrator`` empty for kinematics scenes; ``value`` is NaN unless
-    ``status`` is ok.
+    ``status`` is ok. ``flag`` qualifies the status (:data:`FLAGS`); ``scheme`` is the kind of scheme the engine
+    declares its integrator or IK solver to be on the scene (``core.engine.Engine.scheme``; "" when it does not
+    say), which the CI gate keys its bounds by.
     """
 
     scene: str
@@ -93,6 +101,7 @@ class ResultRow:
     status: str
     detail: str = ""
     flag: str = ""
+    scheme: str = ""
 
     def as_dict(self) -> dict:
         return asdict(self)

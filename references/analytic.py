@@ -281,6 +281,10 @@ class AnalyticEngine(Engine):
     def integrators(self) -> tuple[str, ...]:
         return ("exact",)
 
+    def scheme(self, integrator: str, scene) -> str:
+        """Every answer of this engine is a closed form."""
+        return "closed_form"
+
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         named = self.check_integrator(integrator)
         if not named.ok:

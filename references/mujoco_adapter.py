@@ -53,7 +53,7 @@ from mujoco import rollout
 from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
 from simparity.core.errors import DivergedError
 from simparity.core.ik.problem import IKTolerances
-from simparity.core.scene import Chain, DynamicsScene, Forces
+from simparity.core.scene import Chain, DynamicsScene, Forces, IKScene
 from simparity.core.trajectory import FramePoses, Trajectory
 from simparity.references import contact_params, external_forces, mujoco_ik
 from simparity.references.base_frame import BaseFrame
@@ -306,6 +306,16 @@ class MujocoEngine(Engine):
         """Euler (semi-implicit), implicit and implicitfast are first order, RK4 fourth (MuJoCo's docs,
         "Numerical integration")."""
         return {"euler": 1, "implicit": 1, "implicitfast": 1, "rk4": 4}.get(integrator)
+
+    def scheme(self, integrator: str, scene) -> str:
+        """MuJoCo's Euler is semi-implicit with the orientation advanced by the exponential map (eulerdamp is
+        disabled, so damping is explicit); implicit and implicitfast take velocity-dependent forces implicitly;
+        with planes, its soft contact drives them. Its IK (``dls``) is damped least squares."""
+        if isinstance(scene, IKScene):
+            return "damped_least_squares" if integrator in mujoco_ik.SOLVERS else ""
+        kind = {"euler": "engine_euler", "rk4": "rk4", "implicit": "implicit_damping",
+                "implicitfast": "implicit_damping"}.get(integrator, "")
+        return f"soft+{kind}" if kind and isinstance(scene, DynamicsScene) and scene.contact is not None else kind
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         return self.check_integrator(integrator)

@@ -41,7 +41,7 @@ import pinocchio as pin
 
 from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
 from simparity.core.ik.problem import IKTolerances
-from simparity.core.scene import Chain, DynamicsScene
+from simparity.core.scene import Chain, DynamicsScene, IKScene
 from simparity.core.trajectory import FramePoses, Trajectory
 from simparity.references import external_forces, pinocchio_ik
 from simparity.references.base_frame import BaseFrame
@@ -277,6 +277,13 @@ class PinocchioEngine(UrdfChains, Engine):
     def theoretical_order(self, integrator: str) -> int | None:
         """The harness's steppers: the engines' first-order scheme, classical RK4."""
         return {"euler": 1, "rk4": 4}.get(integrator)
+
+    def scheme(self, integrator: str, scene) -> str:
+        """The harness's steppers on Pinocchio's dynamics: the engines' Euler step and RK4; its IK (``clik``,
+        ``clik-documented``) is the closed-loop IK of its documentation, damped least squares on the SE(3) log."""
+        if isinstance(scene, IKScene):
+            return "damped_least_squares" if integrator in pinocchio_ik.SOLVERS else ""
+        return {"euler": "engine_euler", "rk4": "rk4"}.get(integrator, "")
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         if scene.contact is not None:

@@ -82,7 +82,7 @@ import numpy as np
 from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
 from simparity.core.errors import DivergedError
 from simparity.core.ik.problem import IKTolerances
-from simparity.core.scene import Chain, DynamicsScene
+from simparity.core.scene import Chain, DynamicsScene, IKScene
 from simparity.core.trajectory import FramePoses, Trajectory
 from simparity.references import contact_params, external_forces, pybullet_ik
 from simparity.references.base_frame import BaseFrame
@@ -455,6 +455,17 @@ class PybulletEngine(UrdfChains, Engine):
     def theoretical_order(self, integrator: str) -> int | None:
         """Bullet's semi-implicit Euler step is first order."""
         return 1 if integrator == "euler" else None
+
+    def scheme(self, integrator: str, scene) -> str:
+        """Bullet steps semi-implicit Euler, the orientation by the exponential map; with planes, its velocity-level
+        impulses resolve contact. Its IK is damped least squares (``-nullspace``: with a null-space rest pose)."""
+        if isinstance(scene, IKScene):
+            return ("damped_least_squares+nullspace" if integrator.endswith("nullspace") else
+                    "damped_least_squares" if integrator in pybullet_ik.SOLVERS else "")
+        if integrator != "euler":
+            return ""
+        contact = isinstance(scene, DynamicsScene) and scene.contact is not None
+        return "impulse+engine_euler" if contact else "engine_euler"
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         named = self.check_integrator(integrator)

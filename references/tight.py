@@ -110,6 +110,10 @@ class TightSolveEngine(Engine):
     def integrators(self) -> tuple[str, ...]:
         return ("dop853",)
 
+    def scheme(self, integrator: str, scene) -> str:
+        """DOP853 at a tight tolerance: a truth, not a scheme users pick."""
+        return "adaptive"
+
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         if scene.contact is not None:
             return Support.no("the tight solve has no contact: its bodies would fly through the planes")

@@ -52,8 +52,9 @@ def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
     if meta.get("schema_version") not in READ_SCHEMA_VERSIONS:
         raise ResultsError(f"{info}: schema_version {meta.get('schema_version')!r:.20} (allowed: "
                            f"{', '.join(map(str, READ_SCHEMA_VERSIONS))}, the versions this simparity reads)")
-    if "flag" not in table.columns:  # schema 1: written before rows carried a flag
-        table.insert(table.columns.get_loc("detail") + 1, "flag", "")
+    for column in ("flag", "scheme"):  # schema 1: written before rows carried them
+        if column not in table.columns:
+            table.insert(table.columns.get_loc("detail") + 1 + (column == "scheme"), column, "")
     missing = [c for c in COLUMNS if c not in table.columns]
     if missing:
         raise ResultsError(f"{results}: missing columns {missing} (allowed: a results.csv with {', '.join(COLUMNS)})")

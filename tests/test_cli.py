@@ -281,3 +281,17 @@ def test_bench_is_a_command_with_help():
     with pytest.raises(SystemExit) as done:
         main(["bench", "--help"])
     assert done.value.code == 0
+
+
+def test_check_explain_says_what_holds_an_engine(tmp_path, capsys):
+    """--explain ENGINE: one line per scene and bound that holds the engine's rows, from the bound's file and index,
+    with the rows it holds, to what and why; an engine the run does not have is a one-line error."""
+    run = tmp_path / "run"
+    assert main(["run", "lecture-projectile", "--quick", "--engines", "core", "--out", str(run), "--jobs", "1"]) == EXIT_OK
+    capsys.readouterr()
+    assert main(["check", str(run), "--explain", "core"]) == EXIT_OK
+    lines = capsys.readouterr().out.splitlines()
+    assert lines and all(line.startswith("lecture-projectile: default.toml bound[") for line in lines)
+    assert any("position_error_final" in line and "x dt^1" in line and "g T dt / 2" in line for line in lines)
+    assert main(["check", str(run), "--explain", "nosuch"]) == EXIT_USAGE
+    assert "--explain nosuch: no rows of that engine" in capsys.readouterr().err

@@ -10,6 +10,8 @@ from simparity.comparisons.engines import DEFAULT_ENGINES, make_engine
 from simparity.comparisons.ik_runner import IK_METRICS
 from simparity.comparisons.runner import run_scene
 from simparity.comparisons.ik_targets import random_targets
+from simparity.comparisons.profiles import quick
+from simparity.core.inhouse import InHouseEngine
 from simparity.core.ik.jacobian_solvers import IKOptions
 from simparity.core.results import FAILED, NOT_AVAILABLE, OK
 from tests.helpers import builtin
@@ -133,3 +135,77 @@ def test_singular_start_pose_is_reported():
     assert stretched.value == 1 and "start pose singular" in stretched.note
     bent = start_rank_deficiency(dataclasses.replace(scene, q_start=np.array([0.3, 1.0])), model)
     assert bent.value == 0 and "start pose regular" in bent.note
+
+
+class _Boasting(InHouseEngine):
+    """Core's solvers, but every target is claimed solved (a success criterion gone wrong)."""
+
+    name = "boasting"
+
+    def build_ik(self, chain, solver, options):
+        model = super().build_ik(chain, solver, options)
+        solve = model.solve
+
+        def claims_all(*args):
+            result = solve(*args)
+            return dataclasses.replace(result, success=np.ones_like(result.success),
+                                       reason=np.full_like(result.reason, ""))
+
+        model.solve = claims_all
+        return model
+
+
+class _OffsetFK(InHouseEngine):
+    """Core, with its forward kinematics 1 mm off along x (a frame at fault)."""
+
+    name = "offset-fk"
+
+    def build_kinematics(self, chain):
+        model = super().build_kinematics(chain)
+        fk = model.forward_kinematics
+
+        def shifted(q):
+            poses = fk(q)
+            return dataclasses.replace(poses, position_world=poses.position_world + np.array([1e-3, 0.0, 0.0]))
+
+        model.forward_kinematics = shifted
+        return model
+
+
+def _quick_rows(name, engines):
+    return run_scene(quick(builtin(name)), engines, make_engine, repeats=1)
+
+
+def test_a_claim_no_fk_confirms_is_counted():
+    """A solver that claims every target solved while the transpose method stalls: its unconfirmed claims are
+    counted (the harness's residual check by every engine's FK refuses them); core's own claims are confirmed."""
+    rows = _quick_rows("iiwa-ik", [make_engine("core"), _Boasting()])
+    claims = {(r.engine, r.integrator): r.value for r in rows if r.metric == "unconfirmed_claims"}
+    assert claims[("core", "transpose")] == 0.0 and claims[("boasting", "transpose")] > 0.5
+
+
+def test_a_wrong_fk_is_blamed_on_its_engine_alone():
+    """An engine whose FK is 1 mm off: its own rows show the departure; core's solve rates are judged by the FKs
+    that agree with the reference, so they do not drop."""
+    rows = _quick_rows("ur5-ik", [make_engine("core"), _OffsetFK()])
+    value = {(r.engine, r.integrator, r.metric): r for r in rows}
+    assert value[("offset-fk", "damped_least_squares", "fk_departure_max")].value == pytest.approx(1e-3)
+    assert value[("core", "damped_least_squares", "fk_departure_max")].value == 0.0
+    alone = {(r.integrator, r.metric): r.value for r in _quick_rows("ur5-ik", [make_engine("core")])}
+    assert value[("core", "damped_least_squares", "cross_eval_solve_rate_min")].value == alone[
+        ("damped_least_squares", "cross_eval_solve_rate_min")]
+
+
+def test_the_jacobian_inverse_where_it_applies_and_n_a_where_it_does_not():
+    """The lecture's 3-link planar arm moves in 3 of a pose's 6 directions (x, y, the turn about z): J^-1 solves
+    its planar pose targets; with 3-D position targets its 3 x 3 Jacobian has a zero row: n/a with the reason,
+    never a 0 % ok."""
+    scene = quick(builtin("lecture-3link-ik"))
+    rows = run_scene(scene, [make_engine("core")], make_engine, repeats=1)
+    inverse = {r.metric: r for r in rows if r.integrator == "jacobian_inverse"}
+    assert inverse["cross_eval_solve_rate_min"].status == OK and inverse["cross_eval_solve_rate_min"].value > 0.8
+    position = dataclasses.replace(scene, target_kind="position")
+    rows = run_scene(position, [make_engine("core")], make_engine, repeats=1)
+    inverse = {r.metric: r for r in rows if r.integrator == "jacobian_inverse"}
+    assert inverse["solve_rate"].status == NOT_AVAILABLE
+    assert "moves in 2 of the target's 3" in inverse["solve_rate"].detail

@@ -26,3 +26,17 @@ def test_short_scenes_run_whole_and_samples_shrink():
     assert quick(projectile).dts == tuple(sorted(projectile.dts))  # no contact: the whole ladder, for its orders
     assert quick(builtin("iiwa-ik")).n_targets == QUICK_TARGETS
     assert apply_profile([projectile], "full") == [projectile]
+
+
+def test_the_quick_default_suite_exercises_every_integrator_variant():
+    """Every integrator core offers for free bodies, each orientation update included, runs on at least one scene
+    of the quick default suite (the short rotating scenes keep their variants)."""
+    from simparity.comparisons.engines import make_engine
+    from simparity.comparisons.library import suite
+    from simparity.core.scene import DynamicsScene
+
+    core = make_engine("core")
+    scenes = [quick(s) for s in suite("default") if isinstance(s, DynamicsScene) and s.contact is None]
+    ran = {i for s in scenes for i in core.scene_integrators(s) if not s.integrators or i in s.integrators}
+    offered = set(core.scene_integrators(scenes[0]))
+    assert any(VARIANT_MARK in i for i in offered) and offered <= ran

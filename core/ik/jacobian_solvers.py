@@ -55,9 +55,9 @@ from simparity.core.ik.problem import IKTolerances, check_inputs
 from simparity.core.ik.nullspace import limit_penalty_gradient, nullspace_term, penalty_gradient
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.ik.result import IKResult
-from simparity.core.kinematics import jacobian_of_frames, packed_frames
+from simparity.core.kinematics import jacobian_of_frames, jacobian_world, packed_frames
 from simparity.core.rotations import so3_log
-from simparity.core.scene import Chain
+from simparity.core.scene import Chain, sample_configurations
 
 METHODS = ("jacobian_inverse", "pseudo_inverse", "transpose", "damped_least_squares")
 
@@ -152,8 +152,10 @@ def solve_ik(
     q_start : (n,) or (B, n) ndarray, optional
         Start configuration(s) [rad or m], clipped into the limits; default zeros.
     method : str
-        One of :data:`METHODS`. ``"jacobian_inverse"`` needs a square task Jacobian
-        (n = 3 joints for position, 6 for pose targets).
+        One of :data:`METHODS`. ``"jacobian_inverse"`` needs a square task Jacobian: n = 3 joints for
+        position, 6 for pose targets, or n = the number of task directions the chain moves in at all (a planar
+        arm of 3 joints with pose targets moves in x, y and the turn about the plane's normal: its inverse is
+        taken on those, :func:`task_basis`).
     options : IKOptions
 
     Returns
@@ -172,9 +174,13 @@ def solve_ik(
     if method not in METHODS:
         raise ValueError(f"unknown IK method {method!r}, expected one of {METHODS}")
     rows = 3 if target_rotation is None else 6
+    basis = None
     if method == "jacobian_inverse" and rows != chain.n_joints:
-        raise ValueError(f"jacobian_inverse needs a square Jacobian: the task has {rows} rows, "
-                         f"chain '{chain.name}' has {chain.n_joints} joints")
+        basis = task_basis(chain, rows)
+        if basis.shape[1] != chain.n_joints:
+            raise ValueError(f"jacobian_inverse needs a square Jacobian: the task has {rows} rows, of which "
+                             f"{basis.shape[1]} the chain can move in, and chain '{chain.name}' has "
+                             f"{chain.n_joints} joints")
     lower, upper = chain.lower, chain.upper
     revolute = np.array([j.type == "revolute" for j in chain.joints])
     crossable = crossable_gap(revolute, lower, upper, options.max_step)
@@ -208,7 +214,10 @@ def solve_ik(
         reason[idx[solved]] = ""
 
         jac = jacobian_of_frames(chain, frames)[:, :rows]
-        dq, locked = _update(method, jac, err, qa, lower, upper, revolute, options)
+        if basis is None:
+            dq, locked = _update(method, jac, err, qa, lower, upper, revolute, options)
+        else:  # the task's directions the chain moves in: a planar arm's x, y and turn about the plane's normal
+            dq, locked = _update(method, basis.T @ jac, err @ basis, qa, lower, upper, revolute, options)
         # Only a target that has not progressed for stall_window iterations can stop unsolved: only those are
         # classified (the singular values cost more than the rest of the iteration).
         cause = np.full(len(idx), "iteration_cap", dtype=object)
@@ -249,6 +258,25 @@ def solve_ik(
     violation = np.max(np.maximum(np.maximum(lower - best_q, best_q - upper), 0.0), axis=1, initial=0.0)
     return IKResult(q=best_q, success=reason == "", iterations=iterations, position_residual=pos_res,
                     orientation_residual=rot_res, limit_violation=violation, reason=reason.astype(str))
+
+
+TASK_SAMPLES = 32
+"""Configurations at which :func:`task_basis` samples the Jacobian: a direction a chain cannot move in at 32
+seeded random configurations it cannot move in anywhere (the configurations where it could are not a set of
+measure zero)."""
+
+TASK_RTOL = 1e-9
+"""A singular value below this fraction of the largest is zero (rounding leaves ~1e-16)."""
+
+
+def task_basis(chain: Chain, rows: int) -> np.ndarray:
+    """(rows, k) an orthonormal basis of the task directions (of the first ``rows`` of the world Jacobian: 3
+    for position, 6 for pose) the chain moves in at some configuration, k their number: the span of the
+    Jacobian's columns over :data:`TASK_SAMPLES` seeded random configurations within the limits."""
+    q = sample_configurations(chain, TASK_SAMPLES, 0)
+    columns = np.concatenate(list(jacobian_world(chain, q)[:, :rows]), axis=1)  # (rows, samples x n)
+    u, sigma, _ = np.linalg.svd(columns, full_matrices=False)
+    return u[:, sigma > TASK_RTOL * sigma[0]]
 
 
 def _error(end_world, end_rotation, target_position, target_rotation):

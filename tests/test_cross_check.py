@@ -1,0 +1,73 @@
+"""Cross-checks: a user's scheme held to the built-in schemes of its kind in the same run."""
+
+import dataclasses
+import math
+
+import pandas as pd
+
+from simparity.comparisons.cross_check import CROSS_CHECK_FACTOR, SOLVE_RATE_FRACTION, cross_check
+from simparity.core.results import COLUMNS, ResultRow
+
+BUILTIN = ("core", "mujoco")
+
+
+def _row(engine, value, metric="position_error_max", scheme="rk4", status="ok", flag="", dt=0.01, unit="m"):
+    return ResultRow("s", engine, "my-rk4" if engine == "user" else "rk4", dt, metric, value, unit, "analytic:exact",
+                     status, "", flag, scheme)
+
+
+def _check(*rows):
+    return cross_check(pd.DataFrame([r.as_dict() for r in rows], columns=list(COLUMNS)), BUILTIN)
+
+
+def test_a_user_scheme_beyond_the_largest_builtin_of_its_kind_names_both():
+    """Core's RK4 errs 1e-5, MuJoCo's 2e-6: the user's RK4 may err up to 2 x the larger; at 2.7 x core's it is a
+    violation that names the user's engine and core."""
+    builtin = (_row("core", 1e-5), _row("mujoco", 2e-6))
+    assert _check(*builtin, _row("user", 1e-5)) == []
+    assert _check(*builtin, _row("user", 0.99 * CROSS_CHECK_FACTOR * 1e-5)) == []
+    (violation,) = _check(*builtin, _row("user", 2.7e-5))
+    assert violation.engine == "user" and "core rk4" in violation.reason and "rk4" in violation.reason
+
+
+def test_only_the_same_kind_at_the_same_step_and_never_rounding():
+    """Another kind, another step, or a built-in error at the rounding floor: nothing to hold the user's row to."""
+    assert _check(_row("core", 1e-5, scheme="midpoint"), _row("user", 1.0)) == []
+    assert _check(_row("core", 1e-5, dt=0.02), _row("user", 1.0)) == []
+    assert _check(_row("core", 1e-13, flag="rounding-floor"), _row("user", 1e-12)) == []
+    assert _check(_row("core", 1e-5), _row("user", 1.0, scheme="")) == []  # a user's engine that does not say
+
+
+def test_saturated_where_the_builtins_measured_is_a_violation():
+    (violation,) = _check(_row("core", 1e-5), _row("user", math.nan, status="n/a", flag="saturated"))
+    assert violation.found == "saturated" and "core rk4" in violation.reason
+
+
+def test_a_solve_rate_below_the_fraction_of_the_best_builtin_of_its_kind():
+    rate = dict(metric="cross_eval_solve_rate_min", scheme="damped_least_squares", dt=math.nan, unit="1")
+    builtin = (_row("core", 0.96, **rate), _row("mujoco", 0.6, **rate))
+    assert _check(*builtin, _row("user", 0.96 * SOLVE_RATE_FRACTION + 0.01, **rate)) == []
+    (violation,) = _check(*builtin, _row("user", 0.24, **rate))
+    assert violation.engine == "user" and "core" in violation.reason
+
+
+def test_builtins_are_not_cross_checked_against_each_other():
+    assert _check(_row("core", 1e-3), _row("mujoco", 1e-6)) == []
+
+
+def test_a_nullspace_term_that_moves_away_from_the_rest_pose():
+    """The user's null-space solver ends farther from the rest pose (2.9 rad) than its plain solver (2.8): the
+    secondary objective is worse, not better; equal (no redundancy) passes."""
+    rest = dict(metric="rest_distance_median", dt=math.nan, unit="rad or m")
+    plain = _row("user", 2.8, scheme="damped_least_squares", **rest)
+    worse = ResultRow("s", "user", "dls+ns", math.nan, "rest_distance_median", 2.9, "rad or m", "core:fk", "ok", "",
+                      "", "damped_least_squares+nullspace")
+    (violation,) = _check(plain, worse)
+    assert violation.integrator == "dls+ns" and "null-space" in violation.reason
+    assert _check(plain, dataclasses.replace(worse, value=2.8)) == []
+
+
+def test_an_unsolved_user_solver_against_a_builtin_that_solves():
+    rate = dict(metric="cross_eval_solve_rate_min", scheme="damped_least_squares", dt=math.nan, unit="1")
+    (violation,) = _check(_row("core", 0.96, **rate), _row("user", math.nan, status="n/a", flag="unsolved", **rate))
+    assert violation.found == "0 (unsolved)"
