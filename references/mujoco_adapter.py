@@ -205,7 +205,7 @@ def contact_detail(scene: DynamicsScene, dt: float) -> str:
             f"sqrt(pi^2 + ln^2 k) ({solrefs}); solreffriction {fmt(contact_params.mujoco_solreffriction(dt))}; "
             f"solimp {fmt(contact_params.SOLIMP)} (constant impedance); points as spheres of "
             f"{contact_params.POINT_RADIUS:g} m with pair margin -{contact_params.POINT_RADIUS:g} m (contact at the "
-            f"centre); restitution approximate (measured, not imposed); rest_speed {contact.rest_speed:g} m/s not "
+            f"centre); MuJoCo has no restitution coefficient: the restitution is measured, not imposed (the damping above is derived from k); rest_speed {contact.rest_speed:g} m/s not "
             f"modelled (no rest rule; small bounces decay in the soft contact); penetration up to ~2 v dt in an "
             f"impact at speed v" + (f"; {static}" if static else ""))
 

@@ -291,7 +291,7 @@ def test_check_explain_says_what_holds_an_engine(tmp_path, capsys):
     capsys.readouterr()
     assert main(["check", str(run), "--explain", "core"]) == EXIT_OK
     lines = capsys.readouterr().out.splitlines()
-    assert lines and all(line.startswith("lecture-projectile: default.toml bound[") for line in lines)
+    assert lines and all(line.startswith("lecture-projectile: default.toml: bound[") for line in lines)
     assert any("position_error_final" in line and "x dt^1" in line and "g T dt / 2" in line for line in lines)
     assert main(["check", str(run), "--explain", "nosuch"]) == EXIT_USAGE
     assert "--explain nosuch: no rows of that engine" in capsys.readouterr().err
