@@ -3,8 +3,8 @@
 ``quick`` keeps every scene and every engine, and keeps what the verdicts need (the time steps
 of the order fits and of the hard cases' verdicts, the hard IK targets), but
 
-- a dynamics scene runs for at most :data:`QUICK_MAX_STEPS` of its finest kept time step (a whole
-  number of the coarsest), with one orientation update per scheme (the default; the ``+matrix`` /
+- a dynamics scene runs for at most :data:`QUICK_MAX_STEPS` of its finest kept time step
+  (:data:`QUICK_CONTACT_STEPS` for a contact scene; a whole number of the coarsest), with one orientation update per scheme (the default; the ``+matrix`` /
   ``+expmap`` variants are left to the full run), except on a rotating scene of at most
   :data:`QUICK_VARIANT_STEPS` steps, which runs every variant, so that CI exercises every orientation
   update. Which time steps it keeps is chosen by what the
@@ -33,6 +33,11 @@ QUICK_MAX_STEPS = 2000
 Dzhanibekov flip and the separatrix over 10-20 s, 10^5 and 10^6 steps) runs whole, so the hard
 cases show the verdict they show in the full run and the closed-form bounds hold for the whole
 horizon; a long horizon is cut to 2,000 steps, which keeps the suite near a minute on 2 cores."""
+
+QUICK_CONTACT_STEPS = 1000
+"""Steps at the finest kept time step of a contact scene: its coarsest steps are what its verdicts need, and a
+contact step costs several free steps (event detection, every engine's contact solver), so the contact scenes
+keep the horizon they had (the first bounces of every built-in one, the hard cases whole)."""
 
 QUICK_VARIANT_STEPS = 1000
 """A rotating scene of at most this many steps at its finest kept step runs every orientation variant in the
@@ -72,7 +77,8 @@ def quick(scene):
         if scene.contact is not None:
             dts = dts[:QUICK_LADDER]
         coarsest = dts[0]
-        duration = max(1, math.floor(QUICK_MAX_STEPS * dts[-1] / coarsest + 1e-9)) * coarsest
+        steps = QUICK_MAX_STEPS if scene.contact is None else QUICK_CONTACT_STEPS
+        duration = max(1, math.floor(steps * dts[-1] / coarsest + 1e-9)) * coarsest
         if duration >= scene.duration or not all(_divides(duration, dt) for dt in dts):
             duration = scene.duration
         short = duration / dts[-1] <= QUICK_VARIANT_STEPS * (1 + 1e-9) and _rotates(scene)
