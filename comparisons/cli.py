@@ -44,7 +44,8 @@ from simparity.comparisons.execution import count_cases, default_jobs, run_scene
 from simparity.comparisons.isolation import DEFAULT_CASE_SECONDS, GIB, CaseLimits, IsolatedPool
 from simparity.comparisons.journal import CASES_FOLDER, Journal, read_request, run_lock, write_request
 from simparity.comparisons.placeholder_engines import BrokenEngine, UnavailableEngine
-from simparity.comparisons.profiles import apply_profile
+from simparity.comparisons.profiles import (QUICK_CONTACT_STEPS, QUICK_LADDER, QUICK_MAX_STEPS, QUICK_TARGETS,
+                                             apply_profile)
 from simparity.comparisons.progress import ProgressBar
 from simparity.comparisons.runner import DEFAULT_REPEATS
 from simparity.comparisons.scene_limits import DEFAULT_LIMITS, Limits
@@ -146,8 +147,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help=f"timed repeats per case, the best is kept (default: {DEFAULT_REPEATS}; --quick: 0, one "
                      "cold timing)")
     run.add_argument("--quick", action="store_true",
-                     help="the CI profile: every scene shortened (3 coarsest time steps, <= 1000 steps, 50 IK "
-                     "targets), about half a minute")
+                     help=f"the CI profile: every scene shortened (<= {QUICK_MAX_STEPS} steps; a contact scene its "
+                     f"{QUICK_LADDER} coarsest time steps, <= {QUICK_CONTACT_STEPS} steps; {QUICK_TARGETS} IK targets), "
+                     "a few minutes on 2 cores")
     run.add_argument("--jobs", type=int, default=None, metavar="N",
                      help=f"worker processes (with --executor dask and no --scheduler: the local cluster's workers; "
                      f"default: one per CPU, here {default_jobs()})")

@@ -21,7 +21,7 @@ from simparity.core.ik.jacobian_solvers import IKOptions
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.kinematics import forward_kinematics
 from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix, rpy_to_matrix, so3_exp
-from simparity.core.scene import Chain, DynamicsScene, Forces, Joint, RigidBody
+from simparity.core.scene import Chain, DynamicsScene, Forces, IKScene, Joint, KinematicsScene, RigidBody
 from simparity.core.urdf import chain_from_urdf
 
 
@@ -152,9 +152,31 @@ TIMING_PREFIX = "time_"
 """Metrics that are wall times: they differ between any two runs; every other value must not."""
 
 
-def quick_scenes(names=MIXED_SCENES):
-    """Built-in scenes in the quick profile."""
-    return apply_profile([builtin(n) for n in names], "quick")
+SMOKE_STEPS = 100
+"""Steps at the coarsest time step of a smoke scene: every code path of a case runs, in a fraction of a second."""
+
+SMOKE_TARGETS = 10
+"""IK targets (and kinematics configurations) of a smoke scene."""
+
+
+def smoke(scene):
+    """``scene`` in the quick profile, trimmed further for tests of execution (executors, journals, isolation)
+    rather than of verdicts: a dynamics scene's two coarsest time steps over at most :data:`SMOKE_STEPS` of the
+    coarsest, at most :data:`SMOKE_TARGETS` IK targets or configurations."""
+    scene = apply_profile([scene], "quick")[0]
+    if isinstance(scene, DynamicsScene):
+        dts = sorted(scene.dts, reverse=True)[:2]
+        return dataclasses.replace(scene, dts=tuple(sorted(dts)), duration=min(scene.duration, SMOKE_STEPS * dts[0]))
+    if isinstance(scene, KinematicsScene):
+        return dataclasses.replace(scene, n_configurations=min(scene.n_configurations, SMOKE_TARGETS))
+    if isinstance(scene, IKScene):
+        return dataclasses.replace(scene, n_targets=min(scene.n_targets, SMOKE_TARGETS))
+    return scene
+
+
+def smoke_scenes(names=MIXED_SCENES):
+    """Built-in scenes trimmed to smoke tests of execution (:func:`smoke`)."""
+    return [smoke(builtin(n)) for n in names]
 
 
 def built_engines(names=RUN_ENGINES):

@@ -19,7 +19,7 @@ from simparity.comparisons import library
 from simparity.comparisons.isolation import CaseLimits, IsolatedPool
 from simparity.core.errors import SimparityError
 from simparity.core.results import RESULTS_FILE
-from tests.helpers import THROWN_BALL, InProcess, built_engines, comparable, no_leftovers_within, quick_scenes
+from tests.helpers import THROWN_BALL, InProcess, built_engines, comparable, no_leftovers_within, smoke_scenes
 
 WORKERS = 2
 
@@ -32,7 +32,7 @@ def dask():
 
 
 def test_a_local_dask_cluster_gives_the_results_of_this_process(dask):
-    scenes = quick_scenes()
+    scenes = smoke_scenes()
     expected = list(run_scenes(scenes, built_engines(), make_engine, 0, InProcess()))
     got = list(run_scenes(scenes, built_engines(), make_engine, 0, dask))
     assert [s.name for s, _, _ in got] == [s.name for s in scenes]
@@ -42,7 +42,7 @@ def test_a_local_dask_cluster_gives_the_results_of_this_process(dask):
 
 
 def test_a_crash_on_a_dask_worker_fails_its_case_alone(dask):
-    scenes = quick_scenes(("lecture-projectile",))
+    scenes = smoke_scenes(("lecture-projectile",))
     engines = built_engines(("core",)) + [make_engine("tests.hostile_engines:SegfaultingEngine")]
     specs = {"segfaulting": "tests.hostile_engines:SegfaultingEngine"}
     [(_, rows, _)] = run_scenes(scenes, engines, make_engine, 0, dask, specs=specs)
@@ -53,7 +53,9 @@ def test_a_crash_on_a_dask_worker_fails_its_case_alone(dask):
 
 
 def test_the_cli_runs_on_dask_and_writes_the_local_executor_results(tmp_path):
-    args = ["run", "lecture-projectile", "lecture-2link-ik", "--quick", "--jobs", str(WORKERS)]
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    args = ["run", str(scene), "ur5-kinematics", "--quick", "--jobs", str(WORKERS)]
     assert main(args + ["--out", str(tmp_path / "local")]) == 0
     assert main(args + ["--executor", "dask", "--out", str(tmp_path / "dask")]) == 0
     tables = [pd.read_csv(tmp_path / name / RESULTS_FILE, dtype=str, keep_default_na=False) for name in ("local", "dask")]

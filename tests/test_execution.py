@@ -10,11 +10,11 @@ from simparity.comparisons.execution import count_cases, estimated_cost, run_sce
 from simparity.comparisons.isolation import CaseLimits, IsolatedPool
 from simparity.comparisons.journal import Journal
 from simparity.core.results import STATUSES, case_counts
-from tests.helpers import InProcess, built_engines, comparable, quick_scenes
+from tests.helpers import InProcess, built_engines, comparable, smoke_scenes
 
 @pytest.fixture(scope="module")
 def in_process():
-    scenes = quick_scenes()
+    scenes = smoke_scenes()
     return scenes, list(run_scenes(scenes, built_engines(), make_engine, 0, InProcess()))
 
 
@@ -29,7 +29,7 @@ def test_worker_processes_give_bit_identical_results_whatever_their_number(in_pr
 
 
 def test_every_case_is_heard_once_and_the_costliest_group_goes_first():
-    scenes = quick_scenes(("lecture-planar-arm", "lecture-projectile"))
+    scenes = smoke_scenes(("lecture-planar-arm", "lecture-projectile"))
     heard = []
     executor = InProcess()
     results = list(run_scenes(scenes, built_engines(("core",)), make_engine, 0, executor,
@@ -58,7 +58,7 @@ def test_an_interrupted_run_resumes_without_recomputing_what_finished(tmp_path, 
 
 
 def test_a_changed_scene_or_engine_version_is_computed_again(tmp_path, monkeypatch):
-    scenes = quick_scenes(("lecture-projectile",))
+    scenes = smoke_scenes(("lecture-projectile",))
     list(run_scenes(scenes, built_engines(("core",)), make_engine, 0, InProcess(), Journal(tmp_path)))
     again = InProcess()
     list(run_scenes(scenes, built_engines(("core",)), make_engine, 0, again, Journal(tmp_path)))

@@ -21,9 +21,10 @@ from simparity.comparisons.execution import count_cases, run_scenes
 from simparity.comparisons.journal import CASES_FOLDER, Journal, run_lock
 from simparity.comparisons.profiles import apply_profile
 from simparity.core.results import RESULTS_FILE
-from tests.helpers import InProcess, builtin
+from simparity.comparisons import library
+from tests.helpers import THROWN_BALL, InProcess, builtin
 
-SCENES = ("lecture-projectile", "dzhanibekov", "ball-bounce-k05", "lecture-2link-ik")
+SCENES = ("ball-bounce-k05", "lecture-2link-ik", "ur5-kinematics")
 KILL_WAIT_SECONDS = 240
 """How long the test waits for half the cases to finish before it gives up (they take ~10 s on 2 cores)."""
 
@@ -115,10 +116,17 @@ def test_a_key_digest_is_a_file_name(dt):
     assert len(digest) == 64 and all(c in "0123456789abcdef" for c in digest)
 
 
-def _interrupted(run_dir) -> int:
-    """Leave in ``run_dir`` the kept cases an interrupted run of lecture-projectile on core leaves, each claiming a
-    detail no engine writes; returns how many there are."""
-    scenes = apply_profile([builtin("lecture-projectile")], "quick")
+def _thrown_ball(folder) -> str:
+    """A scene file of milliseconds per case (:data:`tests.helpers.THROWN_BALL`) in ``folder``; its path."""
+    path = folder / "throw.toml"
+    path.write_text(THROWN_BALL, encoding="utf-8")
+    return str(path)
+
+
+def _interrupted(run_dir, scene_file: str) -> int:
+    """Leave in ``run_dir`` the kept cases an interrupted quick run of ``scene_file`` on core leaves, each claiming
+    a detail no engine writes; returns how many there are."""
+    scenes = apply_profile(library.load([scene_file]), "quick")
     list(run_scenes(scenes, [make_engine("core")], make_engine, 0, InProcess(), Journal(run_dir)))
     journal, planted = Journal(run_dir), 0
     for path in (run_dir / CASES_FOLDER).glob("*.pickle"):
@@ -130,15 +138,16 @@ def _interrupted(run_dir) -> int:
 
 
 def test_a_forced_new_run_reuses_nothing_a_run_left_and_a_finished_run_keeps_no_cases(tmp_path):
-    argv = ["run", "lecture-projectile", "--quick", "--engines", "core", "--jobs", "1", "--out", str(tmp_path)]
+    scene, out = _thrown_ball(tmp_path), tmp_path / "run"
+    argv = ["run", scene, "--quick", "--engines", "core", "--jobs", "1", "--out", str(out)]
     assert main(argv) == 0
-    assert not (tmp_path / CASES_FOLDER).exists()  # finished, every case done: they are in results.csv
-    assert _interrupted(tmp_path) > 0
+    assert not (out / CASES_FOLDER).exists()  # finished, every case done: they are in results.csv
+    assert _interrupted(out, scene) > 0
     assert main(argv + ["--force"]) == 0
-    assert "planted" not in (tmp_path / RESULTS_FILE).read_text(encoding="utf-8")
-    _interrupted(tmp_path)
-    assert main(["run", "--resume", str(tmp_path)]) == 0  # a resumed run, by contrast, keeps what it finds
-    assert "planted" in (tmp_path / RESULTS_FILE).read_text(encoding="utf-8")
+    assert "planted" not in (out / RESULTS_FILE).read_text(encoding="utf-8")
+    _interrupted(out, scene)
+    assert main(["run", "--resume", str(out)]) == 0  # a resumed run, by contrast, keeps what it finds
+    assert "planted" in (out / RESULTS_FILE).read_text(encoding="utf-8")
 
 
 def test_a_folder_being_written_by_another_run_is_refused(tmp_path, capsys):
@@ -149,8 +158,9 @@ def test_a_folder_being_written_by_another_run_is_refused(tmp_path, capsys):
 
 
 def test_a_finished_run_is_not_resumed(tmp_path, capsys):
-    assert main(["run", "lecture-projectile", "--quick", "--engines", "core", "--jobs", "1", "--out", str(tmp_path)]) == 0
+    out = tmp_path / "run"
+    assert main(["run", _thrown_ball(tmp_path), "--quick", "--engines", "core", "--jobs", "1", "--out", str(out)]) == 0
     capsys.readouterr()
-    assert main(["run", "--resume", str(tmp_path)]) == 2
+    assert main(["run", "--resume", str(out)]) == 2
     err = capsys.readouterr().err
     assert "that run finished" in err and err.count("\n") == 1
