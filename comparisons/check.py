@@ -19,7 +19,7 @@ from simparity.comparisons.cross_check import CROSS_CHECK_FACTOR, SOLVE_RATE_FRA
 from simparity.comparisons.violation import Violation, row_label
 from simparity.comparisons.engines import ENGINE_NAMES
 from simparity.comparisons.tolerances import Bound, bound_for
-from simparity.core.results import ALARM_FLAGS, DIMENSIONLESS, NOT_AVAILABLE, OK
+from simparity.core.results import ALARM_FLAGS, DIMENSIONLESS, NOT_AVAILABLE, OK, ROUNDING_FLOOR
 
 CASE_KEYS = ("scene", "engine", "integrator", "dt")
 ROW_KEYS = CASE_KEYS + ("metric",)
@@ -65,6 +65,8 @@ def _judge(bound: Bound, row) -> tuple[str, str] | None:
     if status != OK or not bound.bounds_a_number:
         return None
     low, high = bound.limits(dt)
+    if flag == ROUNDING_FLOOR and low <= value:
+        return None  # exact up to rounding: what any upper bound asks, however tight it was written
     if not (low <= value <= high):
         unit = "" if row["unit"] == DIMENSIONLESS else f" {row['unit']}"
         return f"{value:.4g}{unit}", bound.describe(dt)

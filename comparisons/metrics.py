@@ -381,7 +381,8 @@ def rounding_floors(scene: DynamicsScene, traj: Trajectory, n_steps: int) -> dic
 
     The state's scale: |x| + T |v| for positions [m] (a velocity rounded at each step moves the
     position for the rest of the run), |v| for velocities [m/s], 1 + T |omega| for orientations
-    [rad], |omega| for angular velocities [rad/s]; maxima over the run.
+    [rad], |omega| for angular velocities [rad/s]; maxima over the run. With contact, the velocity's floor adds
+    what rounding the impacts' timing adds (:func:`event_velocity_floor`).
     """
     duration = float(traj.times[-1] - traj.times[0])
     speed = float(np.linalg.norm(traj.velocity_world, axis=-1).max())
@@ -394,7 +395,26 @@ def rounding_floors(scene: DynamicsScene, traj: Trajectory, n_steps: int) -> dic
     }
     kappa = max(np.linalg.cond(b.inertia_body) for b in scene.bodies)
     unit_roundoff = ROUNDING_FLOOR_FACTOR * np.finfo(float).eps * (max(n_steps, 1) + kappa)
-    return {metric: unit_roundoff * scale for metric, scale in scales.items()}
+    floors = {metric: unit_roundoff * scale for metric, scale in scales.items()}
+    floors["velocity_error_max"] += event_velocity_floor(scene, floors["position_error_max"])
+    return floors
+
+
+def event_velocity_floor(scene: DynamicsScene, gap: float) -> float:
+    """[m/s] What rounding a contact event's timing adds to the velocity's rounding floor.
+
+    An impact is timed from the body's gap to a plane, known to ``gap`` [m] (the position's rounding floor: it
+    grows with the distance from the origin); its time is off by gap / v_n, and the rebound, |g| (1 + k) times
+    that, by at most 2 |g| gap / v_n. The slowest impact a scene has is one at its rest speed (slower ones end in
+    resting contact), and never slower than a fall through the gap itself, sqrt(2 |g| gap). 0 without contact or
+    gravity.
+    """
+    gravity = scene.forces.gravity_world
+    if scene.contact is None or gravity is None or gap <= 0.0:
+        return 0.0
+    g = float(np.linalg.norm(gravity))
+    slowest = max(scene.contact.rest_speed, math.sqrt(2.0 * g * gap))
+    return 2.0 * g * gap / slowest if slowest > 0.0 else 0.0
 
 
 def at_rounding_floor(errors: dict[str, Measured], floors: dict[str, float]) -> dict[str, Measured]:

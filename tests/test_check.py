@@ -15,7 +15,7 @@ from simparity.comparisons.store import RunWriter
 from simparity.comparisons.tolerances import load_tolerances
 from simparity.core import quaternion_integrators
 from simparity.core.files import tomllib
-from simparity.core.results import COLUMNS, ResultRow
+from simparity.core.results import COLUMNS, ROUNDING_FLOOR, ResultRow
 from simparity.reports.store import read_run
 from tests.helpers import builtin
 from tests.test_scene_loader import VALID_DYNAMICS
@@ -156,3 +156,26 @@ def test_na_when_names_flags_only(tmp_path):
     path.write_text('[[bound]]\nmetric = "*"\nstatus = "ok"\nna_when = ["nothing"]\nreason = "r"\n', encoding="utf-8")
     with pytest.raises(Exception, match="na_when"):
         load_tolerances(path)
+
+
+def test_an_error_at_its_rounding_floor_meets_any_upper_bound_and_no_lower_one(tmp_path):
+    """A value the harness flags as at its rounding floor is exact up to rounding: an upper bound written tighter
+    than the rounding of this scene (an exact scheme's 1e-9 m/s, far from the origin) passes; the same value
+    without the flag fails, and a lower bound it is under still fails."""
+    path = tmp_path / "tol.toml"
+    path.write_text("""
+[[bound]]
+metric = "velocity_error_max"
+max = 1e-9
+reason = "exact scheme"
+[[bound]]
+metric = "position_error_final"
+min = 0.1
+reason = "closed form of the scheme's error"
+""", encoding="utf-8")
+    bounds = load_tolerances(path)
+    far = _row("velocity_error_max", 1.05e-9, dt=0.002, integrator="backup")
+    assert not check_table(_table([far]), bounds, cross_checked=False).passed
+    assert check_table(_table([dataclasses.replace(far, flag=ROUNDING_FLOOR)]), bounds, cross_checked=False).passed
+    low = dataclasses.replace(_row("position_error_final", 1e-15, dt=0.002), flag=ROUNDING_FLOOR)
+    assert not check_table(_table([low]), bounds, cross_checked=False).passed

@@ -1,6 +1,7 @@
 """Metrics that cannot lie: drift relative to an energy scale that does not depend on the origin, orders
 only from errors that mean something, saturated values n/a. Expected numbers are worked by hand from the definitions in docs/metrics.md."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -17,6 +18,7 @@ from simparity.comparisons.runner import run_scene
 from simparity.comparisons.engines import make_engine
 from simparity.core.scene import DynamicsScene, Forces, RigidBody
 from simparity.core.trajectory import Trajectory
+from tests.helpers import builtin
 
 ROUND_OFF = 1e-14
 """Relative slack for sums of a few float64 terms."""
@@ -237,3 +239,18 @@ def test_near_a_separatrix_euler_family_orders_are_never_ok():
     assert rotational[("rk4", "order_angular_velocity")].status == "ok"
     assert rotational[("rk4", "order_angular_velocity")].flag == ""
     assert rotational[("midpoint", "order_orientation")].flag == "superconvergent"
+
+
+def test_contact_events_raise_the_velocity_rounding_floor_with_the_distance_from_the_origin():
+    """An impact is timed from a gap known to the position's rounding, which grows with the distance from the
+    origin: the velocity's rounding floor grows with it (2 |g| gap / rest speed), is 0 without contact, and at a
+    rest speed of 0 is bounded by a fall through the gap itself."""
+    from simparity.comparisons.metrics import event_velocity_floor
+
+    scene = builtin("ball-bounce-k05")
+    g = float(np.linalg.norm(scene.forces.gravity_world))
+    near, far = event_velocity_floor(scene, 1e-13), event_velocity_floor(scene, 1e-10)
+    assert far == pytest.approx(1000 * near) and near == pytest.approx(2 * g * 1e-13 / scene.contact.rest_speed)
+    assert event_velocity_floor(dataclasses.replace(scene, contact=None), 1e-10) == 0.0
+    resting = dataclasses.replace(scene, contact=dataclasses.replace(scene.contact, rest_speed=0.0))
+    assert event_velocity_floor(resting, 1e-10) == pytest.approx(math.sqrt(2 * g * 1e-10))
