@@ -206,15 +206,15 @@ def test_run_check_junit_summary_and_history(tmp_path, capsys):
                  "--jobs", "1"]) == EXIT_OK
     assert "check passed" in capsys.readouterr().out
     tight = tmp_path / "tight.toml"
-    tight.write_text('[[bound]]\nintegrator = "rk4"\nmetric = "position_error_max"\nmax = 1e-20\n'
-                     'reason = "tighter than rounding"\n', encoding="utf-8")
+    tight.write_text('[[bound]]\nintegrator = "explicit_euler"\nmetric = "position_error_max"\nmax = 1e-20\n'
+                     'reason = "tighter than any first-order error"\n', encoding="utf-8")
     junit, summary = tmp_path / "junit.xml", tmp_path / "summary.md"
     code = main(["check", str(first), "--tolerances", str(tight), "--junit", str(junit), "--summary", str(summary)])
     out = capsys.readouterr().out
     assert code == 1
     violations = [line for line in out.splitlines() if line.startswith("violation: ")]
     steps = len(quick(builtin("lecture-projectile")).dts)  # one violation per time step of the quick profile
-    assert len(violations) == steps and all("rk4" in v and "tighter than rounding" in v for v in violations)
+    assert len(violations) == steps and all("explicit_euler" in v and "first-order" in v for v in violations)
     assert ET.parse(junit).getroot().get("failures") == str(steps)
     assert "## simparity check: failed" in summary.read_text(encoding="utf-8")
     second = tmp_path / "second"
