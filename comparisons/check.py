@@ -78,12 +78,9 @@ def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = 
     row to the built-in schemes of its kind (:mod:`comparisons.cross_check`)."""
     result = CheckResult()
     for row in table.to_dict("records"):
-        key = tuple(row[k] for k in CASE_KEYS)
-        key = key[:3] + ("nan" if math.isnan(float(key[3])) else float(key[3]),)
+        key = _case_key(row["scene"], row["engine"], row["integrator"], float(row["dt"]))
         result.cases.setdefault(key, [])
-        scheme = row.get("scheme", "")
-        bound = bound_for(bounds, row["scene"], row["engine"], row["integrator"], row["metric"], float(row["dt"]),
-                          scheme if isinstance(scheme, str) else "")
+        bound = _row_bound(bounds, row)
         if bound is None:
             result.unchecked += 1
             continue
@@ -97,12 +94,21 @@ def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = 
             result.cases[key].append(violation)
     for violation in cross_check(table, ENGINE_NAMES) if cross_checked else ():
         result.violations.append(violation)
-        result.cases.setdefault(_case_key(violation), []).append(violation)
+        result.cases.setdefault(_case_key(violation.scene, violation.engine, violation.integrator, violation.dt),
+                                []).append(violation)
     return result
 
 
-def _case_key(v: Violation) -> tuple:
-    return (v.scene, v.engine, v.integrator, "nan" if math.isnan(v.dt) else v.dt)
+def _case_key(scene: str, engine: str, integrator: str, dt: float) -> tuple:
+    """A case's key in :attr:`CheckResult.cases` (NaN dt as "nan", so that order rows share one key)."""
+    return (scene, engine, integrator, "nan" if math.isnan(dt) else dt)
+
+
+def _row_bound(bounds: list[Bound], row: dict) -> Bound | None:
+    """The bound that decides ``row`` (a results table's record; a table without a scheme column: "")."""
+    scheme = row.get("scheme", "")
+    return bound_for(bounds, row["scene"], row["engine"], row["integrator"], row["metric"], float(row["dt"]),
+                     scheme if isinstance(scheme, str) else "")
 
 
 @dataclass(frozen=True)
@@ -121,9 +127,7 @@ def explain(table: pd.DataFrame, bounds: list[Bound], engine: str) -> list[Appli
     counts them as without a bound)."""
     decided: dict[tuple[str, str], tuple[Bound, dict[str, None], int]] = {}
     for row in table[table["engine"] == engine].to_dict("records"):
-        scheme = row.get("scheme", "")
-        bound = bound_for(bounds, row["scene"], row["engine"], row["integrator"], row["metric"], float(row["dt"]),
-                          scheme if isinstance(scheme, str) else "")
+        bound = _row_bound(bounds, row)
         if bound is None:
             continue
         key = (row["scene"], bound.where)

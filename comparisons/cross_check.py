@@ -45,6 +45,10 @@ RATE_METRICS = ("cross_eval_solve_rate_min",)
 NULLSPACE = "+nullspace"
 """The scheme modifier of an IK solver with a secondary objective in the Jacobian's null space."""
 
+NULLSPACE_ROUNDING = 1e-9
+"""Relative rounding allowed when the null-space solver's rest distance equals the plain one's (a chain with no
+redundancy has no null space: the two solutions are the same)."""
+
 
 def nullspace_checks(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Violation]:
     """A user's null-space solver (``<kind>+nullspace...``) whose median distance from the rest pose
@@ -69,11 +73,6 @@ def nullspace_checks(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Viol
                 f"cross-check: the null-space term must keep the solutions nearer the rest pose than "
                 f"{row['engine']} {plain.iloc[0]['integrator']} without it"))
     return out
-
-
-NULLSPACE_ROUNDING = 1e-9
-"""Relative rounding allowed when the null-space solver's rest distance equals the plain one's (a chain with no
-redundancy has no null space: the two solutions are the same)."""
 
 
 def _builtin_rows(table: pd.DataFrame, builtin: tuple[str, ...]) -> pd.DataFrame:

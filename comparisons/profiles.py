@@ -4,10 +4,10 @@
 of the order fits and of the hard cases' verdicts, the hard IK targets), but
 
 - a dynamics scene runs for at most :data:`QUICK_MAX_STEPS` of its finest kept time step
-  (:data:`QUICK_CONTACT_STEPS` for a contact scene; a whole number of the coarsest), with one orientation update per scheme (the default; the ``+matrix`` /
-  ``+expmap`` variants are left to the full run), except on a rotating scene of at most
-  :data:`QUICK_VARIANT_STEPS` steps, which runs every variant, so that CI exercises every orientation
-  update. Which time steps it keeps is chosen by what the
+  (:data:`QUICK_CONTACT_STEPS` for a contact scene; a whole number of the coarsest), with one
+  orientation update per scheme (the default; the ``+matrix`` / ``+expmap`` variants are left to the
+  full run), except on a rotating scene of at most :data:`QUICK_VARIANT_STEPS` steps, which runs
+  every variant, so that CI exercises every orientation update. Which time steps it keeps is chosen by what the
   scene's rows judge: a scene without contact keeps its whole ladder, so that its order fits find
   the asymptotic range in it (the finest steps whose local slopes agree, above the rounding floor;
   coarse steps alone saturate or sit before it, fine ones alone may reach the floor); a contact
@@ -81,10 +81,10 @@ def quick(scene):
         duration = max(1, math.floor(steps * dts[-1] / coarsest + 1e-9)) * coarsest
         if duration >= scene.duration or not all(_divides(duration, dt) for dt in dts):
             duration = scene.duration
-        short = duration / dts[-1] <= QUICK_VARIANT_STEPS * (1 + 1e-9) and _rotates(scene)
-        integrators = scene.integrators if short else (
-            scene.integrators or tuple(i for i in known_integrators() if VARIANT_MARK not in i))
-        integrators = integrators if short else tuple(i for i in integrators if VARIANT_MARK not in i) or integrators
+        integrators = scene.integrators  # a short rotating scene: every variant
+        if not (duration / dts[-1] <= QUICK_VARIANT_STEPS * (1 + 1e-9) and _rotates(scene)):
+            named = scene.integrators or known_integrators()
+            integrators = tuple(i for i in named if VARIANT_MARK not in i) or named
         return replace(scene, duration=duration, dts=tuple(sorted(dts)), integrators=integrators)
     if isinstance(scene, KinematicsScene):
         return replace(scene, n_configurations=min(scene.n_configurations, QUICK_SAMPLES))

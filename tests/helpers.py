@@ -237,6 +237,28 @@ integrators = ["rk4"]
 """A ball thrown under gravity for 1 s at two time steps, RK4 only: a scene of milliseconds per case."""
 
 
+THROWN_INTO_WIND = """
+[scene]
+name = "toss"
+kind = "dynamics"
+reference = "analytic"
+[world]
+gravity_world = [0.0, 0.0, -9.81]
+air_velocity_world = [4.0, 1.0, 0.0]
+[[body]]
+name = "leaf"
+mass = 1.0
+inertia_body_diagonal = [0.01, 0.01, 0.01]
+velocity_world = [1.0, 0.0, 5.0]
+linear_drag = 0.5
+[simulation]
+duration = 1.0
+dt = [0.04, 0.02, 0.01]
+integrators = ["rk4"]
+"""
+"""A body thrown into wind with linear drag (closed form: the analytic reference), rk4 only: a few cases."""
+
+
 LEFTOVER_SECONDS = 10.0
 """How long the processes an engine left running may take to be killed once its cases are back (the worker
 kills them right after the case's process ends, which may be just after its last result arrived)."""

@@ -170,3 +170,46 @@ def test_built_in_scenes_need_only_the_runtime_dependencies():
     for name, path in library.builtin_paths().items():
         if EXAMPLE_ROBOT_DATA_PREFIX in path.read_text(encoding="utf-8"):
             assert "example-robot-data" in runtime, f"{name} needs example-robot-data, a test-only extra"
+
+
+@pytest.mark.parametrize("engine, integrator, scene, kind", [
+    # MuJoCo: Euler is semi-implicit with the exponential map; implicit(fast) take damping implicitly; with planes
+    # its soft constraint drives them; dls is damped least squares (docs/check.md, engine-conventions notes).
+    ("mujoco", "euler", "wind", "engine_euler"),
+    ("mujoco", "implicitfast", "wind", "implicit_damping"),
+    ("mujoco", "euler", "ball-bounce-k05", "soft+engine_euler"),
+    ("mujoco", "dls", "ur5-ik", "damped_least_squares"),
+    # Bullet: the same Euler step; with planes, velocity-level impulses; its IK with a rest pose is null-space.
+    ("pybullet", "euler", "wind", "engine_euler"),
+    ("pybullet", "euler", "ball-bounce-k05", "impulse+engine_euler"),
+    ("pybullet", "dls-nullspace", "iiwa-ik", "damped_least_squares+nullspace"),
+    # The harness's steppers on Pinocchio, and its documented CLIK.
+    ("pinocchio", "euler", "wind", "engine_euler"),
+    ("pinocchio", "clik", "ur5-ik", "damped_least_squares"),
+    # Core: named after what they are; a variant is its scheme; penalty drives a time integrator; IK keeps limits.
+    ("core", "rk4+matrix", "wind", "rk4"),
+    ("core", "penalty_rk4", "lecture-bouncing-particle", "penalty+rk4"),
+    ("core", "backup", "ball-bounce-k05", "backup"),
+    ("core", "damped_least_squares", "iiwa-ik", "damped_least_squares+limits"),
+    # The truths.
+    ("analytic", "closed_form", "wind", "closed_form"),
+    ("tight", "dop853", "dzhanibekov", "adaptive"),
+])
+def test_every_built_in_engine_declares_the_kind_of_scheme_it_runs(engine, integrator, scene, kind):
+    """The gate's bounds are keyed by these kinds: a wrong declaration would hold a scheme to another kind's
+    bounds (or to none)."""
+    assert make_engine(engine).scheme(integrator, builtin(scene)) == kind
+
+
+def test_a_plugin_that_names_its_integrators_after_their_kind_needs_no_declaration():
+    """Engine.scheme's default: an integrator named as a kind is of that kind, its variant left out; on a contact
+    scene penalty_<kind> is penalty+<kind>; a name that is no kind says nothing ("")."""
+    from simparity.core.engine import Engine
+
+    default = Engine.scheme
+    plugin = make_engine("core")
+    assert default(plugin, "midpoint+expmap", builtin("wind")) == "midpoint"
+    assert default(plugin, "penalty_semi_implicit_euler", builtin("lecture-bouncing-particle")) == (
+        "penalty+semi_implicit_euler")
+    assert default(plugin, "leapfrog_demo", builtin("wind")) == ""
+    assert default(plugin, "damped_least_squares", builtin("iiwa-ik")) == "damped_least_squares"

@@ -47,6 +47,7 @@ from simparity.core.errors import TransformError
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.results import DIVERGED, FAILED, OK, ResultRow
 from simparity.core.scene import IKScene, KinematicsScene, Plane
+from tests.helpers import THROWN_INTO_WIND
 
 ENGINES = ("core", "analytic", "mujoco", "pybullet", "pinocchio")
 
@@ -372,26 +373,8 @@ def test_an_unknown_unit_fails_its_case_and_a_missing_row_is_a_change():
     assert rows["mujoco", "invariance_status_changes_ms"].value == 1
 
 
-TOSS = """
-[scene]
-name = "toss"
-kind = "dynamics"
-reference = "analytic"
-[world]
-gravity_world = [0.0, 0.0, -9.81]
-air_velocity_world = [4.0, 1.0, 0.0]
-[[body]]
-name = "leaf"
-mass = 1.0
-inertia_body_diagonal = [0.01, 0.01, 0.01]
-velocity_world = [1.0, 0.0, 5.0]
-linear_drag = 0.5
-[simulation]
-duration = 1.0
-dt = [0.04, 0.02, 0.01]
-integrators = ["rk4", "semi_implicit_euler"]
-"""
-"""A body thrown into wind with linear drag (closed form), two of core's schemes: a few cases."""
+TOSS = THROWN_INTO_WIND.replace('integrators = ["rk4"]', 'integrators = ["rk4", "semi_implicit_euler"]')
+"""The thrown leaf with two of core's schemes: a few cases."""
 
 
 def test_run_with_transforms_adds_invariance_rows_that_the_gate_holds(tmp_path, capsys):

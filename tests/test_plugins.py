@@ -25,6 +25,7 @@ from simparity.comparisons.engines import (ENGINE_NAMES, check_engine_names, ins
 from simparity.core.errors import UnknownEngineError
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.results import FAILED, NOT_AVAILABLE, OK
+from tests.helpers import THROWN_INTO_WIND
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "plugin-engine"
@@ -34,7 +35,7 @@ EXAMPLE_VERSION = "0.1.0"
 INSTALL_SECONDS = 120
 """pip may first fetch setuptools from the package index for an isolated build (about 3 s when cached)."""
 RUN_SECONDS = 120
-"""The tiny scene below on core's rk4 and the example, two worker processes and the report: about 10 s."""
+"""The tiny scene (SCENE) on core's rk4 and the example, two worker processes and the report: about 10 s."""
 
 EULER_ORDER_BAND = 0.1
 """Explicit Euler's global error is C dt (1 + O(dt)): on this smooth scene, over dt 0.01-0.04 s against a
@@ -42,26 +43,7 @@ time scale of 2 s (m / b), the fitted slope is within a few hundredths of 1; 0.1
 RK4_ORDER_BAND = 0.5
 """The shipped tolerances' band for rk4* (half the gap to the next integer order)."""
 
-SCENE = """
-[scene]
-name = "toss"
-kind = "dynamics"
-reference = "analytic"
-[world]
-gravity_world = [0.0, 0.0, -9.81]
-air_velocity_world = [4.0, 1.0, 0.0]
-[[body]]
-name = "leaf"
-mass = 1.0
-inertia_body_diagonal = [0.01, 0.01, 0.01]
-velocity_world = [1.0, 0.0, 5.0]
-linear_drag = 0.5
-[simulation]
-duration = 1.0
-dt = [0.04, 0.02, 0.01]
-integrators = ["rk4"]
-"""
-"""A body thrown into wind with linear drag (closed form: the analytic reference), rk4 only: a few cases."""
+SCENE = THROWN_INTO_WIND
 
 ENGINES_SOURCE = '''
 from simparity.core.inhouse import InHouseEngine
