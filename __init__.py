@@ -16,6 +16,14 @@ engines.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:  # what the lazy names are, for type checkers; nothing is imported at run time
+    from simparity.comparisons.api import load_scene as load_scene
+    from simparity.comparisons.api import load_scenes as load_scenes
+    from simparity.comparisons.api import run_scene as run_scene
+    from simparity.reports.store import read_run as read_run
+
 _PUBLIC = {
     "load_scene": "simparity.comparisons.api",
     "load_scenes": "simparity.comparisons.api",
@@ -26,7 +34,7 @@ _PUBLIC = {
 __all__ = sorted(_PUBLIC)
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> object:
     if name in _PUBLIC:
         import importlib
 

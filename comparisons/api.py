@@ -2,17 +2,20 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pandas as pd
 
-from simparity.comparisons import library
-from simparity.comparisons.engines import DEFAULT_ENGINES, check_engine_names, make_engine
-from simparity.comparisons.runner import DEFAULT_REPEATS, run_scene as _run_scene
-from simparity.comparisons.scene_loader import load_scene as load_scene_file
-from simparity.core.results import COLUMNS
-from simparity.core.scene import Scene
+from simparity.comparisons.engines.registry import DEFAULT_ENGINES, EngineSet, check_engine_names
+from simparity.comparisons.execute.execution import default_jobs
+from simparity.comparisons.execute.runner import DEFAULT_REPEATS
+from simparity.comparisons.execute.session import IN_PROCESS, ISOLATED, Execution, Session, engine_specs
+from simparity.comparisons.scenes import library
+from simparity.comparisons.scenes.loader import load_scene as load_scene_file
+from simparity.core.model.scene import Scene
 
 
-def load_scene(name_or_path: str) -> Scene:
+def load_scene(name_or_path: str | Path) -> Scene:
     """A built-in scene by name (see ``simparity list``) or a scene file, checked; a file with a ``[sweep]``
     is several scenes: :func:`load_scenes`.
 
@@ -24,32 +27,45 @@ def load_scene(name_or_path: str) -> Scene:
     return load_scene_file(library.resolve(str(name_or_path)))
 
 
-def load_scenes(name_or_path: str) -> list[Scene]:
+def load_scenes(name_or_path: str | Path) -> list[Scene]:
     """The scenes of a built-in scene name or a scene file, checked: its one scene, or the variants of its
     ``[sweep]`` in the sweep's order (each with its swept values in ``scene.sweep``)."""
     return library.load([str(name_or_path)])
 
 
-def run_scene(scene: Scene | str, engines=DEFAULT_ENGINES, repeats: int = DEFAULT_REPEATS) -> pd.DataFrame:
-    """Run one scene on engines (names) and measure them against the scene's reference.
+def run_scene(scene: Scene | str | Path, engines=DEFAULT_ENGINES, repeats: int = DEFAULT_REPEATS, *,
+              isolate: bool = True, jobs: int | None = None, profile: str = "full") -> pd.DataFrame:
+    """Run one scene on engines and measure them against the scene's reference.
 
     Parameters
     ----------
-    scene : Scene or str
+    scene : Scene, str or Path
         A scene object, a built-in scene name or a scene file.
-    engines : iterable of str
-        Engine names (default: ``core, analytic, mujoco, pybullet, pinocchio``).
+    engines : iterable of str or Engine
+        Engine names as ``simparity engines`` lists them, ``module:Class`` specs, or Engine subclasses or
+        instances (built again from their class in a worker) (default: ``core, analytic, mujoco, pybullet,
+        pinocchio``).
     repeats : int
         Timed repeats per case; the best is kept.
+    isolate : bool
+        True (default): the cases run in worker processes, as ``simparity run`` runs them, so an engine that
+        crashes, hangs or exhausts memory gives ``failed`` rows and this interpreter goes on; it costs a worker
+        start (about a second) per call, and an engine defined in ``__main__`` (a script, a notebook) cannot
+        be imported there (refused with the way out). False: the cases run in this process — faster, and an
+        engine that crashes takes the interpreter with it.
+    jobs : int, optional
+        Worker processes when isolated (default: one per CPU).
+    profile : str
+        ``full`` (default) or ``quick`` (the CI profile: shortened).
 
     Returns
     -------
     pandas.DataFrame
         The columns of ``results.csv`` (``scene, engine, integrator, dt, metric, value, unit,
-        reference, status, detail``), one row per case and metric.
+        reference, status, detail, ...``), one row per case and metric.
     """
-    if isinstance(scene, str):
+    if isinstance(scene, (str, Path)):
         scene = load_scene(scene)
-    names = check_engine_names(tuple(engines))
-    rows = _run_scene(scene, [make_engine(n) for n in names], make_engine, repeats=repeats)
-    return pd.DataFrame([r.as_dict() for r in rows], columns=list(COLUMNS))
+    engine_set = EngineSet(check_engine_names(engine_specs(engines)))
+    execution = Execution(ISOLATED if isolate else IN_PROCESS, default_jobs() if jobs is None else jobs)
+    return Session([scene], engine_set, profile=profile, repeats=repeats, execution=execution).run().table

@@ -19,6 +19,7 @@ Results go to ``benchmarks.csv`` (one tidy row per measurement) and ``BENCHMARKS
 from __future__ import annotations
 
 import csv
+import functools
 import math
 import os
 import platform
@@ -30,26 +31,27 @@ import tempfile
 import time
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
-from simparity.comparisons import library
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.ik_targets import random_targets
-from simparity.comparisons.metrics import kinematics_errors, trajectory_errors
-from simparity.core.ik.problem import IKTolerances
+from simparity.comparisons.scenes import library
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.execute.ik_targets import random_targets
+from simparity.comparisons.measure.metrics import kinematics_errors, trajectory_errors
+from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix
-from simparity.core.scene import DynamicsScene, Forces, RigidBody, sample_configurations
+from simparity.core.model.scene import DynamicsScene, Forces, RigidBody, sample_configurations
 from simparity.references.differential_ik import MinkIK, PinkIK, available
-from simparity.references.mujoco_adapter import BatchRollout, MujocoChain
-from simparity.references.pinocchio_adapter import PinocchioChain
+from simparity.references.mujoco.adapter import BatchRollout, MujocoChain
+from simparity.references.pinocchio.adapter import PinocchioChain
+from simparity.core.model.metric_catalogue import JACOBIAN_ERROR_MAX, ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX
 
 ERROR_BODIES = 4
 """Bodies whose trajectories are compared with the tight reference."""
 ERROR_STEPS = 1000
 """Steps over which the error is measured (1 s at dt = 1e-3)."""
-ERROR_METRIC = {"tumbling": "orientation_error_max", "falling-drag": "position_error_max"}
+ERROR_METRIC = {"tumbling": ORIENTATION_ERROR_MAX, "falling-drag": POSITION_ERROR_MAX}
 """The error each workload is judged by: torque-free tumbling moves only the orientation in an interesting way."""
 ERROR_UNIT = {"tumbling": "rad", "falling-drag": "m"}
 DT = 1e-3
@@ -203,7 +205,7 @@ def kinematics_rows(batches: list[int], say: Callable[[str], None]) -> list[Benc
                 poses, jac = both()
                 k = min(count, ERROR_CONFIGURATIONS)
                 errors = kinematics_errors(poses_slice(poses, k), jac[:k], poses_slice(ref_poses, k), ref_jacobian[:k])
-                error = max(errors["position_error_max"].value, errors["jacobian_error_max"].value)
+                error = max(errors[POSITION_ERROR_MAX].value, errors[JACOBIAN_ERROR_MAX].value)
                 rows.append(BenchRow("kinematics", chain.name, engine, "fk+jacobian", batch, seconds / count * 1e6,
                                      "us/configuration", error, "m", "vs pinocchio" if engine != "pinocchio" else ""))
                 say(f"  {chain.name:<13} {engine:<10} B={batch:<6} {seconds / count * 1e6:9.3f} us/configuration")
@@ -213,6 +215,11 @@ def kinematics_rows(batches: list[int], say: Callable[[str], None]) -> list[Benc
 def poses_slice(poses, k: int):
     """The first k configurations' frame poses."""
     return replace(poses, position_world=poses.position_world[:k], rotation_world=poses.rotation_world[:k])
+
+
+def _build_ik(engine: str, chain, solver: str, options: IKTolerances) -> Any:
+    """Engine ``engine``'s IK solver ``solver`` for ``chain``, built when the bench reaches it."""
+    return make_engine(engine).build_ik(chain, solver, options)
 
 
 def _library_ik(name: str, chain, options: IKTolerances):
@@ -229,9 +236,10 @@ def ik_rows(n_targets: int | None, say: Callable[[str], None]) -> list[BenchRow]
             scene = replace(scene, n_targets=n_targets)
         targets = random_targets(scene, make_engine(scene.reference).build_kinematics(scene.chain))
         options = IKTolerances(scene.position_tolerance, scene.orientation_tolerance, scene.max_iterations)
-        solvers = [(engine, solver, lambda e=engine, s=solver: make_engine(e).build_ik(scene.chain, s, options))
-                   for engine, solver in IK]
-        solvers += [(name, "documented loop", lambda n=name: _library_ik(n, scene.chain, options)) for name in LIBRARY_IK]
+        solvers: list[tuple[str, str, Callable[[], Any]]] = [
+            (engine, solver, functools.partial(_build_ik, engine, scene.chain, solver, options)) for engine, solver in IK]
+        solvers += [(name, "documented loop", functools.partial(_library_ik, name, scene.chain, options))
+                    for name in LIBRARY_IK]
         for engine, solver, build in solvers:
             count = min(scene.n_targets, LIBRARY_TARGETS) if engine in LIBRARY_IK else scene.n_targets
             missing = available(engine) if engine in LIBRARY_IK else ""
@@ -242,7 +250,8 @@ def ik_rows(n_targets: int | None, say: Callable[[str], None]) -> list[BenchRow]
                 continue
             model = build()
             start = time.perf_counter()
-            result = model.solve(targets.position_world[:count], targets.rotation_world[:count], scene.q_start)
+            rotation = None if targets.rotation_world is None else targets.rotation_world[:count]
+            result = model.solve(targets.position_world[:count], rotation, scene.q_start)
             seconds = time.perf_counter() - start
             violations = int(np.sum(result.limit_violation > 0))
             sample = f"; the first {count:,} targets" if count < scene.n_targets else ""
@@ -266,7 +275,7 @@ def memory_rows(quick: bool, folder: Path, say: Callable[[str], None]) -> list[B
     for steps in ((10_000, 100_000) if quick else (100_000, 1_000_000)):
         scene = folder / f"memory-{steps}.toml"
         scene.write_text(text.replace("duration = 100.0", f"duration = {steps * 1e-4!r}"), encoding="utf-8")
-        command = [sys.executable, "-c", "import sys; from simparity.comparisons.cli import main; sys.exit(main())",
+        command = [sys.executable, "-c", "import sys; from simparity.comparisons.cli.main import main; sys.exit(main())",
                    "run", str(scene), "--repeats", "0", "--jobs", "1", "--force", "--out", str(folder / f"run-{steps}")]
         start = time.perf_counter()
         done = subprocess.run(command, capture_output=True, text=True)
@@ -321,7 +330,7 @@ def equal_error_factor(error: float, other_error: float, order: int) -> float:
 
 def targets(rows: list[BenchRow]) -> list[tuple[str, str, bool | None]]:
     """(target, what was measured, met) for the issue's targets; met None where this run cannot tell."""
-    out = []
+    out: list[tuple[str, str, bool | None]] = []
     largest = max((r.batch for r in rows if r.section == "dynamics"), default=0)
     core = _best(rows, section="dynamics", workload="tumbling", engine="core", method="rk4", batch=largest)
     for engine, method, factor in (("mujoco", "rk4", 5.0), ("mujoco-rollout", "rk4", 5.0),
@@ -399,13 +408,13 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
                          + f" | {_cell(error, '.2e')} |")
         notes = sorted({f"{r.engine} {r.method} B = {r.batch:,}: {r.note}" for r in mine if r.note})
         lines += [""] + [f"- {n}" for n in notes] + ([""] if notes else [])
-        core = {r.batch: r.value for r in mine if (r.engine, r.method) == ("core", "rk4")}
+        core: dict[int, float] = {r.batch: r.value for r in mine if (r.engine, r.method) == ("core", "rk4")}
         lines += ["Ratio engine / core rk4 (> 1: core is faster per body-step):", "",
                   "| engine | integrator | " + " | ".join(f"B = {b:,}" for b in batches) + " |",
                   "|---|---|" + "---|" * len(batches)]
         for engine, method in dict.fromkeys((r.engine, r.method) for r in mine if r.engine != "core"):
-            cells = {r.batch: r.value for r in mine if (r.engine, r.method) == (engine, method)}
-            lines.append(f"| {engine} | {method} | " + " | ".join(_cell(cells[b] / core[b]) for b in batches) + " |")
+            values = {r.batch: r.value for r in mine if (r.engine, r.method) == (engine, method)}
+            lines.append(f"| {engine} | {method} | " + " | ".join(_cell(values[b] / core[b]) for b in batches) + " |")
         lines.append("")
     kin = [r for r in rows if r.section == "kinematics"]
     if kin:

@@ -27,8 +27,8 @@ from types import MappingProxyType
 
 import numpy as np
 
-from simparity.core.errors import SceneError
-from simparity.core.scene import Chain, Joint
+from simparity.core.model.errors import SceneError
+from simparity.core.model.scene import Chain, Joint
 
 CONVENTIONS = ("standard", "modified")
 JOINT_TYPES = ("revolute", "prismatic")
@@ -159,7 +159,7 @@ def chain_from_dh(
             before = before @ _rot_x(table["alpha"][i]) @ _trans(0, table["a"][i])
         origin = before @ _rot_z(table["theta_offset"][i]) @ _trans(2, table["d"][i])
         joints.append(Joint(
-            name=f"joint_{i + 1}", type=joint_types[i], axis=(0.0, 0.0, 1.0),
+            name=f"joint_{i + 1}", type=joint_types[i], axis=np.array([0.0, 0.0, 1.0]),
             origin_xyz=origin[:3, 3], origin_rotation=origin[:3, :3],
             lower=limits[i, 0], upper=limits[i, 1],
         ))

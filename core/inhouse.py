@@ -7,9 +7,9 @@ from dataclasses import asdict, replace
 
 import numpy as np
 
-from simparity.core import point_mass
-from simparity.core.allocator import keep_freed_memory
-from simparity.core.contact import (
+from simparity.core.dynamics import point_mass
+from simparity.core.runtime.allocator import keep_freed_memory
+from simparity.core.contact.bodies import (
     PENALTY_SCHEMES,
     Bodies,
     ContactModel,
@@ -17,21 +17,21 @@ from simparity.core.contact import (
     penalty_stability_limit,
     penalty_wrench,
 )
-from simparity.core.contact_act_after import GAUSS_SEIDEL_PASSES, ActAfterStepper
-from simparity.core.contact_backup import FREE, MAX_EVENTS_PER_STEP, BackupStepper
-from simparity.core.engine import Engine, IKModel, KinematicsModel, Simulation, Support
-from simparity.core.forces import make_wrench
+from simparity.core.contact.act_after import GAUSS_SEIDEL_PASSES, ActAfterStepper
+from simparity.core.contact.backup import FREE, MAX_EVENTS_PER_STEP, BackupStepper
+from simparity.core.model.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.dynamics.forces import make_wrench
 from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik, task_basis
-from simparity.core.ik.problem import IKTolerances
+from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.ik.restarts import Restarts, solve_ik_with_restarts
-from simparity.core.ik.result import IKResult
-from simparity.core.integrators import ORDER, ORIENTATION_UPDATES, SCHEMES, make_step
-from simparity.core.quaternion_integrators import PackedBodies, make_packed_step, pack
+from simparity.core.model.ik_result import IKResult
+from simparity.core.dynamics.integrators import ORDER, ORIENTATION_UPDATES, SCHEMES, Step, make_step
+from simparity.core.dynamics.quaternion_integrators import PackedBodies, make_packed_step, pack
 from simparity.core.kinematics import forward_kinematics, jacobian_world
-from simparity.core.rigid_body import MassProperties, State, initial_state, velocities
+from simparity.core.dynamics.rigid_body import MassProperties, State, initial_state, velocities
 from simparity.core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
-from simparity.core.scene import PENALTY_PREFIX, Chain, DynamicsScene, IKScene
-from simparity.core.trajectory import FramePoses, Trajectory
+from simparity.core.model.scene import PENALTY_PREFIX, Chain, DynamicsScene, IKScene
+from simparity.core.model.trajectory import FramePoses, Trajectory
 
 _DEFAULT_ORIENTATION = "quaternion"
 _SINGLE_ORIENTATION_SCHEMES = ("engine_euler",)
@@ -77,7 +77,7 @@ class _RigidBodySimulation(Simulation):
         self._state0 = initial_state(scene.bodies, self._props, quaternion=self._packed)
         if self._packed:
             self._bodies = PackedBodies(self._props)
-            self._step = make_packed_step(scheme, self._props, wrench)
+            self._packed_step = make_packed_step(scheme, self._props, wrench)
         else:
             self._step = make_step(scheme, orientation, self._props, wrench)
         self._dt = dt
@@ -93,7 +93,7 @@ class _RigidBodySimulation(Simulation):
         record = np.empty((n_steps + 1,) + state.shape)
         record[0] = state
         for i in range(1, n_steps + 1):
-            state = record[i] = self._step((i - 1) * dt, state, dt)
+            state = record[i] = self._packed_step((i - 1) * dt, state, dt)
         return self._bodies.samples(record.transpose(1, 0, 2))
 
     def _run_matrix(self, n_steps: int) -> tuple[np.ndarray, ...]:
@@ -151,6 +151,7 @@ class _ContactSimulation(Simulation):
 
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
         contact = scene.contact
+        assert contact is not None  # built only when supported: contact integrators need the scene's contact
         self._props = MassProperties.of(scene.bodies)
         self._state0 = initial_state(scene.bodies, self._props, quaternion=True)
         self._model = ContactModel.of(contact, self._props.mass)
@@ -165,7 +166,7 @@ class _ContactSimulation(Simulation):
                            f"rest); a body at rest slides or stays, it never rolls (a sphere sliding with friction "
                            f"stops instead of rolling)")
         elif integrator == "act_after":
-            self._step = ActAfterStepper(Bodies(self._props, self._model, scene.forces)).step
+            self._step: Step = ActAfterStepper(Bodies(self._props, self._model, scene.forces)).step
             self.detail = (f"in-house act_after: free flight rk4 (quaternion), then push-out and impulse with "
                            f"restitution and Coulomb friction ({GAUSS_SEIDEL_PASSES} Gauss-Seidel passes), plastic "
                            f"below rest_speed {contact.rest_speed:g} m/s and for a body touching since the step's "
@@ -254,7 +255,7 @@ class InHouseEngine(Engine):
     name = "core"
 
     def __init__(self) -> None:
-        keep_freed_memory()  # batched temporaries: see core/allocator.py
+        keep_freed_memory()  # batched temporaries: see core/runtime/allocator.py
 
     def version(self) -> str:
         return f"numpy {np.__version__}, python {platform.python_version()}"

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from simparity.core.rotations import skew, so3_log
-from simparity.core.scene import Chain
-from simparity.core.trajectory import FramePoses
+from simparity.core.model.scene import Chain
+from simparity.core.model.trajectory import FramePoses
 
 
 def _as_batch(chain: Chain, q: np.ndarray) -> np.ndarray:
@@ -24,12 +24,18 @@ def _as_batch(chain: Chain, q: np.ndarray) -> np.ndarray:
     return q
 
 
-Sparse = tuple[tuple[int, ...], ...]
-"""The nonzero entries of a constant vector ((k, value), ...) or matrix ((k, j, value), ...)."""
+SparseVector = tuple[tuple[int, float], ...]
+"""The nonzero entries of a constant vector ((k, value), ...)."""
+SparseMatrix = tuple[tuple[int, int, float], ...]
+"""The nonzero entries of a constant matrix ((k, j, value), ...)."""
 
 
-def _sparse(a: np.ndarray) -> Sparse:
-    return tuple(tuple(int(i) for i in index) + (float(a[index]),) for index in zip(*np.nonzero(a)))
+def _sparse_vector(a: np.ndarray) -> SparseVector:
+    return tuple((int(k), float(a[k])) for (k,) in zip(*np.nonzero(a)))
+
+
+def _sparse_matrix(a: np.ndarray) -> SparseMatrix:
+    return tuple((int(k), int(j), float(a[k, j])) for k, j in zip(*np.nonzero(a)))
 
 
 @dataclass(frozen=True)
@@ -38,11 +44,11 @@ class _JointPlan:
     axis's cross-product matrices K, K^2."""
 
     revolute: bool
-    origin_xyz: Sparse
-    origin_rotation: Sparse | None  # None: the identity
-    axis: Sparse
-    k: Sparse
-    k2: Sparse
+    origin_xyz: SparseVector
+    origin_rotation: SparseMatrix | None  # None: the identity
+    axis: SparseVector
+    k: SparseMatrix
+    k2: SparseMatrix
 
 
 @dataclass(frozen=True)
@@ -50,8 +56,8 @@ class _ChainPlan:
     """A chain's constants for the packed FK: its joints', then the end effector's offset and rotation."""
 
     joints: tuple[_JointPlan, ...]
-    end_xyz: Sparse
-    end_rotation: Sparse
+    end_xyz: SparseVector
+    end_rotation: SparseMatrix
 
 
 _PLANS: dict[int, tuple[Chain, _ChainPlan]] = {}
@@ -63,22 +69,24 @@ def _plan(chain: Chain) -> _ChainPlan:
     cached = _PLANS.get(id(chain))
     if cached is not None and cached[0] is chain:
         return cached[1]
-    plan = []
+    joint_plans = []
     for joint in chain.joints:
         rotation = np.asarray(joint.origin_rotation, dtype=float)
         k = skew(np.asarray(joint.axis, dtype=float))
-        plan.append(_JointPlan(joint.type == "revolute", _sparse(np.asarray(joint.origin_xyz, dtype=float)),
-                               None if np.array_equal(rotation, np.eye(3)) else _sparse(rotation),
-                               _sparse(np.asarray(joint.axis, dtype=float)), _sparse(k), _sparse(k @ k)))
-    plan = _ChainPlan(tuple(plan), _sparse(np.asarray(chain.end_effector_xyz, dtype=float)),
-                      _sparse(np.asarray(chain.end_effector_rotation, dtype=float)))
+        joint_plans.append(_JointPlan(joint.type == "revolute",
+                                      _sparse_vector(np.asarray(joint.origin_xyz, dtype=float)),
+                                      None if np.array_equal(rotation, np.eye(3)) else _sparse_matrix(rotation),
+                                      _sparse_vector(np.asarray(joint.axis, dtype=float)), _sparse_matrix(k),
+                                      _sparse_matrix(k @ k)))
+    plan = _ChainPlan(tuple(joint_plans), _sparse_vector(np.asarray(chain.end_effector_xyz, dtype=float)),
+                      _sparse_matrix(np.asarray(chain.end_effector_rotation, dtype=float)))
     if len(_PLANS) >= _PLAN_CACHE_SIZE:
         _PLANS.clear()
     _PLANS[id(chain)] = (chain, plan)
     return plan
 
 
-def _times_constant(r: np.ndarray, m: Sparse) -> np.ndarray:
+def _times_constant(r: np.ndarray, m: SparseMatrix) -> np.ndarray:
     """r m for packed rotations r (3, 3, B) and a constant matrix given by its nonzeros."""
     out = np.zeros_like(r)
     for k, j, value in m:
@@ -86,7 +94,7 @@ def _times_constant(r: np.ndarray, m: Sparse) -> np.ndarray:
     return out
 
 
-def _apply_constant(r: np.ndarray, v: Sparse) -> np.ndarray:
+def _apply_constant(r: np.ndarray, v: SparseVector) -> np.ndarray:
     """r v for packed rotations r (3, 3, B) and a constant vector given by its nonzeros. -> (3, B)."""
     out = np.zeros(r.shape[::2])
     for k, value in v:
@@ -167,6 +175,7 @@ def joint_frames(chain: Chain, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
         Joint axes a_i in world axes.
     """
     frames = packed_frames(chain, q, all_rotations=True)
+    assert frames.rotations is not None  # all_rotations=True always fills them
     return (frames.positions.transpose(2, 0, 1), frames.rotations.transpose(3, 0, 1, 2),
             frames.axes_world.transpose(2, 0, 1))
 

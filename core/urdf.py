@@ -33,15 +33,16 @@ from __future__ import annotations
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
-from simparity.core.errors import SceneError
-from simparity.core.files import MAX_FILE_BYTES, read_input
-from simparity.core.names import NAME_RULE, name_problem
-from simparity.core.ranges import NORM_RANGES, RANGES, safe_norm
+from simparity.core.model.errors import SceneError
+from simparity.core.model.files import MAX_FILE_BYTES, read_input
+from simparity.core.model.names import NAME_RULE, name_problem
+from simparity.core.model.ranges import NORM_RANGES, RANGES, safe_norm
 from simparity.core.rotations import rpy_to_matrix
-from simparity.core.scene import Chain, Joint
+from simparity.core.model.scene import Chain, Joint
 
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 _CHAIN_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed")
@@ -115,8 +116,8 @@ def chain_from_urdf(
     tip = _pick_tip(tip_link, base, links, joints, source)
     path = _path(base, tip, parent_joint, source)
     robot = root.get("name", "")
-    if robot and name_problem(robot):
-        raise SceneError(source, "robot/@name", name_problem(robot), NAME_RULE)
+    if robot and (problem := name_problem(robot)):
+        raise SceneError(source, "robot/@name", problem, NAME_RULE)
     chain = _assemble(robot, path, tip, source)
     is_file = not os.fspath(path_or_text).lstrip().startswith("<")
     return replace(chain, urdf_path=os.fspath(path_or_text) if is_file else None, base_link=base)
@@ -181,7 +182,7 @@ def _joints(root: ET.Element, source: str, links: list[str]) -> list[dict]:
         kind = element.get("type")
         if kind not in URDF_JOINT_TYPES:
             raise SceneError(source, f"{key}/@type", f"unknown joint type {kind!r}", ", ".join(URDF_JOINT_TYPES))
-        joint = {"name": name, "key": key, "type": kind, "element": element}
+        joint: dict[str, Any] = {"name": name, "key": key, "type": kind, "element": element}
         for end in ("parent", "child"):
             link = element.find(end)
             if link is None or not link.get("link"):
@@ -203,9 +204,9 @@ def _joints(root: ET.Element, source: str, links: list[str]) -> list[dict]:
 
 def _numbers(element: ET.Element | None, attribute: str, default: tuple[float, ...], key: str,
              source: str) -> np.ndarray:
-    if element is None or element.get(attribute) is None:
+    text = None if element is None else element.get(attribute)
+    if text is None:
         return np.array(default)
-    text = element.get(attribute)
     try:
         values = np.array([float(word) for word in text.split()])
     except ValueError:
@@ -267,8 +268,8 @@ def _check_tree(root_link: str, links: list[str], joints: list[dict], source: st
 def _pick_base(base_link: str | None, root_link: str, links: list[str], source: str) -> str:
     if base_link is None:
         return root_link
-    if name_problem(base_link):
-        raise SceneError(source, "base_link", name_problem(base_link), NAME_RULE)
+    if problem := name_problem(base_link):
+        raise SceneError(source, "base_link", problem, NAME_RULE)
     if base_link not in set(links):
         raise SceneError(source, "base_link", f"no link named {base_link!r}", ", ".join(links))
     return base_link
@@ -276,8 +277,8 @@ def _pick_base(base_link: str | None, root_link: str, links: list[str], source: 
 
 def _pick_tip(tip_link: str | None, base: str, links: list[str], joints: list[dict], source: str) -> str:
     if tip_link is not None:
-        if name_problem(tip_link):
-            raise SceneError(source, "tip_link", name_problem(tip_link), NAME_RULE)
+        if problem := name_problem(tip_link):
+            raise SceneError(source, "tip_link", problem, NAME_RULE)
         if tip_link not in set(links):
             raise SceneError(source, "tip_link", f"no link named {tip_link!r}", ", ".join(links))
         return tip_link
@@ -295,7 +296,8 @@ def _pick_tip(tip_link: str | None, base: str, links: list[str], joints: list[di
 
 
 def _path(base: str, tip: str, parent_joint: dict[str, dict], source: str) -> list[dict]:
-    path, link = [], tip
+    path: list[dict] = []
+    link = tip
     while link != base:
         if link not in parent_joint:
             raise SceneError(source, "tip_link", f"link {tip!r} is not below base link {base!r}",
@@ -365,8 +367,8 @@ def _assemble(robot_name: str, path: list[dict], tip: str, source: str) -> Chain
             upper=upper,
         ))
         position, rotation = np.zeros(3), np.eye(3)
-    if name_problem(tip):
-        raise SceneError(source, f"robot/link[@name='{tip}']", name_problem(tip), NAME_RULE)
+    if problem := name_problem(tip):
+        raise SceneError(source, f"robot/link[@name='{tip}']", problem, NAME_RULE)
     if not chain_joints:
         raise SceneError(source, "tip_link", f"no movable joint between the base and {tip!r}",
                          "a path with at least one revolute, continuous or prismatic joint")

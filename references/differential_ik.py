@@ -30,12 +30,12 @@ import importlib.util
 
 import numpy as np
 
-from simparity.core.engine import IKModel
-from simparity.core.ik.problem import IKTolerances, check_inputs
-from simparity.core.ik.result import IKResult
-from simparity.core.scene import Chain
-from simparity.references.conventions import rotation_angle
-from simparity.references.ik_outcome import ik_outcome
+from simparity.core.model.engine import IKModel
+from simparity.core.model.ik_problem import IKTolerances, check_inputs
+from simparity.core.model.ik_result import IKResult
+from simparity.core.model.scene import Chain
+from simparity.references.common.conventions import rotation_angle
+from simparity.references.common.ik_outcome import ik_outcome
 
 DT = 1e-2
 """[s] Step of the velocity integration (with gain 1 the update is the same for any dt)."""

@@ -13,7 +13,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from simparity.core.results import (
+from simparity.core.model.run_info import RunInfo
+from simparity.core.model.results import (
     GROUND_TRUTH_ENGINES,
     HARD_VERDICT_SUFFIXES,
     NOT_AVAILABLE,
@@ -35,6 +36,11 @@ from simparity.reports.blocks import (
     scene_heading,
 )
 from simparity.reports.sweep_summary import Sweep, merge_variants, union
+from simparity.core.model.metric_catalogue import (
+    APEX_HEIGHT_ERROR, CROSS_EVAL_SOLVE_RATE_MIN, ENERGY_GAIN_MAX, IMPACT_TIME_ERROR, ITERATIONS_MEDIAN,
+    LIMIT_VIOLATIONS, ORIENTATION_ERROR_MAX, PENETRATION_MAX, POSITION_ERROR_MAX, POSITION_RESIDUAL_MEDIAN,
+    RESTITUTION_MEASURED, REST_TIME_ERROR, SOLVE_RATE, STOPPING_DISTANCE, TIME_PER_FK, TIME_PER_SOLVE, TIME_PER_STEP,
+)
 
 FIGURES_DIR = "figures"
 """Sub-folder of the run folder the figures are written to (SVG and PNG)."""
@@ -49,8 +55,8 @@ class ToleranceVerdict:
     violations: tuple[str, ...] = ()
 
 
-_IK_COMPACT = ("solve_rate", "position_residual_median", "iterations_median", "time_per_solve", "limit_violations",
-               "cross_eval_solve_rate_min")
+_IK_COMPACT = (SOLVE_RATE, POSITION_RESIDUAL_MEDIAN, ITERATIONS_MEDIAN, TIME_PER_SOLVE, LIMIT_VIOLATIONS,
+               CROSS_EVAL_SOLVE_RATE_MIN)
 _IK_PROTOCOL = (
     "Protocol (TRAC-IK): seeded random reachable targets (end-effector poses of seeded random configurations "
     "within the limits), every solve from the scene's one start pose, success when the residuals are within "
@@ -59,7 +65,7 @@ _IK_PROTOCOL = (
     "solution is also put through every engine's forward kinematics (worst solve rate and largest "
     "disagreement shown), so no solver passes on its own kinematics alone."
 )
-_TIMING_METRICS = ("time_per_step", "time_per_fk", "time_per_solve")
+_TIMING_METRICS = (TIME_PER_STEP, TIME_PER_FK, TIME_PER_SOLVE)
 _DEFINITIONS = (
     "Statuses: `ok` measured; `n/a` not measured, with the reason: the engine cannot do what the scene asks, "
     "or the metric means nothing here (saturated: an orientation error at >= pi/2, another error at >= 1/4 of "
@@ -72,8 +78,8 @@ _DEFINITIONS = (
     "max |L(t) - L(0)| / |L(0)|. Cost is compute per simulated second, time per step / dt. Definitions: "
     "docs/metrics.md."
 )
-_HEADLINE_NAMES = {"position_error_max": ("position error max", "m"),
-                   "orientation_error_max": ("orientation error max", "rad")}
+_HEADLINE_NAMES = {POSITION_ERROR_MAX: ("position error max", "m"),
+                   ORIENTATION_ERROR_MAX: ("orientation error max", "rad")}
 
 
 def _notes(scene_rows: pd.DataFrame) -> list[Block]:
@@ -142,10 +148,10 @@ def _verdict_line(name: str, rows: pd.DataFrame) -> str:
     return text + (f"; diverged: {', '.join(diverged)}" if diverged else "")
 
 
-def _hard_cases(table: pd.DataFrame, info: dict, groups: dict[str, str]) -> list[Block]:
+def _hard_cases(table: pd.DataFrame, info: RunInfo, groups: dict[str, str]) -> list[Block]:
     """The verdict every engine earned on each scene of the hard suite in the run; a sweep's variants (``groups``:
     {variant: its sweep's label}) share one line, with no grid of their own (the sweep's section has one)."""
-    names = [name for name, about in info.get("scenes", {}).items() if "hard" in about.get("suites", ())]
+    names = [name for name, about in info.scenes.items() if "hard" in about.get("suites", ())]
     names = [name for name in names if (table["scene"] == name).any()]
     if not names:
         return []
@@ -175,13 +181,13 @@ def _hard_cases(table: pd.DataFrame, info: dict, groups: dict[str, str]) -> list
 
 
 def _kind(rows: pd.DataFrame) -> str:
-    if (rows["metric"] == "solve_rate").any():
+    if (rows["metric"] == SOLVE_RATE).any():
         return "ik"
     return "dynamics" if rows["dt"].notna().any() else "kinematics"
 
 
 def _headline(about: dict) -> str:
-    return about.get("headline_metric", "position_error_max")
+    return about.get("headline_metric", POSITION_ERROR_MAX)
 
 
 def _scheme(case: pd.Series | None, unit: str) -> str:
@@ -201,7 +207,7 @@ def _overhead_mark(engine: str, about: dict) -> str:
 
 
 class _Builder:
-    def __init__(self, table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: ToleranceVerdict | None,
+    def __init__(self, table: pd.DataFrame, info: RunInfo, series: pd.DataFrame, verdict: ToleranceVerdict | None,
                  figure_dir: Path, writer: figures.FigureWriter, sweeps: list[Sweep]) -> None:
         self.table, self.info, self.series, self.verdict = table, info, series, verdict
         self.figure_dir, self.writer = figure_dir, writer
@@ -216,7 +222,7 @@ class _Builder:
         return scene not in self.sweep_of or scene in self.sweep_of[scene].shown
 
     def about(self, scene: str) -> dict:
-        return self.info.get("scenes", {}).get(scene, {})
+        return self.info.scenes.get(scene, {})
 
     def figure(self, fig, name: str, caption: str) -> list[Block]:
         if fig is None:
@@ -228,7 +234,9 @@ class _Builder:
 
     def summary(self) -> list[Block]:
         blocks: list[Block] = [Heading(2, "Summary")]
-        dyn_rows, ik_rows, swept = [], [], set()
+        dyn_rows: list[tuple[str, ...]] = []
+        ik_rows: list[tuple[str, ...]] = []
+        swept: set[str] = set()
         for scene, rows in self.table.groupby("scene", sort=False):
             kind, about = _kind(rows), self.about(scene)
             if scene in self.sweep_of:
@@ -302,7 +310,7 @@ class _Builder:
         flags = self.merged(summary.contact_flags(self.table), ["metric", "engine", "integrator"],
                             value_max=("value_max", "max"), dts=("dts", union))
         for (scene, metric), g in flags.groupby(["scene", "metric"], sort=False):
-            what = ("**energy gained at an impact**" if metric == "energy_gain_max" else "**tunnelling**")
+            what = ("**energy gained at an impact**" if metric == ENERGY_GAIN_MAX else "**tunnelling**")
             cases = ", ".join(f"{r['engine']} {r['integrator']} {number(r['value_max'])} (dt {_dts(r)}"
                               f"{self.in_variants(r, '; ')})" for _, r in g.iterrows())
             items.append(f"{what} in {scene} (`{metric}`): " + cases)
@@ -404,17 +412,18 @@ class _Builder:
     def kinematics(self, rows: pd.DataFrame) -> list[Block]:
         """One section for every kinematics scene: frame and Jacobian errors against each scene's reference."""
         scenes = list(dict.fromkeys(rows["scene"]))
-        return [Heading(2, "Kinematics"),
-                Bullets(tuple(f"**{scene}**: {self.introduction(scene, rows[rows['scene'] == scene])}"
-                              for scene in scenes)),
-                tables.metric_table(rows, tables.KINEMATICS_COLUMNS, ["scene", "engine"])] + _notes(rows)
+        blocks: list[Block] = [Heading(2, "Kinematics"),
+                               Bullets(tuple(f"**{scene}**: {self.introduction(scene, rows[rows['scene'] == scene])}"
+                                             for scene in scenes)),
+                               tables.metric_table(rows, tables.KINEMATICS_COLUMNS, ["scene", "engine"])]
+        return blocks + _notes(rows)
 
     def dynamics(self, scene, rows, about, reference, series) -> list[Block]:
         headline = _headline(about)
         name, unit = _HEADLINE_NAMES[headline]
         cases = summary.dynamics_cases(rows, headline)
         observed = summary.orders(rows, headline)
-        theory = self.info.get("theoretical_orders", {})
+        theory = self.info.theoretical_orders
         blocks = self.figure(figures.work_precision_figure(scene, cases, headline, reference), f"{scene}-work-precision",
                              f"Work-precision: {name} [{unit}] against compute per simulated second, one point per dt.")
         if not about.get("contact"):  # with contact the error has no order (impacts), so no convergence figure
@@ -426,7 +435,7 @@ class _Builder:
         if about.get("contact"):
             blocks += self.contact(scene, rows, about, reference, series)
         best = summary.best_per_scheme(cases)
-        variants = self.info.get("integrator_variants", {})
+        variants = self.info.integrator_variants
         per_scheme: dict[tuple[str, str], list[tuple[str, tuple[str, ...]]]] = {}
         for _, b in best[best["any_result"]].iterrows():
             p = theory.get(b["engine"], {}).get(b["integrator"])
@@ -434,20 +443,21 @@ class _Builder:
             scheme, variant = variants.get(b["engine"], {}).get(b["integrator"], (b["integrator"], ""))
             per_scheme.setdefault((b["engine"], scheme), []).append((variant, (
                 number(b["dt"]), number(b["error"]), number(b["cost"]),
-                number(b["time_per_step"]) + _overhead_mark(b["engine"], about),
+                number(b[TIME_PER_STEP]) + _overhead_mark(b["engine"], about),
                 f"{number(fitted)} ({p})" if p else number(fitted), b["statuses"])))
         blocks += [Table(("engine", "integrator", "best dt [s]", f"error [{unit}]", "cost [s/s]", "time per step [s]",
                           "order (theory)", "time steps"),
                          tuple(_scheme_row(engine, scheme, members) for (engine, scheme), members in per_scheme.items()))]
 
-        full = [tables.metric_table(rows[rows["dt"].notna()], tables.DYNAMICS_COLUMNS,
+        full: list[Block] = [tables.metric_table(rows[rows["dt"].notna()], tables.DYNAMICS_COLUMNS,
                                     ["engine", "integrator", "dt"])]
         orders = rows[rows["dt"].isna()]
         if not orders.empty:
-            full += [Paragraph("Observed order of convergence: slope of log(error max) against log(dt) over the finest "
-                               "time steps whose local slopes agree; errors at the rounding floor or saturated are "
-                               "left out."),
-                     tables.metric_table(orders, tables.ORDER_COLUMNS, ["engine", "integrator"])] + _fits(orders)
+            explained: list[Block] = [
+                Paragraph("Observed order of convergence: slope of log(error max) against log(dt) over the finest "
+                          "time steps whose local slopes agree; errors at the rounding floor or saturated are left out."),
+                tables.metric_table(orders, tables.ORDER_COLUMNS, ["engine", "integrator"])]
+            full += explained + _fits(orders)
         return blocks + [Details(f"{scene}: every engine × integrator × dt", tuple(full), markdown=False)]
 
     def contact(self, scene, rows, about, reference, series) -> list[Block]:
@@ -464,10 +474,10 @@ class _Builder:
             finest = g[g["status"] == OK].head(1)
             at = (lambda m: number(float(finest[m].iloc[0])) if not finest.empty else "—")
             table.append((engine, integrator)
-                         + tuple(number(float(g.loc[g["dt"] == dt, "restitution_measured"].max())) for dt in dts)
-                         + (number(float(g["penetration_max"].max())), number(float(g["energy_gain_max"].max())),
-                            at("dt"), at("impact_time_error"), at("apex_height_error"), at("rest_time_error"),
-                            at("stopping_distance"), " · ".join(dict.fromkeys(g["status"]))))
+                         + tuple(number(float(g.loc[g["dt"] == dt, RESTITUTION_MEASURED].max())) for dt in dts)
+                         + (number(float(g[PENETRATION_MAX].max())), number(float(g[ENERGY_GAIN_MAX].max())),
+                            at("dt"), at(IMPACT_TIME_ERROR), at(APEX_HEIGHT_ERROR), at(REST_TIME_ERROR),
+                            at(STOPPING_DISTANCE), " · ".join(dict.fromkeys(g["status"]))))
         blocks += [Paragraph(f"Contact: requested restitution {', '.join(f'{k:g}' for k in requested)}; measured "
                              "from each run's first rebound (v_out / |v_in|, extrapolated along the free flight "
                              "from the samples either side), at each dt. Penetration and energy gained: the worst "
@@ -529,7 +539,7 @@ def _sweep_row(sweep: Sweep) -> tuple[str, ...]:
             f"({len(sweep.variants)} variants)")
     ranked = sweep.across[sweep.across["status"] == OK]
     if sweep.kind == "ik":
-        best, fastest = summary.best_ik(ranked.rename(columns={"value": "solve_rate", "cost": "time_per_solve"}))
+        best, fastest = summary.best_ik(ranked.rename(columns={"value": SOLVE_RATE, "cost": TIME_PER_SOLVE}))
         return link, _solver(best), _solver(fastest)
     name, unit = _HEADLINE_NAMES[sweep.metric]
     cases = ranked.rename(columns={"value": "error"})
@@ -546,10 +556,10 @@ def _dts(row: pd.Series) -> str:
 def _solver(row: pd.Series | None) -> str:
     if row is None:
         return "none"
-    return f"{row['engine']} {row['integrator']}: {row['solve_rate']:.1%} at {number(row['time_per_solve'])} s"
+    return f"{row['engine']} {row['integrator']}: {row[SOLVE_RATE]:.1%} at {number(row[TIME_PER_SOLVE])} s"
 
 
-def build(table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: ToleranceVerdict | None,
+def build(table: pd.DataFrame, info: RunInfo, series: pd.DataFrame, verdict: ToleranceVerdict | None,
           run_dir: Path) -> tuple[list[Block], dict[str, str]]:
     """(the report's blocks, the SVG text of each figure by name); figures are written to
     ``run_dir/figures``, on one process per CPU. ``verdict``: the run held to tolerances, None if it was not."""
@@ -561,14 +571,14 @@ def build(table: pd.DataFrame, info: dict, series: pd.DataFrame, verdict: Tolera
     return blocks, svgs
 
 
-def _blocks(builder: _Builder, table: pd.DataFrame, info: dict) -> list[Block]:
+def _blocks(builder: _Builder, table: pd.DataFrame, info: RunInfo) -> list[Block]:
     """Every block of the report, in order."""
-    versions = ", ".join(f"{k} {v}" for k, v in info.get("engine_versions", {}).items())
-    m = info.get("machine", {})
+    versions = ", ".join(f"{k} {v}" for k, v in info.engine_versions.items())
+    m = info.machine
     counts = case_counts(table.to_dict("records"))
     blocks: list[Block] = [
         Heading(1, "simparity report"),
-        Paragraph(f"Run {info.get('created_utc', '?')} · commit {info.get('git_commit', '?')} · "
+        Paragraph(f"Run {info.created_utc} · commit {info.git_commit} · "
                   f"{m.get('platform', '?')} · {m.get('cpu_count', '?')} CPUs · Python {m.get('python', '?')}"),
         Paragraph(f"Engines: {versions}"),
         Paragraph("Cases (failed or diverged if any row is, ok if anything was measured): "
@@ -582,7 +592,7 @@ def _blocks(builder: _Builder, table: pd.DataFrame, info: dict) -> list[Block]:
     blocks += builder.summary()
     blocks += _hard_cases(table, info, builder.groups)
     blocks += [Details("Definitions", (Paragraph(_DEFINITIONS), Paragraph(_IK_PROTOCOL)))]
-    blocks += sweep_sections.sections(builder.sweeps, builder.figure, info.get("theoretical_orders", {}))
+    blocks += sweep_sections.sections(builder.sweeps, builder.figure, info.theoretical_orders)
     kinds = {scene: _kind(rows) for scene, rows in table.groupby("scene", sort=False)}
     for scene, rows in table.groupby("scene", sort=False):
         blocks += builder.scene(scene, rows) if kinds[scene] != "kinematics" and builder.listed(scene) else []

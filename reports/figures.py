@@ -24,17 +24,18 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from simparity.core.processes import die_with_parent  # noqa: E402
-from simparity.core.results import SWEEP_PREFIX  # noqa: E402
+from simparity.core.runtime.processes import die_with_parent  # noqa: E402
+from simparity.core.model.results import SWEEP_PREFIX  # noqa: E402
 from simparity.reports.figure_layout import finish, legend, title  # noqa: E402
 from simparity.reports.summary import ERROR_BUDGETS  # noqa: E402
+from simparity.core.model.metric_catalogue import ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE, TIME_PER_SOLVE
 
 _ENGINE_MARKERS = {"core": "o", "mujoco": "s", "pybullet": "^", "pinocchio": "D"}
-_HEADLINE_LABELS = {"position_error_max": "position error max [m]",
-                    "orientation_error_max": "orientation error max [rad]"}
+_HEADLINE_LABELS = {POSITION_ERROR_MAX: "position error max [m]",
+                    ORIENTATION_ERROR_MAX: "orientation error max [rad]"}
 _DRIFT_PANELS = [("energy_change", "|E(t) - E(0)| / |E(0)|"), ("angular_momentum_change", "|L(t) - L(0)| / |L(0)|"),
                  ("position_error", "position error [m]"), ("orientation_error", "orientation error [rad]")]
-_COLORS = plt.get_cmap("tab20").colors + plt.get_cmap("tab20b").colors
+_COLORS = tuple(plt.get_cmap("tab20").colors) + tuple(plt.get_cmap("tab20b").colors)  # type: ignore[attr-defined]  # ListedColormap
 """40 distinct colours: a scene's schemes (up to ~25 with core's orientation updates) each get their own."""
 _WIDTH = 9.0
 """[in] Figure width: a report column at 100 dpi."""
@@ -154,12 +155,12 @@ def contact_height_figure(scene: str, series: pd.DataFrame, reference: str):
 
 def ik_rate_figure(scene: str, solvers: pd.DataFrame, reference: str):
     """Solve rate against time per solve (log), one point per engine x solver."""
-    rated = solvers.dropna(subset=["solve_rate", "time_per_solve"])
+    rated = solvers.dropna(subset=[SOLVE_RATE, TIME_PER_SOLVE])
     if rated.empty:
         return None
     fig, ax = plt.subplots(figsize=(_WIDTH, 4.0))
     for i, (_, r) in enumerate(rated.iterrows()):
-        ax.plot([r["time_per_solve"]], [r["solve_rate"]], linestyle="none",
+        ax.plot([r[TIME_PER_SOLVE]], [r[SOLVE_RATE]], linestyle="none",
                 label=f"{r['engine']} {r['integrator']}", **_style(i, r["engine"]) | {"markersize": 7})
     ax.set(xscale="log", xlabel="time per solve [s]", ylabel="solve rate", ylim=(-0.03, 1.03))
     title(ax, f"{scene}: solve rate against time per solve (targets from {reference})")

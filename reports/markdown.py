@@ -34,7 +34,7 @@ def to_markdown(blocks: list[Block], figure_dir: str = "figures") -> str:
     lines: list[str] = []
     for is_figure, run in itertools.groupby(blocks, key=lambda b: isinstance(b, Figure)):
         if is_figure:  # consecutive figures on one line: side by side where there is room
-            lines += [" ".join(f"![{f.caption}]({figure_dir}/{f.name}.svg)" for f in run), ""]
+            lines += [" ".join(f"![{f.caption}]({figure_dir}/{f.name}.svg)" for f in run if isinstance(f, Figure)), ""]
         else:
             lines += [line for block in run for line in _lines(block, figure_dir)]
     while lines and not lines[-1]:

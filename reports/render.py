@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from simparity.core.results import REPORT_FILE, REPORT_HTML_FILE
+from simparity.core.model.results import REPORT_FILE, REPORT_HTML_FILE
 from simparity.reports.content import FIGURES_DIR, ToleranceVerdict, build
 from simparity.reports.html import to_html
 from simparity.reports.markdown import to_markdown
@@ -34,5 +34,5 @@ def write_report(run_dir: str | Path, verdict: ToleranceVerdict | None = None) -
     _remove_stale_figures(run_dir / FIGURES_DIR, set(svgs))
     markdown, page = run_dir / REPORT_FILE, run_dir / REPORT_HTML_FILE
     markdown.write_text(to_markdown(blocks), encoding="utf-8")
-    page.write_text(to_html(blocks, svgs, f"simparity report {info.get('created_utc', '')}".strip()), encoding="utf-8")
+    page.write_text(to_html(blocks, svgs, f"simparity report {info.created_utc}".strip()), encoding="utf-8")
     return markdown, page

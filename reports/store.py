@@ -2,18 +2,17 @@
 
 from __future__ import annotations
 
-import json
 import math
 import re
 from pathlib import Path
 
 import pandas as pd
 
-from simparity.core.errors import ResultsError, one_line
-from simparity.core.results import (
+from simparity.core.model.errors import ResultsError, one_line
+from simparity.core.model.run_info import RunInfo
+from simparity.core.model.results import (
     COLUMNS,
     RESULTS_FILE,
-    READ_SCHEMA_VERSIONS,
     RUN_INFO_FILE,
     SERIES_COLUMNS,
     SERIES_FILE,
@@ -26,7 +25,7 @@ from simparity.core.results import (
 _EXACT_FLOATS = {"float_precision": "round_trip"} if int(pd.__version__.split(".")[0]) < 3 else {}
 
 
-def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
+def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, RunInfo]:
     """(results table, run information) of a stored run; raises ResultsError if unusable.
 
     The table has :data:`core.results.COLUMNS` (``dt`` and ``value`` float64) and, for a run of swept scenes,
@@ -38,20 +37,17 @@ def read_run(run_dir: str | Path) -> tuple[pd.DataFrame, dict]:
         if not path.is_file():
             raise ResultsError(f"{one_line(path)}: missing (allowed: the output folder of 'simparity run', holding "
                                f"{RESULTS_FILE} and {RUN_INFO_FILE})")
+    meta = RunInfo.read(info)
     try:
-        meta = json.loads(info.read_text(encoding="utf-8"))
         swept = [c for c in pd.read_csv(results, nrows=0).columns if c == SWEEP_COLUMN or c.startswith(SWEEP_PREFIX)]
         # keep_default_na=False: pandas would read the status "n/a" as missing.
         table = pd.read_csv(results, keep_default_na=False, **_EXACT_FLOATS, dtype={c: str for c in swept},
                             na_values={"value": ["", "nan", "NaN"], "dt": ["", "nan", "NaN"]})
         for column in (c for c in swept if c != SWEEP_COLUMN):
             table[column] = _swept_values(table[column])
-    except (json.JSONDecodeError, pd.errors.ParserError, UnicodeDecodeError, ValueError) as err:
+    except (pd.errors.ParserError, UnicodeDecodeError, ValueError) as err:
         raise ResultsError(f"{one_line(run_dir)}: unreadable stored run: {one_line(err)} (allowed: a folder written by "
                            "'simparity run')") from None
-    if meta.get("schema_version") not in READ_SCHEMA_VERSIONS:
-        raise ResultsError(f"{info}: schema_version {meta.get('schema_version')!r:.20} (allowed: "
-                           f"{', '.join(map(str, READ_SCHEMA_VERSIONS))}, the versions this simparity reads)")
     for column in ("flag", "scheme"):  # schema 1: written before rows carried them
         if column not in table.columns:
             table.insert(table.columns.get_loc("detail") + 1 + (column == "scheme"), column, "")

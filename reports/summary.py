@@ -9,7 +9,7 @@ import math
 
 import pandas as pd
 
-from simparity.core.results import (
+from simparity.core.model.results import (
     BELOW_THEORY,
     GROUND_TRUTH_ENGINES,
     NOT_AVAILABLE,
@@ -19,6 +19,11 @@ from simparity.core.results import (
     SATURATED,
     SUPERCONVERGENT,
     case_status,
+)
+from simparity.core.model.metric_catalogue import (
+    APEX_HEIGHT_ERROR, ENERGY_GAIN_MAX, IMPACT_TIME_ERROR, ORDER_ORIENTATION, ORDER_POSITION, ORIENTATION_ERROR_MAX,
+    PENETRATION_MAX, POSITION_ERROR_MAX, RESTITUTION_MEASURED, REST_TIME_ERROR, SOLVE_RATE, STABLE_DT_MAX,
+    STOPPING_DISTANCE, TIME_PER_SOLVE, TIME_PER_STEP, TUNNELLED,
 )
 
 ERROR_BUDGETS = (1e-3, 1e-6, 1e-9)
@@ -55,12 +60,12 @@ def dynamics_cases(rows: pd.DataFrame, headline: str) -> pd.DataFrame:
     per_dt = rows[rows["dt"].notna() & ~rows["engine"].isin(GROUND_TRUTH_ENGINES)
                   & (rows["engine"] + ":" + rows["integrator"] != rows["reference"])]
     cases = per_dt.groupby(keys, sort=False)["status"].agg(case_status).rename("status").reset_index()
-    measured = per_dt[(per_dt["status"] == OK) & per_dt["metric"].isin([headline, "time_per_step"])]
+    measured = per_dt[(per_dt["status"] == OK) & per_dt["metric"].isin([headline, TIME_PER_STEP])]
     values = measured.pivot_table(index=keys, columns="metric", values="value", sort=False)
-    cases = cases.merge(values.reindex(columns=[headline, "time_per_step"]).reset_index(), on=keys, how="left")
+    cases = cases.merge(values.reindex(columns=[headline, TIME_PER_STEP]).reset_index(), on=keys, how="left")
     cases = cases.rename(columns={headline: "error"})
-    cases["cost"] = cases["time_per_step"] / cases["dt"]
-    return cases[["scene", "engine", "integrator", "dt", "status", "error", "time_per_step", "cost"]]
+    cases["cost"] = cases[TIME_PER_STEP] / cases["dt"]
+    return cases[["scene", "engine", "integrator", "dt", "status", "error", TIME_PER_STEP, "cost"]]
 
 
 def _measured(cases: pd.DataFrame) -> pd.DataFrame:
@@ -90,10 +95,10 @@ def best_per_scheme(cases: pd.DataFrame) -> pd.DataFrame:
     summary = cases.groupby(keys, sort=False)["status"].agg(
         statuses=lambda s: ", ".join(f"{status} {n}" for status, n in s.value_counts().items()),
         any_result=lambda s: bool((s != NOT_AVAILABLE).any())).reset_index()
-    return summary.merge(best[keys + ["dt", "error", "cost", "time_per_step"]], on=keys, how="left")
+    return summary.merge(best[keys + ["dt", "error", "cost", TIME_PER_STEP]], on=keys, how="left")
 
 
-ORDER_METRICS = {"position_error_max": "order_position", "orientation_error_max": "order_orientation"}
+ORDER_METRICS = {POSITION_ERROR_MAX: ORDER_POSITION, ORIENTATION_ERROR_MAX: ORDER_ORIENTATION}
 """The row holding the observed order of convergence of each headline error."""
 
 
@@ -106,19 +111,19 @@ def orders(rows: pd.DataFrame, headline: str) -> dict[tuple[str, str], float]:
 
 def ik_solvers(rows: pd.DataFrame) -> pd.DataFrame:
     """Per engine x solver of an IK scene: solve rate and time per solve (NaN where not measured)."""
-    measured = rows[rows["metric"].isin(["solve_rate", "time_per_solve"]) & (rows["status"] == OK)]
+    measured = rows[rows["metric"].isin([SOLVE_RATE, TIME_PER_SOLVE]) & (rows["status"] == OK)]
     wide = measured.pivot_table(index=["engine", "integrator"], columns="metric", values="value", sort=False)
-    return wide.reindex(columns=["solve_rate", "time_per_solve"]).reset_index()
+    return wide.reindex(columns=[SOLVE_RATE, TIME_PER_SOLVE]).reset_index()
 
 
 def best_ik(solvers: pd.DataFrame) -> tuple[pd.Series | None, pd.Series | None]:
     """(the solver of best solve rate, the fastest quicker one on a tie; the fastest at >= 99 %)."""
-    rated = solvers.dropna(subset=["solve_rate", "time_per_solve"])
+    rated = solvers.dropna(subset=[SOLVE_RATE, TIME_PER_SOLVE])
     if rated.empty:
         return None, None
-    best = rated.sort_values(["solve_rate", "time_per_solve"], ascending=[False, True]).iloc[0]
-    reliable = rated[rated["solve_rate"] >= SOLVED_ENOUGH]
-    return best, (None if reliable.empty else reliable.loc[reliable["time_per_solve"].idxmin()])
+    best = rated.sort_values([SOLVE_RATE, TIME_PER_SOLVE], ascending=[False, True]).iloc[0]
+    reliable = rated[rated[SOLVE_RATE] >= SOLVED_ENOUGH]
+    return best, (None if reliable.empty else reliable.loc[reliable[TIME_PER_SOLVE].idxmin()])
 
 
 def unresolved_cases(table: pd.DataFrame) -> pd.DataFrame:
@@ -175,8 +180,8 @@ def order_findings(table: pd.DataFrame) -> pd.DataFrame:
 
 
 
-CONTACT_COLUMNS = ("restitution_measured", "penetration_max", "energy_gain_max", "impact_time_error",
-                   "apex_height_error", "rest_time_error", "stopping_distance")
+CONTACT_COLUMNS = (RESTITUTION_MEASURED, PENETRATION_MAX, ENERGY_GAIN_MAX, IMPACT_TIME_ERROR,
+                   APEX_HEIGHT_ERROR, REST_TIME_ERROR, STOPPING_DISTANCE)
 """The contact metrics a contact scene's compact table shows, per engine x integrator."""
 
 
@@ -193,7 +198,7 @@ def contact_cases(rows: pd.DataFrame) -> pd.DataFrame:
 
 def stability_limits(rows: pd.DataFrame) -> pd.DataFrame:
     """The measured stable_dt_max rows of a scene: engine, integrator, status, value [s], detail."""
-    limits = rows[rows["metric"] == "stable_dt_max"]
+    limits = rows[rows["metric"] == STABLE_DT_MAX]
     return limits[["engine", "integrator", "status", "value", "detail"]]
 
 
@@ -202,8 +207,8 @@ def contact_flags(table: pd.DataFrame) -> pd.DataFrame:
     through a plane (tunnelled > 0), ground truths left out: per scene x metric x engine x integrator the
     largest value and the time steps it happened at."""
     ok = table[(table["status"] == OK) & ~table["engine"].isin(GROUND_TRUTH_ENGINES)]
-    flagged = ok[((ok["metric"] == "energy_gain_max") & (ok["value"] > ENERGY_GAIN_FLAGGED))
-                 | ((ok["metric"] == "tunnelled") & (ok["value"] > 0))]
+    flagged = ok[((ok["metric"] == ENERGY_GAIN_MAX) & (ok["value"] > ENERGY_GAIN_FLAGGED))
+                 | ((ok["metric"] == TUNNELLED) & (ok["value"] > 0))]
     per_scheme = flagged.groupby(["scene", "metric", "engine", "integrator"], sort=False).agg(
         value_max=("value", "max"), dts=("dt", lambda d: sorted(d)))
     return per_scheme.reset_index().reindex(columns=["scene", "metric", "engine", "integrator", "value_max", "dts"])

@@ -13,7 +13,7 @@ from typing import Callable
 import numpy as np
 import pandas as pd
 
-from simparity.core.results import GROUND_TRUTH_ENGINES, NOT_AVAILABLE, OK, SWEEP_PREFIX
+from simparity.core.model.results import GROUND_TRUTH_ENGINES, NOT_AVAILABLE, OK, SWEEP_PREFIX
 from simparity.reports import figures, sweep_summary, tables
 from simparity.reports.blocks import Block, Details, Heading, Paragraph, Table, number, scene_heading
 from simparity.reports.sweep_summary import METRICS, Sweep
@@ -210,10 +210,11 @@ def _section(sweep: Sweep, figure: Callable[..., list[Block]], theory: dict) -> 
     blocks += figure(figures.sweep_figure(sweep.base, drawn, sweep.keys[-1], panels, label, sweep.reference),
                      f"{sweep.base}-sweep", f"{title} against `{last}`"
                      + (f", one panel per value of {per_panel}." if per_panel else ".") + note)
-    grid = _grid(cases, sweep.keys, dt_axis)
-    if len(grid.rows) > TABLE_ROWS:
+    table = _grid(cases, sweep.keys, dt_axis)
+    grid: Block = table
+    if len(table.rows) > TABLE_ROWS:
         grid = Details(f"{sweep.base}: {label} of every engine × integrator × variant" + (" × dt" if dt_axis else "")
-                       + f" ({len(grid.rows)} rows)", (grid,), markdown=False)
+                       + f" ({len(table.rows)} rows)", (table,), markdown=False)
     return blocks + [grid, _every_value(sweep)]
 
 

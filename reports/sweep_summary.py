@@ -12,20 +12,24 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from simparity.core.results import OK, SWEEP_COLUMN, SWEEP_PREFIX, case_status
+from simparity.core.model.run_info import RunInfo
+from simparity.core.model.results import OK, SWEEP_COLUMN, SWEEP_PREFIX, case_status
 from simparity.reports import summary
+from simparity.core.model.metric_catalogue import (
+    ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE, TIME_PER_FK, TIME_PER_SOLVE,
+)
 
 METRICS = {
-    "position_error_max": ("position error max", "m"),
-    "orientation_error_max": ("orientation error max", "rad"),
-    "solve_rate": ("solve rate", ""),
+    POSITION_ERROR_MAX: ("position error max", "m"),
+    ORIENTATION_ERROR_MAX: ("orientation error max", "rad"),
+    SOLVE_RATE: ("solve rate", ""),
 }
 """The metric a sweep is judged by, with its name and unit: a dynamics scene's headline error (``run.json``; the
 position error where the variants' headlines differ), an IK scene's solve rate, a kinematics scene's frame position
 error."""
 
-_KIND_METRIC = {"ik": "solve_rate", "kinematics": "position_error_max"}
-_KIND_COST = {"dynamics": "cost", "ik": "time_per_solve", "kinematics": "time_per_fk"}
+_KIND_METRIC = {"ik": SOLVE_RATE, "kinematics": POSITION_ERROR_MAX}
+_KIND_COST = {"dynamics": "cost", "ik": TIME_PER_SOLVE, "kinematics": TIME_PER_FK}
 """The price of a scheme per kind: compute per simulated second [s/s], time per solve [s], time per FK [s]. Over a
 sweep it is the median over the variants: the physics barely changes what a step costs, and one slow timing (a
 busy CPU) would decide the largest."""
@@ -61,7 +65,7 @@ class Sweep:
 
 def _lower_is_better(metric: str) -> bool:
     """Whether a smaller value of the metric is the better one: errors yes, a solve rate no."""
-    return metric != "solve_rate"
+    return metric != SOLVE_RATE
 
 
 def metric_label(metric: str) -> str:
@@ -70,7 +74,7 @@ def metric_label(metric: str) -> str:
     return f"{name} [{unit}]" if unit else name
 
 
-def sweeps(table: pd.DataFrame, info: dict) -> list[Sweep]:
+def sweeps(table: pd.DataFrame, info: RunInfo) -> list[Sweep]:
     """Every swept scene of the run, in the order its rows first appear; empty for a run without a sweep."""
     if SWEEP_COLUMN not in table.columns:
         return []
@@ -84,26 +88,26 @@ def sweeps(table: pd.DataFrame, info: dict) -> list[Sweep]:
         keys = ["engine", "integrator"] + (["dt"] if kind == "dynamics" else [])
         shown = _shown(cases, variants, keys, lower) if kind != "kinematics" else {}   # kinematics: one section
         out.append(Sweep(base, [c for c in columns if rows[c].notna().any()], variants, kind, metric,
-                         rows["reference"].iloc[0], info.get("scenes", {}).get(variants[0], {}).get("source"),
+                         rows["reference"].iloc[0], info.scenes.get(variants[0], {}).get("source"),
                          rows, cases, across(cases, keys, lower), shown))
     return out
 
 
-def _ordered_variants(rows: pd.DataFrame, info: dict) -> list[str]:
+def _ordered_variants(rows: pd.DataFrame, info: RunInfo) -> list[str]:
     """The variants of one sweep in the sweep's order (``run.json``), whatever order their rows were stored in."""
-    scenes = info.get("scenes", {})
+    scenes = info.scenes
     names = list(dict.fromkeys(rows["scene"]))
     return sorted(names, key=lambda name: scenes.get(name, {}).get("sweep", {}).get("index", math.inf))
 
 
-def _metric(variants: list[str], info: dict) -> tuple[str, str]:
+def _metric(variants: list[str], info: RunInfo) -> tuple[str, str]:
     """(the kind of the variants, the metric their sweep is judged by)."""
-    about = [info.get("scenes", {}).get(name, {}) for name in variants]
+    about = [info.scenes.get(name, {}) for name in variants]
     kind = about[0].get("kind", "dynamics")
     if kind in _KIND_METRIC:
         return kind, _KIND_METRIC[kind]
-    headlines = {a.get("headline_metric", "position_error_max") for a in about}
-    return kind, headlines.pop() if len(headlines) == 1 else "position_error_max"
+    headlines = {a.get("headline_metric", POSITION_ERROR_MAX) for a in about}
+    return kind, headlines.pop() if len(headlines) == 1 else POSITION_ERROR_MAX
 
 
 def variant_cases(rows: pd.DataFrame, kind: str, metric: str) -> pd.DataFrame:

@@ -2,7 +2,7 @@
 
 import pytest
 
-from simparity.comparisons.history import HISTORY_ENV
+from simparity.comparisons.gate.history import HISTORY_ENV
 
 
 @pytest.fixture(autouse=True)

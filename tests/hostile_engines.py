@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from simparity.core.engine import Simulation
+from simparity.core.model.engine import Simulation
 from simparity.core.inhouse import InHouseEngine
 
 ALLOCATION_BYTES = 100 * 1024 ** 2

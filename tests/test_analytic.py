@@ -7,7 +7,7 @@ from simparity.core.inhouse import InHouseEngine
 from simparity.core.rotations import geodesic_angle_quat_wxyz, so3_exp
 
 from simparity.core.kinematics import forward_kinematics, jacobian_world
-from simparity.references.analytic import AnalyticEngine
+from simparity.references.analytic.engine import AnalyticEngine
 from tests.helpers import builtin, exact_projectile, random_chain, tumbling_box
 
 # Two float64 evaluations of equivalent closed forms on a ~2.4 m arm.
@@ -52,6 +52,7 @@ def test_applied_force_torque_is_not_available():
 TUMBLING_TOL = 1e-9
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("moments, rotated", [((0.1, 0.2, 0.3), False), ((0.1, 0.2, 0.3), True),
                                               ((0.2, 0.2, 0.3), False), ((0.1, 0.3, 0.3), True)])
 def test_tumbling_closed_forms_in_any_body_frame(moments, rotated):

@@ -11,10 +11,10 @@ import time
 import numpy as np
 import pytest
 
-from simparity.core.scene import (AppliedForce, Contact, DynamicsScene, Forces, Material, Plane, RigidBody,
+from simparity.core.model.scene import (AppliedForce, Contact, DynamicsScene, Forces, Material, Plane, RigidBody,
                                   Shape)
-from simparity.references.analytic import AnalyticEngine
-from simparity.references.analytic_contact import contact_events
+from simparity.references.analytic.engine import AnalyticEngine
+from simparity.references.analytic.contact import contact_events
 
 G = 9.81
 GRAVITY = np.array([0.0, 0.0, -G])

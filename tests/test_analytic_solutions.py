@@ -6,15 +6,15 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from simparity.core.inertia import inertia_solid_box
+from simparity.core.dynamics.inertia import inertia_solid_box
 from simparity.core.rotations import (
     geodesic_angle_quat_wxyz,
     quat_wxyz_multiply,
     quat_wxyz_normalize,
     quat_wxyz_to_matrix,
 )
-from simparity.comparisons.invariants import angular_momentum_world, kinetic_energy
-from simparity.references.analytic_solutions import (
+from simparity.comparisons.measure.invariants import angular_momentum_world, kinetic_energy
+from simparity.references.analytic.solutions import (
     intermediate_axis_flip_period,
     linear_angular_drag_isotropic,
     linear_drag,
@@ -215,6 +215,7 @@ def _dop853_fixed_step_extended(rhs, y0: np.ndarray, duration: float, n_steps: i
     return np.array(out)
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(np.finfo(np.longdouble).eps > 1e-18, reason="np.longdouble is not extended here")
 def test_asymmetric_meets_accuracy_target_for_gazebo_box():
     """Gazebo box over 10 s against an 80-bit solve: omega to 1e-13 relative, orientation to 1e-11 rad."""

@@ -49,6 +49,7 @@ def test_markdown_shows_tables_ratios_and_misses():
     assert "profile lines" in text
 
 
+@pytest.mark.slow
 def test_a_small_real_run_measures_every_section(monkeypatch, tmp_path):
     """Every section runs end to end on tiny sizes and gives finite times with errors (or n/a saying why)."""
     monkeypatch.setattr(bench, "DYNAMICS", (("core", "rk4"), ("mujoco", "rk4"), ("mujoco-rollout", "euler")))

@@ -6,16 +6,16 @@ import math
 import pandas as pd
 import pytest
 
-from simparity.comparisons.check import BASELINE_RELATIVE, check_table, compare_with_baseline
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.profiles import quick
-from simparity.comparisons.runner import run_scene
-from simparity.comparisons.scene_loader import parse_scenes
-from simparity.comparisons.store import RunWriter
-from simparity.comparisons.tolerances import load_tolerances
-from simparity.core import quaternion_integrators
-from simparity.core.files import tomllib
-from simparity.core.results import COLUMNS, ROUNDING_FLOOR, ResultRow
+from simparity.comparisons.gate.check import BASELINE_RELATIVE, check_table, compare_with_baseline
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.scenes.profiles import quick
+from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.scenes.loader import parse_scenes
+from simparity.comparisons.execute.store import RunWriter
+from simparity.comparisons.gate.tolerances import load_tolerances
+from simparity.core.dynamics import quaternion_integrators
+from simparity.core.model.files import tomllib
+from simparity.core.model.results import COLUMNS, ROUNDING_FLOOR, ResultRow
 from simparity.reports.store import read_run
 from tests.helpers import builtin
 from tests.test_scene_loader import VALID_DYNAMICS
@@ -87,6 +87,7 @@ def test_baseline_flags_a_1e9_change_inside_tolerance_and_keeps_timing_apart():
     assert BASELINE_RELATIVE < 1e-3
 
 
+@pytest.mark.slow
 def test_a_degraded_rk4_fails_the_shipped_tolerances(monkeypatch):
     """RK4 with a wrong stage weight (b = 1/6, 1/3, 1/3, 1/6 -> 1/6, 1/6, 1/2, 1/6: still consistent, second
     order at best) fails the shipped order gate on a tumbling box; the true RK4 passes."""

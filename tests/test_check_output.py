@@ -2,8 +2,8 @@
 
 import junitparser
 
-from simparity.comparisons.check import BaselineDiff, CheckResult, Violation
-from simparity.comparisons.check_output import junit_xml, summary_markdown
+from simparity.comparisons.gate.check import BaselineDiff, CheckResult, Violation
+from simparity.comparisons.gate.check_output import junit_xml, summary_markdown
 
 
 def _result():

@@ -8,11 +8,11 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from simparity.comparisons.cli import EXIT_OK, EXIT_USAGE, main
-from simparity.comparisons.engines import DEFAULT_ENGINES
-from simparity.comparisons.library import builtin_paths
-from simparity.comparisons.profiles import quick
-from simparity.core.results import COLUMNS, NOT_AVAILABLE, OK, STATUSES
+from simparity.comparisons.cli.main import EXIT_OK, EXIT_USAGE, main
+from simparity.comparisons.engines.registry import DEFAULT_ENGINES
+from simparity.comparisons.scenes.library import builtin_paths
+from simparity.comparisons.scenes.profiles import quick
+from simparity.core.model.results import COLUMNS, NOT_AVAILABLE, OK, STATUSES
 from simparity.reports.store import read_run
 from tests.helpers import builtin
 from tests.test_scene_loader import BROKEN
@@ -45,7 +45,7 @@ def test_run_without_scenes_runs_a_whole_builtin_suite(tmp_path, monkeypatch, su
             seen.append((scene.name, tuple(e.name for e in engines)))
             yield scene, [], []
 
-    monkeypatch.setattr("simparity.comparisons.cli.run_scenes", run_scenes)
+    monkeypatch.setattr("simparity.comparisons.execute.session.run_scenes", run_scenes)
     code, _ = _run(["run", "--out", str(tmp_path), "--jobs", "1"] + (["--suite", suite] if suite else []))
     assert code == EXIT_OK
     wanted = suite or "default"
@@ -61,6 +61,7 @@ def test_scenes_and_a_suite_together_are_refused(tmp_path, capsys):
     assert "give one" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_lecture_scenes_end_to_end(tmp_path):
     """'simparity run' on the two lecture scenes writes results.csv and report.md with every engine's rows."""
     code, text = _run(["run", "lecture-projectile", "lecture-planar-arm", "--out", str(tmp_path), "--repeats", "1"])
@@ -128,6 +129,7 @@ def test_export_prints_the_model_for_dynamics(engine, marker):
     assert code == EXIT_OK and marker in text
 
 
+@pytest.mark.slow
 def test_report_rerenders_a_stored_run(tmp_path):
     """'simparity report DIR' rebuilds report.md from results.csv alone."""
     assert _run(["run", "lecture-planar-arm", "--engines", "core,analytic", "--out", str(tmp_path), "--repeats", "1"])[0] == 0
@@ -136,6 +138,7 @@ def test_report_rerenders_a_stored_run(tmp_path):
     assert code == EXIT_OK and "lecture-planar-arm" in (tmp_path / "report.md").read_text()
 
 
+@pytest.mark.slow
 def test_console_script_help():
     """The installed entry point answers --help for every command."""
     for argv in ([], ["run"], ["list"], ["export"], ["report"]):
@@ -159,6 +162,7 @@ def test_urdf_with_an_unsupported_element_exits_2_naming_it(tmp_path, capsys):
     assert err.count("\n") == 1 and "mimic" in err and "j2" in err
 
 
+@pytest.mark.slow
 def test_repeated_engine_names_run_once(tmp_path):
     """--engines core,core runs core once."""
     code, _ = _run(["run", "lecture-planar-arm", "--engines", "core,core", "--out", str(tmp_path), "--repeats", "1"])
@@ -167,6 +171,7 @@ def test_repeated_engine_names_run_once(tmp_path):
     assert table.duplicated(["engine", "metric"]).sum() == 0
 
 
+@pytest.mark.slow
 def test_export_output_is_only_the_model():
     """Piped, 'export --engine pybullet' is one XML document (a provenance comment, then the robot) and says
     nothing on stderr: PyBullet's banner stays out."""
@@ -177,6 +182,7 @@ def test_export_output_is_only_the_model():
     assert "build time" not in done.stderr
 
 
+@pytest.mark.slow
 def test_out_holding_a_run_is_refused_unless_forced(tmp_path, capsys):
     """A second run into the same --out exits 2 and leaves the first run untouched; --force overwrites."""
     argv = ["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0", "--out", str(tmp_path)]
@@ -190,6 +196,7 @@ def test_out_holding_a_run_is_refused_unless_forced(tmp_path, capsys):
     assert main(argv + ["--force"]) == EXIT_OK
 
 
+@pytest.mark.slow
 def test_default_output_folders_never_collide(tmp_path, monkeypatch):
     """Two runs in the same second get two folders."""
     monkeypatch.chdir(tmp_path)
@@ -198,6 +205,7 @@ def test_default_output_folders_never_collide(tmp_path, monkeypatch):
     assert len([p for p in (tmp_path / "simparity-results").iterdir() if p.is_dir()]) == 2
 
 
+@pytest.mark.slow
 def test_run_check_junit_summary_and_history(tmp_path, capsys):
     """run --check passes on the shipped tolerances; a tolerance the run breaks gives exit 1 with the violation on one
     line, a JUnit file with the failing case and a summary; history shows both runs side by side."""
@@ -227,6 +235,7 @@ def test_run_check_junit_summary_and_history(tmp_path, capsys):
     assert shown[0].count("#") == 2 and len(euler) == 1 and euler[0].count("0.97536") == 2
 
 
+@pytest.mark.slow
 def test_a_broken_history_database_never_loses_a_run(tmp_path, capsys, monkeypatch):
     """A corrupt database: one line on stderr, the run's CSV and report are written, exit 0."""
     corrupt = tmp_path / "history.sqlite"
@@ -244,6 +253,7 @@ def test_export_refuses_a_time_step_that_is_not_one(capsys, dt):
     assert "(allowed: a finite number of seconds > 0" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_a_reader_that_stops_early_gets_no_traceback():
     """`simparity list | head -1`: the closed pipe ends the command quietly with exit 0."""
     process = subprocess.Popen([sys.executable, "-m", "simparity.comparisons.cli", "list"], stdout=subprocess.PIPE,
@@ -266,6 +276,7 @@ def test_show_reports_a_point_mass_body_and_the_contact_settings():
     assert "tetra on floor: restitution 0.3, friction static 0.5, kinetic 0.5" in text
 
 
+@pytest.mark.slow
 def test_every_run_ends_with_its_wall_time_and_peak_memory(tmp_path):
     """Issue #11: the last line of `simparity run` is what the run cost; a refused run prints no cost."""
     code, text = _run(["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0", "--out",
@@ -283,6 +294,7 @@ def test_bench_is_a_command_with_help():
     assert done.value.code == 0
 
 
+@pytest.mark.slow
 def test_check_explain_says_what_holds_an_engine(tmp_path, capsys):
     """--explain ENGINE: one line per scene and bound that holds the engine's rows, from the bound's file and index,
     with the rows it holds, to what and why; an engine the run does not have is a one-line error."""

@@ -5,7 +5,7 @@ import re
 import numpy as np
 import pytest
 
-from simparity.core.collision import (
+from simparity.core.contact.particle import (
     BAD_RESTITUTION,
     UNKNOWN_METHOD,
     Plane,
@@ -15,7 +15,7 @@ from simparity.core.collision import (
     step_particles,
     time_of_impact,
 )
-from simparity.core.scene import ZERO_NORMAL
+from simparity.core.model.scene import ZERO_NORMAL
 
 G = 9.81  # [m/s^2]
 SEED = 20240617

@@ -9,10 +9,10 @@ import math
 import numpy as np
 import pytest
 
-from simparity.core.contact import ContactModel, impulse_response, penalty_stability_limit
+from simparity.core.contact.bodies import ContactModel, impulse_response, penalty_stability_limit
 from simparity.core.inhouse import CONTACT_INTEGRATORS, InHouseEngine, integrator_names
 from simparity.core.rotations import quat_wxyz_from_rotvec, quat_wxyz_to_matrix
-from simparity.core.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
+from simparity.core.model.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
 
 G = 9.81  # [m/s^2]
 SEED = 20261123
@@ -128,7 +128,8 @@ def test_engine_runs_contact_methods_only_on_scenes_with_contact():
 # --- backup: bounces ------------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("dt", [0.001, 0.01, 0.1])
+@pytest.mark.parametrize("dt", [pytest.param(0.001, marks=pytest.mark.slow), pytest.param(0.01, marks=pytest.mark.slow),
+                                0.1])
 def test_backup_bounces_follow_the_closed_form(dt):
     """Particles and spheres dropped from 1 m (k = 0.8 and 0.5): 10 impact times and apex heights h k^2n."""
     height, radius, duration = 1.0, 0.1, 3.7  # t_10 = 3.58 s at k = 0.8
@@ -268,6 +269,7 @@ def test_backup_block_above_the_friction_angle_slides_by_the_closed_form(dt):
     np.testing.assert_allclose(trajectory.position_world, expected, rtol=0, atol=SLIDE_TOL)
 
 
+@pytest.mark.slow
 def test_backup_resting_bodies_neither_sink_nor_jitter():
     """A sphere, a point and a box placed on the floor: 1000 steps later not a picometre has moved."""
     half = (0.2, 0.15, 0.1)
@@ -282,6 +284,7 @@ def test_backup_resting_bodies_neither_sink_nor_jitter():
 # --- backup: bodies that turn ---------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_backup_box_dropped_flat_bounces_like_a_particle():
     """A box landing on a face: the particle's impact times and apexes, offset by its half height; no spin."""
     half, k, height = (0.2, 0.15, 0.1), 0.8, 1.0
@@ -351,6 +354,7 @@ def _world_inertia(quat, inertia_body):
     return rotation @ inertia_body @ np.swapaxes(rotation, -1, -2)
 
 
+@pytest.mark.slow
 def test_backup_tumbling_bodies_never_gain_energy_nor_go_inside():
     """Seeded random boxes thrown spinning at a floor and an incline: energy never above the start, no corner
     inside a plane at any sample, all at rest in the end."""
@@ -406,6 +410,7 @@ def test_backup_ball_between_a_floor_and_an_incline():
     np.testing.assert_array_equal(trajectory.velocity_world[-1], 0.0)
 
 
+@pytest.mark.slow
 def test_backup_ball_wedged_in_a_valley_is_put_at_rest():
     """Between two 45 deg slopes a ball resting on one slides into the other: the step's rest cap stops it."""
     planes = (Plane((-1.0, 0.0, 1.0), 0.0, "left"), Plane((1.0, 0.0, 1.0), 0.0, "right"))
@@ -550,6 +555,7 @@ def test_penalty_semi_implicit_euler_is_bounded_only_below_2_over_omega(fraction
         assert not np.isfinite(energy).all() or energy[out].max() > 2.0 * energy[0]
 
 
+@pytest.mark.slow
 def test_penalty_rests_at_the_static_depth_and_slides_by_coulomb():
     """Damped (zeta = 0.5), a particle settles m g / k_s deep; sliding at 2 m/s with mu = 0.3 it stops
     after v^2 / (2 mu g), up to the friction's regularisation."""
@@ -566,7 +572,8 @@ def test_penalty_rests_at_the_static_depth_and_slides_by_coulomb():
 # --- many bodies ----------------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("integrator", ["backup", "act_after", "penalty_rk4"])
+@pytest.mark.parametrize("integrator", [pytest.param("backup", marks=pytest.mark.slow),
+                                        pytest.param("act_after", marks=pytest.mark.slow), "penalty_rk4"])
 def test_a_thousand_bodies_run_vectorised(integrator):
     """1000 seeded boxes, spheres and points thrown at a floor: finite, and (backup, act_after) none inside."""
     rng = np.random.default_rng(SEED)
@@ -630,6 +637,7 @@ def test_act_after_bounces_a_body_that_starts_on_the_plane_striking_it():
 TIPPED_TOL = 1.0  # [deg] lying on a side: its face flat on the floor up to the settling's rounding
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["backup", "act_after"])
 def test_a_tall_box_landing_while_sliding_fast_tips_over(method):
     """A 0.1 x 0.1 x 1 m box landing flat at 5 m/s sideways with mu = 0.5: friction moves the centre of pressure
@@ -648,6 +656,7 @@ def test_a_tall_box_landing_while_sliding_fast_tips_over(method):
     assert trajectory.position_world[-1, 0, 2] == pytest.approx(0.05, abs=settled)
 
 
+@pytest.mark.slow
 def test_hitting_the_event_cap_is_said_in_the_detail():
     """A ball with k = 0.99 and a rest speed of 1e-12 m/s bounces ever faster toward its accumulation time; the
     bounces left when a step holds more than the cap of events are cut short by putting the ball at rest, and

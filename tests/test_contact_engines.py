@@ -15,13 +15,13 @@ import pybullet
 import pytest
 from scipy.integrate import solve_ivp
 
-from simparity.core.scene import Contact, DynamicsScene, Forces, Material, Plane, PointMasses, RigidBody, Shape
-from simparity.references import contact_params
-from simparity.references.conventions import quat_wxyz_to_matrix, wxyz_from_xyzw
-from simparity.references.mjcf import dynamics_mjcf
-from simparity.references.mujoco_adapter import MujocoEngine
-from simparity.references.pinocchio_adapter import NO_CONTACT, PinocchioEngine
-from simparity.references.pybullet_adapter import PybulletEngine
+from simparity.core.model.scene import Contact, DynamicsScene, Forces, Material, Plane, PointMasses, RigidBody, Shape
+from simparity.references.common import contact_params
+from simparity.references.common.conventions import quat_wxyz_to_matrix, wxyz_from_xyzw
+from simparity.references.mujoco.mjcf import dynamics_mjcf
+from simparity.references.mujoco.adapter import MujocoEngine
+from simparity.references.pinocchio.adapter import NO_CONTACT, PinocchioEngine
+from simparity.references.pybullet.adapter import PybulletEngine
 from tests.helpers import builtin
 
 G = 9.81  # [m/s^2]

@@ -6,9 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from simparity.comparisons.contact_metrics import contact_metrics, impacts
-from simparity.core.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
-from simparity.core.trajectory import Trajectory
+from simparity.comparisons.measure.contact_metrics import contact_metrics, impacts
+from simparity.core.model.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
+from simparity.core.model.trajectory import Trajectory
 
 G = 9.81
 H = 1.0  # [m] drop height of the lowest point
@@ -178,7 +178,7 @@ def test_a_sustained_gain_is_a_blow_up_and_a_single_one_a_number():
     """After a nearly plastic first impact, three successive rebounds 20 % faster than their impacts (apexes
     1.44 x higher each): each gain is small beside the first drop's energy, but together they are a contact that
     pumps energy in: diverged, with the count; one such rebound stays a number (energy_kept_max 1.44)."""
-    from simparity.comparisons.contact_metrics import contact_blow_up, read_contact
+    from simparity.comparisons.measure.contact_metrics import contact_blow_up, read_contact
 
     times = np.arange(0, 6.0, 0.001)
     pumping = _trajectory(times, *_gaining_bounces(times, [0.3, 1.2, 1.2, 1.2]))
@@ -229,7 +229,7 @@ def test_a_resting_body_jitters_without_diverging():
     """A box resting on the floor that jitters 0.1 mm up and down at 5 cm/s: its energy rises across each
     touch by a few 1e-4 of m |g| size, not of its own (tiny) kinetic energy: not a blow-up; the jitter is its
     own metric (0.2 mm peak to peak)."""
-    from simparity.comparisons.contact_metrics import contact_blow_up, read_contact
+    from simparity.comparisons.measure.contact_metrics import contact_blow_up, read_contact
 
     times = np.arange(0, 2.0, 0.001)
     half = np.array([0.1, 0.1, 0.05])
@@ -246,7 +246,7 @@ def test_a_resting_body_jitters_without_diverging():
 def test_contact_verdicts_do_not_depend_on_where_the_origin_is():
     """The same bounce with the floor and the ball 1 km higher: the same statuses and values (up to rounding of
     positions of 1 km) and the same verdict on divergence."""
-    from simparity.comparisons.divergence import blow_up
+    from simparity.comparisons.measure.divergence import blow_up
 
     times = np.arange(0, 1.2, 0.005)
     height, velocity = _bounce_heights(times, 0.6)

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from simparity.references import conventions as c
+from simparity.references.common import conventions as c
 
 EXACT_TOL = 1e-15  # a few float64 operations on values of size 1
 

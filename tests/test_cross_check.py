@@ -5,8 +5,8 @@ import math
 
 import pandas as pd
 
-from simparity.comparisons.cross_check import CROSS_CHECK_FACTOR, SOLVE_RATE_FRACTION, cross_check
-from simparity.core.results import COLUMNS, ResultRow
+from simparity.comparisons.gate.cross_check import CROSS_CHECK_FACTOR, SOLVE_RATE_FRACTION, cross_check
+from simparity.core.model.results import COLUMNS, ResultRow
 
 BUILTIN = ("core", "mujoco")
 

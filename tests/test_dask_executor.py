@@ -10,15 +10,15 @@ import time
 import pandas as pd
 import pytest
 
-from simparity.comparisons.cli import main
-from simparity.comparisons import dask_executor
-from simparity.comparisons.dask_executor import DaskExecutor
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.execution import run_scenes
-from simparity.comparisons import library
-from simparity.comparisons.isolation import CaseLimits, IsolatedPool
-from simparity.core.errors import SimparityError
-from simparity.core.results import RESULTS_FILE
+from simparity.comparisons.cli.main import main
+from simparity.comparisons.execute import dask_executor
+from simparity.comparisons.execute.dask_executor import DaskExecutor
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.execute.execution import run_scenes
+from simparity.comparisons.scenes import library
+from simparity.comparisons.execute.isolation import CaseLimits, IsolatedPool
+from simparity.core.model.errors import SimparityError
+from simparity.core.model.results import RESULTS_FILE
 from tests.helpers import THROWN_BALL, InProcess, built_engines, comparable, no_leftovers_within, smoke_scenes
 
 WORKERS = 2
@@ -31,6 +31,7 @@ def dask():
     executor.close()
 
 
+@pytest.mark.slow
 def test_a_local_dask_cluster_gives_the_results_of_this_process(dask):
     scenes = smoke_scenes()
     expected = list(run_scenes(scenes, built_engines(), make_engine, 0, InProcess()))
@@ -41,6 +42,7 @@ def test_a_local_dask_cluster_gives_the_results_of_this_process(dask):
     assert all(address.startswith("tcp://127.0.0.1:") for address in dask.client.scheduler_info()["workers"])
 
 
+@pytest.mark.slow
 def test_a_crash_on_a_dask_worker_fails_its_case_alone(dask):
     scenes = smoke_scenes(("lecture-projectile",))
     engines = built_engines(("core",)) + [make_engine("tests.hostile_engines:SegfaultingEngine")]
@@ -52,6 +54,7 @@ def test_a_crash_on_a_dask_worker_fails_its_case_alone(dask):
     assert failed and all("SIGSEGV" in r.detail for r in failed)  # n/a: integrators it refuses before running
 
 
+@pytest.mark.slow
 def test_the_cli_runs_on_dask_and_writes_the_local_executor_results(tmp_path):
     scene = tmp_path / "throw.toml"
     scene.write_text(THROWN_BALL, encoding="utf-8")
@@ -95,7 +98,7 @@ class _NotDask(socketserver.BaseRequestHandler):
             time.sleep(UNREACHABLE_SECONDS)  # a web server waiting for the rest of a request
 
 
-@pytest.mark.parametrize("banner", [b"SSH-2.0-OpenSSH_9.6 not dask\r\n" * 4, b""])
+@pytest.mark.parametrize("banner", [b"SSH-2.0-OpenSSH_9.6 not dask\r\n" * 4, pytest.param(b"", marks=pytest.mark.slow)])
 def test_a_service_that_is_not_dask_at_the_scheduler_address_is_a_one_line_error(tmp_path, capsys, monkeypatch,
                                                                                    banner):
     """Dask's own client raised a MemoryError from the banner's bytes read as a frame length, and waited for ever
@@ -115,6 +118,7 @@ def test_a_service_that_is_not_dask_at_the_scheduler_address_is_a_one_line_error
     assert not out.exists()
 
 
+@pytest.mark.slow
 def test_a_running_scheduler_is_reached_and_a_worker_address_is_refused(dask):
     """A real cluster's scheduler, named by its address, takes the run (and its memory limits are its nodes')."""
     scheduler = DaskExecutor(dask.client.scheduler.address, WORKERS, CaseLimits(60.0, None))
@@ -139,6 +143,7 @@ SWEEP = THROWN_BALL + """
 """
 
 
+@pytest.mark.slow
 def test_a_sweep_of_100_variants_on_two_dask_workers_gives_the_local_results(tmp_path, dask):
     """Issue #12's done-when: 100 scene variants on a local Dask cluster of 2 workers give, bit for bit, the
     results of the local executor's 2 worker processes."""
@@ -158,6 +163,7 @@ STREAM_LIMIT_SECONDS = 6.0
 """The per-case time limit of the streaming test: the hanging case fails this long after it starts."""
 
 
+@pytest.mark.slow
 def test_cases_stream_back_one_by_one_while_their_group_still_runs(tmp_path, dask):
     """A finished case comes back (and is journaled) while a later case of its group still runs: core's case
     arrives a good part of the time limit before the hanging engine's case of the same group fails (sent
@@ -178,6 +184,7 @@ def test_cases_stream_back_one_by_one_while_their_group_still_runs(tmp_path, das
     assert arrivals["hanging"] - arrivals["core"] > STREAM_LIMIT_SECONDS / 2
 
 
+@pytest.mark.slow
 def test_a_group_lost_for_good_fails_only_the_cases_that_never_came_back(tmp_path):
     """A lost node (here: a case kills its Dask worker, and the cluster allows no retry) fails the cases of its
     group that were not back yet, with the cause; the cases already back keep their results."""
@@ -199,6 +206,7 @@ def test_a_group_lost_for_good_fails_only_the_cases_that_never_came_back(tmp_pat
     assert lost and all(r.status == "failed" and "the Dask task was lost: KilledWorker" in r.detail for r in lost)
 
 
+@pytest.mark.slow
 def test_what_an_engine_starts_and_leaves_running_ends_with_its_cases_on_dask(tmp_path, dask):
     """A Dask worker keeps its pool between tasks, so nothing closes it after a run: the processes an engine
     started and left running are killed when its cases end (held-out test: they were orphaned)."""

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from simparity.core.dh import CONVENTIONS, UR5_DH, chain_from_dh, dh_forward
-from simparity.core.errors import SceneError
+from simparity.core.model.errors import SceneError
 from simparity.core.kinematics import joint_frames
 
 # The chain and the direct product multiply the same elementary matrices grouped

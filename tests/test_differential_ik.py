@@ -5,12 +5,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from simparity.comparisons.ik_targets import random_targets
-from simparity.core.ik.problem import IKTolerances
-from simparity.core.ik.result import LIMIT_TOLERANCE
+from simparity.comparisons.execute.ik_targets import random_targets
+from simparity.core.model.ik_problem import IKTolerances
+from simparity.core.model.ik_result import LIMIT_TOLERANCE
 from simparity.references.differential_ik import QP_SOLVER, MinkIK, PinkIK, available
-from simparity.references.mujoco_adapter import MujocoChain
-from simparity.references.pinocchio_adapter import PinocchioChain
+from simparity.references.mujoco.adapter import MujocoChain
+from simparity.references.pinocchio.adapter import PinocchioChain
 from tests.helpers import builtin
 
 pytestmark = pytest.mark.skipif(bool(available("mink") or available("pink")),

@@ -4,12 +4,12 @@ import math
 
 import numpy as np
 
-from simparity.comparisons.divergence import AT_REST, DIVERGENCE_MARGIN, divergence
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.runner import run_scene
-from simparity.core.results import DIVERGED, OK
-from simparity.core.scene import AppliedForce, DynamicsScene, Forces, RigidBody
-from simparity.core.trajectory import Trajectory
+from simparity.comparisons.measure.divergence import AT_REST, DIVERGENCE_MARGIN, divergence
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.core.model.results import DIVERGED, OK
+from simparity.core.model.scene import AppliedForce, DynamicsScene, Forces, RigidBody
+from simparity.core.model.trajectory import Trajectory
 
 
 def _body(velocity=(0.0, 0.0, 0.0), omega=(0.0, 0.0, 0.0), inertia=(1.0, 2.0, 3.0), mass=2.0, position=(0, 0, 0)):

@@ -9,8 +9,8 @@ spin along a principal axis (no gyroscopic term), omega1 = omega0 + dt tau / I_z
 import numpy as np
 import pytest
 
-from simparity.comparisons.engines import make_engine
-from simparity.core.scene import AppliedForce, DynamicsScene, Forces, RigidBody
+from simparity.comparisons.engines.registry import make_engine
+from simparity.core.model.scene import AppliedForce, DynamicsScene, Forces, RigidBody
 from tests.helpers import HAND_WRENCH, hand_wrench_forces
 
 ENGINES = [("mujoco", "euler"), ("pybullet", "euler"), ("pinocchio", "euler"), ("core", "engine_euler")]

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from simparity.comparisons.engines import make_engine
+from simparity.comparisons.engines.registry import make_engine
 from simparity.core.ik.jacobian_solvers import IKOptions
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.kinematics import forward_kinematics

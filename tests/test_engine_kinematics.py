@@ -7,7 +7,7 @@ own importer (core reads it with its own URDF reader).
 import numpy as np
 import pytest
 
-from simparity.comparisons.engines import make_engine
+from simparity.comparisons.engines.registry import make_engine
 from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.rotations import geodesic_angle_matrix
 from tests.helpers import builtin, random_chain, unlimited

@@ -8,11 +8,11 @@ import time
 import pandas as pd
 import pytest
 
-from simparity.comparisons import engine_probe
-from simparity.comparisons.cli import main
-from simparity.comparisons.engine_probe import PROBE_CHAIN, DescribedEngine, probe_engines
-from simparity.comparisons.placeholder_engines import BrokenEngine
-from simparity.core.engine import Engine, Support
+from simparity.comparisons.engines import probe as engine_probe
+from simparity.comparisons.cli.main import main
+from simparity.comparisons.engines.probe import PROBE_CHAIN, DescribedEngine, probe_engines
+from simparity.comparisons.engines.placeholders import BrokenEngine
+from simparity.core.model.engine import Engine, Support
 from simparity.core.inhouse import InHouseEngine
 from tests.helpers import THROWN_BALL, builtin
 
@@ -43,6 +43,7 @@ def test_a_probe_describes_an_engine_as_it_describes_itself():
     assert described.supports_kinematics(PROBE_CHAIN).ok
 
 
+@pytest.mark.slow
 def test_a_crash_or_an_exit_while_building_or_describing_is_a_broken_engine():
     found = probe_engines(["tests.hostile_engines:SegfaultOnConstruction", "tests.hostile_engines:ExitInVersion",
                            "no_such_module_here:Engine"])
@@ -55,12 +56,14 @@ def test_a_crash_or_an_exit_while_building_or_describing_is_a_broken_engine():
     assert isinstance(missing, BrokenEngine) and "does not import here: ModuleNotFoundError" in missing.reason
 
 
+@pytest.mark.slow
 def test_a_hang_while_describing_is_a_broken_engine_within_the_limit(monkeypatch):
     monkeypatch.setattr(engine_probe, "PROBE_SECONDS", SHORT_PROBE_SECONDS)
     hung = probe_engines(["tests.hostile_engines:HangInIntegrators"])["tests.hostile_engines:HangInIntegrators"]
     assert isinstance(hung, BrokenEngine) and f"took more than {SHORT_PROBE_SECONDS:g} s" in hung.reason
 
 
+@pytest.mark.slow
 def test_a_run_goes_on_when_an_engine_crashes_as_it_is_built(tmp_path, monkeypatch):
     """Before, the segfault in the constructor killed `simparity run` itself; now its cases fail, core's complete."""
     scene = tmp_path / "throw.toml"
@@ -77,6 +80,7 @@ def test_a_run_goes_on_when_an_engine_crashes_as_it_is_built(tmp_path, monkeypat
     assert len(core) >= 2 and set(core.status) == {"ok"}
 
 
+@pytest.mark.slow
 def test_an_engine_that_hung_while_described_is_not_built_again_by_the_cases(tmp_path, monkeypatch):
     """Its cases fail at once with the probe's cause, instead of each hanging to the 900 s case limit."""
     monkeypatch.setattr(engine_probe, "PROBE_SECONDS", SHORT_PROBE_SECONDS)
@@ -122,6 +126,7 @@ class OwnIntegrators(Engine):
         return 4
 
 
+@pytest.mark.slow
 def test_a_scene_file_and_the_quick_profile_may_name_a_spec_engines_own_integrators(tmp_path):
     """Before, `own_rk4` was refused as no engine's integrator: only built-ins' and installed plugins' names were
     known when the scene file was checked."""

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import pytest
 
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.execution import count_cases, estimated_cost, run_scenes
-from simparity.comparisons.isolation import CaseLimits, IsolatedPool
-from simparity.comparisons.journal import Journal
-from simparity.core.results import STATUSES, case_counts
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.execute.execution import count_cases, estimated_cost, run_scenes
+from simparity.comparisons.execute.isolation import CaseLimits, IsolatedPool
+from simparity.comparisons.execute.journal import Journal
+from simparity.core.model.results import STATUSES, case_counts
 from tests.helpers import InProcess, built_engines, comparable, smoke_scenes
 
 @pytest.fixture(scope="module")
@@ -18,6 +18,7 @@ def in_process():
     return scenes, list(run_scenes(scenes, built_engines(), make_engine, 0, InProcess()))
 
 
+@pytest.mark.slow
 def test_worker_processes_give_bit_identical_results_whatever_their_number(in_process):
     """Determinism: one worker, two workers and this process agree on every non-timing value."""
     scenes, expected = in_process
@@ -40,6 +41,7 @@ def test_every_case_is_heard_once_and_the_costliest_group_goes_first():
     assert costs == sorted(costs, reverse=True) and executor.jobs[0].group.scene.name == "lecture-projectile"
 
 
+@pytest.mark.slow
 def test_an_interrupted_run_resumes_without_recomputing_what_finished(tmp_path, in_process):
     scenes, expected = in_process
     total = sum(count_cases(scenes, built_engines(), make_engine))
@@ -57,6 +59,7 @@ def test_an_interrupted_run_resumes_without_recomputing_what_finished(tmp_path, 
     assert comparable(resumed) == comparable(expected)
 
 
+@pytest.mark.slow
 def test_a_changed_scene_or_engine_version_is_computed_again(tmp_path, monkeypatch):
     scenes = smoke_scenes(("lecture-projectile",))
     list(run_scenes(scenes, built_engines(("core",)), make_engine, 0, InProcess(), Journal(tmp_path)))

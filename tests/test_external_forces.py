@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from simparity.references import external_forces
-from simparity.references.conventions import quat_wxyz_to_matrix
+from simparity.references.common import external_forces
+from simparity.references.common.conventions import quat_wxyz_to_matrix
 from tests.helpers import HAND_WRENCH, hand_wrench_forces
 
 HAND_TOL = 1e-14  # the hand values are written to 15 digits

@@ -7,6 +7,7 @@ import sys
 import time
 
 import pandas as pd
+import pytest
 
 from simparity.reports import figures
 
@@ -82,6 +83,7 @@ def _alive(pid: int) -> bool:
         return False
 
 
+@pytest.mark.slow
 def test_the_figure_processes_of_a_killed_report_do_not_outlive_it(tmp_path):
     """SIGKILL while figures are written (a CI job cancelled): the pool's processes end with their parent."""
     done = subprocess.run([sys.executable, "-c", KILLED_WRITER, str(tmp_path)], capture_output=True, text=True,

@@ -1,13 +1,14 @@
 """Run history in SQLite: runs side by side, the latest for a baseline, never breaking on a bad database."""
 
+import dataclasses
 import math
 import multiprocessing
 
 import pandas as pd
 import pytest
 
-from simparity.core.errors import HistoryError
-from simparity.comparisons.history import (
+from simparity.core.model.errors import HistoryError
+from simparity.comparisons.gate.history import (
     HISTORY_ENV,
     history_path,
     latest_before,
@@ -16,10 +17,11 @@ from simparity.comparisons.history import (
     run_table,
     runs,
 )
-from simparity.core.results import COLUMNS, SWEEP_COLUMN, ResultRow, sweep_column
+from simparity.core.model.run_info import RunInfo
+from simparity.core.model.results import COLUMNS, SWEEP_COLUMN, ResultRow, sweep_column
 
-INFO = {"created_utc": "2026-11-22T10:00:00+00:00", "git_commit": "abc", "command": "simparity run",
-        "machine": {"cpu_count": 2}, "engine_versions": {"core": "1"}}
+INFO = RunInfo(created_utc="2026-11-22T10:00:00+00:00", git_commit="abc", command="simparity run",
+               machine={"cpu_count": 2}, engine_versions={"core": "1"})
 
 
 def _table(value):
@@ -31,7 +33,7 @@ def _table(value):
 def test_two_runs_side_by_side_and_the_latest_for_a_baseline(tmp_path):
     db = tmp_path / "h.sqlite"
     first = record_run(db, tmp_path / "r1", INFO, _table(1e-6))
-    second = record_run(db, tmp_path / "r2", INFO | {"created_utc": "2026-11-22T11:00:00+00:00"}, _table(2e-6))
+    second = record_run(db, tmp_path / "r2", dataclasses.replace(INFO, created_utc="2026-11-22T11:00:00+00:00"), _table(2e-6))
     shown = metric_history(db, scene="s", metric="position_error_max")
     assert list(shown.columns[-2:]) == [f"#{first} 2026-11-22T10:00:00+00:00", f"#{second} 2026-11-22T11:00:00+00:00"]
     assert list(shown.iloc[0, -2:]) == ["1e-06", "2e-06"]
@@ -62,6 +64,7 @@ def _writer(db, name, count):
         record_run(db, f"{name}{i}", INFO, _table(float(i)))
 
 
+@pytest.mark.slow
 def test_two_processes_writing_at_once_lose_nothing(tmp_path):
     db = tmp_path / "h.sqlite"
     context = multiprocessing.get_context("spawn")

@@ -10,7 +10,7 @@ import time
 
 import pytest
 
-from simparity.comparisons.cli import EXIT_USAGE, main
+from simparity.comparisons.cli.main import EXIT_USAGE, main
 from tests.test_scene_loader import VALID_DYNAMICS, VALID_KINEMATICS
 
 FAST_SECONDS = 20.0
@@ -113,7 +113,9 @@ def _refused(capsys, argv):
     return err
 
 
-@pytest.mark.parametrize("text", [t for _, t in SCENES], ids=[n for n, _ in SCENES])
+@pytest.mark.parametrize("text", [pytest.param(t, marks=pytest.mark.slow)
+                                  if n in ("20,000 bodies", "sweep of a million values") else t for n, t in SCENES],
+                         ids=[n for n, _ in SCENES])
 def test_hostile_scene_is_refused_on_one_line(tmp_path, capsys, text):
     path = tmp_path / "scene.toml"
     path.write_text(text, encoding="utf-8")
@@ -211,9 +213,9 @@ FUZZ_VALUES = [[], [1.0], [0.5, 2.0], [1.0, 1.0], ["a"], [True], [[1.0]], [{}], 
 def test_fuzzed_sweep_tables_load_or_are_refused_on_one_line():
     """Seeded random [sweep] tables over valid and broken keys and values: each loads, or raises SceneError with
     one line that says what is allowed; nothing else escapes (no traceback in the CLI)."""
-    from simparity.comparisons.scene_loader import parse_scenes
-    from simparity.core.errors import SceneError
-    from simparity.core.files import tomllib
+    from simparity.comparisons.scenes.loader import parse_scenes
+    from simparity.core.model.errors import SceneError
+    from simparity.core.model.files import tomllib
 
     rng = random.Random(12)
     base = tomllib.loads(VALID_DYNAMICS)

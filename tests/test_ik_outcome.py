@@ -1,11 +1,11 @@
-"""The engines' IK verdict (references/ik_outcome.py): hand-made residuals and joint values."""
+"""The engines' IK verdict (references/common/ik_outcome.py): hand-made residuals and joint values."""
 
 import numpy as np
 
-from simparity.core.ik.problem import IKTolerances
-from simparity.core.ik.result import LIMIT_TOLERANCE
-from simparity.core.scene import Chain, Joint
-from simparity.references.ik_outcome import ik_outcome
+from simparity.core.model.ik_problem import IKTolerances
+from simparity.core.model.ik_result import LIMIT_TOLERANCE
+from simparity.core.model.scene import Chain, Joint
+from simparity.references.common.ik_outcome import ik_outcome
 
 # A planar 2-link arm, links 1.0 m and 0.8 m: reach 1.8 m from the first joint.
 ELBOW_LOWER, ELBOW_UPPER = 0.2, 2.0

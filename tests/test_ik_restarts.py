@@ -7,12 +7,12 @@ import dataclasses
 import numpy as np
 import pytest
 
-from simparity.comparisons.ik_targets import random_targets
+from simparity.comparisons.execute.ik_targets import random_targets
 from simparity.core.ik.jacobian_solvers import IKOptions, solve_ik
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.ik.restarts import RESTART_STREAM, Restarts, solve_ik_with_restarts
 from simparity.core.inhouse import InHouseEngine
-from simparity.core.scene import sample_configurations
+from simparity.core.model.scene import sample_configurations
 from tests.helpers import builtin
 
 N_TARGETS = 300
@@ -30,6 +30,7 @@ def panda():
     return scene, targets.position_world[n], targets.rotation_world[n], options
 
 
+@pytest.mark.slow
 def test_restarts_solve_what_one_start_does_not_inside_the_limits(panda):
     scene, p, r, options = panda
     plain = solve_ik(scene.chain, p, r, scene.q_start, "damped_least_squares", options)
@@ -42,6 +43,7 @@ def test_restarts_solve_what_one_start_does_not_inside_the_limits(panda):
     assert np.all(restarted.position_residual[restarted.success] <= options.position_tolerance)
 
 
+@pytest.mark.slow
 def test_restarts_are_deterministic_and_zero_attempts_is_the_plain_solver(panda):
     scene, p, r, options = panda
     a = solve_ik_with_restarts(scene.chain, p, r, scene.q_start, "damped_least_squares", options)
@@ -84,6 +86,7 @@ def test_the_in_house_engine_offers_the_restarted_solver_with_what_it_does_in_it
             Restarts(**bad)
 
 
+@pytest.mark.slow
 def test_a_target_beyond_the_real_reach_is_named_unreachable_not_capped():
     """Held-out finding: beyond the arm's real reach but inside the triangle-inequality bound, short capped
     attempts ended "iteration_cap"; judged at the best configuration they are "unreachable" like the plain

@@ -6,14 +6,14 @@ import math
 import numpy as np
 import pytest
 
-from simparity.comparisons.engines import DEFAULT_ENGINES, make_engine
-from simparity.comparisons.ik_runner import IK_METRICS
-from simparity.comparisons.runner import run_scene
-from simparity.comparisons.ik_targets import random_targets
-from simparity.comparisons.profiles import quick
+from simparity.comparisons.engines.registry import DEFAULT_ENGINES, make_engine
+from simparity.comparisons.execute.ik_runner import IK_METRICS
+from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.execute.ik_targets import random_targets
+from simparity.comparisons.scenes.profiles import quick
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.ik.jacobian_solvers import IKOptions
-from simparity.core.results import FAILED, NOT_AVAILABLE, OK
+from simparity.core.model.results import FAILED, NOT_AVAILABLE, OK
 from tests.helpers import builtin
 
 # Issue #4: core's best solver solves >= 99.5 % of 1000 seeded iiwa pose targets.
@@ -27,6 +27,7 @@ def iiwa_rows():
     return run_scene(scene, [make_engine(name) for name in DEFAULT_ENGINES], make_engine, repeats=1)
 
 
+@pytest.mark.slow
 def test_every_engine_and_solver_has_every_metric(iiwa_rows):
     """Each engine x solver has all IK metrics (ok, or n/a with a reason) and a row per hard target."""
     cases = {}
@@ -42,6 +43,7 @@ def test_every_engine_and_solver_has_every_metric(iiwa_rows):
         assert all(r.detail for r in rows if r.status == NOT_AVAILABLE)
 
 
+@pytest.mark.slow
 def test_unreachable_targets_are_reported_failures_with_finite_residuals(iiwa_rows):
     """Beyond reach: every solver reports a failure (reason given) with a finite residual, never NaN."""
     far = [r for r in iiwa_rows if r.metric == "hard_beyond_reach" and r.status == OK]
@@ -51,6 +53,7 @@ def test_unreachable_targets_are_reported_failures_with_finite_residuals(iiwa_ro
         assert r.detail.startswith("failed: unreachable"), (r.engine, r.integrator, r.detail)
 
 
+@pytest.mark.slow
 def test_cross_evaluation_agrees_across_engines(iiwa_rows):
     """Every engine's FK puts each solution's end effector within float32 precision of the others'."""
     spread = [r.value for r in iiwa_rows if r.metric == "cross_eval_disagreement_max" and r.status == OK]
@@ -70,6 +73,7 @@ def test_core_solves_the_iiwa_criterion():
     assert np.all(np.isfinite(result.position_residual)) and np.all(np.isfinite(result.q))
 
 
+@pytest.mark.slow
 def test_analytic_two_link_beside_the_iterative_solvers():
     """On the lecture's 2-link arm the analytic solver solves every reachable target; others are measured. The
     Jacobian inverse works on the arm's plane (its 2 joints move the tip in 2 directions: a square system there)."""
@@ -99,6 +103,7 @@ def test_a_failing_solver_still_reports_every_hard_target():
     assert {r.status for r in dls} == {FAILED} and all("no solver today" in r.detail for r in dls)
 
 
+@pytest.mark.slow
 def test_float32_judge_does_not_fail_double_precision_solutions():
     """A solution within tolerance in double is granted by every judge, PyBullet's float32 FK included."""
     scene = dataclasses.replace(builtin("lecture-2link-ik"), n_targets=40)
@@ -111,7 +116,7 @@ def test_float32_judge_does_not_fail_double_precision_solutions():
 
 def test_unavailable_engine_says_why_in_ik_scenes():
     """An engine whose library fails to import gets n/a IK rows naming the import error."""
-    from simparity.comparisons.engines import UnavailableEngine
+    from simparity.comparisons.engines.registry import UnavailableEngine
 
     scene = dataclasses.replace(builtin("lecture-2link-ik"), n_targets=5)
     rows = run_scene(scene, [UnavailableEngine("mujoco", "No module named 'mujoco'")], make_engine, repeats=1)
@@ -128,7 +133,7 @@ def test_an_engine_without_ik_solvers_says_so_in_ik_scenes():
 def test_singular_start_pose_is_reported():
     """The planar 2-link arm stretched straight (q = 0) loses a direction of motion there: the start pose is
     reported singular (rank deficiency 1); bent (q2 = 1 rad) it is regular."""
-    from simparity.comparisons.ik_runner import start_rank_deficiency
+    from simparity.comparisons.execute.ik_runner import start_rank_deficiency
 
     scene = builtin("lecture-2link-ik")
     model = make_engine("pinocchio").build_kinematics(scene.chain)
@@ -177,6 +182,7 @@ def _quick_rows(name, engines):
     return run_scene(quick(builtin(name)), engines, make_engine, repeats=1)
 
 
+@pytest.mark.slow
 def test_a_claim_no_fk_confirms_is_counted():
     """A solver that claims every target solved while the transpose method stalls: its unconfirmed claims are
     counted (the harness's residual check by every engine's FK refuses them); core's own claims are confirmed."""
@@ -185,6 +191,7 @@ def test_a_claim_no_fk_confirms_is_counted():
     assert claims[("core", "transpose")] == 0.0 and claims[("boasting", "transpose")] > 0.5
 
 
+@pytest.mark.slow
 def test_a_wrong_fk_is_blamed_on_its_engine_alone():
     """An engine whose FK is 1 mm off: its own rows show the departure; core's solve rates are judged by the FKs
     that agree with the reference, so they do not drop."""
@@ -197,6 +204,7 @@ def test_a_wrong_fk_is_blamed_on_its_engine_alone():
         ("damped_least_squares", "cross_eval_solve_rate_min")]
 
 
+@pytest.mark.slow
 def test_the_jacobian_inverse_where_it_applies_and_n_a_where_it_does_not():
     """The lecture's 3-link planar arm moves in 3 of a pose's 6 directions (x, y, the turn about z): J^-1 solves
     its planar pose targets; with 3-D position targets its 3 x 3 Jacobian has a zero row: n/a with the reason,

@@ -11,12 +11,12 @@ import pytest
 from simparity.core.dh import UR5_DH, chain_from_dh
 from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik
 from simparity.core.ik.reach import reach_upper_bound
-from simparity.core.ik.result import REASONS, IKResult
+from simparity.core.model.ik_result import REASONS, IKResult
 from simparity.core.ik import steps
 from simparity.core.ik.limits import cross_gap, crossable_gap, wrap_into_limits
 from simparity.core.kinematics import joint_frames
 from simparity.core.rotations import so3_exp
-from simparity.core.scene import Chain, Joint
+from simparity.core.model.scene import Chain, Joint
 from simparity.core.urdf import chain_from_urdf
 
 IIWA = chain_from_urdf(os.path.join(pybullet_data.getDataPath(), "kuka_iiwa/model.urdf"))

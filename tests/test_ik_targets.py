@@ -4,8 +4,8 @@ import dataclasses
 
 import numpy as np
 
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.ik_targets import ORIENTATION_ONLY, hard_target, random_targets
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.execute.ik_targets import ORIENTATION_ONLY, hard_target, random_targets
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.kinematics import forward_kinematics
 from simparity.core.rotations import geodesic_angle_matrix

@@ -10,9 +10,9 @@ import dataclasses
 import numpy as np
 import pytest
 
-from simparity.comparisons.engines import make_engine
-from simparity.core import forces as core_forces
-from simparity.core.scene import Forces
+from simparity.comparisons.engines.registry import make_engine
+from simparity.core.dynamics import forces as core_forces
+from simparity.core.model.scene import Forces
 from tests.helpers import builtin
 
 REFERENCES = [("mujoco", "euler"), ("mujoco", "rk4"), ("pybullet", "euler"), ("pinocchio", "euler"),

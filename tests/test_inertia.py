@@ -9,8 +9,8 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from simparity.core.errors import SceneError
-from simparity.core.inertia import (
+from simparity.core.model.errors import SceneError
+from simparity.core.dynamics.inertia import (
     inertia_from_point_masses,
     inertia_problem,
     inertia_solid_box,
@@ -20,7 +20,7 @@ from simparity.core.inertia import (
     mass_and_center_of_mass,
 )
 from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix
-from simparity.references.conventions import fmt
+from simparity.references.common.conventions import fmt
 
 # Sums of a few dozen float64 products of O(1) numbers: rounding is ~1e-15 relative to
 # the largest entry; 1e-13 leaves margin without hiding any modelling difference.

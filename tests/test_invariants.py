@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from simparity.comparisons.invariants import angular_momentum_world, kinetic_energy, potential_energy
+from simparity.comparisons.measure.invariants import angular_momentum_world, kinetic_energy, potential_energy
 from simparity.core.rotations import so3_exp
 
 EXACT_TOL = 1e-14

@@ -8,13 +8,13 @@ import sysconfig
 import pandas as pd
 import pytest
 
-from simparity.comparisons.cli import main
-from simparity.comparisons import library
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.execution import run_scenes
-from simparity.comparisons.isolation import (BLAS_THREAD_VARIABLES, CaseLimits, IsolatedPool, death_cause,
+from simparity.comparisons.cli.main import main
+from simparity.comparisons.scenes import library
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.execute.execution import run_scenes
+from simparity.comparisons.execute.isolation import (BLAS_THREAD_VARIABLES, CaseLimits, IsolatedPool, death_cause,
                                             worker_environment)
-from simparity.comparisons.library import builtin_paths
+from simparity.comparisons.scenes.library import builtin_paths
 from tests.helpers import THROWN_BALL, no_leftovers_within
 
 HANGING = ("tests.hostile_engines:HangingEngine", "hung: no result within the per-case time limit of 5 s")
@@ -58,11 +58,13 @@ def _run(tmp_path, hostile: dict, seconds: float) -> pd.DataFrame:
     return table
 
 
+@pytest.mark.slow
 def test_a_segfault_and_a_memory_blow_up_each_fail_alone(tmp_path, capsys):
     _run(tmp_path, CRASHING, CRASH_SECONDS)
     assert "4 cases did not finish (crashed, hung or out of memory)" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_a_hang_fails_alone(tmp_path):
     _run(tmp_path, {"hanging": HANGING}, HANG_SECONDS)
 
@@ -76,6 +78,7 @@ def _core_values(tmp_path, engines: str, name: str) -> pd.DataFrame:
     return rows[["integrator", "dt", "metric", "status", "value"]].reset_index(drop=True)
 
 
+@pytest.mark.slow
 def test_an_engine_that_changes_its_process_cannot_change_another_engines_results(tmp_path):
     """The rounding engine switches the FPU to round upward before its cases; core's cases and the reference,
     run after it by the same single worker, are bit-identical to a run without it: each engine's cases run in
@@ -86,6 +89,7 @@ def test_an_engine_that_changes_its_process_cannot_change_another_engines_result
     pd.testing.assert_frame_equal(alone, beside, check_exact=True)
 
 
+@pytest.mark.slow
 def test_an_engine_that_ends_its_process_quietly_fails_its_case(tmp_path):
     """os._exit(0) in the middle of a case: failed rows saying so; core, after it in the same worker, completes."""
     table = _first_then_core(tmp_path, "tests.hostile_engines:ExitingEngine")
@@ -125,6 +129,7 @@ def _first_then_core(tmp_path, spec: str) -> pd.DataFrame:
     return pd.read_csv(tmp_path / "run" / "results.csv")
 
 
+@pytest.mark.slow
 def test_a_trajectory_that_cannot_be_measured_fails_with_the_error_not_as_a_crash(tmp_path):
     table = _first_then_core(tmp_path, "tests.hostile_engines:MalformedEngine")
     rows = table[(table.engine == "malformed") & table.dt.notna()]
@@ -133,6 +138,7 @@ def test_a_trajectory_that_cannot_be_measured_fails_with_the_error_not_as_a_cras
                                     regex=False).all()
 
 
+@pytest.mark.slow
 def test_two_engines_or_two_scenes_of_one_name_are_refused(tmp_path, capsys):
     twins = "tests.hostile_engines:HangingEngine,tests.hostile_engines:HangingTwin"
     assert main(["run", "lecture-projectile", "--engines", twins, "--out", str(tmp_path / "a")]) == 2
@@ -162,6 +168,7 @@ def test_workers_use_one_blas_thread_whatever_the_user_set(monkeypatch):
     assert all(env[variable] == "1" for variable in BLAS_THREAD_VARIABLES)
 
 
+@pytest.mark.slow
 def test_what_an_engine_starts_and_leaves_running_ends_with_its_cases(tmp_path):
     """An engine that starts a process in every case and never stops it: the processes are killed when its
     cases end, while the pool's workers live on (as a Dask worker's pool does between tasks)."""

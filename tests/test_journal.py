@@ -14,14 +14,14 @@ import time
 import pandas as pd
 import pytest
 
-from simparity.comparisons.cases import CaseKey, CaseOutcome
-from simparity.comparisons.cli import main
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.execution import count_cases, run_scenes
-from simparity.comparisons.journal import CASES_FOLDER, Journal, run_lock
-from simparity.comparisons.profiles import apply_profile
-from simparity.core.results import RESULTS_FILE
-from simparity.comparisons import library
+from simparity.comparisons.execute.cases import CaseKey, CaseOutcome
+from simparity.comparisons.cli.main import main
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.execute.execution import count_cases, run_scenes
+from simparity.comparisons.execute.journal import CASES_FOLDER, Journal, run_lock
+from simparity.comparisons.scenes.profiles import apply_profile
+from simparity.core.model.results import RESULTS_FILE, ResultRow
+from simparity.comparisons.scenes import library
 from tests.helpers import THROWN_BALL, InProcess, builtin
 
 SCENES = ("ball-bounce-k05", "lecture-2link-ik", "ur5-kinematics")
@@ -41,6 +41,7 @@ def _table(run_dir) -> pd.DataFrame:
     return table
 
 
+@pytest.mark.slow
 def test_a_run_killed_halfway_and_resumed_writes_the_same_results(tmp_path):
     total = sum(count_cases(apply_profile([builtin(n) for n in SCENES], "quick"),
                             [make_engine(n) for n in ("core", "analytic", "mujoco", "pybullet", "pinocchio")],
@@ -82,9 +83,24 @@ def test_unfinished_and_unreadable_cases_are_computed_again(tmp_path):
     journal.save(key, CaseOutcome([]))
     assert journal.load(key) == CaseOutcome([])
     (tmp_path / CASES_FOLDER / f"{key.digest()}.pickle").write_bytes(b"truncated")
-    assert journal.load(key) is None
+    assert journal.load(key) is None and journal.unreadable == 1
     other = CaseKey("hash", "core", "1.1", "rk4", 0.01, "dynamics")
     assert other.digest() != key.digest()
+
+
+def test_a_case_kept_before_its_types_moved_is_read_by_their_names(tmp_path):
+    """A journal names its types by module path; kept by a simparity whose modules were elsewhere (before the
+    folders per job: simparity.comparisons.cases, simparity.core.results), it is still read, not computed again."""
+    journal = Journal(tmp_path)
+    key = CaseKey("hash", "core", "1.0", "rk4", 0.01, "dynamics")
+    row = ResultRow("s", "core", "rk4", 0.01, "position_error_max", 1e-6, "m", "analytic:exact", "ok")
+    kept = pickle.dumps((key, CaseOutcome([row])), protocol=2)  # protocol 2 names each type as "module\nname"
+    for new, old in ((b"simparity.comparisons.execute.cases", b"simparity.comparisons.cases"),
+                     (b"simparity.core.model.results", b"simparity.core.results")):
+        assert new in kept
+        kept = kept.replace(new, old)
+    (tmp_path / CASES_FOLDER / f"{key.digest()}.pickle").write_bytes(kept)
+    assert journal.load(key) == CaseOutcome([row]) and journal.unreadable == 0
 
 
 class _Planted:
@@ -137,6 +153,7 @@ def _interrupted(run_dir, scene_file: str) -> int:
     return planted
 
 
+@pytest.mark.slow
 def test_a_forced_new_run_reuses_nothing_a_run_left_and_a_finished_run_keeps_no_cases(tmp_path):
     scene, out = _thrown_ball(tmp_path), tmp_path / "run"
     argv = ["run", scene, "--quick", "--engines", "core", "--jobs", "1", "--out", str(out)]
@@ -157,6 +174,7 @@ def test_a_folder_being_written_by_another_run_is_refused(tmp_path, capsys):
     assert "another simparity run is writing this folder" in err and err.count("\n") == 1
 
 
+@pytest.mark.slow
 def test_a_finished_run_is_not_resumed(tmp_path, capsys):
     out = tmp_path / "run"
     assert main(["run", _thrown_ball(tmp_path), "--quick", "--engines", "core", "--jobs", "1", "--out", str(out)]) == 0

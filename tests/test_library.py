@@ -1,4 +1,4 @@
-"""The built-in library and its suites (comparisons/library.py), and the hard suite's verdicts."""
+"""The built-in library and its suites (comparisons/scenes/library.py), and the hard suite's verdicts."""
 
 import dataclasses
 import fnmatch
@@ -10,18 +10,18 @@ import pandas as pd
 import numpy as np
 import pytest
 
-from simparity.comparisons import library
-from simparity.comparisons.check import check_table
-from simparity.comparisons.describe import describe
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.profiles import quick
-from simparity.comparisons.scene_loader import EXAMPLE_ROBOT_DATA_PREFIX
-from simparity.comparisons.runner import run_scene
-from simparity.comparisons.tolerances import load_tolerances
-from simparity.core.errors import SceneError, SimparityError, UnknownSceneError
-from simparity.core.files import tomllib
-from simparity.core.results import COLUMNS, DIVERGED, OK, ResultRow
-from simparity.core.scene import DynamicsScene, IKScene, SweepPoint
+from simparity.comparisons.scenes import library
+from simparity.comparisons.gate.check import check_table
+from simparity.comparisons.scenes.describe import describe
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.scenes.profiles import quick
+from simparity.comparisons.scenes.loader import EXAMPLE_ROBOT_DATA_PREFIX
+from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.gate.tolerances import load_tolerances
+from simparity.core.model.errors import SceneError, SimparityError, UnknownSceneError
+from simparity.core.model.files import tomllib
+from simparity.core.model.results import COLUMNS, DIVERGED, OK, ResultRow
+from simparity.core.model.scene import DynamicsScene, IKScene, SweepPoint
 from tests.helpers import builtin
 
 MIN_HARD_CASES = 20
@@ -204,7 +204,7 @@ def test_every_built_in_engine_declares_the_kind_of_scheme_it_runs(engine, integ
 def test_a_plugin_that_names_its_integrators_after_their_kind_needs_no_declaration():
     """Engine.scheme's default: an integrator named as a kind is of that kind, its variant left out; on a contact
     scene penalty_<kind> is penalty+<kind>; a name that is no kind says nothing ("")."""
-    from simparity.core.engine import Engine
+    from simparity.core.model.engine import Engine
 
     default = Engine.scheme
     plugin = make_engine("core")

@@ -26,11 +26,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pytest
 
-from simparity.comparisons import library, profiles
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.execution import run_scenes
-from simparity.comparisons.isolation import CaseLimits, IsolatedPool
-from simparity.comparisons.metamorphic import (
+from simparity.comparisons.scenes import library, profiles
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.execute.execution import run_scenes
+from simparity.comparisons.execute.isolation import CaseLimits, IsolatedPool
+from simparity.comparisons.invariance.metamorphic import (
     AT_THRESHOLD,
     CHANGES_METRIC,
     MISSING,
@@ -42,11 +42,11 @@ from simparity.comparisons.metamorphic import (
     check_invariance,
     in_process,
 )
-from simparity.comparisons.transforms import FIXED_TRANSFORMS, fixed_transforms, transform_scene
-from simparity.core.errors import TransformError
+from simparity.comparisons.invariance.transforms import FIXED_TRANSFORMS, fixed_transforms, transform_scene
+from simparity.core.model.errors import TransformError
 from simparity.core.inhouse import InHouseEngine
-from simparity.core.results import DIVERGED, FAILED, OK, ResultRow
-from simparity.core.scene import IKScene, KinematicsScene, Plane
+from simparity.core.model.results import DIVERGED, FAILED, OK, ResultRow
+from simparity.core.model.scene import IKScene, KinematicsScene, Plane
 from tests.helpers import THROWN_INTO_WIND
 
 ENGINES = ("core", "analytic", "mujoco", "pybullet", "pinocchio")
@@ -153,28 +153,28 @@ KNOWN_ENGINE_FINDINGS: tuple[KnownFinding, ...] = (
         "solve stops early or at once; implicit and implicitfast lift a resting block (block-slide: energy x 30, "
         "diverged); Euler and RK4 slide differently")),
     KnownFinding(("point-mass-tumble",), ("mujoco",), ANY, ("rescale",), ANY, (
-        "references/contact_params.py POINT_RADIUS = 1e-5 m: the spheres standing for points do not scale with "
+        "references/common/contact_params.py POINT_RADIUS = 1e-5 m: the spheres standing for points do not scale with "
         "the scene's length unit (3 % on energy_kept_min; with it scaled the rest, 7.5e-5, is MuJoCo's "
         "tolerance)")),
     KnownFinding(CONTACT_SLIDING, ("pybullet",), ANY, ("rotate",), ANY, (
         "PyBullet's friction is not isotropic in the world: block-slide turned about the plane's normal slides "
         "0.6746 m at 0 and 90 degrees, 0.7494 m at 45 degrees (friction directions tied to world axes)")),
     KnownFinding(CONTACT_RESTING, ("pybullet",), ANY, ("rescale", "ms"), ANY, (
-        "references/pybullet_adapter.py SOLVER_RESIDUAL = 1e-12 (solverResidualThreshold, in (m/s)^2) and "
+        "references/pybullet/adapter.py SOLVER_RESIDUAL = 1e-12 (solverResidualThreshold, in (m/s)^2) and "
         "contact_params.POINT_RADIUS = 1e-5 m (contactSlop, point spheres) are absolute: scaled by (L/T)^2 and L "
         "the rescaled and ms runs agree to 1e-8")),
     KnownFinding(IK_SCENES + ("*-kinematics", "lecture-planar-arm*"), ANY, ANY, ("translate",),
                  ("cross_eval_*", "position_error_max"), (
         "PyBullet's link states are float32: 2 km from the origin its FK is off by ~8e-5 m (every solution is "
-        "judged by it: cross_eval_*), beyond references/pybullet_adapter.py LINK_STATE_RESOLUTION = 1e-6 m, an "
+        "judged by it: cross_eval_*), beyond references/pybullet/adapter.py LINK_STATE_RESOLUTION = 1e-6 m, an "
         "absolute resolution that holds for coordinates of a few metres only")),
     KnownFinding(IK_SCENES, ("pybullet",), ANY, ("translate",), ANY, (
         "PyBullet's IK runs on its float32 link states: 2 km from the origin its residuals are ~1e-4 m")),
     KnownFinding(IK_SCENES, ("core", "mujoco", "pinocchio", "pybullet"), ANY, ("rescale",), ANY, (
         "every IK solver here compares lengths with fixed numbers or adds metres to radians: core's damping_max "
         "1e-3 and singular_threshold 1e-2 [m/rad] (core/ik/jacobian_solvers.py IKOptions); MuJoCo's dm_control "
-        "lambda 3e-2 while |e_pos| + |e_rot| > 0.1 (references/mujoco_ik.py); Pinocchio's DAMP 1e-12 and "
-        "DOCUMENTED_EPS 1e-4 (references/pinocchio_ik.py); PyBullet's residualThreshold and jointDamping")),
+        "lambda 3e-2 while |e_pos| + |e_rot| > 0.1 (references/mujoco/ik.py); Pinocchio's DAMP 1e-12 and "
+        "DOCUMENTED_EPS 1e-4 (references/pinocchio/ik.py); PyBullet's residualThreshold and jointDamping")),
     KnownFinding(("incline-blocks",), ("mujoco",), ANY, ("rotate",), ("velocity_error_max",), (
         "MuJoCo activates a contact while its distance is below the pair's margin (0): the 'holds' block is placed "
         "exactly on the incline, its corners at +-1e-17 m, and rounding decides whether they touch at t = 0 (none "
@@ -192,7 +192,7 @@ KNOWN_ENGINE_FINDINGS: tuple[KnownFinding, ...] = (
         "solvers stall at the same place in every frame")),
     KnownFinding(("snake-20-ik",), ("mujoco",), ("dls",), ("rotate",), ANY, (
         "dm_control's damped least squares takes an unregularised lstsq step once |e_pos| + |e_rot| < 0.1 "
-        "(references/mujoco_ik.py REGULARIZATION_THRESHOLD): on the 20-joint snake, near the singular stretched "
+        "(references/mujoco/ik.py REGULARIZATION_THRESHOLD): on the 20-joint snake, near the singular stretched "
         "pose, that step amplifies rounding beyond the two ulp seeds' spread")),
 )
 """Absolute constants inside the engines, their adapters and core (docs/invariance.md)."""
@@ -223,6 +223,7 @@ def _line(scene: str, transform: str, c) -> str:
 
 
 @pytest.mark.slow
+@pytest.mark.sweep
 def test_every_builtin_scene_is_invariant_or_a_known_finding(invariance):
     """Statuses equal and values within bounds, on every engine, under every fixed transform; what is not is a
     known finding with its cause."""
@@ -233,6 +234,7 @@ def test_every_builtin_scene_is_invariant_or_a_known_finding(invariance):
 
 
 @pytest.mark.slow
+@pytest.mark.sweep
 def test_every_known_finding_is_still_found(invariance):
     """A finding whose cause was fixed must leave the lists (they are for known, live causes only)."""
     found = list(_failures(invariance))
@@ -242,6 +244,7 @@ def test_every_known_finding_is_still_found(invariance):
 
 
 @pytest.mark.slow
+@pytest.mark.sweep
 def test_every_scene_is_compared_under_every_transform_that_applies(invariance):
     """Nothing is skipped silently: a transform is skipped only as a no-op, or because the scene's reference has
     no model of the transformed scene (the planar closed forms), and says so."""
@@ -296,7 +299,7 @@ class OriginCore(InHouseEngine):
 
 @pytest.mark.parametrize("engine, scene_name, transform, integrator", [
     (ZUpCore, "falling-linear-drag", "rotate", "rk4"),
-    (OriginCore, "ball-bounce-k05", "translate", "backup"),
+    pytest.param(OriginCore, "ball-bounce-k05", "translate", "backup", marks=pytest.mark.slow),
 ])
 def test_an_engine_that_hard_codes_the_frame_is_caught_without_a_reference(engine, scene_name, transform,
                                                                             integrator):
@@ -377,9 +380,10 @@ TOSS = THROWN_INTO_WIND.replace('integrators = ["rk4"]', 'integrators = ["rk4", 
 """The thrown leaf with two of core's schemes: a few cases."""
 
 
+@pytest.mark.slow
 def test_run_with_transforms_adds_invariance_rows_that_the_gate_holds(tmp_path, capsys):
     """'simparity run --transform' adds each case's invariance rows to the run, the report and --check."""
-    from simparity.comparisons.cli import EXIT_OK, main
+    from simparity.comparisons.cli.main import EXIT_OK, main
     from simparity.reports.store import read_run
 
     scene = tmp_path / "toss.toml"
@@ -398,7 +402,7 @@ def test_run_with_transforms_adds_invariance_rows_that_the_gate_holds(tmp_path, 
 
 
 def test_an_unknown_transform_is_one_line_and_exit_2(tmp_path, capsys):
-    from simparity.comparisons.cli import EXIT_USAGE, main
+    from simparity.comparisons.cli.main import EXIT_USAGE, main
 
     assert main(["run", "wind", "--transform", "rotate,spin", "--out", str(tmp_path / "o")]) == EXIT_USAGE
     err = capsys.readouterr().err

@@ -7,17 +7,17 @@ import math
 import numpy as np
 import pytest
 
-from simparity.comparisons.metrics import (
+from simparity.comparisons.measure.metrics import (
     SATURATED_ORIENTATION,
     drifts,
     observed_order,
     rounding_floors,
     trajectory_errors,
 )
-from simparity.comparisons.runner import run_scene
-from simparity.comparisons.engines import make_engine
-from simparity.core.scene import DynamicsScene, Forces, RigidBody
-from simparity.core.trajectory import Trajectory
+from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.engines.registry import make_engine
+from simparity.core.model.scene import DynamicsScene, Forces, RigidBody
+from simparity.core.model.trajectory import Trajectory
 from tests.helpers import builtin
 
 ROUND_OFF = 1e-14
@@ -147,6 +147,7 @@ def test_rounding_floor_grows_with_steps_and_state_size():
     assert one["position_error_max"] == pytest.approx(one["velocity_error_max"] * (100 + 4) / 4)
 
 
+@pytest.mark.slow
 def test_exact_scheme_over_a_long_fall_has_no_order():
     """RK4 is exact under constant gravity: over 40,000 steps its errors are rounding, and its position and
     velocity orders are n/a (the old fixed 1e-11 m floor reported -2.0 and 0.06 as ok). Semi-implicit Euler,
@@ -168,7 +169,7 @@ def _scales_scene(body):
 def test_each_error_saturates_against_its_own_quantity_scale():
     """The reference moves 4 m at 2 m/s while spinning at 3 rad/s; an error of a quarter of a quantity's scale
     is saturated (n/a, flagged, the scale in the reason), just below it is a number."""
-    from simparity.comparisons.metrics import SATURATED_FRACTION, saturation_scales
+    from simparity.comparisons.measure.metrics import SATURATED_FRACTION, saturation_scales
 
     body = _body(velocity=(2.0, 0, 0), omega=(0, 0, 3.0), inertia=SMALL)
     times = np.linspace(0.0, 2.0, 3)
@@ -192,7 +193,7 @@ def test_each_error_saturates_against_its_own_quantity_scale():
 def test_saturation_scales_have_physical_floors():
     """A box spinning in place has no range of motion: its position scale is its size; a body at rest has no
     speed: its velocity scale is its size over the run's duration, its angular one 1 / duration."""
-    from simparity.comparisons.metrics import saturation_scales
+    from simparity.comparisons.measure.metrics import saturation_scales
 
     times = np.linspace(0.0, 2.0, 3)
     still = Trajectory(times, np.zeros((3, 1, 3)), np.tile([1.0, 0, 0, 0], (3, 1, 1)), np.zeros((3, 1, 3)),
@@ -221,6 +222,7 @@ def test_order_fits_say_what_their_data_supports():
         assert fit.unmeasurable and fit.flag == flag, flag
 
 
+@pytest.mark.slow
 def test_near_a_separatrix_euler_family_orders_are_never_ok():
     """A torque-free box spun 0.5 % off its intermediate axis: Euler-type schemes lose the orbit (angular
     velocity errors of about half of |omega|), so their errors are saturated and no order is ok; RK4 keeps the
@@ -245,7 +247,7 @@ def test_contact_events_raise_the_velocity_rounding_floor_with_the_distance_from
     """An impact is timed from a gap known to the position's rounding, which grows with the distance from the
     origin: the velocity's rounding floor grows with it (2 |g| gap / rest speed), is 0 without contact, and at a
     rest speed of 0 is bounded by a fall through the gap itself."""
-    from simparity.comparisons.metrics import event_velocity_floor
+    from simparity.comparisons.measure.metrics import event_velocity_floor
 
     scene = builtin("ball-bounce-k05")
     g = float(np.linalg.norm(scene.forces.gravity_world))

@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from simparity.core.rotations import quat_wxyz_to_matrix, so3_exp
-from simparity.references.mjcf import dynamics_mjcf
-from simparity.references.mujoco_adapter import MujocoEngine
+from simparity.references.mujoco.mjcf import dynamics_mjcf
+from simparity.references.mujoco.adapter import MujocoEngine
 from tests.helpers import builtin, exact_projectile, tumbling_box
 
 # Both sides evaluate float64 kinematics of ~1 m chains: agreement is ~1e-15; 1e-12 is
@@ -83,7 +83,7 @@ def test_export_is_the_model_that_runs():
 
 def test_instability_is_reported_not_reset_silently():
     """MuJoCo resets an unstable run to its initial state; the adapter raises DivergedError instead."""
-    from simparity.core.errors import DivergedError
+    from simparity.core.model.errors import DivergedError
 
     scene = builtin("fast-spinner")
     sim = MujocoEngine().build_dynamics(scene, "euler", 0.02)
@@ -110,7 +110,7 @@ def test_euler_damping_is_implicit_unless_eulerdamp_is_disabled():
     """With drag as dof_damping, default Euler damps implicitly (v / (1 + dt b / m)); the adapter's is explicit."""
     from dataclasses import replace
 
-    from simparity.core.scene import Forces
+    from simparity.core.model.scene import Forces
 
     scene = replace(tumbling_box(inertia_body=0.2 * np.eye(3), gravity=None), forces=Forces(linear_drag=np.array([4.0])))
     dt, b, m = 0.01, 4.0, scene.bodies[0].mass
@@ -123,11 +123,12 @@ def test_euler_damping_is_implicit_unless_eulerdamp_is_disabled():
     np.testing.assert_allclose(implicit, v0 / (1 + dt * b / m), rtol=1e-14)
 
 
+@pytest.mark.slow
 def test_a_scene_without_contact_gets_an_arena_sized_by_its_bodies():
     """Issue #11: MuJoCo's default arena grows as nv^2 (1.7 GiB at 1,000 bodies; 10,000 failed to allocate);
     a scene without contact has no constraints and gets 1 MiB + 2 KiB per body, in the detail too."""
     from simparity.comparisons.bench import boxes
-    from simparity.references.mjcf import arena_kib
+    from simparity.references.mujoco.mjcf import arena_kib
 
     scene = boxes(3000, drag=False)
     sim = MujocoEngine().build_dynamics(scene, "euler", 1e-3)
@@ -139,7 +140,7 @@ def test_a_scene_without_contact_gets_an_arena_sized_by_its_bodies():
 def test_the_batch_rollout_steps_each_body_as_the_scene_adapter_does():
     """BatchRollout (B single-body rollouts, the bench's MuJoCo batch) is bit-identical to the B-body model."""
     from simparity.comparisons.bench import boxes
-    from simparity.references.mujoco_adapter import BatchRollout
+    from simparity.references.mujoco.adapter import BatchRollout
 
     for drag in (False, True):
         scene = boxes(5, drag)

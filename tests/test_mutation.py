@@ -17,16 +17,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simparity.comparisons.engines import make_engine
-from simparity.core.engine import Engine
-from simparity.core.ik.problem import IKTolerances
-from simparity.core.ik.result import IKResult
-from simparity.core.trajectory import Trajectory
+from simparity.comparisons.engines.registry import make_engine
+from simparity.core.model.engine import Engine
+from simparity.core.model.ik_problem import IKTolerances
+from simparity.core.model.ik_result import IKResult
+from simparity.core.model.trajectory import Trajectory
 from tests.helpers import builtin, tumbling_box
 from tests.mutation.behaviour import differences
 from tests.mutation.campaign import BATCH_SIZE, batches, score_suite
 from tests.mutation.catalogue import MUTANTS, judges_others
-from tests.mutation.copy_of_core import (CORE_PACKAGE, FAITHFUL_NAME, SHARED, CoreCopy, copied_modules, materialise,
+from tests.mutation.copy_of_core import (CORE_PACKAGE, FAITHFUL_NAME, CoreCopy, shared, copied_modules, materialise,
                                          module_name)
 from tests.mutation.gate import EXIT_VIOLATION, GateRun, Violation, verdicts
 from tests.mutation.mutation import SUITES, Mutation, MutationError
@@ -34,7 +34,7 @@ from tests.mutation.mutation import SUITES, Mutation, MutationError
 OPT_IN = "SIMPARITY_MUTATION"
 """Set to 1 to run the whole-suite runs (``SIMPARITY_MUTATION=1 python -m pytest -m slow tests/test_mutation.py``)."""
 
-whole_suite = [pytest.mark.slow, pytest.mark.skipif(
+whole_suite = [pytest.mark.slow, pytest.mark.sweep, pytest.mark.skipif(
     os.environ.get(OPT_IN) != "1", reason=f"whole-scene and whole-suite runs of the mutants (~2 hours): set {OPT_IN}=1")]
 """The marks of the runs of whole scenes and suites."""
 
@@ -73,7 +73,7 @@ def imported(tmp_path, monkeypatch):
 
 
 def _mutation(**changes) -> Mutation:
-    fields = dict(id="demo", kind="integrator weights", file="quaternion_integrators.py",
+    fields = dict(id="demo", kind="integrator weights", file="dynamics/quaternion_integrators.py",
                   old="[1 / 6, 1 / 3, 1 / 3, 1 / 6]", new="[1 / 4, 1 / 4, 1 / 4, 1 / 4]",
                   description="equal weights", suites=("default",), witness="wind")
     return Mutation(**(fields | changes))
@@ -84,8 +84,8 @@ def _mutation(**changes) -> Mutation:
 
 def test_a_mutation_changes_only_its_text_in_the_copy(tmp_path):
     copy = materialise(_mutation(), tmp_path)
-    changed = (tmp_path / copy.package / "quaternion_integrators.py").read_text(encoding="utf-8")
-    original = (Path(sys.modules[CORE_PACKAGE].__file__).parent / "quaternion_integrators.py").read_text("utf-8")
+    changed = (tmp_path / copy.package / "dynamics" / "quaternion_integrators.py").read_text(encoding="utf-8")
+    original = (Path(sys.modules[CORE_PACKAGE].__file__).parent / "dynamics" / "quaternion_integrators.py").read_text("utf-8")
     assert "[1 / 4, 1 / 4, 1 / 4, 1 / 4]" in changed and "[1 / 6, 1 / 3, 1 / 3, 1 / 6]" not in changed
     assert changed.replace(copy.package, CORE_PACKAGE).replace("[1 / 4, 1 / 4, 1 / 4, 1 / 4]",
                                                               "[1 / 6, 1 / 3, 1 / 3, 1 / 6]") == original
@@ -101,7 +101,7 @@ def test_a_mutation_whose_text_is_not_found_exactly_once_raises(tmp_path, old, p
 def test_a_mutation_of_the_shared_data_model_raises(tmp_path):
     """The data model is the real core's in every copy: a bug planted there would not act."""
     with pytest.raises(MutationError, match="not a copied module"):
-        materialise(_mutation(file="trajectory.py", old="class Trajectory", new="class Trajectory_"), tmp_path)
+        materialise(_mutation(file="model/trajectory.py", old="class Trajectory", new="class Trajectory_"), tmp_path)
 
 
 def test_a_bad_mutation_record_raises():
@@ -130,8 +130,9 @@ def test_the_copy_runs_its_own_methods_on_the_real_data_model(imported):
         np.array([[1.2, 0.9, 0.0]]), None, np.full(scene.chain.n_joints, 0.3))
     assert type(result) is IKResult and result.success.all()
     loaded = {n[len(copy.package) + 1:] for n in sys.modules if n.startswith(copy.package + ".")}
-    assert {"integrators", "quaternion_integrators", "rotations", "kinematics", "ik.jacobian_solvers"} <= loaded
-    assert not loaded & SHARED
+    assert {"dynamics.integrators", "dynamics.quaternion_integrators", "rotations", "kinematics",
+            "ik.jacobian_solvers"} <= loaded
+    assert not any(shared(name) for name in loaded)
     assert sys.modules[f"{copy.package}.inhouse"].Trajectory is Trajectory
 
 
@@ -143,14 +144,15 @@ def test_the_copy_imports_nothing_of_core_but_the_shared_modules(tmp_path):
             if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith(CORE_PACKAGE):
                 sub = node.module[len(CORE_PACKAGE):].lstrip(".")
                 names = [sub] if sub else [a.name for a in node.names]
-                assert set(names) <= SHARED, f"{path.name}:{node.lineno} imports {node.module}"
+                assert all(shared(n) for n in names), f"{path.name}:{node.lineno} imports {node.module}"
 
 
 def test_the_copy_holds_every_method_module_of_core():
     core = Path(sys.modules[CORE_PACKAGE].__file__).parent
     every = {module_name(p) for p in core.rglob("*.py") if p.name != "__init__.py"}
-    assert set(copied_modules()) == every - SHARED
-    assert {"integrators", "quaternion_integrators", "contact", "kinematics", "ik.jacobian_solvers"} <= set(
+    assert set(copied_modules()) == {m for m in every if not shared(m)}
+    assert {"dynamics.integrators", "dynamics.quaternion_integrators", "contact.bodies", "kinematics",
+            "ik.jacobian_solvers"} <= set(
         copied_modules())
 
 
@@ -165,7 +167,8 @@ def test_the_catalogue_covers_the_issue():
     assert len(MUTANTS) >= ISSUE_MUTANTS
     assert len({m.kind for m in MUTANTS}) >= ISSUE_KINDS
     files = {m.file for m in MUTANTS}
-    assert {"quaternion_integrators.py", "forces.py", "contact.py", "kinematics.py", "ik/jacobian_solvers.py",
+    assert {"dynamics/quaternion_integrators.py", "dynamics/forces.py", "contact/bodies.py", "kinematics.py",
+            "ik/jacobian_solvers.py",
             "ik/nullspace.py", "ik/steps.py"} <= files
 
 

@@ -89,6 +89,7 @@ def test_limit_penalty_pushes_toward_mid_range_on_limited_joints_only():
     np.testing.assert_allclose(limit_penalty_gradient(q, lower, upper, 2.0), [[2 * 2 * 0.5 / 4, 2 * 2 * 1 / 16, 0.0]])
 
 
+@pytest.mark.slow
 def test_control_expression_pulls_joints_toward_rest_pose():
     """theta += J+ V + dt (J+ J - I) grad H: H falls every step while the pose residual stays within tolerance."""
     rng = np.random.default_rng(34)

@@ -5,10 +5,13 @@ import sys
 import zipfile
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 BUILD_SECONDS = 300  # pip may fetch the build backend (setuptools) from the package index first
 
 
+@pytest.mark.slow
 def test_the_wheel_holds_only_the_simparity_namespace(tmp_path):
     """No top-level core/references/comparisons/reports: they are simparity.core and so on."""
     subprocess.run([sys.executable, "-m", "pip", "wheel", str(ROOT), "--no-deps", "-q", "-w", str(tmp_path)],
@@ -21,4 +24,4 @@ def test_the_wheel_holds_only_the_simparity_namespace(tmp_path):
     assert "simparity/comparisons/scenes/dzhanibekov.toml" in names
     assert not any(n.startswith("simparity/tests/") or n.startswith("simparity/benchmarks/") for n in names)
     entry_points = next(n for n in names if n.endswith("entry_points.txt"))
-    assert "simparity = simparity.comparisons.console:main" in zipfile.ZipFile(wheel).read(entry_points).decode()
+    assert "simparity = simparity.comparisons.cli.console:main" in zipfile.ZipFile(wheel).read(entry_points).decode()

@@ -3,7 +3,7 @@
 import numpy as np
 import pinocchio as pin
 
-from simparity.references.pinocchio_adapter import PinocchioEngine, free_body_model
+from simparity.references.pinocchio.adapter import PinocchioEngine, free_body_model
 from tests.helpers import builtin, exact_projectile, tumbling_box
 
 KINEMATICS_TOL = 1e-12  # see tests/test_mujoco_adapter.py
@@ -59,10 +59,10 @@ def test_harness_rk4_on_aba_is_fourth_order():
     """RK4 (RKMK on SO(3)) on aba's accelerations converges as dt^4 against the closed forms."""
     from dataclasses import replace
 
-    from simparity.comparisons.metrics import observed_order
+    from simparity.comparisons.measure.metrics import observed_order
     from simparity.core.rotations import geodesic_angle_quat_wxyz
-    from simparity.core.scene import Forces
-    from simparity.references.analytic import AnalyticEngine
+    from simparity.core.model.scene import Forces
+    from simparity.references.analytic.engine import AnalyticEngine
 
     scene = replace(tumbling_box(duration=1.0), forces=Forces(np.array([0.0, 0.0, -9.81]), linear_drag=np.array([1.5])))
     ladder, position, orientation = (0.02, 0.01, 0.005), [], []

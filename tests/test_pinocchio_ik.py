@@ -7,7 +7,7 @@ import pytest
 
 from simparity.core.ik.jacobian_solvers import IKOptions
 from simparity.core.kinematics import forward_kinematics
-from simparity.references.pinocchio_ik import DOCUMENTED_EPS, DOCUMENTED_IT_MAX
+from simparity.references.pinocchio.ik import DOCUMENTED_EPS, DOCUMENTED_IT_MAX
 from tests.helpers import CONTINUOUS7, IIWA, REVOLUTE7, build_ik, reachable_targets, reached_rate
 
 OPTIONS = IKOptions()  # 1e-6 m, 1e-6 rad, 200 iterations

@@ -18,13 +18,13 @@ import pandas as pd
 import pytest
 
 from simparity import load_scene, run_scene
-from simparity.comparisons import plugins
-from simparity.comparisons.cli import EXIT_FAILED_CASES, EXIT_OK, EXIT_USAGE, main
-from simparity.comparisons.engines import (ENGINE_NAMES, check_engine_names, installed_integrators, known_integrators,
+from simparity.comparisons.engines import plugins
+from simparity.comparisons.cli.main import EXIT_FAILED_CASES, EXIT_OK, EXIT_USAGE, main
+from simparity.comparisons.engines.registry import (ENGINE_NAMES, check_engine_names, EngineSet,
                                            make_engine)
-from simparity.core.errors import UnknownEngineError
+from simparity.core.model.errors import UnknownEngineError
 from simparity.core.inhouse import InHouseEngine
-from simparity.core.results import FAILED, NOT_AVAILABLE, OK
+from simparity.core.model.results import FAILED, NOT_AVAILABLE, OK
 from tests.helpers import THROWN_INTO_WIND
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -123,8 +123,6 @@ class _Site:
 
 def _forget_plugins() -> None:
     plugins.discover.cache_clear()
-    known_integrators.cache_clear()
-    installed_integrators.cache_clear()
 
 
 @pytest.fixture
@@ -181,6 +179,7 @@ def _simparity(args: list[str], target: Path, cwd: Path) -> subprocess.Completed
                           capture_output=True, text=True, timeout=RUN_SECONDS)
 
 
+@pytest.mark.slow
 def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_its_order(tmp_path, scene_file):
     target = _install_example(tmp_path)
     listing = _simparity(["engines"], target, tmp_path)
@@ -209,6 +208,7 @@ def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_
 
 # --- Plugins that cannot run ----------------------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site, scene_file):
     """Asked for and never run, it must not pass the gate as n/a: its rows fail, naming the import error."""
     site.install({"ghost": "no_such_module_for_simparity_tests:Engine"})
@@ -223,6 +223,7 @@ def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site
         assert OK in set(_rows(table, "core").status)
 
 
+@pytest.mark.slow
 def test_a_mistyped_spec_module_fails_the_run_and_the_gate(tmp_path, capsys):
     out = tmp_path / "run"
     code = main(["run", "lecture-projectile", "--quick", "--engines", "core,no_such_module_for_simparity_tests:X",
@@ -231,6 +232,7 @@ def test_a_mistyped_spec_module_fails_the_run_and_the_gate(tmp_path, capsys):
     assert "check FAILED" in capsys.readouterr().out
 
 
+@pytest.mark.slow
 def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(site, scene_file, tmp_path):
     """In worker processes, as 'simparity run' runs: exit 1 (an engine failed), every other case measured."""
     site.install({"exploding": "plugin_engines_a:Exploding"}, "plugin_engines_a")
@@ -246,6 +248,7 @@ def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(si
     assert set(core[core.metric == "position_error_max"].status) == {OK}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("attr, reason", [
     ("NoVersion", "version() raised RuntimeError: no version here"),
     ("ListedIntegrators", "integrators() returned ['rk4'] (allowed: a tuple of str)"),
@@ -264,6 +267,7 @@ def test_an_engine_that_breaks_the_interface_fails_its_rows_with_the_reason(site
     assert OK in set(_rows(table, "core").status)
 
 
+@pytest.mark.slow
 def test_an_engine_whose_build_raises_fails_each_case_with_the_error(site, scene_file):
     site.add_module("plugin_engines_c")
     table = run_scene(load_scene(str(scene_file)), engines=["plugin_engines_c:CrashingBuild"], repeats=0)
@@ -274,6 +278,7 @@ def test_an_engine_whose_build_raises_fails_each_case_with_the_error(site, scene
 
 # --- Names: specs, shadowing, unknown names --------------------------------------------------------------------------
 
+@pytest.mark.slow
 def test_a_module_class_spec_runs_under_the_engine_s_own_name(site, scene_file):
     site.add_module("plugin_engines_d")
     assert check_engine_names(["core", "plugin_engines_d:Renamed"]) == ("core", "plugin_engines_d:Renamed")
@@ -296,6 +301,7 @@ def test_a_spec_s_module_is_found_in_the_current_folder(tmp_path, monkeypatch):
     assert engine.name == "mine" and sys.path[-1] == str(folder)
 
 
+@pytest.mark.slow
 def test_a_built_in_name_wins_over_a_plugin_and_simparity_engines_lists_every_state(site):
     site.install({"core": "plugin_engines_f:Renamed", "exploding": "plugin_engines_f:Exploding",
                   "ghost": "no_such_module_for_simparity_tests:Engine", "two,names": "plugin_engines_f:Renamed",
@@ -334,7 +340,7 @@ def test_a_failed_search_for_plugins_leaves_the_built_ins_working(monkeypatch):
     try:
         with pytest.raises(UnknownEngineError, match="nosuch"):
             check_engine_names(["nosuch"])
-        assert type(make_engine("core")) is InHouseEngine and "rk4" in known_integrators()
+        assert type(make_engine("core")) is InHouseEngine and "rk4" in EngineSet().integrators
         out = io.StringIO()
         assert main(["engines"], out=out) == EXIT_OK
         assert out.getvalue().splitlines()[-1].startswith("plugins not searched: ") and "unreadable" in out.getvalue()
@@ -349,11 +355,12 @@ def test_a_scene_file_may_name_a_plugin_s_integrator(site, tmp_path):
     assert load_scene(str(path)).integrators == ("leapfrog_demo",)
 
 
+@pytest.mark.slow
 def test_an_installed_plugin_a_run_does_not_name_is_never_asked(site, scene_file, tmp_path, monkeypatch):
     """Describing a plugin takes a process of its own (a slow one: up to the probe's minute): a run, a scene file
     or the quick profile that does not need it never asks; a run naming it asks it alone, once per command
     for the scene files and once for the run."""
-    from simparity.comparisons import engine_probe
+    from simparity.comparisons.engines import probe as engine_probe
 
     site.install({"leap": "plugin_engines_h:Leapfrog", "other": "plugin_engines_h:Renamed"}, "plugin_engines_h")
     asked = []

@@ -5,9 +5,9 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from simparity.comparisons.library import builtin_paths
-from simparity.comparisons.scene_loader import LENGTH_UNITS, load_scene
-from simparity.core import point_mass
+from simparity.comparisons.scenes.library import builtin_paths
+from simparity.comparisons.scenes.loader import LENGTH_UNITS, load_scene
+from simparity.core.dynamics import point_mass
 from simparity.core.inhouse import InHouseEngine
 
 # The lecture's worked example, in feet and seconds, exactly as printed on the slide.

@@ -3,7 +3,7 @@ process ran it: tests/test_execution.py)."""
 
 import io
 
-from simparity.comparisons.progress import ProgressBar
+from simparity.comparisons.execute.progress import ProgressBar
 
 
 class _Terminal(io.StringIO):

@@ -6,9 +6,9 @@ import tempfile
 import numpy as np
 import pybullet
 
-from simparity.references.conventions import wxyz_from_xyzw, xyzw_from_wxyz
-from simparity.references.pybullet_adapter import PybulletEngine
-from simparity.references.urdf_export import body_urdf
+from simparity.references.common.conventions import wxyz_from_xyzw, xyzw_from_wxyz
+from simparity.references.pybullet.adapter import PybulletEngine
+from simparity.references.common.urdf_export import body_urdf
 from tests.helpers import builtin, exact_projectile, tumbling_box
 
 # getLinkState returns float32: relative error ~6e-8 of coordinates up to ~3 m, and

@@ -2,6 +2,8 @@
 
 from pathlib import Path
 
+import pytest
+
 pytest_plugins = ["pytester"]
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "docs" / "examples" / "test_my_numerics.py"
@@ -13,6 +15,7 @@ def test_the_documented_example_passes(pytester):
     result.assert_outcomes(passed=1)
 
 
+@pytest.mark.slow
 def test_a_tolerance_the_run_breaks_fails_with_the_violation(pytester):
     """A bound no RK4 run can meet (order exactly 5) fails the test and names the metric and the bound."""
     pytester.makefile(".toml", tight='[[bound]]\nintegrator = "rk4"\nmetric = "order_velocity"\n'
@@ -27,12 +30,13 @@ def test_broken(simparity):
     result.stdout.fnmatch_lines(["falling-linear-drag core rk4 order_velocity: 4.0*, bound in *"])
 
 
+@pytest.mark.slow
 def test_a_baseline_that_differs_fails(pytester, tmp_path):
     """--simparity-baseline with a stored run whose value differs: the move is reported."""
     from simparity.comparisons.api import load_scene, run_scene
-    from simparity.comparisons.profiles import quick
-    from simparity.comparisons.store import RunWriter
-    from simparity.core.results import ResultRow
+    from simparity.comparisons.scenes.profiles import quick
+    from simparity.comparisons.execute.store import RunWriter
+    from simparity.core.model.results import ResultRow
 
     scene = quick(load_scene("lecture-projectile"))
     table = run_scene(scene, engines=["core"], repeats=0)

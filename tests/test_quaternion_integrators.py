@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from simparity.core.forces import make_wrench
-from simparity.core.quaternion_integrators import (
+from simparity.core.dynamics.forces import make_wrench
+from simparity.core.dynamics.quaternion_integrators import (
     TABLEAUX,
     PackedBodies,
     make_packed_step,
@@ -12,9 +12,9 @@ from simparity.core.quaternion_integrators import (
     rotation_rows,
     unpack,
 )
-from simparity.core.rigid_body import MassProperties, initial_state
+from simparity.core.dynamics.rigid_body import MassProperties, initial_state
 from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix
-from simparity.core.scene import Forces, RigidBody
+from simparity.core.model.scene import Forces, RigidBody
 
 ROUNDING = 1e-14
 """Agreement of two evaluation orders of the same float64 arithmetic on O(1) values."""

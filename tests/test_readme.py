@@ -4,8 +4,8 @@ import math
 import re
 from pathlib import Path
 
-from simparity.comparisons.store import RunWriter
-from simparity.core.results import ResultRow
+from simparity.comparisons.execute.store import RunWriter
+from simparity.core.model.results import ResultRow
 
 README = Path(__file__).resolve().parents[1] / "README.md"
 

@@ -10,8 +10,9 @@ import textwrap
 import pandas as pd
 import pytest
 
-from simparity.comparisons.cli import main
-from simparity.core.results import REPORT_FILE, REPORT_HTML_FILE, SERIES_COLUMNS, ResultRow
+from simparity.comparisons.cli.main import main
+from simparity.core.model.run_info import RunInfo
+from simparity.core.model.results import REPORT_FILE, REPORT_HTML_FILE, SERIES_COLUMNS, ResultRow
 from simparity.reports.content import ToleranceVerdict, build
 from simparity.reports.markdown import to_markdown
 from simparity.reports.store import read_run
@@ -35,6 +36,7 @@ def run_dir(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_markdown_starts_with_the_summary_and_links_existing_figures(run_dir):
     text = (run_dir / REPORT_FILE).read_text()
     headings = re.findall(r"^(#+) (.*)$", text, flags=re.M)
@@ -52,6 +54,7 @@ def test_markdown_starts_with_the_summary_and_links_existing_figures(run_dir):
             "lecture-2link-ik-solve-rate", "lecture-2link-ik-residuals", "lecture-2link-ik-fk-agreement"} <= names
 
 
+@pytest.mark.slow
 def test_contact_section_shows_measured_restitution_at_every_dt_and_the_height_figure(run_dir):
     """Issue #10: a contact scene's section has the height figure (no convergence figure: no order with
     impacts) and a table of the restitution each engine measured at each dt next to the requested one."""
@@ -67,6 +70,7 @@ def test_contact_section_shows_measured_restitution_at_every_dt_and_the_height_f
     assert pinocchio.rstrip(" |").endswith("n/a")
 
 
+@pytest.mark.slow
 def test_compact_table_names_reference_units_and_theoretical_order(run_dir):
     section = (run_dir / REPORT_FILE).read_text().split("## dzhanibekov (dynamics)", 1)[1].split("\n## ", 1)[0]
     assert "Reference: `analytic:exact`" in section
@@ -75,11 +79,12 @@ def test_compact_table_names_reference_units_and_theoretical_order(run_dir):
     assert rk4.split("|")[7].strip().endswith("(4)")   # the order column shows RK4's theory
 
 
+@pytest.mark.slow
 def test_theoretical_orders_are_the_ones_observed(run_dir):
     """The order each engine claims for its integrators (drawn as the convergence plot's slope) matches the
     order measured on the Dzhanibekov flip, wherever an order was fitted; every engine claims some."""
     table, info = read_run(run_dir)
-    theory = info["theoretical_orders"]
+    theory = info.theoretical_orders
     assert {"core", "mujoco", "pybullet", "pinocchio"} <= set(theory)
     fitted = table[(table["scene"] == "dzhanibekov") & (table["metric"] == "order_orientation")
                    & (table["status"] == "ok")]
@@ -92,6 +97,7 @@ def test_theoretical_orders_are_the_ones_observed(run_dir):
     assert {e for e in fitted["engine"] if e in theory} == {"core", "mujoco", "pybullet", "pinocchio"} and checked >= 10
 
 
+@pytest.mark.slow
 def test_html_is_self_contained(run_dir):
     """Every figure inline as SVG, no script, no stylesheet link, nothing fetched from a host."""
     page = (run_dir / REPORT_HTML_FILE).read_text()
@@ -110,11 +116,12 @@ _NO_ENGINES = textwrap.dedent("""
             if name.split(".")[0] in ("mujoco", "pybullet", "pybullet_data", "pinocchio"):
                 raise ImportError(f"{name} blocked by the test")
     sys.meta_path.insert(0, Block())
-    from simparity.comparisons.cli import main
+    from simparity.comparisons.cli.main import main
     sys.exit(main(["report", sys.argv[1]]))
 """)
 
 
+@pytest.mark.slow
 def test_report_regenerates_a_copied_run_with_no_engine_importable(run_dir, tmp_path):
     copy = tmp_path / "copied"
     shutil.copytree(run_dir, copy)
@@ -128,6 +135,7 @@ def test_report_regenerates_a_copied_run_with_no_engine_importable(run_dir, tmp_
     assert (copy / REPORT_HTML_FILE).stat().st_size > MIN_PAGE_BYTES
 
 
+@pytest.mark.slow
 def test_report_removes_the_figures_an_earlier_rendering_left(run_dir, tmp_path):
     """A figure no longer drawn (its scene's rows removed from results.csv) does not outlive the re-rendering; every
     figure the report links is there, and a file that is not a figure is left alone."""
@@ -147,7 +155,7 @@ def _findings(verdict, tmp_path) -> str:
     rows = [ResultRow("s", "core", "rk4", 0.01, metric, 1e-6, "rad", "analytic:exact", "ok")
             for metric in ("orientation_error_max", "time_per_step")]
     series = pd.DataFrame(columns=list(SERIES_COLUMNS))
-    blocks, _ = build(pd.DataFrame([r.as_dict() for r in rows]), {}, series, verdict, tmp_path)
+    blocks, _ = build(pd.DataFrame([r.as_dict() for r in rows]), RunInfo(), series, verdict, tmp_path)
     text = to_markdown(blocks)
     return text.split("### Flagged findings", 1)[1].split("###", 1)[0]
 

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from simparity.comparisons.cli import main
-from simparity.core.results import REPORT_HTML_FILE
+from simparity.comparisons.cli.main import main
+from simparity.core.model.results import REPORT_HTML_FILE
 
 ARTIFACTS = Path(__file__).resolve().parents[1] / "test-artifacts"
 """Where the screenshot is written (kept by CI as a test artifact; ignored by git)."""
@@ -28,6 +28,7 @@ def _browser() -> str:
     return found
 
 
+@pytest.mark.slow
 def test_report_renders_in_chromium_without_network(tmp_path):
     sync_api = pytest.importorskip("playwright.sync_api", reason="playwright (a test dependency) is not installed")
     browser_path = _browser()

@@ -2,7 +2,7 @@
 
 import math
 
-from simparity.core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, case_counts, case_status
+from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, case_counts, case_status
 
 
 def test_case_status_precedence():

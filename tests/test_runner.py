@@ -6,12 +6,12 @@ import math
 import numpy as np
 import pytest
 
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.metrics import DYNAMICS_METRICS, KINEMATICS_METRICS, ORDER_METRICS, dynamics_metrics
-from simparity.comparisons.runner import run_scene
-from simparity.core.engine import Simulation, Support
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.measure.metrics import DYNAMICS_METRICS, KINEMATICS_METRICS, ORDER_METRICS, dynamics_metrics
+from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.core.model.engine import Simulation, Support
 from simparity.core.inhouse import InHouseEngine
-from simparity.core.results import DIVERGED, FAILED, NOT_AVAILABLE, OK
+from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK
 from tests.helpers import builtin
 
 
@@ -70,6 +70,7 @@ def _cases(rows):
     return {(r.engine, r.integrator, r.dt): r.status for r in rows}
 
 
+@pytest.mark.slow
 def test_each_case_has_every_metric_and_crashes_do_not_stop_the_run():
     """A crashing engine gets failed rows with the error; the engines after it still run."""
     scene = builtin("lecture-projectile")
@@ -135,6 +136,7 @@ def test_blown_up_but_finite_run_is_diverged():
     assert spin[("mujoco", "rk4", 0.005)].status == OK
 
 
+@pytest.mark.slow
 def test_finite_blow_up_is_diverged_by_the_runner_bound():
     """A finite trajectory faster than the scene's forces allow (DIVERGENCE_MARGIN x the bound) is diverged."""
     scene = builtin("lecture-projectile")
@@ -148,6 +150,7 @@ def _retimed(times_of):
     return lambda traj: dataclasses.replace(traj, times=times_of(np.array(traj.times)))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("rewrite, problem", [
     (_retimed(lambda t: np.where(np.arange(len(t)) == 3, np.nan, t)), "sample 3 is at t = nan"),
     (_retimed(lambda t: t * 2.0), "sample 1 is at t = "),
@@ -166,6 +169,7 @@ def test_a_trajectory_off_the_time_grid_fails_instead_of_being_measured(rewrite,
     assert problem in cases[0].detail
 
 
+@pytest.mark.slow
 def test_a_trajectory_of_complex_values_fails_instead_of_losing_its_imaginary_part():
     """NumPy casts complex to real with no more than a warning: a state with an imaginary part is refused."""
     def complex_positions(traj):
@@ -194,6 +198,7 @@ def test_energy_drift_without_energy_is_not_available():
     assert all(r.status == NOT_AVAILABLE and "nothing to measure" in r.detail for r in drift)
 
 
+@pytest.mark.slow
 def test_warnings_raised_in_a_case_go_into_its_rows_not_the_console(recwarn):
     """An engine that warns (here: NumPy overflow) keeps the console clean; the warning is in the case's detail."""
     import warnings as _warnings
@@ -220,7 +225,7 @@ def test_warnings_raised_in_a_case_go_into_its_rows_not_the_console(recwarn):
 
 def _drop_scene(**contact):
     """A particle dropped 0.2 m onto z = 0 with restitution 0.5 (a contact scene built in code)."""
-    from simparity.core.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
+    from simparity.core.model.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
 
     body = RigidBody("particle", 1.0, np.eye(3) * 1e-3, np.array([0.0, 0.0, 0.2]), np.array([1.0, 0, 0, 0]),
                      np.zeros(3), np.zeros(3))
@@ -235,6 +240,7 @@ def _drop_scene(**contact):
 CONTACT_EXACT = 1e-12  # [m] backing up time is exact for a dropped particle; rounding of O(1) values is ~1e-15
 
 
+@pytest.mark.slow
 def test_a_contact_scene_gets_contact_metrics_na_orders_and_a_stability_limit():
     """Issue #10: every case of a contact scene has the contact metrics; observed orders are n/a (impacts make the
     error jump with dt); the penalty integrator gets its measured stability limit; backing up time is exact."""

@@ -10,9 +10,9 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from simparity.comparisons.engines import make_engine
+from simparity.comparisons.engines.registry import make_engine
 from simparity.core.rotations import geodesic_angle_quat_wxyz, so3_exp
-from simparity.core.scene import AppliedForce, Forces
+from simparity.core.model.scene import AppliedForce, Forces
 from tests.helpers import tumbling_box
 
 # Each step rounds differently on each side (~1e-16) and the tumbling amplifies it:

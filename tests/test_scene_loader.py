@@ -7,11 +7,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simparity.comparisons.library import builtin_paths
-from simparity.comparisons.describe import describe
-from simparity.comparisons.scene_loader import LENGTH_UNITS, load_scene, load_scenes, parse_scene, parse_scenes
-from simparity.core.files import tomllib
-from simparity.core.errors import SceneError
+from simparity.comparisons.scenes.library import builtin_paths
+from simparity.comparisons.scenes.describe import describe
+from simparity.comparisons.scenes.loader import LENGTH_UNITS, load_scene, load_scenes, parse_scene, parse_scenes
+from simparity.core.model.files import tomllib
+from simparity.core.model.errors import SceneError
 
 VALID_DYNAMICS = """
 [scene]

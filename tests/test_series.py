@@ -3,16 +3,17 @@
 import math
 
 import numpy as np
+import pytest
 
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.metrics import conserved_changes
-from simparity.comparisons.rows import Case
-from simparity.comparisons.runner import run_scene
-from simparity.comparisons.series import dynamics_series, envelope
-from simparity.comparisons.store import RunWriter
-from simparity.core.results import SERIES_POINTS
-from simparity.core.scene import DynamicsScene, Forces, RigidBody
-from simparity.core.trajectory import Trajectory
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.measure.metrics import conserved_changes
+from simparity.comparisons.measure.rows import Case
+from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.measure.series import dynamics_series, envelope
+from simparity.comparisons.execute.store import RunWriter
+from simparity.core.model.results import SERIES_POINTS
+from simparity.core.model.scene import DynamicsScene, Forces, RigidBody
+from simparity.core.model.trajectory import Trajectory
 from simparity.reports.store import read_series
 from tests.helpers import builtin
 from tests.test_engine_kinematics import DOUBLE_TOL
@@ -59,6 +60,7 @@ def test_dynamics_series_from_a_hand_made_trajectory():
     assert "angular_momentum_change" not in by_quantity   # nothing spins: no |L| to drift
 
 
+@pytest.mark.slow
 def test_runner_series_round_trip_through_the_store(tmp_path):
     """Every ok case of a real scene gets its series; written with the rows and read back by pandas."""
     scene = builtin("dzhanibekov")
@@ -76,6 +78,7 @@ def test_runner_series_round_trip_through_the_store(tmp_path):
     assert energy.groupby(["engine", "integrator", "dt"]).size().max() <= SERIES_POINTS
 
 
+@pytest.mark.slow
 def test_ik_series_hold_distributions_and_the_fk_matrix():
     scene = builtin("lecture-2link-ik")
     engines = [make_engine("core"), make_engine("mujoco")]

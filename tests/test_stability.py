@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.stability import stable_dt_max
-from simparity.core.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.measure.stability import stable_dt_max
+from simparity.core.model.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
 
 STIFFNESS, MASS = 1.0e4, 1.0  # omega = 100 rad/s
 LINEAR_FACTOR = 2.0

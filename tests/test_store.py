@@ -5,12 +5,12 @@ import math
 
 import pytest
 
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.scene_loader import parse_scenes
-from simparity.comparisons.store import RunWriter
-from simparity.core.errors import ResultsError
-from simparity.core.files import tomllib
-from simparity.core.results import COLUMNS, RESULTS_FILE, ResultRow
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.scenes.loader import parse_scenes
+from simparity.comparisons.execute.store import RunWriter
+from simparity.core.model.errors import ResultsError
+from simparity.core.model.files import tomllib
+from simparity.core.model.results import COLUMNS, RESULTS_FILE, ResultRow
 from simparity.reports.store import read_run
 from tests.helpers import builtin
 from tests.test_scene_loader import VALID_DYNAMICS, VALID_KINEMATICS
@@ -26,13 +26,13 @@ def test_rows_round_trip_with_full_precision(tmp_path):
     table, info = read_run(tmp_path)
     assert table["value"].iloc[0] == value and table["dt"].iloc[0] == 1 / 30
     assert math.isnan(table["value"].iloc[1]) and table["detail"].iloc[0] == "a, b"
-    assert info["engine_versions"] == {"core": core.version()} and "lecture-projectile" in info["scenes"]
-    assert info["theoretical_orders"]["core"]["rk4"] == 4 and "taylor2" not in info["theoretical_orders"]["core"]
-    assert info["scenes"]["lecture-projectile"]["bodies"] == 1
-    variants = info["integrator_variants"]["core"]
+    assert info.engine_versions == {"core": core.version()} and "lecture-projectile" in info.scenes
+    assert info.theoretical_orders["core"]["rk4"] == 4 and "taylor2" not in info.theoretical_orders["core"]
+    assert info.scenes["lecture-projectile"]["bodies"] == 1
+    variants = info.integrator_variants["core"]
     assert variants["rk4+matrix"] == ["rk4", "matrix"] and variants["rk4"] == ["rk4", "quaternion"]
     assert "engine_euler" not in variants and "taylor2" not in variants   # one orientation update; a particle rule
-    assert {"platform", "cpu_count", "python"} <= set(info["machine"]) and info["git_commit"]
+    assert {"platform", "cpu_count", "python"} <= set(info.machine) and info.git_commit
 
 
 def test_bad_run_folders_raise_results_error(tmp_path):
@@ -75,9 +75,9 @@ def test_a_run_of_swept_scenes_has_a_column_per_swept_key(tmp_path):
     assert mass.dtype == float and list(mass[2:4]) == [1.0, 0.1 + 0.2] and mass.isna().sum() == 4
     seed = table["sweep:targets.seed"]
     assert str(seed.dtype) == "Int64" and list(seed[:2]) == [3, 2**63 - 1] and seed.isna().sum() == 4
-    assert info["scenes"]["drop_mass-0.30000000000000004"]["sweep"] == {
+    assert info.scenes["drop_mass-0.30000000000000004"]["sweep"] == {
         "base": "drop", "index": 1, "count": 2, "values": {"body[ball].mass": 0.1 + 0.2}}
-    assert "sweep" not in info["scenes"]["lecture-projectile"]
+    assert "sweep" not in info.scenes["lecture-projectile"]
 
 
 def test_a_run_without_sweeps_keeps_exactly_the_fixed_columns(tmp_path):

@@ -5,7 +5,7 @@ import math
 
 import pandas as pd
 
-from simparity.core.results import ResultRow
+from simparity.core.model.results import ResultRow
 from simparity.reports import summary
 from simparity.reports.content import _scheme_row
 

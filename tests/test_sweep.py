@@ -1,12 +1,12 @@
-"""A scene file's [sweep] (comparisons/sweep.py): key paths found in the file, values from lists and ranges,
+"""A scene file's [sweep] (comparisons/scenes/sweep.py): key paths found in the file, values from lists and ranges,
 variants combined and named, every bad table refused with the sweep key, what was wrong and what is allowed."""
 
 import pytest
 
-from simparity.comparisons.sweep import MAX_KEYS, MAX_VARIANTS, read_sweep
-from simparity.core.errors import SceneError
-from simparity.core.names import NAME_MAX, name_problem
-from simparity.core.scene import SweepPoint
+from simparity.comparisons.scenes.sweep import MAX_KEYS, MAX_VARIANTS, read_sweep
+from simparity.core.model.errors import SceneError
+from simparity.core.model.names import NAME_MAX, name_problem
+from simparity.core.model.scene import SweepPoint
 
 DATA = {
     "scene": {"name": "bounce", "kind": "dynamics", "reference": "analytic"},

@@ -5,12 +5,13 @@ only, read from a stored run; a run without a sweep has no such section."""
 import math
 
 import pandas as pd
+import pytest
 
-from simparity.comparisons.cli import main
-from simparity.comparisons.scene_loader import parse_scenes
-from simparity.comparisons.store import RunWriter
-from simparity.core.files import tomllib
-from simparity.core.results import REPORT_FILE, SERIES_COLUMNS, ResultRow
+from simparity.comparisons.cli.main import main
+from simparity.comparisons.scenes.loader import parse_scenes
+from simparity.comparisons.execute.store import RunWriter
+from simparity.core.model.files import tomllib
+from simparity.core.model.results import REPORT_FILE, SERIES_COLUMNS, ResultRow
 from simparity.reports.blocks import Details, Figure, Heading, Paragraph, Table
 from simparity.reports.content import build
 from simparity.reports.markdown import to_markdown
@@ -85,6 +86,7 @@ def test_headline_against_two_swept_keys_per_engine_and_integrator(tmp_path):
     assert len(drawn[1][0].axes) == 2   # a panel per mass
 
 
+@pytest.mark.slow
 def test_a_scheme_is_judged_by_its_worst_variant(tmp_path):
     """The summary's row and the table over the variants take each scheme at its worst variant (and median cost);
     a scheme that diverged in one variant is not ranked, however cheap."""
@@ -108,6 +110,7 @@ def test_a_scheme_is_judged_by_its_worst_variant(tmp_path):
     assert cells[2] == "core rk4 @ dt 0.01: 4e-06 m, 0.025 s/s" and cells[3] == "none"   # within 1e-3, not 1e-6
 
 
+@pytest.mark.slow
 def test_only_the_first_last_and_hardest_variants_have_sections(tmp_path):
     scenes = parse_scenes(tomllib.loads(MASS_SWEEP))
     names = [s.name for s in scenes]
@@ -180,6 +183,7 @@ def test_a_large_table_is_folded_into_the_html(tmp_path):
     assert "scheme0 | 1e-06" not in to_markdown(blocks)
 
 
+@pytest.mark.slow
 def test_variants_share_a_line_in_findings_and_cases_without_a_result(tmp_path):
     hard = GRAVITY_SWEEP.replace('kind = "dynamics"', 'kind = "dynamics"\nsuites = ["hard"]')
     scenes = parse_scenes(tomllib.loads(hard))
@@ -204,6 +208,7 @@ def test_sweep_cases_leave_out_ground_truths_and_the_reference_scheme(tmp_path):
     assert set(cases["integrator"]) == {"act_after"}
 
 
+@pytest.mark.slow
 def test_a_sweep_file_runs_end_to_end(tmp_path):
     """`simparity run FILE` runs every variant; results.csv has the sweep columns and the report the section."""
     path = tmp_path / "drop.toml"

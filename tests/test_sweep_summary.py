@@ -6,7 +6,8 @@ import math
 
 import pandas as pd
 
-from simparity.core.results import ResultRow
+from simparity.core.model.run_info import RunInfo
+from simparity.core.model.results import ResultRow
 from simparity.reports import sweep_summary
 from simparity.reports.sweep_summary import FIRST, HARDEST, LAST, across, merge_variants, union, variant_cases
 
@@ -72,4 +73,4 @@ def test_variant_cases_of_ik_keep_every_solver_and_take_the_time_per_solve_as_co
 def test_a_run_without_a_sweep_has_no_sweeps():
     table = pd.DataFrame([ResultRow("s", "core", "rk4", 0.01, "position_error_max", 1e-6, "m", "analytic:exact",
                                     "ok").as_dict()])
-    assert sweep_summary.sweeps(table, {}) == []
+    assert sweep_summary.sweeps(table, RunInfo()) == []

@@ -4,7 +4,7 @@ import math
 
 import pandas as pd
 
-from simparity.core.results import ResultRow
+from simparity.core.model.results import ResultRow
 from simparity.reports.tables import DYNAMICS_COLUMNS, metric_table, swept_value
 
 

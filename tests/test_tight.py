@@ -3,8 +3,8 @@
 import numpy as np
 
 from simparity.core.rotations import geodesic_angle_quat_wxyz
-from simparity.references.analytic import AnalyticEngine
-from simparity.references.tight import TightSolveEngine
+from simparity.references.analytic.engine import AnalyticEngine
+from simparity.references.analytic.tight import TightSolveEngine
 from tests.helpers import builtin, tumbling_box
 
 # Measured 8e-10 rad on the 10 s Dzhanibekov flip; the reference is used for errors far above.

@@ -1,4 +1,4 @@
-"""Timing and resource figures (comparisons/timing.py)."""
+"""Timing and resource figures (comparisons/execute/timing.py)."""
 
 import subprocess
 import sys
@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simparity.comparisons.timing import peak_memory_bytes, resource_line, status_bytes
+from simparity.comparisons.execute.timing import peak_memory_bytes, resource_line, status_bytes
 
 PARENT_BYTES = 300 * 2**20
 """Resident memory the test process takes before starting a child."""
@@ -19,7 +19,7 @@ def test_a_process_started_by_a_large_one_reports_its_own_peak():
     reported 3.8 GiB; the peak now comes from VmHWM, which starts afresh."""
     ballast = np.ones(PARENT_BYTES // 8)
     assert peak_memory_bytes()[0] >= PARENT_BYTES
-    child = subprocess.run([sys.executable, "-c", "from simparity.comparisons.timing import peak_memory_bytes; "
+    child = subprocess.run([sys.executable, "-c", "from simparity.comparisons.execute.timing import peak_memory_bytes; "
                             "print(peak_memory_bytes()[0])"], capture_output=True, text=True, check=True)
     assert int(child.stdout) < PARENT_BYTES / 2 and ballast.sum() > 0
 

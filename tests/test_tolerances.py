@@ -5,8 +5,8 @@ import os
 
 import pytest
 
-from simparity.comparisons.tolerances import DEFAULT_TOLERANCES, bound_for, load_tolerances
-from simparity.core.errors import ToleranceError
+from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, bound_for, load_tolerances
+from simparity.core.model.errors import ToleranceError
 
 
 def _write(tmp_path, text):

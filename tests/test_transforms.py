@@ -15,21 +15,21 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from simparity.comparisons import library
-from simparity.comparisons.cases import scene_hash
-from simparity.comparisons.engines import make_engine
-from simparity.comparisons.perturb import ulp_perturbed
-from simparity.comparisons.rounding_allowance import rounding_floors
-from simparity.comparisons.transforms import (
+from simparity.comparisons.scenes import library
+from simparity.comparisons.execute.cases import scene_hash
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.invariance.perturb import ulp_perturbed
+from simparity.comparisons.invariance.rounding_allowance import rounding_floors
+from simparity.comparisons.invariance.transforms import (
     FIXED_TRANSFORMS,
     TRANSFORM_NAMES,
     Transform,
     fixed_transforms,
     transform_scene,
 )
-from simparity.comparisons.units import Dimension, unit_dimensions, unit_factor
-from simparity.core.errors import TransformError, UnitError
-from simparity.core.scene import AppliedForce
+from simparity.comparisons.invariance.units import Dimension, unit_dimensions, unit_factor
+from simparity.core.model.errors import TransformError, UnitError
+from simparity.core.model.scene import AppliedForce
 
 CLOSED_FORM_RTOL = 1e-9
 """The closed forms evaluated in two frames agree to rounding of their operands (sines, elliptic functions of

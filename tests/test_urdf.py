@@ -9,7 +9,7 @@ import pinocchio as pin
 import pybullet_data
 import pytest
 
-from simparity.core.errors import SceneError
+from simparity.core.model.errors import SceneError
 from simparity.core.kinematics import joint_frames
 from simparity.core.urdf import MAX_URDF_JOINTS, chain_from_urdf
 

@@ -9,13 +9,13 @@ import textwrap
 import numpy as np
 import pytest
 
-from simparity.comparisons.engines import make_engine
+from simparity.comparisons.engines.registry import make_engine
 from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.rotations import geodesic_angle_matrix
-from simparity.core.scene import DynamicsScene, Forces, RigidBody
+from simparity.core.model.scene import DynamicsScene, Forces, RigidBody
 from simparity.core.urdf import chain_from_urdf
-from simparity.references.mjcf import dynamics_mjcf
-from simparity.references.urdf_export import chain_urdf, movable_joints_above_base
+from simparity.references.mujoco.mjcf import dynamics_mjcf
+from simparity.references.common.urdf_export import chain_urdf, movable_joints_above_base
 from tests.helpers import builtin
 
 ENGINES = ("mujoco", "pybullet", "pinocchio")
@@ -91,7 +91,7 @@ def test_engines_get_no_geometry_and_never_open_a_mesh(tmp_path):
     chain = chain_from_urdf(str(path))
     assert "mesh" not in chain_urdf(chain) and "<visual" not in chain_urdf(chain)
     script = textwrap.dedent(f"""
-        from simparity.comparisons.engines import make_engine
+        from simparity.comparisons.engines.registry import make_engine
         from simparity.core.urdf import chain_from_urdf
         chain = chain_from_urdf({str(path)!r})
         for engine in {ENGINES!r}:
@@ -129,7 +129,7 @@ def test_names_are_escaped_in_the_model_text():
 def test_ik_below_the_root_link_moves_only_the_chain(engine, solver):
     """Targets in link 2's frame are reached by the chain's joints alone: the engine's own residual
     equals what core's FK measures at the returned joint values."""
-    from simparity.core.ik.problem import IKTolerances
+    from simparity.core.model.ik_problem import IKTolerances
 
     chain = chain_from_urdf(builtin("iiwa-kinematics").chain.urdf_path, base_link="lbr_iiwa_link_2")
     rng = np.random.default_rng(12)

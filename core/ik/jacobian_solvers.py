@@ -51,13 +51,13 @@ import numpy as np
 
 from simparity.core.ik import steps
 from simparity.core.ik.limits import cross_gap, crossable_gap, inside, wrap_into_limits
-from simparity.core.ik.problem import IKTolerances, check_inputs
+from simparity.core.model.ik_problem import IKTolerances, check_inputs
 from simparity.core.ik.nullspace import limit_penalty_gradient, nullspace_term, penalty_gradient
 from simparity.core.ik.reach import reach_upper_bound
-from simparity.core.ik.result import IKResult
+from simparity.core.model.ik_result import IKResult
 from simparity.core.kinematics import jacobian_of_frames, jacobian_world, packed_frames
 from simparity.core.rotations import so3_log
-from simparity.core.scene import Chain, sample_configurations
+from simparity.core.model.scene import Chain, sample_configurations
 
 METHODS = ("jacobian_inverse", "pseudo_inverse", "transpose", "damped_least_squares")
 
@@ -65,7 +65,7 @@ METHODS = ("jacobian_inverse", "pseudo_inverse", "transpose", "damped_least_squa
 @dataclass(frozen=True)
 class IKOptions(IKTolerances):
     """Settings of the in-house iterative solvers: the problem's tolerances and iteration
-    cap (:class:`~simparity.core.ik.problem.IKTolerances`) plus their own.
+    cap (:class:`~simparity.core.model.ik_problem.IKTolerances`) plus their own.
 
     Attributes
     ----------

@@ -26,14 +26,15 @@ budget is replaced by an attempt budget. Iterations are summed over the attempts
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import cast
 
 import numpy as np
 
 from simparity.core.ik.jacobian_solvers import IKOptions, failure_causes, solve_ik
-from simparity.core.ik.problem import check_inputs
+from simparity.core.model.ik_problem import check_inputs
 from simparity.core.ik.reach import reach_upper_bound
-from simparity.core.ik.result import IKResult
-from simparity.core.scene import Chain, sample_configurations
+from simparity.core.model.ik_result import IKResult
+from simparity.core.model.scene import Chain, sample_configurations
 
 RESTART_STREAM = 0x5E57A27
 """Spawn key of the restart draws' stream of the seed."""
@@ -120,7 +121,9 @@ def solve_ik_with_restarts(
                          sample_configurations(chain, rows.size, rng), method, attempt)
         np.add.at(best["iterations"], rows, again.iterations)
         merit = np.where(again.success, -1.0, _merit(again.position_residual, again.orientation_residual))
-        pick = rows.size and np.argmin(merit.reshape(todo.size, starts), axis=1) + np.arange(todo.size) * starts
+        # rows.size >= 1 (todo is not empty, starts >= 1), so pick is always the index array
+        pick = cast(np.ndarray, rows.size and np.argmin(merit.reshape(todo.size, starts), axis=1)
+                    + np.arange(todo.size) * starts)
         take = again.success[pick] | (merit[pick] < _merit(best["position_residual"][todo],
                                                             best["orientation_residual"][todo]))
         for name in _FIELDS:

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from simparity.comparisons import library
+from simparity.comparisons.scenes import library
 from tests.mutation.catalogue import judges_others
 from tests.mutation.copy_of_core import FAITHFUL_NAME, MUTANT_NAME, materialise
 from tests.mutation.gate import GateRun, Verdict, check_run, run_gate, verdicts

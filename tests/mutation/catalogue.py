@@ -33,57 +33,57 @@ IK = ("default", "hard")
 MUTANTS: tuple[Mutation, ...] = (
     # --- Dynamics: integrators ------------------------------------------------------------------------------
     Mutation(
-        "rk4_weights", "integrator weights", "quaternion_integrators.py",
+        "rk4_weights", "integrator weights", "dynamics/quaternion_integrators.py",
         "[1 / 6, 1 / 3, 1 / 3, 1 / 6], [0.0, 0.5, 0.5, 1.0]),",
         "[1 / 4, 1 / 4, 1 / 4, 1 / 4], [0.0, 0.5, 0.5, 1.0]),",
         "RK4's four slopes averaged with equal weights 1/4 instead of 1/6, 1/3, 1/3, 1/6 (second order)",
         FLIGHT, "wind"),
     Mutation(
-        "rk4_last_stage", "integrator stages", "quaternion_integrators.py",
+        "rk4_last_stage", "integrator stages", "dynamics/quaternion_integrators.py",
         "[[], [0.5], [0.0, 0.5], [0.0, 0.0, 1.0]]",
         "[[], [0.5], [0.0, 0.5], [0.0, 0.0, 0.5]]",
         "RK4's fourth stage taken half a step along k3 instead of a whole step (first order)",
         FLIGHT, "wind"),
     Mutation(
-        "midpoint_full_step", "integrator stages", "quaternion_integrators.py",
+        "midpoint_full_step", "integrator stages", "dynamics/quaternion_integrators.py",
         '"midpoint": ([[], [0.5]], [0.0, 1.0], [0.0, 0.5]),',
         '"midpoint": ([[], [1.0]], [0.0, 1.0], [0.0, 0.5]),',
         "the midpoint rule's second stage evaluated a whole step ahead instead of half a step (first order)",
         FLIGHT, "wind"),
     Mutation(
-        "semi_implicit_old_momentum", "integrator stages", "quaternion_integrators.py",
+        "semi_implicit_old_momentum", "integrator stages", "dynamics/quaternion_integrators.py",
         "new[X] = s[X] + dt * new[P] * bodies.inverse_mass",
         "new[X] = s[X] + dt * s[P] * bodies.inverse_mass",
         "semi-implicit Euler moves the position with the momentum from before the kick (explicit Euler, still "
         "first order)",
         FLIGHT, "falling-linear-drag"),
     Mutation(
-        "taylor_no_half", "integrator weights", "point_mass.py",
+        "taylor_no_half", "integrator weights", "dynamics/point_mass.py",
         "return x + v * dt + a * dt * dt / 2, v + a * dt",
         "return x + v * dt + a * dt * dt, v + a * dt",
         "the lecture's Taylor rule with a dt^2 term missing its 1/2",
         DYNAMICS, "lecture-projectile"),
     Mutation(
         "samples_lag_one_step", "time bookkeeping", "inhouse.py",
-        "state = record[i] = self._step((i - 1) * dt, state, dt)",
-        "record[i], state = state, self._step((i - 1) * dt, state, dt)",
+        "state = record[i] = self._packed_step((i - 1) * dt, state, dt)",
+        "record[i], state = state, self._packed_step((i - 1) * dt, state, dt)",
         "each sample records the state from before its step: the trajectory lags one step behind its times",
         DYNAMICS, "lecture-projectile"),
     # --- Dynamics: rotation, inertia, forces -----------------------------------------------------------------
     Mutation(
-        "gyroscopic_sign", "gyroscopic term", "quaternion_integrators.py",
+        "gyroscopic_sign", "gyroscopic term", "dynamics/quaternion_integrators.py",
         "bodies.apply_inverse_inertia_body(_tmatvec(rotation, torque) - gyro)",
         "bodies.apply_inverse_inertia_body(_tmatvec(rotation, torque) + gyro)",
         "the engines' Euler step adds the gyroscopic term omega x I omega instead of subtracting it",
         DYNAMICS, "tumbling-box-stable"),
     Mutation(
-        "inertia_wrong_frame", "inertia frame", "quaternion_integrators.py",
+        "inertia_wrong_frame", "inertia frame", "dynamics/quaternion_integrators.py",
         "return _matvec(rotation, self.apply_inverse_inertia_body(_tmatvec(rotation, angular_momentum)))",
         "return _tmatvec(rotation, self.apply_inverse_inertia_body(_matvec(rotation, angular_momentum)))",
         "omega = R^T I_body^-1 R L: the inverse inertia rotated the wrong way round (body and world swapped)",
         FLIGHT, "tumbling-box-stable"),
     Mutation(
-        "quaternion_rate_body_frame", "frames and conventions", "quaternion_integrators.py",
+        "quaternion_rate_body_frame", "frames and conventions", "dynamics/quaternion_integrators.py",
         "    out[0], out[1] = -ox * x - oy * y - oz * z, ox * w + oy * z - oz * y\n"
         "    out[2], out[3] = oy * w - ox * z + oz * x, oz * w + ox * y - oy * x\n",
         "    out[0], out[1] = -ox * x - oy * y - oz * z, ox * w - oy * z + oz * y\n"
@@ -91,19 +91,19 @@ MUTANTS: tuple[Mutation, ...] = (
         "dq/dt = 1/2 q (0, omega): the world angular velocity multiplied on the body side of the quaternion",
         FLIGHT, "tumbling-box-stable"),
     Mutation(
-        "torque_cross_order", "torque sign", "forces.py",
+        "torque_cross_order", "torque sign", "dynamics/forces.py",
         "np.add.at(torque, applied_body, np.cross(lever, applied_force))",
         "np.add.at(torque, applied_body, np.cross(applied_force, lever))",
         "the torque of a force at a body point written f x r instead of r x f",
         ("default",), "point-force-torque"),
     Mutation(
-        "force_point_not_rotated", "force application point", "forces.py",
+        "force_point_not_rotated", "force application point", "dynamics/forces.py",
         'lever = np.einsum("aij,aj->ai", rotation[applied_body], applied_point)',
         "lever = applied_point",
         "a force's body-fixed point used as a world offset: the lever does not turn with the body",
         ("default",), "point-force-torque"),
     Mutation(
-        "drag_applied_twice", "damping", "forces.py",
+        "drag_applied_twice", "damping", "dynamics/forces.py",
         "force -= b[:, None] * relative",
         "force -= b[:, None] * (relative + v)",
         "linear drag applied twice: against the velocity relative to the air, and again against the ground "
@@ -111,37 +111,37 @@ MUTANTS: tuple[Mutation, ...] = (
         DYNAMICS, "wind"),
     # --- Contact ---------------------------------------------------------------------------------------------
     Mutation(
-        "restitution_squared", "contact response", "contact.py",
+        "restitution_squared", "contact response", "contact/bodies.py",
         "j_n = np.where(speed_n < 0.0, -(1.0 + restitution) * speed_n, 0.0)",
         "j_n = np.where(speed_n < 0.0, -(1.0 + restitution**2) * speed_n, 0.0)",
         "restitution applied twice: a body rebounds at k^2 times its approach speed",
         CONTACT_HARD, "ball-bounce-k05"),
     Mutation(
-        "friction_static_kinetic_swapped", "friction coefficient", "contact_backup.py",
+        "friction_static_kinetic_swapped", "friction coefficient", "contact/backup.py",
         "for table in (model.friction_static, model.friction_kinetic))",
         "for table in (model.friction_kinetic, model.friction_static))",
         "a body resting on a plane gets the kinetic coefficient where the static one belongs and vice versa",
         CONTACT, "block-slide"),
     Mutation(
-        "angular_impulse_sign", "contact torque", "contact.py",
+        "angular_impulse_sign", "contact torque", "contact/bodies.py",
         "return p + impulse, l + cross(lever, impulse)",
         "return p + impulse, l + cross(impulse, lever)",
         "the angular impulse of a contact written j x r instead of r x j",
         CONTACT, "box-edge-drop"),
     Mutation(
-        "penalty_damping_sign", "contact coefficient sign", "collision.py",
+        "penalty_damping_sign", "contact coefficient sign", "contact/particle.py",
         "push = -stiffness * depth - damping * (velocity_world @ plane.normal_world)",
         "push = -stiffness * depth + damping * (velocity_world @ plane.normal_world)",
         "the penalty damper pushes with the approach speed instead of against it: energy enters at every contact",
         CONTACT_HARD, "lecture-bouncing-particle"),
     Mutation(
-        "backup_time_full_gravity", "back-up time", "contact_roots.py",
+        "backup_time_full_gravity", "back-up time", "contact/roots.py",
         "hit, s = entry_time(e0, u, a / 2.0, horizon[:, None])",
         "hit, s = entry_time(e0, u, a, horizon[:, None])",
         "the exact entry time solved with a s^2 where a s^2 / 2 belongs: impacts timed early, above the plane",
         CONTACT_HARD, "ball-bounce-k05"),
     Mutation(
-        "push_out_sign", "contact response", "contact_act_after.py",
+        "push_out_sign", "contact response", "contact/act_after.py",
         "x = x - np.minimum(depth, 0.0)[:, None] * normal",
         "x = x + np.minimum(depth, 0.0)[:, None] * normal",
         "act_after's push-out moves a penetrating body further into the plane instead of out of it",

@@ -1,6 +1,6 @@
 """A copy of core's in-house methods as a package of its own, with at most one mutation applied.
 
-The copy holds every module of ``core/`` but the shared ones (:data:`SHARED`), under a new top-level package
+The copy holds every module of ``core/`` but the shared ones (:func:`shared`), under a new top-level package
 in a folder of the caller's (never in the repository); imports of copied modules are rewritten to the copy,
 imports of shared modules keep pointing at the real ``simparity.core``. The shared modules are the data model
 the harness checks with ``isinstance`` (a Trajectory or IKResult of a class of the copy's would be refused) and
@@ -28,11 +28,11 @@ CORE = Path(simparity.core.__file__).resolve().parent
 
 CORE_PACKAGE = "simparity.core"
 
-SHARED = frozenset({
-    "arrays", "engine", "errors", "files", "names", "ranges", "results", "scene", "trajectory",
-    "ik.problem", "ik.result",
-    "allocator", "processes",
-})
+SHARED_PACKAGES = ("model", "runtime")
+"""Core's folders the copy shares whole: the data model and the process and memory plumbing."""
+
+SHARED_ALIASES = frozenset({"arrays", "engine", "errors", "results", "scene", "trajectory", "ik.problem", "ik.result"})
+"""The data model's public aliases at its old paths (re-exports of ``model``)."""
 """Modules of core (dotted, relative to it) the copy imports from the real ``simparity.core``: the data model
 (what the harness and the references share with core, ``tests/test_architecture.py``'s DATA_MODEL, plus the
 file, name and range checks the scene model uses) and the process and memory plumbing (no numerics)."""
@@ -83,12 +83,17 @@ def module_name(path: Path) -> str:
 def copied_modules() -> dict[str, Path]:
     """Every module of core the copy holds (dotted name -> source file); package ``__init__``s not included."""
     found = {module_name(p): p for p in sorted(CORE.rglob("*.py")) if p.name != "__init__.py"}
-    missing = SHARED - set(found)
+    missing = SHARED_ALIASES - set(found)
     if missing:
-        raise MutationError(f"shared modules not found in core: {sorted(missing)} (update SHARED)")
+        raise MutationError(f"shared modules not found in core: {sorted(missing)} (update SHARED_ALIASES)")
     if PLUGIN_MODULE in found:
         raise MutationError(f"core has a module named {PLUGIN_MODULE}: choose another PLUGIN_MODULE")
-    return {name: path for name, path in found.items() if name not in SHARED}
+    return {name: path for name, path in found.items() if not shared(name)}
+
+
+def shared(name: str) -> bool:
+    """Whether core's module ``name`` (dotted, relative to core) stays the real one in a copy."""
+    return name in SHARED_ALIASES or name.split(".")[0] in SHARED_PACKAGES
 
 
 def _packages() -> set[str]:

@@ -19,7 +19,7 @@ import tempfile
 from pathlib import Path
 
 import simparity
-from simparity.comparisons.tolerances import DEFAULT_TOLERANCES
+from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES
 from tests.mutation.campaign import SuiteScore, recheck_suite, score_suite, score_witnesses
 from tests.mutation.catalogue import MUTANTS, by_id
 from tests.mutation.copy_of_core import FAITHFUL_NAME

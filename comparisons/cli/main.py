@@ -1,0 +1,346 @@
+"""The ``simparity`` command: list, engines, run, check, history, export, show, report, bench.
+
+User mistakes (bad scene or tolerances files, unknown names, missing runs, a folder that already
+holds a run) print one line ``simparity: error: ...`` and exit with code 2; tracebacks are kept
+for real bugs. ``run`` exits 1 when some engine failed (raised), and with ``--check`` when a
+metric is outside its bound; ``check`` exits 0 when every checked metric is inside its bound and
+nothing moved since the baseline, else 1. Results computed before an error are kept either way.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+from simparity.comparisons.scenes import library
+from simparity.comparisons.gate.check import (
+    CheckResult,
+    check_table,
+    compare_with_baseline,
+    explain,
+    explain_lines,
+)
+from simparity.comparisons.gate.check_output import junit_xml, summary_markdown
+from simparity.comparisons.scenes.describe import describe
+from simparity.comparisons.cli.console import EXIT_INTERRUPTED
+from simparity.comparisons.engines.registry import (
+    ENGINE_NAMES,
+    EngineSet,
+    check_engine_names,
+    make_engine,
+)
+from simparity.comparisons.gate.history import history_path, latest_before, metric_history, run_table
+from simparity.comparisons.execute.execution import default_jobs
+from simparity.comparisons.execute.isolation import GIB, CaseLimits
+from simparity.comparisons.execute.journal import CASES_FOLDER, Journal, read_request
+from simparity.comparisons.engines.placeholders import BrokenEngine, UnavailableEngine
+from simparity.comparisons.execute.runner import DEFAULT_REPEATS
+from simparity.comparisons.execute.session import Execution, Session, write_run_report
+from simparity.comparisons.cli.parser import build_parser
+from simparity.comparisons.scenes.limits import Limits
+from simparity.comparisons.execute.store import default_out_dir
+from simparity.comparisons.execute.timing import resource_line
+from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, load_tolerances
+from simparity.comparisons.invariance.transforms import fixed_transforms
+from simparity.core.model.errors import SimparityError, one_line
+from simparity.core.model.ranges import RANGES
+from simparity.core.model.results import RESULTS_FILE, RUN_INFO_FILE
+from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
+from simparity.reports.store import read_run
+
+EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE = 0, 1, 2
+MAX_JOBS = 256
+"""Worker processes at most: each is a Python process of ~250 MiB with the engines loaded."""
+RESUMED_OPTIONS = ("scenes", "suite", "engines", "out", "force", "quick", "repeats", "max_steps", "max_samples",
+                   "max_joints", "transform")
+"""What a resumed run takes from the run it resumes (``resume.json``), never from the command line."""
+MESSAGE_LIMIT = 1000
+"""Characters of an error message printed: one line, whatever the input echoed into it."""
+
+
+def cmd_list(args, out) -> int:
+    scenes = library.suite(args.suite) if args.suite else library.load(list(library.builtin_paths().values()))
+    for scene in scenes:
+        print(f"{scene.name:<28} {scene.kind:<11} reference={scene.reference:<10} {','.join(scene.suites):<14} "
+              f"{scene.description}", file=out)
+    return EXIT_OK
+
+
+def cmd_engines(args, out) -> int:
+    from simparity.comparisons.engines.listing import engine_lines  # builds every engine: only when asked
+
+    for line in engine_lines():
+        print(line, file=out)
+    return EXIT_OK
+
+
+def _out_dir(args) -> Path:
+    """The run's folder: --out (refused when it holds a run, unless --force), else a new one."""
+    if args.out is None:
+        return default_out_dir()
+    try:
+        return _checked_out_dir(args.out, args.force)
+    except (OSError, ValueError) as err:  # a name the OS rejects: too long, a NUL byte
+        raise SimparityError(f"--out {one_line(args.out)}: {getattr(err, 'strerror', None) or err} (allowed: a "
+                             "folder path the system accepts)") from None
+
+
+def _checked_out_dir(out_dir: Path, force: bool) -> Path:
+    if out_dir.exists() and not out_dir.is_dir():
+        raise SimparityError(f"--out {one_line(out_dir)}: exists and is not a folder (allowed: a new or empty folder)")
+    held = [name for name in (RESULTS_FILE, RUN_INFO_FILE) if (out_dir / name).exists()]
+    if held and not force:
+        raise SimparityError(f"--out {one_line(out_dir)}: already holds a run ({', '.join(held)}); nothing was "
+                             "overwritten (allowed: a new folder, no --out for a new timestamped one, or --force)")
+    return out_dir
+
+
+def _resumed(args) -> None:
+    """Fill ``args`` with what the run in ``--resume DIR`` was asked to do; refuse options that would change it."""
+    defaults = build_parser().parse_args(["run"])
+    given = [name for name in RESUMED_OPTIONS if getattr(args, name) != getattr(defaults, name)]
+    if given:
+        flags = ", ".join("SCENE" if name == "scenes" else "--" + name.replace("_", "-") for name in given)
+        raise SimparityError(f"--resume {one_line(args.resume)} with {flags}: a resumed run does what it was asked to "
+                             "(allowed with --resume: --jobs, --executor, --scheduler, --case-timeout, --case-memory, "
+                             "--check and its options, --history)")
+    request = read_request(args.resume)
+    if not (args.resume / CASES_FOLDER).is_dir():
+        raise SimparityError(f"--resume {one_line(args.resume)}: that run finished (every case is in its "
+                             f"{RESULTS_FILE}); nothing to resume (allowed: the folder of a run that did not finish; "
+                             "'simparity report DIR' re-renders a finished one)")
+    try:
+        for name in RESUMED_OPTIONS:
+            if name == "transform":  # runs requested before --transform existed had none
+                args.transform = tuple(request.get(name, ()))
+            elif name not in ("out", "force"):
+                setattr(args, name, request[name] if name != "engines" else tuple(request[name]))
+    except (KeyError, TypeError) as err:
+        raise SimparityError(f"--resume {one_line(args.resume)}: its request lacks {one_line(err)} (allowed: the "
+                             "file a run wrote)") from None
+    args.out, args.force = args.resume, True
+
+
+def _request(args, names: tuple[str, ...], repeats: int) -> dict:
+    """What this run is asked to do, for ``--resume``: scene files by absolute path, everything else as given."""
+    scenes = [str(Path(a).resolve()) if Path(a).is_file() else a for a in args.scenes]
+    return {"scenes": scenes, "suite": args.suite, "engines": list(names), "repeats": repeats, "quick": args.quick,
+            "max_steps": args.max_steps, "max_samples": args.max_samples, "max_joints": args.max_joints,
+            "transform": list(args.transform)}
+
+
+def _limits(args, jobs: int) -> CaseLimits:
+    """The per-case limits from --case-timeout and --case-memory (default: a share of the machine a case runs on)."""
+    if not (math.isfinite(args.case_timeout) and args.case_timeout > 0):
+        raise SimparityError(f"--case-timeout {args.case_timeout}: out of range (allowed: a number of seconds > 0)")
+    if args.case_memory is None:  # on Dask, each node's own default
+        return CaseLimits(args.case_timeout, CaseLimits.default(jobs).memory_bytes if args.executor == "local" else None)
+    if not (math.isfinite(args.case_memory) and 0 < args.case_memory <= 1e6):
+        raise SimparityError(f"--case-memory {args.case_memory}: out of range (allowed: GiB > 0, up to 1e6)")
+    return CaseLimits(args.case_timeout, int(args.case_memory * GIB))
+
+
+def cmd_run(args, out) -> int:
+    start = time.perf_counter()
+    if args.resume is not None:
+        _resumed(args)
+    repeats = (0 if args.quick else DEFAULT_REPEATS) if args.repeats is None else args.repeats
+    if repeats < 0 or repeats > 100:
+        raise SimparityError(f"--repeats {args.repeats}: out of range (allowed: 0 to 100; 0 times one cold call)")
+    jobs = default_jobs() if args.jobs is None else args.jobs
+    for flag, value in (("--max-steps", args.max_steps), ("--max-samples", args.max_samples),
+                        ("--max-joints", args.max_joints), ("--jobs", jobs)):
+        if value < 1:
+            raise SimparityError(f"{flag} {value}: out of range (allowed: a whole number >= 1)")
+    if jobs > MAX_JOBS:
+        raise SimparityError(f"--jobs {jobs}: out of range (allowed: 1 to {MAX_JOBS})")
+    if args.scheduler is not None and args.executor != "dask":
+        raise SimparityError(f"--scheduler {one_line(args.scheduler)} without --executor dask (allowed: add --executor "
+                             "dask, or drop --scheduler)")
+    execution = Execution(args.executor, jobs, _limits(args, jobs), args.scheduler)
+    transforms = fixed_transforms(args.transform) if args.transform else ()
+    engines = EngineSet(check_engine_names(args.engines))
+    run_limits = Limits(max_steps=args.max_steps, max_samples=args.max_samples, max_joints=args.max_joints)
+    if args.scenes and args.suite:
+        raise SimparityError(f"--suite {args.suite} with scenes named: give one (allowed: scene names or files, "
+                             "or --suite)")
+    chosen = (library.load(args.scenes, run_limits, engines) if args.scenes
+              else library.suite(args.suite or "default", run_limits, engines))
+    bounds = load_tolerances(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
+    out_dir = _out_dir(args)
+
+    def say(line: str) -> None:
+        print(line, file=out, flush=True)
+
+    session = Session(chosen, engines, profile="quick" if args.quick else "full", repeats=repeats,
+                      execution=execution, out_dir=out_dir, history=history_path(args.history), bounds=bounds,
+                      transforms=transforms, command=" ".join(["simparity"] + sys.argv[1:]),
+                      request=_request(args, engines.names, repeats), resume=args.resume is not None, say=say,
+                      warn=lambda line: print(line, file=sys.stderr), progress=sys.stderr)
+    if args.resume is not None:
+        stand_ins = [n for n, e in zip(session.names, session.engines) if isinstance(e, (UnavailableEngine, BrokenEngine))]
+        if stand_ins:  # its kept cases would be replaced by n/a or failed rows
+            raise SimparityError(f"--resume {one_line(args.resume)}: engine(s) {one_line(', '.join(stand_ins))} of "
+                                 "that run cannot be built here (allowed: resume where the run's engines import, e.g. "
+                                 "from the folder a module:Class engine was found in)")
+    where = (f"{jobs} worker processes" if args.executor == "local" else
+             f"Dask at {args.scheduler}" if args.scheduler else f"a local Dask cluster of {jobs} workers")
+
+    def start_line() -> str:
+        return (f"{_cost(session.scenes)}; {len(session.names)} engines; {where}" + (" (quick profile)" if args.quick
+                else "") + (f"; resuming {len(Journal(out_dir))} finished cases" if args.resume else ""))
+
+    try:
+        result = session.run(start_line)
+        if result.interrupted:
+            return EXIT_INTERRUPTED
+        code = EXIT_FAILED_CASES if result.failed_cases else EXIT_OK
+        if result.check is not None:
+            code = max(code, _check(out_dir, bounds, args, out, result.check))
+        return code
+    finally:  # what the run cost, also when it was interrupted or stopped by an error
+        print(resource_line(time.perf_counter() - start), file=out, flush=True)
+
+
+def _cost(scenes) -> str:
+    """What the run will do, counted before it starts."""
+    steps = sum(s.n_steps(dt) * len(s.bodies) for s in scenes if isinstance(s, DynamicsScene) for dt in s.dts)
+    samples = sum(s.n_configurations for s in scenes if isinstance(s, KinematicsScene))
+    targets = sum(s.n_targets + len(s.hard_targets) for s in scenes if isinstance(s, IKScene))
+    return (f"{len(scenes)} scenes: {steps:,} body-steps per integrator, {samples:,} configurations, "
+            f"{targets:,} IK targets per solver")
+
+
+def _baseline_table(option: str, run_dir: Path, history_option: str | None):
+    if option == "latest":
+        path = history_path(history_option)
+        run_id, _ = latest_before(path, run_dir.resolve())
+        return run_table(path, run_id)
+    return read_run(Path(option))[0]
+
+
+def _check(run_dir: Path, bounds, args, out, result: CheckResult | None = None) -> int:
+    """Print the verdict on a stored run (and the moves since the baseline); 0 passed, 1 not.
+    ``result``: the run already held to ``bounds``."""
+    table, _ = read_run(run_dir)
+    result = check_table(table, bounds) if result is None else result
+    diff = None
+    if args.baseline:
+        if not math.isfinite(args.baseline_rel) or args.baseline_rel < 0:
+            raise SimparityError(f"--baseline-rel {args.baseline_rel}: out of range (allowed: a number >= 0)")
+        diff = compare_with_baseline(table, _baseline_table(args.baseline, run_dir, args.history), args.baseline_rel)
+    for violation in result.violations:
+        print(f"violation: {one_line(violation.line(), MESSAGE_LIMIT)}", file=out)
+    if diff is not None:
+        for label, items in (("moved", diff.moved), ("missing", diff.missing), ("new", diff.new),
+                             ("timing (not blocking)", diff.timing)):
+            for item in items:
+                print(f"{label}: {one_line(item, MESSAGE_LIMIT)}", file=out)
+    if args.junit:
+        args.junit.write_text(junit_xml(result, diff), encoding="utf-8")
+    if args.summary:
+        with open(args.summary, "a", encoding="utf-8") as handle:
+            handle.write(summary_markdown(result, diff))
+    passed = result.passed and not (diff and diff.blocking)
+    moved = "" if diff is None else (f"; since the baseline {len(diff.moved)} moved, {len(diff.missing)} missing, "
+                                     f"{len(diff.new)} new")
+    print(f"check {'passed' if passed else 'FAILED'}: {result.checked} metrics checked, {len(result.violations)} "
+          f"outside their bounds, {result.unchecked} without a bound{moved}", file=out)
+    return EXIT_OK if passed else EXIT_FAILED_CASES
+
+
+def cmd_check(args, out) -> int:
+    bounds = load_tolerances(args.tolerances or DEFAULT_TOLERANCES)
+    run_dir = args.run_dir
+    if run_dir is None:
+        _, latest = latest_before(history_path(args.history))
+        run_dir = Path(latest)
+    if args.explain is not None:
+        return _explain(run_dir, bounds, args.explain, out)
+    return _check(run_dir, bounds, args, out)
+
+
+def _explain(run_dir: Path, bounds, engine: str, out) -> int:
+    """What the gate holds ``engine`` to in the run of ``run_dir``: one line per scene and bound."""
+    table, _ = read_run(run_dir)
+    engines = sorted(set(table["engine"]))
+    if engine not in engines:
+        raise SimparityError(f"--explain {one_line(engine)}: no rows of that engine in {one_line(run_dir)} (allowed: "
+                             f"{', '.join(engines)})")
+    lines = explain_lines(explain(table, bounds, engine), engine in ENGINE_NAMES)
+    print("\n".join(lines) if lines else f"no bound holds {engine}'s rows", file=out)
+    return EXIT_OK
+
+
+def cmd_history(args, out) -> int:
+    table = metric_history(history_path(args.history), args.scene, args.engine, args.metric)
+    if table.empty:
+        print("no recorded values match", file=out)
+    else:
+        print(table.to_string(index=False), file=out)
+    return EXIT_OK
+
+
+def cmd_export(args, out) -> int:
+    if args.dt is not None and not (args.dt > 0 and RANGES["dt"].allows(args.dt)):
+        raise SimparityError(f"--dt {args.dt}: not a time step (allowed: a finite number of seconds > 0, "
+                             f"{RANGES['dt'].text()})")
+    scenes = library.load([args.scene])
+    if len(scenes) > 1:
+        raise SimparityError(f"{one_line(args.scene)}: a sweep of {len(scenes)} variants; export takes one (allowed: a "
+                             f"variant's name as 'simparity list' prints it, e.g. {scenes[0].name}, or a file without "
+                             "[sweep])")
+    scene = scenes[0]
+    engine = make_engine(args.engine)
+    print(engine.export(scene, args.integrator, args.dt), file=out, end="")
+    return EXIT_OK
+
+
+def cmd_show(args, out) -> int:
+    print("\n".join(describe(scene) for scene in library.load([args.scene])), file=out, end="")
+    return EXIT_OK
+
+
+def cmd_bench(args, out) -> int:
+    from simparity.comparisons.bench import run_bench  # imports every engine: only when asked
+
+    def say(line: str) -> None:
+        print(line, file=out, flush=True)
+
+    path = run_bench(args.out, args.quick, " ".join(["simparity"] + sys.argv[1:]), say)
+    say(f"wrote {path} and {path.with_name('benchmarks.csv')}")
+    return EXIT_OK
+
+
+def cmd_report(args, out) -> int:
+    write_run_report(args.run_dir, lambda line: print(line, file=out),
+                     load_tolerances(args.tolerances) if args.tolerances else None)
+    return EXIT_OK
+
+
+_COMMANDS = {"list": cmd_list, "engines": cmd_engines, "run": cmd_run, "check": cmd_check, "history": cmd_history, "export": cmd_export,
+             "show": cmd_show, "report": cmd_report, "bench": cmd_bench}
+
+
+def main(argv: list[str] | None = None, out=None) -> int:
+    """Entry point of the ``simparity`` console script; returns the exit code."""
+    out = out or sys.stdout
+    try:
+        args = build_parser().parse_args(argv)
+        return _COMMANDS[args.command](args, out)
+    except SimparityError as err:
+        print(f"simparity: error: {one_line(err, MESSAGE_LIMIT)}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:  # Ctrl-C outside a run's cases (start-up, a report): one line, not a traceback
+        print("simparity: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # the reader went away (`simparity list | head`): stop quietly, like Unix tools
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

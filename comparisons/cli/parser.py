@@ -1,0 +1,189 @@
+"""The ``simparity`` command line: its commands, options and help text (parsing only; :mod:`.main` runs them)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from simparity.comparisons.engines.registry import DEFAULT_ENGINES, allowed_engines
+from simparity.comparisons.execute.execution import default_jobs
+from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS
+from simparity.comparisons.execute.runner import DEFAULT_REPEATS
+from simparity.comparisons.execute.store import DEFAULT_OUT_ROOT
+from simparity.comparisons.gate.check import BASELINE_RELATIVE
+from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES
+from simparity.comparisons.invariance.transforms import TRANSFORM_NAMES
+from simparity.comparisons.scenes.limits import DEFAULT_LIMITS
+from simparity.comparisons.scenes.profiles import QUICK_CONTACT_STEPS, QUICK_LADDER, QUICK_MAX_STEPS, QUICK_TARGETS
+from simparity.core.model.errors import UsageError
+from simparity.core.model.scene import SUITES
+
+EXPORTABLE = ("mujoco", "pybullet", "pinocchio")
+EXECUTORS = ("local", "dask")
+MEMORY_HELP = ("80%% of the memory of the machine a case runs on, shared between its workers (on Dask: a worker's own "
+               "memory limit shared between its threads, if it has one), at least 1 GiB")
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse whose errors are one line and exit 2 like every other bad input (no usage block)."""
+
+    def error(self, message: str):
+        raise UsageError(f"{self.prog}: {message} (allowed: see '{self.prog} --help')")
+
+
+def _engine_list(text: str) -> tuple[str, ...]:
+    return tuple(n.strip() for n in text.split(",") if n.strip())
+
+
+def _add_check_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--tolerances", type=Path, default=None, metavar="FILE",
+                        help=f"bounds to hold the run to (default: the shipped {DEFAULT_TOLERANCES.name})")
+    parser.add_argument("--baseline", default=None, metavar="DIR|latest",
+                        help="also flag every metric that moved since this run ('latest': the run before, from the "
+                        "history)")
+    parser.add_argument("--baseline-rel", type=float, default=BASELINE_RELATIVE, metavar="X",
+                        help=f"relative change that counts as a move (default: {BASELINE_RELATIVE:g}); timing "
+                        "changes are listed apart and never fail the check")
+    parser.add_argument("--junit", type=Path, default=None, metavar="FILE",
+                        help="write JUnit XML: one test case per scene x engine x integrator x dt")
+    parser.add_argument("--summary", type=Path, default=None, metavar="FILE",
+                        help="write a Markdown summary (e.g. $GITHUB_STEP_SUMMARY)")
+
+
+def _add_history_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--history", default=None, metavar="PATH",
+                        help=f"run history database (default: $SIMPARITY_HISTORY or {DEFAULT_OUT_ROOT}/history.sqlite)")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="simparity",
+        description="Run textbook IK and rigid-body methods beside MuJoCo, PyBullet and Pinocchio "
+        "on identical scenes; report error, drift and speed, and check them against tolerances.",
+    )
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+
+    listing = sub.add_parser("list", help="list the built-in scenes",
+                             description="List the built-in scenes, one per line, with the suites they are in.")
+    listing.add_argument("--suite", default=None, choices=SUITES, help="only the scenes of this suite")
+
+    sub.add_parser(
+        "engines", help="list the engines: built-in and installed plugins, with what each supports",
+        description="List every engine, one per line: its name (what --engines takes), where it comes from (built-in, "
+        "or the installed package and entry point of a plugin in the group 'simparity.engines'), its version, its "
+        "dynamics integrators, IK solvers and whether it does kinematics; an engine that cannot run says why, a "
+        "plugin shadowed by a built-in of the same name says so. Code that is not packaged runs as "
+        "--engines module:Class. Writing one: docs/plugins.md.")
+
+    run = sub.add_parser(
+        "run", help="run scenes on engines and write results.csv and report.md",
+        description="Run scenes on engines; write results.csv, run.json and report.md into a new output folder, "
+        "and record the run in the history database.",
+    )
+    run.add_argument("scenes", nargs="*", metavar="SCENE|FILE",
+                     help="built-in scene names or scene files (default: the scenes of --suite)")
+    run.add_argument("--suite", default=None, choices=SUITES,
+                     help="run a built-in suite: default (what 'simparity run' runs), contact (every scene with "
+                     "planes), hard (the numerical-stability cases, each with the verdict it must earn) or bench (the "
+                     "arms 'simparity bench' times, 10,000 IK targets each)")
+    run.add_argument("--engines", type=_engine_list, default=DEFAULT_ENGINES, metavar="A,B,...",
+                     help=f"comma-separated engines to run (default: {','.join(DEFAULT_ENGINES)}; "
+                     f"known: {allowed_engines()}; 'simparity engines' lists them)")
+    run.add_argument("--out", type=Path, default=None, metavar="DIR",
+                     help=f"output folder; must not hold a run yet (default: a new {DEFAULT_OUT_ROOT}/<UTC date-time>/)")
+    run.add_argument("--force", action="store_true", help="overwrite the run already in --out")
+    run.add_argument("--repeats", type=int, default=None, metavar="N",
+                     help=f"timed repeats per case, the best is kept (default: {DEFAULT_REPEATS}; --quick: 0, one "
+                     "cold timing)")
+    run.add_argument("--quick", action="store_true",
+                     help=f"the CI profile: every scene shortened (<= {QUICK_MAX_STEPS} steps; a contact scene its "
+                     f"{QUICK_LADDER} coarsest time steps, <= {QUICK_CONTACT_STEPS} steps; {QUICK_TARGETS} IK targets), "
+                     "a few minutes on 2 cores")
+    run.add_argument("--jobs", type=int, default=None, metavar="N",
+                     help=f"worker processes (with --executor dask and no --scheduler: the local cluster's workers; "
+                     f"default: one per CPU, here {default_jobs()})")
+    run.add_argument("--executor", choices=EXECUTORS, default="local",
+                     help="where cases run: local worker processes (default), or a Dask distributed cluster (a "
+                     "LocalCluster on this machine unless --scheduler is given; needs pip install 'simparity[dask]')")
+    run.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                     help="with --executor dask: the scheduler of a running cluster, e.g. tcp://10.0.0.5:8786")
+    run.add_argument("--case-timeout", type=float, default=DEFAULT_CASE_SECONDS, metavar="SECONDS",
+                     help="a case still running after this long is killed and becomes a failed row (default: "
+                     f"{DEFAULT_CASE_SECONDS:g})")
+    run.add_argument("--case-memory", type=float, default=None, metavar="GIB",
+                     help="a case whose worker's resident memory passes this is killed and becomes a failed row "
+                     f"(default: {MEMORY_HELP})")
+    run.add_argument("--resume", type=Path, default=None, metavar="DIR",
+                     help="finish the interrupted run in DIR: its finished cases are kept, the rest run; give no "
+                     "scenes, --suite, --engines, --out, --quick, --repeats or --max-* (the run's own are used)")
+    run.add_argument("--max-steps", type=int, default=DEFAULT_LIMITS.max_steps, metavar="N",
+                     help="refuse a case of more than N body-steps per time step, or IK targets x max_iterations "
+                     f"(default: {DEFAULT_LIMITS.max_steps:,})")
+    run.add_argument("--max-samples", type=int, default=DEFAULT_LIMITS.max_samples, metavar="N",
+                     help=f"refuse more than N configurations or IK targets (default: {DEFAULT_LIMITS.max_samples:,})")
+    run.add_argument("--max-joints", type=int, default=DEFAULT_LIMITS.max_joints, metavar="N",
+                     help=f"refuse a chain or URDF file of more than N movable joints (default: "
+                     f"{DEFAULT_LIMITS.max_joints:,})")
+    run.add_argument("--transform", type=_engine_list, default=(), metavar="NAME[,NAME]",
+                     help="also run every scene transformed (" + ", ".join(TRANSFORM_NAMES) + ": 2 km from the "
+                     "origin, turned with its gravity, its bodies reordered, its units rescaled, time in ms) and add "
+                     "each engine's invariance rows (invariance_ratio_NAME <= 1, invariance_status_changes_NAME = 0; "
+                     "docs/invariance.md); costs about two more runs per transform")
+    run.add_argument("--check", action="store_true",
+                     help="check the run against tolerances when it is done (exit 1 on a violation)")
+    _add_check_options(run)
+    _add_history_option(run)
+
+    check = sub.add_parser(
+        "check", help="hold a stored run to tolerances (exit 1 on a violation)",
+        description="Hold every metric of a stored run to its bound; print each violation on one line. Exit 0 "
+        "when all are inside, 1 when any is not (or, with --baseline, when numerics moved), 2 on bad input.",
+    )
+    check.add_argument("run_dir", nargs="?", type=Path, default=None, metavar="RUN_DIR",
+                       help="a folder written by 'simparity run' (default: the latest run in the history)")
+    check.add_argument("--explain", default=None, metavar="ENGINE",
+                       help="print, per scene, every bound that holds ENGINE's rows (which rows, to what, and why) "
+                       "instead of checking; your engine is held to the bounds of its schemes' kinds")
+    _add_check_options(check)
+    _add_history_option(check)
+
+    history = sub.add_parser("history", help="how metrics moved across recorded runs",
+                             description="Show one metric (or all) across the runs recorded in the history database.")
+    history.add_argument("scene", nargs="?", default=None, metavar="SCENE")
+    history.add_argument("--engine", default=None)
+    history.add_argument("--metric", default=None)
+    _add_history_option(history)
+
+    export = sub.add_parser(
+        "export", help="print the model an adapter builds for a scene",
+        description="Print the model (MJCF, URDF or Pinocchio's model) an engine is given for a scene.",
+    )
+    export.add_argument("scene", metavar="SCENE|FILE")
+    export.add_argument("--engine", required=True, choices=EXPORTABLE)
+    export.add_argument("--integrator", default=None, help="dynamics only (default: the engine's first)")
+    export.add_argument("--dt", type=float, default=None, help="dynamics only, [s] (default: the scene's first)")
+
+    show = sub.add_parser(
+        "show", help="print a scene as the loader understood it",
+        description="Print a scene in SI units as loaded: bodies (mass, COM and inertia tensor, computed for a body "
+        "built from point masses), forces, planes (normalised), shapes and every body-plane material.")
+    show.add_argument("scene", metavar="SCENE|FILE")
+
+    bench = sub.add_parser(
+        "bench", help="measure speed with accuracy, core against the engines; write BENCHMARKS.md",
+        description="Time rigid-body stepping (B = 1, 100, 10,000 bodies), FK + Jacobian and IK (the bench suite's "
+        "arms, 10,000 targets each) for core and every engine in one run, each time with the error it reaches; "
+        "write BENCHMARKS.md and benchmarks.csv with the ratios and the targets met or missed. About 5 minutes "
+        "(--quick: about 1).")
+    bench.add_argument("--out", type=Path, default=Path("."), metavar="DIR",
+                       help="folder for BENCHMARKS.md and benchmarks.csv (default: the current folder)")
+    bench.add_argument("--quick", action="store_true", help="B = 1 and 100 only, 300 IK targets per arm")
+
+    report = sub.add_parser(
+        "report", help="re-render report.md, report.html and figures/ of a stored run",
+        description="Re-render report.md, report.html and the figures (SVG, PNG) from a stored run's results.csv, "
+        "series.csv.gz and run.json; runs no engine. Flagged findings hold the run to --tolerances.")
+    report.add_argument("run_dir", type=Path, metavar="DIR")
+    report.add_argument("--tolerances", type=Path, default=None, metavar="FILE",
+                        help=f"bounds for the flagged findings (default: the shipped {DEFAULT_TOLERANCES.name})")
+    return parser

@@ -1,0 +1,254 @@
+"""A user's engine described without running its code in simparity itself.
+
+A plugin's or spec's import, constructor, ``version()``, ``integrators()`` and the rest of what an
+engine says of itself run in a child process (``python -m simparity.comparisons.engines.probe``) with a
+time limit (:data:`PROBE_SECONDS`) and a memory limit (:data:`PROBE_MEMORY_BYTES`). An engine that
+segfaults, exits, hangs or grows without bound there becomes a
+:class:`~comparisons.placeholder_engines.BrokenEngine` naming the cause, and simparity goes on. What it
+answered comes back as a :class:`DescribedEngine`: its answers as data, all that ``simparity run``
+needs to plan its cases and ``simparity engines`` to list it. The cases themselves build the real
+engine in their worker (:mod:`comparisons.case_worker`).
+"""
+
+from __future__ import annotations
+
+import faulthandler
+import os
+import pickle
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from simparity.comparisons.execute.cases import scene_hash
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.execute.isolation import death_cause, worker_environment
+from simparity.comparisons.engines.placeholders import BrokenEngine, StandInEngine
+from simparity.comparisons.measure.rows import error_text
+from simparity.comparisons.execute.timing import status_bytes
+from simparity.core.model.engine import Engine, KinematicsModel, Simulation, Support
+from simparity.core.model.errors import PluginError, one_line
+from simparity.core.runtime.processes import die_with_parent, kill_group
+from simparity.core.model.scene import Chain, Joint
+
+PROBE_SECONDS = 60.0
+"""Time limit [s] to import, build and describe one engine: MuJoCo takes ~0.3 s, a plugin that loads a large
+library (torch) ~10 s from a cold disk; one still going after a minute is hung."""
+
+PROBE_MEMORY_BYTES = 4 * 1024 ** 3
+"""Memory limit [bytes] of a probe (or 80 % of the machine, if less): a process with every built-in engine
+loaded holds ~250 MiB; building an engine's description needs no scene's worth of memory."""
+
+POLL_SECONDS = 0.05
+"""How often a probe's time and memory are looked at."""
+
+PROBE_CHAIN = Chain("probe", (Joint("joint", "revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.eye(3)),),
+                    end_effector_xyz=np.array([1.0, 0.0, 0.0]))
+"""One revolute joint about z and a 1 m link: the chain an engine's kinematics support is asked about."""
+
+
+@dataclass(frozen=True)
+class EngineDescription:
+    """What an engine says of itself, as data.
+
+    Attributes
+    ----------
+    name, version : str
+    integrators, ik_solvers : tuple of str
+    orders : dict of str to int or None
+        ``theoretical_order`` of each integrator.
+    variants : dict of str to (str, str)
+        ``integrator_variant`` of each integrator.
+    kinematics : str
+        ``yes`` or ``no`` (its support of :data:`PROBE_CHAIN`), or ``unknown (<error>)``.
+    scene_integrators : dict of str to tuple of str or str
+        ``scene_integrators`` of each scene asked about, by :func:`~comparisons.cases.scene_hash`; the error
+        text where it raised.
+    """
+
+    name: str
+    version: str
+    integrators: tuple[str, ...]
+    ik_solvers: tuple[str, ...]
+    orders: dict[str, int | None]
+    variants: dict[str, tuple[str, str]]
+    kinematics: str
+    scene_integrators: dict[str, tuple[str, ...] | str] = field(default_factory=dict)
+
+
+class DescribedEngine(Engine):
+    """An engine known by its :class:`EngineDescription` only: it answers what the description holds and runs
+    nothing (its cases build the real engine in a worker)."""
+
+    def __init__(self, description: EngineDescription) -> None:
+        self.description = description
+        self.name = description.name
+
+    def version(self) -> str:
+        return self.description.version
+
+    def integrators(self) -> tuple[str, ...]:
+        return self.description.integrators
+
+    def ik_solvers(self) -> tuple[str, ...]:
+        return self.description.ik_solvers
+
+    def theoretical_order(self, integrator: str) -> int | None:
+        return self.description.orders.get(integrator)
+
+    def integrator_variant(self, integrator: str) -> tuple[str, str]:
+        return self.description.variants.get(integrator, (integrator, ""))
+
+    def scene_integrators(self, scene) -> tuple[str, ...]:
+        found = self.description.scene_integrators.get(scene_hash(scene))
+        if found is None:
+            raise PluginError(f"{self.name} was not asked about scene {scene.name} (a harness bug)")
+        if isinstance(found, str):
+            raise PluginError(found)
+        return found
+
+    def supports_kinematics(self, chain) -> Support:
+        if chain is not PROBE_CHAIN:
+            raise PluginError(f"{self.name} is described, not built: only its worker can answer for {chain.name}")
+        if self.description.kinematics == "yes":
+            return Support.yes()
+        return Support.no(self.description.kinematics)
+
+    def supports_dynamics(self, scene, integrator: str) -> Support:
+        raise PluginError(f"{self.name} is described, not built: its cases run in a worker")
+
+    def build_dynamics(self, scene, integrator: str, dt: float) -> Simulation:
+        raise PluginError(f"{self.name} is described, not built: its cases run in a worker")
+
+    def build_kinematics(self, chain) -> KinematicsModel:
+        raise PluginError(f"{self.name} is described, not built: its cases run in a worker")
+
+
+def describe(engine: Engine, scenes: list) -> EngineDescription:
+    """The description of a built engine, asked about ``scenes`` (an engine that loaded passed the interface
+    checks of :func:`~comparisons.plugins.load_engine`, so only ``scene_integrators`` and kinematics support
+    may still raise)."""
+    integrators = engine.integrators()
+    kinematics = "unknown"
+    try:
+        kinematics = "yes" if engine.supports_kinematics(PROBE_CHAIN).ok else "no"
+    except Exception as err:  # noqa: BLE001 - a user's engine: say what it raised
+        kinematics = f"unknown ({one_line(error_text(err))})"
+    by_scene: dict[str, tuple[str, ...] | str] = {}
+    for scene in scenes:
+        try:
+            by_scene[scene_hash(scene)] = tuple(engine.scene_integrators(scene))
+        except Exception as err:  # noqa: BLE001 - its case in that scene fails with the error
+            by_scene[scene_hash(scene)] = f"scene_integrators({scene.name}) raised {one_line(error_text(err))}"
+    return EngineDescription(engine.name, engine.version(), integrators, engine.ik_solvers(),
+                             {i: engine.theoretical_order(i) for i in integrators},
+                             {i: engine.integrator_variant(i) for i in integrators}, kinematics, by_scene)
+
+
+def probe_engines(names: list[str], scenes: Sequence = ()) -> dict[str, Engine]:
+    """Each of ``names`` (a plugin's name or a spec ``module:attr``) described in a process of its own, all at
+    once: a :class:`DescribedEngine`, or a :class:`BrokenEngine` standing in for one that cannot run, naming
+    what went wrong: it does not import, an error, a crash, a hang, a memory blow-up."""
+    probes = {name: _Probe(name, list(scenes)) for name in names}
+    try:
+        deadline = time.monotonic() + PROBE_SECONDS
+        while any(p.process.poll() is None for p in probes.values()):
+            for probe in probes.values():
+                if probe.process.poll() is None:
+                    probe.enforce(deadline)
+            time.sleep(POLL_SECONDS)
+        return {name: probe.result() for name, probe in probes.items()}
+    finally:
+        for probe in probes.values():
+            probe.close()
+
+
+def _memory_limit() -> int:
+    physical = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    return min(PROBE_MEMORY_BYTES, int(0.8 * physical))
+
+
+class _Probe:
+    """One probe process: its request (on its standard input), the file it answers in (an inherited descriptor),
+    its standard error, why it was stopped ("" if not). Every file is anonymous: a killed run leaves none."""
+
+    def __init__(self, name: str, scenes: list) -> None:
+        self.name = name
+        request = tempfile.TemporaryFile()
+        pickle.dump((name, scenes), request)
+        request.seek(0)
+        self.answer, self.stderr = tempfile.TemporaryFile(), tempfile.TemporaryFile()
+        self.stopped = ""
+        with request:
+            self.process = subprocess.Popen(
+                [sys.executable, "-m", "simparity.comparisons.engines.probe", str(self.answer.fileno()),
+                 str(os.getpid())],
+                stdin=request, stdout=subprocess.DEVNULL, stderr=self.stderr, pass_fds=(self.answer.fileno(),),
+                env=worker_environment(), start_new_session=True)
+
+    def enforce(self, deadline: float) -> None:
+        """Kill the probe if it is past the deadline or its memory limit."""
+        if time.monotonic() > deadline:
+            self.stopped = (f"hung: building and describing it took more than {PROBE_SECONDS:g} s; the process was "
+                            "killed")
+        elif (status_bytes("VmRSS", self.process.pid) or 0) > _memory_limit():
+            self.stopped = (f"out of memory: building and describing it went past the limit of "
+                            f"{_memory_limit() / 1024 ** 3:.3g} GiB; the process was killed")
+        if self.stopped:
+            self.kill()
+
+    def kill(self) -> None:
+        kill_group(self.process.pid)
+        self.process.wait()
+
+    def result(self) -> Engine:
+        code = self.process.wait()
+        self.answer.seek(0)
+        if not self.stopped and code == 0 and (answer := self.answer.read()):
+            kind, value = pickle.loads(answer)
+            if kind == "described":
+                return DescribedEngine(value)
+            return value
+        if not self.stopped:
+            self.stderr.seek(0)
+            self.stopped = death_cause(code, self.stderr.read()[-64 * 1024:].decode("utf-8", "replace"),
+                                       "the process building it")
+        return BrokenEngine(self.name, self.stopped)
+
+    def close(self) -> None:
+        if self.process.poll() is None:
+            self.kill()
+        self.stderr.close()
+        self.answer.close()
+
+
+def main(argv: list[str]) -> int:
+    """The probe process: build the engine its standard input names, write its description (or stand-in) to the
+    descriptor ``argv[1]``; ``argv[2]`` is the parent's pid."""
+    die_with_parent(int(argv[2]))
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    faulthandler.enable()
+    name, scenes = pickle.load(sys.stdin.buffer)
+    engine = make_engine(name)
+    answer: tuple[str, object]
+    if isinstance(engine, StandInEngine):
+        answer = ("stand-in", engine)
+    else:
+        try:
+            answer = ("described", describe(engine, scenes))
+        except (Exception, SystemExit) as err:  # noqa: BLE001 - a user's code
+            answer = ("stand-in", BrokenEngine(name, f"describing it raised {one_line(error_text(err))}"))
+    with os.fdopen(int(argv[1]), "wb") as f:
+        pickle.dump(answer, f)
+    os._exit(0)  # no interpreter shutdown: a user's atexit or finaliser cannot change the answer
+
+
+if __name__ == "__main__":  # run by its package name, so what it pickles names simparity's module, not __main__
+    from simparity.comparisons.engines import probe as engine_probe
+
+    sys.exit(engine_probe.main(sys.argv))

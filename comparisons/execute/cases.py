@@ -1,0 +1,256 @@
+"""The unit of work: a case (scene x engine x integrator or solver x dt), grouped by what its cases share.
+
+A scene is planned (:func:`plan_scene`) into :class:`CaseGroup` s: a dynamics scene into one group per
+time step (its cases share that step's reference trajectory) and one for the penalty integrators'
+stability limits; a kinematics scene into one group (the reference FK); an IK scene into one group
+(the targets and the judges' FK). A group runs in one worker (``runner.run_group``), case by case,
+each case giving a :class:`CaseOutcome`; :func:`assemble_scene` puts a scene's outcomes back together
+with what needs them all (observed orders of convergence, the IK agreement matrix), in the same
+order whatever ran where. Every case has a :class:`CaseKey` a finished outcome is stored under, so an
+interrupted run resumes where it stopped.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import hashlib
+import math
+import struct
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import cast
+
+import numpy as np
+
+from simparity.comparisons.engines.placeholders import StandInEngine
+from simparity.core.model.engine import Engine
+from simparity.core.model.results import ResultRow, SeriesRecord
+from simparity.core.model.scene import PENALTY_PREFIX, DynamicsScene, IKScene, KinematicsScene, Scene
+
+DYNAMICS, STABILITY, KINEMATICS, IK = "dynamics", "stability", "kinematics", "ik"
+"""What a group computes: stepping at one dt, the penalty integrators' stability limits, FK and
+Jacobians, IK solves."""
+
+NO_INTEGRATOR = "-"
+"""The integrator of the one n/a case of an engine that offers none of the integrators a scene runs
+(or no IK solver)."""
+
+
+@dataclass(frozen=True)
+class CaseSpec:
+    """One case of a group: ``integrator`` holds the IK solver for IK, "" for kinematics."""
+
+    engine: str
+    integrator: str
+
+
+@dataclass(frozen=True)
+class CaseGroup:
+    """Cases that share what is computed once for them, run together in one worker.
+
+    Attributes
+    ----------
+    scene : Scene
+    scene_hash : str
+        :func:`scene_hash` of ``scene``.
+    kind : str
+        DYNAMICS, STABILITY, KINEMATICS or IK.
+    dt : float
+        The time step [s] of a DYNAMICS group; NaN otherwise.
+    cases : tuple of CaseSpec
+    engines : tuple of (str, str)
+        (name, spec) of every engine of the run, in order (an IK group's judges); a worker builds an
+        engine from its spec (``comparisons.engines.make_engine``), a reference from its name.
+    repeats : int
+        Timed repeats per case.
+    reference_label : str
+        The reference named in the rows (``engine:integrator``).
+    stand_ins : tuple of StandInEngine
+        The run's engines that cannot run (:mod:`comparisons.placeholder_engines`): a worker uses them as they
+        are instead of building the engine again.
+    """
+
+    scene: Scene
+    scene_hash: str
+    kind: str
+    dt: float
+    cases: tuple[CaseSpec, ...]
+    engines: tuple[tuple[str, str], ...]
+    repeats: int
+    reference_label: str
+    stand_ins: tuple[StandInEngine, ...] = ()
+
+    @property
+    def engine_names(self) -> tuple[str, ...]:
+        return tuple(name for name, _ in self.engines)
+
+    @property
+    def dynamics_scene(self) -> DynamicsScene:
+        """The scene of a DYNAMICS or STABILITY group (planned only for dynamics scenes)."""
+        return cast(DynamicsScene, self.scene)
+
+    @property
+    def kinematics_scene(self) -> KinematicsScene:
+        """The scene of a KINEMATICS group."""
+        return cast(KinematicsScene, self.scene)
+
+    @property
+    def ik_scene(self) -> IKScene:
+        """The scene of an IK group."""
+        return cast(IKScene, self.scene)
+
+    def spec_of(self, name: str) -> str:
+        """What to build engine ``name`` from: its spec if it is one of the run's, else the name itself."""
+        return dict(self.engines).get(name, name)
+
+
+@dataclass
+class CaseOutcome:
+    """What one case produced.
+
+    Attributes
+    ----------
+    rows : list of ResultRow
+    series : list of SeriesRecord
+    errors, floors : dict
+        A dynamics case's raw errors and their rounding floors, for the order fits.
+    saturation : dict
+        A dynamics case's saturation ratio of each error (>= 1: saturated; ``metrics.saturation_ratios``).
+    integrates_rotation : bool
+    ends : dict of str to ndarray
+        An IK case's end-effector positions (N, 3) [m] of its solutions by each judge's FK.
+    reference_label : str
+        An IK case's label naming its judges (the agreement matrix's).
+    theoretical_order : int or None
+        A dynamics case's integrator's theoretical order, as its engine declares it (None: unknown).
+    harness_failure : bool
+        True when the case did not finish (its worker crashed, hung or ran out of memory): a resumed
+        run computes it again.
+    """
+
+    rows: list[ResultRow]
+    series: list[SeriesRecord] = field(default_factory=list)
+    errors: dict[str, float] = field(default_factory=dict)
+    floors: dict[str, float] = field(default_factory=dict)
+    integrates_rotation: bool = True
+    ends: dict[str, np.ndarray] = field(default_factory=dict)
+    reference_label: str = ""
+    harness_failure: bool = False
+    saturation: dict[str, float] = field(default_factory=dict)
+    theoretical_order: int | None = None
+
+
+@dataclass(frozen=True)
+class CaseKey:
+    """What a finished case is stored and found again under: the scene's content, the engine and its
+    version, the integrator (or solver) and the time step, and what the group computes."""
+
+    scene_hash: str
+    engine: str
+    engine_version: str
+    integrator: str
+    dt: float
+    kind: str
+
+    def digest(self) -> str:
+        """A file-name-safe hash of the key (hex, 64 characters)."""
+        text = "\0".join([self.scene_hash, self.engine, self.engine_version, self.integrator,
+                          float(self.dt).hex(), self.kind])
+        return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def case_key(group: CaseGroup, spec: CaseSpec, versions: dict[str, str]) -> CaseKey:
+    """The key of ``spec`` of ``group``; ``versions`` maps engine names to their versions."""
+    return CaseKey(group.scene_hash, spec.engine, versions[spec.engine], spec.integrator, group.dt, group.kind)
+
+
+def scene_hash(scene) -> str:
+    """SHA-256 of a scene's content: every field of its dataclasses that takes part in their equality (not
+    ``compare=False`` ones, such as the file a scene was read from: the same file by a relative or an absolute
+    path, or moved, is the same scene), arrays by dtype, shape and bytes, floats exactly. The same scene
+    loaded twice, in any process, hashes the same."""
+    digest = hashlib.sha256()
+    _feed(digest, scene)
+    return digest.hexdigest()
+
+
+def _feed(digest, value) -> None:
+    """Feed ``value`` to ``digest`` with its type, so different structures never give the same bytes."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        digest.update(f"<{type(value).__qualname__}".encode())
+        for f in (f for f in dataclasses.fields(value) if f.compare):
+            digest.update(f.name.encode() + b"=")
+            _feed(digest, getattr(value, f.name))
+        digest.update(b">")
+    elif isinstance(value, np.ndarray):
+        digest.update(f"<array {value.dtype.str} {value.shape}>".encode())
+        digest.update(np.ascontiguousarray(value).tobytes())
+    elif isinstance(value, (list, tuple)):
+        digest.update(f"<{type(value).__name__} {len(value)}".encode())
+        for item in value:
+            _feed(digest, item)
+        digest.update(b">")
+    elif isinstance(value, Mapping):
+        digest.update(f"<dict {len(value)}".encode())
+        for k in sorted(value, key=repr):
+            _feed(digest, k)
+            _feed(digest, value[k])
+        digest.update(b">")
+    elif isinstance(value, enum.Enum):
+        digest.update(f"<enum {type(value).__qualname__}.{value.name}>".encode())
+    elif isinstance(value, bool) or value is None:
+        digest.update(f"<{value!r}>".encode())
+    elif isinstance(value, (int, np.integer)):
+        digest.update(f"<int {int(value)}>".encode())
+    elif isinstance(value, (float, np.floating)):
+        digest.update(b"<float" + struct.pack("<d", float(value)) + b">")
+    elif isinstance(value, str):
+        digest.update(f"<str {len(value)}>".encode() + value.encode("utf-8", "surrogatepass"))
+    else:
+        raise TypeError(f"scene_hash: cannot hash a {type(value).__name__}")
+
+
+def _integrators(scene: DynamicsScene, engine: Engine) -> list[str]:
+    """The engine's integrators the scene runs (all it offers unless the scene names some); none when the
+    engine fails to say (its one case then fails in a worker, with the error)."""
+    try:
+        offered = tuple(engine.scene_integrators(scene))
+    except Exception:  # noqa: BLE001 - a user's engine: its n/a case reports the error
+        return []
+    return [i for i in offered if not scene.integrators or i in scene.integrators]
+
+
+def _solvers(engine: Engine) -> tuple[str, ...]:
+    """The engine's IK solvers; none when it fails to say (its one case then fails with the error)."""
+    try:
+        return tuple(engine.ik_solvers())
+    except Exception:  # noqa: BLE001 - a user's engine: its case reports the error
+        return ()
+
+
+def plan_scene(scene, engines: list[Engine], reference: Engine, repeats: int,
+               specs: dict[str, str] | None = None) -> list[CaseGroup]:
+    """The groups of ``scene`` on ``engines`` (built engines, in the run's order) measured against
+    ``reference``, in the order their rows are stored; ``specs`` maps engine names to what they were built
+    from when that is not the name."""
+    names = tuple((e.name, (specs or {}).get(e.name, e.name)) for e in engines)
+    stand_ins = tuple(e for e in engines if isinstance(e, StandInEngine))
+    digest = scene_hash(scene)
+
+    def group(kind: str, dt: float, cases: list[CaseSpec], label: str) -> CaseGroup:
+        return CaseGroup(scene, digest, kind, dt, tuple(cases), names, repeats, label, stand_ins)
+
+    if isinstance(scene, IKScene):
+        cases = [CaseSpec(e.name, s) for e in engines for s in _solvers(e) or (NO_INTEGRATOR,)]
+        return [group(IK, math.nan, cases, f"{scene.reference}:fk")]
+    if not isinstance(scene, DynamicsScene):
+        return [group(KINEMATICS, math.nan, [CaseSpec(e.name, "") for e in engines], f"{reference.name}:fk")]
+    label = f"{reference.name}:{reference.scene_integrators(scene)[0]}"
+    cases = [CaseSpec(e.name, i) for e in engines for i in (_integrators(scene, e) or [NO_INTEGRATOR])]
+    groups = [group(DYNAMICS, dt, cases, label) for dt in scene.dts]
+    if scene.contact is not None:
+        penalty = [c for c in cases if c.integrator.startswith(PENALTY_PREFIX)]
+        if penalty:
+            groups.append(group(STABILITY, math.nan, penalty, label))
+    return groups

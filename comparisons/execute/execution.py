@@ -1,0 +1,141 @@
+"""Running a run's scenes: planned into case groups, executed anywhere, handed back scene by scene in order.
+
+Every scene is planned into groups of cases (:mod:`comparisons.cases`); cases already in the run's
+:class:`~comparisons.journal.Journal` (a resumed run) are taken from it, the others go to an
+executor — local worker processes (:class:`~comparisons.isolation.IsolatedPool`) or a Dask cluster
+(:mod:`comparisons.dask_executor`) — costliest group first. Each case is journaled as it finishes;
+a scene's rows come back as soon as it and every scene before it are complete, so the stored run
+keeps the suite's order whatever finished first, and is the same whatever executed it.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Callable, Iterator, Protocol, cast
+
+from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome, case_key, plan_scene
+from simparity.comparisons.execute.isolation import Job
+from simparity.comparisons.execute.journal import Journal
+from simparity.comparisons.execute.runner import assemble_scene
+from simparity.core.model.engine import Engine
+from simparity.core.model.results import ResultRow, SeriesRecord
+from simparity.core.model.scene import DynamicsScene, IKScene, Scene
+
+OnCase = Callable[[str, str, str], None]
+"""Called with (scene, engine, integrator or solver) after each case, in the calling process."""
+
+SECONDS_PER_UNIT = {"dynamics": 5e-4, "ik": 1.7e-3, "kinematics": 1.2e-4}
+"""Seconds per case x (steps x bodies, targets, or configurations), measured on the default suite
+(2026-11-23, 2 cores, repeats on); only their ratios matter: they order the groups."""
+
+
+def default_jobs() -> int:
+    """Worker processes by default: one per CPU."""
+    return max(1, os.cpu_count() or 1)
+
+
+class Executor(Protocol):
+    """Runs jobs (case groups) somewhere and hands back each case's outcome as it finishes."""
+
+    def run(self, jobs: list[Job]) -> Iterator[tuple[object, int, CaseOutcome]]:
+        """(job key, case index, outcome) of every case not skipped; the jobs are given costliest first."""
+
+    def close(self) -> None:
+        """Stop the workers."""
+
+
+def estimated_cost(group: CaseGroup) -> float:
+    """A group's rough cost [s], to start the costliest first: its cases times the work of one."""
+    scene, cases = group.scene, len(group.cases)
+    if isinstance(scene, DynamicsScene):
+        steps = scene.n_steps(group.dt) if group.dt == group.dt else max(scene.n_steps(dt) for dt in scene.dts)
+        return cases * steps * len(scene.bodies) * SECONDS_PER_UNIT["dynamics"]
+    if isinstance(scene, IKScene):
+        return cases * (scene.n_targets + len(scene.hard_targets)) * SECONDS_PER_UNIT["ik"]
+    return cases * scene.n_configurations * SECONDS_PER_UNIT["kinematics"]
+
+
+@dataclass
+class _Scene:
+    """A scene of the run: its groups and, as they arrive, its cases' outcomes (``outcomes[g][c]``)."""
+
+    scene: Scene
+    groups: list[CaseGroup]
+    outcomes: list[list[CaseOutcome | None]]
+
+    @property
+    def complete(self) -> bool:
+        return all(o is not None for group in self.outcomes for o in group)
+
+
+def plan_run(scenes: list, engines: list[Engine], make_engine: Callable[[str], Engine], repeats: int,
+             specs: dict[str, str] | None = None) -> list[_Scene]:
+    """Every scene's groups on ``engines`` (built from ``specs`` when not from their names), outcomes still to
+    come."""
+    by_name = {e.name: e for e in engines}
+    planned = []
+    for scene in scenes:
+        reference = by_name.get(scene.reference) or by_name.setdefault(scene.reference, make_engine(scene.reference))
+        groups = plan_scene(scene, engines, reference, repeats, specs)
+        planned.append(_Scene(scene, groups, [[None] * len(g.cases) for g in groups]))
+    return planned
+
+
+def run_scenes(scenes: list, engines: list[Engine], make_engine: Callable[[str], Engine], repeats: int,
+               executor: Executor, journal: Journal | None = None, on_case: OnCase | None = None,
+               specs: dict[str, str] | None = None) -> Iterator[tuple[Scene, list[ResultRow], list[SeriesRecord]]]:
+    """(scene, rows, sampled series) for every scene, in order. Cases found in ``journal`` are not run
+    again; every case run is journaled as it finishes. Interrupted (KeyboardInterrupt), it first hands back
+    the finished cases of every scene not yet complete (without what needs them all: orders, agreement),
+    then raises. ``on_case`` hears of every case, restored ones
+    first. ``specs`` maps engine names to what the workers build them from, when that is not the name."""
+    on_case = on_case or (lambda scene, engine, integrator: None)
+    versions = {e.name: e.version() for e in engines}
+    planned = plan_run(scenes, engines, make_engine, repeats, specs)
+    jobs = []
+    for s, item in enumerate(planned):
+        for g, group in enumerate(item.groups):
+            skip = set()
+            for c, spec in enumerate(group.cases):
+                found = None if journal is None else journal.load(case_key(group, spec, versions))
+                if found is not None:
+                    item.outcomes[g][c] = found
+                    skip.add(c)
+                    on_case(item.scene.name, spec.engine, spec.integrator)
+            if len(skip) < len(group.cases):
+                jobs.append(Job((s, g), group, skip))
+    jobs.sort(key=lambda job: -estimated_cost(job.group))
+    emitted = 0
+    try:
+        for key, c, outcome in executor.run(jobs):
+            s, g = cast(tuple[int, int], key)  # the keys given to the jobs above
+            item = planned[s]
+            group = item.groups[g]
+            item.outcomes[g][c] = outcome
+            if journal is not None:
+                journal.save(case_key(group, group.cases[c], versions), outcome)
+            on_case(item.scene.name, group.cases[c].engine, group.cases[c].integrator)
+            while emitted < len(planned) and planned[emitted].complete:
+                yield _assembled(planned[emitted])
+                emitted += 1
+    except KeyboardInterrupt:  # hand back every finished case of the scenes not complete, then stop
+        for item in planned[emitted:]:
+            rows = [r for results in item.outcomes for o in results if o is not None for r in o.rows]
+            if rows:
+                yield item.scene, rows, [r for results in item.outcomes for o in results if o is not None
+                                         for r in o.series]
+        raise
+    while emitted < len(planned):  # scenes restored whole from the journal after the last case run
+        yield _assembled(planned[emitted])
+        emitted += 1
+
+
+def _assembled(item: _Scene) -> tuple[Scene, list[ResultRow], list[SeriesRecord]]:
+    rows, series = assemble_scene(item.scene, item.groups, cast(list[list[CaseOutcome]], item.outcomes))  # complete
+    return item.scene, rows, series
+
+
+def count_cases(scenes: list, engines: list[Engine], make_engine: Callable[[str], Engine]) -> list[int]:
+    """The number of cases of each scene (each reported once to ``on_case``)."""
+    return [sum(len(g.cases) for g in item.groups) for item in plan_run(scenes, engines, make_engine, 0)]

@@ -1,0 +1,290 @@
+"""Worker processes that run case groups with a time and a memory limit per case.
+
+Each worker is a fresh Python process (:mod:`comparisons.case_worker`) speaking over two pipes. The
+pool hands a worker one group at a time and watches it: a worker that dies (a segfault in an engine,
+``os._exit``), goes past the per-case time limit or past the per-case memory limit (resident memory,
+read from /proc) is killed and replaced; the case it was running becomes ``failed`` rows naming the
+cause, and the rest of its group goes on in the new worker. A group's shared part (its reference)
+that takes a worker down is not tried again: its cases run without it.
+"""
+
+from __future__ import annotations
+
+import collections
+import os
+import signal
+import subprocess
+import sys
+import sysconfig
+import tempfile
+import time
+from dataclasses import dataclass, field
+from multiprocessing.connection import Connection, wait
+from typing import Iterator, cast
+
+from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome
+from simparity.comparisons.execute.runner import failed_outcome
+from simparity.comparisons.execute.timing import status_bytes
+from simparity.core.runtime.processes import kill_group
+
+GIB = 1024 ** 3
+
+DEFAULT_CASE_SECONDS = 900.0
+"""Per-case time limit [s] by default: 15 minutes, ~5x the longest case of the built-in suites (the
+bench suite's 10,000 IK targets on PyBullet, ~3 min); a case that needs more is given --case-timeout."""
+
+MEMORY_SHARE = 0.8
+"""Share of the machine's memory the workers may use together by default; the rest is the system's
+and the parent's."""
+
+MIN_MEMORY_BYTES = 1 * GIB
+"""The smallest per-case memory limit by default, on small machines: every built-in scene fits in 1 GiB."""
+
+POLL_SECONDS = 0.05
+"""How often a worker's time and memory are looked at: an allocation of ~1 GB/s overshoots the limit
+by ~50 MB before it is caught."""
+
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+"""Set to 1 in every worker: each worker is one CPU, many small matrix products gain nothing from BLAS
+threads, and results do not depend on how many threads summed them."""
+
+EXIT_GRACE_SECONDS = 1.0
+"""How long a worker whose pipe closed is given to exit by itself before it is killed (a Python exception or
+``sys.exit`` takes milliseconds; killing it at once would report signal 9 instead of its exit code)."""
+
+STDERR_TAIL_BYTES = 64 * 1024
+"""How much of a dead worker's standard error is read for the cause of its death."""
+
+
+def physical_memory_bytes() -> int:
+    """The machine's memory [bytes]."""
+    return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+
+
+@dataclass(frozen=True)
+class CaseLimits:
+    """What one case may take: wall time [s] and resident memory of its worker [bytes]; None: the default of the
+    machine that runs it, resolved there (a Dask node's, :func:`comparisons.dask_executor.node_memory_bytes`)."""
+
+    seconds: float
+    memory_bytes: int | None
+
+    @classmethod
+    def default(cls, workers: int) -> "CaseLimits":
+        """:data:`DEFAULT_CASE_SECONDS`, and :data:`MEMORY_SHARE` of the machine split between ``workers``."""
+        share = int(MEMORY_SHARE * physical_memory_bytes() / max(1, workers))
+        return cls(DEFAULT_CASE_SECONDS, max(MIN_MEMORY_BYTES, share))
+
+
+def worker_environment() -> dict[str, str]:
+    """The environment of a worker: this one, with one BLAS thread and this process's import path."""
+    env = dict(os.environ)
+    for variable in BLAS_THREAD_VARIABLES:
+        env[variable] = "1"
+    env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
+    return env
+
+
+@dataclass
+class Job:
+    """A group to run: ``key`` names it to the caller; ``skip`` are its cases already done."""
+
+    key: object
+    group: CaseGroup
+    skip: set[int] = field(default_factory=set)
+    reference_failure: str = ""
+
+
+class _Worker:
+    """One worker process, the job it runs and what it is doing."""
+
+    def __init__(self) -> None:
+        child_reads, parent_writes = os.pipe()
+        parent_reads, child_writes = os.pipe()
+        self.stderr = tempfile.TemporaryFile(mode="a+b")  # append mode: the parent may truncate it
+        self.process = subprocess.Popen(
+            [sys.executable, "-m", "simparity.comparisons.execute.case_worker", str(child_reads), str(child_writes),
+             str(os.getpid())],
+            pass_fds=(child_reads, child_writes), stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+            stderr=self.stderr, env=worker_environment(), start_new_session=True)
+        os.close(child_reads)
+        os.close(child_writes)
+        self.outbox = Connection(parent_writes, readable=False)
+        self.inbox = Connection(parent_reads, writable=False)
+        self.job: Job | None = None
+        self.phase: int | None = None
+        self.phase_pid = self.process.pid
+        self.since = time.monotonic()
+
+    def start(self, job: Job) -> None:
+        self.stderr.truncate(0)
+        self.job, self.phase, self.phase_pid, self.since = job, None, self.process.pid, time.monotonic()
+        self.outbox.send((job.group, frozenset(job.skip), job.reference_failure))
+
+    def kill(self, grace_seconds: float = 0.0) -> int:
+        """Kill the process (if still alive after ``grace_seconds`` to exit by itself) and return its exit code."""
+        try:
+            self.process.wait(timeout=grace_seconds)
+        except subprocess.TimeoutExpired:
+            pass
+        kill_group(self.process.pid)  # the worker and what it forked, but the child running a case ...
+        if self.phase_pid != self.process.pid:
+            kill_group(self.phase_pid)  # ... which leads a group of its own (case_worker), with what it started
+        code = self.process.wait()
+        for end in (self.inbox, self.outbox):
+            end.close()
+        return code
+
+    def stderr_tail(self) -> str:
+        self.stderr.seek(0, os.SEEK_END)
+        size = self.stderr.tell()
+        self.stderr.seek(max(0, size - STDERR_TAIL_BYTES))
+        return self.stderr.read().decode("utf-8", "replace")
+
+    def close(self) -> None:
+        self.kill()
+        self.stderr.close()
+
+
+def death_cause(code: int, stderr: str, process: str = "the worker") -> str:
+    """Why ``process`` died, from its exit code and the end of its standard error (faulthandler's stack)."""
+    if code < 0:
+        name = signal.Signals(-code).name if -code in signal.valid_signals() else f"signal {-code}"
+        cause = f"crashed: {process} was killed by signal {-code} ({name})"
+        if -code == signal.SIGKILL:
+            cause += " (the system's out-of-memory killer, or another process)"
+    else:
+        cause = f"crashed: {process} exited with code {code}" + (" before its cases finished" if code == 0 else "")
+    lines = [line.strip() for line in stderr.splitlines() if line.strip()]
+    frames = [line for line in lines if line.startswith("File ")]
+    faulthandler_stack = any(line.startswith(("Current thread", "Thread 0x")) for line in lines)
+    if faulthandler_stack and frames:  # most recent call first
+        cause += f", in {frames[0]}"
+        own = next((f for f in frames if not _in_stdlib(f)), frames[0])
+        if own != frames[0]:  # the crash is in the standard library (ctypes): say whose code called it
+            cause += f", called from {own}"
+    elif lines:  # a Python traceback: its last line is the error
+        cause += f": {lines[-1][:300]}" + (f" ({frames[-1][:200]})" if frames else "")
+    return cause
+
+
+def _in_stdlib(frame: str) -> bool:
+    """True when a faulthandler frame line (``File "path", line N in name``) is in Python's standard library."""
+    path = frame.split('"')[1] if frame.count('"') >= 2 else ""
+    stdlib = sysconfig.get_paths()["stdlib"]
+    return path.startswith(stdlib + os.sep) and "site-packages" not in path
+
+
+class IsolatedPool:
+    """``workers`` worker processes running jobs under ``limits``; replaced when one is killed."""
+
+    def __init__(self, workers: int, limits: CaseLimits) -> None:
+        if workers < 1:
+            raise ValueError(f"workers {workers}: at least 1")
+        self.limits = limits
+        self._workers = [_Worker() for _ in range(workers)]
+
+    def run(self, jobs: list[Job]) -> Iterator[tuple[object, int, CaseOutcome]]:
+        """(job key, case index, outcome) of every case of ``jobs`` not skipped, as each finishes; jobs start
+        in the given order."""
+        pending = collections.deque(jobs)
+        while True:
+            for k in range(len(self._workers)):
+                if self._workers[k].job is None and pending:
+                    self._start(k, pending.popleft())
+            busy = [w for w in self._workers if w.job is not None]
+            if not busy:
+                return
+            ready = wait([w.inbox for w in busy], timeout=POLL_SECONDS)
+            for worker in busy:
+                if worker.inbox in ready:
+                    yield from self._receive(worker, pending)
+                elif worker.job is not None:
+                    yield from self._enforce_limits(worker, pending)
+
+    def _start(self, k: int, job: Job) -> None:
+        """Hand ``job`` to worker ``k``, replacing the worker first if it died while idle."""
+        try:
+            self._workers[k].start(job)
+        except OSError:
+            self._workers[k].close()
+            self._workers[k] = _Worker()
+            self._workers[k].start(job)
+
+    def _receive(self, worker: _Worker, pending: collections.deque) -> Iterator[tuple[object, int, CaseOutcome]]:
+        try:
+            message = worker.inbox.recv()
+        except (EOFError, OSError):  # the worker is exiting: its own exit code says more than a kill's
+            code = worker.kill(EXIT_GRACE_SECONDS)
+            yield from self._replace(worker, death_cause(code, worker.stderr_tail()), pending)
+            return
+        except Exception as err:  # noqa: BLE001 - bytes that are no message: something else wrote to the pipe
+            worker.kill()
+            yield from self._replace(worker, f"crashed: the case's process wrote what is not a message to its pipe "
+                                     f"({type(err).__name__}); the worker was killed", pending)
+            return
+        job = cast(Job, worker.job)  # a worker reports only while it runs a job
+        if message[0] == "start":
+            worker.phase, worker.phase_pid, worker.since = message[1], message[2], time.monotonic()
+        elif message[0] == "crashed":  # the child running the cases of one engine died; the worker lives on
+            cause = death_cause(message[1], worker.stderr_tail(), "the case's process")
+            worker.phase = message[2] if worker.phase is None else worker.phase
+            yield from self._fail_phase(worker, cause, pending)
+            worker.job = None
+        elif message[0] == "done":
+            job.skip.add(message[1])
+            yield job.key, message[1], message[2]
+        else:  # the group is done
+            worker.job = None
+
+    def _enforce_limits(self, worker: _Worker, pending) -> Iterator[tuple[object, int, CaseOutcome]]:
+        if worker.process.poll() is not None:  # died, its pipe held open by a child it forked
+            code = worker.kill()
+            yield from self._replace(worker, death_cause(code, worker.stderr_tail()), pending)
+            return
+        elapsed = time.monotonic() - worker.since
+        if elapsed > self.limits.seconds:
+            worker.kill()
+            yield from self._replace(worker, f"hung: no result within the per-case time limit of "
+                                     f"{self.limits.seconds:g} s; the worker was killed", pending)
+            return
+        limit = self.limits.memory_bytes
+        if limit is not None and (status_bytes("VmRSS", worker.phase_pid) or 0) > limit:
+            worker.kill()
+            # not how far past: the memory at the instant it was looked at differs from run to run, the rows must not
+            cause = (f"out of memory: the worker's resident memory went past the per-case limit of "
+                     f"{limit / GIB:.3g} GiB; the worker was killed")
+            yield from self._replace(worker, cause, pending)
+
+    def _replace(self, worker: _Worker, cause: str, pending: collections.deque) -> Iterator[tuple[object, int, CaseOutcome]]:
+        """A new process in ``worker``'s place; the case it ran fails with ``cause``, the rest of its job goes
+        first in the queue."""
+        worker.stderr.close()
+        self._workers[self._workers.index(worker)] = _Worker()
+        yield from self._fail_phase(worker, cause, pending)
+
+    def _fail_phase(self, worker: _Worker, cause: str, pending: collections.deque) -> Iterator[tuple[object, int, CaseOutcome]]:
+        """The case ``worker`` was running fails with ``cause`` (its shared part: the group's cases run again
+        without it); the rest of its job goes first in the queue."""
+        job, phase = cast(Job, worker.job), worker.phase  # a worker fails a phase only while it runs a job
+        if phase is None and not job.reference_failure:
+            job.reference_failure = cause  # its cases run again, without it
+        else:
+            failing = [phase] if phase is not None else [i for i in range(len(job.group.cases)) if i not in job.skip]
+            for index in failing:
+                job.skip.add(index)
+                yield job.key, index, failed_outcome(job.group, job.group.cases[index], cause)
+        if len(job.skip) < len(job.group.cases):
+            pending.appendleft(job)
+
+    def close(self) -> None:
+        """Stop every worker (again: nothing)."""
+        for worker in self._workers:
+            worker.close()
+        self._workers = []
+
+    def __enter__(self) -> "IsolatedPool":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

@@ -1,0 +1,361 @@
+"""One run, whoever asks for it: ``simparity run``, :func:`simparity.run_scene` and the pytest fixture.
+
+A :class:`Session` owns a run from its scenes to its verdict: the scenes (as its profile runs them), the
+engines (described once; a user's engine is asked about itself in a process of its own), where the cases
+execute (:class:`Execution`: isolated worker processes, a Dask cluster, or this process when asked), the
+journal and the stored run when it has a folder, the history it is recorded in, and the tolerances it is
+held to. The CLI parses arguments into a session and prints what it hands back; the API and the fixture
+build one with their defaults. Nothing of a session outlives it: no module state, its engines are its own.
+
+Isolation costs a worker start per session (a Python process importing the engines, about a second) and
+cannot reach an engine that only exists in the calling process: a class defined in ``__main__`` (a script
+run directly, a notebook) cannot be imported by a worker, which starts as a fresh interpreter (like
+multiprocessing's *spawn*). Such an engine is refused with one line naming both ways out: move it into a
+module on the import path, or run in this process (``isolate=False``), where a crash of the engine ends the
+caller's interpreter.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Iterator, Sequence
+
+import pandas as pd
+
+from simparity.comparisons.engines.registry import EngineSet, check_engine_names, describe_engines, make_engine
+from simparity.comparisons.execute.cases import CaseOutcome
+from simparity.comparisons.execute.execution import Executor, count_cases, default_jobs, run_scenes
+from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS, CaseLimits, IsolatedPool, Job
+from simparity.comparisons.execute.journal import Journal, run_lock, write_request
+from simparity.comparisons.execute.progress import ProgressBar
+from simparity.comparisons.execute.runner import DEFAULT_REPEATS, run_group
+from simparity.comparisons.execute.store import RunWriter
+from simparity.comparisons.gate.check import CheckResult, check_table
+from simparity.comparisons.gate.history import record_run
+from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, Bound, load_tolerances
+from simparity.comparisons.invariance.invariance_run import invariance_rows
+from simparity.comparisons.scenes.profiles import apply_profile
+from simparity.core.model.engine import Engine
+from simparity.core.model.errors import HistoryError, SimparityError, one_line
+from simparity.core.model.results import COLUMNS, FAILED, RESULTS_FILE, ResultRow, SeriesRecord, case_counts
+
+ISOLATED, DASK, IN_PROCESS = "local", "dask", "inline"
+"""Where a session's cases run: worker processes here (each case's engine in a child of its own), a Dask
+cluster (the same worker inside each task), or this process (``isolate=False``: fastest, unprotected)."""
+
+Say = Callable[[str], None]
+
+
+def _silent(line: str) -> None:
+    return None
+
+
+@dataclass(frozen=True)
+class Execution:
+    """Where and under which limits a session's cases run.
+
+    ``limits`` None: a share of this machine's memory per worker (:meth:`CaseLimits.default`) here, each
+    node's own limit on Dask. ``scheduler``: a Dask scheduler's address (None: a local cluster)."""
+
+    where: str = ISOLATED
+    jobs: int = field(default_factory=default_jobs)
+    limits: CaseLimits | None = None
+    scheduler: str | None = None
+
+    def executor(self, engine_for: Callable[[str], Engine]) -> Executor:
+        """A new executor of this kind; ``engine_for`` builds an engine in this process (``inline`` only)."""
+        if self.where == IN_PROCESS:
+            return InProcessExecutor(engine_for)
+        if self.where == DASK:
+            from simparity.comparisons.execute.dask_executor import DaskExecutor  # imports Dask: only when asked
+
+            return DaskExecutor(self.scheduler, self.jobs, self.limits or CaseLimits(DEFAULT_CASE_SECONDS, None))
+        return IsolatedPool(self.jobs, self.limits or CaseLimits.default(self.jobs))
+
+
+class InProcessExecutor:
+    """Every job in this process, one after the other (``isolate=False``): no worker to start, and nothing between
+    an engine and the caller, so an engine that crashes ends the caller's interpreter."""
+
+    def __init__(self, engine_for: Callable[[str], Engine]) -> None:
+        self._engine_for = engine_for
+
+    def run(self, jobs: list[Job]) -> Iterator[tuple[object, int, CaseOutcome]]:
+        for job in jobs:
+            for index, outcome in run_group(job.group, self._engine_for, skip=frozenset(job.skip),
+                                            reference_failure=job.reference_failure):
+                yield job.key, index, outcome
+
+    def close(self) -> None:
+        return None
+
+
+def run_in_process(scene, engines: list[Engine], make_reference: Callable[[str], Engine],
+                   repeats: int = DEFAULT_REPEATS, series: list[SeriesRecord] | None = None) -> list[ResultRow]:
+    """All rows of one scene on ``engines`` (objects, used as given) against ``make_reference(scene.reference)``,
+    through the same pipeline as every run, its cases in this process. ``series``, when a list, gets the scene's
+    sampled series (:mod:`comparisons.measure.series`)."""
+    by_name = {e.name: e for e in engines}
+
+    def engine_for(name: str) -> Engine:
+        if name not in by_name:
+            by_name[name] = make_reference(name)
+        return by_name[name]
+
+    [(_, rows, records)] = run_scenes([scene], engines, engine_for, repeats, InProcessExecutor(engine_for))
+    if series is not None:
+        series += records
+    return rows
+
+
+@dataclass(frozen=True)
+class SessionResult:
+    """What a session hands back.
+
+    ``table``: every row (the columns of ``results.csv``); ``failed_cases``: cases whose engine raised or
+    crashed; ``unfinished``: cases that did not finish (``--resume`` tries them again); ``unreadable``: kept
+    cases of a resumed run that could not be read and were computed again; ``check``: the verdict when the
+    session was given tolerances."""
+
+    out_dir: Path | None
+    table: pd.DataFrame
+    failed_cases: int = 0
+    unfinished: int = 0
+    unreadable: int = 0
+    check: CheckResult | None = None
+    interrupted: bool = False
+
+
+def engine_specs(engines) -> tuple[str, ...]:
+    """The names or ``module:Class`` specs of ``engines`` (names, Engine subclasses or instances, mixed): what a
+    worker process builds them from. An instance is built again there from its class."""
+    specs = []
+    for engine in engines:
+        if isinstance(engine, str):
+            specs.append(engine)
+            continue
+        cls = engine if isinstance(engine, type) else type(engine)
+        if not (isinstance(cls, type) and issubclass(cls, Engine)):
+            raise SimparityError(f"engines: {one_line(repr(engine))} is neither an engine name nor an Engine (allowed: "
+                                 "names as 'simparity engines' lists them, module:Class, Engine subclasses or instances)")
+        specs.append(f"{cls.__module__}:{cls.__qualname__}")
+    return tuple(specs)
+
+
+def refuse_unreachable(specs: tuple[str, ...]) -> None:
+    """Refuse, in one line, an engine a worker process cannot import: one defined in ``__main__``."""
+    for spec in specs:
+        module, _, attr = spec.partition(":")
+        if attr and module == "__main__":
+            raise SimparityError(
+                f"engine {one_line(spec)}: defined in __main__ (a script run directly, or a notebook), which a worker "
+                "process cannot import: isolated runs start each worker as a fresh interpreter (allowed: move the "
+                "engine into a module on the import path, or run it in this process with isolate=False, where a "
+                "crash of the engine ends this interpreter)")
+
+
+class Session:
+    """One run of ``scenes`` (loaded with the same ``engines``; the profile is applied here) on ``engines``.
+
+    ``out_dir`` None keeps the run in memory (no journal, report or history); with a folder, the run is
+    stored there as it goes (``results.csv``, the journal of finished cases, ``report.md``/``.html`` when
+    ``report``), recorded in ``history`` (a database path; None: not recorded) and, with ``request``,
+    resumable (``resume.json``). ``resume``: keep the folder's finished cases. ``bounds``: tolerances the
+    finished run is held to. ``say`` hears one line per scene and what the run wrote, ``warn`` what went wrong
+    beside the run (default: ``say``); ``progress`` is a stream for the progress bar (None: no bar)."""
+
+    def __init__(self, scenes: list, engines: EngineSet, *, profile: str = "full", repeats: int = DEFAULT_REPEATS,
+                 execution: Execution = Execution(), out_dir: Path | None = None, history: Path | None = None,
+                 bounds: list[Bound] | None = None, transforms: tuple = (), command: str = "", report: bool = True,
+                 request: dict | None = None, resume: bool = False, say: Say = _silent, warn: Say | None = None,
+                 progress=None) -> None:
+        self.names = check_engine_names(engines.names)
+        if execution.where != IN_PROCESS:
+            refuse_unreachable(self.names)
+        self.scenes = apply_profile(list(scenes), profile, engines)
+        self.repeats, self.execution, self.out_dir = repeats, execution, out_dir
+        self.history, self.bounds, self.transforms, self.command = history, bounds, tuple(transforms), command
+        self.report, self.request, self.resume, self.say, self.progress = report, request, resume, say, progress
+        self.warn = warn or say
+        if execution.where == IN_PROCESS:
+            self.engines = [make_engine(n) for n in self.names]  # the caller asked for its engines in its process
+        else:
+            self.engines = describe_engines(self.names, self.scenes)
+        check_distinct(self.engines, self.names, self.scenes)
+        self.specs = dict(zip((e.name for e in self.engines), self.names))
+
+    def run(self, start: Callable[[], str] | None = None) -> SessionResult:
+        """Run every case, store and check the run; a SimparityError raised midway keeps what was computed
+        (stored and reported) and is raised again. ``start()``, once the executor and the folder are ready, gives
+        a line to say first (what the run will do)."""
+        engines = {e.name: e for e in self.engines}
+
+        def engine_for(name: str) -> Engine:
+            if name not in engines:
+                engines[name] = make_engine(self.specs.get(name, name))
+            return engines[name]
+
+        executor = self.execution.executor(engine_for)  # an unreachable scheduler fails before a folder is made
+        with contextlib.closing(executor), self._folder():
+            if start is not None:
+                self.say(start())
+            return self._run(executor)
+
+    @contextlib.contextmanager
+    def _folder(self):
+        if self.out_dir is None:
+            yield
+            return
+        with run_lock(made(self.out_dir)):
+            if not self.resume:  # a new run: nothing of a run --force replaces is reused
+                if self.request is not None:
+                    write_request(self.out_dir, self.request)
+                Journal(self.out_dir).clear()
+            yield
+
+    def _run(self, executor: Executor) -> SessionResult:
+        journal = Journal(self.out_dir) if self.out_dir is not None else None
+        store = _Store(self.out_dir, self.engines, self.command, self.scenes)
+        sizes = count_cases(self.scenes, self.engines, make_engine)
+        bar = ProgressBar(sum(sizes), self.progress) if self.progress is not None else None
+        failed = 0
+        try:
+            with contextlib.closing(executor):  # the workers stop as soon as the cases do, before the report
+                base_rows = []
+                for k, (scene, rows, series) in enumerate(run_scenes(
+                        self.scenes, self.engines, make_engine, self.repeats, executor, journal,
+                        bar.case_done if bar is not None and bar.active else None, self.specs)):
+                    store.append(rows, series)
+                    counts = case_counts(rows)
+                    failed += counts[FAILED]
+                    if bar is not None:
+                        bar.scene_done(sum(sizes[:k + 1]))
+                    self.say(f"{scene.name}: {sum(counts.values())} cases ("
+                             + ", ".join(f"{s} {c}" for s, c in counts.items() if c) + ")")
+                    base_rows.append(rows)
+                if self.transforms:
+                    if bar is not None:
+                        bar.clear()
+                    for rows in invariance_rows(self.scenes, base_rows, self.transforms, self.engines, executor,
+                                                journal, self.specs, self.say):
+                        store.append(rows)
+                        failed += sum(1 for r in rows if r.status == FAILED)
+        except KeyboardInterrupt:
+            if bar is not None:
+                bar.clear()
+            if self.out_dir is not None:
+                self.say(f"interrupted; results so far are in {self.out_dir / RESULTS_FILE}; finish the run with: "
+                         f"simparity run --resume {self.out_dir}")
+            self._write_report()
+            return SessionResult(self.out_dir, store.table(), failed, interrupted=True)
+        except SimparityError:
+            self._write_report()  # keep what was computed, then report the error
+            raise
+        unfinished = unreadable = 0
+        if journal is not None:
+            unfinished, unreadable = journal.unfinished, journal.unreadable
+            if unreadable:
+                self.say(f"{unreadable} kept cases could not be read (damaged, or kept by another version of "
+                         "simparity) and were computed again")
+            if unfinished:
+                self.say(f"{unfinished} cases did not finish (crashed, hung or out of memory): 'simparity run "
+                         f"--resume {self.out_dir}' tries them again")
+            else:
+                journal.remove()
+        table = store.table()
+        checked = self._write_report()
+        self._record(table)
+        check = None
+        if self.bounds is not None:
+            check = checked if checked is not None else check_table(table, self.bounds)
+        return SessionResult(self.out_dir, table, failed, unfinished, unreadable, check)
+
+    def _write_report(self) -> CheckResult | None:
+        """report.md, report.html and figures/ of a stored run (when asked for); its metrics held to the session's
+        bounds (default: the shipped tolerances) for the report's flagged findings. Returns that verdict."""
+        if self.out_dir is None or not self.report:
+            return None
+        return write_run_report(self.out_dir, self.say, self.bounds)
+
+    def _record(self, table: pd.DataFrame) -> None:
+        """Copy a stored run into the history database; a database problem is one line, never a lost run."""
+        if self.out_dir is None or self.history is None:
+            return
+        from simparity.reports.store import read_run
+
+        _, info = read_run(self.out_dir)
+        try:
+            record_run(self.history, self.out_dir.resolve(), info, table)
+        except HistoryError as err:
+            self.warn(f"simparity: history not updated: {one_line(err, 1000)}; the run is in {self.out_dir}")
+
+
+class _Store:
+    """Where a session's rows go: the run folder (``RunWriter``), or memory when it has none."""
+
+    def __init__(self, out_dir: Path | None, engines: list[Engine], command: str, scenes: list) -> None:
+        self.writer = RunWriter(out_dir, engines, command, scenes) if out_dir is not None else None
+        self.rows: list[ResultRow] = []
+
+    def append(self, rows: list[ResultRow], series: Sequence[SeriesRecord] = ()) -> None:
+        if self.writer is not None:
+            self.writer.append(rows, series)
+        else:
+            self.rows += rows
+
+    def table(self) -> pd.DataFrame:
+        if self.writer is not None:
+            from simparity.reports.store import read_run
+
+            return read_run(self.writer.out_dir)[0]
+        return pd.DataFrame([r.as_dict() for r in self.rows], columns=list(COLUMNS))
+
+
+def write_run_report(out_dir: Path, say: Say, bounds: list[Bound] | None = None) -> CheckResult:
+    """report.md, report.html and figures/ of the run in ``out_dir``; its metrics are held to ``bounds`` (default:
+    the shipped tolerances) for the report's flagged findings, which never changes an exit code. Returns that
+    verdict."""
+    from simparity.reports.content import ToleranceVerdict
+    from simparity.reports.render import write_report
+    from simparity.reports.store import read_run
+
+    table, _ = read_run(out_dir)
+    result = check_table(table, bounds if bounds is not None else load_tolerances(DEFAULT_TOLERANCES))
+    verdict = ToleranceVerdict(result.checked, result.unchecked, tuple(v.line() for v in result.violations))
+    markdown, page = write_report(out_dir, verdict)
+    say(f"results: {Path(out_dir) / RESULTS_FILE}\nreport:  {markdown}\n         {page}")
+    return result
+
+
+def made(out_dir: Path) -> Path:
+    """``out_dir``, created if it is not there."""
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+    except (OSError, ValueError) as err:  # ValueError: a NUL byte in the name
+        raise SimparityError(f"--out {one_line(out_dir)}: cannot create the folder: {getattr(err, 'strerror', None) or err} "
+                             "(allowed: a folder you can write)") from None
+    return out_dir
+
+
+def check_distinct(engines: list[Engine], names: tuple[str, ...], scenes: list) -> None:
+    """Refuse two engines or two scenes of one name: their rows would be indistinguishable."""
+    seen: dict[str, str] = {}
+    for engine, name in zip(engines, names):
+        if engine.name in seen:
+            raise SimparityError(f"--engines: {one_line(seen[engine.name])} and {one_line(name)} are both named "
+                                 f"{one_line(engine.name)} (allowed: engines of distinct names)")
+        seen[engine.name] = name
+    files: dict[str, str] = {}
+    sweeps: dict[str, str] = {}
+    for scene in scenes:
+        if scene.name in files:
+            raise SimparityError(f"{one_line(scene.source or scene.name)}: a second scene named {one_line(scene.name)} "
+                                 f"(the first from {one_line(files[scene.name])}) (allowed: scenes of distinct names)")
+        files[scene.name] = scene.source or scene.name
+        if scene.sweep is not None and sweeps.setdefault(scene.sweep.base, scene.source) != scene.source:
+            raise SimparityError(f"{one_line(scene.source)}: a second sweep named {one_line(scene.sweep.base)} (the "
+                                 f"first from {one_line(sweeps[scene.sweep.base])}): the results and the report group a "
+                                 "sweep's variants by that name (allowed: sweeps of distinct [scene] names)")
+

@@ -1,0 +1,69 @@
+"""The verdict of ``simparity check`` as JUnit XML (for CI test reports) and as Markdown (for a CI
+job summary such as GitHub's ``$GITHUB_STEP_SUMMARY``)."""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+
+from simparity.comparisons.gate.check import BaselineDiff, CheckResult
+
+
+def _case_name(key: tuple) -> tuple[str, str]:
+    """(classname, name) of a case: the scene, and engine, integrator and dt."""
+    scene, engine, integrator, dt = key
+    dt_text = "" if dt == "nan" or (isinstance(dt, float) and math.isnan(dt)) else f" dt={dt:g}"
+    return scene, f"{engine} {integrator or '-'}{dt_text}"
+
+
+def junit_xml(result: CheckResult, diff: BaselineDiff | None = None) -> str:
+    """JUnit XML: one test case per scene x engine x integrator x dt; a case with violations fails with
+    them as its message and text; a baseline comparison is one more test case."""
+    suites = ET.Element("testsuites", name="simparity check")
+    suite = ET.SubElement(suites, "testsuite", name="simparity")
+    failures = 0
+    for key, violations in result.cases.items():
+        classname, name = _case_name(key)
+        case = ET.SubElement(suite, "testcase", classname=classname, name=name, time="0")
+        if violations:
+            failures += 1
+            failure = ET.SubElement(case, "failure", message=f"{len(violations)} metric(s) outside their bounds",
+                                    type="tolerance")
+            failure.text = "\n".join(v.line() for v in violations)
+    tests = len(result.cases)
+    if diff is not None:
+        tests += 1
+        case = ET.SubElement(suite, "testcase", classname="baseline", name="unchanged since the baseline", time="0")
+        if diff.blocking:
+            failures += 1
+            failure = ET.SubElement(case, "failure", message="numerics moved since the baseline", type="baseline")
+            failure.text = "\n".join(diff.moved + [f"missing: {m}" for m in diff.missing])
+    for element in (suites, suite):
+        element.set("tests", str(tests))
+        element.set("failures", str(failures))
+        element.set("errors", "0")
+    return ET.tostring(suites, encoding="unicode", xml_declaration=True) + "\n"
+
+
+def _cell(text: str) -> str:
+    return text.replace("|", "/").replace("\n", " ")
+
+
+def summary_markdown(result: CheckResult, diff: BaselineDiff | None = None) -> str:
+    """A short Markdown verdict: counts, then each violation and each move."""
+    verdict = "passed" if result.passed and not (diff and diff.blocking) else "failed"
+    lines = [f"## simparity check: {verdict}", "",
+             f"{result.checked} metrics checked, {len(result.violations)} outside their bounds, "
+             f"{result.unchecked} without a bound; {len(result.cases)} cases.", ""]
+    if result.violations:
+        lines += ["| scene | engine | integrator | dt | metric | found | bound | reason |", "|---|---|---|---|---|---|---|---|"]
+        lines += ["| " + " | ".join(_cell(str(x)) for x in (v.scene, v.engine, v.integrator or "-",
+                                                             "" if math.isnan(v.dt) else f"{v.dt:g}", v.metric,
+                                                             v.found, v.bound, v.reason)) + " |"
+                  for v in result.violations]
+    if diff is not None:
+        lines += ["", f"Since the baseline: {len(diff.moved)} moved, {len(diff.missing)} missing, "
+                      f"{len(diff.new)} new, {len(diff.timing)} timing changes (not blocking).", ""]
+        lines += [f"- moved: {_cell(m)}" for m in diff.moved] + [f"- missing: {_cell(m)}" for m in diff.missing]
+        lines += [f"- new: {_cell(m)}" for m in diff.new]
+    return "\n".join(lines) + "\n"

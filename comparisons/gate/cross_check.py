@@ -1,0 +1,140 @@
+"""Cross-checks: a user's scheme held to the built-in schemes of the same kind, measured in the same run.
+
+The CI gate's bounds say what a kind of scheme must achieve on a scene; a cross-check says what a user's
+engine achieves beside the built-in engines' schemes of the same kind (the ``scheme`` column), on the same
+scene at the same time step, with the same targets: a scheme silently degraded into another of the same
+order keeps its order but not its error, and an IK solver that solves a quarter of what the built-in
+solver of its kind solves is broken whatever its order. Built-in engines are not cross-checked against
+each other: their differences are the report's findings, held by the bounds.
+
+Each check names both sides: the user's engine and the built-in one it is measured against.
+"""
+
+from __future__ import annotations
+
+import math
+
+import pandas as pd
+
+from simparity.comparisons.gate.violation import Violation
+from simparity.core.model.results import NOT_AVAILABLE, OK, ROUNDING_FLOOR, SATURATED, UNSOLVED
+from simparity.core.model.metric_catalogue import (
+    ANGULAR_MOMENTUM_DRIFT_MAX, ANGULAR_VELOCITY_ERROR_MAX, APEX_HEIGHT_ERROR, CROSS_EVAL_SOLVE_RATE_MIN,
+    ENERGY_DRIFT_MAX, ENERGY_LOSS_ERROR, IMPACT_TIME_ERROR, ORIENTATION_ERROR_MAX, POSITION_ERROR_FINAL,
+    POSITION_ERROR_MAX, REBOUND_VELOCITY_ERROR, RESTITUTION_ERROR, REST_DISTANCE_MEDIAN, REST_TIME_ERROR,
+    STOPPING_DISTANCE_ERROR, VELOCITY_ERROR_MAX,
+)
+
+CROSS_CHECK_FACTOR = 2.0
+"""An error (or drift) more than twice the largest of the built-in schemes of the same kind at the same step
+is a violation. The largest, because faithful implementations of one scheme differ in their error constant
+(core's RK4 on the lecture's (x, q, P, L) state carries 5-9 x MuJoCo's at the same step); twice it, because
+a scheme degraded into another of the same order (a stage weight off, a force evaluated at the wrong stage)
+multiplies its error constant by more (2.7 x core's in the held-out trial), and the same scheme repeated is
+equal to rounding."""
+
+SOLVE_RATE_FRACTION = 0.8
+"""An IK solver that, on the same targets with the same tolerances, solves less than 80 % as often as the best
+built-in solver of its kind is a violation: the quick profile's 50 targets resolve the rate to 2 %, and the
+planted bugs of IK steps, damping and null-space terms cut it by a half or more."""
+
+ERROR_METRICS = (POSITION_ERROR_MAX, POSITION_ERROR_FINAL, ORIENTATION_ERROR_MAX, VELOCITY_ERROR_MAX,
+                 ANGULAR_VELOCITY_ERROR_MAX, ENERGY_DRIFT_MAX, ANGULAR_MOMENTUM_DRIFT_MAX,
+                 IMPACT_TIME_ERROR, REBOUND_VELOCITY_ERROR, APEX_HEIGHT_ERROR, RESTITUTION_ERROR,
+                 ENERGY_LOSS_ERROR, STOPPING_DISTANCE_ERROR, REST_TIME_ERROR)
+"""Metrics where less is better, cross-checked against the largest built-in value."""
+
+RATE_METRICS = (CROSS_EVAL_SOLVE_RATE_MIN,)
+"""Metrics where more is better (the harness's own solve rate), cross-checked against the best built-in."""
+
+
+NULLSPACE = "+nullspace"
+"""The scheme modifier of an IK solver with a secondary objective in the Jacobian's null space."""
+
+NULLSPACE_ROUNDING = 1e-9
+"""Relative rounding allowed when the null-space solver's rest distance equals the plain one's (a chain with no
+redundancy has no null space: the two solutions are the same)."""
+
+
+def nullspace_checks(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Violation]:
+    """A user's null-space solver (``<kind>+nullspace...``) whose median distance from the rest pose
+    (``rest_distance_median``) is larger than that of its engine's solver of the same kind without the term,
+    on the same targets: the secondary objective made worse, not better (on a chain without redundancy the
+    two are equal)."""
+    rows = table[(table["metric"] == REST_DISTANCE_MEDIAN) & (table["status"] == OK)
+                 & ~table["engine"].isin(builtin) & table["scheme"].fillna("").str.contains(NULLSPACE, regex=False)]
+    out = []
+    for row in rows.to_dict("records"):
+        base = row["scheme"].replace(NULLSPACE, "")
+        plain = table[(table["scene"] == row["scene"]) & (table["engine"] == row["engine"])
+                      & (table["metric"] == REST_DISTANCE_MEDIAN) & (table["status"] == OK)
+                      & (table["scheme"] == base)]
+        if plain.empty:
+            continue
+        without = float(plain["value"].min())
+        if float(row["value"]) > without * (1 + NULLSPACE_ROUNDING):
+            out.append(Violation(
+                row["scene"], row["engine"], row["integrator"], float(row["dt"]), row["metric"],
+                f"{float(row['value']):.4g} {row['unit']}", f"<= {without:.4g} {row['unit']}",
+                f"cross-check: the null-space term must keep the solutions nearer the rest pose than "
+                f"{row['engine']} {plain.iloc[0]['integrator']} without it"))
+    return out
+
+
+def _builtin_rows(table: pd.DataFrame, builtin: tuple[str, ...]) -> pd.DataFrame:
+    return table[table["engine"].isin(builtin) & (table["scheme"] != "")]
+
+
+def cross_check(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Violation]:
+    """Every row of an engine not in ``builtin`` with a declared scheme that the built-in rows of the same scene,
+    scheme, time step and metric show to be beyond :data:`CROSS_CHECK_FACTOR` (errors) or below
+    :data:`SOLVE_RATE_FRACTION` (solve rates), or saturated (unsolved) where the built-ins of its kind measured a
+    number; and every null-space solver of such an engine that does worse than its solver without the term
+    (:func:`nullspace_checks`)."""
+    if "scheme" not in table.columns:
+        return []
+    keys = ["scene", "scheme", "dt_key", "metric"]
+    table = table.assign(dt_key=table["dt"].map(lambda d: "nan" if pd.isna(d) else repr(float(d))),
+                         flag=table["flag"].fillna("") if "flag" in table.columns else "")
+    out = nullspace_checks(table, builtin)
+    watched = table[table["metric"].isin(ERROR_METRICS + RATE_METRICS)]
+    users = watched[~watched["engine"].isin(builtin) & (watched["scheme"].fillna("") != "")]
+    reference = {key: rows for key, rows in _builtin_rows(watched, builtin).groupby(keys)}
+    for row in users.to_dict("records"):
+        rows = reference.get(tuple(row[k] for k in keys))
+        if rows is None:
+            continue
+        found = _judge(row, rows)
+        if found:
+            out.append(Violation(row["scene"], row["engine"], row["integrator"], float(row["dt"]), row["metric"],
+                                      *found))
+    return out
+
+
+def _judge(row: dict, builtin: pd.DataFrame) -> tuple[str, str, str] | None:
+    """(what was found, the bound, why) when ``row`` breaks the cross-check against ``builtin`` (the built-in rows
+    of its scene, scheme, step and metric), else None."""
+    measured = builtin[(builtin["status"] == OK)]
+    if measured.empty or (measured["flag"] == ROUNDING_FLOOR).any() or row["flag"] == ROUNDING_FLOOR:
+        return None  # nothing to compare with, or exact up to rounding: rounding has no size to hold
+    kind = row["scheme"]
+    if row["metric"] in RATE_METRICS:
+        best = measured.loc[measured["value"].idxmax()]
+        limit = SOLVE_RATE_FRACTION * float(best["value"])
+        why = (f"cross-check: {SOLVE_RATE_FRACTION:.0%} of the best built-in {kind} solver, {best['engine']} "
+               f"{best['integrator']} ({float(best['value']):.4g}), on the same targets")
+        if row["status"] == OK and float(row["value"]) < limit:
+            return f"{float(row['value']):.4g}", f">= {limit:.3g}", why
+        if row["status"] == NOT_AVAILABLE and row["flag"] == UNSOLVED:
+            return "0 (unsolved)", f">= {limit:.3g}", why
+        return None
+    largest = measured.loc[measured["value"].idxmax()]
+    limit = CROSS_CHECK_FACTOR * float(largest["value"])
+    side = f"{largest['engine']} {largest['integrator']} ({float(largest['value']):.4g} {row['unit']})"
+    if row["status"] == OK and float(row["value"]) > limit and math.isfinite(limit):
+        return (f"{float(row['value']):.4g} {row['unit']}", f"<= {limit:.3g} {row['unit']}",
+                f"cross-check: {CROSS_CHECK_FACTOR:g} x the largest built-in {kind} at this step, {side}")
+    if row["status"] == NOT_AVAILABLE and row["flag"] == SATURATED and (builtin["status"] == OK).all():
+        return ("saturated", f"a number like the built-in {kind}",
+                f"cross-check: saturated where every built-in {kind} at this step measured one, e.g. {side}")
+    return None

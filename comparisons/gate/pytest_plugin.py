@@ -1,0 +1,75 @@
+"""pytest plugin (entry point ``pytest11``): run simparity scenes in your own tests and hold them to tolerances.
+
+In a test::
+
+    def test_my_integrator_is_fourth_order(simparity):
+        simparity.check("scenes/my-box.toml", engines=["core"], tolerances="my-tolerances.toml")
+
+``simparity.check`` runs the scene (a built-in name or a scene file) on the engines, holds every
+row to the tolerances (default: the shipped ones) and fails the test with one line per
+violation; it returns the results table. ``pytest --simparity-baseline DIR`` also compares each
+checked scene with the same scene's rows in a stored run and fails on any metric that moved
+(``--simparity-baseline-rel`` sets the relative threshold). Nothing is imported from the engines
+until a test asks for a run.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+
+def pytest_addoption(parser) -> None:
+    group = parser.getgroup("simparity")
+    group.addoption("--simparity-baseline", metavar="DIR", default=None,
+                    help="a stored run (simparity run --out DIR) to compare each checked scene with")
+    group.addoption("--simparity-baseline-rel", metavar="X", type=float, default=None,
+                    help="relative change that counts as a move (default: simparity's BASELINE_RELATIVE)")
+
+
+class SimparityChecker:
+    """What the ``simparity`` fixture gives a test: ``check(scene, ...)``."""
+
+    def __init__(self, baseline: str | None, relative: float | None) -> None:
+        self._baseline, self._relative = baseline, relative
+
+    def check(self, scene, engines=("core",), tolerances: str | Path | None = None, profile: str = "full",
+              repeats: int = 0, isolate: bool = True):
+        """Run ``scene`` on ``engines``, fail the calling test on any violation; returns the results table.
+
+        The scene runs through the same session as ``simparity run`` (:mod:`comparisons.execute.session`): with
+        ``isolate`` (default) its cases run in worker processes, so an engine that crashes or hangs fails the test
+        with its rows, never the pytest session; ``isolate=False`` runs them in the test's process."""
+        from simparity.comparisons.api import load_scene
+        from simparity.comparisons.engines.registry import EngineSet, check_engine_names
+        from simparity.comparisons.execute.session import (IN_PROCESS, ISOLATED, Execution, Session,
+                                                             engine_specs)
+        from simparity.comparisons.gate.check import BASELINE_RELATIVE, compare_with_baseline
+        from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, load_tolerances
+        from simparity.reports.store import read_run
+
+        loaded = load_scene(scene) if isinstance(scene, (str, Path)) else scene
+        bounds = load_tolerances(tolerances or DEFAULT_TOLERANCES)
+        session = Session([loaded], EngineSet(check_engine_names(engine_specs(engines))), profile=profile,
+                          repeats=repeats, execution=Execution(ISOLATED if isolate else IN_PROCESS), bounds=bounds)
+        result = session.run()
+        table = result.table
+        problems = [v.line() for v in result.check.violations] if result.check is not None else []
+        if self._baseline:
+            before, _ = read_run(self._baseline)
+            diff = compare_with_baseline(table, before[before["scene"] == loaded.name],
+                                         self._relative or BASELINE_RELATIVE)
+            problems += [f"moved since {self._baseline}: {m}" for m in diff.moved]
+            problems += [f"missing since {self._baseline}: {m}" for m in diff.missing]
+        if problems:
+            pytest.fail(f"simparity: {len(problems)} problem(s) in {loaded.name}:\n" + "\n".join(problems),
+                        pytrace=False)
+        return table
+
+
+@pytest.fixture
+def simparity(request) -> SimparityChecker:
+    """Runs scenes and holds them to tolerances: ``simparity.check(scene, engines=..., tolerances=...)``."""
+    return SimparityChecker(request.config.getoption("--simparity-baseline"),
+                            request.config.getoption("--simparity-baseline-rel"))

@@ -1,0 +1,237 @@
+"""Tolerances: the bounds ``simparity check`` holds a run to, each with its reason.
+
+A tolerances file is TOML with one ``[[bound]]`` table per bound (format: ``docs/check.md``)::
+
+    [[bound]]
+    scene = "*"                      # fnmatch patterns; "*" (the default) matches anything
+    engine = "*"
+    integrator = "*"
+    scheme = "rk4"                   # the kind of scheme the engine declares its integrator to be
+    metric = "order_position"
+    expected = 4.0                   # |value - expected| <= band
+    band = 0.3
+    reason = "RK4 is fourth order; 0.3 covers the next term at the ladders used"
+
+Kinds of bound (one table may combine them): ``max`` (value <= max), ``min`` (value >= min),
+``expected`` with ``band`` (absolute, +-) or ``rel`` (relative to ``expected``), any of them scaled
+by dt^``dt_power`` (a scheme's known error, e.g. C dt^1 for Euler), and ``status`` (the statuses the
+row may have; default ``ok`` when a number is bounded, so a metric that went ``n/a`` is a
+violation, not a pass; ``status = "diverged"`` makes a blow-up the expected verdict). ``na_when``
+lists the flags (``core.results.FLAGS``) with which an ``n/a`` row is the right answer although the
+bound wants a number (``na_when = ["nothing-to-measure"]``: a resting run has no energy to gain). A
+row flagged with an alarm (``not-converging``) breaks every bound whose ``na_when`` does not name it,
+whatever its status.
+
+A bound may name one time step (``dt``, in seconds) or ``dt = "*"`` (every time step, but not
+the order rows, which have none); without ``dt`` it holds for every row.
+``scheme`` matches the kind of scheme the engine declares the row's integrator or IK solver to be
+(``core.engine.SCHEME_KINDS``; ``soft+*`` any time integrator under MuJoCo's soft contact; a list of
+patterns matches any of them): a bound keyed by scheme holds every engine's scheme of that kind, a
+user's plugin included, whatever it calls it.
+The most specific bound wins: a key written out exactly counts 2, a pattern other than ``*``
+counts 1, ``*`` counts 0, summed over scene, engine, integrator, scheme, metric and dt; among equally
+specific bounds the later one in the file wins, so a file can be extended by appending.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import math
+from typing import Any
+from dataclasses import dataclass
+from pathlib import Path
+
+from simparity.core.model.errors import SceneError, ToleranceError
+from simparity.core.model.files import read_toml
+from simparity.core.model.results import FLAGS, OK, STATUSES
+
+
+DEFAULT_TOLERANCES = Path(__file__).resolve().parents[1] / "tolerances" / "default.toml"
+"""The shipped tolerances: every built-in scene, each bound with its reason."""
+
+MATCH_KEYS = ("scene", "engine", "integrator", "metric")
+NUMBER_KEYS = ("max", "min", "expected", "band", "rel", "dt_power")
+ALLOWED_KEYS = MATCH_KEYS + ("scheme", "dt") + NUMBER_KEYS + ("status", "na_when", "reason")
+DT_MATCH = 1e-9
+"""Relative difference under which a bound's ``dt`` [s] names a row's time step."""
+
+
+@dataclass(frozen=True)
+class Bound:
+    """One bound of a tolerances file.
+
+    Attributes
+    ----------
+    scene, engine, integrator, metric : str
+        fnmatch patterns the row's fields must match.
+    scheme : tuple of str
+        fnmatch patterns of which the row's ``scheme`` column must match one.
+    dt : float, "*" or None
+        The time step [s] the bound is for; ``"*"``: every time step (the per-time-step rows, not
+        the order rows, which have none); None: every row.
+    max, min, expected, band, rel, dt_power : float or None
+        See the module docstring; ``None`` where not given.
+    statuses : tuple of str
+        Statuses the row may have.
+    na_when : tuple of str
+        Flags with which an n/a row passes although ``statuses`` does not allow n/a; an alarm flag passes
+        only when named here.
+    reason : str
+        Why the bound is what it is.
+    where : str
+        ``file: bound[i]``, for messages.
+    order : int
+        Position in the file (later wins among equally specific bounds).
+    """
+
+    scene: str
+    engine: str
+    integrator: str
+    scheme: tuple[str, ...]
+    metric: str
+    dt: float | str | None
+    max: float | None
+    min: float | None
+    expected: float | None
+    band: float | None
+    rel: float | None
+    dt_power: float | None
+    statuses: tuple[str, ...]
+    reason: str
+    where: str
+    order: int
+    na_when: tuple[str, ...] = ()
+
+    @property
+    def specificity(self) -> int:
+        patterns = (self.scene, self.engine, self.integrator, self.metric)
+        dt_weight = 0 if self.dt is None else 1 if self.dt == "*" else 2
+        scheme_weight = max(_weight(p) for p in self.scheme) if len(self.scheme) == 1 else min(
+            1, *(_weight(p) for p in self.scheme))
+        return dt_weight + scheme_weight + sum(_weight(p) for p in patterns)
+
+    def matches(self, scene: str, engine: str, integrator: str, metric: str, dt: float = math.nan,
+                scheme: str = "") -> bool:
+        if self.dt == "*" and math.isnan(dt):
+            return False
+        if isinstance(self.dt, float) and not abs(dt - self.dt) <= DT_MATCH * self.dt:
+            return False
+        return any(fnmatch.fnmatchcase(scheme, p) for p in self.scheme) and all(
+            fnmatch.fnmatchcase(value, pattern) for value, pattern in
+            zip((scene, engine, integrator, metric), (self.scene, self.engine, self.integrator, self.metric)))
+
+    @property
+    def bounds_a_number(self) -> bool:
+        return self.max is not None or self.min is not None or self.expected is not None
+
+    def limits(self, dt: float) -> tuple[float, float]:
+        """(lowest, highest) value allowed at time step ``dt`` [s] (NaN dt: no scaling)."""
+        scale = dt ** self.dt_power if self.dt_power is not None and math.isfinite(dt) else 1.0
+        low, high = -math.inf, math.inf
+        if self.max is not None:
+            high = self.max * scale
+        if self.min is not None:
+            low = self.min * scale
+        if self.expected is not None:
+            centre = self.expected * scale
+            half = (self.band or 0.0) + (self.rel or 0.0) * abs(centre)
+            low, high = max(low, centre - half), min(high, centre + half)
+        return low, high
+
+    def describe(self, dt: float) -> str:
+        """The bound in words, e.g. ``<= 1e-06`` or ``4 +- 0.3``."""
+        low, high = self.limits(dt)
+        if self.expected is not None or (self.max is not None and self.min is not None):
+            return f"in [{low:.3g}, {high:.3g}]"
+        return f"<= {high:.3g}" if self.max is not None else f">= {low:.3g}"
+
+
+def _weight(pattern: str) -> int:
+    """How specific one pattern is: 0 for ``*``, 1 for another pattern, 2 for a name written out."""
+    return 0 if pattern == "*" else 1 if any(c in pattern for c in "*?[") else 2
+
+
+def _number(source: str, key: str, value, non_negative: bool = False) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ToleranceError(source, key, f"expected a finite number, got {value!r:.60}", "finite numbers")
+    if non_negative and value < 0:
+        raise ToleranceError(source, key, f"{value!r} is negative", "numbers >= 0")
+    return float(value)
+
+
+def _bound(source: str, index: int, table) -> Bound:
+    where = f"bound[{index}]"
+    if not isinstance(table, dict):
+        raise ToleranceError(source, where, "expected a table", "[[bound]] tables")
+    unknown = sorted(set(table) - set(ALLOWED_KEYS))
+    if unknown:
+        raise ToleranceError(source, f"{where}.{unknown[0]}"[:120], "unknown key", ", ".join(ALLOWED_KEYS))
+    patterns: dict[str, Any] = {}
+    for key in MATCH_KEYS:
+        value = table.get(key, "*")
+        if not isinstance(value, str) or not value:
+            raise ToleranceError(source, f"{where}.{key}", f"expected a non-empty pattern, got {value!r:.60}",
+                                 "a name or an fnmatch pattern such as rk4*")
+        patterns[key] = value
+    scheme = table.get("scheme", "*")
+    schemes = (scheme,) if isinstance(scheme, str) else tuple(scheme) if isinstance(scheme, list) else ()
+    if not schemes or not all(isinstance(p, str) and p for p in schemes):
+        raise ToleranceError(source, f"{where}.scheme", f"expected a pattern or a list of them, got {scheme!r:.60}",
+                             "kinds of scheme (core.engine.SCHEME_KINDS) or fnmatch patterns such as soft+*")
+    patterns["scheme"] = schemes
+    dt = table.get("dt")
+    if dt is not None and dt != "*":
+        dt = _number(source, f"{where}.dt", table["dt"])
+        if dt <= 0:
+            raise ToleranceError(source, f"{where}.dt", f"{dt!r} is not a time step", "a time step > 0 [s]")
+    numbers: dict[str, Any] = {key: None for key in NUMBER_KEYS}
+    for key in NUMBER_KEYS:
+        if key in table:
+            numbers[key] = _number(source, f"{where}.{key}", table[key], non_negative=key in ("band", "rel"))
+    if (numbers["band"] is not None or numbers["rel"] is not None) and numbers["expected"] is None:
+        raise ToleranceError(source, f"{where}.band", "band and rel need an expected value", "expected = ...")
+    reason = table.get("reason")
+    if not isinstance(reason, str) or not reason.strip():
+        raise ToleranceError(source, f"{where}.reason", "every bound needs its reason", "a non-empty string")
+    status = table.get("status")
+    if status is None:
+        statuses = (OK,)
+    else:
+        statuses = (status,) if isinstance(status, str) else tuple(status) if isinstance(status, list) else ()
+        if not statuses or any(s not in STATUSES for s in statuses):
+            raise ToleranceError(source, f"{where}.status", f"{status!r:.60} is not a status or a list of them",
+                                 ", ".join(STATUSES))
+    na_when = table.get("na_when", [])
+    if isinstance(na_when, str):
+        na_when = [na_when]
+    if not isinstance(na_when, list) or any(f not in FLAGS for f in na_when):
+        raise ToleranceError(source, f"{where}.na_when", f"{na_when!r:.60} is not a flag or a list of them",
+                             ", ".join(FLAGS))
+    bound = Bound(**patterns, dt=dt, **numbers, statuses=statuses, reason=reason.strip(), where=f"{source}: {where}",
+                  order=index, na_when=tuple(na_when))
+    if not bound.bounds_a_number and status is None:
+        raise ToleranceError(source, where, "bounds nothing", "max, min, expected or status")
+    return bound
+
+
+def load_tolerances(path: str | Path = DEFAULT_TOLERANCES) -> list[Bound]:
+    """The bounds of a tolerances file; raises :class:`ToleranceError` naming the file and key."""
+    source = str(path)
+    try:
+        data = read_toml(source, what="tolerances file")
+    except SceneError as err:  # the file itself: missing, not a regular file, too large, not TOML
+        raise ToleranceError(err.source, err.key, err.problem, err.allowed) from None
+    unknown = sorted(set(data) - {"bound"})
+    if unknown:
+        raise ToleranceError(source, unknown[0][:80], "unknown table", "[[bound]]")
+    tables = data.get("bound", [])
+    if not isinstance(tables, list) or not tables:
+        raise ToleranceError(source, "bound", "no bounds", "one or more [[bound]] tables")
+    return [_bound(source, i, table) for i, table in enumerate(tables)]
+
+
+def bound_for(bounds: list[Bound], scene: str, engine: str, integrator: str, metric: str,
+              dt: float = math.nan, scheme: str = "") -> Bound | None:
+    """The most specific bound that matches (the later one on a tie), or None."""
+    matching = [b for b in bounds if b.matches(scene, engine, integrator, metric, dt, scheme)]
+    return max(matching, key=lambda b: (b.specificity, b.order)) if matching else None

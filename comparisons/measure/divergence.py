@@ -1,0 +1,127 @@
+"""Has a finite run blown up? Bounds the exact motion cannot cross, from the scene's energy budget.
+
+A run is diverged when, for some body,
+
+- its speed exceeds what its forces can give it: the drag pushes v toward the air velocity w
+  and never speeds the body up relative to it, so |v(t)| <= |w| + |v(0) - w| + (|g| + sum |f_i| / m) t;
+- its angular speed exceeds what its angular momentum allows: |omega| <= |L| / I_min, with
+  |L(t)| <= |L(0)| + sum |p_i| |f_i| t (angular drag only takes momentum away); without applied
+  forces also |omega| <= sqrt(2 KE_rot(0) / I_min), as the rotational energy cannot grow. With
+  contact a plane's impulse can turn a body, and the bound is its energy budget instead:
+  |omega| <= sqrt(2 (KE(0) + (m |g| + sum |f_i|) v_max t) / I_min);
+- a quantity the scene conserves grows by more than :data:`CONSERVED_GROWTH_LIMIT` of its
+  scale: the energy (E - E(0) > limit x the body's energy scale, KE(0) plus the largest drop of its
+  potential energy along the run, at least m |g| size: not |E(0)|, which depends on where the origin
+  is; contact only takes energy away, so this holds with contact too) or |L| (not with contact).
+
+Speeds are compared with :data:`DIVERGENCE_MARGIN` times their bound. Energies come from
+:mod:`comparisons.metrics`, rotations from SciPy; nothing here is in-house code.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simparity.comparisons.measure.body_scales import body_sizes, energy_scales
+from simparity.comparisons.measure.contact_metrics import ContactReading, contact_blow_up, read_contact
+from simparity.comparisons.measure.invariants import angular_momentum_world
+from simparity.comparisons.measure.metrics import energies
+from simparity.core.model.scene import DynamicsScene
+from simparity.core.model.trajectory import Trajectory
+from simparity.references.common.conventions import quat_wxyz_to_matrix
+
+DIVERGENCE_MARGIN = 2.0
+"""A speed more than twice its bound is divergence. The bounds hold for the exact motion; an
+accurate run stays near or below them, a run that is merely inaccurate exceeds them by its
+error, and a blown-up one grows geometrically past any factor."""
+
+CONSERVED_GROWTH_LIMIT = 1.0
+"""A conserved quantity that grows by more than 100 % of its initial size (energy or |L|
+doubled) is divergence, not drift."""
+
+AT_REST = 1e-9
+"""Added to every speed bound, times the body's size over the run's duration (linear) or one over it
+(angular): a body with no motion budget at all may still show rounding-level speeds. Relative to the
+body's own scales, so that it scales with the scene's units."""
+
+
+def _speed_bounds(scene: DynamicsScene) -> tuple[np.ndarray, np.ndarray]:
+    """(linear [m/s], angular [rad/s]) upper bounds of the exact motion per body, each (B,)."""
+    forces, duration = scene.forces, scene.duration
+    gravity = 0.0 if forces.gravity_world is None else float(np.linalg.norm(forces.gravity_world))
+    air = np.zeros(3) if forces.air_velocity_world is None else forces.air_velocity_world
+    linear, angular = [], []
+    for index, body in enumerate(scene.bodies):
+        pushes = [a for a in forces.applied if a.body == index]
+        force = sum(float(np.linalg.norm(a.force_world)) for a in pushes)
+        torque = sum(float(np.linalg.norm(a.point_body) * np.linalg.norm(a.force_world)) for a in pushes)
+        linear.append(np.linalg.norm(air) + np.linalg.norm(body.velocity_world - air)
+                      + (gravity + force / body.mass) * duration)
+        moments = np.linalg.eigvalsh(body.inertia_body)
+        rotation = quat_wxyz_to_matrix(body.quat_wxyz)
+        momentum = np.linalg.norm(angular_momentum_world(body.inertia_body, body.angular_velocity_world, rotation))
+        bound = (momentum + torque * duration) / moments[0]
+        omega_body = rotation.T @ body.angular_velocity_world
+        spin_energy = max(omega_body @ body.inertia_body @ omega_body, 0.0) / 2
+        if scene.contact is not None:
+            # A plane's impulse can turn the body (a box landing on an edge), so |L| is no bound; its
+            # energy is: contact only takes energy away, and gravity and the applied forces give at
+            # most their force times the distance the COM can travel.
+            work = (body.mass * gravity + force) * linear[-1] * duration
+            kinetic = spin_energy + body.mass * float(body.velocity_world @ body.velocity_world) / 2
+            bound = max(bound, np.sqrt(2 * (kinetic + work) / moments[0]))
+        elif not pushes:
+            bound = min(bound, np.sqrt(2 * spin_energy / moments[0]))
+        angular.append(bound)
+    return np.array(linear), np.array(angular)
+
+
+def _conserved_growth(scene: DynamicsScene, traj: Trajectory) -> str:
+    if scene.forces.conserves_energy:
+        energy, kinetic, potential = energies(scene, traj)
+        scale = energy_scales(scene, kinetic, potential)
+        growth = (energy - energy[0]).max(axis=0)
+        grown = (scale > 0) & (growth > CONSERVED_GROWTH_LIMIT * scale)
+        if grown.any():
+            b = int(np.argmax(np.where(grown, growth / np.where(scale > 0, scale, 1.0), -np.inf)))
+            return (f"energy of {scene.bodies[b].name} rose by {growth[b] / scale[b]:.3g} x its energy scale "
+                    f"{scale[b]:.3g} J (KE(0) + the largest drop of its potential, at least m |g| size; conserved, "
+                    f"limit {CONSERVED_GROWTH_LIMIT:g} x)")
+    if scene.forces.conserves_angular_momentum and scene.contact is None:
+        inertia = np.stack([b.inertia_body for b in scene.bodies])
+        size = np.linalg.norm(angular_momentum_world(
+            inertia, traj.angular_velocity_world, quat_wxyz_to_matrix(traj.quat_wxyz)), axis=-1)
+        grown = (size[0] > 0) & (size.max(axis=0) > (1 + CONSERVED_GROWTH_LIMIT) * size[0])
+        if grown.any():
+            b = int(np.argmax(grown))
+            return (f"|L| of {scene.bodies[b].name} grew to {size[:, b].max() / size[0, b]:.3g} x |L(0)| "
+                    f"(conserved; limit {1 + CONSERVED_GROWTH_LIMIT:g} x)")
+    return ""
+
+
+def divergence(scene: DynamicsScene, traj: Trajectory) -> str:
+    """Why a finite trajectory counts as diverged (see the module's bounds), or "" when it does not."""
+    linear, angular = _speed_bounds(scene)
+    duration = max(scene.duration, np.finfo(float).tiny)
+    for quantity, values, bound, rounding in (
+            ("speed", traj.velocity_world, linear, AT_REST * body_sizes(scene) / duration),
+            ("angular speed", traj.angular_velocity_world, angular, AT_REST / duration)):
+        peak = np.linalg.norm(values, axis=-1).max(axis=0)
+        limit = DIVERGENCE_MARGIN * bound + rounding
+        over = peak > limit
+        if over.any():
+            b = int(np.argmax(peak / limit))
+            return (f"{quantity} of {scene.bodies[b].name} reached {peak[b]:.3g}, more than {DIVERGENCE_MARGIN:g} x "
+                    f"the {bound[b]:.3g} its forces allow")
+    return _conserved_growth(scene, traj)
+
+
+def blow_up(scene: DynamicsScene, traj: Trajectory) -> tuple[str, ContactReading | None]:
+    """(why ``traj`` counts as diverged, "" if it does not; its contact reading, None without contact or when
+    it blew up before one was taken). Non-finite, :func:`divergence`, or with contact energy gained across
+    one beyond :data:`comparisons.contact_metrics.UNSTABLE_ENERGY_GAIN`."""
+    blown = "non-finite state" if not traj.is_finite() else divergence(scene, traj)
+    if blown or scene.contact is None:
+        return blown, None
+    reading = read_contact(scene, traj)
+    return contact_blow_up(scene, reading), reading

@@ -1,0 +1,82 @@
+"""``simparity show``: a scene as the loader understood it, in SI units and the project's conventions.
+
+It reports what the loader computed (a body built from point masses: its mass, centre of mass and
+inertia tensor; planes normalised to unit normals; every body-plane material; a sweep's variant: its
+swept values) so a user can check the scene before running it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simparity.comparisons.scenes.sweep import value_text
+from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
+
+
+def _vector(values) -> str:
+    return "[" + ", ".join(f"{v:.10g}" for v in np.ravel(values)) + "]"
+
+
+def _matrix(values) -> str:
+    return "[" + ", ".join(_vector(row) for row in np.asarray(values)) + "]"
+
+
+def _body_lines(scene: DynamicsScene) -> list[str]:
+    lines = []
+    for k, body in enumerate(scene.bodies):
+        lines.append(f"body {body.name}: mass {body.mass:.10g} kg, COM {_vector(body.position_world)} m, "
+                     f"quat_wxyz {_vector(body.quat_wxyz)}, velocity_world {_vector(body.velocity_world)} m/s, "
+                     f"angular_velocity_world {_vector(body.angular_velocity_world)} rad/s")
+        lines.append(f"  inertia_body about the COM {_matrix(body.inertia_body)} kg m^2")
+        points = body.point_masses
+        if points is not None:
+            lines.append(f"  computed from {len(points.masses)} point masses: M = sum m_i = {body.mass:.10g} kg; "
+                         f"COM = sum m_i q_i / M = {_vector(points.center_of_mass_given)} m in the frame the points "
+                         "are given in; I = sum m_i (|r_i|^2 E - r_i r_i^T) about the COM, off-diagonal entries "
+                         "-sum m x y (the physical sign; the lecture's table prints them without the minus)")
+        if scene.contact is not None:
+            shape = scene.contact.shapes[k]
+            size = {"sphere": f" radius {shape.radius:.10g} m",
+                    "box": f" half_extents {_vector(shape.half_extents_body)} m at {_vector(shape.center_body)} m",
+                    "points": f" {len(shape.points_body)} points"}.get(shape.kind, "")
+            lines.append(f"  shape {shape.kind}{size}")
+    return lines
+
+
+def _contact_lines(scene: DynamicsScene) -> list[str]:
+    contact = scene.contact
+    if contact is None:
+        return ["contact: none (no engine is given any)"]
+    lines = [f"contact: methods {', '.join(contact.methods)}; rest_speed {contact.rest_speed:.10g} m/s; penalty "
+             f"stiffness {contact.penalty_stiffness:.10g} N/m, damping "
+             + (f"{contact.penalty_damping:.10g} N s/m" if contact.penalty_damping is not None else
+                "from each pair's restitution (linear spring-damper)")]
+    for plane in contact.planes:
+        lines.append(f"plane {plane.name}: E(p) = N . p + d, N = {_vector(plane.normal_world)}, "
+                     f"d = {plane.offset:.10g} m (normalised)")
+    for body, row in zip(scene.bodies, contact.materials):
+        for plane, material in zip(contact.planes, row):
+            lines.append(f"  {body.name} on {plane.name}: restitution {material.restitution:.10g}, friction static "
+                         f"{material.friction_static:.10g}, kinetic {material.friction_kinetic:.10g}")
+    return lines
+
+
+def describe(scene) -> str:
+    """The text ``simparity show`` prints for ``scene``."""
+    head = [f"scene {scene.name} ({scene.kind}), reference {scene.reference}, suites {', '.join(scene.suites)}",
+            f"from {scene.source}"]
+    if scene.sweep is not None:
+        values = ", ".join(f"{key} = {value_text(value)}" for key, value in scene.sweep.values)
+        head.append(f"variant {scene.sweep.index + 1} of {scene.sweep.count} of the sweep of {scene.sweep.base}: "
+                    f"{values} (as written in the file)")
+    if isinstance(scene, DynamicsScene):
+        forces = scene.forces
+        gravity = "none" if forces.gravity_world is None else f"{_vector(forces.gravity_world)} m/s^2"
+        head += [f"gravity_world {gravity}; forces {', '.join(forces.names()) or 'none'}",
+                 f"duration {scene.duration:.10g} s; dt {', '.join(f'{dt:.10g}' for dt in scene.dts)} s"]
+        head += _body_lines(scene) + _contact_lines(scene)
+    elif isinstance(scene, (KinematicsScene, IKScene)):
+        chain = scene.chain
+        head.append(f"chain {chain.name}: {chain.n_joints} joints ({', '.join(j.name for j in chain.joints)}), "
+                    f"end effector {chain.end_effector_name}")
+    return "\n".join(head) + "\n"

@@ -1,0 +1,57 @@
+"""External forces of a scene as a wrench function (the lecture's "Forces").
+
+F = M g - b (v - w) - c |v - w| (v - w) + sum f_i
+tau = -k omega - k_q |omega| omega + sum (R p_i) x f_i      (torques about each COM)
+
+with w the air velocity (wind), f_i constant world-frame forces applied at body-fixed
+points p_i. Terms absent from the scene contribute nothing and cost nothing.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from simparity.core.dynamics.rigid_body import MassProperties, Wrench
+from simparity.core.model.scene import Forces
+
+
+def make_wrench(forces: Forces, props: MassProperties) -> Wrench:
+    """f(t, x, R, v, omega) -> (force_world (B, 3) [N], torque_world (B, 3) [N m])."""
+    n = len(props.mass)
+    constant = np.zeros((n, 3))
+    if forces.gravity_world is not None:
+        constant += props.mass[:, None] * forces.gravity_world
+    air = np.zeros(3) if forces.air_velocity_world is None else forces.air_velocity_world
+    applied_body = np.array([a.body for a in forces.applied], dtype=int)
+    applied_force = np.array([a.force_world for a in forces.applied]).reshape(-1, 3)
+    applied_point = np.array([a.point_body for a in forces.applied]).reshape(-1, 3)
+    np.add.at(constant, applied_body, applied_force)
+    b, c = forces.linear_drag, forces.quadratic_drag
+    k, kq = forces.angular_linear_drag, forces.angular_quadratic_drag
+
+    def wrench(t, x, rotation, v, omega):
+        force = constant.copy()
+        torque = np.zeros_like(force)
+        if b is not None or c is not None:
+            relative = v - air
+            if b is not None:
+                force -= b[:, None] * relative
+            if c is not None:
+                force -= c[:, None] * np.linalg.norm(relative, axis=1, keepdims=True) * relative
+        if k is not None:
+            torque -= k[:, None] * omega
+        if kq is not None:
+            torque -= kq[:, None] * np.linalg.norm(omega, axis=1, keepdims=True) * omega
+        if len(applied_body):
+            lever = np.einsum("aij,aj->ai", rotation[applied_body], applied_point)
+            np.add.at(torque, applied_body, np.cross(lever, applied_force))
+        return force, torque
+
+    return wrench
+
+
+def without_gravity(forces: Forces) -> Forces:
+    """The same forces minus gravity, for engines that apply gravity themselves."""
+    return replace(forces, gravity_world=None)

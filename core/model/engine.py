@@ -1,0 +1,281 @@
+"""The one engine interface shared by the in-house core and every reference.
+
+An engine answers three questions about a scene: can you do it (:class:`Support`, with
+the reason when not), build it (untimed), and run it (timed by the runner). Building and
+running are split so the runner can time the stepping alone.
+"""
+
+from __future__ import annotations
+
+import abc
+from dataclasses import dataclass
+
+import numpy as np
+
+from simparity.core.model.errors import SimparityError
+from simparity.core.model.ik_problem import IKTolerances
+from simparity.core.model.ik_result import IKResult
+from simparity.core.model.scene import Chain, DynamicsScene, KinematicsScene, Scene
+from simparity.core.model.trajectory import FramePoses, Trajectory
+
+
+SCHEME_KINDS = {
+    # How a dynamics integrator steps a free body.
+    "explicit_euler": "explicit (forward) Euler: first order, gains energy on any oscillation or spin",
+    "semi_implicit_euler": "semi-implicit (symplectic) Euler: first order",
+    "engine_euler": "semi-implicit Euler with the orientation advanced by the exponential map, as engines step: "
+                    "first order",
+    "implicit_damping": "semi-implicit Euler with velocity-dependent forces taken implicitly (MuJoCo's "
+                              "implicit, implicitfast): first order, damps stiff drag and fast spins",
+    "midpoint": "the explicit midpoint rule (RK2): second order",
+    "average_velocity": "the lecture's average-velocity rule (Heun's method, RK2): second order",
+    "rk4": "classical fourth-order Runge-Kutta",
+    "taylor2": "the lecture's Taylor rule for a point: exact under constant acceleration",
+    "constant_velocity": "the lecture's rule for a point no force acts on",
+    "closed_form": "a closed-form solution (a truth, not a scheme)",
+    "adaptive": "an adaptive high-order solve at a tight tolerance (a truth, not a scheme)",
+    # How contact with a plane is treated (a contact scene's scheme is "<treatment>+<time integrator>").
+    "backup": "time backed up to each contact, the response there (exact for ballistic flight)",
+    "act_after": "the kinematic response after the step in which the contact happened, with push-out",
+    "penalty": "a spring-damper force on penetration, integrated by a time integrator",
+    "soft": "a soft constraint (MuJoCo's solref/solimp), with no restitution coefficient",
+    "impulse": "velocity-level impulses with restitution and position correction (Bullet)",
+    # How an IK solver steps.
+    "jacobian_inverse": "Newton steps with J^-1 (square, invertible Jacobians only)",
+    "pseudo_inverse": "Newton steps with the Moore-Penrose pseudo-inverse of J",
+    "transpose": "gradient steps along J^T e",
+    "damped_least_squares": "damped least squares (Levenberg-Marquardt) steps",
+    "nullspace": "a secondary objective projected into J's null space (after a '+')",
+    "restarts": "restarts from random configurations when a solve stalls (after a '+')",
+    "limits": "keeps the joints within their limits at every iteration (after a '+')",
+}
+"""The kinds of scheme the CI gate keys its bounds by (``scheme`` in a tolerances file), whatever the engine
+calls its integrators: an engine's :meth:`Engine.scheme` answers with these names, joined by ``+`` where a
+kind is modified (``damped_least_squares+nullspace``) or a contact treatment drives a time integrator
+(``penalty+rk4``, ``soft+rk4``). "" is an engine that does not say, which only the bounds for every scheme
+hold."""
+
+CONTACT_TREATMENTS = ("backup", "act_after", "penalty", "soft", "impulse")
+
+
+def is_scheme_label(label: str) -> bool:
+    """Whether ``label`` is "" or kinds of :data:`SCHEME_KINDS` joined by ``+``."""
+    return label == "" or all(part in SCHEME_KINDS for part in label.split("+"))
+
+
+@dataclass(frozen=True)
+class Support:
+    """Whether an engine can do what a scene asks, and why not when it cannot."""
+
+    ok: bool
+    reason: str = ""
+
+    @classmethod
+    def yes(cls) -> "Support":
+        return cls(True)
+
+    @classmethod
+    def no(cls, reason: str) -> "Support":
+        return cls(False, reason)
+
+
+class Simulation(abc.ABC):
+    """A dynamics scene built for one engine, integrator and time step.
+
+    Attributes
+    ----------
+    detail : str
+        What the engine was configured with beyond the scene (defaults switched off,
+        harness-side stepping, ...); shown in the results' ``detail`` column.
+    integrates_rotation : bool
+        False when the scheme moves only the centre of mass (the lecture's point-mass
+        rules): orientation and angular velocity stay at their initial values, so their
+        errors and orders of convergence measure nothing.
+    """
+
+    detail: str = ""
+    integrates_rotation: bool = True
+
+    @abc.abstractmethod
+    def run(self, n_steps: int) -> Trajectory:
+        """Simulate ``n_steps`` steps from the scene's initial state.
+
+        Every call starts again from the initial state. Returns a :class:`Trajectory` with
+        ``n_steps + 1`` samples.
+        """
+
+
+class KinematicsModel(abc.ABC):
+    """A chain built for one engine.
+
+    Attributes
+    ----------
+    detail : str
+    resolution : tuple of float
+        (position [m], orientation [rad]) below which this engine's FK cannot tell two
+        poses apart (0 for double precision); a judge of IK solutions grants that much.
+    """
+
+    detail: str = ""
+    resolution: tuple[float, float] = (0.0, 0.0)
+
+    @abc.abstractmethod
+    def forward_kinematics(self, q: np.ndarray) -> FramePoses:
+        """Poses of every joint's child-link frame and of the end effector.
+
+        Parameters
+        ----------
+        q : (B, n) ndarray
+            Joint values [rad or m].
+
+        Returns
+        -------
+        FramePoses
+            F = n + 1 frames in the order of :meth:`Chain.frame_names`.
+        """
+
+    @abc.abstractmethod
+    def jacobian_world(self, q: np.ndarray) -> np.ndarray:
+        """Geometric Jacobian of the end-effector frame.
+
+        Rows 0-2 map joint velocities to the linear velocity of the end-effector origin,
+        rows 3-5 to the angular velocity, both in world axes (Pinocchio's
+        LOCAL_WORLD_ALIGNED). (B, n) -> (B, 6, n).
+        """
+
+
+class IKModel(abc.ABC):
+    """An inverse-kinematics solver built for one chain.
+
+    Attributes
+    ----------
+    detail : str
+        What the solver is and how it was configured (library call, iterations, damping).
+    """
+
+    detail: str = ""
+
+    @abc.abstractmethod
+    def solve(self, target_position_world: np.ndarray, target_rotation_world: np.ndarray | None,
+              q_start: np.ndarray) -> IKResult:
+        """Solve a batch of end-effector targets, every one from the same start.
+
+        Parameters
+        ----------
+        target_position_world : (B, 3) ndarray
+            [m].
+        target_rotation_world : (B, 3, 3) ndarray or None
+            End-effector to world rotation; ``None`` for position-only targets.
+        q_start : (n,) ndarray
+            Start configuration [rad or m].
+
+        Returns
+        -------
+        IKResult
+            Never raises for an unreachable or singular target; residuals are measured with
+            the engine's own forward kinematics. ``iterations`` is -1 where the engine does
+            not report it.
+        """
+
+
+class Engine(abc.ABC):
+    """One engine: the in-house core, an analytic truth, or an adapter to a library."""
+
+    name: str = ""
+
+    @abc.abstractmethod
+    def version(self) -> str:
+        """Version string of the library behind the engine."""
+
+    @abc.abstractmethod
+    def integrators(self) -> tuple[str, ...]:
+        """Names of the dynamics integrators the engine offers (empty if none)."""
+
+    def scene_integrators(self, scene: DynamicsScene) -> tuple[str, ...]:
+        """The integrators this engine runs on ``scene``: all of :meth:`integrators` unless the engine's
+        methods differ by kind of scene (core runs its contact methods on a scene with contact, and its
+        free-body integrators on the others). Each is a case of the scene; unsupported ones are n/a rows."""
+        return self.integrators()
+
+    @abc.abstractmethod
+    def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
+        """Whether :meth:`build_dynamics` can simulate ``scene`` with ``integrator``."""
+
+    @abc.abstractmethod
+    def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
+        """Build the model for ``scene`` (not timed). Call only when supported."""
+
+    @abc.abstractmethod
+    def supports_kinematics(self, chain: Chain) -> Support:
+        """Whether :meth:`build_kinematics` can evaluate ``chain``."""
+
+    @abc.abstractmethod
+    def build_kinematics(self, chain: Chain) -> KinematicsModel:
+        """Build the model for ``chain`` (not timed). Call only when supported."""
+
+    def theoretical_order(self, integrator: str) -> int | None:
+        """Global order of accuracy the integrator has in theory (None: unknown, or it depends on the
+        scene). Reports draw it beside the observed order."""
+        return None
+
+    def scheme(self, integrator: str, scene: Scene) -> str:
+        """What kind of scheme ``integrator`` (an IK solver on an IK scene) is on ``scene``, in the names of
+        :data:`SCHEME_KINDS` (``rk4``, ``penalty+rk4``, ``damped_least_squares+nullspace``); "" when unknown.
+        The CI gate holds every engine's scheme of a kind to that kind's bounds.
+
+        By default an integrator named as a kind is of that kind (its variant, after the first ``+`` of
+        :meth:`integrator_variant`, left out), and on a contact scene ``penalty_<kind>`` is ``penalty+<kind>``:
+        an engine that names its integrators and solvers after what they are needs nothing more."""
+        name = integrator
+        if isinstance(scene, DynamicsScene):
+            name = self.integrator_variant(integrator)[0]
+            if scene.contact is not None and name.startswith("penalty_"):
+                name = "penalty+" + name.removeprefix("penalty_")
+        return name if is_scheme_label(name) else ""
+
+    def integrator_variant(self, integrator: str) -> tuple[str, str]:
+        """(scheme, variant) of an integrator: integrators that differ only in a variant of one scheme
+        (core's orientation updates of RK4, say) share the scheme, and reports put them on one row.
+        "" when the integrator has no variants."""
+        return integrator, ""
+
+    def ik_solvers(self) -> tuple[str, ...]:
+        """Names of the IK solvers the engine offers (empty if none)."""
+        return ()
+
+    def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
+        """Whether :meth:`build_ik` can build ``solver`` for ``chain`` and this kind of target."""
+        if solver in self.ik_solvers():
+            return Support.yes()
+        if not self.ik_solvers():
+            return Support.no(f"{self.name} offers no IK solver")
+        return Support.no(f"{self.name} has no IK solver '{solver}' (offers: {', '.join(self.ik_solvers())})")
+
+    def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
+        """Build ``solver`` for ``chain`` with the scene's tolerances and iteration cap (not timed)."""
+        raise SimparityError(f"engine '{self.name}' has no IK solvers (allowed: an engine whose ik_solvers() is not empty)")
+
+    def check_integrator(self, integrator: str) -> Support:
+        """Support for an integrator name alone."""
+        if integrator in self.integrators():
+            return Support.yes()
+        offered = ", ".join(self.integrators()) or "none"
+        return Support.no(f"{self.name} has no integrator '{integrator}' (offers: {offered})")
+
+    def export(self, scene: DynamicsScene | KinematicsScene, integrator: str | None, dt: float | None) -> str:
+        """Text of the model this engine is given for ``scene`` (MJCF, URDF, ...).
+
+        ``integrator`` and ``dt`` apply to dynamics scenes; ``None`` picks the engine's
+        first integrator and the scene's first time step.
+        """
+        raise SimparityError(f"engine '{self.name}' builds no model to export (allowed: mujoco, pybullet, pinocchio)")
+
+    def _export_settings(self, scene: DynamicsScene, integrator: str | None, dt: float | None) -> tuple[str, float]:
+        integrator = integrator or self.integrators()[0]
+        support = self.check_integrator(integrator)
+        if not support.ok:
+            raise SimparityError(f"--integrator: {support.reason} (allowed: {', '.join(self.integrators())})")
+        dt = scene.dts[0] if dt is None else dt
+        if not (dt > 0 and dt < float("inf")):
+            raise SimparityError(f"--dt {dt}: not a time step (allowed: a finite number of seconds > 0)")
+        return integrator, dt

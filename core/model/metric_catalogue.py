@@ -1,0 +1,229 @@
+"""The metric catalogue: every metric a run can write, with its unit and what kind of quantity it is.
+
+One place for what the measuring code, the tolerances, the gate, the report and the figures say about a
+metric: its name (the ``metric`` column), its unit (the ``unit`` column), its kind (an error against the
+reference, a drift, an observed order, a wall time, a contact or IK quantity, a state's validity), whether a
+report ranks schemes by it (headline), the quantity whose own scale saturates it, and the theory it is held
+to. Code refers to a metric by the constants below, never by spelling its name again, so a rename is one edit
+and a typo an import error. The definitions with their reasons: ``docs/metrics.md``.
+
+Families of metrics named after something a scene chooses (an IK scene's hard targets, a metamorphic
+transform) are :class:`MetricFamily` entries: ``hard_<target>_solved``, ``invariance_ratio_<transform>``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from simparity.core.model.results import DIMENSIONLESS
+
+ERROR, DRIFT, ORDER, TIMING, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE = (
+    "error", "drift", "order", "timing", "contact", "ik", "validity", "stability", "invariance")
+KINDS = (ERROR, DRIFT, ORDER, TIMING, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE)
+"""What a metric measures: an error against the reference; a relative drift of a conserved quantity; an observed
+order of convergence; a wall time (never compared between runs); a contact event's quantity; an IK solver's
+outcome; a reported state's validity (unit quaternion, orthonormal matrix); a measured stability limit; a
+metamorphic invariance check."""
+
+
+@dataclass(frozen=True)
+class Metric:
+    """One metric of the catalogue.
+
+    ``scale``: the quantity whose own scale saturates it (``position``, ``velocity``, ``orientation``,
+    ``angular_velocity``, ``energy``; "" when none); ``theory``: the rule it is held to in theory ("" when
+    none), e.g. an order's scheme order; ``source``: for an order, the error it is the slope of."""
+
+    name: str
+    unit: str
+    kind: str
+    headline: bool = False
+    scale: str = ""
+    theory: str = ""
+    source: str = ""
+
+    @property
+    def is_timing(self) -> bool:
+        return self.kind == TIMING
+
+
+@dataclass(frozen=True)
+class MetricFamily:
+    """Metrics named ``prefix + <member> + suffix`` (an IK scene's hard target, a transform's name)."""
+
+    prefix: str
+    suffix: str
+    unit: str
+    kind: str
+
+    def name(self, member: str) -> str:
+        return f"{self.prefix}{member}{self.suffix}"
+
+    def matches(self, name: str) -> bool:
+        middle = name[len(self.prefix):len(name) - len(self.suffix)] if self.suffix else name[len(self.prefix):]
+        return name.startswith(self.prefix) and name.endswith(self.suffix) and bool(middle) and "." not in middle
+
+
+# Dynamics: errors against the reference trajectory (maxima over bodies and samples; final at the last one).
+POSITION_ERROR_MAX = "position_error_max"
+POSITION_ERROR_FINAL = "position_error_final"
+ORIENTATION_ERROR_MAX = "orientation_error_max"
+VELOCITY_ERROR_MAX = "velocity_error_max"
+ANGULAR_VELOCITY_ERROR_MAX = "angular_velocity_error_max"
+QUATERNION_NORM_DEVIATION_MAX = "quaternion_norm_deviation_max"
+TIME_PER_STEP = "time_per_step"
+ENERGY_DRIFT_MAX = "energy_drift_max"
+ANGULAR_MOMENTUM_DRIFT_MAX = "angular_momentum_drift_max"
+ORDER_POSITION = "order_position"
+ORDER_ORIENTATION = "order_orientation"
+ORDER_VELOCITY = "order_velocity"
+ORDER_ANGULAR_VELOCITY = "order_angular_velocity"
+STABLE_DT_MAX = "stable_dt_max"
+# Kinematics: frames and Jacobians against the reference.
+JACOBIAN_ERROR_MAX = "jacobian_error_max"
+ROTATION_ORTHONORMALITY_DEVIATION_MAX = "rotation_orthonormality_deviation_max"
+TIME_PER_FK = "time_per_fk"
+TIME_PER_JACOBIAN = "time_per_jacobian"
+# Contact: events against the exact bounce sequence, slide and rest.
+IMPACT_TIME_ERROR = "impact_time_error"
+REBOUND_VELOCITY_ERROR = "rebound_velocity_error"
+APEX_HEIGHT_ERROR = "apex_height_error"
+RESTITUTION_MEASURED = "restitution_measured"
+RESTITUTION_ERROR = "restitution_error"
+RESTITUTION_MIN = "restitution_min"
+RESTITUTION_MEDIAN = "restitution_median"
+RESTITUTION_MAX = "restitution_max"
+ENERGY_LOSS_ERROR = "energy_loss_error"
+ENERGY_KEPT_MIN = "energy_kept_min"
+ENERGY_KEPT_MEDIAN = "energy_kept_median"
+ENERGY_KEPT_MAX = "energy_kept_max"
+PENETRATION_MAX = "penetration_max"
+TUNNELLED = "tunnelled"
+IMPACTS_MISSED = "impacts_missed"
+ENERGY_GAIN_MAX = "energy_gain_max"
+REST_TIME_ERROR = "rest_time_error"
+REST_JITTER = "rest_jitter"
+STOPPING_DISTANCE = "stopping_distance"
+STOPPING_DISTANCE_ERROR = "stopping_distance_error"
+# IK: a solver's outcome on its targets, judged by the harness.
+SOLVE_RATE = "solve_rate"
+CROSS_EVAL_SOLVE_RATE_MIN = "cross_eval_solve_rate_min"
+CROSS_EVAL_DISAGREEMENT_MAX = "cross_eval_disagreement_max"
+POSITION_RESIDUAL_MEDIAN = "position_residual_median"
+POSITION_RESIDUAL_MAX = "position_residual_max"
+ORIENTATION_RESIDUAL_MEDIAN = "orientation_residual_median"
+ORIENTATION_RESIDUAL_MAX = "orientation_residual_max"
+ITERATIONS_MEDIAN = "iterations_median"
+LIMIT_VIOLATIONS = "limit_violations"
+UNCONFIRMED_CLAIMS = "unconfirmed_claims"
+REST_DISTANCE_MEDIAN = "rest_distance_median"
+START_RANK_DEFICIENCY = "start_rank_deficiency"
+FK_DEPARTURE_MAX = "fk_departure_max"
+JACOBIAN_DEPARTURE_MAX = "jacobian_departure_max"
+TIME_PER_SOLVE = "time_per_solve"
+
+_ANGLE_OR_LENGTH = "rad or m"
+_JACOBIAN_UNIT = "m/rad or 1"
+
+CATALOGUE: dict[str, Metric] = {m.name: m for m in (
+    Metric(POSITION_ERROR_MAX, "m", ERROR, headline=True, scale="position"),
+    Metric(POSITION_ERROR_FINAL, "m", ERROR, scale="position"),
+    Metric(ORIENTATION_ERROR_MAX, "rad", ERROR, headline=True, scale="orientation"),
+    Metric(VELOCITY_ERROR_MAX, "m/s", ERROR, scale="velocity"),
+    Metric(ANGULAR_VELOCITY_ERROR_MAX, "rad/s", ERROR, scale="angular_velocity"),
+    Metric(QUATERNION_NORM_DEVIATION_MAX, DIMENSIONLESS, VALIDITY, theory="0 up to rounding"),
+    Metric(TIME_PER_STEP, "s", TIMING),
+    Metric(ENERGY_DRIFT_MAX, DIMENSIONLESS, DRIFT, scale="energy", theory="0 for a conservative scene"),
+    Metric(ANGULAR_MOMENTUM_DRIFT_MAX, DIMENSIONLESS, DRIFT, theory="0 without torque"),
+    Metric(ORDER_POSITION, DIMENSIONLESS, ORDER, theory="the scheme's order", source=POSITION_ERROR_MAX),
+    Metric(ORDER_ORIENTATION, DIMENSIONLESS, ORDER, theory="the scheme's order", source=ORIENTATION_ERROR_MAX),
+    Metric(ORDER_VELOCITY, DIMENSIONLESS, ORDER, theory="the scheme's order", source=VELOCITY_ERROR_MAX),
+    Metric(ORDER_ANGULAR_VELOCITY, DIMENSIONLESS, ORDER, theory="the scheme's order",
+           source=ANGULAR_VELOCITY_ERROR_MAX),
+    Metric(STABLE_DT_MAX, "s", STABILITY),
+    Metric(JACOBIAN_ERROR_MAX, _JACOBIAN_UNIT, ERROR),
+    Metric(ROTATION_ORTHONORMALITY_DEVIATION_MAX, DIMENSIONLESS, VALIDITY, theory="0 up to rounding"),
+    Metric(TIME_PER_FK, "s", TIMING),
+    Metric(TIME_PER_JACOBIAN, "s", TIMING),
+    Metric(IMPACT_TIME_ERROR, "s", CONTACT),
+    Metric(REBOUND_VELOCITY_ERROR, "m/s", CONTACT),
+    Metric(APEX_HEIGHT_ERROR, "m", CONTACT),
+    Metric(RESTITUTION_MEASURED, DIMENSIONLESS, CONTACT, theory="the requested restitution"),
+    Metric(RESTITUTION_ERROR, DIMENSIONLESS, CONTACT),
+    Metric(RESTITUTION_MIN, DIMENSIONLESS, CONTACT),
+    Metric(RESTITUTION_MEDIAN, DIMENSIONLESS, CONTACT),
+    Metric(RESTITUTION_MAX, DIMENSIONLESS, CONTACT),
+    Metric(ENERGY_LOSS_ERROR, DIMENSIONLESS, CONTACT),
+    Metric(ENERGY_KEPT_MIN, DIMENSIONLESS, CONTACT),
+    Metric(ENERGY_KEPT_MEDIAN, DIMENSIONLESS, CONTACT),
+    Metric(ENERGY_KEPT_MAX, DIMENSIONLESS, CONTACT),
+    Metric(PENETRATION_MAX, "m", CONTACT),
+    Metric(TUNNELLED, DIMENSIONLESS, CONTACT, theory="0: a body never passes through a plane"),
+    Metric(IMPACTS_MISSED, DIMENSIONLESS, CONTACT),
+    Metric(ENERGY_GAIN_MAX, DIMENSIONLESS, CONTACT, theory="at most 1: contact only takes energy away"),
+    Metric(REST_TIME_ERROR, "s", CONTACT),
+    Metric(REST_JITTER, "m", CONTACT),
+    Metric(STOPPING_DISTANCE, "m", CONTACT),
+    Metric(STOPPING_DISTANCE_ERROR, "m", CONTACT),
+    Metric(SOLVE_RATE, DIMENSIONLESS, IK, headline=True),
+    Metric(CROSS_EVAL_SOLVE_RATE_MIN, DIMENSIONLESS, IK),
+    Metric(CROSS_EVAL_DISAGREEMENT_MAX, "m", IK),
+    Metric(POSITION_RESIDUAL_MEDIAN, "m", IK),
+    Metric(POSITION_RESIDUAL_MAX, "m", IK),
+    Metric(ORIENTATION_RESIDUAL_MEDIAN, "rad", IK),
+    Metric(ORIENTATION_RESIDUAL_MAX, "rad", IK),
+    Metric(ITERATIONS_MEDIAN, DIMENSIONLESS, IK),
+    Metric(LIMIT_VIOLATIONS, DIMENSIONLESS, IK),
+    Metric(UNCONFIRMED_CLAIMS, DIMENSIONLESS, IK, theory="0: a solver's success is the harness's"),
+    Metric(REST_DISTANCE_MEDIAN, _ANGLE_OR_LENGTH, IK),
+    Metric(START_RANK_DEFICIENCY, DIMENSIONLESS, IK),
+    Metric(FK_DEPARTURE_MAX, "m", IK),
+    Metric(JACOBIAN_DEPARTURE_MAX, _JACOBIAN_UNIT, IK),
+    Metric(TIME_PER_SOLVE, "s", TIMING),
+)}
+
+HARD_TARGET_ERROR = MetricFamily("hard_", "", "m", IK)
+"""The position residual on one hard IK target (``hard_<target>``)."""
+HARD_TARGET_SOLVED = MetricFamily("hard_", "_solved", DIMENSIONLESS, IK)
+HARD_TARGET_UNREACHABLE = MetricFamily("hard_", "_unreachable", DIMENSIONLESS, IK)
+HARD_TARGET_LIMIT_VIOLATION = MetricFamily("hard_", "_limit_violation", _ANGLE_OR_LENGTH, IK)
+INVARIANCE_RATIO = MetricFamily("invariance_ratio_", "", DIMENSIONLESS, INVARIANCE)
+INVARIANCE_STATUS_CHANGES = MetricFamily("invariance_status_changes_", "", DIMENSIONLESS, INVARIANCE)
+FAMILIES = (HARD_TARGET_SOLVED, HARD_TARGET_UNREACHABLE, HARD_TARGET_LIMIT_VIOLATION, HARD_TARGET_ERROR,
+            INVARIANCE_RATIO, INVARIANCE_STATUS_CHANGES)
+"""Most specific first: ``hard_x_solved`` is a solved flag, not the residual of a target named ``x_solved``."""
+
+
+def family_of(name: str) -> MetricFamily | None:
+    """The family a metric not in :data:`CATALOGUE` belongs to, or None."""
+    return next((f for f in FAMILIES if f.matches(name)), None)
+
+
+def unit_of(name: str) -> str:
+    """The unit of any metric a run writes; raises KeyError for a name the catalogue does not know."""
+    if name in CATALOGUE:
+        return CATALOGUE[name].unit
+    family = family_of(name)
+    if family is None:
+        raise KeyError(f"{name}: not a metric of the catalogue")
+    return family.unit
+
+
+def units(*names: str) -> dict[str, str]:
+    """``{name: unit}`` of catalogued metrics, in the order given (raises KeyError for an unknown name)."""
+    return {name: CATALOGUE[name].unit for name in names}
+
+
+def is_timing(name: str) -> bool:
+    """Whether a metric measures wall time: never compared between runs, never a numerics change."""
+    return name in CATALOGUE and CATALOGUE[name].is_timing
+
+
+def headline_metrics() -> tuple[str, ...]:
+    """The metrics a report ranks by (a dynamics scene's position or orientation error, an IK solver's rate)."""
+    return tuple(m.name for m in CATALOGUE.values() if m.headline)
+
+
+def order_source(order: str) -> str:
+    """The error an observed order is the slope of (``order_position`` -> ``position_error_max``)."""
+    return CATALOGUE[order].source

@@ -1,0 +1,79 @@
+"""Trajectories of free bodies and kinematic results, in the project's conventions."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from simparity.core.model.arrays import readonly
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """States of B bodies at T sample times (the initial state included).
+
+    Attributes
+    ----------
+    times : (T,) ndarray
+        [s], starting at 0.
+    position_world : (T, B, 3) ndarray
+        Centre of mass [m].
+    quat_wxyz : (T, B, 4) ndarray
+        Orientation, body to world (sign as the engine returned it).
+    velocity_world : (T, B, 3) ndarray
+        Centre-of-mass velocity [m/s].
+    angular_velocity_world : (T, B, 3) ndarray
+        [rad/s].
+    """
+
+    times: np.ndarray
+    position_world: np.ndarray
+    quat_wxyz: np.ndarray
+    velocity_world: np.ndarray
+    angular_velocity_world: np.ndarray
+
+    def __post_init__(self) -> None:
+        n = len(self.times)
+        for name, last in (
+            ("position_world", 3),
+            ("quat_wxyz", 4),
+            ("velocity_world", 3),
+            ("angular_velocity_world", 3),
+        ):
+            value = np.asarray(getattr(self, name))
+            if value.ndim != 3 or value.shape[0] != n or value.shape[2] != last:
+                raise ValueError(f"Trajectory.{name} has shape {value.shape}, expected ({n}, B, {last})")
+            object.__setattr__(self, name, readonly(value))
+        object.__setattr__(self, "times", readonly(self.times))
+
+    @property
+    def n_bodies(self) -> int:
+        return self.position_world.shape[1]
+
+    def is_finite(self) -> bool:
+        """True when every recorded value is finite."""
+        return all(
+            bool(np.all(np.isfinite(a)))
+            for a in (self.position_world, self.quat_wxyz, self.velocity_world, self.angular_velocity_world)
+        )
+
+
+@dataclass(frozen=True)
+class FramePoses:
+    """Poses of the frames of a chain at a batch of configurations.
+
+    Attributes
+    ----------
+    position_world : (B, F, 3) ndarray
+        Frame origins [m].
+    rotation_world : (B, F, 3, 3) ndarray
+        Frame to world rotations.
+    """
+
+    position_world: np.ndarray
+    rotation_world: np.ndarray
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "position_world", readonly(self.position_world))
+        object.__setattr__(self, "rotation_world", readonly(self.rotation_world))

@@ -1,0 +1,320 @@
+"""Pinocchio behind the shared engine interface.
+
+Pinocchio computes dynamics but has no time stepper: the harness steps the accelerations
+of ``pin.aba`` itself, and the results say so ("harness-stepped").
+
+Conversions (each pinned by a test in ``tests/test_pinocchio_adapter.py``)
+------------------------------------------------------------------------
+- Free-flyer ``q[3:7]`` is (x, y, z, w): reordered here.
+- Free-flyer ``v[0:3]`` and ``v[3:6]`` are in the LOCAL (body) frame: v_world = R v[0:3],
+  omega_world = R v[3:6]. The joint frame is the COM (lever 0), so v[0:3] is the COM's.
+- ``aba`` returns the SPATIAL acceleration; the classical acceleration of the origin is
+  a[0:3] + omega x v[0:3] (both local).
+- ``euler``: the engines' first-order scheme (as MuJoCo Euler): v_world += dt R a_classical,
+  omega_local += dt a[3:6], then p += dt v_world and R = R exp(dt omega_local).
+- ``rk4``: RK4 on the same accelerations, the rotation by RKMK in the body frame with
+  Pinocchio's own Lie-group functions: R = R0 exp3(u), du/dt = Jlog3(exp3(u)) w (the inverse
+  of the right Jacobian of exp). Stepping ``pin.integrate`` on the local twist instead
+  would follow an SE(3) screw and drift from the others (0.25 m after 2 s of free fall).
+- Forces other than gravity (``model.gravity``) enter ``aba`` as ``fext``, as Pinocchio
+  users give them: per joint a spatial force about the joint origin (the COM) in the LOCAL
+  frame. A force f at a body point p is ``SE3(I, p).act(Force(R^T f, 0))`` (Pinocchio
+  computes its moment); drag and wind (:mod:`references.external_forces`, independent of
+  core) are (R^T F, R^T tau) at the COM.
+- Chains: the chain's URDF text (:func:`references.urdf_export.chain_urdf`: a URDF file
+  without its visual and collision geometry, or the adapter's export) read by
+  ``buildModelFromXML``; fixed base. A ``continuous`` joint has nq = 2 (cos, sin). Joint
+  frames are the child links' frames; Jacobians are LOCAL_WORLD_ALIGNED; poses are
+  re-expressed in the chain's base link (:mod:`references.base_frame`).
+- Contact: a scene with contact is n/a (:data:`NO_CONTACT`). Pinocchio 4.1 has the pieces of ONE
+  contact problem (``PointContactConstraintModel`` with a ``CoulombFrictionCone``, Delassus
+  operators, ``PGSConstraintSolver`` / ``ADMMConstraintSolver`` for a single conic problem,
+  ``constraintDynamics`` for bilateral rigid constraints, ``impulseDynamics`` with a restitution
+  coefficient for bilateral impacts) but no time-stepping contact simulation; assembling one
+  here would be the harness's own contact method, not Pinocchio's.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from simparity.core.model.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.model.ik_problem import IKTolerances
+from simparity.core.model.scene import Chain, DynamicsScene, IKScene
+from simparity.core.model.trajectory import FramePoses, Trajectory
+from simparity.references.common import external_forces
+from simparity.references.pinocchio import ik as pinocchio_ik
+from simparity.references.common.base_frame import BaseFrame
+from simparity.references.common.conventions import matrix_to_quat_wxyz, quat_wxyz_to_matrix
+from simparity.references.common.quiet import captured_output
+from simparity.references.common.urdf_export import UrdfChains, chain_export, chain_source, chain_urdf
+
+
+def free_body_model(body, gravity_world: np.ndarray | None) -> pin.Model:
+    """One free-flyer joint attached to the universe, with the body's mass and inertia about its COM.
+
+    Each body of a scene gets its own model: the bodies are independent, and a model holding B free
+    flyers makes ``createData`` allocate nv x nv matrices and larger (measured: 13 GiB at B = 100).
+    """
+    model = pin.Model()
+    jid = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), f"{body.name}_free")
+    model.appendBodyToJoint(jid, pin.Inertia(body.mass, np.zeros(3), body.inertia_body), pin.SE3.Identity())
+    model.gravity = pin.Motion(np.zeros(3) if gravity_world is None else gravity_world, np.zeros(3))
+    return model
+
+
+NO_CONTACT = (
+    "Pinocchio 4.1 has no time-stepping contact simulation: it solves single contact problems "
+    "(PointContactConstraintModel with one CoulombFrictionCone mu per contact, Delassus operators and the "
+    "PGSConstraintSolver/ADMMConstraintSolver conic solvers; constraintDynamics for bilateral rigid "
+    "constraints; impulseDynamics with a restitution coefficient for bilateral impacts only), but nothing "
+    "that detects the plane contacts step by step, applies Newton restitution in a unilateral frictional "
+    "impact, separates static from kinetic friction or applies the rest speed; stepping those pieces would "
+    "be the harness's own contact integrator, not Pinocchio's"
+)
+"""Why a dynamics scene with contact is n/a for Pinocchio (checked against ``dir(pinocchio)`` of 4.1)."""
+
+INTEGRATORS = ("euler", "rk4")
+"""Harness-side steppers of aba's accelerations: the engines' first-order scheme, and RK4 (RKMK on SO(3))."""
+
+# Classical RK4 tableau.
+_RK4_A = ((), (0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
+_RK4_B = (1 / 6, 1 / 3, 1 / 3, 1 / 6)
+_RK4_C = (0.0, 0.5, 0.5, 1.0)
+
+
+class _Simulation(Simulation):
+    """Free bodies stepped by the harness on aba's accelerations.
+
+    State per body: COM position p and velocity v (world), rotation R, angular velocity w
+    in the LOCAL frame (Pinocchio's). ``euler``: the engines' scheme (velocities first, then
+    p += dt v, R = R exp(dt w)). ``rk4``: classical RK4 on (p, v, w) with the rotation by
+    Runge-Kutta-Munthe-Kaas in the body frame, R = R0 exp(u), du/dt = dexp^-1_{-u}(w).
+    """
+
+    def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
+        models: dict[bytes, tuple[pin.Model, pin.Data]] = {}  # bodies of one mass and inertia share a model
+        self._models = []
+        for body in scene.bodies:
+            key = np.append(body.mass, body.inertia_body).tobytes()
+            if key not in models:
+                model = free_body_model(body, scene.forces.gravity_world)
+                models[key] = (model, model.createData())
+            self._models.append(models[key])
+        self._position0 = np.stack([b.position_world for b in scene.bodies])
+        self._rotation0 = quat_wxyz_to_matrix(np.stack([b.quat_wxyz for b in scene.bodies]))
+        self._velocity0 = np.stack([b.velocity_world for b in scene.bodies])
+        self._omega_local0 = np.einsum(
+            "bji,bj->bi", self._rotation0, np.stack([b.angular_velocity_world for b in scene.bodies])
+        )
+        self._tau = np.zeros(6)
+        self._forces = scene.forces
+        self._drag = external_forces.has_drag(scene.forces) or external_forces.has_angular_drag(scene.forces)
+        self._external = self._drag or bool(scene.forces.applied)
+        self._step = self._rk4 if integrator == "rk4" else self._euler
+        self._dt = dt
+        self.detail = ("harness-stepped: pin.aba accelerations, "
+                       + ("RK4 with RKMK on SO(3)" if integrator == "rk4" else "engines' semi-implicit Euler on SO(3)")
+                       + ("; applied forces as aba fext at their body points (SE3.act)" if scene.forces.applied else "")
+                       + (f"; {external_forces.DETAIL}, as aba fext" if self._drag else ""))
+
+    def run(self, n_steps: int) -> Trajectory:
+        dt, b = self._dt, len(self._position0)
+        state = (self._position0, self._rotation0, self._velocity0, self._omega_local0)
+        pos, rot, vel, omg = (np.empty((n_steps + 1, b) + s) for s in ((3,), (3, 3), (3,), (3,)))
+        for i in range(n_steps + 1):
+            if i:
+                state = self._step((i - 1) * dt, state, dt)
+            p, r, v, w = state
+            pos[i], rot[i], vel[i], omg[i] = p, r, v, np.einsum("bij,bj->bi", r, w)
+        times = np.arange(n_steps + 1) * dt
+        return Trajectory(times, pos, matrix_to_quat_wxyz(rot), vel, omg)
+
+    def _fext(self, r: np.ndarray, v: np.ndarray, w_local: np.ndarray) -> list[pin.StdVec_Force]:
+        """aba's external forces of each body's model (universe, then its joint), LOCAL frame, about the COM."""
+        b = len(r)
+        force, torque = np.zeros((b, 3)), np.zeros((b, 3))
+        if self._drag:
+            force = external_forces.drag_force_world(self._forces, v)
+            torque = external_forces.drag_torque_world(self._forces, np.einsum("bij,bj->bi", r, w_local))
+        per_body = [pin.Force(r[k].T @ force[k], r[k].T @ torque[k]) for k in range(b)]
+        for applied in self._forces.applied:
+            k = applied.body
+            at_point = pin.SE3(np.eye(3), applied.point_body)
+            per_body[k] = per_body[k] + at_point.act(pin.Force(r[k].T @ applied.force_world, np.zeros(3)))
+        out = []
+        for spatial in per_body:
+            fext = pin.StdVec_Force()
+            fext.append(pin.Force.Zero())
+            fext.append(spatial)
+            out.append(fext)
+        return out
+
+    def _accelerations(self, t, p, r, v, w_local) -> tuple[np.ndarray, np.ndarray]:
+        """(dv/dt world (B, 3), dw/dt local (B, 3)) from aba, the scene's non-gravity forces as fext."""
+        b = len(p)
+        v_local = np.einsum("bji,bj->bi", r, v)
+        qd = np.concatenate([v_local, w_local], axis=1)
+        fext = self._fext(r, v, w_local) if self._external else None
+        a = np.empty((b, 6))
+        for k, (model, data) in enumerate(self._models):
+            q = pin.SE3ToXYZQUAT(pin.SE3(r[k], p[k]))
+            a[k] = (pin.aba(model, data, q, qd[k], self._tau, fext[k]) if fext is not None
+                    else pin.aba(model, data, q, qd[k], self._tau))
+        # aba's linear part is the spatial acceleration; the COM's classical one adds w x v.
+        return np.einsum("bij,bj->bi", r, a[:, :3] + np.cross(w_local, v_local)), a[:, 3:]
+
+    def _euler(self, t, state, dt):
+        p, r, v, w = state
+        dv, dw = self._accelerations(t, p, r, v, w)
+        v, w = v + dt * dv, w + dt * dw
+        return p + dt * v, r @ _exp3(dt * w), v, w
+
+    def _rk4(self, t, state, dt):
+        p, r, v, w = state
+        ks = []  # (dp, du, dv, dw) per stage
+        for a_row, c in zip(_RK4_A, _RK4_C):
+            inc = [sum((dt * a * k[j] for a, k in zip(a_row, ks)), start=np.zeros_like(p)) for j in range(4)]
+            u = inc[1]
+            stage_v, stage_w = v + inc[2], w + inc[3]
+            dv, dw = self._accelerations(t + c * dt, p + inc[0], r @ _exp3(u), stage_v, stage_w)
+            ks.append((stage_v, _dexp_inverse(u, stage_w), dv, dw))
+        total = [sum(dt * bi * k[j] for bi, k in zip(_RK4_B, ks)) for j in range(4)]
+        return p + total[0], r @ _exp3(total[1]), v + total[2], w + total[3]
+
+
+def _exp3(rotvec: np.ndarray) -> np.ndarray:
+    """Pinocchio's exp3 per body: (B, 3) rotation vectors -> (B, 3, 3)."""
+    return np.array([pin.exp3(u) for u in rotvec])
+
+
+def _dexp_inverse(u: np.ndarray, w_local: np.ndarray) -> np.ndarray:
+    """du/dt of R = R0 exp3(u) with body angular velocity w: Jlog3(exp3(u)) w. (B, 3) x (B, 3) -> (B, 3)."""
+    return np.array([pin.Jlog3(pin.exp3(uk)) @ wk for uk, wk in zip(u, w_local)])
+
+
+class PinocchioChain(KinematicsModel):
+    """A fixed-base chain in Pinocchio: its URDF file without geometry when it has one, else the adapter's export.
+
+    Attributes
+    ----------
+    model, data : pinocchio.Model, pinocchio.Data
+    end_frame : int
+        Frame id of the end effector (the BODY frame of the link of that name).
+    idx_v : list of int
+        Velocity index of each chain joint (a URDF file may have joints off the chain).
+    base : BaseFrame
+        The chain's base link in Pinocchio's world.
+    """
+
+    def __init__(self, chain: Chain) -> None:
+        with captured_output():
+            self.model = pin.buildModelFromXML(chain_urdf(chain))
+        self.data = self.model.createData()
+        joints = [self.model.joints[self.model.getJointId(j.name)] for j in chain.joints]
+        self._idx_q = [j.idx_q for j in joints]
+        self.idx_v = [j.idx_v for j in joints]
+        self._continuous = [j.nq == 2 for j in joints]
+        # A joint's frame is its child link's frame (URDF); the end effector is a link.
+        self._frames = [self.model.getFrameId(j.name, pin.JOINT) for j in chain.joints]
+        self.end_frame = self.model.getFrameId(chain.end_effector_name, pin.BODY)
+        self._frames.append(self.end_frame)
+        self.base = BaseFrame()
+        if chain.base_link is not None:
+            pin.framesForwardKinematics(self.model, self.data, pin.neutral(self.model))
+            placement = self.data.oMf[self.model.getFrameId(chain.base_link, pin.BODY)]
+            self.base = BaseFrame(placement.translation.copy(), placement.rotation.copy())
+        self.detail = (f"buildModelFromXML of {chain_source(chain)}; forwardKinematics + updateFramePlacements; "
+                       "computeFrameJacobian LOCAL_WORLD_ALIGNED")
+
+    def configuration(self, q_row: np.ndarray) -> np.ndarray:
+        """Pinocchio configuration (nq,) of joint values (n,): (cos, sin) for continuous joints."""
+        q = pin.neutral(self.model)
+        for value, at, continuous in zip(q_row, self._idx_q, self._continuous):
+            if continuous:
+                q[at], q[at + 1] = np.cos(value), np.sin(value)
+            else:
+                q[at] = value
+        return q
+
+    def joint_values(self, configuration: np.ndarray) -> np.ndarray:
+        """Joint values (n,) of a configuration; atan2(sin, cos) in (-pi, pi] for continuous joints."""
+        return np.array([np.arctan2(configuration[at + 1], configuration[at]) if continuous else configuration[at]
+                         for at, continuous in zip(self._idx_q, self._continuous)])
+
+    def forward_kinematics(self, q: np.ndarray) -> FramePoses:
+        q = np.atleast_2d(q)
+        n = len(self._frames)
+        pos, rot = np.empty((len(q), n, 3)), np.empty((len(q), n, 3, 3))
+        for k, row in enumerate(q):
+            pin.framesForwardKinematics(self.model, self.data, self.configuration(row))
+            for f, fid in enumerate(self._frames):
+                pos[k, f] = self.data.oMf[fid].translation
+                rot[k, f] = self.data.oMf[fid].rotation
+        return FramePoses(*self.base.frames(pos, rot))
+
+    def jacobian_world(self, q: np.ndarray) -> np.ndarray:
+        q = np.atleast_2d(q)
+        out = np.empty((len(q), 6, len(self.idx_v)))
+        for k, row in enumerate(q):
+            jac = pin.computeFrameJacobian(self.model, self.data, self.configuration(row), self.end_frame,
+                                           pin.LOCAL_WORLD_ALIGNED)
+            out[k] = jac[:, self.idx_v]
+        return self.base.jacobian(out)
+
+
+class PinocchioEngine(UrdfChains, Engine):
+    """Pinocchio: kinematics from a chain's URDF; dynamics from aba, stepped by the harness."""
+
+    name = "pinocchio"
+
+    def version(self) -> str:
+        return pin.__version__
+
+    def integrators(self) -> tuple[str, ...]:
+        return INTEGRATORS
+
+    def theoretical_order(self, integrator: str) -> int | None:
+        """The harness's steppers: the engines' first-order scheme, classical RK4."""
+        return {"euler": 1, "rk4": 4}.get(integrator)
+
+    def scheme(self, integrator: str, scene) -> str:
+        """The harness's steppers on Pinocchio's dynamics: the engines' Euler step and RK4; its IK (``clik``,
+        ``clik-documented``) is the closed-loop IK of its documentation, damped least squares on the SE(3) log."""
+        if isinstance(scene, IKScene):
+            return "damped_least_squares" if integrator in pinocchio_ik.SOLVERS else ""
+        return {"euler": "engine_euler", "rk4": "rk4"}.get(integrator, "")
+
+    def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
+        if scene.contact is not None:
+            return Support.no(NO_CONTACT)
+        return self.check_integrator(integrator)
+
+    def build_dynamics(self, scene: DynamicsScene, integrator: str, dt: float) -> Simulation:
+        return _Simulation(scene, integrator, dt)
+
+    def build_kinematics(self, chain: Chain) -> KinematicsModel:
+        return PinocchioChain(chain)
+
+    def ik_solvers(self) -> tuple[str, ...]:
+        return pinocchio_ik.SOLVERS
+
+    def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
+        return pinocchio_ik.PinocchioIK(PinocchioChain(chain), chain, solver, options)
+
+    def export(self, scene, integrator, dt) -> str:
+        if not isinstance(scene, DynamicsScene):
+            return chain_export(scene.chain, "pinocchio.buildModelFromXML (fixed base)")
+        integrator, dt = self._export_settings(scene, integrator, dt)
+        models = [free_body_model(body, scene.forces.gravity_world) for body in scene.bodies]
+        inertias = "".join(f"{m.names[1]}: {m.inertias[1]}\n" for m in models)
+        external = [n for n in scene.forces.names() if n != "gravity"]
+        gravity = models[0].gravity.linear if models else scene.forces.gravity_world
+        return (
+            f"# Pinocchio models built in code (no file): one model with one free-flyer per body.\n"
+            f"# gravity: {gravity}; stepped by the harness ({integrator}, dt = {dt!r} s)\n"
+            + (f"# each step, aba's fext (local frame, about the COM): {', '.join(external)}\n" if external else "")
+            + (f"# contact: n/a, not simulated: {NO_CONTACT}\n" if scene.contact is not None else "")
+            + (f"{models[0]}\n" if models else "") + inertias
+        )

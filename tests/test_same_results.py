@@ -1,0 +1,33 @@
+"""The bit-identity check of a redesign (tests/same_results.py) finds a moved number and ignores wall time."""
+
+import pandas as pd
+
+from simparity.core.model.results import RESULTS_FILE
+from tests.same_results import differences
+
+
+def _run(folder, values, detail="x"):
+    folder.mkdir()
+    pd.DataFrame({"scene": ["s", "s"], "engine": ["core", "core"], "integrator": ["rk4", "rk4"], "dt": ["0.1", "0.1"],
+                  "metric": ["position_error_max", "time_per_step"], "value": values, "detail": ["", detail]}
+                 ).to_csv(folder / RESULTS_FILE, index=False)
+    return folder
+
+
+def test_timing_aside_two_runs_are_the_same(tmp_path):
+    assert differences(_run(tmp_path / "a", ["1e-3", "2e-6"]), _run(tmp_path / "b", ["1e-3", "3e-6"], "y")) == []
+
+
+def test_a_number_that_moved_in_its_last_digit_is_found(tmp_path):
+    found = differences(_run(tmp_path / "a", ["0.0010000000000000002", "2e-6"]), _run(tmp_path / "b", ["0.001", "2e-6"]))
+    assert len(found) == 1 and "position_error_max) value" in found[0]
+
+
+def test_where_an_environment_installed_a_package_is_not_a_difference(tmp_path):
+    before = _run(tmp_path / "a", ["1e-3", "2e-6"])
+    after = _run(tmp_path / "b", ["1e-3", "2e-6"])
+    for folder, prefix in ((before, "/venv-a"), (after, "/home/u/.venv")):
+        table = pd.read_csv(folder / RESULTS_FILE, dtype=str, keep_default_na=False)
+        table.loc[0, "detail"] = f"loadURDF of {prefix}/lib/python3.11/site-packages/pybullet_data/kuka_iiwa/model.urdf"
+        table.to_csv(folder / RESULTS_FILE, index=False)
+    assert differences(before, after) == []
