@@ -32,7 +32,7 @@ from tests.mutation.gate import EXIT_VIOLATION, GateRun, Violation, verdicts
 from tests.mutation.mutation import SUITES, Mutation, MutationError
 
 OPT_IN = "SIMPARITY_MUTATION"
-"""Set to 1 to run the whole-suite runs (``SIMPARITY_MUTATION=1 python -m pytest -m slow tests/test_mutation.py``)."""
+"""Set to 1 to run the whole-suite runs (``SIMPARITY_MUTATION=1 python -m pytest -m sweep tests/test_mutation.py``)."""
 
 whole_suite = [pytest.mark.slow, pytest.mark.sweep, pytest.mark.skipif(
     os.environ.get(OPT_IN) != "1", reason=f"whole-scene and whole-suite runs of the mutants (~2 hours): set {OPT_IN}=1")]
