@@ -343,6 +343,7 @@ def test_a_far_wall_is_allowed_and_a_corner_is_not():
 # ------------------------------------------------------------------------------------------- n/a
 
 
+@pytest.mark.slow
 def test_unsupported_cases_name_their_reason():
     floor = [[Material(0.5)]]
     sphere = [Shape("sphere", radius=0.1)]
@@ -416,6 +417,7 @@ def test_samples_never_penetrate_and_energy_never_increases(name, scene):
     assert energy[-1] < energy[0] - 0.1  # and it does lose energy
 
 
+@pytest.mark.slow
 def test_a_million_samples_are_evaluated_at_once():
     h, k, r, rest = 1.0, 0.8, 0.1, 0.5
     scene = scene_of([body([0, 0, h + r])], [Shape("sphere", radius=r)], [[Material(k)]], duration=4.0,

@@ -155,6 +155,7 @@ def test_isotropic_angular_drag_matches_numerical():
     np.testing.assert_allclose(body, omega_body, atol=INVARIANT_RTOL * scale)
 
 
+@pytest.mark.slow
 def test_axisymmetric_matches_numerical():
     """Steady precession of a symmetric top equals a DOP853 solve of Euler's equations."""
     rng = np.random.default_rng(11)
@@ -183,6 +184,7 @@ ASYMMETRIC_CASES = {
 }
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("inertia, omega0, duration", ASYMMETRIC_CASES.values(), ids=ASYMMETRIC_CASES.keys())
 def test_asymmetric_matches_numerical(inertia, omega0, duration):
     """Elliptic functions + quadrature equal a DOP853 solve; the quaternion has no sign jumps."""
@@ -240,6 +242,7 @@ def test_asymmetric_meets_accuracy_target_for_gazebo_box():
     assert geodesic_angle_quat_wxyz(quat, ref[:, 3:]).max() <= ORIENTATION_TARGET
 
 
+@pytest.mark.slow
 def test_asymmetric_reproduces_initial_omega_in_both_regimes():
     """omega_body(0) equals the input for seeded random moments, signs and both sides of the separatrix."""
     rng = np.random.default_rng(14)
@@ -254,6 +257,7 @@ def test_asymmetric_reproduces_initial_omega_in_both_regimes():
     assert regimes == {True, False}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(
     "inertia, omega0",
     [(GAZEBO_INERTIA, GAZEBO_OMEGA), (np.array([3.0, 1.0, 2.0]), np.array([0.2, 4.0, -0.5]))],

@@ -20,6 +20,7 @@ from simparity.comparisons.scenes.loader import load_scene
 from tests.helpers import builtin
 
 
+@pytest.mark.slow
 def test_the_same_scene_hashes_the_same_in_another_process():
     here = scene_hash(builtin("ball-bounce-k05"))
     code = ("from simparity.comparisons.execute.cases import scene_hash; from simparity.comparisons.scenes.loader import "

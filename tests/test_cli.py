@@ -34,6 +34,7 @@ def test_list_names_every_builtin_scene():
     assert [line.split()[0] for line in lines] == [v for name in sorted(builtin_paths()) for v in variants.get(name, [name])]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("suite", [None, "default", "hard"])
 def test_run_without_scenes_runs_a_whole_builtin_suite(tmp_path, monkeypatch, suite):
     """No scene argument means every built-in scene of the suite (default: "default"), each once, on

@@ -156,6 +156,7 @@ def test_backup_bounces_follow_the_closed_form(dt):
     np.testing.assert_allclose(trajectory.angular_velocity_world, 0.0, atol=0.0)
 
 
+@pytest.mark.slow
 def test_backup_ends_the_bounces_at_rest_on_the_plane():
     """Past the pile-up of bounces the ball rests: one "rest" event, then exactly on the plane, no motion."""
     radius = 0.1
@@ -249,6 +250,7 @@ def _incline_scene(angle, mu_s, mu_k, dt, duration):
     return scene, start + np.array([[0.0, 0.0, 0.0], half[2] * normal])
 
 
+@pytest.mark.slow
 def test_backup_block_below_the_friction_angle_stays_put():
     """tan 20 deg = 0.364 < mu_s = 0.5: a point and a box on the incline do not move."""
     scene, start = _incline_scene(math.radians(20.0), 0.5, 0.4, 0.01, 2.0)
@@ -325,6 +327,7 @@ def test_backup_box_dropped_on_an_edge_starts_to_spin_by_the_hand_impulse():
                                rtol=0, atol=ROUNDOFF)
 
 
+@pytest.mark.slow
 def test_backup_point_masses_land_flat_like_a_particle_and_tilted_with_spin():
     """Four 0.25 kg points in a square: flat, they bounce like one particle; tilted, they pick up spin."""
     points = np.array([[0.1, 0.1, 0.0], [0.1, -0.1, 0.0], [-0.1, 0.1, 0.0], [-0.1, -0.1, 0.0]])
@@ -390,6 +393,7 @@ def test_backup_tumbling_bodies_never_gain_energy_nor_go_inside():
     np.testing.assert_array_equal(trajectory.velocity_world[-1], 0.0)
 
 
+@pytest.mark.slow
 def test_backup_ball_between_a_floor_and_an_incline():
     """Dropped onto a 45 deg incline: it bounces down onto the floor, never inside either, and rests there."""
     radius, mass = 0.1, 2.0
@@ -508,6 +512,7 @@ def test_act_after_is_first_order_and_pushes_out():
     np.testing.assert_allclose(slopes, slopes[-1], rtol=FIRST_ORDER_RTOL)
 
 
+@pytest.mark.slow
 def test_act_after_box_landing_flat_does_not_tip_and_rest_stays():
     """A flat box landing stays flat (its four corners respond together); a resting sphere does not move."""
     half = (0.2, 0.15, 0.1)
@@ -538,7 +543,7 @@ def _penalty_drop(dt, duration, stiffness=1e4, damping=0.0, position=(0, 0, 0.2)
                   duration=duration, stiffness=stiffness, damping=damping)
 
 
-@pytest.mark.parametrize("fraction, stable", [(0.1, True), (1.5, False)])
+@pytest.mark.parametrize("fraction, stable", [pytest.param(0.1, True, marks=pytest.mark.slow), (1.5, False)])
 def test_penalty_semi_implicit_euler_is_bounded_only_below_2_over_omega(fraction, stable):
     """Dropped on an undamped k_s = 1e4 N/m plane (omega = 100 rad/s): energy kept at dt = 0.1 (2/omega),
     gained many times over at 1.5 (2/omega)."""
@@ -572,8 +577,8 @@ def test_penalty_rests_at_the_static_depth_and_slides_by_coulomb():
 # --- many bodies ----------------------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("integrator", [pytest.param("backup", marks=pytest.mark.slow),
-                                        pytest.param("act_after", marks=pytest.mark.slow), "penalty_rk4"])
+@pytest.mark.slow
+@pytest.mark.parametrize("integrator", ["backup", "act_after", "penalty_rk4"])
 def test_a_thousand_bodies_run_vectorised(integrator):
     """1000 seeded boxes, spheres and points thrown at a floor: finite, and (backup, act_after) none inside."""
     rng = np.random.default_rng(SEED)

@@ -32,7 +32,9 @@ def _tolerances(engine: str, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return DOUBLE_TOL * scale, DOUBLE_TOL * scale
 
 
-@pytest.mark.parametrize("chain", [IIWA, MIXED6, CONTINUOUS7], ids=["iiwa", "mixed6", "continuous7"])
+@pytest.mark.parametrize("chain", [IIWA, pytest.param(MIXED6, marks=pytest.mark.slow),
+                                   pytest.param(CONTINUOUS7, marks=pytest.mark.slow)],
+                         ids=["iiwa", "mixed6", "continuous7"])
 @pytest.mark.parametrize("pose", [True, False], ids=["pose", "position"])
 @pytest.mark.parametrize("engine, solver", SOLVERS)
 def test_residuals_agree_with_core_fk(engine, solver, chain, pose):
@@ -50,7 +52,7 @@ def test_residuals_agree_with_core_fk(engine, solver, chain, pose):
         assert np.all(result.orientation_residual == 0)
 
 
-@pytest.mark.parametrize("chain", [IIWA, REVOLUTE7], ids=["iiwa", "revolute7"])
+@pytest.mark.parametrize("chain", [IIWA, pytest.param(REVOLUTE7, marks=pytest.mark.slow)], ids=["iiwa", "revolute7"])
 @pytest.mark.parametrize("engine, solver", ALL_SOLVERS)
 def test_unreachable_targets_fail_with_reason(engine, solver, chain):
     """Targets far beyond the reach bound fail as "unreachable" with finite residuals, never an exception."""

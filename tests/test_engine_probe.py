@@ -27,6 +27,7 @@ RUN_SECONDS = 90.0
 take."""
 
 
+@pytest.mark.slow
 def test_a_probe_describes_an_engine_as_it_describes_itself():
     scenes = [builtin("lecture-projectile"), builtin("ball-bounce-k05")]
     described = probe_engines([CORE_SPEC], scenes)[CORE_SPEC]

@@ -26,6 +26,7 @@ def _drawn_labels(fig) -> list[str]:
     return [t.get_text() for ax in fig.axes for t in ax.get_xticklabels() + ax.get_yticklabels() if t.get_text()]
 
 
+@pytest.mark.slow
 def test_dynamics_figures_leave_no_layout_engine_and_label_log_ticks_in_unicode():
     for fig in (figures.work_precision_figure("s", _cases(), "position_error_max", REFERENCE),
                 figures.convergence_figure("s", _cases(), "position_error_max", REFERENCE, {}, {"core": {"rk4": 4}})):

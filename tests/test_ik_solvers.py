@@ -61,6 +61,7 @@ def _one_link(lower: float, upper: float) -> Chain:
 # --------------------------------------------------------------------------- headline
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["damped_least_squares", "pseudo_inverse"])
 def test_iiwa_pose_targets_from_one_start(method):
     """>= 99.5 % of 1000 seeded reachable iiwa pose targets solve from q = 0, all inside the limits."""
@@ -74,6 +75,7 @@ def test_iiwa_pose_targets_from_one_start(method):
     assert not np.any(result.reason == "unreachable")
 
 
+@pytest.mark.slow
 def test_gap_crossing_raises_the_solve_rate():
     """Escaping through the narrow limit gaps of the iiwa's 350 deg joints solves targets that block otherwise."""
     _, positions, rotations = _pose_targets(IIWA, N_TARGETS, seed=1)
@@ -213,6 +215,7 @@ def test_solver_wraps_through_the_short_way():
     np.testing.assert_allclose(result.q[0], [-2.95], rtol=0, atol=1e-6)
 
 
+@pytest.mark.slow
 def test_start_outside_limits_is_clipped_and_every_method_stays_inside():
     """Starts beyond the limits and targets beyond them never give a returned q outside the limits."""
     _, positions, rotations = _pose_targets(IIWA, 50, seed=10)
@@ -247,6 +250,7 @@ def _hard_targets(chain: Chain) -> tuple[np.ndarray, dict[str, slice]]:
     return positions, {"beyond": slice(0, 3), "base": slice(3, 5), "stretched": slice(5, 7)}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("method", ["pseudo_inverse", "transpose", "damped_least_squares"])
 @pytest.mark.parametrize("pose", [False, True], ids=["position", "pose"])
 @pytest.mark.parametrize("start", [0.0, 0.3], ids=["stretched-start", "bent-start"])
@@ -261,6 +265,7 @@ def test_hard_targets_fail_cleanly(method, pose, start):
     assert np.all(result.success == (result.reason == ""))
 
 
+@pytest.mark.slow
 def test_stretched_toward_a_target_beyond_the_true_reach_is_unreachable():
     """A target inside the (loose) reach bound but beyond the true reach stalls stretched and is unreachable."""
     # Link 1 reaches out 1 m and rises 0.5 m, link 2 is 1 m, both turn about z: the end
@@ -280,6 +285,7 @@ def test_stretched_toward_a_target_beyond_the_true_reach_is_unreachable():
     assert result.reason[0] in ("unreachable", "iteration_cap")
 
 
+@pytest.mark.slow
 def test_folded_onto_the_base_is_singular():
     """A planar arm asked for a point inside its inner hole folds up and reports a singularity."""
     chain = chain_from_dh("planar", a=(1.0, 0.6), alpha=(0.0, 0.0), d=(0.0, 0.0), theta_offset=(0.0, 0.0))
@@ -296,6 +302,7 @@ def test_folded_onto_the_base_is_singular():
     assert result.reason[0] in ("singular", "iteration_cap")
 
 
+@pytest.mark.slow
 def test_unreachable_orientation_is_a_failure():
     """A planar arm cannot tilt its end effector out of plane: the pose target is reported, not solved."""
     chain = chain_from_dh("planar", a=(1.0, 0.6), alpha=(0.0, 0.0), d=(0.0, 0.0), theta_offset=(0.0, 0.0))

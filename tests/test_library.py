@@ -32,6 +32,7 @@ def _table(rows):
     return pd.DataFrame([r.as_dict() for r in rows], columns=list(COLUMNS))
 
 
+@pytest.mark.slow
 def test_default_suite_is_every_scene_marked_default_and_hard_is_its_own():
     default = {s.name for s in library.suite("default")}
     hard = {s.name for s in library.suite("hard")}
@@ -87,6 +88,7 @@ def test_the_bench_suite_is_the_three_arms_with_10000_targets_each():
         np.testing.assert_array_equal(scene.q_start, mid)
 
 
+@pytest.mark.slow
 def test_the_contact_suite_is_every_scene_with_planes():
     """Issue #10: every built-in scene with a plane is in the contact suite, and nothing else is."""
     scenes = library.load(list(library.builtin_paths().values()))
@@ -120,6 +122,7 @@ def test_the_hard_suite_has_enough_cases_and_each_has_its_own_expected_verdict()
         assert named, f"{scene.name} has no expected verdict of its own in the shipped tolerances"
 
 
+@pytest.mark.slow
 def test_stiff_drag_verdicts_follow_linear_stability_theory():
     """h c/m = 2.5: Euler (|1 + z| = 1.5) and the second-order rules (1.625) diverge, RK4 (0.648) and
     MuJoCo's implicit damping stay bounded; the shipped tolerances hold exactly that."""

@@ -297,9 +297,10 @@ class OriginCore(InHouseEngine):
         return super().build_dynamics(scene, integrator, dt)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("engine, scene_name, transform, integrator", [
     (ZUpCore, "falling-linear-drag", "rotate", "rk4"),
-    pytest.param(OriginCore, "ball-bounce-k05", "translate", "backup", marks=pytest.mark.slow),
+    (OriginCore, "ball-bounce-k05", "translate", "backup"),
 ])
 def test_an_engine_that_hard_codes_the_frame_is_caught_without_a_reference(engine, scene_name, transform,
                                                                             integrator):

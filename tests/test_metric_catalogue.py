@@ -64,6 +64,7 @@ def _spelled(path: Path) -> list[str]:
             if isinstance(n, ast.Constant) and isinstance(n.value, str) and n.value in CATALOGUE and id(n) not in docs]
 
 
+@pytest.mark.slow
 def test_no_module_spells_a_metric_name_the_catalogue_owns():
     """Measuring, judging and reporting code names metrics by the catalogue's constants: a rename is one edit."""
     catalogue = ROOT / "core" / "model" / "metric_catalogue.py"

@@ -156,6 +156,7 @@ def test_the_copy_holds_every_method_module_of_core():
         copied_modules())
 
 
+@pytest.mark.slow
 def test_every_catalogued_mutation_applies_once(tmp_path):
     for mutation in MUTANTS:
         materialise(mutation, tmp_path)

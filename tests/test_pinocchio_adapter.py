@@ -2,6 +2,7 @@
 
 import numpy as np
 import pinocchio as pin
+import pytest
 
 from simparity.references.pinocchio.adapter import PinocchioEngine, free_body_model
 from tests.helpers import builtin, exact_projectile, tumbling_box
@@ -55,6 +56,7 @@ def test_model_inertia_and_gravity_are_the_scenes():
 ORDER_TOL = 0.2
 
 
+@pytest.mark.slow
 def test_harness_rk4_on_aba_is_fourth_order():
     """RK4 (RKMK on SO(3)) on aba's accelerations converges as dt^4 against the closed forms."""
     from dataclasses import replace

@@ -17,6 +17,7 @@ N_TARGETS = 60
 # Measured solve rates (60 targets, start q = 0): iiwa pose 1.00, iiwa position 1.00,
 # 7R pose 0.93, 7R position 1.00; iterations 113-149 on the iiwa, median 142 (pose):
 # DT = 0.1 contracts the error by 0.9 per update, ln(1e-6) / ln(0.9) = 131.
+@pytest.mark.slow
 @pytest.mark.parametrize("chain, pose, required", [
     (IIWA, True, 0.97), (IIWA, False, 0.97), (REVOLUTE7, True, 0.85), (REVOLUTE7, False, 0.97)])
 def test_clik_solves_reachable_targets(chain, pose, required):
@@ -30,6 +31,7 @@ def test_clik_solves_reachable_targets(chain, pose, required):
     assert not np.any(result.reason == "unreachable")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("pose", [True, False], ids=["pose", "position"])
 def test_documented_constants_stop_at_eps(pose):
     """clik-documented stops once |err| < 1e-4: every target within 1e-4, none within the scene's 1e-6."""
@@ -56,6 +58,7 @@ def test_both_solvers_follow_the_same_iterates():
 
 
 
+@pytest.mark.slow
 def test_continuous_joints_start_and_end_as_angles():
     """A continuous joint's start angle goes in as (cos, sin) and comes back as an angle in (-pi, pi]."""
     p, r = reachable_targets(CONTINUOUS7, N_TARGETS, seed=4)
@@ -74,6 +77,7 @@ def test_continuous_joints_start_and_end_as_angles():
 
 
 
+@pytest.mark.slow
 def test_limit_violation_reported_not_clamped():
     """Joint limits are not enforced: solutions outside them come back as they are, the amount reported."""
     p, r = reachable_targets(IIWA, N_TARGETS, seed=7)

@@ -348,6 +348,7 @@ def test_a_failed_search_for_plugins_leaves_the_built_ins_working(monkeypatch):
         _forget_plugins()
 
 
+@pytest.mark.slow
 def test_a_scene_file_may_name_a_plugin_s_integrator(site, tmp_path):
     site.install({"leap": "plugin_engines_g:Leapfrog"}, "plugin_engines_g")
     path = tmp_path / "leap.toml"

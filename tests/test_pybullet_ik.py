@@ -66,6 +66,7 @@ def test_limit_violation_reported_not_clamped():
     assert np.sum(result.limit_violation > 0) >= 5
 
 
+@pytest.mark.slow
 def test_nullspace_variant_respects_limits_more_but_stops_short():
     """Limits and rest pose keep more solutions inside the limits; the damped projector leaves ~mm residuals."""
     p, r = reachable_targets(IIWA, N_TARGETS, seed=6)

@@ -93,6 +93,7 @@ def test_each_case_has_every_metric_and_crashes_do_not_stop_the_run():
     assert any(r.metric == "time_per_step" and r.value > 0 for r in rows if r.status == DIVERGED)
 
 
+@pytest.mark.slow
 def test_missing_reference_keeps_timings_and_says_why():
     """If the reference cannot do the scene, errors are n/a with the reason and timings are still measured."""
     scene = builtin("lecture-projectile")
@@ -113,6 +114,7 @@ def test_kinematics_rows_and_reference_marking():
     assert all(math.isnan(r.dt) and r.integrator == "" for r in rows)
 
 
+@pytest.mark.slow
 def test_order_rows_fit_the_time_step_ladder():
     """With several time steps every engine and integrator gets an order row; Euler's is 1 on the projectile."""
     scene = builtin("lecture-projectile")
@@ -183,6 +185,7 @@ def test_a_trajectory_of_complex_values_fails_instead_of_losing_its_imaginary_pa
     assert all("complex values where real ones (float64) are expected" in r.detail for r in cases)
 
 
+@pytest.mark.slow
 def test_energy_drift_without_energy_is_not_available():
     """A body dropped from rest at the potential's zero has E(0) = 0: drift is measured against its kinetic energy."""
     from dataclasses import replace

@@ -1,6 +1,7 @@
 """The penalty method's measured stability limit against the linear damped oscillator's (computed here)."""
 
 import numpy as np
+import pytest
 
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.measure.stability import stable_dt_max
@@ -34,6 +35,7 @@ def _linear_limit(zeta: float) -> float:
     raise AssertionError("no limit in range")
 
 
+@pytest.mark.slow
 def test_semi_implicit_euler_limit_is_near_the_linear_one():
     zeta = 0.2155  # restitution 0.5 of the linear spring-damper
     damping = 2 * zeta * np.sqrt(STIFFNESS * MASS)

@@ -171,6 +171,7 @@ def test_many_panels_keep_the_finest_dt_then_evenly_spaced_ones():
     assert _figure_cases(few, ["y", "dt"])[1:] == (["y", "dt"], "")   # 6 panels: all kept
 
 
+@pytest.mark.slow
 def test_a_large_table_is_folded_into_the_html(tmp_path):
     scenes = parse_scenes(tomllib.loads(MASS_SWEEP))
     rows = [_rows(s.name, "core", f"scheme{k}", 1e-6) for s in scenes for k in range(TABLE_ROWS + 1)]

@@ -1,6 +1,7 @@
 """The tight DOP853 reference: as accurate as it says, on scenes with a closed form."""
 
 import numpy as np
+import pytest
 
 from simparity.core.rotations import geodesic_angle_quat_wxyz
 from simparity.references.analytic.engine import AnalyticEngine
@@ -12,6 +13,7 @@ TIGHT_ORIENTATION_TOL = 2e-9  # [rad]
 TIGHT_POSITION_TOL = 1e-11  # [m] smooth translation: DOP853 at 1e-13 is near exact
 
 
+@pytest.mark.slow
 def test_tight_solve_matches_closed_forms():
     """On the intermediate-axis flip and a falling tumbling box the solve agrees with the closed forms."""
     for scene in (builtin("dzhanibekov"), tumbling_box(duration=3.0)):

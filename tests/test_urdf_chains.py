@@ -79,6 +79,7 @@ def test_a_kinematics_only_file_without_inertial_loads(engine, tmp_path):
     _agree(engine, chain, np.random.default_rng(1).uniform(-2, 2, size=(20, 2)))
 
 
+@pytest.mark.slow
 def test_engines_get_no_geometry_and_never_open_a_mesh(tmp_path):
     """Meshes by package://, a missing file, /proc and a FIFO: stripped, so loading neither fails nor hangs."""
     fifo = tmp_path / "mesh.stl"
