@@ -25,7 +25,8 @@ Two sets of rules, because every engine loads the whole file but only the chain 
   mimic ones included, and their names and magnitudes are not held to those rules.
 
 Anything else is rejected with a :class:`~core.errors.SceneError` naming the element; nothing is
-guessed.
+guessed. A file with a ``<!DOCTYPE>`` (hence any entity declaration) or elements nested deeper than
+:data:`core.model.files.MAX_XML_DEPTH` is refused before anything is read from it.
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from simparity.core.model.errors import SceneError
-from simparity.core.model.files import MAX_FILE_BYTES, read_input
+from simparity.core.model.files import MAX_FILE_BYTES, parse_xml, read_input
 from simparity.core.model.names import NAME_RULE, name_problem
 from simparity.core.model.ranges import NORM_RANGES, RANGES, safe_norm
 from simparity.core.rotations import rpy_to_matrix
@@ -94,7 +95,8 @@ def chain_from_urdf(
     Raises
     ------
     SceneError
-        For malformed XML or numbers, missing links, a link with two parents, several
+        For malformed XML or numbers, a ``<!DOCTYPE>`` (DTDs and entities are refused), elements
+        nested deeper than :data:`core.model.files.MAX_XML_DEPTH`, missing links, a link with two parents, several
         roots, an unknown or missing base/tip link, several leaves without ``tip_link``,
         a mimic, floating or planar joint on the path, a joint on the path that cannot move
         (lower == upper), a name on the path outside :data:`core.names.NAME_RULE`, a number on the
@@ -124,22 +126,13 @@ def chain_from_urdf(
 
 
 def _parse(path_or_text: str | os.PathLike, source: str | None, max_bytes: int) -> tuple[ET.Element, str]:
-    """The root element; a file is read as bytes, so its XML declaration's encoding is honoured."""
+    """The root ``<robot>`` element (:func:`core.model.files.parse_xml`: no DOCTYPE, bounded nesting); a file
+    is read as bytes, so its XML declaration's encoding is honoured."""
     text = os.fspath(path_or_text)
     is_text = text.lstrip().startswith("<")
     source = source or ("<urdf text>" if is_text else text)
     data = text if is_text else read_input(text, max_bytes, "URDF file")
-    try:
-        root = ET.fromstring(data)
-    except ET.ParseError as err:
-        raise SceneError(source, "robot", f"not well-formed XML ({err})", "a URDF document") from None
-    except (LookupError, ValueError) as err:  # an encoding Python does not know
-        raise SceneError(source, "robot", f"unreadable encoding ({err})", "UTF-8, Latin-1, UTF-16, ...") from None
-    except RecursionError:
-        raise SceneError(source, "robot", "elements nested too deeply", "a URDF document") from None
-    if root.tag != "robot":
-        raise SceneError(source, root.tag, "the root element is not <robot>", "<robot>")
-    return root, source
+    return parse_xml(data, source, "robot"), source
 
 
 def _check_size(root: ET.Element, source: str, max_joints: int) -> None:

@@ -18,12 +18,13 @@ from simparity.core.model.results import (
     PRE_ASYMPTOTIC,
     SATURATED,
     SUPERCONVERGENT,
+    UNSOLVED,
     case_status,
 )
 from simparity.core.model.metric_catalogue import (
     APEX_HEIGHT_ERROR, ENERGY_GAIN_MAX, IMPACT_TIME_ERROR, ORDER_ORIENTATION, ORDER_POSITION, ORIENTATION_ERROR_MAX,
-    PENETRATION_MAX, POSITION_ERROR_MAX, RESTITUTION_MEASURED, REST_TIME_ERROR, SOLVE_RATE, STABLE_DT_MAX,
-    STOPPING_DISTANCE, TIME_PER_SOLVE, TIME_PER_STEP, TUNNELLED,
+    OWN_STOP_POSITION_TOLERANCE, PENETRATION_MAX, POSITION_ERROR_MAX, RESTITUTION_MEASURED, REST_TIME_ERROR, SOLVE_RATE,
+    SOLVE_RATE_OWN_STOP, STABLE_DT_MAX, STOPPING_DISTANCE, TIME_PER_SOLVE, TIME_PER_STEP, TUNNELLED,
 )
 
 ERROR_BUDGETS = (1e-3, 1e-6, 1e-9)
@@ -109,11 +110,27 @@ def orders(rows: pd.DataFrame, headline: str) -> dict[tuple[str, str], float]:
     return {(r["engine"], r["integrator"]): float(r["value"]) for _, r in fitted.iterrows()}
 
 
+IK_RATES = (SOLVE_RATE, SOLVE_RATE_OWN_STOP)
+"""The two solve rates of an IK solver: at the scene's tolerances, and at the stopping rule it declares."""
+
+
 def ik_solvers(rows: pd.DataFrame) -> pd.DataFrame:
-    """Per engine x solver of an IK scene: solve rate and time per solve (NaN where not measured)."""
-    measured = rows[rows["metric"].isin([SOLVE_RATE, TIME_PER_SOLVE]) & (rows["status"] == OK)]
+    """Per engine x solver of an IK scene: solve rate, time per solve, solve rate at its own stopping rule and
+    that rule's position tolerance [m] (NaN where not measured; a rate n/a flagged ``unsolved`` is 0: the solver
+    ran and solved none)."""
+    columns = [SOLVE_RATE, TIME_PER_SOLVE, SOLVE_RATE_OWN_STOP, OWN_STOP_POSITION_TOLERANCE]
+    unsolved = rows["metric"].isin(IK_RATES) & (rows["flag"] == UNSOLVED)
+    measured = rows[rows["metric"].isin(columns) & ((rows["status"] == OK) | unsolved)]
+    measured = measured.assign(value=measured["value"].where(~unsolved, 0.0))
     wide = measured.pivot_table(index=["engine", "integrator"], columns="metric", values="value", sort=False)
-    return wide.reindex(columns=[SOLVE_RATE, TIME_PER_SOLVE]).reset_index()
+    return wide.reindex(columns=columns).reset_index()
+
+
+def own_rule_differs(solver: pd.Series, position_tolerance: float | None) -> bool:
+    """Whether a solver of :func:`ik_solvers` stops by a rule of its own, not the scene's
+    ``position_tolerance`` [m] (unknown: any rule it declares counts as its own)."""
+    own = solver.get(OWN_STOP_POSITION_TOLERANCE, math.nan)
+    return bool(pd.notna(own) and (position_tolerance is None or not math.isclose(own, position_tolerance)))
 
 
 def best_ik(solvers: pd.DataFrame) -> tuple[pd.Series | None, pd.Series | None]:

@@ -6,7 +6,7 @@ import math
 import pandas as pd
 import pytest
 
-from simparity.comparisons.gate.check import BASELINE_RELATIVE, check_table, compare_with_baseline
+from simparity.comparisons.gate.check import BASELINE_RELATIVE, check_table, compare_with_baseline, explain_rows
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes.profiles import quick
 from simparity.comparisons.execute.session import run_in_process as run_scene
@@ -33,6 +33,7 @@ def _row(metric="order_position", value=4.02, status="ok", dt=math.nan, integrat
 def bounds(tmp_path):
     path = tmp_path / "tol.toml"
     path.write_text("""
+extends = "none"
 [[bound]]
 metric = "*"
 status = ["ok", "n/a"]
@@ -122,6 +123,7 @@ def test_a_bound_says_when_n_a_is_the_right_answer(tmp_path):
     to gain), and fails an n/a row of another flag or none (the engine could not measure it)."""
     path = tmp_path / "tol.toml"
     path.write_text("""
+extends = "none"
 [[bound]]
 metric = "energy_gain_max"
 max = 0.0
@@ -143,6 +145,7 @@ def test_an_alarm_flag_fails_every_bound_that_does_not_name_it(bounds, tmp_path)
     assert len(result.violations) == 1 and "not-converging" in result.violations[0].found
     path = tmp_path / "tol.toml"
     path.write_text("""
+extends = "none"
 [[bound]]
 metric = "order_*"
 status = ["ok", "n/a"]
@@ -154,7 +157,7 @@ reason = "this scene's errors are dominated by its reference's own error"
 
 def test_na_when_names_flags_only(tmp_path):
     path = tmp_path / "tol.toml"
-    path.write_text('[[bound]]\nmetric = "*"\nstatus = "ok"\nna_when = ["nothing"]\nreason = "r"\n', encoding="utf-8")
+    path.write_text('extends = "none"\n[[bound]]\nmetric = "*"\nstatus = "ok"\nna_when = ["nothing"]\nreason = "r"\n', encoding="utf-8")
     with pytest.raises(Exception, match="na_when"):
         load_tolerances(path)
 
@@ -165,6 +168,7 @@ def test_an_error_at_its_rounding_floor_meets_any_upper_bound_and_no_lower_one(t
     without the flag fails, and a lower bound it is under still fails."""
     path = tmp_path / "tol.toml"
     path.write_text("""
+extends = "none"
 [[bound]]
 metric = "velocity_error_max"
 max = 1e-9
@@ -180,3 +184,82 @@ reason = "closed form of the scheme's error"
     assert check_table(_table([dataclasses.replace(far, flag=ROUNDING_FLOOR)]), bounds, cross_checked=False).passed
     low = dataclasses.replace(_row("position_error_final", 1e-15, dt=0.002), flag=ROUNDING_FLOOR)
     assert not check_table(_table([low]), bounds, cross_checked=False).passed
+
+
+def _catch_all_only(tmp_path, numeric: str = ""):
+    path = tmp_path / "catch_all.toml"
+    path.write_text('extends = "none"\n[[bound]]\nmetric = "*"\nstatus = ["ok", "n/a"]\nreason = "it ran"\n' + numeric,
+                    encoding="utf-8")
+    return load_tolerances(path)
+
+
+def test_a_run_held_only_to_its_statuses_is_too_unbounded_to_pass(tmp_path):
+    """Ten series held only by a status catch-all fail the gate with a one-line reason; one numeric bound per series
+    (here on its order) is enough; timing rows and a series with nothing measured (all n/a) do not count."""
+    rows = [_row(metric=m, value=1.0, dt=0.01, integrator=f"scheme{k}") for k in range(10)
+            for m in ("position_error_max", "time_per_step")]
+    rows += [_row(metric="order_position", value=4.0, integrator=f"scheme{k}") for k in range(10)]
+    rows += [_row(metric="position_error_max", value=math.nan, status="n/a", dt=0.01, integrator="cannot")]
+    loose = check_table(_table(rows), _catch_all_only(tmp_path))
+    assert loose.passed and len(loose.series) == 10 and loose.unbounded_share == 1.0
+    reason = loose.too_unbounded()
+    assert reason.startswith("10 of 10 series") and "--allow-unbounded" in reason and "\n" not in reason
+    held = check_table(_table(rows), _catch_all_only(
+        tmp_path, '[[bound]]\nmetric = "order_*"\nmin = 3.5\nreason = "fourth order"\n'))
+    assert held.unbounded_share == 0.0 and held.too_unbounded() == "" and held.value_bounded == 10
+
+
+def test_the_shipped_tolerances_hold_the_built_in_suites_to_values(tmp_path):
+    """The shipped file leaves at most the documented share of the built-in suites' series without a value bound
+    (the quick default suite, stored beside the tests as a results table is too large: measured here on a run of
+    three representative scenes instead: a free body, a contact scene, an IK scene)."""
+    table = pd.concat([_table(run_scene(quick(builtin(name)), [make_engine("core")], make_engine, repeats=0))
+                       for name in ("lecture-projectile", "ball-bounce-k05", "lecture-planar-arm")])
+    result = check_table(table, load_tolerances())
+    assert result.passed and result.too_unbounded() == "", result.too_unbounded()
+
+
+def test_a_diverged_case_is_one_line_with_the_count_of_its_metrics():
+    """Eight rows of one case that went diverged against a bound wanting ok are one grouped line; another case is
+    another line; --verbose keeps every row (the violations themselves)."""
+    from simparity.comparisons.gate.violation import grouped
+
+    metrics = ("position_error_max", "position_error_final", "orientation_error_max", "velocity_error_max",
+               "angular_velocity_error_max", "energy_drift_max", "angular_momentum_drift_max",
+               "quaternion_norm_deviation_max")
+    rows = [_row(metric=m, value=math.nan, status="diverged", dt=dt, integrator="rk4", detail="blew up at t = 1 s")
+            for dt in (0.01, 0.02) for m in metrics]
+    result = check_table(_table(rows), load_tolerances())
+    lines = [g.line() for g in grouped(result.violations)]
+    assert len(result.violations) == 16 and len(lines) == 2
+    assert lines[0].startswith("s core rk4 dt=0.01: 8 metrics (position_error_max, position_error_final, "
+                               "orientation_error_max, +5 more): status diverged; blew up at t = 1 s, bound status ok")
+
+
+def test_a_baseline_compares_only_the_scenes_and_engines_both_runs_ran():
+    """A baseline with more scenes and engines than the run: nothing missing, nothing moved, the left-out rows
+    counted in one line; a row gone within a shared scene x engine is still missing; timing is one line per scene."""
+    def rows(scene, engine, factor=1.0):
+        return [dataclasses.replace(_row("position_error_max", 1e-6, dt=dt, engine=engine), scene=scene)
+                for dt in (0.01, 0.02)] + [dataclasses.replace(_row("time_per_step", 1e-5 * factor, dt=dt,
+                                                                    engine=engine), scene=scene) for dt in (0.01, 0.02)]
+    baseline = _table(rows("a", "core") + rows("a", "mujoco") + rows("b", "core"))
+    subset = _table(rows("a", "core", factor=2.0))
+    diff = compare_with_baseline(subset, baseline)
+    assert not (diff.moved or diff.missing or diff.new or diff.blocking)
+    assert diff.timing == ["a: 2 of 2 timings changed, now / before x2 to x2"]
+    assert diff.out_of_scope == 8 and diff.scope_line() == ("not compared: 8 baseline rows of scenes x engines this "
+                                                            "run did not run")
+    gone = compare_with_baseline(_table(rows("a", "core")[1:]), baseline)
+    assert len(gone.missing) == 1 and gone.blocking
+
+
+def test_explain_rows_lists_every_matching_bound_and_which_decided(tmp_path):
+    path = tmp_path / "mine.toml"
+    path.write_text('[[bound]]\nmetric = "order_*"\nmin = 0.0\nreason = "mine"\n', encoding="utf-8")
+    table = _table([_row(metric="order_position", value=4.0, integrator="rk4")]).assign(scheme="rk4")
+    lines = explain_rows(table, load_tolerances(path), "core", metric="order_*")
+    assert lines[0].startswith("s core rk4 order_position = 4: ") and "bound(s) matched" in lines[0]
+    assert lines[1].startswith("  decides: ") and "mine.toml: bound[0]" in lines[1] and "(mine)" in lines[1]
+    overridden = [line for line in lines[2:] if "default.toml" in line]
+    assert overridden and all("overridden: the deciding bound's file extends this one" in line for line in overridden)

@@ -30,3 +30,15 @@ def test_summary_names_the_verdict_and_each_violation():
     assert text.startswith("## simparity check: failed")
     assert "| s | core | rk4 | 0.01 | order_position | 2.9 | in [3.5, 4.5] | fourth order |" in text
     assert summary_markdown(CheckResult(checked=1)).startswith("## simparity check: passed")
+
+
+def test_a_case_with_nothing_measured_is_skipped_with_its_reason_not_passed(tmp_path):
+    result = _result()
+    result.unmeasured[("k", "core", "", "nan")] = "core cannot do a URDF chain"
+    path = tmp_path / "junit.xml"
+    path.write_text(junit_xml(result), encoding="utf-8")
+    xml = junitparser.JUnitXml.fromfile(str(path))
+    skipped = [case for suite in xml for case in suite if case.is_skipped]
+    assert [(c.classname, c.name) for c in skipped] == [("k", "core -")]
+    assert skipped[0].result[0].message == "n/a: core cannot do a URDF chain"
+    assert '<testsuite name="simparity" tests="3" failures="1" skipped="1"' in path.read_text(encoding="utf-8")

@@ -1,5 +1,6 @@
 """The simparity command: list, run, export, report, and clean errors for user mistakes."""
 
+import dataclasses
 import io
 import re
 import subprocess
@@ -98,7 +99,7 @@ def test_broken_scene_exits_2_with_one_line(tmp_path, capsys, name, base, old, n
 @pytest.mark.parametrize(
     "argv, words",
     [
-        (["run", "no-such-scene"], "neither a built-in scene nor a scene file"),
+        (["run", "no-such-scene"], "'no-such-scene' is not a built-in scene or an existing file"),
         (["run", "lecture-projectile", "--engines", "core,havok"], "unknown engine(s): havok"),
         (["run", "lecture-projectile", "--repeats", "-1"], "--repeats -1"),
         (["run", "lecture-projectile", "--engines", ","], "no engine named"),
@@ -308,3 +309,101 @@ def test_check_explain_says_what_holds_an_engine(tmp_path, capsys):
     assert any("position_error_final" in line and "x dt^1" in line and "g T dt / 2" in line for line in lines)
     assert main(["check", str(run), "--explain", "nosuch"]) == EXIT_USAGE
     assert "--explain nosuch: no rows of that engine" in capsys.readouterr().err
+
+
+def _stored(path, rows, profile="quick"):
+    """A stored run of ``rows`` (ResultRow) with ``profile`` in its run.json, written as 'simparity run' writes."""
+    from simparity.comparisons.execute.store import RunWriter
+
+    RunWriter(path, [], "test", [], profile).append(rows)
+    return path
+
+
+def _user_rows(factor=1.0, status="ok"):
+    from simparity.core.model.results import ResultRow
+
+    return [ResultRow("my-scene", "mine", f"scheme{k}", dt, "position_error_max", 1e-6 * dt * factor, "m",
+                      "analytic:exact", status, "" if status == OK else "raised") for k in range(3) for dt in (0.01, 0.02)]
+
+
+def test_check_bless_round_trips_and_refuses_a_failed_run(tmp_path, capsys):
+    """A user's scene the shipped tolerances do not name: the check fails as too unbounded (exit 1, one line) unless
+    --allow-unbounded; blessed, it passes; a degraded copy fails against the blessed file; a failed run refuses."""
+    run = _stored(tmp_path / "run", _user_rows())
+    assert main(["check", str(run)]) == 1
+    out = capsys.readouterr().out
+    assert "unbounded: 3 of 3 series" in out and "check FAILED" in out
+    assert main(["check", str(run), "--allow-unbounded"]) == EXIT_OK
+    blessed = tmp_path / "blessed.toml"
+    assert main(["check", str(run), "--bless", str(blessed)]) == EXIT_OK
+    assert "blessed 6 bounds" in capsys.readouterr().out
+    assert main(["check", str(run), "--tolerances", str(blessed)]) == EXIT_OK
+    worse = _stored(tmp_path / "worse", _user_rows(factor=2.0))
+    assert main(["check", str(worse), "--tolerances", str(blessed)]) == 1
+    assert capsys.readouterr().out.count("violation: ") == 6
+    failed = _stored(tmp_path / "failed", _user_rows(status="failed"))
+    assert main(["check", str(failed), "--bless", str(tmp_path / "no.toml")]) == EXIT_USAGE
+    assert "nothing was blessed" in capsys.readouterr().err and not (tmp_path / "no.toml").exists()
+
+
+def test_a_baseline_of_another_profile_is_refused_and_a_subset_prints_nothing(tmp_path, capsys):
+    """A baseline that ran more engines and scenes than the run: nothing is missing, nothing printed but the verdict
+    (which says what was not compared); a full-profile baseline for a quick run is refused in one line."""
+    rows = _user_rows()
+    full = _stored(tmp_path / "full", rows, profile="full")
+    quick_run = _stored(tmp_path / "quick", rows, profile="quick")
+    more = rows + [dataclasses.replace(r, engine="other") for r in rows] + [
+        dataclasses.replace(r, scene="other-scene") for r in rows]
+    bigger = _stored(tmp_path / "bigger", more, profile="quick")
+    assert main(["check", str(quick_run), "--allow-unbounded", "--baseline", str(full)]) == EXIT_USAGE
+    assert "a full-profile run, this one is quick" in capsys.readouterr().err
+    assert main(["check", str(quick_run), "--allow-unbounded", "--baseline", str(bigger)]) == EXIT_OK
+    out = capsys.readouterr().out
+    assert [line.split(":")[0] for line in out.splitlines()] == ["check passed"]
+    assert "0 moved, 0 missing, 0 new (not compared: 12 baseline rows of scenes x engines this run did not run)" in out
+
+
+def test_history_without_a_match_exits_1_naming_the_recorded_scenes(tmp_path, capsys, monkeypatch):
+    from simparity.comparisons.gate.history import record_run
+    from simparity.core.model.run_info import RunInfo
+
+    history = tmp_path / "history.sqlite"
+    run = _stored(tmp_path / "run", _user_rows())
+    record_run(history, run, RunInfo(created_utc="2026-11-27T00:00:00+00:00"), read_run(run)[0])
+    assert main(["history", "no-such-scene", "--history", str(history)]) == 1
+    assert "no recorded values match scene no-such-scene" in capsys.readouterr().out
+    assert main(["history", "my-scene", "--history", str(history)]) == EXIT_OK
+
+
+@pytest.mark.parametrize("name", ["nosuchfile.toml", "some/dir/x.toml"])
+def test_run_of_a_missing_scene_file_is_one_line_naming_it(tmp_path, capsys, monkeypatch, name):
+    """Issue #25: a path that does not exist says so, naming it as resolved, not the 40 built-in scenes."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", name, "--out", str(tmp_path / "out")]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith(f"simparity: error: {name}: the file {tmp_path / name} does not exist "
+                                                   "(allowed: ")
+    assert "lecture-projectile" not in err and not (tmp_path / "out").exists()
+
+
+def test_run_of_an_unknown_scene_name_suggests_the_closest(capsys):
+    assert main(["run", "lecture-projectil"]) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "closest: lecture-projectile, lecture-bouncing-particle (allowed: " in err
+    assert "wind" not in err   # not the whole list
+
+
+def test_export_of_a_urdf_nested_5000_deep_is_one_line_in_a_process_of_its_own(tmp_path):
+    """Issue #25, as a user runs it: no RecursionError traceback, exit 2, one line naming the file and the limit."""
+    from simparity.core.model.files import MAX_XML_DEPTH
+
+    from tests.test_urdf import nested_urdf
+
+    (tmp_path / "deep.urdf").write_text(nested_urdf(5_000))
+    (tmp_path / "scene.toml").write_text(
+        '[scene]\nname = "d"\nkind = "kinematics"\nreference = "core"\n[chain]\nurdf = "deep.urdf"\n')
+    done = subprocess.run([sys.executable, "-m", "simparity.comparisons.cli", "export", str(tmp_path / "scene.toml"),
+                           "--engine", "pinocchio"], check=False, capture_output=True, text=True, timeout=120)
+    assert done.returncode == EXIT_USAGE and done.stdout == "" and done.stderr.count("\n") == 1
+    assert (f"deep.urdf: <a> at depth {MAX_XML_DEPTH + 1}: elements nested more than {MAX_XML_DEPTH} levels deep "
+            "(allowed: ") in done.stderr

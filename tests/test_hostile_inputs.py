@@ -11,7 +11,9 @@ import time
 import pytest
 
 from simparity.comparisons.cli.main import EXIT_USAGE, main
+from simparity.core.model.files import MAX_XML_DEPTH
 from tests.test_scene_loader import VALID_DYNAMICS, VALID_KINEMATICS
+from tests.test_urdf import DEEP_URDF, DOCTYPE_URDF
 
 FAST_SECONDS = 20.0
 """A refusal is made on loading: well under the time any run would take (parsing the million-value sweep alone
@@ -164,6 +166,19 @@ def test_bad_urdf_names_the_scene_and_the_element(tmp_path, capsys, name, urdf, 
     (tmp_path / "scene.toml").write_text(_urdf_scene(tmp_path, extra=extra), encoding="utf-8")
     err = _refused(capsys, ["run", str(tmp_path / "scene.toml"), "--out", str(tmp_path / "out")])
     assert str(tmp_path / "scene.toml") in err and "chain.urdf" in err and "robot.urdf" in err and words in err
+
+
+@pytest.mark.parametrize("name, urdf, words", [(n, t, "<!DOCTYPE robot>: a document type declaration")
+                                                for n, t in DOCTYPE_URDF]
+                         + [(n, t, f"<a> at depth {MAX_XML_DEPTH + 1}: elements nested more than") for n, t in DEEP_URDF],
+                         ids=[n for n, _ in DOCTYPE_URDF + DEEP_URDF])
+def test_export_of_a_doctype_or_deeply_nested_urdf_is_one_line(tmp_path, capsys, name, urdf, words):
+    """Issue #25: 'simparity export' of a URDF nested 1,000 deep used to end in a RecursionError traceback; a
+    DOCTYPE (entities internal, parameter or external, a billion laughs) is refused before it is read."""
+    (tmp_path / "robot.urdf").write_text(urdf, encoding="utf-8")
+    (tmp_path / "scene.toml").write_text(_urdf_scene(tmp_path), encoding="utf-8")
+    err = _refused(capsys, ["export", str(tmp_path / "scene.toml"), "--engine", "mujoco"])
+    assert f"{tmp_path / 'scene.toml'}: chain.urdf: robot.urdf: {words}" in err
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")

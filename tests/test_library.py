@@ -3,6 +3,7 @@
 import dataclasses
 import fnmatch
 import math
+import re
 
 from pathlib import Path
 
@@ -67,8 +68,38 @@ def test_a_built_in_variant_is_found_by_the_name_simparity_list_shows():
     assert variant.sweep == SweepPoint("restitution-sweep", (("contact.restitution", 0.7),), 2, 4)
     assert ("variant 3 of 4 of the sweep of restitution-sweep: contact.restitution = 0.7 (as written in the file)"
             in describe(variant).splitlines())   # what `simparity show` prints
-    with pytest.raises(UnknownSceneError, match="neither a built-in scene nor a scene file"):
+    with pytest.raises(UnknownSceneError, match="not a built-in scene or an existing file; closest: restitution-sweep"):
         library.load(["restitution-sweep_restitution-0.8"])
+
+
+@pytest.mark.parametrize("name", ["nosuchfile.toml", "some/dir/x.toml", "robot.URDF", "model.xml", "dir/noext"])
+def test_a_missing_path_is_one_line_saying_the_file_does_not_exist(tmp_path, monkeypatch, name):
+    """Issue #25: anything that looks like a path (a separator, or .toml/.urdf/.xml) names the file as resolved,
+    never the built-in scenes."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(UnknownSceneError) as info:
+        library.load([name])
+    text = str(info.value)
+    assert text.startswith(f"{name}: the file {tmp_path / name} does not exist (allowed: ")
+    assert "\n" not in text and "lecture-projectile" not in text and "built-in scene name" in text
+
+
+def test_a_path_that_is_not_a_regular_file_says_why(tmp_path):
+    with pytest.raises(UnknownSceneError, match="not a regular file"):
+        library.resolve(str(tmp_path))
+
+
+@pytest.mark.parametrize("word, closest", [("lecture-projectil", ["lecture-projectile", "lecture-bouncing-particle"]),
+                                           ("no-such-scene", [])])
+def test_an_unknown_bare_word_names_the_closest_built_in_scenes_only(word, closest):
+    """A word is taken for a scene name: the closest built-in names (at most CLOSEST_NAMES), not the whole list."""
+    with pytest.raises(UnknownSceneError) as info:
+        library.resolve(word)
+    text = str(info.value)
+    assert text.startswith(f"'{word}' is not a built-in scene or an existing file")
+    assert ("; closest: " + ", ".join(closest) + " (") in text if closest else "closest" not in text
+    shown = [name for name in library.builtin_paths() if re.search(rf"[ ,]{re.escape(name)}[,;( ]", text)]
+    assert shown == sorted(closest) and len(shown) <= library.CLOSEST_NAMES
 
 
 def test_the_example_sweep_is_in_the_contact_suite_only():

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -11,6 +13,10 @@ from tests.helpers import IIWA, REVOLUTE7, build_ik, reachable_targets, reached_
 OPTIONS = IKOptions()  # 1e-6 m, 1e-6 rad, 200 iterations
 N_TARGETS = 100
 TUNED = "calculateInverseKinematics-tuned"
+NULLSPACE = "calculateInverseKinematics-tuned-nullspace"
+NULL_SPACE_EFFECT = 1e-3
+"""[rad] A joint difference far above the float32 resolution of PyBullet's joint values (2.4e-7 rad at pi): the
+null-space term moved the solution."""
 
 
 # Measured solve rates (100 targets, start q = 0): iiwa pose 0.99, iiwa position 1.00,
@@ -77,3 +83,27 @@ def test_nullspace_variant_respects_limits_more_but_stops_short():
     assert np.sum(nullspace.limit_violation > 0) < np.sum(tuned.limit_violation > 0)
     assert np.median(nullspace.position_residual) > 1e-4
     assert nullspace.solve_rate <= 0.05
+
+
+def test_each_solver_declares_the_rule_it_stops_by():
+    """PyBullet stops on the position alone: at 1e-4 m by default, at residualThreshold when tuned; the null-space
+    variant's rule carries its upstream limitation and link."""
+    default = build_ik("pybullet", IIWA, "calculateInverseKinematics", OPTIONS).stopping_rule
+    tuned = build_ik("pybullet", IIWA, TUNED, OPTIONS).stopping_rule
+    nullspace = build_ik("pybullet", IIWA, NULLSPACE, OPTIONS).stopping_rule
+    assert (default.position_tolerance, default.orientation_tolerance) == (1e-4, math.inf)
+    assert (tuned.position_tolerance, tuned.note) == (OPTIONS.position_tolerance, "")
+    assert "bullet3/issues/2210" in nullspace.note
+
+
+def test_nullspace_lists_have_one_entry_per_movable_joint_and_take_effect():
+    """PyBullet silently ignores null-space lists of any other length than the body's movable joints (bullet3
+    #3199): the adapter's lists have that length, and with them the result is not the plain solver's."""
+    p, _ = reachable_targets(IIWA, 5, seed=8)
+    model = build_ik("pybullet", IIWA, NULLSPACE, OPTIONS)
+    n_dof = model._kinematics.n_dof
+    assert {len(model._settings[k]) for k in ("lowerLimits", "upperLimits", "jointRanges")} == {n_dof}
+    tuned = build_ik("pybullet", IIWA, TUNED, OPTIONS).solve(p, None, np.zeros(7))
+    nullspace = model.solve(p, None, np.zeros(7))
+    # Measured: the null-space solutions differ from the plain ones by up to 0.21 rad and stop 1.6 mm short (median).
+    assert np.abs(nullspace.q - tuned.q).max() > NULL_SPACE_EFFECT

@@ -47,3 +47,49 @@ def test_a_baseline_that_differs_fails(pytester, tmp_path):
     result = pytester.runpytest_subprocess("--simparity-baseline", str(tmp_path / "base"))
     result.assert_outcomes(failed=1)
     result.stdout.fnmatch_lines(["*moved since*position_error_final*"])
+
+
+@pytest.mark.slow
+def test_paths_are_found_beside_the_test_file_and_bad_input_is_a_one_line_failure(pytester):
+    """Run from another folder, a test finds its scene and tolerances files beside itself; an unknown scene fails
+    its test with simparity's one-line message, not a traceback."""
+    from tests.test_scene_loader import VALID_DYNAMICS
+
+    suite = pytester.mkpydir("suite")
+    (suite / "drop.toml").write_text(VALID_DYNAMICS.replace("dt = [0.01]", "dt = [0.01, 0.005]"), encoding="utf-8")
+    (suite / "mine.toml").write_text('[[bound]]\nscene = "drop"\nmetric = "position_error_max"\nmax = 1e-9\n'
+                                     'reason = "free fall is exact for the lecture\'s Taylor rule"\n'
+                                     'integrator = "taylor2"\n', encoding="utf-8")
+    (suite / "test_mine.py").write_text('''
+def test_found_beside(simparity):
+    simparity.check("drop.toml", engines=["core"], tolerances="mine.toml", profile="quick", allow_unbounded=True)
+
+def test_unknown(simparity):
+    simparity.check("no-such-scene-anywhere", engines=["core"], profile="quick")
+''', encoding="utf-8")
+    result = pytester.runpytest_subprocess("suite")
+    result.assert_outcomes(passed=1, failed=1)
+    output = result.stdout.str()
+    assert "simparity: 'no-such-scene-anywhere'" in output or "simparity: no-such-scene-anywhere" in output
+    assert "Traceback" not in output and "UnknownSceneError" not in output
+
+
+@pytest.mark.slow
+def test_the_documented_example_passes_against_a_baseline_that_ran_more_engines(pytester, tmp_path):
+    """A stored quick run of the example's scene on core and another engine (here: core's rows under a second name),
+    plus another scene: the example, which runs core alone, has nothing moved and nothing missing."""
+    import dataclasses
+
+    from simparity.comparisons.api import load_scene, run_scene
+    from simparity.comparisons.execute.store import RunWriter
+    from simparity.comparisons.scenes.profiles import quick
+    from simparity.core.model.results import ResultRow
+
+    scene = quick(load_scene("lecture-projectile"))
+    rows = [ResultRow(**row) for row in run_scene(scene, engines=["core"], repeats=0).to_dict("records")]
+    more = rows + [dataclasses.replace(r, engine="mujoco") for r in rows] + [
+        dataclasses.replace(r, scene="wind") for r in rows]
+    RunWriter(tmp_path / "base", [], "test", [scene], "quick").append(more)
+    pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
+    result = pytester.runpytest_subprocess("--simparity-baseline", str(tmp_path / "base"))
+    result.assert_outcomes(passed=1)

@@ -7,7 +7,7 @@ import pandas as pd
 
 from simparity.core.model.results import ResultRow
 from simparity.reports import summary
-from simparity.reports.content import _scheme_row
+from simparity.reports.content import _rates, _scheme_row
 
 
 def _case(engine, integrator, dt, error, seconds_per_step, status="ok", detail=""):
@@ -96,3 +96,23 @@ def test_variants_of_a_scheme_share_a_row_listing_what_differs():
                                       ("expmap", ("0.01", "2e-12", "ok 4"))])
     assert row == ("core", "rk4 (quaternion / matrix / expmap)", "0.01", "2e-10 / 4e-09 / 2e-12", "ok 4")
     assert _scheme_row("mujoco", "rk4", [("", ("0.01", "1e-10", "ok 4"))]) == ("mujoco", "rk4", "0.01", "1e-10", "ok 4")
+
+
+def test_ik_rates_at_both_criteria_with_unsolved_as_zero():
+    """A solver stopped by its own 1e-4 m rule: 0 at the scene's 1e-6 m (n/a, unsolved), 0.97 at its own; the
+    report says both, and a solver that stops at the scene's tolerance shows one rate."""
+    rows = []
+    for solver, rate, own, tolerance in [("default", None, 0.97, 1e-4), ("tuned", 0.9, 0.9, 1e-6)]:
+        common = {"scene": "ik", "engine": "pybullet", "integrator": solver, "dt": math.nan, "reference": "core:fk"}
+        unsolved = {"status": "n/a", "flag": "unsolved"} if rate is None else {"status": "ok"}
+        rows += [ResultRow(metric="solve_rate", value=math.nan if rate is None else rate, unit="1", **common,
+                           **unsolved),
+                 ResultRow(metric="solve_rate_own_stop", value=own, unit="1", status="ok", **common),
+                 ResultRow(metric="own_stop_position_tolerance", value=tolerance, unit="m", status="ok", **common),
+                 ResultRow(metric="time_per_solve", value=1e-4, unit="s", status="ok", **common)]
+    solvers = summary.ik_solvers(pd.DataFrame([r.as_dict() for r in rows])).set_index("integrator", drop=False)
+    assert solvers.loc["default", "solve_rate"] == 0.0
+    assert summary.own_rule_differs(solvers.loc["default"], 1e-6)
+    assert not summary.own_rule_differs(solvers.loc["tuned"], 1e-6)
+    assert _rates(solvers.loc["default"], 1e-6) == "0.0% at 1e-06 m, 97.0% at its own 0.0001 m"
+    assert _rates(solvers.loc["tuned"], 1e-6) == "90.0% at 1e-06 m"

@@ -5,13 +5,14 @@ import os
 
 import pytest
 
-from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, bound_for, load_tolerances
+from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, bound_for, load_tolerances, matching_bounds
 from simparity.core.model.errors import ToleranceError
 
 
 def _write(tmp_path, text):
+    """A tolerances file of ``text`` alone (``extends = "none"`` unless the text says what it extends)."""
     path = tmp_path / "tol.toml"
-    path.write_text(text, encoding="utf-8")
+    path.write_text(text if "extends" in text else 'extends = "none"\n' + text, encoding="utf-8")
     return path
 
 
@@ -91,7 +92,7 @@ reason = "order 4"
     ('[[bound]]\nmetric = "m"\nreason = "r"\n', "bound[0]", "bounds nothing"),
     ('[[bound]]\nmetric = "m"\ndt = -1.0\nmax = 1.0\nreason = "r"\n', "bound[0].dt", "not a time step"),
     ('[[bounds]]\nmetric = "m"\n', "bounds", "unknown table"),
-    ('[[bound]\n', "line 1, column 8", "not valid TOML"),
+    ('[[bound]\n', "line 2, column 8", "not valid TOML"),  # line 1 is _write's extends
 ])
 def test_bad_tolerances_name_the_key_and_what_is_allowed(tmp_path, text, key, words):
     with pytest.raises(ToleranceError) as caught:
@@ -113,3 +114,61 @@ def test_a_tolerances_path_that_is_no_regular_file_is_refused_without_opening_it
     for path in (fifo, tmp_path, "/dev/zero"):
         with pytest.raises(ToleranceError, match=r"not a regular file.*\(allowed: the path of a regular tolerances file\)"):
             load_tolerances(path)
+
+
+ONE_BOUND = """
+[[bound]]
+metric = "order_*"
+min = 0.0
+status = ["ok", "n/a"]
+reason = "mine: any order at all"
+"""
+
+
+def test_a_users_file_extends_the_shipped_one_and_its_bounds_win_where_they_match(tmp_path):
+    """One bound of the user's keeps every shipped bound; where both match a row the user's decides although the
+    shipped RK4 order bound (scheme and metric pattern) is more specific; elsewhere the shipped bound decides."""
+    path = tmp_path / "mine.toml"
+    path.write_text(ONE_BOUND, encoding="utf-8")
+    shipped, mine = load_tolerances(DEFAULT_TOLERANCES), load_tolerances(path)
+    assert len(mine) == len(shipped) + 1 and mine[:-1] == shipped
+    rk4_order = ("s", "e", "rk4", "order_position", math.nan, "rk4")
+    shipped_decider = bound_for(shipped, *rk4_order)
+    assert shipped_decider.min == 3.5 and shipped_decider.specificity > mine[-1].specificity
+    assert bound_for(mine, *rk4_order) is mine[-1]
+    error_row = ("s", "e", "rk4", "position_error_max", 0.01, "rk4")
+    assert bound_for(mine, *error_row) == bound_for(shipped, *error_row)
+
+
+def test_extends_none_starts_empty_and_a_chain_of_files_layers_in_order(tmp_path):
+    (tmp_path / "empty.toml").write_text('extends = "none"\n' + ONE_BOUND, encoding="utf-8")
+    assert len(load_tolerances(tmp_path / "empty.toml")) == 1
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "top.toml").write_text(
+        'extends = "../empty.toml"\n[[bound]]\nmetric = "*"\nmax = 1.0\nreason = "top"\n', encoding="utf-8")
+    chain = load_tolerances(tmp_path / "sub" / "top.toml")
+    assert [b.layer for b in chain] == [0, 1]
+    assert bound_for(chain, "s", "e", "i", "order_position") is chain[1]  # the extending file wins
+
+
+@pytest.mark.parametrize("extends, words", [
+    ('"loop.toml"', "extends itself"),
+    ('"nosuch.toml"', "no such file"),
+    ("3", "expected text"),
+])
+def test_a_bad_extends_is_one_line_naming_the_file_and_key(tmp_path, extends, words):
+    path = tmp_path / "loop.toml"
+    path.write_text(f"extends = {extends}\n" + ONE_BOUND, encoding="utf-8")
+    with pytest.raises(ToleranceError) as caught:
+        load_tolerances(path)
+    message = str(caught.value)
+    assert words in message and "(allowed: " in message and "\n" not in message
+
+
+def test_matching_bounds_lists_the_deciding_bound_first(tmp_path):
+    path = tmp_path / "mine.toml"
+    path.write_text(ONE_BOUND, encoding="utf-8")
+    bounds = load_tolerances(path)
+    matched = matching_bounds(bounds, "s", "e", "rk4", "order_position", math.nan, "rk4")
+    assert matched[0] is bound_for(bounds, "s", "e", "rk4", "order_position", math.nan, "rk4")
+    assert len(matched) >= 3 and [b.precedence for b in matched] == sorted((b.precedence for b in matched), reverse=True)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 
 import numpy as np
 import pinocchio as pin
@@ -11,7 +12,9 @@ import pytest
 
 from simparity.core.model.errors import SceneError
 from simparity.core.kinematics import joint_frames
+from simparity.core.model.files import MAX_XML_DEPTH
 from simparity.core.urdf import MAX_URDF_JOINTS, chain_from_urdf
+from simparity.references.common.urdf_export import original_without_geometry
 
 IIWA_PATH = os.path.join(pybullet_data.getDataPath(), "kuka_iiwa/model.urdf")
 
@@ -285,3 +288,60 @@ def test_files_that_are_not_regular_are_never_opened(tmp_path):
     for path in (tmp_path / "fifo.urdf", tmp_path, "/dev/zero"):
         with pytest.raises(SceneError, match="not a regular file"):
             chain_from_urdf(str(path))
+
+
+def nested_urdf(depth: int) -> str:
+    """A valid one-joint robot whose link 'b' holds elements nested down to ``depth`` levels (<robot> is 1)."""
+    inner = "<a>" * (depth - 2) + "</a>" * (depth - 2)
+    return _robot(_joint("j1", "a", "b"), links=("a", "b")).replace("<link name='b'/>", f"<link name='b'>{inner}</link>")
+
+
+def _with_doctype(doctype: str, reference: str) -> str:
+    """The one-joint robot headed by ``doctype``, with ``reference`` (an entity, or nothing) as link a's text."""
+    robot = _robot(_joint("j1", "a", "b"), links=("a", "b"))
+    return doctype + robot.replace("<link name='a'/>", f"<link name='a'>{reference}</link>")
+
+
+_LAUGHS = "<!ENTITY l0 'ha'>" + "".join(f"<!ENTITY l{i} '{f'&l{i - 1};' * 10}'>" for i in range(1, 10))
+DOCTYPE_URDF = [
+    ("internal entity", _with_doctype("<!DOCTYPE robot [<!ENTITY e 'x'>]>", "&e;")),
+    ("parameter entity", _with_doctype("<!DOCTYPE robot [<!ENTITY % p \"<!ENTITY e 'x'>\"> %p;]>", "&e;")),
+    ("billion laughs", _with_doctype(f"<!DOCTYPE robot [{_LAUGHS}]>", "&l9;")),
+    ("external DTD", _with_doctype("<!DOCTYPE robot SYSTEM 'file:///etc/passwd'>", "")),
+    ("external entity", _with_doctype("<!DOCTYPE robot [<!ENTITY e SYSTEM 'file:///etc/passwd'>]>", "&e;")),
+    ("bare DOCTYPE", _with_doctype("<!DOCTYPE robot>", "")),
+]
+"""URDF with a document type declaration: every one refused before any declaration in it is read."""
+DEEP_URDF = [(f"nested {depth:,} deep", nested_urdf(depth)) for depth in (1_000, 5_000)]
+"""URDF nested deeper than ElementTree's writer (and Python's stack) can recurse (issue #25)."""
+
+
+@pytest.mark.parametrize("case, text", DOCTYPE_URDF, ids=[row[0] for row in DOCTYPE_URDF])
+def test_a_doctype_is_refused_before_its_entities_are_read(case, text):
+    with pytest.raises(SceneError) as info:
+        chain_from_urdf(text, source="test.urdf")
+    assert info.value.key == "<!DOCTYPE robot>" and "test.urdf" in str(info.value) and "\n" not in str(info.value)
+    assert "document type declaration" in info.value.problem and "never expanded or fetched" in info.value.allowed
+
+
+@pytest.mark.parametrize("case, text", DEEP_URDF, ids=[row[0] for row in DEEP_URDF])
+def test_deep_nesting_is_refused_at_the_first_element_too_deep(tmp_path, case, text):
+    """From a file, or handed to the exporter as if the file changed after loading: a SceneError, never a
+    RecursionError."""
+    path = tmp_path / "deep.urdf"
+    path.write_text(text)
+    with pytest.raises(SceneError) as info:
+        chain_from_urdf(path)
+    assert info.value.key == f"<a> at depth {MAX_XML_DEPTH + 1}" and info.value.source == str(path)
+    assert f"more than {MAX_XML_DEPTH} levels" in info.value.problem and f"at most {MAX_XML_DEPTH}" in info.value.allowed
+    with pytest.raises(SceneError, match="levels deep"):
+        original_without_geometry(str(path))
+
+
+def test_nesting_up_to_the_limit_loads_and_exports(tmp_path):
+    path = tmp_path / "deepest.urdf"
+    path.write_text(nested_urdf(MAX_XML_DEPTH))
+    assert [joint.name for joint in chain_from_urdf(path).joints] == ["j1"]
+    assert len(re.findall(r"<a\b", original_without_geometry(str(path)))) == MAX_XML_DEPTH - 2
+    with pytest.raises(SceneError, match=f"<a> at depth {MAX_XML_DEPTH + 1}"):
+        chain_from_urdf(nested_urdf(MAX_XML_DEPTH + 1))

@@ -22,7 +22,10 @@ from simparity.comparisons.gate.check import (
     compare_with_baseline,
     explain,
     explain_lines,
+    explain_rows,
 )
+from simparity.comparisons.gate.bless import bless, write_blessed
+from simparity.comparisons.gate.violation import grouped
 from simparity.comparisons.gate.check_output import junit_xml, summary_markdown
 from simparity.comparisons.scenes.describe import describe
 from simparity.comparisons.cli.console import EXIT_INTERRUPTED
@@ -32,7 +35,13 @@ from simparity.comparisons.engines.registry import (
     check_engine_names,
     make_engine,
 )
-from simparity.comparisons.gate.history import history_path, latest_before, metric_history, run_table
+from simparity.comparisons.gate.history import (
+    history_path,
+    latest_before,
+    metric_history,
+    recorded_scenes,
+    run_table,
+)
 from simparity.comparisons.execute.execution import default_jobs
 from simparity.comparisons.execute.isolation import GIB, CaseLimits
 from simparity.comparisons.execute.journal import CASES_FOLDER, Journal, read_request
@@ -42,12 +51,13 @@ from simparity.comparisons.execute.session import Execution, Session, write_run_
 from simparity.comparisons.cli.parser import build_parser
 from simparity.comparisons.scenes.limits import Limits
 from simparity.comparisons.execute.store import default_out_dir
-from simparity.comparisons.execute.timing import resource_line
+from simparity.comparisons.execute.timing import record_peak_memory, resource_line
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, load_tolerances
 from simparity.comparisons.invariance.transforms import fixed_transforms
 from simparity.core.model.errors import SimparityError, one_line
 from simparity.core.model.ranges import RANGES
 from simparity.core.model.results import RESULTS_FILE, RUN_INFO_FILE
+from simparity.core.model.run_info import RunInfo
 from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
 from simparity.reports.store import read_run
 
@@ -203,6 +213,11 @@ def cmd_run(args, out) -> int:
         return code
     finally:  # what the run cost, also when it was interrupted or stopped by an error
         print(resource_line(time.perf_counter() - start), file=out, flush=True)
+        if (out_dir / RUN_INFO_FILE).is_file():  # for the bench: the peaks by name, never parsed from the line
+            try:
+                record_peak_memory(out_dir)
+            except (SimparityError, OSError) as err:
+                print(f"simparity: peak memory not recorded in run.json: {one_line(err)}", file=sys.stderr)
 
 
 def _cost(scenes) -> str:
@@ -215,11 +230,21 @@ def _cost(scenes) -> str:
 
 
 def _baseline_table(option: str, run_dir: Path, history_option: str | None):
+    """The baseline's rows: a stored run's folder, or ``latest``, the latest earlier run of this run's profile in
+    the history; a baseline of another profile is refused (its rows are of other time steps and horizons)."""
+    profile = read_run(run_dir)[1].profile
     if option == "latest":
         path = history_path(history_option)
-        run_id, _ = latest_before(path, run_dir.resolve())
-        return run_table(path, run_id)
-    return read_run(Path(option))[0]
+        run_id, option = latest_before(path, run_dir.resolve(), profile)
+        table = run_table(path, run_id)
+    else:
+        table = read_run(Path(option))[0]
+    info_path = Path(option) / RUN_INFO_FILE
+    other = RunInfo.read(info_path).profile if info_path.is_file() else ""
+    if profile and other and other != profile:
+        raise SimparityError(f"--baseline {one_line(option)}: a {other}-profile run, this one is {profile} (allowed: a "
+                             f"baseline of the {profile} profile; its rows have other time steps and horizons)")
+    return table
 
 
 def _check(run_dir: Path, bounds, args, out, result: CheckResult | None = None) -> int:
@@ -232,23 +257,30 @@ def _check(run_dir: Path, bounds, args, out, result: CheckResult | None = None) 
         if not math.isfinite(args.baseline_rel) or args.baseline_rel < 0:
             raise SimparityError(f"--baseline-rel {args.baseline_rel}: out of range (allowed: a number >= 0)")
         diff = compare_with_baseline(table, _baseline_table(args.baseline, run_dir, args.history), args.baseline_rel)
-    for violation in result.violations:
+    shown = result.violations if args.verbose else grouped(result.violations)
+    for violation in shown:
         print(f"violation: {one_line(violation.line(), MESSAGE_LIMIT)}", file=out)
     if diff is not None:
         for label, items in (("moved", diff.moved), ("missing", diff.missing), ("new", diff.new),
                              ("timing (not blocking)", diff.timing)):
             for item in items:
                 print(f"{label}: {one_line(item, MESSAGE_LIMIT)}", file=out)
+    unbounded = "" if args.allow_unbounded else result.too_unbounded()
+    if unbounded:
+        print(f"unbounded: {unbounded}", file=out)
     if args.junit:
         args.junit.write_text(junit_xml(result, diff), encoding="utf-8")
     if args.summary:
         with open(args.summary, "a", encoding="utf-8") as handle:
-            handle.write(summary_markdown(result, diff))
-    passed = result.passed and not (diff and diff.blocking)
+            handle.write(summary_markdown(result, diff, unbounded))
+    passed = result.passed and not (diff and diff.blocking) and not unbounded
     moved = "" if diff is None else (f"; since the baseline {len(diff.moved)} moved, {len(diff.missing)} missing, "
-                                     f"{len(diff.new)} new")
+                                     f"{len(diff.new)} new" + (f" ({diff.scope_line()})" if diff.scope_line() else ""))
+    cases = "" if args.verbose or len(shown) == len(result.violations) else f" ({len(shown)} lines: --verbose for each)"
     print(f"check {'passed' if passed else 'FAILED'}: {result.checked} metrics checked, {len(result.violations)} "
-          f"outside their bounds, {result.unchecked} without a bound{moved}", file=out)
+          f"outside their bounds{cases}, {result.unchecked} without a bound, {result.value_bounded} held to a value or "
+          f"verdict; {len(result.unbounded_series)} of {len(result.series)} series without a value bound{moved}",
+          file=out)
     return EXIT_OK if passed else EXIT_FAILED_CASES
 
 
@@ -258,29 +290,57 @@ def cmd_check(args, out) -> int:
     if run_dir is None:
         _, latest = latest_before(history_path(args.history))
         run_dir = Path(latest)
+    narrowed = {key: getattr(args, key) for key in ("scene", "integrator", "metric") if getattr(args, key)}
+    if narrowed and args.explain is None:
+        raise SimparityError(f"--{next(iter(narrowed))} without --explain (allowed: --explain ENGINE with --scene, "
+                             "--integrator, --metric)")
+    if args.spread is not None and args.bless is None:
+        raise SimparityError("--spread without --bless (allowed: --bless FILE --spread RUN_DIR)")
     if args.explain is not None:
-        return _explain(run_dir, bounds, args.explain, out)
+        return _explain(run_dir, bounds, args.explain, narrowed, out)
+    if args.bless is not None:
+        return _bless(run_dir, args.bless, args.spread, out)
     return _check(run_dir, bounds, args, out)
 
 
-def _explain(run_dir: Path, bounds, engine: str, out) -> int:
-    """What the gate holds ``engine`` to in the run of ``run_dir``: one line per scene and bound."""
+def _bless(run_dir: Path, path: Path, spread: Path | None, out) -> int:
+    """Write the tolerances file blessed from the run in ``run_dir`` (:mod:`comparisons.gate.bless`)."""
+    table, info = read_run(run_dir)
+    text, count = bless(table, info, run_dir, read_run(spread)[0] if spread is not None else None)
+    write_blessed(path, text)
+    print(f"blessed {count} bounds from {run_dir} into {path} (extends the shipped tolerances; review the diverged "
+          "and n/a ones before committing)", file=out)
+    return EXIT_OK
+
+
+def _explain(run_dir: Path, bounds, engine: str, narrowed: dict[str, str], out) -> int:
+    """What the gate holds ``engine`` to in the run of ``run_dir``: one line per scene and bound, or (``narrowed``
+    to rows by scene, integrator or metric patterns) every bound that matched each row and which decided."""
     table, _ = read_run(run_dir)
     engines = sorted(set(table["engine"]))
     if engine not in engines:
         raise SimparityError(f"--explain {one_line(engine)}: no rows of that engine in {one_line(run_dir)} (allowed: "
                              f"{', '.join(engines)})")
+    if narrowed:
+        lines = explain_rows(table, bounds, engine, **narrowed)
+        print("\n".join(lines) if lines else f"no row of {engine} matches {narrowed}", file=out)
+        return EXIT_OK
     lines = explain_lines(explain(table, bounds, engine), engine in ENGINE_NAMES)
     print("\n".join(lines) if lines else f"no bound holds {engine}'s rows", file=out)
     return EXIT_OK
 
 
 def cmd_history(args, out) -> int:
-    table = metric_history(history_path(args.history), args.scene, args.engine, args.metric)
+    path = history_path(args.history)
+    table = metric_history(path, args.scene, args.engine, args.metric)
     if table.empty:
-        print("no recorded values match", file=out)
-    else:
-        print(table.to_string(index=False), file=out)
+        asked = ", ".join(f"{key} {value}" for key, value in (("scene", args.scene), ("engine", args.engine),
+                                                                ("metric", args.metric)) if value)
+        known = recorded_scenes(path)
+        print(f"no recorded values match {asked or 'anything'} in {path} (scenes recorded: "
+              f"{', '.join(known) if known else 'none'})", file=out)
+        return EXIT_FAILED_CASES
+    print(table.to_string(index=False), file=out)
     return EXIT_OK
 
 

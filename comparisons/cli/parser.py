@@ -10,7 +10,7 @@ from simparity.comparisons.execute.execution import default_jobs
 from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS
 from simparity.comparisons.execute.store import DEFAULT_OUT_ROOT
-from simparity.comparisons.gate.check import BASELINE_RELATIVE
+from simparity.comparisons.gate.check import BASELINE_RELATIVE, UNBOUNDED_SHARE_MAX
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES
 from simparity.comparisons.invariance.transforms import TRANSFORM_NAMES
 from simparity.comparisons.scenes.limits import DEFAULT_LIMITS
@@ -37,10 +37,17 @@ def _engine_list(text: str) -> tuple[str, ...]:
 
 def _add_check_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--tolerances", type=Path, default=None, metavar="FILE",
-                        help=f"bounds to hold the run to (default: the shipped {DEFAULT_TOLERANCES.name})")
+                        help=f"bounds to hold the run to: your file extends the shipped {DEFAULT_TOLERANCES.name} "
+                        "(extends = \"none\" in it starts empty) and its bounds win where they match")
+    parser.add_argument("--allow-unbounded", action="store_true",
+                        help=f"pass although more than {UNBOUNDED_SHARE_MAX * 100:.0f}%% of the series (scene x engine x "
+                        "integrator) have no bound on any value, only on their status")
+    parser.add_argument("--verbose", action="store_true",
+                        help="one line per metric outside its bound (default: one per case and reason, with the "
+                        "count of metrics it covers)")
     parser.add_argument("--baseline", default=None, metavar="DIR|latest",
-                        help="also flag every metric that moved since this run ('latest': the run before, from the "
-                        "history)")
+                        help="also flag every metric that moved since this run, among the scenes x engines both runs "
+                        "ran ('latest': the latest earlier run of the same profile, from the history)")
     parser.add_argument("--baseline-rel", type=float, default=BASELINE_RELATIVE, metavar="X",
                         help=f"relative change that counts as a move (default: {BASELINE_RELATIVE:g}); timing "
                         "changes are listed apart and never fail the check")
@@ -143,7 +150,18 @@ def build_parser() -> argparse.ArgumentParser:
                        help="a folder written by 'simparity run' (default: the latest run in the history)")
     check.add_argument("--explain", default=None, metavar="ENGINE",
                        help="print, per scene, every bound that holds ENGINE's rows (which rows, to what, and why) "
-                       "instead of checking; your engine is held to the bounds of its schemes' kinds")
+                       "instead of checking; your engine is held to the bounds of its schemes' kinds. With --scene, "
+                       "--integrator or --metric: for each row, every bound that matched, its file, and which decided")
+    for key in ("scene", "integrator", "metric"):
+        check.add_argument(f"--{key}", default=None, metavar="PATTERN",
+                           help=f"with --explain: only rows whose {key} matches (fnmatch, e.g. 'order_*')")
+    check.add_argument("--bless", type=Path, default=None, metavar="FILE",
+                       help="write a tolerances file from the run instead of checking: each row held to its measured "
+                       "value with a margin (never timing; a failed row refuses the file; a diverged one is marked "
+                       "'expected - review'); docs/check.md")
+    check.add_argument("--spread", type=Path, default=None, metavar="RUN_DIR",
+                       help="with --bless: a second run of the same scenes (another machine, a perturbed scene); each "
+                       "margin covers 3 x the two runs' difference")
     _add_check_options(check)
     _add_history_option(check)
 

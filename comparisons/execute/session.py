@@ -174,7 +174,7 @@ class Session:
         self.names = check_engine_names(engines.names)
         if execution.where != IN_PROCESS:
             refuse_unreachable(self.names)
-        self.scenes = apply_profile(list(scenes), profile, engines)
+        self.scenes, self.profile = apply_profile(list(scenes), profile, engines), profile
         self.repeats, self.execution, self.out_dir = repeats, execution, out_dir
         self.history, self.bounds, self.transforms, self.command = history, bounds, tuple(transforms), command
         self.report, self.request, self.resume, self.say, self.progress = report, request, resume, say, progress
@@ -217,7 +217,7 @@ class Session:
 
     def _run(self, executor: Executor) -> SessionResult:
         journal = Journal(self.out_dir) if self.out_dir is not None else None
-        store = _Store(self.out_dir, self.engines, self.command, self.scenes)
+        store = _Store(self.out_dir, self.engines, self.command, self.scenes, self.profile)
         sizes = count_cases(self.scenes, self.engines, make_engine)
         bar = ProgressBar(sum(sizes), self.progress) if self.progress is not None else None
         failed = 0
@@ -295,8 +295,8 @@ class Session:
 class _Store:
     """Where a session's rows go: the run folder (``RunWriter``), or memory when it has none."""
 
-    def __init__(self, out_dir: Path | None, engines: list[Engine], command: str, scenes: list) -> None:
-        self.writer = RunWriter(out_dir, engines, command, scenes) if out_dir is not None else None
+    def __init__(self, out_dir: Path | None, engines: list[Engine], command: str, scenes: list, profile: str) -> None:
+        self.writer = RunWriter(out_dir, engines, command, scenes, profile) if out_dir is not None else None
         self.rows: list[ResultRow] = []
 
     def append(self, rows: list[ResultRow], series: Sequence[SeriesRecord] = ()) -> None:

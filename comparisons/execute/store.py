@@ -124,7 +124,7 @@ class RunWriter:
     computed is lost. A run of swept scenes (``scenes``) has the sweep columns of :func:`sweep_cells` after the
     fixed ones, filled from each row's scene."""
 
-    def __init__(self, out_dir: Path, engines: list[Engine], command: str, scenes: list) -> None:
+    def __init__(self, out_dir: Path, engines: list[Engine], command: str, scenes: list, profile: str = "") -> None:
         self.out_dir = Path(out_dir)
         self.out_dir.mkdir(parents=True, exist_ok=True)
         self.results_path = self.out_dir / RESULTS_FILE
@@ -142,6 +142,7 @@ class RunWriter:
             theoretical_orders={e.name: orders for e in engines if (orders := _orders(e))},
             integrator_variants={e.name: variants for e in engines if (variants := _variants(e))},
             scenes={s.name: _scene_info(s) for s in scenes},
+            profile=profile,
         ).write(self.out_dir / RUN_INFO_FILE)
 
     def append(self, rows: list[ResultRow], series: Sequence[SeriesRecord] = ()) -> None:

@@ -5,7 +5,13 @@ from __future__ import annotations
 import resource
 import sys
 import time
-from typing import Callable, TypeVar
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, replace
+from pathlib import Path
+from typing import TypeVar
+
+from simparity.core.model.results import RUN_INFO_FILE
+from simparity.core.model.run_info import RunInfo
 
 T = TypeVar("T")
 
@@ -61,17 +67,53 @@ def _high_water_mark_bytes() -> int | None:
     return status_bytes("VmHWM")
 
 
-def peak_memory_bytes() -> tuple[int, int]:
-    """(peak resident memory of this process, of its largest finished child process) [bytes].
+@dataclass(frozen=True)
+class PeakMemory:
+    """Peak resident memory of a run's processes [bytes], as ``run.json`` records it (``peak_memory``)."""
 
-    A child's figure is ru_maxrss, which counts the parent's resident memory at the time it was started."""
+    this_process_bytes: int
+    """[bytes] The process that ran (``simparity run``): its VmHWM, ru_maxrss where Linux's /proc is missing."""
+    largest_child_bytes: int
+    """[bytes] The largest child process it waited for: a case worker, or a child a worker forked to run one engine's
+    cases (it holds the reference's and the engine's trajectories); engine probes and figure writers count too. Its
+    ru_maxrss, which on Linux includes the resident memory of the process that started it at that moment, so it is
+    at least the parent's size then; 0 without a child."""
+
+    @property
+    def tree_bytes(self) -> int:
+        """[bytes] This process's peak plus its largest child's: with one worker at a time (``--jobs 1``), a bound of
+        what the whole run held at once (a forked child's figure counts the pages it shares with its worker)."""
+        return self.this_process_bytes + self.largest_child_bytes
+
+    @classmethod
+    def of_run(cls, run_dir: Path) -> PeakMemory | None:
+        """What the stored run in ``run_dir`` recorded; None when it recorded none (an older or unfinished run)."""
+        recorded = RunInfo.read(Path(run_dir) / RUN_INFO_FILE).peak_memory
+        try:
+            return cls(**recorded) if recorded else None
+        except TypeError:  # another simparity's fields
+            return None
+
+
+def peak_memory() -> PeakMemory:
+    """This process's and its largest finished child process's peak resident memory."""
     scale = 1 if sys.platform == "darwin" else 1024  # ru_maxrss is in bytes on macOS, KiB on Linux
     own = _high_water_mark_bytes() or resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale
-    return own, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * scale
+    return PeakMemory(own, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * scale)
+
+
+def record_peak_memory(run_dir: Path) -> PeakMemory:
+    """Write :func:`peak_memory` into the ``run.json`` of the run in ``run_dir`` (``peak_memory``) and return it: the
+    run's workers must have been waited for (a worker still running is not counted)."""
+    peak = peak_memory()
+    path = Path(run_dir) / RUN_INFO_FILE
+    replace(RunInfo.read(path), peak_memory=asdict(peak)).write(path)
+    return peak
 
 
 def resource_line(seconds: float) -> str:
-    """What a run cost: its wall time and the peak memory of the process and of its largest worker."""
-    own, worker = peak_memory_bytes()
-    return (f"wall time {seconds:.1f} s; peak memory {own / 2**20:,.0f} MiB"
-            + (f" (largest worker process {worker / 2**20:,.0f} MiB)" if worker else ""))
+    """What a run cost: its wall time and the peak memory of the process and of its largest child (worker)."""
+    peak = peak_memory()
+    return (f"wall time {seconds:.1f} s; peak memory {peak.this_process_bytes / 2**20:,.0f} MiB"
+            + (f" (largest worker process {peak.largest_child_bytes / 2**20:,.0f} MiB)"
+               if peak.largest_child_bytes else ""))

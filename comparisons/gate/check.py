@@ -1,15 +1,20 @@
 """The CI verdict on a stored run: every bounded metric inside its bound, and what moved since a baseline.
 
-:func:`check_table` holds each row to the most specific bound of the tolerances
-(:mod:`comparisons.tolerances`); a row no bound matches is unchecked (counted, never a pass in
-disguise: the count is printed). :func:`compare_with_baseline` lists every metric that moved by
-more than a relative threshold since another run, every case that appeared or disappeared, and
-timing changes apart (non-blocking: these machines are noisy).
+:func:`check_table` holds each row to the bound that decides it (:mod:`comparisons.gate.tolerances`); a row
+no bound matches is unchecked (counted, never a pass in disguise: the count is printed). A status-only bound
+that allows ``ok`` (the shipped catch-all) checks that a case ran, not what it found: a series (scene x
+engine x integrator or solver) none of whose rows is held to a value or a verdict is *without a value
+bound*, and a run where more than :data:`UNBOUNDED_SHARE_MAX` of the series measured are fails the gate
+unless the user allows it. :func:`compare_with_baseline` lists every metric that moved by more than a
+relative threshold since another run among the scenes x engines both runs ran, every row that appeared or
+disappeared there, and timing changes apart, one summary per scene (non-blocking: these machines are noisy).
 """
 
 from __future__ import annotations
 
+import fnmatch
 import math
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -18,12 +23,17 @@ import pandas as pd
 from simparity.comparisons.gate.cross_check import CROSS_CHECK_FACTOR, SOLVE_RATE_FRACTION, cross_check
 from simparity.comparisons.gate.violation import Violation, row_label
 from simparity.comparisons.engines.registry import ENGINE_NAMES
-from simparity.comparisons.gate.tolerances import Bound, bound_for
+from simparity.comparisons.gate.tolerances import Bound, BoundIndex
 from simparity.core.model.metric_catalogue import is_timing
 from simparity.core.model.results import ALARM_FLAGS, DIMENSIONLESS, NOT_AVAILABLE, OK, ROUNDING_FLOOR
 
 CASE_KEYS = ("scene", "engine", "integrator", "dt")
 ROW_KEYS = CASE_KEYS + ("metric",)
+
+UNBOUNDED_SHARE_MAX = 0.10
+"""Share of a run's measured series (scene x engine x integrator or solver) that may have no bound on any
+value before the gate fails: beyond one in ten, a passing check says little more than "it ran". The shipped
+tolerances leave at most 5 % of the built-in suites' series so (docs/check.md)."""
 
 BASELINE_RELATIVE = 1e-6
 """Default relative change of a metric since the baseline that counts as a move: far above the
@@ -42,10 +52,33 @@ class CheckResult:
     unchecked: int = 0
     violations: list[Violation] = field(default_factory=list)
     cases: dict[tuple, list[Violation]] = field(default_factory=dict)
+    value_bounded: int = 0
+    series: dict[tuple[str, str, str], bool] = field(default_factory=dict)
+    unmeasured: dict[tuple, str] = field(default_factory=dict)
 
     @property
     def passed(self) -> bool:
         return not self.violations
+
+    @property
+    def unbounded_series(self) -> list[tuple[str, str, str]]:
+        """The measured series (scene, engine, integrator) none of whose rows is held to a value or a verdict."""
+        return [key for key, bounded in self.series.items() if not bounded]
+
+    @property
+    def unbounded_share(self) -> float:
+        """Share of the measured series without a value bound (0 for a run that measured nothing)."""
+        return len(self.unbounded_series) / len(self.series) if self.series else 0.0
+
+    def too_unbounded(self, allowed_share: float = UNBOUNDED_SHARE_MAX) -> str:
+        """A one-line reason when more than ``allowed_share`` of the series have no value bound, else ""."""
+        unbounded = self.unbounded_series
+        if self.unbounded_share <= allowed_share:
+            return ""
+        first = " ".join(part or "-" for part in unbounded[0])
+        return (f"{len(unbounded)} of {len(self.series)} series (scene x engine x integrator) have no bound on any "
+                f"value, only on their status (first: {first}); more than {allowed_share:.0%} checks too little to "
+                "pass (allowed: bounds in a tolerances file, 'simparity check RUN --bless FILE', or --allow-unbounded)")
 
 
 def _judge(bound: Bound, row) -> tuple[str, str] | None:
@@ -72,29 +105,50 @@ def _judge(bound: Bound, row) -> tuple[str, str] | None:
 
 
 def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = True) -> CheckResult:
-    """Hold every row of a results table to its most specific bound, and (``cross_checked``) every user engine's
-    row to the built-in schemes of its kind (:mod:`comparisons.cross_check`)."""
-    result = CheckResult()
+    """Hold every row of a results table to the bound that decides it, and (``cross_checked``) every user engine's
+    row to the built-in schemes of its kind (:mod:`comparisons.gate.cross_check`)."""
+    result, index = CheckResult(), BoundIndex(bounds)
+    measured: dict[tuple, str | None] = {}  # case -> the reason nothing was measured (None: something was)
     for row in table.to_dict("records"):
         key = _case_key(row["scene"], row["engine"], row["integrator"], float(row["dt"]))
         result.cases.setdefault(key, [])
-        bound = _row_bound(bounds, row)
+        if row["status"] != NOT_AVAILABLE:
+            measured[key] = None
+        elif key not in measured:
+            measured[key] = str(row["detail"] or NOT_AVAILABLE)
+        bound = _row_bound(index, row)
+        _count_series(result, row, bound)
         if bound is None:
             result.unchecked += 1
             continue
         result.checked += 1
+        result.value_bounded += bound.bounds_the_value
         broken = _judge(bound, row)
         if broken:
             found, text = broken
+            flag = row.get("flag", "")
+            verdict = row["status"] if row["status"] != OK else flag if flag in ALARM_FLAGS else ""
             violation = Violation(row["scene"], row["engine"], row["integrator"], float(row["dt"]), row["metric"],
-                                  found, text, bound.reason)
+                                  found, text, bound.reason, verdict)
             result.violations.append(violation)
             result.cases[key].append(violation)
     for violation in cross_check(table, ENGINE_NAMES) if cross_checked else ():
         result.violations.append(violation)
         result.cases.setdefault(_case_key(violation.scene, violation.engine, violation.integrator, violation.dt),
                                 []).append(violation)
+    result.unmeasured = {key: reason for key, reason in measured.items() if reason is not None and not result.cases[key]}
     return result
+
+
+def _count_series(result: CheckResult, row: dict, bound: Bound | None) -> None:
+    """Note whether ``row``'s series is held to a value: timing rows never are (and do not count), a series whose
+    every row is n/a measured nothing (and does not count)."""
+    if is_timing(row["metric"]):
+        return
+    key = (row["scene"], row["engine"], row["integrator"] if isinstance(row["integrator"], str) else "")
+    bounded = bound is not None and bound.bounds_the_value
+    if row["status"] != NOT_AVAILABLE or bounded:
+        result.series[key] = result.series.get(key, False) or bounded
 
 
 def _case_key(scene: str, engine: str, integrator: str, dt: float) -> tuple:
@@ -102,11 +156,16 @@ def _case_key(scene: str, engine: str, integrator: str, dt: float) -> tuple:
     return (scene, engine, integrator, "nan" if math.isnan(dt) else dt)
 
 
-def _row_bound(bounds: list[Bound], row: dict) -> Bound | None:
-    """The bound that decides ``row`` (a results table's record; a table without a scheme column: "")."""
+def _row_key(row: dict) -> tuple[str, str, str, str, float, str]:
+    """What a bound matches of a results table's record (a table without a scheme column: scheme "")."""
     scheme = row.get("scheme", "")
-    return bound_for(bounds, row["scene"], row["engine"], row["integrator"], row["metric"], float(row["dt"]),
-                     scheme if isinstance(scheme, str) else "")
+    return (row["scene"], row["engine"], row["integrator"], row["metric"], float(row["dt"]),
+            scheme if isinstance(scheme, str) else "")
+
+
+def _row_bound(index: BoundIndex, row: dict) -> Bound | None:
+    """The bound that decides ``row`` (a results table's record)."""
+    return index.decider(*_row_key(row))
 
 
 @dataclass(frozen=True)
@@ -124,8 +183,9 @@ def explain(table: pd.DataFrame, bounds: list[Bound], engine: str) -> list[Appli
     metrics it decides and how many rows, in the scene's order; rows no bound matches are left out (the check
     counts them as without a bound)."""
     decided: dict[tuple[str, str], tuple[Bound, dict[str, None], int]] = {}
+    index = BoundIndex(bounds)
     for row in table[table["engine"] == engine].to_dict("records"):
-        bound = _row_bound(bounds, row)
+        bound = _row_bound(index, row)
         if bound is None:
             continue
         key = (row["scene"], bound.where)
@@ -154,18 +214,71 @@ def explain_lines(applied: list[Applied], builtin: bool) -> list[str]:
     return lines
 
 
+EXPLAINED_ROWS_MAX = 50
+"""Rows ``--explain`` details at most (narrow with --scene, --integrator, --metric); the rest are counted."""
+
+
+def explain_rows(table: pd.DataFrame, bounds: list[Bound], engine: str, scene: str = "*", integrator: str = "*",
+                 metric: str = "*") -> list[str]:
+    """For each of ``engine``'s rows matching the fnmatch patterns: the row, then every bound that matched it, the
+    deciding one first, each with its file and why it decides or does not (at most :data:`EXPLAINED_ROWS_MAX`
+    rows)."""
+    rows = [row for row in table[table["engine"] == engine].to_dict("records")
+            if fnmatch.fnmatchcase(row["scene"], scene) and fnmatch.fnmatchcase(row["integrator"] or "", integrator)
+            and fnmatch.fnmatchcase(row["metric"], metric)]
+    lines, index = [], BoundIndex(bounds)
+    for row in rows[:EXPLAINED_ROWS_MAX]:
+        matched = index.matching(*_row_key(row))
+        label = row_label(row["scene"], row["engine"], row["integrator"], float(row["dt"]), row["metric"])
+        value = f"{float(row['value']):.4g}" if row["status"] == OK else row["status"]
+        lines.append(f"{label} = {value}: " + (f"{len(matched)} bound(s) matched" if matched else
+                                                "no bound matched (counted as without a bound)"))
+        for rank, bound in enumerate(matched):
+            verdict = "decides" if rank == 0 else "overridden: " + _why_not(bound, matched[0])
+            lines.append(f"  {verdict}: {bound.where} holds it to {_held(bound, float(row['dt']))} ({bound.reason})")
+    if len(rows) > EXPLAINED_ROWS_MAX:
+        lines.append(f"... and {len(rows) - EXPLAINED_ROWS_MAX} more rows (narrow with --scene, --integrator, --metric)")
+    return lines
+
+
+def _held(bound: Bound, dt: float) -> str:
+    return (bound.describe(dt) + ", " if bound.bounds_a_number else "") + bound.status_text()
+
+
+def _why_not(bound: Bound, decider: Bound) -> str:
+    """Why ``bound`` does not decide a row ``decider`` decides."""
+    if bound.layer < decider.layer:
+        return "the deciding bound's file extends this one, and the extending file wins"
+    if bound.specificity < decider.specificity:
+        return f"less specific ({bound.specificity} against {decider.specificity})"
+    return "as specific, but earlier in its file"
+
+
 @dataclass
 class BaselineDiff:
-    """What changed since a baseline run: moves block, timing changes do not."""
+    """What changed since a baseline run among the scenes x engines both ran: moves block, timing changes do not.
+
+    ``timing``: one summary per scene whose timings changed; ``out_of_scope``: baseline rows of scenes x engines
+    this run did not ask for (not compared, not missing); ``not_in_baseline``: this run's rows of scenes x engines
+    the baseline did not run."""
 
     moved: list[str] = field(default_factory=list)
     missing: list[str] = field(default_factory=list)
     new: list[str] = field(default_factory=list)
     timing: list[str] = field(default_factory=list)
+    out_of_scope: int = 0
+    not_in_baseline: int = 0
 
     @property
     def blocking(self) -> bool:
         return bool(self.moved or self.missing)
+
+    def scope_line(self) -> str:
+        """What the comparison left out, in one line ("" when both runs ran the same scenes x engines)."""
+        parts = ([f"{self.out_of_scope} baseline rows of scenes x engines this run did not run"]
+                 if self.out_of_scope else []) + (
+            [f"{self.not_in_baseline} rows of scenes x engines the baseline did not run"] if self.not_in_baseline else [])
+        return "not compared: " + "; ".join(parts) if parts else ""
 
 
 _INDEX = ("scene", "engine", "integrator", "dt_key", "metric")
@@ -185,13 +298,24 @@ def _key_label(key: tuple) -> str:
     return row_label(scene, engine, integrator, float(dt_key), metric)
 
 
+def _shared(now: pd.DataFrame, before: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Both tables cut to the (scene, engine) pairs both have rows of."""
+    def pairs(table: pd.DataFrame) -> pd.Index:
+        return pd.MultiIndex.from_arrays([table.index.get_level_values("scene"), table.index.get_level_values("engine")])
+    now_pairs, before_pairs = pairs(now), pairs(before)
+    return now[now_pairs.isin(before_pairs)], before[before_pairs.isin(now_pairs)]
+
+
 def compare_with_baseline(table: pd.DataFrame, baseline: pd.DataFrame,
                           relative: float = BASELINE_RELATIVE) -> BaselineDiff:
-    """Rows whose status changed or whose value moved by more than ``relative`` (of the baseline's
-    magnitude) since ``baseline``; rows only one run has; timing changes apart."""
-    now, before = _keyed(table), _keyed(baseline)
+    """Among the scenes x engines both runs ran: rows whose status changed or whose value moved by more than
+    ``relative`` (of the baseline's magnitude) since ``baseline``, rows only one run has, and per scene a summary
+    of its timing changes. Rows of scenes x engines only one run ran are counted apart, never missing."""
+    all_now, all_before = _keyed(table), _keyed(baseline)
+    now, before = _shared(all_now, all_before)
     diff = BaselineDiff(missing=[_key_label(k) for k in before.index.difference(now.index)],
-                        new=[_key_label(k) for k in now.index.difference(before.index)])
+                        new=[_key_label(k) for k in now.index.difference(before.index)],
+                        out_of_scope=len(all_before) - len(before), not_in_baseline=len(all_now) - len(now))
     common = now.index.intersection(before.index)
     a, b = now.loc[common], before.loc[common]
     x, y = a["value"].to_numpy(dtype=float), b["value"].to_numpy(dtype=float)
@@ -200,9 +324,22 @@ def compare_with_baseline(table: pd.DataFrame, baseline: pd.DataFrame,
     status_now, status_before = a["status"].to_numpy(), b["status"].to_numpy()
     retagged = status_now != status_before
     moved = ~retagged & ~(np.isnan(x) & np.isnan(y)) & ~(change <= relative)
+    timing: dict[str, list[float]] = {}
     for i in np.flatnonzero(retagged | moved):
         key = common[i]
+        if is_timing(key[-1]):
+            timing.setdefault(key[0], []).append(x[i] / y[i] if y[i] > 0 and not retagged[i] else math.nan)
+            continue
         text = (f"status {status_before[i]} -> {status_now[i]}" if retagged[i]
                 else f"{y[i]:.6g} -> {x[i]:.6g} ({change[i]:.2g} relative)")
-        (diff.timing if is_timing(key[-1]) else diff.moved).append(f"{_key_label(key)}: {text}")
+        diff.moved.append(f"{_key_label(key)}: {text}")
+    timed = Counter(key[0] for key in common if is_timing(key[-1]))
+    diff.timing = [_timing_line(scene, ratios, timed[scene]) for scene, ratios in timing.items()]
     return diff
+
+
+def _timing_line(scene: str, ratios: list[float], timed: int) -> str:
+    """One scene's timing changes in one line: how many, and the range of now / before."""
+    finite = [r for r in ratios if math.isfinite(r)]
+    spread = f", now / before x{min(finite):.2g} to x{max(finite):.2g}" if finite else ""
+    return f"{scene}: {len(ratios)} of {timed} timings changed{spread}"

@@ -7,6 +7,11 @@ import math
 import xml.etree.ElementTree as ET
 
 from simparity.comparisons.gate.check import BaselineDiff, CheckResult
+from simparity.comparisons.gate.violation import GROUP_METRICS_SHOWN, grouped
+
+
+MESSAGE_CHARS = 500
+"""Characters of a JUnit message attribute (CI viewers show it on one line; the text holds every line)."""
 
 
 def _case_name(key: tuple) -> tuple[str, str]:
@@ -18,17 +23,22 @@ def _case_name(key: tuple) -> tuple[str, str]:
 
 def junit_xml(result: CheckResult, diff: BaselineDiff | None = None) -> str:
     """JUnit XML: one test case per scene x engine x integrator x dt; a case with violations fails with
-    them as its message and text; a baseline comparison is one more test case."""
+    them as its message and text, a case that measured nothing (every row n/a) is skipped with the reason;
+    a baseline comparison is one more test case."""
     suites = ET.Element("testsuites", name="simparity check")
     suite = ET.SubElement(suites, "testsuite", name="simparity")
-    failures = 0
+    failures = skipped = 0
     for key, violations in result.cases.items():
         classname, name = _case_name(key)
         case = ET.SubElement(suite, "testcase", classname=classname, name=name, time="0")
-        if violations:
+        if key in result.unmeasured:
+            skipped += 1
+            ET.SubElement(case, "skipped", message=f"n/a: {result.unmeasured[key]}"[:MESSAGE_CHARS])
+        elif violations:
             failures += 1
-            failure = ET.SubElement(case, "failure", message=f"{len(violations)} metric(s) outside their bounds",
-                                    type="tolerance")
+            reasons = "; ".join(g.line() for g in grouped(violations))
+            failure = ET.SubElement(case, "failure", type="tolerance", message=(
+                f"{len(violations)} metric(s) outside their bounds: {reasons}")[:MESSAGE_CHARS])
             failure.text = "\n".join(v.line() for v in violations)
     tests = len(result.cases)
     if diff is not None:
@@ -41,6 +51,7 @@ def junit_xml(result: CheckResult, diff: BaselineDiff | None = None) -> str:
     for element in (suites, suite):
         element.set("tests", str(tests))
         element.set("failures", str(failures))
+        element.set("skipped", str(skipped))
         element.set("errors", "0")
     return ET.tostring(suites, encoding="unicode", xml_declaration=True) + "\n"
 
@@ -49,21 +60,29 @@ def _cell(text: str) -> str:
     return text.replace("|", "/").replace("\n", " ")
 
 
-def summary_markdown(result: CheckResult, diff: BaselineDiff | None = None) -> str:
-    """A short Markdown verdict: counts, then each violation and each move."""
-    verdict = "passed" if result.passed and not (diff and diff.blocking) else "failed"
+def summary_markdown(result: CheckResult, diff: BaselineDiff | None = None, unbounded: str = "") -> str:
+    """A short Markdown verdict: counts, then each violation and each move (``unbounded``: the reason the run
+    fails for too few value bounds, "" when it does not)."""
+    verdict = "passed" if result.passed and not (diff and diff.blocking) and not unbounded else "failed"
     lines = [f"## simparity check: {verdict}", "",
              f"{result.checked} metrics checked, {len(result.violations)} outside their bounds, "
-             f"{result.unchecked} without a bound; {len(result.cases)} cases.", ""]
+             f"{result.unchecked} without a bound; {len(result.cases)} cases, {len(result.unmeasured)} without a "
+             f"result (n/a); {len(result.unbounded_series)} of {len(result.series)} series without a value bound.", ""]
+    if unbounded:
+        lines += [f"**Too few value bounds:** {_cell(unbounded)}", ""]
     if result.violations:
-        lines += ["| scene | engine | integrator | dt | metric | found | bound | reason |", "|---|---|---|---|---|---|---|---|"]
-        lines += ["| " + " | ".join(_cell(str(x)) for x in (v.scene, v.engine, v.integrator or "-",
-                                                             "" if math.isnan(v.dt) else f"{v.dt:g}", v.metric,
-                                                             v.found, v.bound, v.reason)) + " |"
-                  for v in result.violations]
+        lines += ["| scene | engine | integrator | dt | metrics | found | bound | reason |", "|---|---|---|---|---|---|---|---|"]
+        for group in grouped(result.violations):
+            v, metrics = group.violations[0], [m.metric for m in group.violations]
+            shown = ", ".join(metrics[:GROUP_METRICS_SHOWN]) + (f" (+{len(metrics) - GROUP_METRICS_SHOWN})"
+                                                                 if len(metrics) > GROUP_METRICS_SHOWN else "")
+            lines.append("| " + " | ".join(_cell(str(x)) for x in (
+                v.scene, v.engine, v.integrator or "-", "" if math.isnan(v.dt) else f"{v.dt:g}", shown, v.found,
+                v.bound, v.reason)) + " |")
     if diff is not None:
         lines += ["", f"Since the baseline: {len(diff.moved)} moved, {len(diff.missing)} missing, "
-                      f"{len(diff.new)} new, {len(diff.timing)} timing changes (not blocking).", ""]
+                      f"{len(diff.new)} new; timing changed in {len(diff.timing)} scenes (not blocking). "
+                      f"{diff.scope_line()}", ""]
         lines += [f"- moved: {_cell(m)}" for m in diff.moved] + [f"- missing: {_cell(m)}" for m in diff.missing]
         lines += [f"- new: {_cell(m)}" for m in diff.new]
     return "\n".join(lines) + "\n"

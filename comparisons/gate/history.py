@@ -39,7 +39,8 @@ CREATE TABLE IF NOT EXISTS runs (
     git_commit TEXT,
     command TEXT,
     machine TEXT,
-    engine_versions TEXT
+    engine_versions TEXT,
+    profile TEXT DEFAULT ''
 );
 CREATE TABLE IF NOT EXISTS results (
     run_id INTEGER NOT NULL REFERENCES runs(id),
@@ -76,6 +77,9 @@ def _add_missing_columns(connection: sqlite3.Connection) -> None:
     for column in (c for c in COLUMNS if c not in present):
         with connection:
             connection.execute(f"ALTER TABLE results ADD COLUMN {column} TEXT DEFAULT ''")
+    if "profile" not in {row[1] for row in connection.execute("PRAGMA table_info(runs)")}:
+        with connection:  # the runs' profile (schema 3): unknown ("") for the runs recorded before
+            connection.execute("ALTER TABLE runs ADD COLUMN profile TEXT DEFAULT ''")
 
 
 def record_run(path: Path, run_dir: Path, info: RunInfo, table: pd.DataFrame) -> int:
@@ -84,10 +88,10 @@ def record_run(path: Path, run_dir: Path, info: RunInfo, table: pd.DataFrame) ->
     try:
         with connection:
             cursor = connection.execute(
-                "INSERT INTO runs (run_dir, created_utc, git_commit, command, machine, engine_versions) "
-                "VALUES (?, ?, ?, ?, ?, ?)",
+                "INSERT INTO runs (run_dir, created_utc, git_commit, command, machine, engine_versions, profile) "
+                "VALUES (?, ?, ?, ?, ?, ?, ?)",
                 (str(run_dir), info.created_utc, info.git_commit, info.command,
-                 json.dumps(info.machine), json.dumps(info.engine_versions)))
+                 json.dumps(info.machine), json.dumps(info.engine_versions), info.profile))
             run_id = cast(int, cursor.lastrowid)  # set by the INSERT just made
             records = [(run_id, *(None if pd.isna(v) else v for v in row))
                        for row in table[list(COLUMNS)].itertuples(index=False, name=None)]
@@ -112,8 +116,8 @@ def _query(path: Path, sql: str, params=()) -> pd.DataFrame:
 
 
 def runs(path: Path) -> pd.DataFrame:
-    """The recorded runs, oldest first: id, run_dir, created_utc, git_commit, command."""
-    return _query(path, "SELECT id, run_dir, created_utc, git_commit, command FROM runs ORDER BY id")
+    """The recorded runs, oldest first: id, run_dir, created_utc, git_commit, command, profile ("": unknown)."""
+    return _query(path, "SELECT id, run_dir, created_utc, git_commit, command, profile FROM runs ORDER BY id")
 
 
 def run_table(path: Path, run_id: int) -> pd.DataFrame:
@@ -125,13 +129,18 @@ def run_table(path: Path, run_id: int) -> pd.DataFrame:
     return table.astype({"dt": float, "value": float})
 
 
-def latest_before(path: Path, run_dir: Path | None = None) -> tuple[int, str]:
-    """(id, folder) of the latest recorded run other than ``run_dir``; HistoryError if there is none."""
+def latest_before(path: Path, run_dir: Path | None = None, profile: str = "") -> tuple[int, str]:
+    """(id, folder) of the latest recorded run other than ``run_dir`` (of ``profile``, when given: a run recorded
+    without one counts as any); HistoryError if there is none."""
     recorded = runs(path)
     if run_dir is not None:
         recorded = recorded[recorded["run_dir"] != str(run_dir)]
+    if profile:
+        recorded = recorded[recorded["profile"].fillna("").isin(["", profile])]
     if recorded.empty:
-        raise HistoryError(f"{path}: no earlier run recorded to compare with (allowed: --baseline DIR of a stored run)")
+        of = f" of the {profile} profile" if profile else ""
+        raise HistoryError(f"{path}: no earlier run{of} recorded to compare with (allowed: --baseline DIR of a "
+                           "stored run)")
     last = recorded.iloc[-1]
     return int(last["id"]), str(last["run_dir"])
 
@@ -156,3 +165,8 @@ def metric_history(path: Path, scene: str | None = None, engine: str | None = No
     long["shown"] = [f"{v:.6g}" if s == "ok" else s for v, s in zip(long["value"], long["status"])]
     return long.pivot_table(index=["scene", "engine", "integrator", "dt", "metric"], columns="run", values="shown",
                             aggfunc="last", sort=False).reset_index()
+
+
+def recorded_scenes(path: Path) -> list[str]:
+    """The scenes of which the history holds rows, sorted."""
+    return sorted(_query(path, "SELECT DISTINCT scene FROM results")["scene"].dropna())

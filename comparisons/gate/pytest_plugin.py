@@ -5,12 +5,15 @@ In a test::
     def test_my_integrator_is_fourth_order(simparity):
         simparity.check("scenes/my-box.toml", engines=["core"], tolerances="my-tolerances.toml")
 
-``simparity.check`` runs the scene (a built-in name or a scene file) on the engines, holds every
-row to the tolerances (default: the shipped ones) and fails the test with one line per
-violation; it returns the results table. ``pytest --simparity-baseline DIR`` also compares each
-checked scene with the same scene's rows in a stored run and fails on any metric that moved
-(``--simparity-baseline-rel`` sets the relative threshold). Nothing is imported from the engines
-until a test asks for a run.
+``simparity.check`` runs the scene (a built-in name, or a scene file: a relative path is found beside
+the test file first, then in the current folder) on the engines, holds every row to the tolerances
+(default: the shipped ones; a relative path resolves the same way; a file of yours extends the shipped
+ones) and fails the test with one line per case and reason; it returns the results table. Bad input (an
+unknown scene, a tolerances file with a mistake) fails the test with the one-line message, not a
+traceback. ``pytest --simparity-baseline DIR`` also compares each checked scene with the same scene's
+rows of the same engines in a stored run of the same profile and fails on any metric that moved
+(``--simparity-baseline-rel`` sets the relative threshold). Nothing is imported from the engines until
+a test asks for a run.
 """
 
 from __future__ import annotations
@@ -31,33 +34,56 @@ def pytest_addoption(parser) -> None:
 class SimparityChecker:
     """What the ``simparity`` fixture gives a test: ``check(scene, ...)``."""
 
-    def __init__(self, baseline: str | None, relative: float | None) -> None:
-        self._baseline, self._relative = baseline, relative
+    def __init__(self, baseline: str | None, relative: float | None, test_folder: Path | None = None) -> None:
+        self._baseline, self._relative, self._folder = baseline, relative, test_folder
+
+    def _path(self, name: str | Path) -> str | Path:
+        """A relative file path as found beside the test file, else as given (the current folder, a built-in)."""
+        beside = self._folder / name if self._folder is not None and not Path(name).is_absolute() else None
+        return beside if beside is not None and beside.is_file() else name
 
     def check(self, scene, engines=("core",), tolerances: str | Path | None = None, profile: str = "full",
-              repeats: int = 0, isolate: bool = True):
+              repeats: int = 0, isolate: bool = True, allow_unbounded: bool = False):
         """Run ``scene`` on ``engines``, fail the calling test on any violation; returns the results table.
+
+        As ``simparity check``, the test also fails when more than a small share of the scene's series have no
+        bound on any value (only on their status), unless ``allow_unbounded``.
 
         The scene runs through the same session as ``simparity run`` (:mod:`comparisons.execute.session`): with
         ``isolate`` (default) its cases run in worker processes, so an engine that crashes or hangs fails the test
         with its rows, never the pytest session; ``isolate=False`` runs them in the test's process."""
+        from simparity.core.model.errors import SimparityError, one_line
+
+        try:
+            return self._check(scene, engines, tolerances, profile, repeats, isolate, allow_unbounded)
+        except SimparityError as err:
+            pytest.fail(f"simparity: {one_line(err, 1000)}", pytrace=False)
+
+    def _check(self, scene, engines, tolerances, profile: str, repeats: int, isolate: bool, allow_unbounded: bool):
         from simparity.comparisons.api import load_scene
         from simparity.comparisons.engines.registry import EngineSet, check_engine_names
         from simparity.comparisons.execute.session import (IN_PROCESS, ISOLATED, Execution, Session,
                                                              engine_specs)
         from simparity.comparisons.gate.check import BASELINE_RELATIVE, compare_with_baseline
         from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, load_tolerances
+        from simparity.comparisons.gate.violation import grouped
+        from simparity.core.model.errors import SimparityError
         from simparity.reports.store import read_run
 
-        loaded = load_scene(scene) if isinstance(scene, (str, Path)) else scene
-        bounds = load_tolerances(tolerances or DEFAULT_TOLERANCES)
+        loaded = load_scene(self._path(scene)) if isinstance(scene, (str, Path)) else scene
+        bounds = load_tolerances(self._path(tolerances) if tolerances else DEFAULT_TOLERANCES)
         session = Session([loaded], EngineSet(check_engine_names(engine_specs(engines))), profile=profile,
                           repeats=repeats, execution=Execution(ISOLATED if isolate else IN_PROCESS), bounds=bounds)
         result = session.run()
         table = result.table
-        problems = [v.line() for v in result.check.violations] if result.check is not None else []
+        problems = [g.line() for g in grouped(result.check.violations)] if result.check is not None else []
+        unbounded = "" if allow_unbounded or result.check is None else result.check.too_unbounded()
+        problems += [f"unbounded: {unbounded} (here: allow_unbounded=True)"] if unbounded else []
         if self._baseline:
-            before, _ = read_run(self._baseline)
+            before, info = read_run(self._baseline)
+            if info.profile and info.profile != profile:
+                raise SimparityError(f"--simparity-baseline {self._baseline}: a {info.profile}-profile run, the test "
+                                     f"runs {profile} (allowed: a baseline run of the {profile} profile)")
             diff = compare_with_baseline(table, before[before["scene"] == loaded.name],
                                          self._relative or BASELINE_RELATIVE)
             problems += [f"moved since {self._baseline}: {m}" for m in diff.moved]
@@ -72,4 +98,4 @@ class SimparityChecker:
 def simparity(request) -> SimparityChecker:
     """Runs scenes and holds them to tolerances: ``simparity.check(scene, engines=..., tolerances=...)``."""
     return SimparityChecker(request.config.getoption("--simparity-baseline"),
-                            request.config.getoption("--simparity-baseline-rel"))
+                            request.config.getoption("--simparity-baseline-rel"), Path(str(request.path)).parent)

@@ -28,9 +28,14 @@ the order rows, which have none); without ``dt`` it holds for every row.
 (``core.engine.SCHEME_KINDS``; ``soft+*`` any time integrator under MuJoCo's soft contact; a list of
 patterns matches any of them): a bound keyed by scheme holds every engine's scheme of that kind, a
 user's plugin included, whatever it calls it.
-The most specific bound wins: a key written out exactly counts 2, a pattern other than ``*``
-counts 1, ``*`` counts 0, summed over scene, engine, integrator, scheme, metric and dt; among equally
-specific bounds the later one in the file wins, so a file can be extended by appending.
+A user's file extends the shipped one (``extends = "default"``, the default), starts empty (``extends =
+"none"``) or extends another file (``extends = "path.toml"``, relative to the file). Which bound decides a
+row: first the file — a bound of the extending file beats every bound of the file it extends, however
+specific (where a user's bound and a shipped one both match a row, the user's wins) — then, within one file,
+the most specific: a key written out exactly counts 2, a pattern other than ``*`` counts 1, ``*`` counts 0,
+summed over scene, engine, integrator, scheme, metric and dt; among equally specific bounds the later one in
+the file wins. ``simparity check --explain ENGINE --metric M`` lists, for each row, every bound that matched
+and which one decided.
 """
 
 from __future__ import annotations
@@ -38,10 +43,10 @@ from __future__ import annotations
 import fnmatch
 import math
 from typing import Any
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
-from simparity.core.model.errors import SceneError, ToleranceError
+from simparity.core.model.errors import SceneError, ToleranceError, one_line
 from simparity.core.model.files import read_toml
 from simparity.core.model.results import FLAGS, OK, STATUSES
 
@@ -52,6 +57,10 @@ DEFAULT_TOLERANCES = Path(__file__).resolve().parents[1] / "tolerances" / "defau
 MATCH_KEYS = ("scene", "engine", "integrator", "metric")
 NUMBER_KEYS = ("max", "min", "expected", "band", "rel", "dt_power")
 ALLOWED_KEYS = MATCH_KEYS + ("scheme", "dt") + NUMBER_KEYS + ("status", "na_when", "reason")
+EXTENDS_DEFAULT, EXTENDS_NONE = "default", "none"
+"""``extends`` values: the shipped tolerances (the default of every file but the shipped one), or nothing."""
+MAX_EXTENDS_DEPTH = 16
+"""Files at most in one chain of ``extends``: deeper is a loop or a mistake, refused in one line."""
 DT_MATCH = 1e-9
 """Relative difference under which a bound's ``dt`` [s] names a row's time step."""
 
@@ -82,6 +91,9 @@ class Bound:
         ``file: bound[i]``, for messages.
     order : int
         Position in the file (later wins among equally specific bounds).
+    layer : int
+        The file's place in its ``extends`` chain: 0 for the first file extended (the shipped one), one more
+        for each file that extends it; a higher layer wins whatever the specificity.
     """
 
     scene: str
@@ -101,6 +113,7 @@ class Bound:
     where: str
     order: int
     na_when: tuple[str, ...] = ()
+    layer: int = 0
 
     @property
     def specificity(self) -> int:
@@ -123,6 +136,22 @@ class Bound:
     @property
     def bounds_a_number(self) -> bool:
         return self.max is not None or self.min is not None or self.expected is not None
+
+    @property
+    def bounds_the_value(self) -> bool:
+        """Whether a row this bound decides is held to more than "it ran": a number's limits, or a verdict other
+        than a number (``status = "diverged"``). A status-only bound that allows ``ok`` (the shipped catch-all)
+        checks no value."""
+        return self.bounds_a_number or OK not in self.statuses
+
+    @property
+    def precedence(self) -> tuple[int, int, int]:
+        """The key by which the matching bound with the highest wins: file layer, specificity, order in the file."""
+        return self.layer, self.specificity, self.order
+
+    def status_text(self) -> str:
+        """The statuses in words, e.g. ``status ok or n/a``."""
+        return "status " + " or ".join(self.statuses)
 
     def limits(self, dt: float) -> tuple[float, float]:
         """(lowest, highest) value allowed at time step ``dt`` [s] (NaN dt: no scaling)."""
@@ -215,23 +244,95 @@ def _bound(source: str, index: int, table) -> Bound:
 
 
 def load_tolerances(path: str | Path = DEFAULT_TOLERANCES) -> list[Bound]:
-    """The bounds of a tolerances file; raises :class:`ToleranceError` naming the file and key."""
+    """The bounds of a tolerances file and of the files it extends (module docstring), each with its layer;
+    raises :class:`ToleranceError` naming the file and key."""
+    return _load(Path(path), ())
+
+
+def _load(path: Path, chain: tuple[Path, ...]) -> list[Bound]:
     source = str(path)
     try:
         data = read_toml(source, what="tolerances file")
     except SceneError as err:  # the file itself: missing, not a regular file, too large, not TOML
         raise ToleranceError(err.source, err.key, err.problem, err.allowed) from None
-    unknown = sorted(set(data) - {"bound"})
+    unknown = sorted(set(data) - {"bound", "extends"})
     if unknown:
-        raise ToleranceError(source, unknown[0][:80], "unknown table", "[[bound]]")
+        kind = "table" if isinstance(data[unknown[0]], (dict, list)) else "key"
+        raise ToleranceError(source, unknown[0][:80], f"unknown {kind}", "[[bound]] tables and extends = ...")
+    base = _extended(path, data.get("extends", _default_extends(path)), chain + (_resolved(path),))
     tables = data.get("bound", [])
     if not isinstance(tables, list) or not tables:
         raise ToleranceError(source, "bound", "no bounds", "one or more [[bound]] tables")
-    return [_bound(source, i, table) for i, table in enumerate(tables)]
+    layer = max((b.layer for b in base), default=-1) + 1
+    return base + [replace(_bound(source, i, table), layer=layer) for i, table in enumerate(tables)]
+
+
+def _resolved(path: Path) -> Path:
+    try:
+        return path.resolve()
+    except (OSError, RuntimeError):  # a symlink loop: read_toml names the problem
+        return path.absolute()
+
+
+def _default_extends(path: Path) -> str:
+    """What a file without ``extends`` extends: nothing for the shipped file, the shipped file for any other."""
+    return EXTENDS_NONE if _resolved(path) == _resolved(DEFAULT_TOLERANCES) else EXTENDS_DEFAULT
+
+
+def _extended(path: Path, extends, chain: tuple[Path, ...]) -> list[Bound]:
+    """The bounds of the file ``extends`` names (relative to ``path``'s folder), [] for ``none``."""
+    allowed = f'"{EXTENDS_DEFAULT}" (the shipped tolerances), "{EXTENDS_NONE}" or a tolerances file\'s path'
+    if not isinstance(extends, str) or not extends.strip():
+        raise ToleranceError(str(path), "extends", f"expected text, got {extends!r:.60}", allowed)
+    if extends == EXTENDS_NONE:
+        return []
+    target = DEFAULT_TOLERANCES if extends == EXTENDS_DEFAULT else path.parent / extends
+    if _resolved(target) in chain:
+        raise ToleranceError(str(path), "extends", f"{extends!r:.80} extends itself (a loop of extends)", allowed)
+    if not target.is_file():
+        raise ToleranceError(str(path), "extends", f"{extends!r:.80}: no such file ({one_line(target)})", allowed)
+    if len(chain) >= MAX_EXTENDS_DEPTH:
+        raise ToleranceError(str(path), "extends", f"more than {MAX_EXTENDS_DEPTH} files in a chain of extends",
+                             allowed)
+    return _load(target, chain)
+
+
+class BoundIndex:
+    """Bounds looked up by row without scanning them all: a bound whose scene, engine, integrator and metric are all
+    written out (a blessed file's thousands) is found by that key, only the others are matched one by one."""
+
+    def __init__(self, bounds: list[Bound]) -> None:
+        self.exact: dict[tuple[str, str, str, str], list[Bound]] = {}
+        self.patterned: list[Bound] = []
+        for bound in bounds:
+            key = (bound.scene, bound.engine, bound.integrator, bound.metric)
+            if all(_weight(p) == 2 for p in key):
+                self.exact.setdefault(key, []).append(bound)
+            else:
+                self.patterned.append(bound)
+
+    def matching(self, scene: str, engine: str, integrator: str, metric: str, dt: float = math.nan,
+                 scheme: str = "") -> list[Bound]:
+        """Every bound that matches a row, the deciding one first (highest :attr:`Bound.precedence`)."""
+        candidates = self.exact.get((scene, engine, integrator, metric), []) + self.patterned
+        matching = [b for b in candidates if b.matches(scene, engine, integrator, metric, dt, scheme)]
+        return sorted(matching, key=lambda b: b.precedence, reverse=True)
+
+    def decider(self, scene: str, engine: str, integrator: str, metric: str, dt: float = math.nan,
+                scheme: str = "") -> Bound | None:
+        """The bound that decides a row, or None."""
+        candidates = self.exact.get((scene, engine, integrator, metric), []) + self.patterned
+        matching = [b for b in candidates if b.matches(scene, engine, integrator, metric, dt, scheme)]
+        return max(matching, key=lambda b: b.precedence) if matching else None
+
+
+def matching_bounds(bounds: list[Bound], scene: str, engine: str, integrator: str, metric: str,
+                    dt: float = math.nan, scheme: str = "") -> list[Bound]:
+    """Every bound that matches a row, the deciding one first (highest :attr:`Bound.precedence`)."""
+    return BoundIndex(bounds).matching(scene, engine, integrator, metric, dt, scheme)
 
 
 def bound_for(bounds: list[Bound], scene: str, engine: str, integrator: str, metric: str,
               dt: float = math.nan, scheme: str = "") -> Bound | None:
-    """The most specific bound that matches (the later one on a tie), or None."""
-    matching = [b for b in bounds if b.matches(scene, engine, integrator, metric, dt, scheme)]
-    return max(matching, key=lambda b: (b.specificity, b.order)) if matching else None
+    """The bound that decides a row (highest :attr:`Bound.precedence` among those that match), or None."""
+    return BoundIndex(bounds).decider(scene, engine, integrator, metric, dt, scheme)

@@ -3,6 +3,8 @@
 
 from __future__ import annotations
 
+import difflib
+import os
 from pathlib import Path
 
 from simparity.comparisons.engines.registry import EngineSet
@@ -21,19 +23,49 @@ def builtin_paths() -> dict[str, Path]:
     return {p.stem: p for p in sorted(SCENES_DIR.glob("*.toml"))}
 
 
+PATH_SUFFIXES = (".toml", ".urdf", ".xml")
+"""Endings that make an argument a file's path, never a scene name (as does a path separator)."""
+CLOSEST_NAMES = 3
+"""Built-in names an unknown bare word is answered with, the closest first (not all ~40)."""
+_ALLOWED = "a built-in scene name as 'simparity list' prints it, or the path of an existing scene file"
+
+
+def looks_like_path(name_or_path: str) -> bool:
+    """True when ``name_or_path`` is meant as a file: it holds a path separator or ends in .toml, .urdf or .xml."""
+    has_separator = any(sep and sep in name_or_path for sep in ("/", os.sep, os.altsep))
+    return has_separator or name_or_path.lower().endswith(PATH_SUFFIXES)
+
+
+def _unknown(name_or_path: str, problem: str, names: list[str]) -> UnknownSceneError:
+    """The one-line error for an argument that names no scene: a path that is missing or unusable says so
+    (as resolved), a bare word gets the closest built-in names."""
+    shown = one_line(name_or_path)
+    if not problem.startswith("no such"):
+        return UnknownSceneError(f"{shown}: {problem} (allowed: {_ALLOWED})")
+    if looks_like_path(name_or_path):
+        resolved = one_line(os.path.abspath(name_or_path))
+        return UnknownSceneError(f"{shown}: the file {resolved} does not exist (allowed: {_ALLOWED})")
+    closest = difflib.get_close_matches(name_or_path, names, n=CLOSEST_NAMES)
+    hint = f"; closest: {', '.join(closest)}" if closest else ""
+    return UnknownSceneError(f"'{shown}' is not a built-in scene or an existing file{hint} (allowed: {_ALLOWED})")
+
+
 def resolve(name_or_path: str) -> Path:
-    """The file of a built-in scene name, or an existing scene file path."""
+    """The file of a built-in scene name, or an existing scene file path.
+
+    Raises
+    ------
+    UnknownSceneError
+        One line: for a path (:func:`looks_like_path`), that the file does not exist (or why it cannot be
+        read); for a bare word, the closest built-in names.
+    """
     builtin = builtin_paths()
     if name_or_path in builtin:
         return builtin[name_or_path]
     problem = file_problem(name_or_path, "scene file")
     if problem is None:
         return Path(name_or_path)
-    where = "" if problem.startswith("no such") else f" ({problem})"
-    raise UnknownSceneError(
-        f"'{one_line(name_or_path)}' is neither a built-in scene nor a scene file{where} "
-        f"(allowed: {', '.join(builtin)}, or the path of a regular TOML file; see 'simparity list')"
-    )
+    raise _unknown(name_or_path, problem, list(builtin))
 
 
 def _declared_suites(path: Path) -> list:
@@ -72,7 +104,7 @@ def load(names_or_paths, limits: Limits = DEFAULT_LIMITS, engines: EngineSet | N
         try:
             scenes += load_scenes(resolve(name), limits, engines)
         except UnknownSceneError:
-            variant = _builtin_variant(str(name), limits, engines)
+            variant = None if looks_like_path(str(name)) else _builtin_variant(str(name), limits, engines)
             if variant is None:
                 raise
             scenes.append(variant)

@@ -1,5 +1,6 @@
 """Reading input files safely: regular files only, of bounded size, every OS error a SceneError;
-TOML files (scenes, tolerances) decoded with the line and column of a mistake.
+TOML files (scenes, tolerances) decoded with the line and column of a mistake; XML (URDF) parsed
+without a document type declaration and nested at most :data:`MAX_XML_DEPTH` deep.
 
 A folder, a FIFO or a device (``/dev/zero``) is never opened: opening a FIFO blocks forever and a
 device can be endless. Paths the OS rejects (a component longer than it allows, a NUL byte) are
@@ -12,6 +13,7 @@ import os
 import re
 import stat
 import sys
+import xml.etree.ElementTree as ET
 
 from simparity.core.model.errors import SceneError
 
@@ -102,3 +104,54 @@ def read_toml(path: str | os.PathLike, max_bytes: int = MAX_FILE_BYTES, what: st
         raise SceneError(source, key, f"not valid TOML: {problem}", "TOML (https://toml.io)") from None
     except RecursionError:
         raise SceneError(source, "-", "arrays or tables nested too deeply", MAX_NESTING_HINT) from None
+
+
+MAX_XML_DEPTH = 100
+"""Deepest nesting of elements an XML (URDF) file may have [levels, the root element is level 1]: real URDF
+files nest fewer than 10 deep (robot/link/visual/geometry/mesh is 5); writing or indenting a tree recurses
+once per level, so a file 1,000 deep would exhaust Python's stack in the exporter."""
+_XML_NESTING_ALLOWED = f"elements nested at most {MAX_XML_DEPTH} levels deep (URDF files nest fewer than 10)"
+_NO_DOCTYPE = "a document without <!DOCTYPE ...>: URDF has no DTD, and its entities are never expanded or fetched"
+
+
+class _GuardedTree(ET.TreeBuilder):
+    """ElementTree's tree builder that refuses a document type declaration (so no entity, internal, parameter or
+    external, is ever declared, expanded or fetched) and elements nested deeper than :data:`MAX_XML_DEPTH`."""
+
+    def __init__(self, source: str) -> None:
+        super().__init__()
+        self.source = source
+        self.depth = 0
+
+    def start(self, tag: str, attrs: dict[str, str]) -> ET.Element:
+        self.depth += 1
+        if self.depth > MAX_XML_DEPTH:
+            raise SceneError(self.source, f"<{tag}> at depth {self.depth}",
+                             f"elements nested more than {MAX_XML_DEPTH} levels deep", _XML_NESTING_ALLOWED)
+        return super().start(tag, attrs)
+
+    def end(self, tag: str) -> ET.Element:
+        self.depth -= 1
+        return super().end(tag)
+
+    def doctype(self, name: str, pubid: str | None, system: str | None) -> None:
+        """Called by the parser at ``<!DOCTYPE``, before any of its declarations is read."""
+        raise SceneError(self.source, f"<!DOCTYPE {name}>", "a document type declaration (DTD)", _NO_DOCTYPE)
+
+
+def parse_xml(data: str | bytes, source: str, root: str) -> ET.Element:
+    """The root element of the XML ``data`` (bytes: its XML declaration's encoding is honoured), which must be
+    ``<root>``; SceneError (naming ``source``) for malformed XML, an unknown encoding, a ``<!DOCTYPE>`` (DTDs
+    and entities refused outright), elements nested deeper than :data:`MAX_XML_DEPTH`, or another root."""
+    allowed = f"a well-formed <{root}> document"
+    parser = ET.XMLParser(target=_GuardedTree(source))
+    try:
+        parser.feed(data)
+        element = parser.close()
+    except ET.ParseError as err:
+        raise SceneError(source, root, f"not well-formed XML ({err})", allowed) from None
+    except (LookupError, ValueError) as err:  # an encoding Python does not know
+        raise SceneError(source, root, f"unreadable encoding ({err})", "UTF-8, Latin-1, UTF-16, ...") from None
+    if element.tag != root:
+        raise SceneError(source, element.tag, f"the root element is not <{root}>", f"<{root}>")
+    return element

@@ -107,6 +107,8 @@ STOPPING_DISTANCE = "stopping_distance"
 STOPPING_DISTANCE_ERROR = "stopping_distance_error"
 # IK: a solver's outcome on its targets, judged by the harness.
 SOLVE_RATE = "solve_rate"
+SOLVE_RATE_OWN_STOP = "solve_rate_own_stop"
+OWN_STOP_POSITION_TOLERANCE = "own_stop_position_tolerance"
 CROSS_EVAL_SOLVE_RATE_MIN = "cross_eval_solve_rate_min"
 CROSS_EVAL_DISAGREEMENT_MAX = "cross_eval_disagreement_max"
 POSITION_RESIDUAL_MEDIAN = "position_residual_median"
@@ -166,6 +168,10 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(STOPPING_DISTANCE, "m", CONTACT),
     Metric(STOPPING_DISTANCE_ERROR, "m", CONTACT),
     Metric(SOLVE_RATE, DIMENSIONLESS, IK, headline=True),
+    Metric(SOLVE_RATE_OWN_STOP, DIMENSIONLESS, IK,
+           theory="solve_rate where the solver stops at the scene's tolerances"),
+    Metric(OWN_STOP_POSITION_TOLERANCE, "m", IK,
+           theory="the scene's position tolerance unless the solver declares its own"),
     Metric(CROSS_EVAL_SOLVE_RATE_MIN, DIMENSIONLESS, IK),
     Metric(CROSS_EVAL_DISAGREEMENT_MAX, "m", IK),
     Metric(POSITION_RESIDUAL_MEDIAN, "m", IK),

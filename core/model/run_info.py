@@ -11,7 +11,7 @@ from pathlib import Path
 from simparity.core.model.errors import ResultsError, one_line
 from simparity.core.model.results import READ_SCHEMA_VERSIONS, SCHEMA_VERSION
 
-_MAPPINGS = ("machine", "engine_versions", "theoretical_orders", "integrator_variants", "scenes")
+_MAPPINGS = ("machine", "engine_versions", "theoretical_orders", "integrator_variants", "scenes", "peak_memory")
 
 
 @dataclass(frozen=True)
@@ -21,7 +21,10 @@ class RunInfo:
     ``machine``: platform, CPUs, Python; ``engine_versions``: {engine: version}; ``theoretical_orders``:
     {engine: {integrator: order}} of the engines that declare any; ``integrator_variants``: {engine: {integrator:
     [scheme, variant]}} of those with variants; ``scenes``: {scene: what a report needs of it (kind, reference,
-    suites, source, bodies, contact, sweep)}."""
+    suites, source, bodies, contact, sweep)}; ``profile``: the run profile (``full`` or ``quick``; "" for a run an
+    older simparity wrote, which did not record it); ``peak_memory``: {``this_process_bytes``,
+    ``largest_child_bytes``} [bytes], the peak resident memory of the run's process and of its largest child process
+    (a case worker, or a child a worker forked), written when the run ends ({} for a run that did not record it)."""
 
     schema_version: int = SCHEMA_VERSION
     created_utc: str = ""
@@ -32,6 +35,8 @@ class RunInfo:
     theoretical_orders: dict = field(default_factory=dict)
     integrator_variants: dict = field(default_factory=dict)
     scenes: dict = field(default_factory=dict)
+    profile: str = ""
+    peak_memory: dict = field(default_factory=dict)
 
     def scene(self, name: str) -> dict:
         """What the run recorded of scene ``name`` ({} for a scene it did not run)."""
@@ -62,7 +67,7 @@ class RunInfo:
         for key in _MAPPINGS:
             if not isinstance(values.get(key, {}), dict):
                 raise ResultsError(f"{path}: {key} is not a table (allowed: the run.json 'simparity run' wrote)")
-        for key in ("created_utc", "command", "git_commit"):
+        for key in ("created_utc", "command", "git_commit", "profile"):
             if not isinstance(values.get(key, ""), str):
                 raise ResultsError(f"{path}: {key} is not text (allowed: the run.json 'simparity run' wrote)")
         return cls(**values)

@@ -28,6 +28,7 @@ import xml.etree.ElementTree as ET
 from typing import TYPE_CHECKING, cast
 
 from simparity.core.model.engine import Support
+from simparity.core.model.files import parse_xml
 from simparity.core.model.scene import Chain, RigidBody
 from simparity.references.common.conventions import (
     PLACEHOLDER_INERTIA,
@@ -126,9 +127,16 @@ def exported_chain_urdf(chain: Chain) -> str:
     return _text(root)
 
 
+def _parsed(urdf_path: str) -> ET.Element:
+    """The ``<robot>`` element of a URDF file, parsed as the loader parsed it (no DOCTYPE, bounded nesting:
+    :func:`core.model.files.parse_xml`), so a file changed since it was loaded is refused, never recursed into."""
+    with open(urdf_path, "rb") as handle:
+        return parse_xml(handle.read(), urdf_path, "robot")
+
+
 def original_without_geometry(urdf_path: str) -> str:
     """The URDF file's text with every link's visual and collision elements removed."""
-    root = ET.parse(urdf_path).getroot()
+    root = _parsed(urdf_path)
     for link in root.findall("link"):
         for tag in GEOMETRY:
             for element in link.findall(tag):
@@ -142,7 +150,7 @@ def movable_joints_above_base(chain: Chain) -> list[str]:
         return []
     # The file is one load_urdf read: every joint has a name and <parent link=...>, <child link=...>.
     parent_joint = {cast(ET.Element, j.find("child")).get("link"): j
-                    for j in ET.parse(chain.urdf_path).getroot().findall("joint")}
+                    for j in _parsed(chain.urdf_path).findall("joint")}
     names: list[str] = []
     link = chain.base_link
     while link in parent_joint:

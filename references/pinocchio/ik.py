@@ -30,6 +30,11 @@ Conventions and what the adapter does (pinned in ``tests/test_pinocchio_ik.py``)
   |p_des - p| [m] and the angle of R^T R_des [rad] (the norm of log6's angular part).
   The 6-vector |err| mixes metres and radians, and its linear part is not p_des - p; it
   is only the documented stopping rule.
+- ``clik-documented`` declares that rule (:class:`StoppingRule`, the ``solve_rate_own_stop``
+  row) in the residuals the harness measures: position <= :data:`DOCUMENTED_EPS` m and angle
+  <= :data:`DOCUMENTED_EPS` rad, both of which |err| < eps implies (its angular part is the
+  angle; its linear part equals p_des - p up to second order in the angle); ``clik`` stops at
+  the scene's tolerances.
 """
 
 from __future__ import annotations
@@ -37,7 +42,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from simparity.core.model.engine import IKModel
+from simparity.core.model.engine import IKModel, StoppingRule
 from simparity.core.model.ik_problem import IKTolerances, check_inputs
 from simparity.core.model.ik_result import IKResult
 from simparity.core.model.scene import Chain
@@ -86,6 +91,9 @@ class PinocchioIK(IKModel):
         stop = (f"|log6 err| < {DOCUMENTED_EPS:g}, IT_MAX {DOCUMENTED_IT_MAX}" if self._documented else
                 f"position <= {options.position_tolerance:g} m and angle <= {options.orientation_tolerance:g} rad, "
                 f"IT_MAX {options.max_iterations}")
+        if self._documented:
+            self.stopping_rule = StoppingRule(
+                DOCUMENTED_EPS, DOCUMENTED_EPS, f"|log6 err| < {DOCUMENTED_EPS:g} (the documentation's eps)")
         self.detail = (f"Pinocchio documented CLIK (log6 / Jlog6, LOCAL frame Jacobian), DT {DT:g}, damp {DAMP:g}; "
                        f"stops at {stop}; no joint limits; residuals from Pinocchio FK (double)")
 

@@ -9,7 +9,14 @@ to a null-space variant that IGNORES jointDamping: it damps J J^T with a fixed
 lambda^2 = 0.36 and adds (I - J^T (J J^T + lambda^2 I)^-1 J) times a push toward the
 rest pose and back inside the limits. That projector is damped, so the push leaks into
 the task and the iteration settles millimetres from the target (measured on the iiwa),
-and the limits stay soft: the result can still lie outside them.
+and the limits stay soft: the result can still lie outside them. The lists have the right
+length (one entry per movable joint of the body, ``n_dof``; a list of any other length, the
+body's joint count included, makes PyBullet fall back to the plain solver without a word,
+bullet3 #3199, #1714): with them the result differs from the plain solver's, with a wrong
+length it is the same bit for bit; the millimetres stay with limits pushed to +-1e6, with the
+rest pose at the target's own configuration and with 2000 iterations (iiwa, UR5, Panda,
+measured), so they are Bullet's damped projector (``Jacobian::CalcDeltaThetasDLSwithNullspace``),
+reported upstream as bullet3 #2210 (:data:`NULLSPACE_LIMITATION`, in the rows' detail).
 
 Conventions and what the adapter does (pinned in ``tests/test_pybullet_ik.py``)
 -----------------------------------------------------------------------------
@@ -33,6 +40,9 @@ Conventions and what the adapter does (pinned in ``tests/test_pybullet_ik.py``)
 - PyBullet reports neither iterations (``iterations`` is -1) nor why it stopped (see
   :mod:`references.ik_outcome` for the failure reasons); it does not clamp to the limits,
   and neither does the adapter (``limit_violation`` says how far outside they are).
+- Its own stopping rule (:class:`StoppingRule`, the ``solve_rate_own_stop`` row): the position
+  residual within ``residualThreshold`` (:data:`DEFAULT_RESIDUAL_THRESHOLD` by default, the
+  scene's tolerance when tuned), the orientation never tested.
 """
 
 from __future__ import annotations
@@ -40,7 +50,7 @@ from __future__ import annotations
 import numpy as np
 from simparity.references.pybullet.quiet import pybullet
 
-from simparity.core.model.engine import IKModel
+from simparity.core.model.engine import IKModel, StoppingRule
 from simparity.core.model.ik_problem import IKTolerances, check_inputs
 from simparity.core.model.ik_result import IKResult
 from simparity.core.model.scene import Chain
@@ -58,6 +68,15 @@ SOLVERS = ("calculateInverseKinematics", "calculateInverseKinematics-tuned",
 # rank <= 6 for 7 joints. PyBullet's default (0.5 per joint, the project's notes)
 # stopped a 3-joint chain at 9.6e-3 m after 20 iterations where 1e-3 converged.
 TUNED_JOINT_DAMPING = 1e-3
+
+DEFAULT_RESIDUAL_THRESHOLD = 1e-4
+"""[m] PyBullet's default ``residualThreshold``: it stops once the position error is below it."""
+
+NULLSPACE_LIMITATION = (
+    "upstream: Bullet's null-space IK damps its projector (J J^T + 0.36 I, jointDamping ignored), so the rest-pose "
+    "and limit push leaks into the task and the solve settles ~mm from the target whatever the iterations "
+    "(https://github.com/bulletphysics/bullet3/issues/2210)")
+"""The known limitation of the ``-nullspace`` solver, in its ``solve_rate_own_stop`` row's detail."""
 
 # Joint limits handed to the null-space solver for an unlimited joint [rad or m]: far
 # outside any reachable value, so its limit push never acts (jointRanges divides it).
@@ -97,7 +116,9 @@ class PybulletIK(IKModel):
         self._kinematics = kinematics
         self._settings = {}
         configured = "PyBullet defaults (maxNumIterations 20, residualThreshold 1e-4 m, jointDamping)"
+        threshold = DEFAULT_RESIDUAL_THRESHOLD
         if solver != "calculateInverseKinematics":
+            threshold = options.position_tolerance
             self._settings = dict(maxNumIterations=options.max_iterations,
                                   residualThreshold=options.position_tolerance,
                                   jointDamping=[TUNED_JOINT_DAMPING] * kinematics.n_dof)
@@ -110,6 +131,9 @@ class PybulletIK(IKModel):
                                   upperLimits=self._per_dof(upper, _UNLIMITED),
                                   jointRanges=self._per_dof(upper - lower, 2 * _UNLIMITED))
             configured += "; joint limits and restPoses = q_start (null-space variant, soft limits)"
+        self.stopping_rule = StoppingRule(
+            threshold, description=f"residualThreshold {threshold:g} m (PyBullet never tests the orientation)",
+            note=NULLSPACE_LIMITATION if solver.endswith("-nullspace") else "")
         self.detail = (f"pybullet.calculateInverseKinematics (IK_DLS), {configured}; "
                        "residuals from getLinkState (float32); iterations not reported")
 
