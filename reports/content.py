@@ -6,8 +6,8 @@ lists scenes (:mod:`reports.sweep_sections`). Reads a stored run only; figures a
 from __future__ import annotations
 
 import concurrent.futures
-
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -49,11 +49,18 @@ FIGURES_DIR = "figures"
 @dataclass(frozen=True)
 class ToleranceVerdict:
     """The run held to tolerances, as the report's flagged findings show it: how many metrics had a bound,
-    how many had none, and one line per metric outside its bound."""
+    how many had none, and the lines saying which metrics were outside their bounds."""
 
     checked: int
     unchecked: int
     violations: tuple[str, ...] = ()
+    outside: int | None = None
+    """Metrics outside their bounds (``violations`` may say them in fewer lines: one per case and reason); None:
+    one per line."""
+
+    @property
+    def outside_count(self) -> int:
+        return len(self.violations) if self.outside is None else self.outside
 
 
 _IK_COMPACT = (SOLVE_RATE, POSITION_RESIDUAL_MEDIAN, ITERATIONS_MEDIAN, TIME_PER_SOLVE, LIMIT_VIOLATIONS,
@@ -305,84 +312,95 @@ class _Builder:
         return f"{lead}in {row['variants']} of {count} variants" if count else ""
 
     def findings(self) -> list[Block]:
-        items = []
+        """Flagged findings as one table: a row per finding x scene x engine, its schemes, time steps, largest value
+        and what it means; then the tolerances' verdict, with every metric outside its bound folded below."""
+        rows: list[tuple[str, ...]] = []
         gains = self.merged(summary.energy_gains(self.series), ["engine", "integrator"],
                             gain_max=("gain_max", "max"), dts=("dts", union))
-        for scene, g in gains.groupby("scene", sort=False):
-            cases = ", ".join(f"{r['engine']} {r['integrator']} +{number(r['gain_max'])} (dt {_dts(r)}"
-                              f"{self.in_variants(r, '; ')})" for _, r in g.iterrows())
-            items.append(f"**energy gained** in {scene} (conserves energy; largest (E - E(0)) / the body's energy "
-                         "scale per scheme): " + cases)
+        rows += self.finding_rows("energy gained", gains, "gain_max",
+                                  "the scene conserves energy: (E - E(0)) / the body's energy scale rose")
         flags = self.merged(summary.contact_flags(self.table), ["metric", "engine", "integrator"],
                             value_max=("value_max", "max"), dts=("dts", union))
-        for (scene, metric), g in flags.groupby(["scene", "metric"], sort=False):
-            what = ("**energy gained at an impact**" if metric == ENERGY_GAIN_MAX else "**tunnelling**")
-            cases = ", ".join(f"{r['engine']} {r['integrator']} {number(r['value_max'])} (dt {_dts(r)}"
-                              f"{self.in_variants(r, '; ')})" for _, r in g.iterrows())
-            items.append(f"{what} in {scene} (`{metric}`): " + cases)
-        for _, s in self.merged(summary.saturated(self.table), ["metric"], n_cases=("n_cases", "sum")).iterrows():
-            items.append(f"**saturated**: {s['scene']} `{s['metric']}` in {s['n_cases']} cases{self.in_variants(s)} "
-                         "(n/a: the error lost all meaning there)")
-        items += self.order_findings()
+        for metric, g in flags.groupby("metric", sort=False):
+            what, meaning = (("energy gained at an impact", f"`{metric}`: an impact gave the body energy")
+                             if metric == ENERGY_GAIN_MAX else ("tunnelling", f"`{metric}`: a body went through a plane"))
+            rows += self.finding_rows(what, g, "value_max", meaning)
+        saturated = self.merged(summary.saturated(self.table), ["metric"], n_cases=("n_cases", "sum"))
+        for scene, g in saturated.groupby("scene", sort=False):
+            counted = ", ".join(f"`{r['metric']}` {r['n_cases']}{self.in_variants(r, ' ')}" for _, r in g.iterrows())
+            rows.append(("saturated", scene, counted, "", "", "n/a: the error reached its quantity's scale and lost all "
+                         "meaning (cases counted per metric)"))
+        rows += self.order_findings()
         blocks: list[Block] = [Heading(3, "Flagged findings")]
-        verdict = self.verdict
-        unbounded = f"; {verdict.unchecked} without a bound, so not held to anything" if verdict and verdict.unchecked else ""
-        if verdict is None:
-            items.append("**tolerances**: not checked in this report")
-        elif verdict.violations:
-            items.append(f"**outside the tolerances**: {len(verdict.violations)} of {verdict.checked} checked metrics "
-                         f"(an engine disagreeing with the truth or the others beyond its bound; listed below){unbounded}")
-        elif verdict.checked:
-            items.append(f"**tolerances**: all {verdict.checked} checked metrics inside their bounds{unbounded}")
-        else:
-            items.append(f"**tolerances**: nothing checked: no bound matches this run's metrics ({verdict.unchecked} "
-                         "without a bound)")
-        blocks.append(Bullets(tuple(items)))
-        if verdict and verdict.violations:
-            blocks.append(Details(f"{len(verdict.violations)} metrics outside their bounds",
-                                  (Bullets(tuple(f"`{v}`" for v in verdict.violations)),)))
+        if rows:
+            blocks.append(Table(("finding", "scene", "engine × scheme (or metric: cases)", "dt [s]", "largest",
+                                 "what it means"), tuple(rows)))
+        blocks.append(Paragraph(self.tolerance_line()))
+        if self.verdict and self.verdict.violations:
+            blocks.append(Details(f"{self.verdict.outside_count} metrics outside their bounds",
+                                  (Bullets(tuple(f"`{_clip(v, LINE_CHARS - 10)}`" for v in self.verdict.violations)),)))
         return blocks
 
-    def order_findings(self) -> list[str]:
-        """One line per scene x flag of order fits flagged as findings (:func:`reports.summary.order_findings`)."""
-        what = {"not-converging": "**orders that do not converge** (errors far from saturation and rounding that "
-                                  "do not fall with dt: an alarm)",
-                "below-theory": "**orders below theory** (clean fits more than 0.5 under the scheme's order)",
-                "superconvergent": "**superconvergent orders** (clean fits more than 0.5 above the scheme's order: "
-                                   "error terms cancel, or the steps are before the asymptotic range)",
-                "pre-asymptotic": "**orders not in the asymptotic range** (local slopes disagree: finer steps needed)"}
-        items = []
+    def finding_rows(self, finding: str, frame: pd.DataFrame, value: str, meaning: str) -> list[tuple[str, ...]]:
+        """One row per scene of ``frame`` (scene, engine, integrator, ``value``, dts): its engines' schemes named
+        compactly, the time steps' range and the largest value."""
+        out: list[tuple[str, ...]] = []
+        for scene, g in frame.groupby("scene", sort=False):
+            out.append((finding, scene, _per_engine(g, self.in_variants), _dt_range(union(g["dts"])),
+                        number(g[value].max()), meaning))
+        return out
+
+    def tolerance_line(self) -> str:
+        """The tolerances' verdict in one sentence."""
+        verdict = self.verdict
+        if verdict is None:
+            return "**Tolerances**: not checked in this report."
+        unbounded = f"; {verdict.unchecked} without a bound, so not held to anything" if verdict.unchecked else ""
+        if verdict.violations:
+            return (f"**Outside the tolerances**: {verdict.outside_count} of {verdict.checked} checked metrics: an "
+                    f"engine disagreeing with the truth or the others beyond its bound (listed below, one line per "
+                    f"case and reason){unbounded}.")
+        if verdict.checked:
+            return f"**Tolerances**: all {verdict.checked} checked metrics inside their bounds{unbounded}."
+        return f"**Tolerances**: nothing checked: no bound matches this run's metrics ({verdict.unchecked} without a bound)."
+
+    def order_findings(self) -> list[tuple[str, ...]]:
+        """One row per scene x flag x engine of order fits flagged as findings (:func:`reports.summary.order_findings`),
+        each scheme with its fitted orders."""
+        what = {"not-converging": ("orders that do not converge", "errors far from saturation and rounding that do "
+                                   "not fall with dt: an alarm"),
+                "below-theory": ("orders below theory", "clean fits more than 0.5 under the scheme's order"),
+                "superconvergent": ("superconvergent orders", "clean fits more than 0.5 above the scheme's order: "
+                                    "error terms cancel, or the steps are before the asymptotic range"),
+                "pre-asymptotic": ("orders not in the asymptotic range", "local slopes disagree: finer steps needed")}
+        rows: list[tuple[str, ...]] = []
         for (scene, flag), g in summary.order_findings(self.table).groupby(["scene", "flag"], sort=False):
-            cases = ", ".join(f"{r['engine']} {r['integrator']} "
-                              + "/".join(number(v) if v == v else "n/a" for v in r["values"]) for _, r in g.iterrows())
-            items.append(f"{what[flag]} in {scene}: {cases}")
-        return items
+            fitted = g.assign(integrator=[f"{r['integrator']} " + "/".join(number(v) if v == v else "n/a"
+                                                                            for v in r["values"]) for _, r in g.iterrows()])
+            rows.append((what[flag][0], scene, _per_engine(fitted, lambda r, lead: ""), "", "", what[flag][1]))
+        return rows
 
     def unresolved(self) -> list[Block]:
+        """Every case without a result, as one table: a row per status and kind of reason (:func:`_reason_kind`: the
+        same words, other numbers), with the scenes, engines and schemes it covers, the count and the time steps."""
         cases = summary.unresolved_cases(self.table)
         if cases.empty:
             return [Heading(3, "Cases without a result"), Paragraph("None: every case was measured.")]
         cases = self.merged(cases, ["status", "order_fit", "engine", "integrator", "reason"],
                             n_cases=("n_cases", "sum"), dts=("dts", union))
-
-        def label(c) -> str:
-            dts = f" (dt {', '.join(f'{dt:g}' for dt in c['dts'])})" if c["dts"] else ""
-            return f"{c['engine']} {c['integrator']}".strip() + dts + self.in_variants(c)
-
-        # Failed and diverged cases get a line per scene, each case with its reason; n/a cases (the engine
-        # cannot, or nothing to fit) share one line per kind, grouped by reason.
-        lines = []
-        for (status, scene), group in cases[cases["status"] != NOT_AVAILABLE].groupby(["status", "scene"], sort=False):
-            lines.append(f"**{status}** in {scene} ({group['n_cases'].sum()} cases): "
-                         + "; ".join(f"{label(c)}: {c['reason'] or 'no reason given'}" for _, c in group.iterrows()))
-        for order_fit, shared in cases[cases["status"] == NOT_AVAILABLE].groupby("order_fit", sort=False):
-            reasons = [f"{reason or 'no reason given'} ({g['n_cases'].sum()}) — "
-                       + "; ".join(f"{c['scene']} {label(c)}" for _, c in g.iterrows())
-                       for reason, g in shared.groupby("reason", sort=False)]
-            lines.append(f"**n/a** {'order fits' if order_fit else 'runs'} ({shared['n_cases'].sum()}): "
-                         + " · ".join(reasons))
+        cases = cases.assign(kind=cases["reason"].fillna("").map(_reason_kind))
+        rows = []
+        for (status, order_fit, _), g in cases.groupby(["status", "order_fit", "kind"], sort=False, dropna=False):
+            label = status if status != NOT_AVAILABLE else f"n/a ({'order fit' if order_fit else 'run'})"
+            rows.append((label, _names(list(dict.fromkeys(g["scene"]))), _per_engine(g, self.in_variants),
+                         str(g["n_cases"].sum()), _dt_range(union(g["dts"])),
+                         _clip(g["reason"].iloc[0] or "no reason given", REASON_CHARS)
+                         + (f" (and {g['reason'].nunique() - 1} more like it)" if g["reason"].nunique() > 1 else "")))
         return [Heading(3, "Cases without a result"),
-                Paragraph("Every failed, diverged or n/a case with its reason."), Bullets(tuple(lines))]
+                Paragraph("Every failed, diverged or n/a case, counted, with its reason (the full reason of each row "
+                          "is its `detail` in `results.csv`)."),
+                Table(("status", "scenes", "engine × scheme", "cases", "dt [s]", "reason (the first; others alike but for "
+                       "their numbers)"), tuple(rows))]
 
     # -- scenes --------------------------------------------------------------------------------
 
@@ -430,12 +448,21 @@ class _Builder:
         cases = summary.dynamics_cases(rows, headline)
         observed = summary.orders(rows, headline)
         theory = self.info.theoretical_orders
-        blocks = self.figure(figures.work_precision_figure(scene, cases, headline, reference), f"{scene}-work-precision",
-                             f"Work-precision: {name} [{unit}] against compute per simulated second, one point per dt.")
+        blocks = self.figure(figures.work_precision_figure(scene, cases, headline, reference,
+                                                           self.info.integrator_variants),
+                             f"{scene}-work-precision",
+                             f"Work-precision: x = {name} [{unit}] (log), y = compute per simulated second [s/s] (log); "
+                             "one point per dt, lower left is better. A scheme's variants share its colour, one marker "
+                             "each; dotted: the summary's error budgets.")
         if not about.get("contact"):  # with contact the error has no order (impacts), so no convergence figure
-            blocks += self.figure(figures.convergence_figure(scene, cases, headline, reference, observed, theory),
-                                  f"{scene}-convergence", f"Convergence: {name} [{unit}] against dt, observed and "
-                                  "theoretical order.")
+            order_rows = rows[rows["dt"].isna() & (rows["metric"] == summary.ORDER_METRICS[headline])
+                              & (rows["status"] != OK)]
+            unfitted = {(r["engine"], r["integrator"]): r["detail"] for _, r in order_rows.iterrows()}
+            blocks += self.figure(figures.convergence_figure(scene, cases, headline, reference, observed, theory,
+                                                             unfitted),
+                                  f"{scene}-convergence", f"Convergence: x = time step dt [s] (log), y = {name} "
+                                  f"[{unit}] (log); observed order (theory) in the legend, grey dashed: a line of each "
+                                  "theoretical order's slope; schemes whose errors agree to 0.1 % share one line.")
         blocks += self.figure(figures.drift_figure(scene, series, reference), f"{scene}-drift",
                               "Drift over time at the coarsest dt, from the stored series.")
         if about.get("contact"):
@@ -555,9 +582,49 @@ def _sweep_row(sweep: Sweep) -> tuple[str, ...]:
             + tuple(_scheme(summary.most_accurate_within(cases, b), unit) for b in summary.TIME_BUDGETS))
 
 
-def _dts(row: pd.Series) -> str:
-    """The time steps of a flagged row, as the findings list them."""
-    return ", ".join(f"{d:g}" for d in row["dts"])
+NAMES_SHOWN = 4
+"""Schemes or scenes a findings cell names before it counts the rest: a row stays one line."""
+
+REASON_CHARS = 160
+"""Characters of a reason in a findings table; the whole reason is the rows' ``detail`` in results.csv."""
+
+LINE_CHARS = 300
+"""Characters a line of report.md stays under (issue #26): what is longer is said compactly or folded."""
+
+
+def _names(names: list[str]) -> str:
+    """``a, b, c, d (+3 more)``: at most :data:`NAMES_SHOWN` names, then the count of the rest."""
+    shown = ", ".join(names[:NAMES_SHOWN])
+    return shown + (f" (+{len(names) - NAMES_SHOWN} more)" if len(names) > NAMES_SHOWN else "")
+
+
+def _per_engine(frame: pd.DataFrame, variants) -> str:
+    """``core: rk4, midpoint (+3 more); mujoco: euler``: each engine's schemes (``integrator``) of ``frame``,
+    ``variants(row, lead)`` adding how many of a sweep's variants a row stands for."""
+    return "; ".join(f"{engine}: " + _names(list(dict.fromkeys(f"{r['integrator']}{variants(r, ' ')}"
+                                                                for _, r in g.iterrows())))
+                     for engine, g in frame.groupby("engine", sort=False))
+
+
+_NUMBER = re.compile(r"[-+]?\d[\d.]*(?:e[-+]?\d+)?")
+
+
+def _reason_kind(reason: str) -> str:
+    """What a reason says, whatever its numbers and after its first clause (the engine's description): the key
+    that groups "energy of rod rose by 1.05 x ..." with "energy of rod rose by 8.9 x ..."."""
+    return _NUMBER.sub("#", reason.split("; ")[0])
+
+
+def _dt_range(dts: list[float]) -> str:
+    """``0.0025-0.01 (3)``: the range of time steps and how many; one step as itself; none as ""."""
+    if not dts:
+        return ""
+    return f"{dts[0]:g}" if len(dts) == 1 else f"{min(dts):g}-{max(dts):g} ({len(dts)})"
+
+
+def _clip(text: str, limit: int) -> str:
+    """``text`` cut to ``limit`` characters with an ellipsis."""
+    return text if len(text) <= limit else text[:limit - 1].rstrip() + "…"
 
 
 def _solver(row: pd.Series | None, position_tolerance: float | None) -> str:

@@ -11,9 +11,14 @@ a legend is measured once.
 
 from __future__ import annotations
 
+import functools
+import math
 import re
 import textwrap
 
+import matplotlib
+from matplotlib.axis import Axis, XAxis
+from matplotlib.backends.backend_agg import RendererAgg
 from matplotlib.font_manager import FontProperties
 from matplotlib.ticker import LogFormatterSciNotation
 
@@ -27,11 +32,26 @@ LEGEND_GAP = 0.15
 LEGEND_FONT_SIZE = 7
 """[pt] Legend text: up to ~25 schemes must fit beside a 4.8 in high axes."""
 
+MAX_LEGEND_COLUMNS = 3
+"""A legend too tall for its figure takes up to this many columns (each ~2 in of the width of the axes)."""
+
 TITLE_FONT_SIZE = 10
 """[pt] Titles, a size above the tick labels'."""
 
 TITLE_LINE = 0.2
 """[in] What each line of a wrapped title adds to the top margin: 10 pt text at matplotlib's 1.2 line spacing."""
+
+TICK_LABEL_GAP = 6.0
+"""[px] Least room between two neighbouring tick labels of a log axis (at the figure's dpi): about half a
+character of 10 pt text, so that two labels never read as one ("2×10⁻⁴3×10⁻⁴")."""
+
+LEGEND_LABEL_CHARS = 52
+"""[characters] A legend entry longer than this is wrapped onto more lines (a reason a fit failed, the schemes whose
+results agree), so that the legend does not take the axes' width."""
+
+SUBLABELS = ((1, 2, 3, 4, 5, 6, 7, 8, 9), (1, 2, 3, 4, 6), (1, 2, 5), (1, 3), (1,))
+"""The coefficients k of k×10ⁿ that a log axis spanning less than a decade or two may label, densest first
+(matplotlib's own two choices, then sparser ones): the densest whose labels keep :data:`TICK_LABEL_GAP` apart."""
 
 _SUPERSCRIPT = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
 _POWER = re.compile(r"\^\{(-?[0-9]+)\}")
@@ -42,8 +62,52 @@ class UnicodeLogFormatter(LogFormatterSciNotation):
     """matplotlib's log-axis tick labels (the same ticks labelled, ``10^{k}`` and ``2\\times10^{k}``) as plain
     text with Unicode superscripts, so a label is laid out from the font without parsing TeX."""
 
+    _sublabels: set | None   # matplotlib's: the coefficients k of k×10ⁿ to label (None: every one)
+
     def __call__(self, x, pos=None) -> str:
         return plain(super().__call__(x, pos))
+
+    def set_locs(self, locs=None) -> None:
+        """matplotlib's choice of the coefficients to label (every one on an axis spanning less than ~0.4 decade,
+        1, 2, 3, 4, 6 on one under two decades, decades alone otherwise), thinned to the densest of
+        :data:`SUBLABELS` whose labels, with the decades', do not come closer than :data:`TICK_LABEL_GAP` on this
+        axis: at 2×10⁻⁴ to 3×10⁻³ on a 5 in axis matplotlib's labels touch."""
+        super().set_locs(locs)
+        axis = self.axis
+        if self._sublabels is None or self._sublabels == {1} or not isinstance(axis, Axis):
+            return
+        vmin, vmax = sorted(axis.get_view_interval())
+        horizontal = isinstance(axis, XAxis)
+        box = axis.axes.bbox
+        length = box.width if horizontal else box.height
+        if not (0 < vmin < vmax and length > 0):
+            return
+        lo, hi = math.log10(vmin), math.log10(vmax)
+        size = _tick_label_size(axis, horizontal, max(abs(math.floor(lo)), abs(math.floor(hi))))
+        for coefficients in (c for c in SUBLABELS if len(c) <= len(self._sublabels)):
+            labelled = [math.log10(k) + n for n in range(math.floor(lo), math.ceil(hi) + 1) for k in coefficients
+                        if lo <= math.log10(k) + n <= hi]
+            gaps = [(b - a) / (hi - lo) * length for a, b in zip(labelled, labelled[1:])]
+            if all(gap >= size + TICK_LABEL_GAP for gap in gaps):
+                self._sublabels = set(coefficients)
+                return
+        self._sublabels = {1}
+
+
+@functools.lru_cache(maxsize=4)
+def _measuring(dpi: float) -> RendererAgg:
+    """An Agg renderer at ``dpi`` to measure text with, whatever canvas is drawing (saving as SVG swaps the canvas
+    for one that has no renderer to ask, and draws at 72 dpi)."""
+    return RendererAgg(1, 1, dpi)
+
+
+def _tick_label_size(axis, horizontal: bool, exponent: int) -> float:
+    """[px] The extent along ``axis`` (horizontal: an x axis) of its widest k×10⁻ⁿ label (``exponent``: the largest |n|) when horizontal,
+    of one line of its labels when vertical."""
+    font = FontProperties(size=matplotlib.rcParams["xtick.labelsize" if horizontal else "ytick.labelsize"])
+    text = "8×10\N{MINUS SIGN}" + str(exponent).translate(_SUPERSCRIPT)
+    width, height, _ = _measuring(axis.figure.dpi).get_text_width_height_descent(text, font, ismath=False)
+    return width if horizontal else height
 
 
 def plain(label: str) -> str:
@@ -69,8 +133,18 @@ def title(ax, text: str) -> None:
 
 
 def legend(ax) -> None:
-    """The legend outside the axes, on their right, top-aligned."""
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=LEGEND_FONT_SIZE, frameon=False)
+    """The legend outside the axes, on their right, top-aligned; in as many columns as it needs to end above the
+    figure's bottom edge (22 schemes beside a 3.2 in high figure take two)."""
+    fig = ax.figure
+    room = (fig.get_size_inches()[1] - MARGINS["top"]) * fig.dpi
+    renderer = fig.canvas.get_renderer()
+    columns = 1
+    while True:
+        made = ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=LEGEND_FONT_SIZE, frameon=False,
+                         ncols=columns)
+        if columns == MAX_LEGEND_COLUMNS or made.get_window_extent(renderer).height <= room:
+            return
+        columns += 1
 
 
 def finish(fig, column_gap: float = 0.0, row_gap: float = 0.0, margins: dict[str, float] | None = None):
@@ -100,3 +174,14 @@ def finish(fig, column_gap: float = 0.0, row_gap: float = 0.0, margins: dict[str
                         hspace=row_gap * rows / max(inner_height - row_gap * (rows - 1), 1e-3))
     fig.set_layout_engine(None)
     return fig
+
+
+def power_of_ten(value: float) -> str:
+    """``value``, a power of ten, as a tick label sets it (``10⁻⁶``)."""
+    exponent = round(math.log10(value))
+    return "10" + str(exponent).translate(_SUPERSCRIPT).replace("-", "\N{MINUS SIGN}")
+
+
+def wrap(label: str) -> str:
+    """A legend entry on lines of at most :data:`LEGEND_LABEL_CHARS` characters, later lines indented."""
+    return textwrap.fill(label, LEGEND_LABEL_CHARS, subsequent_indent="  ", break_on_hyphens=False)

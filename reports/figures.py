@@ -14,6 +14,7 @@ import multiprocessing
 import os
 import pickle
 import signal
+from collections.abc import Mapping
 from pathlib import Path
 
 import matplotlib
@@ -26,24 +27,41 @@ import pandas as pd  # noqa: E402
 
 from simparity.core.runtime.processes import die_with_parent  # noqa: E402
 from simparity.core.model.results import SWEEP_PREFIX  # noqa: E402
-from simparity.reports.figure_layout import finish, legend, title  # noqa: E402
+from simparity.reports.figure_layout import finish, legend, power_of_ten, title, wrap  # noqa: E402
 from simparity.reports.summary import ERROR_BUDGETS  # noqa: E402
 from simparity.core.model.metric_catalogue import ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE, TIME_PER_SOLVE
 
 _ENGINE_MARKERS = {"core": "o", "mujoco": "s", "pybullet": "^", "pinocchio": "D"}
+"""The marker of a scheme without variants: its engine's."""
+_VARIANT_MARKERS = ("P", "X", "*", "v", "<", ">")
+"""The markers of the variants of a scheme (core's orientation updates), in the order the run names the variants;
+none is an engine's marker, so a marker says either the engine or the variant."""
+_KEY_COLOR = "0.35"
+"""The grey of the legend's marker key and of the theoretical slopes: no scheme's colour."""
+AGREE_RELATIVE = 1e-3
+"""Errors of two schemes at the same time steps that agree to this relative difference are drawn as one line
+labelled with both ("core rk4 = mujoco rk4"): on a log axis 1e-3 is 4e-4 of a decade, far below a pixel, so separate
+lines would hide each other. Measured in the quick run: MuJoCo's and Pinocchio's rk4 on dzhanibekov agree to 3e-5
+(near the rounding floor), core's explicit and semi-implicit Euler exactly; different schemes differ by percents."""
+SLOPE_OFFSET = 4.0
+"""[factor] A theoretical slope is drawn this far below the lowest line of its order (0.6 decade): beside the data,
+not over it."""
 _HEADLINE_LABELS = {POSITION_ERROR_MAX: "position error max [m]",
                     ORIENTATION_ERROR_MAX: "orientation error max [rad]"}
 _DRIFT_PANELS = [("energy_change", "|E(t) - E(0)| / |E(0)|"), ("angular_momentum_change", "|L(t) - L(0)| / |L(0)|"),
                  ("position_error", "position error [m]"), ("orientation_error", "orientation error [rad]")]
-_COLORS = tuple(plt.get_cmap("tab20").colors) + tuple(plt.get_cmap("tab20b").colors)  # type: ignore[attr-defined]  # ListedColormap
-"""40 distinct colours: a scene's schemes (up to ~25 with core's orientation updates) each get their own."""
-_WIDTH = 9.0
-"""[in] Figure width: a report column at 100 dpi."""
+_COLORS = (tuple(plt.get_cmap("tab10").colors) + tuple(plt.get_cmap("tab20").colors[1::2])  # type: ignore[attr-defined]  # ListedColormap
+           + tuple(plt.get_cmap("tab20b").colors))  # type: ignore[attr-defined]
+"""40 colours, the 10 most distinct first (tab10, then its light shades): a scene's schemes (13 engine x scheme in
+the default suite, core's orientation updates sharing one) each get their own."""
+_WIDTH = 10.0
+"""[in] Figure width: report.html scales every figure to its 1200 px column (10 pt text at ~17 px, the legend's
+7 pt at ~12 px); report.md's PNG is 1000 px wide at 100 dpi."""
 _PANEL_GAP = 0.12
 """[in] Between panels stacked on one time or swept axis: their x tick labels show on the lowest one only."""
 _SIDE_BY_SIDE_GAP = 0.95
 """[in] Between panels side by side: room for the right one's y tick labels and y label."""
-_MATRIX_MARGINS = {"left": 0.9, "right": 1.0, "top": 0.3}
+_MATRIX_MARGINS = {"left": 1.4, "right": 1.0, "top": 0.3}
 """[in] The FK matrix: engine names on the left, the colour bar with its ticks and label on the right."""
 
 
@@ -58,20 +76,71 @@ def _positive(values) -> np.ndarray:
     return np.where(values > 0, values, np.nan)
 
 
-def work_precision_figure(scene: str, cases: pd.DataFrame, headline: str, reference: str):
-    """Error (x, log) against cost per simulated second (y, log): one line per engine x integrator,
-    one point per dt, with the error budgets of the summary as dotted lines.
+def _scheme_and_variant(engine: str, integrator: str, variants: Mapping | None) -> tuple[str, str]:
+    """(scheme, variant) of ``integrator`` by ``variants`` (run.json's ``integrator_variants``: {engine: {integrator:
+    [scheme, variant]}}; an integrator it does not name has no variant: ""); without it, by the name
+    ``<scheme>+<variant>`` (the plain ``<scheme>`` then is its variant "")."""
+    if variants is not None:
+        scheme, variant = variants.get(engine, {}).get(integrator, (integrator, ""))
+        return str(scheme), str(variant)
+    scheme, plus, variant = integrator.partition("+")
+    return (scheme, variant) if plus else (integrator, "")
+
+
+def _plot_grouped(ax, lines: dict[tuple[str, str], pd.DataFrame], x: str, y: str, variants: Mapping | None) -> dict:
+    """Draw ``lines`` (a frame per (engine, integrator), sorted by dt) as ``x`` against ``y``, the variants of a
+    scheme grouped: one colour per engine x scheme, one marker per variant (:data:`_VARIANT_MARKERS`), one legend
+    entry per scheme naming its variants and, after them, a grey marker key of the variants; a scheme without
+    variants keeps its engine's marker. Returns each line's style by (engine, integrator)."""
+    named = {pair: _scheme_and_variant(*pair, variants) for pair in lines}
+    schemes = list(dict.fromkeys((engine, named[engine, integrator][0]) for engine, integrator in lines))
+    members = {scheme: [pair for pair in lines if (pair[0], named[pair][0]) == scheme] for scheme in schemes}
+    kinds = list(dict.fromkeys(named[pair][1] or "default" for group in members.values() if len(group) > 1
+                               for pair in group))
+    styles = {}
+    for i, (engine, scheme) in enumerate(schemes):
+        group = members[engine, scheme]
+        for pair in group:
+            style = _style(i, engine)
+            label = f"{engine} {pair[1]}"
+            if len(group) > 1:
+                kind = named[pair][1] or "default"
+                style |= {"marker": _VARIANT_MARKERS[kinds.index(kind) % len(_VARIANT_MARKERS)], "markersize": 5}
+                label = "_" + label  # the scheme's entry below stands for it
+            ax.plot(lines[pair][x], lines[pair][y], label=label, **style)
+            styles[pair] = style
+        if len(group) > 1:
+            names = ", ".join(named[pair][1] or "default" for pair in group)
+            ax.plot([], [], color=_style(i, engine)["color"], linewidth=1.2, label=wrap(f"{engine} {scheme} ({names})"))
+    for k, kind in enumerate(kinds):
+        ax.plot([], [], linestyle="none", marker=_VARIANT_MARKERS[k % len(_VARIANT_MARKERS)], color=_KEY_COLOR,
+                markersize=5, label=f"marker: variant {kind}")
+    return styles
+
+
+def _error_budgets(ax) -> None:
+    """The summary's error budgets as dotted vertical lines, each labelled inside the axes' top."""
+    for budget in ERROR_BUDGETS:
+        ax.axvline(budget, color="0.6", linestyle=":", linewidth=0.8)
+        ax.text(budget, 0.98, f"error budget {power_of_ten(budget)}", transform=ax.get_xaxis_transform(),
+                rotation=90, ha="right", va="top", fontsize=7, color=_KEY_COLOR,
+                bbox={"facecolor": "white", "edgecolor": "none", "alpha": 0.8, "pad": 1})  # readable over a line
+
+
+def work_precision_figure(scene: str, cases: pd.DataFrame, headline: str, reference: str,
+                          variants: Mapping | None = None):
+    """Error (x, log) against cost per simulated second (y, log): one line per engine x integrator, one point per
+    dt, the variants of a scheme in its colour with a marker each (``variants``: run.json's
+    ``integrator_variants``; see :func:`_scheme_and_variant`), the error budgets of the summary dotted and labelled.
 
     ``cases``: :func:`reports.summary.dynamics_cases`."""
     measured = cases[(cases["status"] == "ok") & (cases["error"] > 0) & (cases["cost"] > 0)]
     if measured.empty:
         return None
     fig, ax = plt.subplots(figsize=(_WIDTH, 4.8))
-    for i, ((engine, integrator), g) in enumerate(measured.groupby(["engine", "integrator"], sort=False)):
-        g = g.sort_values("dt")
-        ax.plot(g["error"], g["cost"], label=f"{engine} {integrator}", **_style(i, engine))
-    for budget in ERROR_BUDGETS:
-        ax.axvline(budget, color="0.6", linestyle=":", linewidth=0.8)
+    lines = {pair: g.sort_values("dt") for pair, g in measured.groupby(["engine", "integrator"], sort=False)}
+    _plot_grouped(ax, lines, "error", "cost", variants)
+    _error_budgets(ax)
     ax.set(xscale="log", yscale="log", xlabel=_HEADLINE_LABELS[headline],
            ylabel="compute per simulated second [s/s]")
     title(ax, f"{scene}: work against precision (one point per dt; error against {reference})")
@@ -80,28 +149,61 @@ def work_precision_figure(scene: str, cases: pd.DataFrame, headline: str, refere
     return finish(fig)
 
 
+def _agree(a: pd.DataFrame, b: pd.DataFrame) -> bool:
+    """Whether two lines (sorted by dt) have the same time steps and errors within :data:`AGREE_RELATIVE`."""
+    return (len(a) == len(b) and bool(np.array_equal(a["dt"].to_numpy(), b["dt"].to_numpy()))
+            and bool(np.allclose(a["error"], b["error"], rtol=AGREE_RELATIVE, atol=0.0)))
+
+
+def _fit_text(pair: tuple[str, str], g: pd.DataFrame, observed: Mapping, unfitted: Mapping | None) -> str:
+    """"observed 4.00", or "no fit: <reason>": the order row's reason up to its first colon (``unfitted``: {(engine,
+    integrator): the n/a order row's detail}), else what the figure's own points say."""
+    fitted = observed.get(pair, math.nan)
+    if math.isfinite(fitted):
+        return f"observed {fitted:.2f}"
+    reason = (unfitted or {}).get(pair, "")
+    if not reason:
+        reason = f"only {len(g)} time steps measured" if len(g) < 3 else "no order in the run (see the order table)"
+    return f"no fit: {reason.split(':')[0]}"
+
+
 def convergence_figure(scene: str, cases: pd.DataFrame, headline: str, reference: str,
-                       observed: dict[tuple[str, str], float], theory: dict[str, dict[str, int]]):
-    """Error (log) against dt (log) per engine x integrator, the observed order in the legend, and the
-    theoretical slope drawn dashed through the finest point."""
+                       observed: dict[tuple[str, str], float], theory: dict[str, dict[str, int]],
+                       unfitted: Mapping | None = None):
+    """Error (log) against dt (log) per engine x integrator, the observed order in the legend ("no fit: <reason>",
+    dotted, where none was fitted; ``unfitted``: :func:`_fit_text`), schemes whose errors agree
+    (:data:`AGREE_RELATIVE`) as one line naming them all, and per theoretical order p a grey dashed line of slope p
+    (:data:`SLOPE_OFFSET` under the lowest line of that order), labelled."""
     measured = cases[(cases["status"] == "ok") & (cases["error"] > 0)]
     if measured["dt"].nunique() < 2:
         return None
     fig, ax = plt.subplots(figsize=(_WIDTH, 4.8))
-    for i, ((engine, integrator), g) in enumerate(measured.groupby(["engine", "integrator"], sort=False)):
+    groups: list[tuple[list[tuple[str, str]], pd.DataFrame]] = []
+    for (engine, integrator), g in measured.groupby(["engine", "integrator"], sort=False):
         g = g.sort_values("dt")
-        style = _style(i, engine)
         p = theory.get(engine, {}).get(integrator)
-        fitted = observed.get((engine, integrator), math.nan)
-        label = (f"{engine} {integrator}: observed {fitted:.2f}" if math.isfinite(fitted) else
-                 f"{engine} {integrator}: no fit") + (f", theory {p}" if p else "")
-        ax.plot(g["dt"], g["error"], label=label, **style)
-        if p and len(g) > 1:
-            dt0, e0 = g["dt"].iloc[0], g["error"].iloc[0]
-            dts = np.array([g["dt"].iloc[0], g["dt"].iloc[-1]])
-            ax.plot(dts, e0 * (dts / dt0) ** p, linestyle="--", linewidth=0.7, color=style["color"])
+        same = next((members for members, first in groups if _agree(first, g)
+                     and theory.get(members[0][0], {}).get(members[0][1]) == p), None)
+        if same is None:
+            groups.append(([(engine, integrator)], g))
+        else:
+            same.append((engine, integrator))
+    lowest: dict[int, pd.DataFrame] = {}
+    for i, (members, g) in enumerate(groups):
+        p = theory.get(members[0][0], {}).get(members[0][1])
+        fits = " / ".join(dict.fromkeys(_fit_text(pair, g, observed, unfitted) for pair in members))
+        label = " = ".join(f"{engine} {integrator}" for engine, integrator in members) + f": {fits}"
+        ax.plot(g["dt"], g["error"], label=wrap(label + (f", theory {p}" if p else "")),
+                **_style(i, members[0][0]) | ({"linestyle": ":"} if "no fit" in fits else {}))
+        if p and len(g) > 1 and (p not in lowest or g["error"].iloc[0] < lowest[p]["error"].iloc[0]):
+            lowest[p] = g
+    for p, g in sorted(lowest.items()):
+        dts = np.geomspace(g["dt"].iloc[0], g["dt"].iloc[-1], 3)
+        errors = g["error"].iloc[0] / SLOPE_OFFSET * (dts / dts[0]) ** p
+        ax.plot(dts, errors, linestyle="--", linewidth=0.9, color=_KEY_COLOR)
+        ax.text(dts[1], errors[1], f"slope {p}", ha="left", va="top", fontsize=7, color=_KEY_COLOR)
     ax.set(xscale="log", yscale="log", xlabel="time step dt [s]", ylabel=_HEADLINE_LABELS[headline])
-    title(ax, f"{scene}: convergence against {reference} (dashed: theoretical slope)")
+    title(ax, f"{scene}: convergence against {reference} (grey dashed: theoretical slope p)")
     ax.grid(True, which="major", alpha=0.3)
     legend(ax)
     return finish(fig)
@@ -146,7 +248,7 @@ def contact_height_figure(scene: str, series: pd.DataFrame, reference: str):
     for i, ((engine, integrator), g) in enumerate(at_dt.groupby(["engine", "integrator"], sort=False)):
         ax.plot(g["x"], g["value"], label=f"{engine} {integrator}", **(_style(i, engine) | {"marker": None}))
     ax.axhline(0.0, color="black", linewidth=0.8)
-    ax.set(xlabel="time [s]", ylabel="lowest point above the plane [m]")
+    ax.set(xlabel="time [s]", ylabel="lowest point height [m]")
     ax.grid(True, which="major", alpha=0.3)
     title(ax, f"{scene}: height of the lowest point at dt = {dt:g} s (reference {reference})")
     legend(ax)
@@ -198,13 +300,15 @@ def fk_matrix_figure(scene: str, series: pd.DataFrame):
     matrix = np.full((len(names), len(names)), np.nan)
     for _, r in rows.iterrows():
         matrix[names.index(r["engine"]), names.index(r["integrator"])] = r["value"]
-    fig, ax = plt.subplots(figsize=(1.2 * len(names) + 2.5, 1.0 * len(names) + 1.2))
+    fig, ax = plt.subplots(figsize=(_WIDTH, 0.5 * len(names) + 1.2))
     shown = np.log10(np.maximum(matrix, 1e-17))
-    image = ax.imshow(shown, cmap="viridis")
+    image = ax.imshow(shown, cmap="viridis", aspect="auto")  # cells as wide as the page allows
     for i in range(len(names)):
         for j in range(len(names)):
             text = "—" if i == j else f"{matrix[i, j]:.1e}"
-            ax.text(j, i, text, ha="center", va="center", fontsize=8, color="white" if i != j else "0.5")
+            light = i != j and sum(image.cmap(image.norm(shown[i, j]))[:3]) > 1.5  # a light cell: dark text
+            ax.text(j, i, text, ha="center", va="center", fontsize=8,
+                    color="0.5" if i == j else "black" if light else "white")
     ax.set_xticks(range(len(names)), names)
     ax.set_yticks(range(len(names)), names)
     fig.colorbar(image, ax=ax, label="log10 distance [m]")
@@ -212,23 +316,23 @@ def fk_matrix_figure(scene: str, series: pd.DataFrame):
     return finish(fig, margins=_MATRIX_MARGINS)
 
 
-def sweep_work_precision_figure(base: str, across: pd.DataFrame, label: str, reference: str, variants: int):
-    """Work against precision over a sweep's variants: per engine x integrator one point per dt at its worst
+def sweep_work_precision_figure(base: str, across: pd.DataFrame, label: str, reference: str, variants: int,
+                                integrator_variants: Mapping | None = None):
+    """Work against precision over a sweep's ``variants``: per engine x integrator one point per dt at its worst
     variant's error (x, log) and its median cost over the variants (y, log), a band from there to its best
-    variant's error, the error budgets of the summary dotted; None when no scheme was ok in every variant.
+    variant's error, the variants of a scheme grouped as in :func:`work_precision_figure` (``integrator_variants``),
+    the error budgets of the summary dotted and labelled; None when no scheme was ok in every variant.
 
     ``across``: :func:`reports.sweep_summary.across` of a dynamics sweep's cases (value: the error)."""
     measured = across[(across["status"] == "ok") & (across["value"] > 0) & (across["cost"] > 0)]
     if measured.empty:
         return None
     fig, ax = plt.subplots(figsize=(_WIDTH, 4.8))
-    for i, ((engine, integrator), g) in enumerate(measured.groupby(["engine", "integrator"], sort=False)):
-        g = g.sort_values("dt")
-        style = _style(i, engine)
-        ax.plot(g["value"], g["cost"], label=f"{engine} {integrator}", **style)
-        ax.hlines(g["cost"], _positive(g["best"]), g["value"], color=style["color"], linewidth=4, alpha=0.3)
-    for budget in ERROR_BUDGETS:
-        ax.axvline(budget, color="0.6", linestyle=":", linewidth=0.8)
+    lines = {pair: g.sort_values("dt") for pair, g in measured.groupby(["engine", "integrator"], sort=False)}
+    styles = _plot_grouped(ax, lines, "value", "cost", integrator_variants)
+    for pair, g in lines.items():
+        ax.hlines(g["cost"], _positive(g["best"]), g["value"], color=styles[pair]["color"], linewidth=4, alpha=0.3)
+    _error_budgets(ax)
     ax.set(xscale="log", yscale="log", xlabel=label, ylabel="compute per simulated second, median [s/s]")
     title(ax, f"{base}: work against precision over {variants} variants (worst variant; band to the best; error "
               f"against {reference})")

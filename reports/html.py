@@ -14,7 +14,7 @@ table { border-collapse: collapse; margin: .5em 0 1em; font-size: 12px; }
 th, td { border: 1px solid #ccc; padding: 2px 6px; text-align: left; vertical-align: top; }
 th { background: #f3f3f3; }
 figure { margin: 1em 0; }
-figure svg { max-width: 100%; height: auto; }
+figure svg { display: block; width: 100%; height: auto; }
 figcaption { font-size: 12px; color: #555; }
 details { margin: .5em 0; }
 summary { cursor: pointer; color: #035; }
@@ -36,9 +36,16 @@ def _inline(text: str) -> str:
     return out
 
 
+_SVG_SIZE = re.compile(r'\s(?:width|height)="[^"]*"')
+
+
 def _svg_body(svg: str) -> str:
-    """An SVG file's text without its XML prolog and DOCTYPE, to put inline."""
-    return svg[svg.index("<svg"):]
+    """An SVG file's text without its XML prolog and DOCTYPE, to put inline, and without the root's ``width`` and
+    ``height`` (matplotlib's, in pt: 10 in is 720 pt, 960 CSS px), so that the figure takes the column's width
+    (``figure svg`` in the style) and its ``viewBox`` the height; ``max-width`` alone would keep it at 960 px."""
+    body = svg[svg.index("<svg"):]
+    end = body.index(">")
+    return _SVG_SIZE.sub("", body[:end]) + body[end:]
 
 
 def _html(block: Block, svgs: dict[str, str]) -> str:

@@ -81,3 +81,24 @@ def test_a_second_run_widens_the_margin_to_its_spread(tmp_path):
     assert check_table(_table(other), bounds).passed
     widest = max(b.max for b in bounds if b.max is not None and b.scene == "my-scene")
     assert widest == pytest.approx(3.2e-5 * (1 + 0.5 * BLESS_SPREAD_FACTOR))
+
+
+def test_a_row_that_breaks_a_shipped_bound_refuses_the_file(tmp_path):
+    """An RK4 (declared scheme rk4) whose order fell to 2 breaks the shipped order bound: blessing it would let the
+    blessed bound win and pass the bug, so nothing is blessed."""
+    broken = [dataclasses.replace(r, value=2.0, scheme="rk4") if r.metric == "order_position" else r for r in ROWS]
+    with pytest.raises(ToleranceError) as caught:
+        bless(_table(broken), INFO, tmp_path)
+    assert "break the bounds the blessed file would extend" in str(caught.value) and "order_position" in str(caught.value)
+
+
+@pytest.mark.parametrize("bad", ["spread-failed", "non-finite"])
+def test_a_failed_spread_run_or_a_non_finite_ok_value_refuses_the_file(tmp_path, bad):
+    if bad == "spread-failed":
+        spread = _table([dataclasses.replace(r, status="failed") if r.metric == "time_per_step" else r for r in ROWS])
+        call = lambda: bless(_table(ROWS), INFO, tmp_path, spread)  # noqa: E731
+    else:
+        rows = [dataclasses.replace(r, value=math.inf) if r.dt == 0.02 else r for r in ROWS]
+        call = lambda: bless(_table(rows), INFO, tmp_path)  # noqa: E731
+    with pytest.raises(ToleranceError, match="nothing was blessed"):
+        call()

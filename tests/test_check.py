@@ -263,3 +263,22 @@ def test_explain_rows_lists_every_matching_bound_and_which_decided(tmp_path):
     assert lines[1].startswith("  decides: ") and "mine.toml: bound[0]" in lines[1] and "(mine)" in lines[1]
     overridden = [line for line in lines[2:] if "default.toml" in line]
     assert overridden and all("overridden: the deciding bound's file extends this one" in line for line in overridden)
+
+
+def test_a_series_that_measured_nothing_neither_counts_nor_hides_an_unbounded_one(tmp_path):
+    """Held-out finding: an all-n/a series decided by a value bound that allows n/a measured nothing; it must not
+    count as bounded, so the one measured series without a value bound is 1 of 1."""
+    bounds = _catch_all_only(tmp_path, '[[bound]]\nintegrator = "cannot"\nmetric = "*"\nmax = 1.0\n'
+                                       'status = ["ok", "n/a"]\nreason = "allows n/a"\n')
+    rows = [_row(metric="position_error_max", value=math.nan, status="n/a", dt=0.01, integrator="cannot"),
+            _row(metric="position_error_max", value=1e-3, dt=0.01, integrator="measured")]
+    result = check_table(_table(rows), bounds)
+    assert result.series == {("s", "core", "measured"): False} and result.too_unbounded()
+
+
+def test_an_ok_row_without_a_finite_value_breaks_a_numeric_bound_and_a_huge_power_does_not_crash(tmp_path):
+    bounds = _catch_all_only(tmp_path, '[[bound]]\nmetric = "order_*"\nmin = 3.5\nreason = "fourth order"\n'
+                                       '[[bound]]\nmetric = "position_*"\nmax = 1e308\ndt_power = -1e5\nreason = "x"\n')
+    rows = [_row(value=math.inf), _row(metric="position_error_max", value=1.0, dt=0.01)]
+    result = check_table(_table(rows), bounds)
+    assert [v.metric for v in result.violations] == ["order_position"]

@@ -194,8 +194,8 @@ def test_variants_share_a_line_in_findings_and_cases_without_a_result(tmp_path):
     rows += [_rows(name, "mujoco", "euler", math.nan, "diverged") for name in names[:2]]
     table, info = _stored(tmp_path, scenes, rows)
     report = _report(tmp_path, table, info)
-    assert "— sweep of drop pinocchio euler (dt 0.01) in 4 of 4 variants" in report
-    assert "**diverged** in sweep of drop (2 cases): mujoco euler (dt 0.01) in 2 of 4 variants: why" in report
+    assert "| n/a (run) | sweep of drop | pinocchio: euler in 4 of 4 variants | 4 | 0.01 |" in report
+    assert "| diverged | sweep of drop | mujoco: euler in 2 of 4 variants | 2 | 0.01 | why |" in report
     assert "- **sweep of drop**: ok 4, n/a 4, diverged 2; diverged: mujoco euler" in report   # hard cases: one line
     assert names[1] not in report.split("## Sweeps", 1)[0]
 

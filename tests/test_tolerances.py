@@ -152,7 +152,7 @@ def test_extends_none_starts_empty_and_a_chain_of_files_layers_in_order(tmp_path
 
 
 @pytest.mark.parametrize("extends, words", [
-    ('"loop.toml"', "extends itself"),
+    ('"loop.toml"', "closes a loop of extends"),
     ('"nosuch.toml"', "no such file"),
     ("3", "expected text"),
 ])

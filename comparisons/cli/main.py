@@ -269,7 +269,7 @@ def _check(run_dir: Path, bounds, args, out, result: CheckResult | None = None) 
     if unbounded:
         print(f"unbounded: {unbounded}", file=out)
     if args.junit:
-        args.junit.write_text(junit_xml(result, diff), encoding="utf-8")
+        args.junit.write_text(junit_xml(result, diff, unbounded), encoding="utf-8")
     if args.summary:
         with open(args.summary, "a", encoding="utf-8") as handle:
             handle.write(summary_markdown(result, diff, unbounded))
@@ -299,14 +299,21 @@ def cmd_check(args, out) -> int:
     if args.explain is not None:
         return _explain(run_dir, bounds, args.explain, narrowed, out)
     if args.bless is not None:
-        return _bless(run_dir, args.bless, args.spread, out)
+        return _bless(run_dir, args.bless, args.spread, args.tolerances, out)
     return _check(run_dir, bounds, args, out)
 
 
-def _bless(run_dir: Path, path: Path, spread: Path | None, out) -> int:
-    """Write the tolerances file blessed from the run in ``run_dir`` (:mod:`comparisons.gate.bless`)."""
+def _bless(run_dir: Path, path: Path, spread: Path | None, tolerances: Path | None, out) -> int:
+    """Write the tolerances file blessed from the run in ``run_dir`` (:mod:`comparisons.gate.bless`), extending
+    ``tolerances`` (default: the shipped ones); a ``spread`` run of another profile is refused."""
     table, info = read_run(run_dir)
-    text, count = bless(table, info, run_dir, read_run(spread)[0] if spread is not None else None)
+    other = read_run(spread) if spread is not None else None
+    if other is not None and info.profile and other[1].profile and other[1].profile != info.profile:
+        raise SimparityError(f"--spread {one_line(spread)}: a {other[1].profile}-profile run, this one is "
+                             f"{info.profile} (allowed: a second run of the same scenes and profile)")
+    extended = load_tolerances(tolerances) if tolerances else None
+    extends = str(tolerances.resolve()) if tolerances else "default"
+    text, count = bless(table, info, run_dir, other[0] if other else None, extended, extends)
     write_blessed(path, text)
     print(f"blessed {count} bounds from {run_dir} into {path} (extends the shipped tolerances; review the diverged "
           "and n/a ones before committing)", file=out)

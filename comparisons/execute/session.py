@@ -33,6 +33,7 @@ from simparity.comparisons.execute.progress import ProgressBar
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS, run_group
 from simparity.comparisons.execute.store import RunWriter
 from simparity.comparisons.gate.check import CheckResult, check_table
+from simparity.comparisons.gate.violation import grouped
 from simparity.comparisons.gate.history import record_run
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, Bound, load_tolerances
 from simparity.comparisons.invariance.invariance_run import invariance_rows
@@ -265,8 +266,8 @@ class Session:
             else:
                 journal.remove()
         table = store.table()
+        self._record(table)  # before the report: a report that cannot be drawn never costs the run its history
         checked = self._write_report()
-        self._record(table)
         check = None
         if self.bounds is not None:
             check = checked if checked is not None else check_table(table, self.bounds)
@@ -323,7 +324,8 @@ def write_run_report(out_dir: Path, say: Say, bounds: list[Bound] | None = None)
 
     table, _ = read_run(out_dir)
     result = check_table(table, bounds if bounds is not None else load_tolerances(DEFAULT_TOLERANCES))
-    verdict = ToleranceVerdict(result.checked, result.unchecked, tuple(v.line() for v in result.violations))
+    verdict = ToleranceVerdict(result.checked, result.unchecked, tuple(g.line() for g in grouped(result.violations)),
+                               len(result.violations))
     markdown, page = write_report(out_dir, verdict)
     say(f"results: {Path(out_dir) / RESULTS_FILE}\nreport:  {markdown}\n         {page}")
     return result

@@ -12,8 +12,10 @@ extends the shipped tolerances (``extends = "default"``), and its bounds win whe
 - With a second run of the same scenes (``--spread RUN2``: another machine, another BLAS, a perturbed scene),
   each margin is at least :data:`BLESS_SPREAD_FACTOR` times the two runs' difference, so a chaotic scene gets
   the wider bound it needs; a status that differs between the runs is blessed as either.
-- Timing rows are never blessed (wall time is not numerics). A ``failed`` row, or one flagged with an alarm,
-  refuses the whole file: a bug must not become a passing gate by one command. A ``diverged`` case is blessed as
+- Timing rows are never blessed (wall time is not numerics). A ``failed`` row, one flagged with an alarm, an
+  ``ok`` row without a finite value (in the run or the ``--spread`` run), or a value that breaks a bound of the
+  tolerances the file extends (the shipped ones: an RK4 of order 2) refuses the whole file: the blessed bound
+  would win over the broken one, and a bug must not become a passing gate by one command. A ``diverged`` case is blessed as
   the expected verdict, with "expected — review" in its reason; an ``n/a`` row as n/a, with its reason.
 """
 
@@ -25,9 +27,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES
+from simparity.comparisons.gate.check import check_table
+from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, Bound, load_tolerances
 from simparity.comparisons.gate.violation import row_label
-from simparity.core.model.errors import ToleranceError
+from simparity.core.model.errors import ToleranceError, one_line
 from simparity.core.model.metric_catalogue import CATALOGUE, DRIFT, ERROR, ORDER, VALIDITY, family_of, is_timing
 from simparity.core.model.results import ALARM_FLAGS, DIVERGED, FAILED, OK
 from simparity.core.model.run_info import RunInfo
@@ -67,17 +70,33 @@ def _key_lines(row: dict, metric: str) -> list[str]:
 
 
 def _refuse(run_dir: Path, table: pd.DataFrame) -> None:
-    """Raise ToleranceError naming the first failed or alarmed row of ``table``, if any."""
+    """Raise ToleranceError naming the first failed, alarmed or non-finite ok row of ``table``, if any."""
     flags = table["flag"].fillna("") if "flag" in table else pd.Series("", index=table.index)
-    bad = table[(table["status"] == FAILED) | flags.isin(ALARM_FLAGS)]
+    values = pd.to_numeric(table["value"], errors="coerce")
+    bad = table[(table["status"] == FAILED) | flags.isin(ALARM_FLAGS)
+                | ((table["status"] == OK) & ~values.apply(math.isfinite))]
     if bad.empty:
         return
     row = bad.iloc[0]
-    what = f"status {row['status']}" + (f", flag {row['flag']}" if row.get("flag") in ALARM_FLAGS else "")
+    what = f"status {row['status']}" + (f", flag {row['flag']}" if row.get("flag") in ALARM_FLAGS else "") + (
+        f", value {row['value']}" if row["status"] == OK else "")
     raise ToleranceError(str(run_dir), row_label(row["scene"], row["engine"], row["integrator"], float(row["dt"]),
                                                    row["metric"]),
-                         f"{len(bad)} row(s) failed or flagged an alarm, first {what}: nothing was blessed",
-                         "a run whose rows are ok, n/a or diverged (fix or drop what failed, then bless)")
+                         f"{len(bad)} row(s) failed, flagged an alarm or are ok without a finite value, first {what}: "
+                         "nothing was blessed",
+                         "a run whose rows are ok with a number, n/a or diverged (fix or drop what failed, then bless)")
+
+
+def _refuse_violations(run_dir: Path, table: pd.DataFrame, extended: list[Bound]) -> None:
+    """Raise ToleranceError when a row breaks a bound of the tolerances the blessed file extends (a value or a
+    cross-check; a case that diverged is blessed, marked for review): the blessed file would win over that bound
+    and turn the violation into a pass."""
+    broken = [v for v in check_table(table, extended).violations if v.verdict != DIVERGED]
+    if broken:
+        raise ToleranceError(str(run_dir), "--bless", f"{len(broken)} metric(s) break the bounds the blessed file "
+                             f"would extend, first {one_line(broken[0].line(), 300)}: nothing was blessed",
+                             "a run that passes 'simparity check' but for diverged cases (fix it, or write that "
+                             "bound yourself with its reason)")
 
 
 def _numbers(row: dict, other: dict | None) -> list[str]:
@@ -92,10 +111,16 @@ def _numbers(row: dict, other: dict | None) -> list[str]:
     return [f"expected = {value!r}", f"band = {band!r}"]
 
 
-def bless(table: pd.DataFrame, info: RunInfo, run_dir: Path, spread: pd.DataFrame | None = None) -> tuple[str, int]:
+def bless(table: pd.DataFrame, info: RunInfo, run_dir: Path, spread: pd.DataFrame | None = None,
+          extended: list[Bound] | None = None, extends: str = "default") -> tuple[str, int]:
     """(the tolerances file's text, the bounds in it) blessing every row of ``table`` (module docstring);
-    ToleranceError when a row failed or flagged an alarm."""
+    ToleranceError when a row of ``table`` or ``spread`` failed, flagged an alarm or is ok without a finite value,
+    or (``extended``: the bounds the file extends, default the shipped ones; ``extends``: the file's ``extends``
+    value naming them) a row breaks one of those bounds."""
     _refuse(run_dir, table)
+    if spread is not None:
+        _refuse(run_dir, spread)
+    _refuse_violations(run_dir, table, load_tolerances() if extended is None else extended)
     origin = f"blessed from run {run_dir} at commit {info.git_commit or 'unknown'} ({info.created_utc or 'undated'})"
     others = _indexed(spread) if spread is not None else {}
     blocks, diverged_cases = [], set()
@@ -125,7 +150,7 @@ def bless(table: pd.DataFrame, info: RunInfo, run_dir: Path, spread: pd.DataFram
             why += f"; {' or '.join(statuses)} between the two runs (--spread): review"
         blocks.append(lines + [f"reason = {_text(why)}"])
     header = [f"# simparity tolerances {origin}.", "# Review before committing: a blessed 'diverged' or 'n/a' is what "
-              "that run did, not necessarily what it should do.", 'extends = "default"', "", ""]
+              "that run did, not necessarily what it should do.", f"extends = {_text(extends)}", "", ""]
     body = ["[[bound]]\n" + "\n".join(lines) + "\n" for lines in blocks]
     return "\n".join(header) + "\n".join(body), len(blocks)
 

@@ -95,6 +95,8 @@ def _judge(bound: Bound, row) -> tuple[str, str] | None:
         return f"status {status}{why}"[:300], f"status {allowed}"
     if status != OK or not bound.bounds_a_number:
         return None
+    if not math.isfinite(value):
+        return f"{value} (an ok row without a finite value)", bound.describe(dt)
     low, high = bound.limits(dt)
     if flag == ROUNDING_FLOOR and low <= value:
         return None  # exact up to rounding: what any upper bound asks, however tight it was written
@@ -145,10 +147,10 @@ def _count_series(result: CheckResult, row: dict, bound: Bound | None) -> None:
     every row is n/a measured nothing (and does not count)."""
     if is_timing(row["metric"]):
         return
+    if row["status"] == NOT_AVAILABLE:  # nothing measured: neither a series measured nor a value held
+        return
     key = (row["scene"], row["engine"], row["integrator"] if isinstance(row["integrator"], str) else "")
-    bounded = bound is not None and bound.bounds_the_value
-    if row["status"] != NOT_AVAILABLE or bounded:
-        result.series[key] = result.series.get(key, False) or bounded
+    result.series[key] = result.series.get(key, False) or (bound is not None and bound.bounds_the_value)
 
 
 def _case_key(scene: str, engine: str, integrator: str, dt: float) -> tuple:

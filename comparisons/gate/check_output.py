@@ -21,10 +21,11 @@ def _case_name(key: tuple) -> tuple[str, str]:
     return scene, f"{engine} {integrator or '-'}{dt_text}"
 
 
-def junit_xml(result: CheckResult, diff: BaselineDiff | None = None) -> str:
+def junit_xml(result: CheckResult, diff: BaselineDiff | None = None, unbounded: str = "") -> str:
     """JUnit XML: one test case per scene x engine x integrator x dt; a case with violations fails with
     them as its message and text, a case that measured nothing (every row n/a) is skipped with the reason;
-    a baseline comparison is one more test case."""
+    a baseline comparison is one more test case, and so is the share of series held to a value (``unbounded``:
+    the reason it fails, "" when it does not)."""
     suites = ET.Element("testsuites", name="simparity check")
     suite = ET.SubElement(suites, "testsuite", name="simparity")
     failures = skipped = 0
@@ -48,6 +49,11 @@ def junit_xml(result: CheckResult, diff: BaselineDiff | None = None) -> str:
             failures += 1
             failure = ET.SubElement(case, "failure", message="numerics moved since the baseline", type="baseline")
             failure.text = "\n".join(diff.moved + [f"missing: {m}" for m in diff.missing])
+    tests += 1
+    case = ET.SubElement(suite, "testcase", classname="tolerances", name="series held to a value", time="0")
+    if unbounded:
+        failures += 1
+        ET.SubElement(case, "failure", message=unbounded[:MESSAGE_CHARS], type="unbounded").text = unbounded
     for element in (suites, suite):
         element.set("tests", str(tests))
         element.set("failures", str(failures))

@@ -35,6 +35,8 @@ class SimparityChecker:
     """What the ``simparity`` fixture gives a test: ``check(scene, ...)``."""
 
     def __init__(self, baseline: str | None, relative: float | None, test_folder: Path | None = None) -> None:
+        if relative is not None and not (relative >= 0 and relative < float("inf")):
+            raise pytest.UsageError(f"--simparity-baseline-rel {relative}: out of range (allowed: a number >= 0)")
         self._baseline, self._relative, self._folder = baseline, relative, test_folder
 
     def _path(self, name: str | Path) -> str | Path:
@@ -57,7 +59,8 @@ class SimparityChecker:
         try:
             return self._check(scene, engines, tolerances, profile, repeats, isolate, allow_unbounded)
         except SimparityError as err:
-            pytest.fail(f"simparity: {one_line(err, 1000)}", pytrace=False)
+            problem = f"simparity: {one_line(err, 1000)}"
+        pytest.fail(problem, pytrace=False)  # outside the except: one message, no chained traceback
 
     def _check(self, scene, engines, tolerances, profile: str, repeats: int, isolate: bool, allow_unbounded: bool):
         from simparity.comparisons.api import load_scene
@@ -70,6 +73,15 @@ class SimparityChecker:
         from simparity.core.model.errors import SimparityError
         from simparity.reports.store import read_run
 
+        from simparity.comparisons.scenes.profiles import PROFILES
+        from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
+
+        if profile not in PROFILES or not isinstance(repeats, int) or not 0 <= repeats <= 100:
+            raise SimparityError(f"profile {profile!r:.40}, repeats {repeats!r:.20}: out of range (allowed: profile "
+                                 f"{' or '.join(PROFILES)}, repeats 0 to 100)")
+        if not isinstance(scene, (str, Path, DynamicsScene, KinematicsScene, IKScene)):
+            raise SimparityError(f"scene {scene!r:.60}: not a scene (allowed: a built-in name, a scene file's path, "
+                                 "or a loaded scene)")
         loaded = load_scene(self._path(scene)) if isinstance(scene, (str, Path)) else scene
         bounds = load_tolerances(self._path(tolerances) if tolerances else DEFAULT_TOLERANCES)
         session = Session([loaded], EngineSet(check_engine_names(engine_specs(engines))), profile=profile,
@@ -85,7 +97,7 @@ class SimparityChecker:
                 raise SimparityError(f"--simparity-baseline {self._baseline}: a {info.profile}-profile run, the test "
                                      f"runs {profile} (allowed: a baseline run of the {profile} profile)")
             diff = compare_with_baseline(table, before[before["scene"] == loaded.name],
-                                         self._relative or BASELINE_RELATIVE)
+                                         BASELINE_RELATIVE if self._relative is None else self._relative)
             problems += [f"moved since {self._baseline}: {m}" for m in diff.moved]
             problems += [f"missing since {self._baseline}: {m}" for m in diff.missing]
         if problems:

@@ -155,7 +155,10 @@ class Bound:
 
     def limits(self, dt: float) -> tuple[float, float]:
         """(lowest, highest) value allowed at time step ``dt`` [s] (NaN dt: no scaling)."""
-        scale = dt ** self.dt_power if self.dt_power is not None and math.isfinite(dt) else 1.0
+        try:
+            scale = dt ** self.dt_power if self.dt_power is not None and math.isfinite(dt) else 1.0
+        except OverflowError:  # a huge negative power of a small step: no finite limit
+            scale = math.inf
         low, high = -math.inf, math.inf
         if self.max is not None:
             high = self.max * scale
@@ -261,8 +264,8 @@ def _load(path: Path, chain: tuple[Path, ...]) -> list[Bound]:
         raise ToleranceError(source, unknown[0][:80], f"unknown {kind}", "[[bound]] tables and extends = ...")
     base = _extended(path, data.get("extends", _default_extends(path)), chain + (_resolved(path),))
     tables = data.get("bound", [])
-    if not isinstance(tables, list) or not tables:
-        raise ToleranceError(source, "bound", "no bounds", "one or more [[bound]] tables")
+    if not isinstance(tables, list) or not (tables or ("extends" in data and base)):
+        raise ToleranceError(source, "bound", "no bounds", "one or more [[bound]] tables, or extends = a file that has some")
     layer = max((b.layer for b in base), default=-1) + 1
     return base + [replace(_bound(source, i, table), layer=layer) for i, table in enumerate(tables)]
 
@@ -288,9 +291,10 @@ def _extended(path: Path, extends, chain: tuple[Path, ...]) -> list[Bound]:
         return []
     target = DEFAULT_TOLERANCES if extends == EXTENDS_DEFAULT else path.parent / extends
     if _resolved(target) in chain:
-        raise ToleranceError(str(path), "extends", f"{extends!r:.80} extends itself (a loop of extends)", allowed)
+        raise ToleranceError(str(path), "extends", f"{extends!r:.80} closes a loop of extends", allowed)
     if not target.is_file():
-        raise ToleranceError(str(path), "extends", f"{extends!r:.80}: no such file ({one_line(target)})", allowed)
+        problem = "not a regular file" if target.exists() else "no such file"
+        raise ToleranceError(str(path), "extends", f"{extends!r:.80}: {problem} ({one_line(target)})", allowed)
     if len(chain) >= MAX_EXTENDS_DEPTH:
         raise ToleranceError(str(path), "extends", f"more than {MAX_EXTENDS_DEPTH} files in a chain of extends",
                              allowed)
