@@ -57,7 +57,6 @@ from simparity.comparisons.invariance.transforms import fixed_transforms
 from simparity.core.model.errors import SimparityError, one_line
 from simparity.core.model.ranges import RANGES
 from simparity.core.model.results import RESULTS_FILE, RUN_INFO_FILE
-from simparity.core.model.run_info import RunInfo
 from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
 from simparity.reports.store import read_run
 
@@ -229,34 +228,31 @@ def _cost(scenes) -> str:
             f"{targets:,} IK targets per solver")
 
 
-def _baseline_table(option: str, run_dir: Path, history_option: str | None):
-    """The baseline's rows: a stored run's folder, or ``latest``, the latest earlier run of this run's profile in
-    the history; a baseline of another profile is refused (its rows are of other time steps and horizons)."""
-    profile = read_run(run_dir)[1].profile
+def _baseline_table(option: str, run_dir: Path, profile: str, history_option: str | None):
+    """The baseline's rows: a stored run's folder, or ``latest``, the latest earlier run of ``profile`` (this run's)
+    in the history; a baseline of another profile is refused (its rows are of other time steps and horizons)."""
     if option == "latest":
         path = history_path(history_option)
-        run_id, option = latest_before(path, run_dir.resolve(), profile)
-        table = run_table(path, run_id)
-    else:
-        table = read_run(Path(option))[0]
-    info_path = Path(option) / RUN_INFO_FILE
-    other = RunInfo.read(info_path).profile if info_path.is_file() else ""
-    if profile and other and other != profile:
-        raise SimparityError(f"--baseline {one_line(option)}: a {other}-profile run, this one is {profile} (allowed: a "
-                             f"baseline of the {profile} profile; its rows have other time steps and horizons)")
+        run_id, _ = latest_before(path, run_dir.resolve(), profile)  # of this profile, or of none recorded
+        return run_table(path, run_id)
+    table, info = read_run(Path(option))
+    if profile and info.profile and info.profile != profile:
+        raise SimparityError(f"--baseline {one_line(option)}: a {info.profile}-profile run, this one is {profile} "
+                             f"(allowed: a baseline of the {profile} profile; its rows have other time steps and "
+                             "horizons)")
     return table
 
 
 def _check(run_dir: Path, bounds, args, out, result: CheckResult | None = None) -> int:
     """Print the verdict on a stored run (and the moves since the baseline); 0 passed, 1 not.
     ``result``: the run already held to ``bounds``."""
-    table, _ = read_run(run_dir)
+    table, info = read_run(run_dir)
     result = check_table(table, bounds) if result is None else result
     diff = None
     if args.baseline:
         if not math.isfinite(args.baseline_rel) or args.baseline_rel < 0:
             raise SimparityError(f"--baseline-rel {args.baseline_rel}: out of range (allowed: a number >= 0)")
-        diff = compare_with_baseline(table, _baseline_table(args.baseline, run_dir, args.history), args.baseline_rel)
+        diff = compare_with_baseline(table, _baseline_table(args.baseline, run_dir, info.profile, args.history), args.baseline_rel)
     shown = result.violations if args.verbose else grouped(result.violations)
     for violation in shown:
         print(f"violation: {one_line(violation.line(), MESSAGE_LIMIT)}", file=out)

@@ -324,10 +324,9 @@ class BoundIndex:
 
     def decider(self, scene: str, engine: str, integrator: str, metric: str, dt: float = math.nan,
                 scheme: str = "") -> Bound | None:
-        """The bound that decides a row, or None."""
-        candidates = self.exact.get((scene, engine, integrator, metric), []) + self.patterned
-        matching = [b for b in candidates if b.matches(scene, engine, integrator, metric, dt, scheme)]
-        return max(matching, key=lambda b: b.precedence) if matching else None
+        """The bound that decides a row (the first of :meth:`matching`), or None."""
+        matching = self.matching(scene, engine, integrator, metric, dt, scheme)
+        return matching[0] if matching else None
 
 
 def matching_bounds(bounds: list[Bound], scene: str, engine: str, integrator: str, metric: str,

@@ -1,7 +1,8 @@
 """The CI gate on copies of core: ``simparity run --quick --check`` with them beside core, and its verdicts.
 
-One process per run, the copies' folder on its import path. Violation lines name their engine
-(``violation: <scene> <engine> <integrator> [dt=...] <metric>: ...``), so several copies can share a run.
+One process per run, the copies' folder on its import path. Violation lines (``--verbose``: one per metric, not
+one per case and reason) name their engine (``violation: <scene> <engine> <integrator> [dt=...] <metric>: ...``),
+so several copies can share a run.
 
 A copy is *caught* when the run exits 1 and a violation names it on a row (scene, integrator, dt, metric) on
 which the faithful copy broke no bound in the baseline run of the suite (core beside the faithful copy): a row
@@ -129,7 +130,7 @@ def run_gate(copies: list[CoreCopy], suite: str, out: Path, scenes: tuple[str, .
     out = Path(out)
     path = [str(roots.pop())] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
     which = list(scenes) if scenes else ["--suite", suite]
-    command = [str(SIMPARITY), "run", "--quick", "--check", *which, "--engines",
+    command = [str(SIMPARITY), "run", "--quick", "--check", "--verbose", *which, "--engines",
                ",".join(["core"] + [c.spec for c in copies]), "--out", str(out), "--jobs", str(JOBS),
                "--case-timeout", str(CASE_TIMEOUT), "--history", _history(out)]
     start = time.monotonic()
@@ -150,7 +151,7 @@ def check_run(out: Path) -> GateRun:
     out = Path(out)
     timing = json.loads(out.with_name(out.name + TIMING_SUFFIX).read_text(encoding="utf-8"))
     engines = tuple(json.loads((out / "run.json").read_text(encoding="utf-8"))["engine_versions"])
-    command = [str(SIMPARITY), "check", str(out), "--history", _history(out)]
+    command = [str(SIMPARITY), "check", str(out), "--verbose", "--history", _history(out)]
     exit_code, violations, summary = _parse(subprocess.run(command, capture_output=True, text=True), command)
     return GateRun(timing["suite"], engines, exit_code, violations, timing["seconds"], summary)
 
