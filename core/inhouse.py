@@ -10,6 +10,7 @@ import numpy as np
 from simparity.core.dynamics import point_mass
 from simparity.core.runtime.allocator import keep_freed_memory
 from simparity.core.contact.bodies import (
+    FLIGHT_SCHEME,
     PENALTY_SCHEMES,
     Bodies,
     ContactModel,
@@ -19,13 +20,13 @@ from simparity.core.contact.bodies import (
 )
 from simparity.core.contact.act_after import GAUSS_SEIDEL_PASSES, ActAfterStepper
 from simparity.core.contact.backup import FREE, MAX_EVENTS_PER_STEP, BackupStepper
-from simparity.core.model.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.model.engine import BatchedRun, Engine, IKModel, KinematicsModel, Simulation, Support
 from simparity.core.dynamics.forces import make_wrench
 from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik, task_basis
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.ik.restarts import Restarts, solve_ik_with_restarts
 from simparity.core.model.ik_result import IKResult
-from simparity.core.dynamics.integrators import ORDER, ORIENTATION_UPDATES, SCHEMES, Step, make_step
+from simparity.core.dynamics.integrators import ORDER, ORIENTATION_UPDATES, SCHEMES, STAGES, Step, make_step
 from simparity.core.dynamics.quaternion_integrators import PackedBodies, make_packed_step, pack
 from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.dynamics.rigid_body import MassProperties, State, initial_state, velocities
@@ -67,8 +68,26 @@ def parse_integrator(name: str) -> tuple[str, str]:
     return scheme, orientation or _DEFAULT_ORIENTATION
 
 
-class _RigidBodySimulation(Simulation):
+PARTICLE_STAGES = 1
+"""Wrench evaluations per step of a particle rule: the particle loop evaluates the scene's force once per step,
+whatever the rule (``constant_velocity`` discards it)."""
+
+
+class _InHouseSimulation(Simulation):
+    """Core's simulations, vectorised over bodies: copies of a scene step together as one scene of their bodies."""
+
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
+        self._scene, self._integrator, self._dt = scene, integrator, dt
+
+    def batched(self, copies: int) -> BatchedRun:
+        """The run of this simulation built again for ``copies`` copies of its scene
+        (:meth:`DynamicsScene.replicated`): one call of every step for all of them."""
+        return type(self)(self._scene.replicated(copies), self._integrator, self._dt).run
+
+
+class _RigidBodySimulation(_InHouseSimulation):
+    def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
+        super().__init__(scene, integrator, dt)
         scheme, orientation = parse_integrator(integrator)
         self._props = MassProperties.of(scene.bodies)
         wrench = make_wrench(scene.forces, self._props)
@@ -80,7 +99,6 @@ class _RigidBodySimulation(Simulation):
             self._packed_step = make_packed_step(scheme, self._props, wrench)
         else:
             self._step = make_step(scheme, orientation, self._props, wrench)
-        self._dt = dt
         self.detail = f"in-house {scheme}, orientation update: {orientation}"
 
     def run(self, n_steps: int) -> Trajectory:
@@ -111,12 +129,13 @@ class _RigidBodySimulation(Simulation):
         return pos, matrix_to_quat_wxyz(ori), vel, omg
 
 
-class _ParticleSimulation(Simulation):
+class _ParticleSimulation(_InHouseSimulation):
     """The lecture's point-mass rules; orientation and angular velocity stay at their initial values."""
 
     integrates_rotation = False
 
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
+        super().__init__(scene, integrator, dt)
         self._rule = point_mass.RULES[integrator]
         props = MassProperties.of(scene.bodies)
         self._wrench = make_wrench(scene.forces, props)
@@ -125,7 +144,6 @@ class _ParticleSimulation(Simulation):
         self._v0 = np.stack([b.velocity_world for b in scene.bodies])
         self._q0 = np.stack([b.quat_wxyz for b in scene.bodies])
         self._r0 = quat_wxyz_to_matrix(np.stack([b.quat_wxyz for b in scene.bodies]))
-        self._dt = dt
         self.detail = f"in-house particle rule {integrator} (lecture, Bodies in Free Fall)"
 
     def run(self, n_steps: int) -> Trajectory:
@@ -142,7 +160,7 @@ class _ParticleSimulation(Simulation):
         return Trajectory(np.arange(n_steps + 1) * dt, pos, quat, vel, omg)
 
 
-class _ContactSimulation(Simulation):
+class _ContactSimulation(_InHouseSimulation):
     """Bodies against the scene's planes by one of core's contact methods.
 
     After :meth:`run`, ``events`` holds the backup method's contact events (:class:`core.contact.EventLog`;
@@ -150,25 +168,26 @@ class _ContactSimulation(Simulation):
     """
 
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
+        super().__init__(scene, integrator, dt)
         contact = scene.contact
         assert contact is not None  # built only when supported: contact integrators need the scene's contact
         self._props = MassProperties.of(scene.bodies)
         self._state0 = initial_state(scene.bodies, self._props, quaternion=True)
         self._model = ContactModel.of(contact, self._props.mass)
-        self._dt, self._method = dt, integrator
+        self._method = integrator
         self.events = EventLog()
         if integrator == "backup":
             self._backup = BackupStepper(Bodies(self._props, self._model, scene.forces))
             self.detail = (f"in-house backup: time backed up to each contact (exact root for bodies that do not "
                            f"turn, bracketed root finder otherwise), impulse with restitution and Coulomb friction, "
-                           f"resting contact below rest_speed {contact.rest_speed:g} m/s; free flight rk4 "
+                           f"resting contact below rest_speed {contact.rest_speed:g} m/s; free flight {FLIGHT_SCHEME} "
                            f"(quaternion); at most {MAX_EVENTS_PER_STEP} events per body and step (more: put at "
                            f"rest); a body at rest slides or stays, it never rolls (a sphere sliding with friction "
                            f"stops instead of rolling)")
         elif integrator == "act_after":
             self._step: Step = ActAfterStepper(Bodies(self._props, self._model, scene.forces)).step
-            self.detail = (f"in-house act_after: free flight rk4 (quaternion), then push-out and impulse with "
-                           f"restitution and Coulomb friction ({GAUSS_SEIDEL_PASSES} Gauss-Seidel passes), plastic "
+            self.detail = (f"in-house act_after: free flight {FLIGHT_SCHEME} (quaternion), then push-out and impulse "
+                           f"with restitution and Coulomb friction ({GAUSS_SEIDEL_PASSES} Gauss-Seidel passes), plastic "
                            f"below rest_speed {contact.rest_speed:g} m/s and for a body touching since the step's "
                            f"start; pushed out before each sample, so no penetration shows")
         else:
@@ -284,6 +303,23 @@ class InHouseEngine(Engine):
         if integrator in CONTACT_INTEGRATORS:
             return None
         return ORDER.get(parse_integrator(integrator)[0])
+
+    def stages(self, integrator: str) -> int | None:
+        """Wrench evaluations per step, counted in the code (:data:`core.integrators.STAGES`): a scheme's stages
+        whatever its orientation update; a particle rule 1 (:data:`PARTICLE_STAGES`); ``penalty_<scheme>`` its
+        scheme's (the penalty force is part of the wrench); backup and act_after their free flight's, RK4's 4.
+        That is all act_after evaluates (its push-out and impulses evaluate no force). Backup's event handling is
+        not counted, so its 4 is a lower bound: every step it also evaluates the wrench for the resting support
+        (1) and the contact search (1 for the exact root, a trial flight of 4 for the root finder), and backing
+        up time to each contact adds root-finder flights and a second flight for the rest of the step. None for
+        an integrator core does not offer."""
+        if integrator in point_mass.RULES:
+            return PARTICLE_STAGES
+        if integrator in ("backup", "act_after"):
+            return STAGES[FLIGHT_SCHEME]
+        if integrator in CONTACT_INTEGRATORS:
+            return STAGES[integrator.removeprefix(PENALTY_PREFIX)]
+        return STAGES.get(parse_integrator(integrator)[0])
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
         named = self.check_integrator(integrator)

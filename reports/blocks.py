@@ -40,20 +40,24 @@ class Table:
 
 @dataclass(frozen=True)
 class Figure:
-    """A figure written by :func:`reports.figures.save` as ``figures/<name>.svg`` (and .png)."""
+    """A figure written by :func:`reports.figures.save` as ``figures/<name>.svg`` (and .png). ``caption`` is under
+    it in the HTML; report.md links it with its short ``alt`` (the figure's name when empty): docs/report.md says how
+    to read each figure."""
 
     name: str
     caption: str
+    alt: str = ""
 
 
 @dataclass(frozen=True)
 class Details:
-    """Folded content: collapsed in HTML; in Markdown a ``<details>`` block, or left out when
-    ``markdown`` is False (it is in ``results.csv`` and the HTML)."""
+    """Folded content: collapsed in HTML (unfolded when ``open``); in Markdown a ``<details>`` block, or left out
+    when ``markdown`` is False (it is in ``results.csv`` and the HTML)."""
 
     summary: str
     blocks: tuple = field(default_factory=tuple)
     markdown: bool = True
+    open: bool = False
 
 
 Block = Heading | Paragraph | Bullets | Table | Figure | Details

@@ -8,6 +8,7 @@ from __future__ import annotations
 import concurrent.futures
 import math
 import re
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +24,7 @@ from simparity.core.model.results import (
     case_counts,
     case_status,
 )
-from simparity.reports import figures, summary, sweep_sections, sweep_summary, tables
+from simparity.reports import engine_summary, figures, summary, sweep_sections, sweep_summary, tables
 from simparity.reports.blocks import (
     Block,
     Bullets,
@@ -35,6 +36,7 @@ from simparity.reports.blocks import (
     number,
     scene_heading,
 )
+from simparity.reports.markdown import LINE_CHARS
 from simparity.reports.sweep_summary import Sweep, merge_variants, union
 from simparity.core.model.metric_catalogue import (
     APEX_HEIGHT_ERROR, CROSS_EVAL_SOLVE_RATE_MIN, ENERGY_GAIN_MAX, IMPACT_TIME_ERROR, ITERATIONS_MEDIAN,
@@ -153,7 +155,7 @@ def _verdict_line(name: str, rows: pd.DataFrame) -> str:
     counts = statuses.value_counts()
     diverged = sorted({f"{e} {i}" for (_, e, i, _), s in statuses.items() if s == "diverged"})
     text = f"**{name}**: " + ", ".join(f"{s} {counts[s]}" for s in STATUSES if s in counts)
-    return text + (f"; diverged: {', '.join(diverged)}" if diverged else "")
+    return text + (f"; diverged: {_names(diverged)}" if diverged else "")
 
 
 def _hard_cases(table: pd.DataFrame, info: RunInfo, groups: dict[str, str]) -> list[Block]:
@@ -168,10 +170,8 @@ def _hard_cases(table: pd.DataFrame, info: RunInfo, groups: dict[str, str]) -> l
     swept = set(groups.values())
     blocks: list[Block] = [
         Heading(2, "Hard cases"),
-        Paragraph("The numerical-stability cases of the `hard` suite and the verdict each engine earned: a case is "
-                  "`diverged` when a conserved quantity or a speed left its bound, `ok` when it stayed bounded (its "
-                  "errors are in the scene's section). The verdict each must earn is in the shipped tolerances "
-                  "(`simparity check`).")]
+        Paragraph("The `hard` suite's numerical-stability cases: `diverged` when a conserved quantity or a speed left "
+                  "its bound, `ok` when it stayed bounded; the verdict each must earn is in the shipped tolerances.")]
     lines = []
     for name in scenes:
         rows = table[table["_group"] == name]
@@ -199,10 +199,22 @@ def _headline(about: dict) -> str:
 
 
 def _scheme(case: pd.Series | None, unit: str) -> str:
+    """A case the summary picked for its accuracy: ``mujoco rk4 @ 0.01: 1.09e-08 rad``."""
     if case is None:
         return "none"
-    return (f"{case['engine']} {case['integrator']} @ dt {case['dt']:g}: {number(case['error'])} {unit}, "
-            f"{number(case['cost'])} s/s")
+    return f"{case['engine']} {case['integrator']} @ {case['dt']:g}: {number(case['error'])} {unit}"
+
+
+def _ranking_text(by: str) -> str:
+    """What the summary ranks by, and why that is fair."""
+    truths = f"Ground truths ({', '.join(GROUND_TRUTH_ENGINES)}) are not ranked."
+    if by == summary.WALL:
+        return ("Ranked by wall time per simulated second [s/s]: this run has no force evaluation counts (its "
+                "engines declare no stages). Within one engine that is fair (its per-call overhead is shared); across "
+                f"engines it also measures each one's overhead per call. {truths}")
+    return ("Ranked by force evaluations per simulated second (stages / dt: Hairer's hardware-neutral work, blind to "
+            "per-call overhead), ties by wall time (each scene's section has it, and the batched time). "
+            f"{truths[:-1]}; schemes without a stage count only within their engine.")
 
 
 _OVERHEAD_MARK = "†"
@@ -212,6 +224,25 @@ def _overhead_mark(engine: str, about: dict) -> str:
     """A mark on core's time when the scene's batch is small enough for per-call overhead to dominate."""
     bodies = about.get("bodies")
     return f" {_OVERHEAD_MARK}" if engine == "core" and bodies is not None and bodies < summary.OVERHEAD_DOMINATED_BODIES else ""
+
+
+@dataclass(frozen=True)
+class _Contact:
+    """What a contact scene's section adds: its height figure, per engine (its measured restitution's range, its
+    worst penetration) as cells, and its blocks after the tables."""
+
+    figure: list[Block]
+    per_engine: dict[str, tuple[str, str]]
+    blocks: list[Block]
+
+
+def _value_range(values: pd.Series) -> str:
+    """``0.486-0.601``: the range of the measured values; one value as itself; none as an em dash."""
+    measured = values.dropna()
+    if measured.empty:
+        return "—"
+    low, high = number(float(measured.min())), number(float(measured.max()))
+    return low if low == high else f"{low}-{high}"
 
 
 class _Builder:
@@ -224,6 +255,12 @@ class _Builder:
         self.sweep_of = {name: sweep for sweep in sweeps for name in sweep.variants}
         self.groups = sweep_summary.groups(sweeps)
         self.counts = sweep_summary.counts(sweeps)
+        self.cases = {scene: summary.dynamics_cases(rows, _headline(self.about(scene)))
+                      for scene, rows in table.groupby("scene", sort=False)
+                      if _kind(rows) == "dynamics" and scene not in self.sweep_of}
+        ranked = list(self.cases.values()) + [s.across for s in sweeps if s.kind == "dynamics"]
+        self.by = summary.ranking_cost(pd.concat(ranked)) if ranked else summary.WALL
+        self.findings_per_scene: Counter = Counter()
 
     def listed(self, scene: str) -> bool:
         """Whether ``scene`` has a section of its own: a scene outside a sweep, or a variant the sweep shows."""
@@ -245,20 +282,21 @@ class _Builder:
         dyn_rows: list[tuple[str, ...]] = []
         ik_rows: list[tuple[str, ...]] = []
         swept: set[str] = set()
+        by = self.by
         for scene, rows in self.table.groupby("scene", sort=False):
             kind, about = _kind(rows), self.about(scene)
             if scene in self.sweep_of:
                 sweep = self.sweep_of[scene]
                 if sweep.base not in swept and kind in ("dynamics", "ik"):
-                    (dyn_rows if kind == "dynamics" else ik_rows).append(_sweep_row(sweep))
+                    (dyn_rows if kind == "dynamics" else ik_rows).append(_sweep_row(sweep, by))
                 swept.add(sweep.base)
             elif kind == "dynamics":
-                headline = _headline(about)
-                name, unit = _HEADLINE_NAMES[headline]
-                cases = summary.dynamics_cases(rows, headline)
-                cells = [f"[{scene}](#{scene_heading(scene, kind).anchor})", f"{name} [{unit}] vs `{rows['reference'].iloc[0]}`"]
-                cells += [_scheme(summary.cheapest_within(cases, b), unit) for b in summary.ERROR_BUDGETS]
-                cells += [_scheme(summary.most_accurate_within(cases, b), unit) for b in summary.TIME_BUDGETS]
+                name, unit = _HEADLINE_NAMES[_headline(about)]
+                cases = self.cases[scene]
+                cells = [f"[{scene}](#{scene_heading(scene, kind).anchor})",
+                         f"{name.removesuffix(' error max')} [{unit}] vs `{rows['reference'].iloc[0]}`"]
+                cells += [engine_summary.overall(cases, b, by) for b in summary.ERROR_BUDGETS]
+                cells += [_scheme(summary.most_accurate_within(cases, b, by), unit) for b in summary.cost_budgets(by)]
                 dyn_rows.append(tuple(cells))
             elif kind == "ik":
                 best, fastest = summary.best_ik(summary.ik_solvers(rows[~rows["metric"].str.startswith("hard_")]))
@@ -266,39 +304,37 @@ class _Builder:
                 ik_rows.append((f"[{scene}](#{scene_heading(scene, kind).anchor})", _solver(best, tolerance),
                                 _solver(fastest, tolerance)))
         if dyn_rows:
-            blocks += [
-                Heading(3, "Which integrator for this scene?"),
-                Paragraph("Per dynamics scene, the cheapest engine × integrator × dt whose error is within each budget, "
-                          "and the most accurate within each compute budget (cost = compute per simulated second "
-                          "[s/s]; 1e-2 s/s is 100× faster than real time). Errors are in the scene's headline metric "
-                          "(the orientation error where a body turns, else the position error) against the named "
-                          f"reference; ground truths ({', '.join(GROUND_TRUTH_ENGINES)}) are not ranked. "
-                          "\"none\": no scheme run reached it."),
-                Table(("scene", "error (reference)") + tuple(f"error ≤ {b:g}" for b in summary.ERROR_BUDGETS)
-                      + tuple(f"most accurate at ≤ {b:g} s/s" for b in summary.TIME_BUDGETS), tuple(dyn_rows)),
-                *([_SWEEP_ROWS_DYNAMICS] if any(s.kind == "dynamics" for s in self.sweeps) else []),
-                Paragraph("Each dynamics scene's section below has its work-precision, convergence and drift figures "
-                          "and, per engine × integrator, the time step of least error with its cost and time per "
-                          "step, the observed order of that error (theory in brackets) and the status of its time "
-                          "steps; an integrator with variants (core's orientation updates: quaternion, matrix, "
-                          "expmap) has one row, each cell listing its variants' values in the order named, or one "
-                          "value where they agree. Every engine × integrator × dt is in the HTML report and "
-                          "`results.csv`. "
-                          f"{_OVERHEAD_MARK} on core's time per step: the scene has fewer than "
-                          f"{summary.OVERHEAD_DOMINATED_BODIES} bodies, so the time is mostly NumPy's per-call "
-                          "overhead, not arithmetic; per body it falls tenfold and more with 100 bodies in one batch "
-                          "(`simparity bench`, BENCHMARKS.md).")]
+            blocks += [Heading(3, "Which integrator?"), Paragraph(_ranking_text(by)), *self.per_engine_table(),
+                       Table(("scene", "error (reference)") + tuple(f"error ≤ {b:g}" for b in summary.ERROR_BUDGETS)
+                             + tuple(f"most accurate at {summary.cost_label(by, b)}" for b in summary.cost_budgets(by)),
+                             tuple(dyn_rows)),
+                       *([_SWEEP_ROWS_DYNAMICS] if any(s.kind == "dynamics" for s in self.sweeps) else [])]
         if ik_rows:
             blocks += [Heading(3, "Which IK solver?"),
-                       Paragraph(f"Best solve rate (the faster on a tie) and the fastest solver at ≥ "
-                                 f"{summary.SOLVED_ENOUGH:.0%} solve rate, on the scene's random targets, ranked at "
-                                 "the scene's position tolerance. A solver that stops by a looser rule of its own (a "
-                                 "library's default threshold) is ranked at the scene's tolerance too, which it was "
-                                 "not configured to meet: its rate at its own rule is given beside it."),
+                       Paragraph(f"Best solve rate (the faster on a tie) and the fastest at ≥ "
+                                 f"{summary.SOLVED_ENOUGH:.0%}, at the scene's position tolerance (a solver with a "
+                                 "looser rule of its own: its rate at that rule beside it)."),
                        Table(("scene", "best solve rate", f"fastest at ≥ {summary.SOLVED_ENOUGH:.0%}"),
                              tuple(ik_rows)),
                        *([_SWEEP_ROWS_IK] if any(s.kind == "ik" for s in self.sweeps) else [])]
         return blocks + self.findings() + self.unresolved()
+
+    def per_engine_table(self) -> list[Block]:
+        """The per-engine answer over the run's dynamics scenes (sweeps have theirs in their section): how often each
+        scheme of an engine was its own cheapest within each error budget and most accurate within each cost
+        budget."""
+        per_scene = [engine_summary.choices(cases, self.by) for scene, cases in self.cases.items()]
+        if not per_scene:
+            return []
+        tallies = engine_summary.tally(per_scene)
+        columns = list(next(iter(per_scene[0].values()), {}))
+        head = ("engine",) + tuple(f"cheapest at {c}" if c.startswith("error") else f"most accurate at {c}"
+                                   for c in columns)
+        return [Paragraph(f"Each engine's own choice over {len(per_scene)} scenes (\"rk4 ×9\": on 9; \"none\": none "
+                          "of its schemes reached the budget), then the overall best per scene (\"+k as cheap\": k "
+                          "others do the same work)."),
+                Table(head, tuple((_ran_on(engine, per_scene),) + tuple(cells.get(c, "none") for c in columns)
+                                  for engine, cells in tallies.items()))]
 
     def merged(self, frame: pd.DataFrame, keys: list[str], **aggregations) -> pd.DataFrame:
         """``frame`` with each sweep's variants merged (:func:`reports.sweep_summary.merge_variants`); as it is in a
@@ -331,6 +367,7 @@ class _Builder:
             rows.append(("saturated", scene, counted, "", "", "n/a: the error reached its quantity's scale and lost all "
                          "meaning (cases counted per metric)"))
         rows += self.order_findings()
+        self.findings_per_scene = Counter(row[1] for row in rows)
         blocks: list[Block] = [Heading(3, "Flagged findings")]
         if rows:
             blocks.append(Table(("finding", "scene", "engine × scheme (or metric: cases)", "dt [s]", "largest",
@@ -397,18 +434,15 @@ class _Builder:
                          _clip(g["reason"].iloc[0] or "no reason given", REASON_CHARS)
                          + (f" (and {g['reason'].nunique() - 1} more like it)" if g["reason"].nunique() > 1 else "")))
         return [Heading(3, "Cases without a result"),
-                Paragraph("Every failed, diverged or n/a case, counted, with its reason (the full reason of each row "
-                          "is its `detail` in `results.csv`)."),
                 Table(("status", "scenes", "engine × scheme", "cases", "dt [s]", "reason (the first; others alike but for "
-                       "their numbers)"), tuple(rows))]
+                       "their numbers; each in full: its `detail` in `results.csv`)"), tuple(rows))]
 
     # -- scenes --------------------------------------------------------------------------------
 
     def introduction(self, scene: str, rows: pd.DataFrame) -> str:
-        """What the scene is (a sweep's variant: its values), its reference and file, and how its hard IK targets
-        fared."""
+        """What the scene is (a sweep's variant: its values), its reference and the name of its file (run.json has
+        the path)."""
         about = self.about(scene)
-        solved, total = _hard_solved(rows)
         sweep = about.get("sweep")
         shown = (f" ({sweep_sections.roles(self.sweep_of[scene], scene)})"
                  if scene in self.sweep_of and scene in self.sweep_of[scene].shown else "")
@@ -417,43 +451,59 @@ class _Builder:
                    f"(#{sweep_sections.heading(sweep['base']).anchor}){shown}: "
                    + ", ".join(f"`{key}` = {value}" for key, value in sweep["values"].items()) + ". " if sweep else "")
                 + f"Reference: `{rows['reference'].iloc[0]}`."
-                + (f" Scene file: `{about['source']}`." if about.get("source") else "")
-                + (f" Hard targets: {solved} of {total} solves succeeded (each solver's verdict per target: the "
-                   "HTML report, `results.csv`)." if total else ""))
+                + (f" Scene file: `{Path(about['source']).name}`." if about.get("source") else ""))
 
     def scene(self, scene: str, rows: pd.DataFrame) -> list[Block]:
-        """The section of a dynamics or IK scene."""
+        """The section of a dynamics or IK scene: its verdict in one line and what the scene is, then its figures
+        and tables."""
         kind, about = _kind(rows), self.about(scene)
         reference = rows["reference"].iloc[0]
-        blocks: list[Block] = [scene_heading(scene, kind), Paragraph(self.introduction(scene, rows))]
         series = self.series[self.series["scene"] == scene]
-        if kind == "dynamics":
-            blocks += self.dynamics(scene, rows, about, reference, series)
-        else:
-            blocks += self.ik(scene, rows, about, reference, series)
-        return blocks + _notes(rows)
+        run = self.dynamics if kind == "dynamics" else self.ik
+        verdict, body = run(scene, rows, about, reference, series)
+        lead = Bullets((f"**Verdict**: {verdict}", f"**Scene**: {self.introduction(scene, rows)}"))
+        return [scene_heading(scene, kind), lead, *body, *_notes(rows)]
 
     def kinematics(self, rows: pd.DataFrame) -> list[Block]:
-        """One section for every kinematics scene: frame and Jacobian errors against each scene's reference."""
+        """One section for every kinematics scene: in report.md each scene's frame position error per engine (the
+        status where it was not measured); in report.html frame and Jacobian errors and times per scene × engine."""
         scenes = list(dict.fromkeys(rows["scene"]))
+        engines = list(dict.fromkeys(rows["engine"]))
+        compact = []
+        for scene in scenes:
+            own = rows[rows["scene"] == scene]
+            cells = []
+            for engine in engines:
+                cell = own[(own["engine"] == engine) & (own["metric"] == POSITION_ERROR_MAX)]
+                cells.append("—" if cell.empty else number(cell["value"].iloc[0]) if cell["status"].iloc[0] == OK
+                             else cell["status"].iloc[0])
+            compact.append((scene, *cells))
+        full = tables.metric_table(rows, tables.KINEMATICS_COLUMNS, ["scene", "engine"])
         blocks: list[Block] = [Heading(2, "Kinematics"),
                                Bullets(tuple(f"**{scene}**: {self.introduction(scene, rows[rows['scene'] == scene])}"
                                              for scene in scenes)),
-                               tables.metric_table(rows, tables.KINEMATICS_COLUMNS, ["scene", "engine"])]
+                               Paragraph("Frame position error max [m] against each scene's reference; orientation and "
+                                         "Jacobian errors, times and the reasons for n/a: the HTML report."),
+                               Table(("scene", *engines), tuple(compact)),
+                               Details("Every kinematics metric", (full,), markdown=False, open=True)]
         return blocks + _notes(rows)
 
-    def dynamics(self, scene, rows, about, reference, series) -> list[Block]:
+    def dynamics(self, scene, rows, about, reference, series) -> tuple[str, list[Block]]:
+        """(the scene's verdict in one line, its blocks): figures, a row per engine in report.md (its most accurate
+        scheme, its cheapest within each error budget, its orders or contact measures, its cases), and in report.html
+        the row per engine × integrator and every engine × integrator × dt."""
         headline = _headline(about)
         name, unit = _HEADLINE_NAMES[headline]
-        cases = summary.dynamics_cases(rows, headline)
+        cases = self.cases[scene] if scene in self.cases else summary.dynamics_cases(rows, headline)
         observed = summary.orders(rows, headline)
         theory = self.info.theoretical_orders
         blocks = self.figure(figures.work_precision_figure(scene, cases, headline, reference,
                                                            self.info.integrator_variants),
                              f"{scene}-work-precision",
-                             f"Work-precision: x = {name} [{unit}] (log), y = compute per simulated second [s/s] (log); "
-                             "one point per dt, lower left is better. A scheme's variants share its colour, one marker "
-                             "each; dotted: the summary's error budgets.")
+                             f"Work-precision: x = {name} [{unit}] (log), y = wall time per simulated second [s/s] "
+                             "(log; below, where counted: force evaluations per simulated second, the hardware-neutral "
+                             "cost); one point per dt, lower left is better. A scheme's variants share its colour, one "
+                             "marker each; dotted: the summary's error budgets.")
         if not about.get("contact"):  # with contact the error has no order (impacts), so no convergence figure
             order_rows = rows[rows["dt"].isna() & (rows["metric"] == summary.ORDER_METRICS[headline])
                               & (rows["status"] != OK)]
@@ -465,8 +515,50 @@ class _Builder:
                                   "theoretical order's slope; schemes whose errors agree to 0.1 % share one line.")
         blocks += self.figure(figures.drift_figure(scene, series, reference), f"{scene}-drift",
                               "Drift over time at the coarsest dt, from the stored series.")
-        if about.get("contact"):
-            blocks += self.contact(scene, rows, about, reference, series)
+        fits = engine_summary.fitted_orders(rows, headline, theory)
+        contact = self.contact(scene, rows, about, reference, series) if about.get("contact") else None
+        blocks += contact.figure if contact else []
+        blocks += [self.per_engine(cases, fits, unit, contact), self.per_scheme(cases, observed, about, unit)]
+        blocks += contact.blocks if contact else []
+        full: list[Block] = [tables.metric_table(rows[rows["dt"].notna()], tables.DYNAMICS_COLUMNS,
+                                                 ["engine", "integrator", "dt"])]
+        orders = rows[rows["dt"].isna()]
+        if not orders.empty:
+            explained: list[Block] = [
+                Paragraph("Observed order of convergence: slope of log(error max) against log(dt) over the finest "
+                          "time steps whose local slopes agree; errors at the rounding floor or saturated are left out."),
+                tables.metric_table(orders, tables.ORDER_COLUMNS, ["engine", "integrator"])]
+            full += explained + _fits(orders)
+        verdict = engine_summary.dynamics_verdict(cases, fits, self.findings_per_scene.get(scene, 0), unit)
+        return verdict, blocks + [Details(f"{scene}: every engine × integrator × dt", tuple(full), markdown=False)]
+
+    def per_engine(self, cases: pd.DataFrame, fits: pd.DataFrame, unit: str, contact: _Contact | None) -> Table:
+        """report.md's table of a dynamics scene: a row per engine (the user's first) with its most accurate scheme,
+        its cheapest within each error budget (by the summary's cost), its fitted orders against theory (a contact
+        scene: its measured restitution and worst penetration) and how its cases ended."""
+        choices = engine_summary.choices(cases, self.by)
+        rows = []
+        for engine, picks in choices.items():
+            own = cases[cases["engine"] == engine]
+            best = own[(own["status"] == OK) & own["error"].notna()].sort_values(["error", summary.WALL])
+            accurate = engine_summary.pick(best.iloc[0] if not best.empty else None, self.by, show_error=True)
+            ranked_by = engine_summary.own_cost(own, self.by)
+            budgets = [engine_summary.pick(picks[f"error ≤ {b:g}"], ranked_by, show_error=False)
+                       for b in summary.ERROR_BUDGETS]
+            measures = (contact.per_engine.get(engine, ("—", "—")) if contact else
+                        (engine_summary.orders_text(fits[fits["engine"] == engine]),))
+            statuses = ", ".join(f"{k} {n}" for k, n in own["status"].value_counts().items())
+            rows.append((engine, accurate, *budgets, *measures, statuses))
+        measured = (("restitution measured", "penetration max [m]") if contact else ("orders vs theory",))
+        return Table(("engine", f"most accurate [{unit}]") + tuple(f"cheapest at error ≤ {b:g}"
+                                                                 for b in summary.ERROR_BUDGETS)
+                     + measured + ("cases",), tuple(rows))
+
+    def per_scheme(self, cases: pd.DataFrame, observed: dict, about: dict, unit: str) -> Details:
+        """Per engine × integrator (variants of a scheme on one row): the time step of least error with its error,
+        wall time, force evaluations and batched time per simulated second, time per step, observed order (theory)
+        and how its time steps ended; unfolded in report.html, not in report.md (which has a row per engine)."""
+        theory = self.info.theoretical_orders
         best = summary.best_per_scheme(cases)
         variants = self.info.integrator_variants
         per_scheme: dict[tuple[str, str], list[tuple[str, tuple[str, ...]]]] = {}
@@ -475,28 +567,20 @@ class _Builder:
             fitted = observed.get((b["engine"], b["integrator"]), math.nan)
             scheme, variant = variants.get(b["engine"], {}).get(b["integrator"], (b["integrator"], ""))
             per_scheme.setdefault((b["engine"], scheme), []).append((variant, (
-                number(b["dt"]), number(b["error"]), number(b["cost"]),
-                number(b[TIME_PER_STEP]) + _overhead_mark(b["engine"], about),
+                number(b["dt"]), number(b["error"]), number(b["cost"]), number(b[summary.EVALUATIONS]),
+                number(b["batched_cost"]), number(b[TIME_PER_STEP]) + _overhead_mark(b["engine"], about),
                 f"{number(fitted)} ({p})" if p else number(fitted), b["statuses"])))
-        blocks += [Table(("engine", "integrator", "best dt [s]", f"error [{unit}]", "cost [s/s]", "time per step [s]",
-                          "order (theory)", "time steps"),
-                         tuple(_scheme_row(engine, scheme, members) for (engine, scheme), members in per_scheme.items()))]
+        table = Table(("engine", "integrator", "best dt [s]", f"error [{unit}]", "cost [s/s]", "evaluations [1/s]",
+                       "batched cost [s/s]", "time per step [s]", "order (theory)", "time steps"),
+                      tuple(_scheme_row(engine, scheme, members) for (engine, scheme), members in per_scheme.items()))
+        return Details("Per engine × integrator: the time step of least error (batched cost: one copy's share of a "
+                       "batch stepped together, where the engine can batch)", (table,), markdown=False, open=True)
 
-        full: list[Block] = [tables.metric_table(rows[rows["dt"].notna()], tables.DYNAMICS_COLUMNS,
-                                    ["engine", "integrator", "dt"])]
-        orders = rows[rows["dt"].isna()]
-        if not orders.empty:
-            explained: list[Block] = [
-                Paragraph("Observed order of convergence: slope of log(error max) against log(dt) over the finest "
-                          "time steps whose local slopes agree; errors at the rounding floor or saturated are left out."),
-                tables.metric_table(orders, tables.ORDER_COLUMNS, ["engine", "integrator"])]
-            full += explained + _fits(orders)
-        return blocks + [Details(f"{scene}: every engine × integrator × dt", tuple(full), markdown=False)]
-
-    def contact(self, scene, rows, about, reference, series) -> list[Block]:
-        """The height figure, the contact table (restitution at every dt, the worst penetration and energy
-        gain, errors at the finest dt) and the penalty method's measured stability limits."""
-        blocks = self.figure(figures.contact_height_figure(scene, series, reference), f"{scene}-height",
+    def contact(self, scene, rows, about, reference, series) -> _Contact:
+        """The height figure; per engine its measured restitution's range and worst penetration; in report.html the
+        contact table (restitution at every dt, the worst penetration and energy gain, errors at the finest dt); the
+        penalty method's measured stability limits (one line in report.md, with how each was found in the HTML)."""
+        figure = self.figure(figures.contact_height_figure(scene, series, reference), f"{scene}-height",
                              "Height of the lowest point above the plane against time, from the stored series.")
         cases = summary.contact_cases(rows)
         dts = sorted(cases["dt"].unique())
@@ -511,40 +595,87 @@ class _Builder:
                          + (number(float(g[PENETRATION_MAX].max())), number(float(g[ENERGY_GAIN_MAX].max())),
                             at("dt"), at(IMPACT_TIME_ERROR), at(APEX_HEIGHT_ERROR), at(REST_TIME_ERROR),
                             at(STOPPING_DISTANCE), " · ".join(dict.fromkeys(g["status"]))))
-        blocks += [Paragraph(f"Contact: requested restitution {', '.join(f'{k:g}' for k in requested)}; measured "
-                             "from each run's first rebound (v_out / |v_in|, extrapolated along the free flight "
-                             "from the samples either side), at each dt. Penetration and energy gained: the worst "
-                             "over the time steps; the errors after them at the finest time step measured (named)."),
-                   Table(("engine", "integrator") + tuple(f"restitution at dt {dt:g}" for dt in dts)
-                         + ("penetration max [m]", "energy gained max (rel.)", "finest ok dt [s]", "impact time error [s]",
-                            "apex height error [m]", "rest time error [s]", "stopping distance [m]", "time steps"),
-                         tuple(table))]
+        per_engine = {engine: (_value_range(g[RESTITUTION_MEASURED]), number(float(g[PENETRATION_MAX].max())))
+                      for engine, g in cases.groupby("engine", sort=False)}
+        blocks: list[Block] = [Details(
+            f"Contact, per engine × integrator: requested restitution {', '.join(f'{k:g}' for k in requested)}",
+            (Paragraph("Restitution measured from each run's first rebound (v_out / |v_in|, extrapolated along the "
+                       "free flight from the samples either side), at each dt. Penetration and energy gained: the "
+                       "worst over the time steps; the errors after them at the finest time step measured (named)."),
+             Table(("engine", "integrator") + tuple(f"restitution at dt {dt:g}" for dt in dts)
+                   + ("penetration max [m]", "energy gained max (rel.)", "finest ok dt [s]", "impact time error [s]",
+                      "apex height error [m]", "rest time error [s]", "stopping distance [m]", "time steps"),
+                   tuple(table))), markdown=False, open=True)]
         limits = summary.stability_limits(rows)
         if not limits.empty:
-            items = tuple(f"{r['engine']} {r['integrator']}: "
-                          + (f"{number(r['value'])} s" if r["status"] == OK else f"{r['status']}")
-                          + f" ({r['detail']})" for _, r in limits.iterrows())
-            blocks += [Paragraph("Penalty method, measured stability limit (the largest step that neither blows "
-                                 "up nor gains energy at an impact):"), Bullets(items)]
-        return blocks
+            values = "; ".join(f"{r['engine']} {r['integrator']} "
+                               + (f"{number(r['value'])} s" if r["status"] == OK else r["status"])
+                               for _, r in limits.iterrows())
+            items = tuple(f"{r['engine']} {r['integrator']}: {r['detail']}" for _, r in limits.iterrows())
+            blocks += [Paragraph("Penalty method, measured stability limit (the largest step that neither blows up "
+                                 f"nor gains energy at an impact): {values}."),
+                       Details("How each stability limit was found", (Bullets(items),), markdown=False)]
+        return _Contact(figure, per_engine, blocks)
 
-    def ik(self, scene, rows, about, reference, series) -> list[Block]:
+    def ik(self, scene, rows, about, reference, series) -> tuple[str, list[Block]]:
+        """(the scene's verdict in one line, its blocks): figures, a row per engine in report.md (its best solver and
+        its fastest reliable one), and in report.html the row per solver, every metric and the hard targets."""
         solvers = summary.ik_solvers(rows[~rows["metric"].str.startswith("hard_")])
+        tolerance = about.get("position_tolerance")
         blocks = self.figure(figures.ik_rate_figure(scene, solvers, reference), f"{scene}-solve-rate",
                              "Solve rate against time per solve.")
-        blocks += self.figure(figures.ik_distribution_figure(scene, series, about.get("position_tolerance")),
+        blocks += self.figure(figures.ik_distribution_figure(scene, series, tolerance),
                               f"{scene}-residuals", "Distributions of the position residual [m] and the iterations.")
         blocks += self.figure(figures.fk_matrix_figure(scene, series), f"{scene}-fk-agreement",
                               "Cross-engine FK agreement on every solution [m].")
-        blocks += _own_rules(solvers, about.get("position_tolerance"))
+        per_engine = []
+        for engine in engine_summary.engine_order(solvers["engine"]):
+            own = solvers[solvers["engine"] == engine]
+            best, fastest = summary.best_ik(own)
+            solved = int((own[SOLVE_RATE] > 0).sum())
+            per_engine.append((engine, _rate_and_time(best), _rate_and_time(fastest),
+                               f"{solved} of {len(own)} solve any target"))
+        blocks.append(Table(("engine", "best solve rate, time per solve", f"fastest at ≥ {summary.SOLVED_ENOUGH:.0%}",
+                             "solvers"),
+                            tuple(per_engine)))
         plain = rows[~rows["metric"].str.startswith("hard_")].rename(columns={"integrator": "solver"})
         measured = plain.groupby(["engine", "solver"], sort=False)["status"].transform(lambda s: (s != NOT_AVAILABLE).any())
         compact = [c for c in tables.IK_COLUMNS if c[0] in _IK_COMPACT]
-        blocks.append(tables.metric_table(plain[measured], compact, ["engine", "solver"]))
+        blocks.append(Details("Per engine × solver", (*_own_rules(solvers, tolerance),
+                                                      tables.metric_table(plain[measured], compact, ["engine", "solver"])),
+                              markdown=False, open=True))
         hard = _hard_table(rows)
-        return blocks + [Details(f"{scene}: every metric and hard target",
-                                 (tables.metric_table(plain, tables.IK_COLUMNS, ["engine", "solver"]), *hard),
-                                 markdown=False)]
+        blocks.append(Details(f"{scene}: every metric and hard target",
+                              (tables.metric_table(plain, tables.IK_COLUMNS, ["engine", "solver"]), *hard),
+                              markdown=False))
+        return _ik_verdict(solvers, tolerance, _hard_solved(rows), self.findings_per_scene.get(scene, 0)), blocks
+
+
+def _ran_on(engine: str, per_scene: list[dict]) -> str:
+    """An engine in the per-engine table: its name, and on how many of the scenes it ran where not on all."""
+    ran = sum(engine in scene for scene in per_scene)
+    return engine if ran == len(per_scene) else f"{engine} ({ran} of {len(per_scene)} scenes)"
+
+
+def _rate_and_time(solver: pd.Series | None) -> str:
+    """A solver in an engine's row: ``dls: 90.0 %, 0.000949 s``."""
+    return "none" if solver is None else f"{solver['integrator']}: {solver[SOLVE_RATE]:.1%}, {number(solver[TIME_PER_SOLVE])} s"
+
+
+def _ik_verdict(solvers: pd.DataFrame, tolerance: float | None, hard: tuple[int, int], findings: int) -> str:
+    """An IK scene in one line: its best solver, its fastest reliable one, the solvers that solve nothing at the
+    scene's tolerance, the hard targets solved and the findings."""
+    best, fastest = summary.best_ik(solvers)
+    reliable = f"fastest at ≥ {summary.SOLVED_ENOUGH:.0%}: " + ("the same" if fastest is not None and best is not None
+                                                               and fastest.name == best.name
+                                                               else _solver(fastest, tolerance))
+    parts = [f"best {_solver(best, tolerance)}", reliable]
+    none = [f"{r['engine']} {r['integrator']}" for _, r in solvers.iterrows() if r[SOLVE_RATE] == 0]
+    if none:
+        parts.append(f"{len(none)} solve none at its tolerance ({_names(none, 2)})")
+    if hard[1]:
+        parts.append(f"hard targets: {hard[0]} of {hard[1]} solves succeeded")
+    return "; ".join(parts + [f"{findings} finding{'s' if findings != 1 else ''}"])
 
 
 def _scheme_row(engine: str, scheme: str, members: list[tuple[str, tuple[str, ...]]]) -> tuple[str, ...]:
@@ -567,7 +698,7 @@ _SWEEP_ROWS_IK = Paragraph(
     "its median time per solve, and a solver not measured in every variant is not ranked.")
 
 
-def _sweep_row(sweep: Sweep) -> tuple[str, ...]:
+def _sweep_row(sweep: Sweep, by: str) -> tuple[str, ...]:
     """A sweep's row of the summary's table for its kind: its schemes judged by their worst variant."""
     link = (f"[{sweep_summary.label(sweep.base)}](#{sweep_sections.heading(sweep.base).anchor}) "
             f"({len(sweep.variants)} variants)")
@@ -577,9 +708,9 @@ def _sweep_row(sweep: Sweep) -> tuple[str, ...]:
         return link, _solver(best, None), _solver(fastest, None)
     name, unit = _HEADLINE_NAMES[sweep.metric]
     cases = ranked.rename(columns={"value": "error"})
-    return ((link, f"{name} [{unit}] vs `{sweep.reference}`")
-            + tuple(_scheme(summary.cheapest_within(cases, b), unit) for b in summary.ERROR_BUDGETS)
-            + tuple(_scheme(summary.most_accurate_within(cases, b), unit) for b in summary.TIME_BUDGETS))
+    return ((link, f"{name.removesuffix(' error max')} [{unit}] vs `{sweep.reference}`")
+            + tuple(engine_summary.overall(cases, b, by) for b in summary.ERROR_BUDGETS)
+            + tuple(_scheme(summary.most_accurate_within(cases, b, by), unit) for b in summary.cost_budgets(by)))
 
 
 NAMES_SHOWN = 4
@@ -588,14 +719,11 @@ NAMES_SHOWN = 4
 REASON_CHARS = 160
 """Characters of a reason in a findings table; the whole reason is the rows' ``detail`` in results.csv."""
 
-LINE_CHARS = 300
-"""Characters a line of report.md stays under (issue #26): what is longer is said compactly or folded."""
 
 
-def _names(names: list[str]) -> str:
-    """``a, b, c, d (+3 more)``: at most :data:`NAMES_SHOWN` names, then the count of the rest."""
-    shown = ", ".join(names[:NAMES_SHOWN])
-    return shown + (f" (+{len(names) - NAMES_SHOWN} more)" if len(names) > NAMES_SHOWN else "")
+def _names(names: list[str], shown: int = NAMES_SHOWN) -> str:
+    """``a, b, c, d (+3 more)``: at most ``shown`` names, then the count of the rest."""
+    return ", ".join(names[:shown]) + (f" (+{len(names) - shown} more)" if len(names) > shown else "")
 
 
 def _per_engine(frame: pd.DataFrame, variants) -> str:
@@ -632,8 +760,7 @@ def _solver(row: pd.Series | None, position_tolerance: float | None) -> str:
     and its rate at its own stopping rule where that rule is not the scene's."""
     if row is None:
         return "none"
-    return (f"{row['engine']} {row['integrator']}: {_rates(row, position_tolerance)}, "
-            f"{number(row[TIME_PER_SOLVE])} s per solve")
+    return f"{row['engine']} {row['integrator']}: {_rates(row, position_tolerance)}, {number(row[TIME_PER_SOLVE])} s"
 
 
 def _rates(row: pd.Series, position_tolerance: float | None) -> str:
@@ -680,18 +807,15 @@ def _blocks(builder: _Builder, table: pd.DataFrame, info: RunInfo) -> list[Block
         Paragraph(f"Run {info.created_utc} · commit {info.git_commit} · "
                   f"{m.get('platform', '?')} · {m.get('cpu_count', '?')} CPUs · Python {m.get('python', '?')}"),
         Paragraph(f"Engines: {versions}"),
-        Paragraph("Cases (failed or diverged if any row is, ok if anything was measured): "
-                  + ", ".join(f"{s} {counts[s]}" for s in STATUSES)
-                  + f". `{NOT_AVAILABLE}`: nothing was measured, and the rows say why. Errors are maxima over every "
-                  "body and sample against the reference named per scene; times are the best of several repeats of "
-                  "the stepping alone (model building excluded; a run of 0.1 s or more is timed once), indicative: "
-                  "`simparity bench` measures speed precisely. Every value of every case: `results.csv`; sampled "
-                  "series: `series.csv.gz`."),
+        Paragraph("Cases: " + ", ".join(f"{s} {counts[s]}" for s in STATUSES)
+                  + " (failed or diverged if any row is, ok if anything was measured; n/a rows say why). Errors: "
+                  "maxima over bodies and samples; times: the best repeat, indicative (`simparity bench` measures "
+                  "speed). Values: `results.csv`; definitions: docs/metrics.md."),
     ]
     blocks += builder.summary()
     blocks += _hard_cases(table, info, builder.groups)
-    blocks += [Details("Definitions", (Paragraph(_DEFINITIONS), Paragraph(_IK_PROTOCOL)))]
-    blocks += sweep_sections.sections(builder.sweeps, builder.figure, info.theoretical_orders)
+    blocks += [Details("Definitions", (Paragraph(_DEFINITIONS), Paragraph(_IK_PROTOCOL)), markdown=False)]
+    blocks += sweep_sections.sections(builder.sweeps, builder.figure, info.theoretical_orders, info.integrator_variants)
     kinds = {scene: _kind(rows) for scene, rows in table.groupby("scene", sort=False)}
     for scene, rows in table.groupby("scene", sort=False):
         blocks += builder.scene(scene, rows) if kinds[scene] != "kinematics" and builder.listed(scene) else []

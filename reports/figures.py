@@ -28,7 +28,7 @@ import pandas as pd  # noqa: E402
 from simparity.core.runtime.processes import die_with_parent  # noqa: E402
 from simparity.core.model.results import SWEEP_PREFIX  # noqa: E402
 from simparity.reports.figure_layout import finish, legend, power_of_ten, title, wrap  # noqa: E402
-from simparity.reports.summary import ERROR_BUDGETS  # noqa: E402
+from simparity.reports.summary import ERROR_BUDGETS, EVALUATIONS  # noqa: E402
 from simparity.core.model.metric_catalogue import ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE, TIME_PER_SOLVE
 
 _ENGINE_MARKERS = {"core": "o", "mujoco": "s", "pybullet": "^", "pinocchio": "D"}
@@ -132,21 +132,30 @@ def work_precision_figure(scene: str, cases: pd.DataFrame, headline: str, refere
     """Error (x, log) against cost per simulated second (y, log): one line per engine x integrator, one point per
     dt, the variants of a scheme in its colour with a marker each (``variants``: run.json's
     ``integrator_variants``; see :func:`_scheme_and_variant`), the error budgets of the summary dotted and labelled.
+    Where the cases counted their force evaluations, a second panel below puts the same points against force
+    evaluations per simulated second: the hardware-neutral cost, on which engines compare without their per-call
+    overhead.
 
     ``cases``: :func:`reports.summary.dynamics_cases`."""
     measured = cases[(cases["status"] == "ok") & (cases["error"] > 0) & (cases["cost"] > 0)]
     if measured.empty:
         return None
-    fig, ax = plt.subplots(figsize=(_WIDTH, 4.8))
-    lines = {pair: g.sort_values("dt") for pair, g in measured.groupby(["engine", "integrator"], sort=False)}
-    _plot_grouped(ax, lines, "error", "cost", variants)
-    _error_budgets(ax)
-    ax.set(xscale="log", yscale="log", xlabel=_HEADLINE_LABELS[headline],
-           ylabel="compute per simulated second [s/s]")
-    title(ax, f"{scene}: work against precision (one point per dt; error against {reference})")
-    ax.grid(True, which="major", alpha=0.3)
-    legend(ax)
-    return finish(fig)
+    counted = EVALUATIONS in measured and bool((measured[EVALUATIONS] > 0).any())
+    costs = [("cost", "wall time per simulated second [s/s]")] + (
+        [(EVALUATIONS, "force evaluations per simulated second [1/s]")] if counted else [])
+    fig, axes = plt.subplots(len(costs), 1, figsize=(_WIDTH, 4.8 + 3.2 * (len(costs) - 1)), sharex=True,
+                             squeeze=False)
+    for ax, (column, label) in zip(axes[:, 0], costs):
+        shown = measured[measured[column] > 0]
+        lines = {pair: g.sort_values("dt") for pair, g in shown.groupby(["engine", "integrator"], sort=False)}
+        _plot_grouped(ax, lines, "error", column, variants)
+        _error_budgets(ax)
+        ax.set(xscale="log", yscale="log", ylabel=label)
+        ax.grid(True, which="major", alpha=0.3)
+    axes[-1, 0].set_xlabel(_HEADLINE_LABELS[headline])
+    title(axes[0, 0], f"{scene}: work against precision (one point per dt; error against {reference})")
+    legend(axes[0, 0])
+    return finish(fig, row_gap=_PANEL_GAP)
 
 
 def _agree(a: pd.DataFrame, b: pd.DataFrame) -> bool:

@@ -64,7 +64,7 @@ def _html(block: Block, svgs: dict[str, str]) -> str:
                 f"<figcaption>{_inline(block.caption)}</figcaption></figure>")
     if isinstance(block, Details):
         inner = "".join(_html(b, svgs) for b in block.blocks)
-        return f"<details><summary>{_inline(block.summary)}</summary>{inner}</details>"
+        return f"<details{' open' if block.open else ''}><summary>{_inline(block.summary)}</summary>{inner}</details>"
     raise TypeError(f"unknown block {block!r:.80}")
 
 

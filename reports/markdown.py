@@ -1,26 +1,81 @@
-"""``report.md``: the report's blocks as Markdown, figures linked from ``figures/``."""
+"""``report.md``: the report's blocks as Markdown, figures linked from ``figures/``. No line is longer than
+:data:`LINE_CHARS`: text wraps between words (a paragraph's soft line breaks render as spaces), and a table row
+that would be longer has its longest cells shortened (report.html and results.csv keep every cell whole)."""
 
 from __future__ import annotations
 
 import itertools
+import re
 
 from simparity.reports.blocks import Block, Bullets, Details, Figure, Heading, Paragraph, Table
+
+LINE_CHARS = 300
+"""Characters a line of report.md stays under (issue #26): a reader scanning the file in an editor or a diff, and
+a table row a reviewer can read on one screen; what is longer is said compactly, wrapped or shortened."""
+
+WRAP_CHARS = LINE_CHARS
+"""Where text wraps: a line takes words while it stays within :data:`LINE_CHARS` (longer only for a single word
+longer than that); a narrower wrap would spend lines of the report's 400-line budget on paragraphs."""
+
+_OPENS_BLOCK = re.compile(r"^(?:[-+*#>|<]|\d+[.)]|=+|-+|`{3,}|~{3,})(?:\s|$)")
+"""A word that would open a list item, heading, quote, table, HTML block or fence, or underline a heading, at the
+start of a line: never wrapped onto one."""
+
+
+def _tokens(text: str) -> list[str]:
+    """``text``'s words, each word that would open a block (:data:`_OPENS_BLOCK`) glued to the word before it, so
+    that no line can start with it."""
+    tokens: list[str] = []
+    for word in text.split(" "):
+        if tokens and _OPENS_BLOCK.match(word):
+            tokens[-1] += " " + word
+        else:
+            tokens.append(word)
+    return tokens
+
+
+def _wrap(text: str, indent: str = "") -> list[str]:
+    """``text`` in lines of at most :data:`WRAP_CHARS` where words allow, broken only between words, never before
+    one that Markdown would read as opening a block; continuation lines start with ``indent``."""
+    lines: list[str] = []
+    line = ""
+    for token in _tokens(text):
+        if line and len(line) + 1 + len(token) > WRAP_CHARS:
+            lines.append(line)
+            line = indent + token
+        else:
+            line = f"{line} {token}" if line else token
+    return lines + [line]
 
 
 def _cell(text: str) -> str:
     return text.replace("|", "/").replace("\n", " ")
 
 
+def _row(cells: list[str]) -> str:
+    """A table row within :data:`LINE_CHARS`: while it is longer, its longest cell is cut with an ellipsis (a cell
+    holding a link only when no other is left to cut: a cut link leads nowhere)."""
+    cells = [_cell(c) for c in cells]
+    while len(line := "| " + " | ".join(cells) + " |") > LINE_CHARS:
+        plain = [k for k, cell in enumerate(cells) if "](" not in cell and len(cell) > 2]
+        longest = max(plain or range(len(cells)), key=lambda k: len(cells[k]))
+        excess = len(line) - LINE_CHARS
+        if len(cells[longest]) <= 2:
+            break
+        cells[longest] = cells[longest][:max(1, len(cells[longest]) - excess - 1)].rstrip() + "…"
+    return line
+
+
 def _lines(block: Block, figure_dir: str) -> list[str]:
     if isinstance(block, Heading):  # a heading ends at its line: no blank line needed after it
         return [f"{'#' * block.level} {block.text}"]
     if isinstance(block, Paragraph):
-        return [block.text, ""]
+        return _wrap(block.text) + [""]
     if isinstance(block, Bullets):
-        return [f"- {item}" for item in block.items] + [""] if block.items else []
+        return [line for item in block.items for line in _wrap(f"- {item}", "  ")] + [""] if block.items else []
     if isinstance(block, Table):
-        return (["| " + " | ".join(_cell(h) for h in block.head) + " |", "|" + "---|" * len(block.head)]
-                + ["| " + " | ".join(_cell(c) for c in row) + " |" for row in block.rows] + [""])
+        return ([_row(list(block.head)), "|" + "---|" * len(block.head)]
+                + [_row(list(row)) for row in block.rows] + [""])
     if isinstance(block, Details):
         if not block.markdown:
             return []
@@ -29,12 +84,18 @@ def _lines(block: Block, figure_dir: str) -> list[str]:
     raise TypeError(f"unknown block {block!r:.80}")
 
 
+def _figures(run: list[Figure], figure_dir: str) -> list[str]:
+    """Consecutive figures on one line (side by side where there is room), each linked with its short alt."""
+    links = [f"![{f.alt or f.name}]({figure_dir}/{f.name}.svg)" for f in run]
+    return _wrap(" ".join(links)) + [""]
+
+
 def to_markdown(blocks: list[Block], figure_dir: str = "figures") -> str:
     """Markdown text of the blocks; folded blocks marked markdown=False are left out (they are in the HTML)."""
     lines: list[str] = []
     for is_figure, run in itertools.groupby(blocks, key=lambda b: isinstance(b, Figure)):
-        if is_figure:  # consecutive figures on one line: side by side where there is room
-            lines += [" ".join(f"![{f.caption}]({figure_dir}/{f.name}.svg)" for f in run if isinstance(f, Figure)), ""]
+        if is_figure:
+            lines += _figures([f for f in run if isinstance(f, Figure)], figure_dir)
         else:
             lines += [line for block in run for line in _lines(block, figure_dir)]
     while lines and not lines[-1]:

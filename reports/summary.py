@@ -25,6 +25,7 @@ from simparity.core.model.metric_catalogue import (
     APEX_HEIGHT_ERROR, ENERGY_GAIN_MAX, IMPACT_TIME_ERROR, ORDER_ORIENTATION, ORDER_POSITION, ORIENTATION_ERROR_MAX,
     OWN_STOP_POSITION_TOLERANCE, PENETRATION_MAX, POSITION_ERROR_MAX, RESTITUTION_MEASURED, REST_TIME_ERROR, SOLVE_RATE,
     SOLVE_RATE_OWN_STOP, STABLE_DT_MAX, STOPPING_DISTANCE, TIME_PER_SOLVE, TIME_PER_STEP, TUNNELLED,
+    EVALUATIONS_PER_SECOND, TIME_PER_STEP_BATCHED,
 )
 
 ERROR_BUDGETS = (1e-3, 1e-6, 1e-9)
@@ -33,7 +34,16 @@ animation budget, a typical engineering one, and one near double precision's rea
 
 TIME_BUDGETS = (1e-3, 1e-2)
 """Compute budgets [s per simulated second] the summary finds the most accurate scheme for: 1000x
-and 100x faster than real time."""
+and 100x faster than real time (wall time: ranked where a run has no force evaluation counts)."""
+
+EVALUATION_BUDGETS = (100.0, 1000.0)
+"""Work budgets [force evaluations per simulated second] the summary finds the most accurate scheme for: one
+evaluation per step at 100 Hz (an animation's frame rate), and at 1 kHz (a robot controller's rate; an RK4 step
+at 250 Hz)."""
+
+EVALUATIONS, WALL = "evaluations", "cost"
+"""The costs a summary can rank by (columns of :func:`dynamics_cases`): force evaluations per simulated second
+(stages / dt, hardware-neutral, as Hairer's work-precision diagrams count it) or wall time per simulated second."""
 
 SOLVED_ENOUGH = 0.99
 """Solve rate at which an IK solver counts as reliable for "the fastest at >= 99 %"."""
@@ -55,48 +65,82 @@ def dynamics_cases(rows: pd.DataFrame, headline: str) -> pd.DataFrame:
     against itself ranks nothing.
 
     Columns: scene, engine, integrator, dt [s], status (the case's), error (the headline metric where it
-    was measured, else NaN), time_per_step [s] and cost [s of compute per simulated second].
+    was measured, else NaN), time_per_step [s], cost [s of compute per simulated second], evaluations [force
+    evaluations per simulated second] and batched_cost [s per simulated second of one copy stepped in a batch:
+    ``time_per_step_batched`` / dt; NaN where the engine cannot batch].
     """
     keys = ["scene", "engine", "integrator", "dt"]
     per_dt = rows[rows["dt"].notna() & ~rows["engine"].isin(GROUND_TRUTH_ENGINES)
                   & (rows["engine"] + ":" + rows["integrator"] != rows["reference"])]
     cases = per_dt.groupby(keys, sort=False)["status"].agg(case_status).rename("status").reset_index()
-    measured = per_dt[(per_dt["status"] == OK) & per_dt["metric"].isin([headline, TIME_PER_STEP])]
+    columns = [headline, TIME_PER_STEP, EVALUATIONS_PER_SECOND, TIME_PER_STEP_BATCHED]
+    measured = per_dt[(per_dt["status"] == OK) & per_dt["metric"].isin(columns)]
     values = measured.pivot_table(index=keys, columns="metric", values="value", sort=False)
-    cases = cases.merge(values.reindex(columns=[headline, TIME_PER_STEP]).reset_index(), on=keys, how="left")
-    cases = cases.rename(columns={headline: "error"})
-    cases["cost"] = cases[TIME_PER_STEP] / cases["dt"]
-    return cases[["scene", "engine", "integrator", "dt", "status", "error", TIME_PER_STEP, "cost"]]
+    cases = cases.merge(values.reindex(columns=columns).reset_index(), on=keys, how="left")
+    cases = cases.rename(columns={headline: "error", EVALUATIONS_PER_SECOND: EVALUATIONS})
+    cases[WALL] = cases[TIME_PER_STEP] / cases["dt"]
+    cases["batched_cost"] = cases[TIME_PER_STEP_BATCHED] / cases["dt"]
+    return cases[["scene", "engine", "integrator", "dt", "status", "error", TIME_PER_STEP, WALL, EVALUATIONS,
+                  "batched_cost"]]
 
 
-def _measured(cases: pd.DataFrame) -> pd.DataFrame:
-    return cases[(cases["status"] == OK) & cases["error"].notna() & cases["cost"].notna()]
+def ranking_cost(cases: pd.DataFrame) -> str:
+    """The cost a summary ranks ``cases`` by: :data:`EVALUATIONS` where any case counted its force evaluations (a
+    plugin's scheme that declares no stage count then goes unranked), else :data:`WALL`."""
+    return EVALUATIONS if EVALUATIONS in cases and cases[EVALUATIONS].notna().any() else WALL
 
 
-def cheapest_within(cases: pd.DataFrame, budget: float) -> pd.Series | None:
-    """The case of least cost whose error is within ``budget``, or None."""
-    within = _measured(cases)
+def _measured(cases: pd.DataFrame, by: str = WALL) -> pd.DataFrame:
+    return cases[(cases["status"] == OK) & cases["error"].notna() & cases[by].notna()]
+
+
+def equally_cheap(cases: pd.DataFrame, budget: float, by: str = WALL) -> pd.DataFrame:
+    """The cases whose error is within ``budget`` at the least ``by`` cost, the least wall time first (several
+    where schemes do the same work: RK4 at one dt in every engine); empty when none is within it."""
+    within = _measured(cases, by)
     within = within[within["error"] <= budget]
-    return None if within.empty else within.loc[within["cost"].idxmin()]
+    if within.empty:
+        return within
+    least = within[within[by] == within[by].min()]
+    return least.sort_values([WALL, "error"], na_position="last", kind="stable")
 
 
-def most_accurate_within(cases: pd.DataFrame, time_budget: float) -> pd.Series | None:
-    """The case of least error whose cost is within ``time_budget`` [s per simulated s], or None."""
-    within = _measured(cases)
-    within = within[within["cost"] <= time_budget]
-    return None if within.empty else within.loc[within["error"].idxmin()]
+def cheapest_within(cases: pd.DataFrame, budget: float, by: str = WALL) -> pd.Series | None:
+    """The case of least ``by`` cost (:data:`WALL` or :data:`EVALUATIONS`; ties: the least wall time) whose error
+    is within ``budget``, or None."""
+    least = equally_cheap(cases, budget, by)
+    return None if least.empty else least.iloc[0]
+
+
+def most_accurate_within(cases: pd.DataFrame, budget: float, by: str = WALL) -> pd.Series | None:
+    """The case of least error (ties: the least wall time) whose ``by`` cost is within ``budget`` [s per simulated
+    s for :data:`WALL`, evaluations per simulated s for :data:`EVALUATIONS`], or None."""
+    within = _measured(cases, by)
+    within = within[within[by] <= budget]
+    return None if within.empty else within.sort_values(["error", WALL], kind="stable").iloc[0]
+
+
+def cost_budgets(by: str) -> tuple[float, ...]:
+    """The budgets of the "most accurate within" columns for a ranking by ``by``."""
+    return EVALUATION_BUDGETS if by == EVALUATIONS else TIME_BUDGETS
+
+
+def cost_label(by: str, budget: float) -> str:
+    """A cost budget as a column says it: "≤ 100 evaluations/s" or "≤ 0.001 s/s"."""
+    return f"≤ {budget:g} evaluations/s" if by == EVALUATIONS else f"≤ {budget:g} s/s"
 
 
 def best_per_scheme(cases: pd.DataFrame) -> pd.DataFrame:
-    """Per engine x integrator: the time step of least error (the cheaper on a tie) with its error, cost
-    and time per step (NaN where none was measured), ``statuses`` (how many of its time steps ended ok /
+    """Per engine x integrator: the time step of least error (the cheaper on a tie) with its error, cost,
+    evaluations, batched cost and time per step (NaN where none was measured), ``statuses`` (how many of its time steps ended ok /
     diverged / failed / n/a) and ``any_result`` (False when every time step is n/a)."""
     keys = ["engine", "integrator"]
     best = _measured(cases).sort_values(["error", "cost"]).drop_duplicates(keys)
     summary = cases.groupby(keys, sort=False)["status"].agg(
         statuses=lambda s: ", ".join(f"{status} {n}" for status, n in s.value_counts().items()),
         any_result=lambda s: bool((s != NOT_AVAILABLE).any())).reset_index()
-    return summary.merge(best[keys + ["dt", "error", "cost", TIME_PER_STEP]], on=keys, how="left")
+    return summary.merge(best[keys + ["dt", "error", WALL, EVALUATIONS, "batched_cost", TIME_PER_STEP]], on=keys,
+                         how="left")
 
 
 ORDER_METRICS = {POSITION_ERROR_MAX: ORDER_POSITION, ORIENTATION_ERROR_MAX: ORDER_ORIENTATION}

@@ -188,7 +188,7 @@ def _intro(sweep: Sweep) -> Paragraph:
                      + (f" Shown with a section of their own: {shown}." if shown else ""))
 
 
-def _section(sweep: Sweep, figure: Callable[..., list[Block]], theory: dict) -> list[Block]:
+def _section(sweep: Sweep, figure: Callable[..., list[Block]], theory: dict, variants: dict | None) -> list[Block]:
     """The blocks of one sweep: its paragraph, the table over the variants, the figures and the table of every
     value."""
     label = sweep_summary.metric_label(sweep.metric)
@@ -196,7 +196,8 @@ def _section(sweep: Sweep, figure: Callable[..., list[Block]], theory: dict) -> 
     blocks: list[Block] = [heading(sweep.base), _intro(sweep), _across_table(sweep, theory)]
     if sweep.kind == "dynamics":
         count = len(sweep.variants)
-        blocks += figure(figures.sweep_work_precision_figure(sweep.base, sweep.across, label, sweep.reference, count),
+        blocks += figure(figures.sweep_work_precision_figure(sweep.base, sweep.across, label, sweep.reference, count,
+                                                             variants),
                          f"{sweep.base}-sweep-work-precision",
                          f"Work-precision over the {count} variants: {label} of each engine × integrator at its worst "
                          "variant against its median cost, one point per dt; the band reaches its best variant.")
@@ -218,10 +219,11 @@ def _section(sweep: Sweep, figure: Callable[..., list[Block]], theory: dict) -> 
     return blocks + [grid, _every_value(sweep)]
 
 
-def sections(all_sweeps: list[Sweep], figure: Callable[..., list[Block]], theory: dict) -> list[Block]:
+def sections(all_sweeps: list[Sweep], figure: Callable[..., list[Block]], theory: dict,
+             variants: dict | None = None) -> list[Block]:
     """The "Sweeps" section of a report: per swept scene its blocks (:func:`_section`; ``figure(fig, name,
-    caption)`` draws and names a figure, ``theory`` the engines' theoretical orders); nothing for a run without
-    a sweep."""
+    caption)`` draws and names a figure, ``theory`` the engines' theoretical orders, ``variants`` run.json's
+    ``integrator_variants``, which the work-precision figure groups); nothing for a run without a sweep."""
     if not all_sweeps:
         return []
     blocks: list[Block] = [
@@ -239,5 +241,5 @@ def sections(all_sweeps: list[Sweep], figure: Callable[..., list[Block]], theory
                   "every variant is in `results.csv`, its swept values in the `sweep:KEY` columns (the numbers "
                   "written into the file, in its length unit).")]
     for sweep in all_sweeps:
-        blocks += _section(sweep, figure, theory)
+        blocks += _section(sweep, figure, theory, variants)
     return blocks

@@ -112,21 +112,22 @@ def _metric(variants: list[str], info: RunInfo) -> tuple[str, str]:
 
 def variant_cases(rows: pd.DataFrame, kind: str, metric: str) -> pd.DataFrame:
     """One row per variant x engine x integrator (x dt for dynamics): scene, engine, integrator, dt, status (the
-    case's), value (``metric`` where measured, else NaN) and cost (:data:`_KIND_COST`). Dynamics leaves out the
+    case's), value (``metric`` where measured, else NaN), cost (:data:`_KIND_COST`) and evaluations (force evaluations
+    per simulated second; NaN but for dynamics). Dynamics leaves out the
     ground truths and the reference's own scheme (:func:`reports.summary.dynamics_cases`); IK and kinematics keep
     every engine, as their scenes' tables do."""
     if kind == "dynamics":
         cases = summary.dynamics_cases(rows, metric)
         return cases.rename(columns={"error": "value"})[["scene", "engine", "integrator", "dt", "status", "value",
-                                                          "cost"]]
+                                                          "cost", summary.EVALUATIONS]]
     keys = ["scene", "engine", "integrator"]
     plain = rows[~rows["metric"].str.startswith("hard_")]
     cases = plain.groupby(keys, sort=False)["status"].agg(case_status).rename("status").reset_index()
     measured = plain[(plain["status"] == OK) & plain["metric"].isin([metric, _KIND_COST[kind]])]
     values = measured.pivot_table(index=keys, columns="metric", values="value", sort=False)
     values = values.reindex(columns=[metric, _KIND_COST[kind]]).set_axis(["value", "cost"], axis=1)
-    return cases.merge(values.reset_index(), on=keys, how="left").assign(dt=math.nan)[
-        ["scene", "engine", "integrator", "dt", "status", "value", "cost"]]
+    return cases.merge(values.reset_index(), on=keys, how="left").assign(dt=math.nan, **{summary.EVALUATIONS: math.nan})[
+        ["scene", "engine", "integrator", "dt", "status", "value", "cost", summary.EVALUATIONS]]
 
 
 def _status_across(statuses: pd.Series) -> str:
@@ -138,8 +139,11 @@ def _status_across(statuses: pd.Series) -> str:
 def across(cases: pd.DataFrame, keys: list[str], lower_is_better: bool = True) -> pd.DataFrame:
     """One row per ``keys`` (engine, integrator, and dt for dynamics) over every variant: ``status``
     (:func:`_status_across`), ``value`` at the worst variant and that variant (``worst_scene``), ``median`` and
-    ``best`` of the value over the variants measured, ``cost`` its median (:data:`_KIND_COST`), ``statuses`` (how
+    ``best`` of the value over the variants measured, ``cost`` its median (:data:`_KIND_COST`; ``evaluations`` the
+    median force evaluations per simulated second, dynamics only), ``statuses`` (how
     many variants ended ok / diverged / failed / n/a) and ``variants`` (how many were measured)."""
+    if summary.EVALUATIONS not in cases:  # cases of a kind, or a caller, that counts no force evaluations
+        cases = cases.assign(**{summary.EVALUATIONS: math.nan})
     grouped = cases.groupby(keys, sort=False, dropna=False)
     out = grouped["status"].agg(status=_status_across,
                                 statuses=lambda s: ", ".join(f"{k} {n}" for k, n in s.value_counts().items()))
@@ -149,7 +153,7 @@ def across(cases: pd.DataFrame, keys: list[str], lower_is_better: bool = True) -
     out = out.join(pd.DataFrame({"value": measured.loc[worst.values, "value"].values,
                                  "worst_scene": measured.loc[worst.values, "scene"].values}, index=worst.index))
     out = out.join(by["value"].agg(median="median", best="min" if lower_is_better else "max", variants="size"))
-    out = out.join(grouped["cost"].median())
+    out = out.join(grouped[["cost", summary.EVALUATIONS]].median())
     out["variants"] = out["variants"].fillna(0).astype(int)
     return out.reset_index()
 

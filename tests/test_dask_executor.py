@@ -58,7 +58,9 @@ def test_a_crash_on_a_dask_worker_fails_its_case_alone(dask):
 def test_the_cli_runs_on_dask_and_writes_the_local_executor_results(tmp_path):
     scene = tmp_path / "throw.toml"
     scene.write_text(THROWN_BALL, encoding="utf-8")
-    args = ["run", str(scene), "ur5-kinematics", "--quick", "--jobs", str(WORKERS)]
+    # One small dynamics scene: this test is of the command's --executor dask (its cluster, its results.csv);
+    # scenes of every kind on Dask against this process are test_a_local_dask_cluster_gives_the_results_of_this_process
+    args = ["run", str(scene), "--quick", "--jobs", str(WORKERS)]
     assert main(args + ["--out", str(tmp_path / "local")]) == 0
     assert main(args + ["--executor", "dask", "--out", str(tmp_path / "dask")]) == 0
     tables = [pd.read_csv(tmp_path / name / RESULTS_FILE, dtype=str, keep_default_na=False) for name in ("local", "dask")]
@@ -144,6 +146,7 @@ SWEEP = THROWN_BALL + """
 
 
 @pytest.mark.slow
+@pytest.mark.sweep  # a sweep of 100 variants, run twice: with the metamorphic sweep in .ci/run, not the default run
 def test_a_sweep_of_100_variants_on_two_dask_workers_gives_the_local_results(tmp_path, dask):
     """Issue #12's done-when: 100 scene variants on a local Dask cluster of 2 workers give, bit for bit, the
     results of the local executor's 2 worker processes."""

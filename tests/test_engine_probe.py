@@ -37,6 +37,7 @@ def test_a_probe_describes_an_engine_as_it_describes_itself():
     assert described.integrators() == real.integrators() and described.ik_solvers() == real.ik_solvers()
     for integrator in real.integrators():
         assert described.theoretical_order(integrator) == real.theoretical_order(integrator)
+        assert described.stages(integrator) == real.stages(integrator)
         assert described.integrator_variant(integrator) == real.integrator_variant(integrator)
     for scene in scenes:  # contact methods on the bouncing ball, free-body integrators on the projectile
         assert described.scene_integrators(scene) == real.scene_integrators(scene)
@@ -145,5 +146,6 @@ def test_a_scene_file_and_the_quick_profile_may_name_a_spec_engines_own_integrat
 
 def test_a_described_engine_runs_nothing():
     described = probe_engines([CORE_SPEC])[CORE_SPEC]
+    assert described.stages("rk4") == 4 and described.stages("explicit_euler") == 1  # what it declared, as data
     with pytest.raises(Exception, match="described, not built"):
         described.build_dynamics(builtin("lecture-projectile"), "rk4", 0.01)

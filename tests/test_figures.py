@@ -118,6 +118,10 @@ IK_TIMES = (2.1e-4, 3.2e-3)
 which ran into each other on iiwa-ik and ur5-ik."""
 
 
+STAGES = {1: 1, 2: 2, 4: 4}
+"""Force evaluations per step of a scheme of each order here: Euler 1, midpoint 2, RK4 4."""
+
+
 def _representative_cases() -> pd.DataFrame:
     """Every dynamics scheme of a quick run at three time steps (summary.dynamics_cases' columns)."""
     rows = []
@@ -130,7 +134,8 @@ def _representative_cases() -> pd.DataFrame:
             for dt in DTS:
                 cost = {"core": 1e-4, "pinocchio": 3e-5}.get(engine, 2e-6) * (1 + k / 10) / dt
                 rows.append({"scene": "s", "engine": engine, "integrator": integrator, "dt": dt, "status": "ok",
-                             "error": scale * dt ** p, "time_per_step": cost * dt, "cost": cost})
+                             "error": scale * dt ** p, "time_per_step": cost * dt, "cost": cost,
+                             "evaluations": STAGES[p] / dt})
     return pd.DataFrame(rows)
 
 
@@ -229,7 +234,7 @@ def test_the_overlap_check_sees_tick_labels_printed_over_each_other():
 
 def test_the_variants_of_a_scheme_share_a_colour_with_a_marker_each():
     fig = figures.work_precision_figure("s", _representative_cases(), ORIENTATION_ERROR_MAX, REFERENCE, VARIANTS)
-    (ax,) = fig.axes
+    ax = fig.axes[0]
     drawn = {line.get_label().removeprefix("_"): line for line in ax.get_lines() if len(line.get_xdata())}
     updates = [drawn[f"core {name}"] for name in ("rk4", "rk4+matrix", "rk4+expmap")]
     assert len({line.get_color() for line in updates}) == 1
@@ -239,6 +244,21 @@ def test_the_variants_of_a_scheme_share_a_colour_with_a_marker_each():
     assert "core rk4 (quaternion, matrix, expmap)" in entries and "marker: variant matrix" in entries
     assert not any(entry.startswith("core rk4+") for entry in entries)
     assert [t.get_text() for t in ax.texts] == [f"error budget {power_of_ten(b)}" for b in ERROR_BUDGETS]
+    figures.plt.close(fig)
+
+
+def test_work_precision_puts_the_same_points_against_force_evaluations_where_counted():
+    """Issue #26: beside wall time, the hardware-neutral cost: a second panel of force evaluations per simulated
+    second, the same errors on x; a run that counted none draws the wall-time panel alone."""
+    cases = _representative_cases()
+    fig = figures.work_precision_figure("s", cases, ORIENTATION_ERROR_MAX, REFERENCE, VARIANTS)
+    wall, work = fig.axes
+    assert "wall time" in wall.get_ylabel() and "force evaluations" in work.get_ylabel()
+    rk4 = next(line for line in work.get_lines() if line.get_label().removeprefix("_") == "mujoco rk4")
+    assert list(rk4.get_ydata()) == [4 / dt for dt in sorted(DTS)]   # 4 stages a step, per simulated second
+    figures.plt.close(fig)
+    fig = figures.work_precision_figure("s", cases.drop(columns=["evaluations"]), ORIENTATION_ERROR_MAX, REFERENCE)
+    assert len(fig.axes) == 1
     figures.plt.close(fig)
 
 

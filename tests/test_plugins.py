@@ -20,6 +20,7 @@ import pytest
 
 from simparity import load_scene, run_scene
 from simparity.comparisons.engines import plugins
+from simparity.comparisons.engines.placeholders import BrokenEngine
 from simparity.comparisons.cli.main import EXIT_FAILED_CASES, EXIT_OK, EXIT_USAGE, main
 from simparity.comparisons.engines.registry import (ENGINE_NAMES, check_engine_names, EngineSet,
                                            make_engine)
@@ -71,6 +72,16 @@ class RaisingOrder(InHouseEngine):
 
     def theoretical_order(self, integrator):
         raise KeyError(integrator)
+
+
+class NegativeStages(InHouseEngine):
+    def stages(self, integrator):
+        return -1
+
+
+class FloatStages(InHouseEngine):
+    def stages(self, integrator):
+        return 4.0
 
 
 class NotAnEngine:
@@ -266,6 +277,17 @@ def test_an_engine_that_breaks_the_interface_fails_its_rows_with_the_reason(site
     assert len(broken) and set(broken.status) == {FAILED}
     assert broken.detail.str.contains(reason, regex=False).all(), broken.detail.iloc[0]
     assert OK in set(_rows(table, "core").status)
+
+
+@pytest.mark.parametrize("attr, returned", [("NegativeStages", "-1"), ("FloatStages", "4.0")])
+def test_an_engine_declaring_a_bad_stage_count_is_broken_with_a_one_line_reason(site, attr, returned):
+    """stages() is force evaluations per step: a negative or non-integer count is refused as it loads, in one line."""
+    site.add_module("plugin_engines_b")
+    engine = plugins.load_engine(f"plugin_engines_b:{attr}")
+    assert isinstance(engine, BrokenEngine)
+    first = InHouseEngine().integrators()[0]
+    assert engine.reason == (f"plugin_engines_b:{attr} is broken: plugin_engines_b:{attr}: stages({first!r}) "
+                             f"returned {returned} (allowed: an int >= 0, force evaluations per step, or None)")
 
 
 @pytest.mark.slow

@@ -30,16 +30,25 @@ def test_broken(simparity):
     result.stdout.fnmatch_lines(["falling-linear-drag core rk4 order_velocity: 4.0*, bound in *"])
 
 
-@pytest.mark.slow
-def test_a_baseline_that_differs_fails(pytester, tmp_path):
-    """--simparity-baseline with a stored run whose value differs: the move is reported."""
+@pytest.fixture(scope="module")
+def example_run():
+    """The example's scene as it checks it (quick, core) and the table run_scene gives for it: one run of ~10 s for
+    the baselines below, each built from its own copy."""
     from simparity.comparisons.api import load_scene, run_scene
     from simparity.comparisons.scenes.profiles import quick
+
+    scene = quick(load_scene("lecture-projectile"))
+    return scene, run_scene(scene, engines=["core"], repeats=0)
+
+
+@pytest.mark.slow
+def test_a_baseline_that_differs_fails(pytester, tmp_path, example_run):
+    """--simparity-baseline with a stored run whose value differs: the move is reported."""
     from simparity.comparisons.execute.store import RunWriter
     from simparity.core.model.results import ResultRow
 
-    scene = quick(load_scene("lecture-projectile"))
-    table = run_scene(scene, engines=["core"], repeats=0)
+    scene, table = example_run
+    table = table.copy()
     table.loc[table["metric"] == "position_error_final", "value"] *= 1.01
     writer = RunWriter(tmp_path / "base", [], "test", [scene])
     writer.append([ResultRow(**row) for row in table.to_dict("records")])
@@ -75,18 +84,16 @@ def test_unknown(simparity):
 
 
 @pytest.mark.slow
-def test_the_documented_example_passes_against_a_baseline_that_ran_more_engines(pytester, tmp_path):
+def test_the_documented_example_passes_against_a_baseline_that_ran_more_engines(pytester, tmp_path, example_run):
     """A stored quick run of the example's scene on core and another engine (here: core's rows under a second name),
     plus another scene: the example, which runs core alone, has nothing moved and nothing missing."""
     import dataclasses
 
-    from simparity.comparisons.api import load_scene, run_scene
     from simparity.comparisons.execute.store import RunWriter
-    from simparity.comparisons.scenes.profiles import quick
     from simparity.core.model.results import ResultRow
 
-    scene = quick(load_scene("lecture-projectile"))
-    rows = [ResultRow(**row) for row in run_scene(scene, engines=["core"], repeats=0).to_dict("records")]
+    scene, table = example_run
+    rows = [ResultRow(**row) for row in table.to_dict("records")]
     more = rows + [dataclasses.replace(r, engine="mujoco") for r in rows] + [
         dataclasses.replace(r, scene="wind") for r in rows]
     RunWriter(tmp_path / "base", [], "test", [scene], "quick").append(more)

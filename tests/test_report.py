@@ -14,7 +14,7 @@ from simparity.comparisons.cli.main import main
 from simparity.core.model.run_info import RunInfo
 from simparity.core.model.results import REPORT_FILE, REPORT_HTML_FILE, SERIES_COLUMNS, ResultRow
 from simparity.reports.content import ToleranceVerdict, build
-from simparity.reports.markdown import to_markdown
+from simparity.reports.markdown import LINE_CHARS, to_markdown
 from simparity.reports.store import read_run
 
 SCENES = ["dzhanibekov", "lecture-2link-ik", "iiwa-kinematics", "ball-bounce-k05"]
@@ -54,29 +54,69 @@ def test_markdown_starts_with_the_summary_and_links_existing_figures(run_dir):
             "lecture-2link-ik-solve-rate", "lecture-2link-ik-residuals", "lecture-2link-ik-fk-agreement"} <= names
 
 
+def _md_section(run_dir, heading: str) -> str:
+    return (run_dir / REPORT_FILE).read_text().split(f"## {heading}", 1)[1].split("\n## ", 1)[0]
+
+
+def _html_rows(run_dir, anchor: str) -> list[list[str]]:
+    """Every table row (header rows too) of a scene's section of report.html, as its cells' text."""
+    page = (run_dir / REPORT_HTML_FILE).read_text()
+    section = page.split(f'<h2 id="{anchor}">', 1)[1].split("<h2 ", 1)[0]
+    return [[re.sub(r"<[^>]+>", "", cell) for cell in re.findall(r"<t[dh]>(.*?)</t[dh]>", row)]
+            for row in re.findall(r"<tr>(.*?)</tr>", section)]
+
+
+def _md_row(section: str, start: str) -> list[str]:
+    return [cell.strip() for cell in next(line for line in section.splitlines() if line.startswith(start)).split("|")[1:-1]]
+
+
 @pytest.mark.slow
 def test_contact_section_shows_measured_restitution_at_every_dt_and_the_height_figure(run_dir):
     """Issue #10: a contact scene's section has the height figure (no convergence figure: no order with
-    impacts) and a table of the restitution each engine measured at each dt next to the requested one."""
-    section = (run_dir / REPORT_FILE).read_text().split("## ball-bounce-k05 (dynamics)", 1)[1].split("\n## ", 1)[0]
+    impacts), per engine the range of the restitution it measured (report.md), and per engine × integrator the
+    restitution at each dt next to the requested one (report.html)."""
+    section = _md_section(run_dir, "ball-bounce-k05 (dynamics)")
     assert "figures/ball-bounce-k05-height.svg" in section and "ball-bounce-k05-convergence" not in section
-    assert "requested restitution 0.5" in section
-    header = next(line for line in section.splitlines() if line.startswith("| engine | integrator | restitution"))
-    dts = re.findall(r"restitution at dt ([0-9.e-]+)", header)
-    assert len(dts) == 3   # the quick profile's three time steps
-    backup = next(line for line in section.splitlines() if line.startswith("| core | backup |"))
-    assert [cell.strip() for cell in backup.split("|")[3:6]] == ["0.5"] * 3   # exact at every dt
-    pinocchio = next(line for line in section.splitlines() if line.startswith("| pinocchio | euler |"))
-    assert pinocchio.rstrip(" |").endswith("n/a")
+    head = _md_row(section, "| engine |")
+    core, pinocchio = _md_row(section, "| core |"), _md_row(section, "| pinocchio |")
+    assert core[head.index("restitution measured")].startswith("0.5")   # backup is exact: the range starts at 0.5
+    assert pinocchio[-1].startswith("n/a") and "ok" not in pinocchio[-1]  # no contact in Pinocchio: every case n/a
+    rows = _html_rows(run_dir, "ball-bounce-k05-dynamics")
+    assert "requested restitution 0.5" in (run_dir / REPORT_HTML_FILE).read_text()
+    header = next(row for row in rows if len(row) > 2 and row[2].startswith("restitution at dt"))
+    assert sum(cell.startswith("restitution at dt") for cell in header) == 3   # the quick profile's three time steps
+    backup = next(row for row in rows if row[:2] == ["core", "backup"] and len(row) == len(header))
+    assert backup[2:5] == ["0.5"] * 3   # exact at every dt
+    euler = next(row for row in rows if row[:2] == ["pinocchio", "euler"] and len(row) == len(header))
+    assert euler[-1] == "n/a"
 
 
 @pytest.mark.slow
-def test_compact_table_names_reference_units_and_theoretical_order(run_dir):
-    section = (run_dir / REPORT_FILE).read_text().split("## dzhanibekov (dynamics)", 1)[1].split("\n## ", 1)[0]
+def test_scene_sections_lead_with_a_verdict_and_a_row_per_engine(run_dir):
+    """Issue #26: report.md's scene section says its verdict in one line, then has one row per engine (core first,
+    ground truths left out) naming its most accurate scheme and its cheapest within each error budget; the row per
+    engine × integrator (with its force evaluations per simulated second) is in report.html."""
+    section = _md_section(run_dir, "dzhanibekov (dynamics)")
+    assert section.splitlines()[1].startswith("- **Verdict**: most accurate: core ")
     assert "Reference: `analytic:exact`" in section
-    assert "| engine | integrator | best dt [s] | error [rad] | cost [s/s] |" in section
-    rk4 = next(line for line in section.splitlines() if line.startswith("| mujoco | rk4 |"))
-    assert rk4.split("|")[7].strip().endswith("(4)")   # the order column shows RK4's theory
+    head = _md_row(section, "| engine |")
+    assert head[:3] == ["engine", "most accurate [rad]", "cheapest at error ≤ 0.001"]
+    engines = [line.split("|")[1].strip() for line in section.splitlines() if line.startswith("| ")][1:]
+    assert engines == ["core", "mujoco", "pybullet", "pinocchio"]    # the user's engine first, no ground truth
+    assert _md_row(section, "| mujoco |")[1].startswith("rk4 @ ")      # MuJoCo's most accurate is its RK4
+    rows = _html_rows(run_dir, "dzhanibekov-dynamics")
+    header = next(row for row in rows if row[:4] == ["engine", "integrator", "best dt [s]", "error [rad]"])
+    rk4 = next(row for row in rows if row[:2] == ["mujoco", "rk4"] and len(row) == len(header))
+    assert rk4[header.index("order (theory)")].endswith("(4)")   # the order column shows RK4's theory
+    # RK4 evaluates the forces 4 times a step: 4 / dt per simulated second at its best dt
+    assert float(rk4[header.index("evaluations [1/s]")]) == pytest.approx(4 / float(rk4[2]), rel=1e-2)
+
+
+@pytest.mark.slow
+def test_markdown_lines_stay_short(run_dir):
+    """Issue #26: no line of report.md is longer than LINE_CHARS characters."""
+    lines = (run_dir / REPORT_FILE).read_text().splitlines()
+    assert max(len(line) for line in lines) <= LINE_CHARS
 
 
 @pytest.mark.slow

@@ -8,7 +8,9 @@ import pytest
 
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.measure.metrics import DYNAMICS_METRICS, KINEMATICS_METRICS, ORDER_METRICS, dynamics_metrics
+from simparity.comparisons.execute.runner import BATCH_STEPS
 from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.scenes.profiles import quick
 from simparity.core.model.engine import Simulation, Support
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK
@@ -66,6 +68,20 @@ class _Refusing(InHouseEngine):
         return Support.no("cannot, for a reason")
 
 
+SHORT_RUN_STEPS = 2 * BATCH_STEPS
+"""Steps of a case whose rows, not its numerics, are under test: more than the batched timing takes."""
+
+
+class _Uncounted(InHouseEngine):
+    name = "uncounted"
+
+    def integrators(self):
+        return ("rk4",)
+
+    def stages(self, integrator):
+        return None
+
+
 def _cases(rows):
     return {(r.engine, r.integrator, r.dt): r.status for r in rows}
 
@@ -102,6 +118,35 @@ def test_missing_reference_keeps_timings_and_says_why():
     errors = [r for r in rows if r.metric in DYNAMICS_METRICS and "_error_" in r.metric]
     assert all(r.status == OK and r.value > 0 for r in timing)
     assert all(r.status == NOT_AVAILABLE and "cannot, for a reason" in r.detail for r in errors)
+
+
+def test_every_dynamics_case_has_its_cost_and_its_batched_timing():
+    """Issue #26: evaluations_per_second is the declared stages over dt, exactly; core and MuJoCo time copies of the
+    scene stepped together; an engine that cannot batch, or declares no stage count, has n/a rows saying why."""
+    scene = quick(builtin("dzhanibekov"))
+    scene = dataclasses.replace(scene, dts=scene.dts[:1], duration=SHORT_RUN_STEPS * scene.dts[0],
+                                integrators=("rk4", "euler"))
+    engines = [make_engine(name) for name in ("core", "mujoco", "pybullet", "pinocchio")]
+    rows = run_scene(scene, engines + [_Uncounted(), _rewritten(lambda traj: traj, "unbatched")], make_engine,
+                     repeats=0)
+    cost = {(r.engine, r.integrator): r for r in rows if r.metric == "evaluations_per_second"}
+    batched = {(r.engine, r.integrator): r for r in rows if r.metric == "time_per_step_batched"}
+    for engine in engines:
+        for integrator in set(engine.integrators()) & {"rk4", "euler"}:
+            row = cost[(engine.name, integrator)]
+            assert row.status == OK and row.unit == "1/s" and row.value == engine.stages(integrator) / scene.dts[0]
+    assert cost[("core", "rk4")].value == 4 / scene.dts[0] and cost[("mujoco", "euler")].value == 1 / scene.dts[0]
+    for case in (("core", "rk4"), ("mujoco", "rk4"), ("mujoco", "euler")):
+        assert batched[case].status == OK and math.isfinite(batched[case].value) and batched[case].value > 0
+        assert batched[case].unit == "s"
+    for case, reason in ((("pybullet", "euler"), "pybullet steps one world per stepSimulation call"),
+                         (("pinocchio", "rk4"), "steps pinocchio's aba one body at a time"),
+                         (("unbatched", "rk4"), "declares no batched stepping (Simulation.batched)")):
+        assert batched[case].status == NOT_AVAILABLE and reason in batched[case].detail
+    assert cost[("unbatched", "rk4")].status == OK
+    uncounted = cost[("uncounted", "rk4")]
+    assert uncounted.status == NOT_AVAILABLE and uncounted.detail == "uncounted declares no stage count for rk4 " \
+        "(Engine.stages)"
 
 
 def test_kinematics_rows_and_reference_marking():

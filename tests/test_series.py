@@ -15,7 +15,7 @@ from simparity.core.model.results import SERIES_POINTS
 from simparity.core.model.scene import DynamicsScene, Forces, RigidBody
 from simparity.core.model.trajectory import Trajectory
 from simparity.reports.store import read_series
-from tests.helpers import builtin
+from tests.helpers import builtin, smoke
 from tests.test_engine_kinematics import DOUBLE_TOL
 
 
@@ -63,7 +63,11 @@ def test_dynamics_series_from_a_hand_made_trajectory():
 @pytest.mark.slow
 def test_runner_series_round_trip_through_the_store(tmp_path):
     """Every ok case of a real scene gets its series; written with the rows and read back by pandas."""
-    scene = builtin("dzhanibekov")
+    # Trimmed (smoke: the two coarsest dts over 1 s): every integrator of both engines still runs, and the
+    # finer dt's 200 steps are more than SERIES_POINTS, so the bound below still needs the thinning to hold
+    # (the full scene, 10 s down to 2.5 ms with its tight reference, was one of the suite's costliest tests).
+    scene = smoke(builtin("dzhanibekov"))
+    assert scene.duration / min(scene.dts) > SERIES_POINTS
     engines = [make_engine("core"), make_engine("mujoco")]
     series = []
     rows = run_scene(scene, engines, make_engine, repeats=0, series=series)

@@ -9,8 +9,8 @@ Whatever goes wrong comes back as an engine standing in for the one asked for
 (:mod:`comparisons.placeholder_engines`), never as an exception: a module that will not import (a
 missing dependency) gives n/a rows, like a built-in engine's missing library; a module or constructor
 that raises, or an engine whose ``version()``, ``integrators()``, ``ik_solvers()``,
-``theoretical_order()`` or ``integrator_variant()`` raises or returns what the interface does not
-allow, gives failed rows with the error. How to write one: docs/plugins.md.
+``theoretical_order()``, ``stages()`` or ``integrator_variant()`` raises or returns what the interface
+does not allow, gives failed rows with the error. How to write one: docs/plugins.md.
 """
 
 from __future__ import annotations
@@ -161,7 +161,8 @@ def _instantiate(found: object, target: str) -> Engine:
 def _interface_problem(engine: Engine) -> str:
     """What the engine's description of itself breaks ("" when nothing): ``version()`` a str,
     ``integrators()`` and ``ik_solvers()`` tuples of names (:data:`OFFERED_NAME`), ``theoretical_order(i)``
-    an int or None and ``integrator_variant(i)`` two strs for each integrator. Their errors are problems too."""
+    an int or None, ``stages(i)`` an int >= 0 or None and ``integrator_variant(i)`` two strs for each integrator.
+    Their errors are problems too."""
     step = "version()"
     try:
         version = engine.version()
@@ -177,6 +178,10 @@ def _interface_problem(engine: Engine) -> str:
             order = engine.theoretical_order(integrator)
             if order is not None and (isinstance(order, bool) or not isinstance(order, int)):
                 return f"{step} returned {echo(order)} (allowed: an int or None)"
+            step = f"stages({integrator!r})"
+            stages = engine.stages(integrator)
+            if stages is not None and (isinstance(stages, bool) or not isinstance(stages, int) or stages < 0):
+                return f"{step} returned {echo(stages)} (allowed: an int >= 0, force evaluations per step, or None)"
             step = f"integrator_variant({integrator!r})"
             variant = engine.integrator_variant(integrator)
             if not (isinstance(variant, tuple) and len(variant) == 2 and all(isinstance(v, str) for v in variant)):

@@ -62,6 +62,8 @@ class EngineDescription:
     integrators, ik_solvers : tuple of str
     orders : dict of str to int or None
         ``theoretical_order`` of each integrator.
+    stages : dict of str to int or None
+        ``stages`` of each integrator.
     variants : dict of str to (str, str)
         ``integrator_variant`` of each integrator.
     kinematics : str
@@ -76,6 +78,7 @@ class EngineDescription:
     integrators: tuple[str, ...]
     ik_solvers: tuple[str, ...]
     orders: dict[str, int | None]
+    stages: dict[str, int | None]
     variants: dict[str, tuple[str, str]]
     kinematics: str
     scene_integrators: dict[str, tuple[str, ...] | str] = field(default_factory=dict)
@@ -100,6 +103,9 @@ class DescribedEngine(Engine):
 
     def theoretical_order(self, integrator: str) -> int | None:
         return self.description.orders.get(integrator)
+
+    def stages(self, integrator: str) -> int | None:
+        return self.description.stages.get(integrator)
 
     def integrator_variant(self, integrator: str) -> tuple[str, str]:
         return self.description.variants.get(integrator, (integrator, ""))
@@ -147,6 +153,7 @@ def describe(engine: Engine, scenes: list) -> EngineDescription:
             by_scene[scene_hash(scene)] = f"scene_integrators({scene.name}) raised {one_line(error_text(err))}"
     return EngineDescription(engine.name, engine.version(), integrators, engine.ik_solvers(),
                              {i: engine.theoretical_order(i) for i in integrators},
+                             {i: engine.stages(i) for i in integrators},
                              {i: engine.integrator_variant(i) for i in integrators}, kinematics, by_scene)
 
 

@@ -54,12 +54,14 @@ from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, 
 from simparity.comparisons.measure.series import dynamics_series
 from simparity.comparisons.measure.stability import STABILITY_METRICS, stable_dt_max
 from simparity.comparisons.execute.timing import best_of
-from simparity.core.model.engine import Engine, Support
-from simparity.core.model.errors import DivergedError
+from simparity.core.model.engine import Engine, Simulation, Support
+from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
 from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
 from simparity.core.model.trajectory import Trajectory
-from simparity.core.model.metric_catalogue import STABLE_DT_MAX, TIME_PER_FK, TIME_PER_JACOBIAN, TIME_PER_STEP
+from simparity.core.model.metric_catalogue import (
+    EVALUATIONS_PER_SECOND, STABLE_DT_MAX, TIME_PER_FK, TIME_PER_JACOBIAN, TIME_PER_STEP, TIME_PER_STEP_BATCHED, unit_of,
+)
 
 EngineFor = Callable[[str], Engine]
 """The engine of a name (the run's engines, the scene's reference)."""
@@ -69,6 +71,18 @@ OnStart = Callable[[int | None], None]
 
 DEFAULT_REPEATS = 3
 """Timed repeats per measurement (the minimum is kept), after one warm-up run."""
+
+BATCH_COPIES = 100
+"""Copies of a scene an engine that batches steps together for ``time_per_step_batched``: at 100 a vectorised
+engine's fixed cost per call (Python dispatch: core's RK4 step costs about the same for 1 body as for 100) is
+spread over the copies, which is what batching is for, while a batch still fits in cache (100 x 13 floats) and adds
+little to a run."""
+
+BATCH_STEPS = 10
+"""Steps of the batched timing at most (the case's own when fewer), from the scene's start: 10^3 copy-steps take
+milliseconds, far above the clock's resolution. Measured on the quick profile: 9 s of batched stepping over its
+~500 batched cases, about 1.5 % of its wall time on two workers (100 steps would be ten times that). A free
+flight's steps all cost the same; a contact scene's events later in its run are not in them."""
 
 TIME_GRID_TOLERANCE = 1e-3
 """How far [steps] a trajectory's sample time may be from k * dt: a clock kept as t += dt drifts at most
@@ -187,6 +201,43 @@ def _theory(engine: Engine, integrator: str) -> int | None:
     return order if isinstance(order, int) and not isinstance(order, bool) and order > 0 else None
 
 
+def _stages(engine: Engine, integrator: str) -> int | None:
+    """The integrator's force evaluations per step as the engine declares them; None when it does not say (or fails
+    to: a plugin's answer was checked when it loaded, :mod:`comparisons.engines.plugins`)."""
+    try:
+        stages = engine.stages(integrator)
+    except Exception:  # noqa: BLE001 - a user's engine; its rows report what fails
+        return None
+    return stages if isinstance(stages, int) and not isinstance(stages, bool) and stages >= 0 else None
+
+
+def _cost(engine: Engine, sim: Simulation, case: Case, n: int, repeats: int) -> dict[str, Measured]:
+    """A case's hardware-neutral cost and its batched timing, measured right after its own timing.
+
+    ``evaluations_per_second`` = stages / dt [1/s], the force evaluations per simulated second the engine declares
+    (n/a when it declares no stage count); ``time_per_step_batched`` [s], the wall time per copy and step of
+    :data:`BATCH_COPIES` copies of the scene's initial state stepped together for min(n, :data:`BATCH_STEPS`) steps,
+    best of ``repeats`` like the case's own (n/a with the engine's reason when it cannot batch).
+    """
+    stages = _stages(engine, case.integrator)
+    evaluations = (Measured(stages / case.dt, unit_of(EVALUATIONS_PER_SECOND)) if stages is not None else
+                   Measured(math.nan, unit_of(EVALUATIONS_PER_SECOND), unmeasurable=(
+                       f"{engine.name} declares no stage count for {case.integrator} (Engine.stages)")))
+    return {EVALUATIONS_PER_SECOND: evaluations, TIME_PER_STEP_BATCHED: _batched_time(sim, n, repeats)}
+
+
+def _batched_time(sim: Simulation, n: int, repeats: int) -> Measured:
+    """Wall time [s] per copy and step of :data:`BATCH_COPIES` copies stepped together (:meth:`Simulation.batched`,
+    built untimed) for min(n, :data:`BATCH_STEPS`) steps; n/a with the engine's reason when it cannot batch."""
+    steps = min(n, BATCH_STEPS)
+    try:
+        run = sim.batched(BATCH_COPIES)
+    except NotBatchedError as why:
+        return Measured(math.nan, unit_of(TIME_PER_STEP_BATCHED), unmeasurable=str(why))
+    seconds, _ = best_of(lambda: run(steps), repeats)
+    return Measured(seconds / (BATCH_COPIES * steps), unit_of(TIME_PER_STEP_BATCHED))
+
+
 def _no_integrator_rows(scene: DynamicsScene, engine: Engine, case: Case, metrics: dict) -> list[ResultRow]:
     """The rows of an engine that runs none of the scene's integrators: n/a with why (the engine's own refusal
     when it offers none, e.g. its library does not import), failed when it cannot even say."""
@@ -264,6 +315,7 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
         sim = engine.build_dynamics(scene, case.integrator, case.dt)
         with np.errstate(all="ignore"):  # a diverging run overflows; it is reported as diverged
             seconds, traj = best_of(lambda: sim.run(n), repeats)
+            cost = _cost(engine, sim, case, n, repeats)
     except DivergedError as err:
         return CaseOutcome(case.rows(metrics, DIVERGED, str(err)))
     except Exception as err:  # noqa: BLE001 - reported in the rows
@@ -272,7 +324,8 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
         problem = sampling_problem(scene, traj, n, case.dt)
         if problem:
             return CaseOutcome(case.rows(metrics, FAILED, f"its trajectory does not sample the scene: {problem}"))
-        return _measured_case(scene, sim, case, metrics, n, traj, seconds, ref_traj, ref_problem, is_reference)
+        return _measured_case(scene, sim, case, metrics, n, traj, {TIME_PER_STEP: Measured(seconds / n, "s")} | cost,
+                              ref_traj, ref_problem, is_reference)
     except Exception as err:  # noqa: BLE001 - a user's engine returned what cannot be measured
         return CaseOutcome(case.rows(metrics, FAILED, f"its trajectory cannot be measured: {error_text(err)}"))
 
@@ -297,10 +350,11 @@ def sampling_problem(scene: DynamicsScene, traj, n: int, dt: float) -> str:
     return ""
 
 
-def _measured_case(scene, sim, case: Case, metrics: dict, n: int, traj, seconds: float, ref_traj,
+def _measured_case(scene, sim, case: Case, metrics: dict, n: int, traj, timed: dict[str, Measured], ref_traj,
                    ref_problem: tuple[str, str], is_reference: bool) -> CaseOutcome:
-    """The rows of a case whose simulation ran: ``traj`` measured against ``ref_traj``."""
-    values = {TIME_PER_STEP: Measured(seconds / n, "s")}
+    """The rows of a case whose simulation ran: ``traj`` measured against ``ref_traj``; ``timed``: its time and
+    cost, measured as it ran."""
+    values = dict(timed)
     with np.errstate(all="ignore"):
         blown, reading = blow_up(scene, traj)
         if blown:

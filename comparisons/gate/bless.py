@@ -5,7 +5,8 @@ scene, engine, integrator, time step and metric, with the run and commit it came
 extends the shipped tolerances (``extends = "default"``), and its bounds win where they match.
 
 - An error, a drift or a state's deviation (lower is better) is held to at most its value plus
-  :data:`BLESS_RELATIVE_MARGIN`; any other number (an order, a rate, a measured restitution, a stability limit)
+  :data:`BLESS_RELATIVE_MARGIN`; any other number (an order, a rate, a measured restitution, a stability limit,
+  a cost in force evaluations per second)
   to its value plus or minus that margin (:data:`BLESS_ORDER_BAND` for an order). A row at its rounding floor
   stays a pass whatever its bound (the check lets a ``rounding-floor`` row through any upper bound), so no
   blessed bound sits below a metric's rounding floor.

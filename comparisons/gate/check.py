@@ -24,7 +24,7 @@ from simparity.comparisons.gate.cross_check import CROSS_CHECK_FACTOR, SOLVE_RAT
 from simparity.comparisons.gate.violation import Violation, row_label
 from simparity.comparisons.engines.registry import ENGINE_NAMES
 from simparity.comparisons.gate.tolerances import Bound, BoundIndex
-from simparity.core.model.metric_catalogue import is_timing
+from simparity.core.model.metric_catalogue import is_cost, is_timing
 from simparity.core.model.results import ALARM_FLAGS, DIMENSIONLESS, NOT_AVAILABLE, OK, ROUNDING_FLOOR
 
 CASE_KEYS = ("scene", "engine", "integrator", "dt")
@@ -143,9 +143,10 @@ def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = 
 
 
 def _count_series(result: CheckResult, row: dict, bound: Bound | None) -> None:
-    """Note whether ``row``'s series is held to a value: timing rows never are (and do not count), a series whose
-    every row is n/a measured nothing (and does not count)."""
-    if is_timing(row["metric"]):
+    """Note whether ``row``'s series is held to a value: timing rows never are (and do not count), nor are cost rows
+    (a declared stage count over dt: a bound on it holds no numerics), a series whose every row is n/a measured
+    nothing (and does not count)."""
+    if is_timing(row["metric"]) or is_cost(row["metric"]):
         return
     if row["status"] == NOT_AVAILABLE:  # nothing measured: neither a series measured nor a value held
         return

@@ -37,7 +37,7 @@ from simparity.core.model.metric_catalogue import (
     ANGULAR_MOMENTUM_DRIFT_MAX, ANGULAR_VELOCITY_ERROR_MAX, ENERGY_DRIFT_MAX, JACOBIAN_ERROR_MAX,
     ORDER_ANGULAR_VELOCITY, ORDER_ORIENTATION, ORDER_POSITION, ORDER_VELOCITY, ORIENTATION_ERROR_MAX,
     POSITION_ERROR_FINAL, POSITION_ERROR_MAX, QUATERNION_NORM_DEVIATION_MAX, ROTATION_ORTHONORMALITY_DEVIATION_MAX,
-    TIME_PER_FK, TIME_PER_JACOBIAN, TIME_PER_STEP, VELOCITY_ERROR_MAX,
+    EVALUATIONS_PER_SECOND, TIME_PER_FK, TIME_PER_JACOBIAN, TIME_PER_STEP, TIME_PER_STEP_BATCHED, VELOCITY_ERROR_MAX,
 )
 
 DYNAMICS_METRICS = units(
@@ -48,6 +48,8 @@ DYNAMICS_METRICS = units(
     ANGULAR_VELOCITY_ERROR_MAX,
     QUATERNION_NORM_DEVIATION_MAX,
     TIME_PER_STEP,
+    TIME_PER_STEP_BATCHED,
+    EVALUATIONS_PER_SECOND,
 )
 DRIFT_METRICS = units(ENERGY_DRIFT_MAX, ANGULAR_MOMENTUM_DRIFT_MAX)
 ORDER_METRICS = units(
@@ -281,7 +283,7 @@ def kinematics_errors(poses: FramePoses, jacobian: np.ndarray, ref_poses: FrameP
 
 
 def dynamics_metrics(scene: DynamicsScene) -> dict[str, str]:
-    """The per-case metrics of a scene: errors and time, plus drift of what the scene conserves."""
+    """The per-case metrics of a scene: errors, time and cost, plus drift of what the scene conserves."""
     metrics = dict(DYNAMICS_METRICS)
     if scene.contact is not None:  # contact takes energy away and turns bodies: nothing is conserved
         return metrics | CONTACT_METRICS

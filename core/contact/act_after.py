@@ -22,7 +22,7 @@ from typing import cast
 
 import numpy as np
 
-from simparity.core.contact.bodies import CONTACT_TOLERANCE, Bodies, contact_lever, impulse_response, put_state, take_state
+from simparity.core.contact.bodies import CONTACT_TOLERANCE, FLIGHT_SCHEME, Bodies, contact_lever, impulse_response, put_state, take_state
 from simparity.core.dynamics.integrators import make_step
 from simparity.core.dynamics.rigid_body import State, velocities
 from simparity.core.rotations import cross
@@ -92,7 +92,7 @@ class ActAfterStepper:
 
     def __init__(self, bodies: Bodies) -> None:
         self._bodies = bodies
-        self._flight = make_step("rk4", "quaternion", bodies.props, bodies.external)
+        self._flight = make_step(FLIGHT_SCHEME, "quaternion", bodies.props, bodies.external)
 
     def step(self, t: float, state: State, dt: float) -> State:
         """Advance every body by dt [s] from time t."""

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simparity.core.contact.bodies import (RESTING_GAP, Bodies, EventLog, contact_lever, impulse_response, put_state, supported,
+from simparity.core.contact.bodies import (FLIGHT_SCHEME, RESTING_GAP, Bodies, EventLog, contact_lever, impulse_response, put_state, supported,
                                     take_state)
 from simparity.core.contact.act_after import resolve_after
 from simparity.core.contact.roots import distances, exact_contact, root_contact
@@ -68,7 +68,7 @@ class _Flight:
     def __init__(self, bodies: Bodies, normal, slide, stuck, mu_k) -> None:
         self.bodies, self.normal, self.slide, self.stuck, self.mu_k = bodies, normal, slide, stuck, mu_k
         self._external = bodies.external
-        self._step = make_packed_step("rk4", bodies.props, self.wrench)
+        self._step = make_packed_step(FLIGHT_SCHEME, bodies.props, self.wrench)
 
     def take(self, idx: np.ndarray) -> "_Flight":
         """The flight of the bodies ``idx`` (itself if that is all of them)."""

@@ -52,6 +52,9 @@ FRICTION_REGULARISATION_SPEED = 1e-2
 default stiffness, so it does not make the system stiffer than the spring does; a body held by
 friction creeps at ~v_reg |g_t| / (mu_k |g_n|)."""
 
+FLIGHT_SCHEME = "rk4"
+"""The scheme the backup and act_after methods fly bodies by between contacts (quaternion orientation)."""
+
 PENALTY_SCHEMES = ("explicit_euler", "semi_implicit_euler", "midpoint", "average_velocity", "rk4")
 """Core's schemes the penalty method is run with (``penalty_<scheme>``)."""
 

@@ -57,6 +57,14 @@ ORDER = {
 }
 """Theoretical order of global accuracy of each scheme."""
 
+STAGES = {scheme: len(weights) for scheme, (_, weights, _) in TABLEAUX.items()} | {
+    "semi_implicit_euler": 1,
+    "engine_euler": 1,
+}
+"""Evaluations of the scene's wrench per step of each scheme, whatever its orientation update: one per stage of a
+Runge-Kutta tableau (explicit Euler 1, midpoint and average velocity 2, RK4 4), one for the Euler steps that take
+the forces at the step's start."""
+
 # Below this rotation angle [rad] dexpinv uses its series; its error there is ~1e-17.
 _DEXPINV_SERIES_ANGLE = 1e-3
 

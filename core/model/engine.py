@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import abc
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from simparity.core.model.errors import SimparityError
+from simparity.core.model.errors import NotBatchedError, SimparityError
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.ik_result import IKResult
 from simparity.core.model.scene import Chain, DynamicsScene, KinematicsScene, Scene
@@ -80,6 +81,11 @@ class Support:
         return cls(False, reason)
 
 
+BatchedRun = Callable[[int], object]
+"""``run(n_steps)`` of :meth:`Simulation.batched`: every copy stepped ``n_steps`` steps from the initial state; what it
+returns is not measured (only its wall time is)."""
+
+
 class Simulation(abc.ABC):
     """A dynamics scene built for one engine, integrator and time step.
 
@@ -104,6 +110,16 @@ class Simulation(abc.ABC):
         Every call starts again from the initial state. Returns a :class:`Trajectory` with
         ``n_steps + 1`` samples.
         """
+
+    def batched(self, copies: int) -> BatchedRun:
+        """``run(n_steps)`` stepping ``copies`` copies of the scene's initial state together, the same model and
+        options as :meth:`run` (built here, untimed; the runner times its calls, each from the initial state, and
+        stores the time per copy and step).
+
+        Raises :class:`NotBatchedError` with the reason when the engine cannot step copies in one call: the
+        default, so an engine that does not say has an ``n/a`` batched timing.
+        """
+        raise NotBatchedError("the engine's simulation declares no batched stepping (Simulation.batched)")
 
 
 class KinematicsModel(abc.ABC):
@@ -253,6 +269,13 @@ class Engine(abc.ABC):
     def theoretical_order(self, integrator: str) -> int | None:
         """Global order of accuracy the integrator has in theory (None: unknown, or it depends on the
         scene). Reports draw it beside the observed order."""
+        return None
+
+    def stages(self, integrator: str) -> int | None:
+        """Evaluations of the scene's force model (the right-hand side of its ODE) per step of ``integrator``: a
+        step's cost in the unit of Hairer's work-precision diagrams, the same on every machine (RK4 4, Euler 1).
+        None: unknown (the default), or it varies from step to step (an adaptive solve, a closed form). The runner
+        stores ``stages / dt``, evaluations per simulated second."""
         return None
 
     def scheme(self, integrator: str, scene: Scene) -> str:

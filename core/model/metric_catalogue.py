@@ -17,12 +17,13 @@ from dataclasses import dataclass
 
 from simparity.core.model.results import DIMENSIONLESS
 
-ERROR, DRIFT, ORDER, TIMING, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE = (
-    "error", "drift", "order", "timing", "contact", "ik", "validity", "stability", "invariance")
-KINDS = (ERROR, DRIFT, ORDER, TIMING, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE)
+ERROR, DRIFT, ORDER, TIMING, COST, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE = (
+    "error", "drift", "order", "timing", "cost", "contact", "ik", "validity", "stability", "invariance")
+KINDS = (ERROR, DRIFT, ORDER, TIMING, COST, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE)
 """What a metric measures: an error against the reference; a relative drift of a conserved quantity; an observed
-order of convergence; a wall time (never compared between runs); a contact event's quantity; an IK solver's
-outcome; a reported state's validity (unit quaternion, orthonormal matrix); a measured stability limit; a
+order of convergence; a wall time (never compared between runs); a hardware-neutral cost (exact, from what the
+engine declares: the same on every machine, and no measure of its numerics); a contact event's quantity; an IK
+solver's outcome; a reported state's validity (unit quaternion, orthonormal matrix); a measured stability limit; a
 metamorphic invariance check."""
 
 
@@ -72,6 +73,8 @@ VELOCITY_ERROR_MAX = "velocity_error_max"
 ANGULAR_VELOCITY_ERROR_MAX = "angular_velocity_error_max"
 QUATERNION_NORM_DEVIATION_MAX = "quaternion_norm_deviation_max"
 TIME_PER_STEP = "time_per_step"
+TIME_PER_STEP_BATCHED = "time_per_step_batched"
+EVALUATIONS_PER_SECOND = "evaluations_per_second"
 ENERGY_DRIFT_MAX = "energy_drift_max"
 ANGULAR_MOMENTUM_DRIFT_MAX = "angular_momentum_drift_max"
 ORDER_POSITION = "order_position"
@@ -135,6 +138,8 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(ANGULAR_VELOCITY_ERROR_MAX, "rad/s", ERROR, scale="angular_velocity"),
     Metric(QUATERNION_NORM_DEVIATION_MAX, DIMENSIONLESS, VALIDITY, theory="0 up to rounding"),
     Metric(TIME_PER_STEP, "s", TIMING),
+    Metric(TIME_PER_STEP_BATCHED, "s", TIMING),
+    Metric(EVALUATIONS_PER_SECOND, "1/s", COST, theory="the integrator's stages / dt"),
     Metric(ENERGY_DRIFT_MAX, DIMENSIONLESS, DRIFT, scale="energy", theory="0 for a conservative scene"),
     Metric(ANGULAR_MOMENTUM_DRIFT_MAX, DIMENSIONLESS, DRIFT, theory="0 without torque"),
     Metric(ORDER_POSITION, DIMENSIONLESS, ORDER, theory="the scheme's order", source=POSITION_ERROR_MAX),
@@ -223,6 +228,12 @@ def units(*names: str) -> dict[str, str]:
 def is_timing(name: str) -> bool:
     """Whether a metric measures wall time: never compared between runs, never a numerics change."""
     return name in CATALOGUE and CATALOGUE[name].is_timing
+
+
+def is_cost(name: str) -> bool:
+    """Whether a metric is a hardware-neutral cost: exact, from what the engine declares (its stage count), no
+    measure of its numerics."""
+    return name in CATALOGUE and CATALOGUE[name].kind == COST
 
 
 def headline_metrics() -> tuple[str, ...]:

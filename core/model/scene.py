@@ -11,7 +11,7 @@ and reports the file and key of a bad one) or directly in code (tests, benchmark
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -478,6 +478,24 @@ class DynamicsScene:
     def n_steps(self, dt: float) -> int:
         """Number of steps of size ``dt`` that cover ``duration``."""
         return int(round(self.duration / dt))
+
+    def replicated(self, copies: int) -> DynamicsScene:
+        """The scene ``copies`` times over, as one scene of ``copies * N`` bodies: copy c's body k is body
+        ``c * N + k``, with its forces (per-body arrays tiled, applied forces re-indexed) and its contact shape and
+        materials. Bodies never interact, so every copy moves as the scene does: an engine batched over bodies
+        steps all copies together."""
+        n, forces = len(self.bodies), self.forces
+
+        def tiled(values: np.ndarray | None) -> np.ndarray | None:
+            return None if values is None else np.tile(values, copies)
+
+        applied = tuple(replace(a, body=a.body + c * n) for c in range(copies) for a in forces.applied)
+        forces = replace(forces, linear_drag=tiled(forces.linear_drag), quadratic_drag=tiled(forces.quadratic_drag),
+                         angular_linear_drag=tiled(forces.angular_linear_drag),
+                         angular_quadratic_drag=tiled(forces.angular_quadratic_drag), applied=applied)
+        contact = None if self.contact is None else replace(self.contact, shapes=self.contact.shapes * copies,
+                                                            materials=self.contact.materials * copies)
+        return replace(self, bodies=self.bodies * copies, forces=forces, contact=contact)
 
 
 @dataclass(frozen=True)

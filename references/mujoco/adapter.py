@@ -50,8 +50,8 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from simparity.core.model.engine import Engine, IKModel, KinematicsModel, Simulation, Support
-from simparity.core.model.errors import DivergedError
+from simparity.core.model.engine import BatchedRun, Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.scene import Chain, DynamicsScene, Forces, IKScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
@@ -136,13 +136,27 @@ class _Simulation(Simulation):
     def _stepwise(self) -> bool:
         return bool(self._applied) or self._drags is not None
 
-    def _rollout(self, n_steps: int) -> np.ndarray:
+    def _rollout(self, initial: np.ndarray, n_steps: int) -> np.ndarray:
+        """The states after each of ``n_steps`` steps from each initial state, (R, n_steps, nstate), by one
+        ``mujoco.rollout`` call on this thread (R = len(initial)); wind as constant ``xfrc_applied``."""
         if not np.any(self._xfrc):
-            states, _ = rollout.rollout(self.model, self._data, self._state0[None], nstep=n_steps)
+            states, _ = rollout.rollout(self.model, self._data, initial, nstep=n_steps)
         else:
-            states, _ = rollout.rollout(self.model, self._data, self._state0[None], self._xfrc.ravel()[None, None],
+            states, _ = rollout.rollout(self.model, self._data, initial, self._xfrc.ravel()[None, None],
                                         control_spec=mujoco.mjtState.mjSTATE_XFRC_APPLIED, nstep=n_steps)
-        return states[0]
+        return states
+
+    def batched(self, copies: int) -> BatchedRun:
+        """``copies`` rollouts of this model and options from its initial state, in one ``mujoco.rollout`` call
+        on one thread, as :meth:`run` makes one. NotBatchedError when the adapter applies forces from Python at
+        every step (an ``mj_step`` loop), which a rollout cannot apply."""
+        if self._stepwise:
+            stepwise = (["applied forces (mj_applyFT)"] if self._applied else []) + (
+                ["quadratic drag (xfrc_applied)"] if self._drags else [])
+            raise NotBatchedError(f"the adapter sets {' and '.join(stepwise)} from Python at every step, which "
+                                  "mujoco.rollout cannot apply: no batched timing of this scene")
+        initial = np.repeat(self._state0[None], copies, axis=0)
+        return lambda n_steps: self._rollout(initial, n_steps)
 
     def _apply_forces(self) -> None:
         """Set xfrc_applied and qfrc_applied from the current state (positions updated first)."""
@@ -178,7 +192,7 @@ class _Simulation(Simulation):
         messages: list[str] = []
         mujoco.set_mju_user_warning(messages.append)
         try:
-            stepped = self._loop(n_steps) if self._stepwise else self._rollout(n_steps)
+            stepped = self._loop(n_steps) if self._stepwise else self._rollout(self._state0[None], n_steps)[0]
         finally:
             mujoco.set_mju_user_warning(None)
         if any(warning.number for warning in warnings):
@@ -307,6 +321,13 @@ class MujocoEngine(Engine):
     def theoretical_order(self, integrator: str) -> int | None:
         """Euler (semi-implicit), implicit and implicitfast are first order, RK4 fourth (MuJoCo's docs,
         "Numerical integration")."""
+        return {"euler": 1, "implicit": 1, "implicitfast": 1, "rk4": 4}.get(integrator)
+
+    def stages(self, integrator: str) -> int | None:
+        """Force evaluations per ``mj_step``: one ``mj_forward`` for Euler, implicit and implicitfast (the implicit
+        ones also take the derivative of the velocity-dependent forces and factor M - dt D once per step: work
+        beyond the count), four for RK4 (``mj_RungeKutta``: the step's ``mj_forward`` and three more). Forces the
+        adapter sets from Python at each step's start are evaluated once per step whatever the integrator."""
         return {"euler": 1, "implicit": 1, "implicitfast": 1, "rk4": 4}.get(integrator)
 
     def scheme(self, integrator: str, scene) -> str:

@@ -39,7 +39,8 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from simparity.core.model.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.model.engine import BatchedRun, Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.model.errors import NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.scene import Chain, DynamicsScene, IKScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
@@ -118,6 +119,11 @@ class _Simulation(Simulation):
                        + ("RK4 with RKMK on SO(3)" if integrator == "rk4" else "engines' semi-implicit Euler on SO(3)")
                        + ("; applied forces as aba fext at their body points (SE3.act)" if scene.forces.applied else "")
                        + (f"; {external_forces.DETAIL}, as aba fext" if self._drag else ""))
+
+    def batched(self, copies: int) -> BatchedRun:
+        """The harness calls aba body by body: NotBatchedError."""
+        raise NotBatchedError("the harness steps pinocchio's aba one body at a time from Python: no batched "
+                              "stepping")
 
     def run(self, n_steps: int) -> Trajectory:
         dt, b = self._dt, len(self._position0)
@@ -277,6 +283,10 @@ class PinocchioEngine(UrdfChains, Engine):
 
     def theoretical_order(self, integrator: str) -> int | None:
         """The harness's steppers: the engines' first-order scheme, classical RK4."""
+        return {"euler": 1, "rk4": 4}.get(integrator)
+
+    def stages(self, integrator: str) -> int | None:
+        """``pin.aba`` calls per body and step: once for the Euler step, once per stage of RK4."""
         return {"euler": 1, "rk4": 4}.get(integrator)
 
     def scheme(self, integrator: str, scene) -> str:

@@ -79,8 +79,8 @@ import tempfile
 
 import numpy as np
 
-from simparity.core.model.engine import Engine, IKModel, KinematicsModel, Simulation, Support
-from simparity.core.model.errors import DivergedError
+from simparity.core.model.engine import BatchedRun, Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.scene import Chain, DynamicsScene, IKScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
@@ -281,6 +281,10 @@ class _Simulation(Simulation):
         pybullet.setCollisionFilterGroupMask(uid, -1, PLANE_GROUP, BODY_GROUP, physicsClientId=c)
         return uid
 
+    def batched(self, copies: int) -> BatchedRun:
+        """PyBullet has no batch API: NotBatchedError."""
+        raise NotBatchedError("pybullet steps one world per stepSimulation call: no batched stepping")
+
     def run(self, n_steps: int) -> Trajectory:
         c = self._client.id
         if self._contact is not None:  # Bullet's breaking threshold is process-global: another world may have set it
@@ -457,6 +461,11 @@ class PybulletEngine(UrdfChains, Engine):
 
     def theoretical_order(self, integrator: str) -> int | None:
         """Bullet's semi-implicit Euler step is first order."""
+        return 1 if integrator == "euler" else None
+
+    def stages(self, integrator: str) -> int | None:
+        """One force evaluation per ``stepSimulation`` (the adapter's forces, set before each step, are held over
+        it); the constraint solver's iterations at a contact are not counted."""
         return 1 if integrator == "euler" else None
 
     def scheme(self, integrator: str, scene) -> str:
