@@ -202,7 +202,7 @@ def _scheme(case: pd.Series | None, unit: str) -> str:
     """A case the summary picked for its accuracy: ``mujoco rk4 @ 0.01: 1.09e-08 rad``."""
     if case is None:
         return "none"
-    return f"{case['engine']} {case['integrator']} @ {case['dt']:g}: {number(case['error'])} {unit}"
+    return f"{case['engine']} {case['integrator']} @ {number(case['dt'])}: {number(case['error'])} {unit}"
 
 
 def _ranking_text(by: str) -> str:
@@ -213,7 +213,7 @@ def _ranking_text(by: str) -> str:
                 "engines declare no stages). Within one engine that is fair (its per-call overhead is shared); across "
                 f"engines it also measures each one's overhead per call. {truths}")
     return ("Ranked by force evaluations per simulated second (stages / dt: Hairer's hardware-neutral work, blind to "
-            "per-call overhead), ties by wall time (each scene's section has it, and the batched time). "
+            "per-call overhead), ties by wall time (report.html has it per scheme, and the batched time). "
             f"{truths[:-1]}; schemes without a stage count only within their engine.")
 
 
@@ -261,6 +261,10 @@ class _Builder:
         ranked = list(self.cases.values()) + [s.across for s in sweeps if s.kind == "dynamics"]
         self.by = summary.ranking_cost(pd.concat(ranked)) if ranked else summary.WALL
         self.findings_per_scene: Counter = Counter()
+
+    def findings_of(self, scene: str) -> int:
+        """How many rows of the flagged findings are about ``scene`` (a sweep's variant: about its sweep)."""
+        return self.findings_per_scene.get(self.groups.get(scene, scene), 0)
 
     def listed(self, scene: str) -> bool:
         """Whether ``scene`` has a section of its own: a scene outside a sweep, or a variant the sweep shows."""
@@ -326,13 +330,15 @@ class _Builder:
         per_scene = [engine_summary.choices(cases, self.by) for scene, cases in self.cases.items()]
         if not per_scene:
             return []
-        tallies = engine_summary.tally(per_scene)
-        columns = list(next(iter(per_scene[0].values()), {}))
+        tallies = engine_summary.tally(per_scene, self.info.integrator_variants)
+        columns = [f"error ≤ {b:g}" for b in summary.ERROR_BUDGETS] + [summary.cost_label(self.by, b)
+                                                                       for b in summary.cost_budgets(self.by)]
         head = ("engine",) + tuple(f"cheapest at {c}" if c.startswith("error") else f"most accurate at {c}"
                                    for c in columns)
-        return [Paragraph(f"Each engine's own choice over {len(per_scene)} scenes (\"rk4 ×9\": on 9; \"none\": none "
-                          "of its schemes reached the budget), then the overall best per scene (\"+k as cheap\": k "
-                          "others do the same work)."),
+        return [Paragraph(f"Each engine's own scheme (its variants together) over {len(per_scene)} scenes (\"rk4 ×9\": "
+                          "on 9; \"none\": no "
+                          "scheme of it reached the budget; n/a, diverged: why it had none), then the overall best per "
+                          "scene (\"+k as cheap\": k others do the same work)."),
                 Table(head, tuple((_ran_on(engine, per_scene),) + tuple(cells.get(c, "none") for c in columns)
                                   for engine, cells in tallies.items()))]
 
@@ -529,7 +535,8 @@ class _Builder:
                           "time steps whose local slopes agree; errors at the rounding floor or saturated are left out."),
                 tables.metric_table(orders, tables.ORDER_COLUMNS, ["engine", "integrator"])]
             full += explained + _fits(orders)
-        verdict = engine_summary.dynamics_verdict(cases, fits, self.findings_per_scene.get(scene, 0), unit)
+        verdict = engine_summary.dynamics_verdict(cases, fits, self.findings_of(scene), unit,
+                                                  engine_summary.order_alarms(rows, headline))
         return verdict, blocks + [Details(f"{scene}: every engine × integrator × dt", tuple(full), markdown=False)]
 
     def per_engine(self, cases: pd.DataFrame, fits: pd.DataFrame, unit: str, contact: _Contact | None) -> Table:
@@ -540,8 +547,9 @@ class _Builder:
         rows = []
         for engine, picks in choices.items():
             own = cases[cases["engine"] == engine]
-            best = own[(own["status"] == OK) & own["error"].notna()].sort_values(["error", summary.WALL])
-            accurate = engine_summary.pick(best.iloc[0] if not best.empty else None, self.by, show_error=True)
+            best = engine_summary.most_accurate(own)
+            accurate = engine_summary.pick(best if best is not None else engine_summary.unmeasured(own), self.by,
+                                           show_error=True)
             ranked_by = engine_summary.own_cost(own, self.by)
             budgets = [engine_summary.pick(picks[f"error ≤ {b:g}"], ranked_by, show_error=False)
                        for b in summary.ERROR_BUDGETS]
@@ -629,7 +637,7 @@ class _Builder:
         blocks += self.figure(figures.fk_matrix_figure(scene, series), f"{scene}-fk-agreement",
                               "Cross-engine FK agreement on every solution [m].")
         per_engine = []
-        for engine in engine_summary.engine_order(solvers["engine"]):
+        for engine in engine_summary.engine_order(solvers["engine"], truths=True):
             own = solvers[solvers["engine"] == engine]
             best, fastest = summary.best_ik(own)
             solved = int((own[SOLVE_RATE] > 0).sum())
@@ -648,7 +656,7 @@ class _Builder:
         blocks.append(Details(f"{scene}: every metric and hard target",
                               (tables.metric_table(plain, tables.IK_COLUMNS, ["engine", "solver"]), *hard),
                               markdown=False))
-        return _ik_verdict(solvers, tolerance, _hard_solved(rows), self.findings_per_scene.get(scene, 0)), blocks
+        return _ik_verdict(solvers, tolerance, _hard_solved(rows), self.findings_of(scene)), blocks
 
 
 def _ran_on(engine: str, per_scene: list[dict]) -> str:
@@ -672,7 +680,7 @@ def _ik_verdict(solvers: pd.DataFrame, tolerance: float | None, hard: tuple[int,
     parts = [f"best {_solver(best, tolerance)}", reliable]
     none = [f"{r['engine']} {r['integrator']}" for _, r in solvers.iterrows() if r[SOLVE_RATE] == 0]
     if none:
-        parts.append(f"{len(none)} solve none at its tolerance ({_names(none, 2)})")
+        parts.append(f"{len(none)} solve none at the scene's tolerance ({_names(none, 2)})")
     if hard[1]:
         parts.append(f"hard targets: {hard[0]} of {hard[1]} solves succeeded")
     return "; ".join(parts + [f"{findings} finding{'s' if findings != 1 else ''}"])

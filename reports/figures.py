@@ -28,7 +28,7 @@ import pandas as pd  # noqa: E402
 from simparity.core.runtime.processes import die_with_parent  # noqa: E402
 from simparity.core.model.results import SWEEP_PREFIX  # noqa: E402
 from simparity.reports.figure_layout import finish, legend, power_of_ten, title, wrap  # noqa: E402
-from simparity.reports.summary import ERROR_BUDGETS, EVALUATIONS  # noqa: E402
+from simparity.reports.summary import AGREE_RELATIVE, ERROR_BUDGETS, EVALUATIONS  # noqa: E402
 from simparity.core.model.metric_catalogue import ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE, TIME_PER_SOLVE
 
 _ENGINE_MARKERS = {"core": "o", "mujoco": "s", "pybullet": "^", "pinocchio": "D"}
@@ -38,11 +38,6 @@ _VARIANT_MARKERS = ("P", "X", "*", "v", "<", ">")
 none is an engine's marker, so a marker says either the engine or the variant."""
 _KEY_COLOR = "0.35"
 """The grey of the legend's marker key and of the theoretical slopes: no scheme's colour."""
-AGREE_RELATIVE = 1e-3
-"""Errors of two schemes at the same time steps that agree to this relative difference are drawn as one line
-labelled with both ("core rk4 = mujoco rk4"): on a log axis 1e-3 is 4e-4 of a decade, far below a pixel, so separate
-lines would hide each other. Measured in the quick run: MuJoCo's and Pinocchio's rk4 on dzhanibekov agree to 3e-5
-(near the rounding floor), core's explicit and semi-implicit Euler exactly; different schemes differ by percents."""
 SLOPE_OFFSET = 4.0
 """[factor] A theoretical slope is drawn this far below the lowest line of its order (0.6 decade): beside the data,
 not over it."""

@@ -100,3 +100,51 @@ def test_a_dynamics_verdict_says_each_engines_best_orders_findings_and_cases_wit
                               "pinocchio rk4 1e-08 rad")
     assert "orders 2 of 3 as theory; below: core explicit_euler 0.31" in verdict
     assert verdict.endswith("2 findings; cases diverged 1")
+
+
+def test_errors_that_agree_to_rounding_are_one_result_and_the_cheapest_is_named():
+    """Pinocchio's RK4 error a last digit below MuJoCo's (the same method) does not make it the most accurate: within
+    AGREE_RELATIVE the cheaper on the clock is named."""
+    close = CASES.copy()
+    close.loc[close["engine"] == "pinocchio", "error"] = 1e-8 * (1 - summary.AGREE_RELATIVE / 10)
+    best = summary.most_accurate_within(close, 1000.0, summary.EVALUATIONS)
+    assert (best["engine"], best["integrator"]) == ("mujoco", "rk4")
+    close.loc[close["engine"] == "pinocchio", "error"] = 1e-8 * (1 - 10 * summary.AGREE_RELATIVE)
+    assert summary.most_accurate_within(close, 1000.0, summary.EVALUATIONS)["engine"] == "pinocchio"  # really better
+
+
+def test_an_engine_that_measured_nothing_says_why_in_every_cell_and_in_the_verdict():
+    nothing = _cases([("pybullet", "euler", 0.01, math.nan, math.nan, math.nan)]).assign(status="n/a")
+    blown = _cases([("pinocchio", "euler", 0.01, math.nan, math.nan, math.nan)]).assign(status="diverged")
+    cases = pd.concat([CASES[CASES["engine"] != "pinocchio"], nothing, blown])
+    picks = engine_summary.choices(cases, summary.EVALUATIONS)
+    assert set(picks["pybullet"].values()) == {"n/a"} and set(picks["pinocchio"].values()) == {"diverged"}
+    assert engine_summary.tally([picks, picks])["pybullet"]["error ≤ 0.001"] == "n/a ×2"
+    verdict = engine_summary.dynamics_verdict(cases, pd.DataFrame(columns=["engine", "integrator", "value", "flag"]),
+                                              0, "m")
+    assert "pybullet: n/a" in verdict and "pinocchio: diverged" in verdict
+
+
+def test_an_engine_with_a_scheme_without_a_stage_count_ranks_all_its_schemes_by_wall_time():
+    """Ranking by work would silently drop the scheme that declares no count, however good."""
+    partly = CASES.copy()
+    partly.loc[(partly["engine"] == "core") & (partly["integrator"] == "explicit_euler"), summary.EVALUATIONS] = math.nan
+    assert engine_summary.own_cost(partly[partly["engine"] == "core"], summary.EVALUATIONS) == summary.WALL
+    picks = engine_summary.choices(partly, summary.EVALUATIONS)["core"]
+    assert picks["error ≤ 0.001"]["dt"] == 0.02                   # RK4 at 0.02: 0.02 s/s, the least wall time within
+    uncounted = CASES.assign(**{summary.EVALUATIONS: math.nan})
+    assert engine_summary.overall(uncounted, 1e-6, summary.EVALUATIONS) == (
+        "none counted (4 cases without a stage count within)")
+
+
+def test_tally_always_says_how_often_an_engine_had_none():
+    scenes = [engine_summary.choices(_cases([("core", name, 0.01, error, 0.01, 100.0)]), summary.EVALUATIONS)
+              for name, error in (("a", 1e-4), ("b", 1e-4), ("c", 1e-4), ("d", 1e-4), ("e", 1.0))]
+    assert engine_summary.tally(scenes)["core"]["error ≤ 0.001"] == "a ×1, b ×1, c ×1, others ×1, none ×1"
+
+
+def test_tally_counts_the_variants_of_a_scheme_as_the_scheme():
+    variants = {"core": {"rk4+matrix": ["rk4", "matrix"], "rk4": ["rk4", "quaternion"]}}
+    scenes = [engine_summary.choices(_cases([("core", name, 0.01, 1e-8, 0.01, 400.0)]), summary.EVALUATIONS)
+              for name in ("rk4", "rk4+matrix", "rk4+matrix")]
+    assert engine_summary.tally(scenes, variants)["core"]["error ≤ 1e-06"] == "rk4 ×3"

@@ -79,6 +79,13 @@ class NegativeStages(InHouseEngine):
         return -1
 
 
+class ZeroStages(InHouseEngine):
+    """A step that evaluates no force is no step: 0 would make every scheme free and win every work budget."""
+
+    def stages(self, integrator):
+        return 0
+
+
 class FloatStages(InHouseEngine):
     def stages(self, integrator):
         return 4.0
@@ -279,15 +286,15 @@ def test_an_engine_that_breaks_the_interface_fails_its_rows_with_the_reason(site
     assert OK in set(_rows(table, "core").status)
 
 
-@pytest.mark.parametrize("attr, returned", [("NegativeStages", "-1"), ("FloatStages", "4.0")])
+@pytest.mark.parametrize("attr, returned", [("NegativeStages", "-1"), ("ZeroStages", "0"), ("FloatStages", "4.0")])
 def test_an_engine_declaring_a_bad_stage_count_is_broken_with_a_one_line_reason(site, attr, returned):
-    """stages() is force evaluations per step: a negative or non-integer count is refused as it loads, in one line."""
+    """stages() is force evaluations per step: a count below 1 or not an integer is refused as it loads, in one line."""
     site.add_module("plugin_engines_b")
     engine = plugins.load_engine(f"plugin_engines_b:{attr}")
     assert isinstance(engine, BrokenEngine)
     first = InHouseEngine().integrators()[0]
     assert engine.reason == (f"plugin_engines_b:{attr} is broken: plugin_engines_b:{attr}: stages({first!r}) "
-                             f"returned {returned} (allowed: an int >= 0, force evaluations per step, or None)")
+                             f"returned {returned} (allowed: an int >= 1, force evaluations per step, or None)")
 
 
 @pytest.mark.slow

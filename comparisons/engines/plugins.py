@@ -161,7 +161,7 @@ def _instantiate(found: object, target: str) -> Engine:
 def _interface_problem(engine: Engine) -> str:
     """What the engine's description of itself breaks ("" when nothing): ``version()`` a str,
     ``integrators()`` and ``ik_solvers()`` tuples of names (:data:`OFFERED_NAME`), ``theoretical_order(i)``
-    an int or None, ``stages(i)`` an int >= 0 or None and ``integrator_variant(i)`` two strs for each integrator.
+    an int or None, ``stages(i)`` an int >= 1 or None and ``integrator_variant(i)`` two strs for each integrator.
     Their errors are problems too."""
     step = "version()"
     try:
@@ -180,8 +180,8 @@ def _interface_problem(engine: Engine) -> str:
                 return f"{step} returned {echo(order)} (allowed: an int or None)"
             step = f"stages({integrator!r})"
             stages = engine.stages(integrator)
-            if stages is not None and (isinstance(stages, bool) or not isinstance(stages, int) or stages < 0):
-                return f"{step} returned {echo(stages)} (allowed: an int >= 0, force evaluations per step, or None)"
+            if stages is not None and (isinstance(stages, bool) or not isinstance(stages, int) or stages < 1):
+                return f"{step} returned {echo(stages)} (allowed: an int >= 1, force evaluations per step, or None)"
             step = f"integrator_variant({integrator!r})"
             variant = engine.integrator_variant(integrator)
             if not (isinstance(variant, tuple) and len(variant) == 2 and all(isinstance(v, str) for v in variant)):

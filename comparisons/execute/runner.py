@@ -208,7 +208,7 @@ def _stages(engine: Engine, integrator: str) -> int | None:
         stages = engine.stages(integrator)
     except Exception:  # noqa: BLE001 - a user's engine; its rows report what fails
         return None
-    return stages if isinstance(stages, int) and not isinstance(stages, bool) and stages >= 0 else None
+    return stages if isinstance(stages, int) and not isinstance(stages, bool) and stages >= 1 else None
 
 
 def _cost(engine: Engine, sim: Simulation, case: Case, n: int, repeats: int) -> dict[str, Measured]:
@@ -228,13 +228,17 @@ def _cost(engine: Engine, sim: Simulation, case: Case, n: int, repeats: int) -> 
 
 def _batched_time(sim: Simulation, n: int, repeats: int) -> Measured:
     """Wall time [s] per copy and step of :data:`BATCH_COPIES` copies stepped together (:meth:`Simulation.batched`,
-    built untimed) for min(n, :data:`BATCH_STEPS`) steps; n/a with the engine's reason when it cannot batch."""
+    built untimed) for min(n, :data:`BATCH_STEPS`) steps; n/a with the engine's reason when it cannot batch, or with
+    the error when its batched stepping raised (the case's own rows stand)."""
     steps = min(n, BATCH_STEPS)
     try:
         run = sim.batched(BATCH_COPIES)
+        seconds, _ = best_of(lambda: run(steps), repeats)
     except NotBatchedError as why:
         return Measured(math.nan, unit_of(TIME_PER_STEP_BATCHED), unmeasurable=str(why))
-    seconds, _ = best_of(lambda: run(steps), repeats)
+    except Exception as err:  # noqa: BLE001 - a user's engine: its batched timing is lost, not the case it ran
+        return Measured(math.nan, unit_of(TIME_PER_STEP_BATCHED),
+                        unmeasurable=f"its batched stepping raised: {error_text(err)}")
     return Measured(seconds / (BATCH_COPIES * steps), unit_of(TIME_PER_STEP_BATCHED))
 
 
