@@ -71,3 +71,16 @@ def test_an_unsolved_user_solver_against_a_builtin_that_solves():
     rate = dict(metric="cross_eval_solve_rate_min", scheme="damped_least_squares", dt=math.nan, unit="1")
     (violation,) = _check(_row("core", 0.96, **rate), _row("user", math.nan, status="n/a", flag="unsolved", **rate))
     assert violation.found == "0 (unsolved)"
+
+
+def test_a_user_scheme_declaring_less_work_than_every_builtin_of_its_kind():
+    """Core's and MuJoCo's RK4 evaluate the forces 4 times a step (400/s at dt 0.01): a user's RK4 declaring one
+    stage (100/s) would be ranked the cheapest of every budget, and is a violation naming the built-in it undercuts;
+    the same count, or more work, is none."""
+    builtin = (_row("core", 400.0, metric="evaluations_per_second", unit="1/s"),
+               _row("mujoco", 400.0, metric="evaluations_per_second", unit="1/s"))
+    assert _check(*builtin, _row("user", 400.0, metric="evaluations_per_second", unit="1/s")) == []
+    assert _check(*builtin, _row("user", 800.0, metric="evaluations_per_second", unit="1/s")) == []
+    (violation,) = _check(*builtin, _row("user", 100.0, metric="evaluations_per_second", unit="1/s"))
+    assert violation.engine == "user" and violation.metric == "evaluations_per_second"
+    assert "core rk4" in violation.reason and "stages()" in violation.reason

@@ -20,7 +20,7 @@ from simparity.comparisons.gate.violation import Violation
 from simparity.core.model.results import NOT_AVAILABLE, OK, ROUNDING_FLOOR, SATURATED, UNSOLVED
 from simparity.core.model.metric_catalogue import (
     ANGULAR_MOMENTUM_DRIFT_MAX, ANGULAR_VELOCITY_ERROR_MAX, APEX_HEIGHT_ERROR, CROSS_EVAL_SOLVE_RATE_MIN,
-    ENERGY_DRIFT_MAX, ENERGY_LOSS_ERROR, IMPACT_TIME_ERROR, ORIENTATION_ERROR_MAX, POSITION_ERROR_FINAL,
+    ENERGY_DRIFT_MAX, ENERGY_LOSS_ERROR, EVALUATIONS_PER_SECOND, IMPACT_TIME_ERROR, ORIENTATION_ERROR_MAX, POSITION_ERROR_FINAL,
     POSITION_ERROR_MAX, REBOUND_VELOCITY_ERROR, RESTITUTION_ERROR, REST_DISTANCE_MEDIAN, REST_TIME_ERROR,
     STOPPING_DISTANCE_ERROR, VELOCITY_ERROR_MAX,
 )
@@ -46,6 +46,17 @@ ERROR_METRICS = (POSITION_ERROR_MAX, POSITION_ERROR_FINAL, ORIENTATION_ERROR_MAX
 
 RATE_METRICS = (CROSS_EVAL_SOLVE_RATE_MIN,)
 """Metrics where more is better (the harness's own solve rate), cross-checked against the best built-in."""
+
+
+WORK_METRICS = (EVALUATIONS_PER_SECOND,)
+"""Metrics a scheme declares rather than measures (force evaluations per simulated second, stages / dt): fewer than
+every built-in scheme of its kind at the same step is a violation. An RK4 that declares one stage instead of four
+would be ranked the cheapest scheme of every budget in the report; declaring more is no violation (a user's scheme
+may do extra work)."""
+
+SAME_WORK_RELATIVE = 1e-9
+"""Relative rounding allowed between two declared counts per simulated second: stages / dt of one time step differ
+in their last bits at most."""
 
 
 NULLSPACE = "+nullspace"
@@ -87,8 +98,8 @@ def _builtin_rows(table: pd.DataFrame, builtin: tuple[str, ...]) -> pd.DataFrame
 
 def cross_check(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Violation]:
     """Every row of an engine not in ``builtin`` with a declared scheme that the built-in rows of the same scene,
-    scheme, time step and metric show to be beyond :data:`CROSS_CHECK_FACTOR` (errors) or below
-    :data:`SOLVE_RATE_FRACTION` (solve rates), or saturated (unsolved) where the built-ins of its kind measured a
+    scheme, time step and metric show to be beyond :data:`CROSS_CHECK_FACTOR` (errors), below
+    :data:`SOLVE_RATE_FRACTION` (solve rates) or below the least (declared work, :data:`WORK_METRICS`), or saturated (unsolved) where the built-ins of its kind measured a
     number; and every null-space solver of such an engine that does worse than its solver without the term
     (:func:`nullspace_checks`)."""
     if "scheme" not in table.columns:
@@ -97,7 +108,7 @@ def cross_check(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Violation
     table = table.assign(dt_key=table["dt"].map(lambda d: "nan" if pd.isna(d) else repr(float(d))),
                          flag=table["flag"].fillna("") if "flag" in table.columns else "")
     out = nullspace_checks(table, builtin)
-    watched = table[table["metric"].isin(ERROR_METRICS + RATE_METRICS)]
+    watched = table[table["metric"].isin(ERROR_METRICS + RATE_METRICS + WORK_METRICS)]
     users = watched[~watched["engine"].isin(builtin) & (watched["scheme"].fillna("") != "")]
     reference = {key: rows for key, rows in _builtin_rows(watched, builtin).groupby(keys)}
     for row in users.to_dict("records"):
@@ -118,6 +129,14 @@ def _judge(row: dict, builtin: pd.DataFrame) -> tuple[str, str, str] | None:
     if measured.empty or (measured["flag"] == ROUNDING_FLOOR).any() or row["flag"] == ROUNDING_FLOOR:
         return None  # nothing to compare with, or exact up to rounding: rounding has no size to hold
     kind = row["scheme"]
+    if row["metric"] in WORK_METRICS:
+        least = measured.loc[measured["value"].idxmin()]
+        if row["status"] == OK and float(row["value"]) < float(least["value"]) * (1 - SAME_WORK_RELATIVE):
+            return (f"{float(row['value']):.4g} {row['unit']}", f">= {float(least['value']):.4g} {row['unit']}",
+                    f"cross-check: a {kind} step evaluates the forces at least as often as the built-in {kind}, "
+                    f"{least['engine']} {least['integrator']} ({float(least['value']):.4g} {row['unit']}); the "
+                    "engine's stages() declares fewer")
+        return None
     if row["metric"] in RATE_METRICS:
         best = measured.loc[measured["value"].idxmax()]
         limit = SOLVE_RATE_FRACTION * float(best["value"])
