@@ -261,6 +261,14 @@ class _Builder:
         ranked = list(self.cases.values()) + [s.across for s in sweeps if s.kind == "dynamics"]
         self.by = summary.ranking_cost(pd.concat(ranked)) if ranked else summary.WALL
         self.findings_per_scene: Counter = Counter()
+        self._choices: dict[str, dict] = {}
+
+    def choices(self, scene: str, cases: pd.DataFrame) -> dict:
+        """Each engine's choices on ``scene`` (:func:`reports.engine_summary.choices`), computed once for the
+        summary's tally and the scene's table."""
+        if scene not in self._choices:
+            self._choices[scene] = engine_summary.choices(cases, self.by)
+        return self._choices[scene]
 
     def findings_of(self, scene: str) -> int:
         """How many rows of the flagged findings are about ``scene`` (a sweep's variant: about its sweep)."""
@@ -327,7 +335,7 @@ class _Builder:
         """The per-engine answer over the run's dynamics scenes (sweeps have theirs in their section): how often each
         scheme of an engine was its own cheapest within each error budget and most accurate within each cost
         budget."""
-        per_scene = [engine_summary.choices(cases, self.by) for scene, cases in self.cases.items()]
+        per_scene = [self.choices(scene, cases) for scene, cases in self.cases.items()]
         if not per_scene:
             return []
         tallies = engine_summary.tally(per_scene, self.info.integrator_variants)
@@ -524,7 +532,7 @@ class _Builder:
         fits = engine_summary.fitted_orders(rows, headline, theory)
         contact = self.contact(scene, rows, about, reference, series) if about.get("contact") else None
         blocks += contact.figure if contact else []
-        blocks += [self.per_engine(cases, fits, unit, contact), self.per_scheme(cases, observed, about, unit)]
+        blocks += [self.per_engine(scene, cases, fits, unit, contact), self.per_scheme(cases, observed, about, unit)]
         blocks += contact.blocks if contact else []
         full: list[Block] = [tables.metric_table(rows[rows["dt"].notna()], tables.DYNAMICS_COLUMNS,
                                                  ["engine", "integrator", "dt"])]
@@ -539,11 +547,12 @@ class _Builder:
                                                   engine_summary.order_alarms(rows, headline))
         return verdict, blocks + [Details(f"{scene}: every engine × integrator × dt", tuple(full), markdown=False)]
 
-    def per_engine(self, cases: pd.DataFrame, fits: pd.DataFrame, unit: str, contact: _Contact | None) -> Table:
+    def per_engine(self, scene: str, cases: pd.DataFrame, fits: pd.DataFrame, unit: str,
+                   contact: _Contact | None) -> Table:
         """report.md's table of a dynamics scene: a row per engine (the user's first) with its most accurate scheme,
         its cheapest within each error budget (by the summary's cost), its fitted orders against theory (a contact
         scene: its measured restitution and worst penetration) and how its cases ended."""
-        choices = engine_summary.choices(cases, self.by)
+        choices = self.choices(scene, cases)
         rows = []
         for engine, picks in choices.items():
             own = cases[cases["engine"] == engine]

@@ -47,15 +47,11 @@ ERROR_NOT_MEASURED = "error n/a"
 """An engine whose cases ran but measured no headline error (saturated, or nothing to measure it against)."""
 
 
-def _measured(own: pd.DataFrame) -> pd.DataFrame:
-    return own[(own["status"] == OK) & own["error"].notna()]
-
-
 def unmeasured(own: pd.DataFrame) -> str | None:
     """Why an engine's cases of a scene measured no headline error: "failed" or "diverged" (none ok, some of that
     status, the graver first), "n/a" (every case n/a: it cannot run the scene), :data:`ERROR_NOT_MEASURED`; None
     when some case measured one."""
-    if not _measured(own).empty:
+    if not summary.measured(own, None).empty:
         return None
     statuses = set(own["status"])
     return next((s for s in ("failed", "diverged") if s in statuses),
@@ -66,7 +62,7 @@ def own_cost(own: pd.DataFrame, by: str) -> str:
     """The cost one engine's cases ``own`` are ranked by among themselves: the run's ``by``, or wall time where any
     of its measured cases counted no force evaluations (a plugin that declares no stages for some scheme: ranking by
     work would drop that scheme); within one engine wall time is fair, its overhead is shared."""
-    return summary.WALL if by not in own or _measured(own)[by].isna().any() else by
+    return summary.WALL if by not in own or summary.measured(own, None)[by].isna().any() else by
 
 
 def choices(cases: pd.DataFrame, by: str) -> dict[str, dict[str, Choice]]:
@@ -139,7 +135,7 @@ def overall(cases: pd.DataFrame, budget: float, by: str) -> str:
     cheap)``, naming how many others do the same work within it; "none"."""
     least = summary.equally_cheap(cases, budget, by)
     if least.empty:
-        uncounted = _measured(cases)
+        uncounted = summary.measured(cases, None)
         uncounted = uncounted[(uncounted["error"] <= budget) & uncounted[by].isna()] if by in cases else uncounted[0:0]
         return f"none counted ({_schemes(len(uncounted))} without a stage count within)" if len(uncounted) else "none"
     best = least.iloc[0]
@@ -177,7 +173,7 @@ def fitted_orders(rows: pd.DataFrame, headline: str, theory: dict) -> pd.DataFra
 def most_accurate(own: pd.DataFrame) -> pd.Series | None:
     """An engine's most accurate case (errors within :data:`reports.summary.AGREE_RELATIVE` of the least are one
     result: the cheapest of them); None when none measured its error."""
-    measured = _measured(own)
+    measured = summary.measured(own, None)
     return None if measured.empty else summary.equally_accurate(measured).iloc[0]
 
 

@@ -90,8 +90,10 @@ def ranking_cost(cases: pd.DataFrame) -> str:
     return EVALUATIONS if EVALUATIONS in cases and cases[EVALUATIONS].notna().any() else WALL
 
 
-def _measured(cases: pd.DataFrame, by: str = WALL) -> pd.DataFrame:
-    return cases[(cases["status"] == OK) & cases["error"].notna() & cases[by].notna()]
+def measured(cases: pd.DataFrame, by: str | None = WALL) -> pd.DataFrame:
+    """The ok cases with an error, and with a ``by`` cost unless ``by`` is None."""
+    kept = (cases["status"] == OK) & cases["error"].notna()
+    return cases[kept & cases[by].notna()] if by is not None else cases[kept]
 
 
 SAME_COST_RELATIVE = 1e-9
@@ -110,7 +112,7 @@ def equally_cheap(cases: pd.DataFrame, budget: float, by: str = WALL) -> pd.Data
     """The cases whose error is within ``budget`` at the least ``by`` cost (within :data:`SAME_COST_RELATIVE`), the
     least wall time first (several where schemes do the same work: RK4 at one dt in every engine); empty when none
     is within it."""
-    within = _measured(cases, by)
+    within = measured(cases, by)
     within = within[within["error"] <= budget]
     if within.empty:
         return within
@@ -137,7 +139,7 @@ def most_accurate_within(cases: pd.DataFrame, budget: float, by: str = WALL) -> 
     """The case of least error (errors within :data:`AGREE_RELATIVE` of it count as equal: the cheapest of them)
     whose ``by`` cost is within ``budget`` [s per simulated s for :data:`WALL`, evaluations per simulated s for
     :data:`EVALUATIONS`], or None."""
-    within = _measured(cases, by)
+    within = measured(cases, by)
     within = within[within[by] <= budget]
     return None if within.empty else equally_accurate(within).iloc[0]
 
@@ -157,7 +159,7 @@ def best_per_scheme(cases: pd.DataFrame) -> pd.DataFrame:
     evaluations, batched cost and time per step (NaN where none was measured), ``statuses`` (how many of its time steps ended ok /
     diverged / failed / n/a) and ``any_result`` (False when every time step is n/a)."""
     keys = ["engine", "integrator"]
-    best = _measured(cases).sort_values(["error", "cost"]).drop_duplicates(keys)
+    best = measured(cases).sort_values(["error", "cost"]).drop_duplicates(keys)
     summary = cases.groupby(keys, sort=False)["status"].agg(
         statuses=lambda s: ", ".join(f"{status} {n}" for status, n in s.value_counts().items()),
         any_result=lambda s: bool((s != NOT_AVAILABLE).any())).reset_index()
