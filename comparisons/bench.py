@@ -11,7 +11,9 @@ computed from the same run:
 2. forward kinematics + end-effector Jacobian of the iiwa and the UR5, time per configuration, with
    the largest difference to Pinocchio;
 3. IK on the ``bench`` suite's arms (TRAC-IK protocol), solve rate and time per solve, failures
-   inside the time, limit violations.
+   inside the time, limit violations;
+4. joint-space dynamics (M + h, RNEA, ABA) of the ``articulated`` suite's real arms, time per state with the largest
+   relative difference to Pinocchio (:mod:`comparisons.bench_joint_dynamics`).
 
 Results go to ``benchmarks.csv`` (one tidy row per measurement) and ``BENCHMARKS.md``, with a verdict on each of
 the issue's targets that says what it compared. The targets are set for the full sizes (:data:`TARGET_BATCH` bodies
@@ -39,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from simparity.comparisons import bench_joint_dynamics
 from simparity.comparisons.scenes import library
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.ik_targets import random_targets
@@ -456,6 +459,9 @@ def targets(rows: list[BenchRow]) -> list[Verdict]:
                               f"core at B = {big:,} vs Pinocchio at B = {p.batch:,} (its best): {p.value / c.value:.2f}x "
                               f"({c.value:.3g} vs {p.value:.3g} us per configuration)", p.value / c.value >= 2,
                               f"B = {big:,}", f"B = {TARGET_BATCH:,}"))
+    largest_states = max((r.batch for r in rows if r.section == "joint_dynamics"), default=0)
+    out += [_sized(target, compared, met, f"B = {largest_states:,}", f"B = {TARGET_BATCH:,}")
+            for target, compared, met in bench_joint_dynamics.target_lines(rows)]
     out += _memory_targets(rows)
     for chain in sorted({r.workload for r in rows if r.section == "ik"}):
         mine = [r for r in rows if r.section == "ik" and r.workload == chain]
@@ -564,6 +570,7 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
             lines.append(f"| {chain} | {engine} | " + " | ".join(_cell(cells[b].value) for b in batches)
                          + f" | {_cell(max(c.accuracy for c in cells.values()), '.1e')} |")
         lines.append("")
+    lines += bench_joint_dynamics.markdown_lines(rows)
     ik = [r for r in rows if r.section == "ik"]
     if ik:
         lines += [f"## IK, TRAC-IK protocol ({ik[0].batch:,} seeded pose targets per arm from mid-range, success at "
@@ -629,6 +636,8 @@ def run_bench(out_dir: Path, quick: bool, command: str, say: Callable[[str], Non
     rows = dynamics_rows(batches, quick, say)
     say("forward kinematics + Jacobian")
     rows += kinematics_rows(batches, say)
+    say("joint-space dynamics (time per state, with the difference to Pinocchio)")
+    rows += bench_joint_dynamics.joint_dynamics_rows(batches, lambda fn: median_time(fn, REPEATS), BenchRow, say)
     say("IK")
     rows += ik_rows(300 if quick else None, say)
     say("memory of simparity run against the number of steps")

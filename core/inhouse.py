@@ -20,7 +20,9 @@ from simparity.core.contact.bodies import (
 )
 from simparity.core.contact.act_after import GAUSS_SEIDEL_PASSES, ActAfterStepper
 from simparity.core.contact.backup import FREE, MAX_EVENTS_PER_STEP, BackupStepper
-from simparity.core.model.engine import BatchedRun, Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.model.engine import (BatchedRun, Engine, IKModel, JointDynamicsModel, KinematicsModel, Simulation,
+                                         Support)
+from simparity.core.articulated import model as joint_dynamics
 from simparity.core.dynamics.forces import make_wrench
 from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik, task_basis
 from simparity.core.model.ik_problem import IKTolerances
@@ -358,6 +360,19 @@ class InHouseEngine(Engine):
 
     def ik_solvers(self) -> tuple[str, ...]:
         return METHODS + (NULLSPACE, RESTARTS)
+
+    def joint_dynamics_methods(self) -> tuple[str, ...]:
+        """Featherstone's recursive algorithms and the lecture's sum over link Jacobians
+        (:mod:`core.articulated`)."""
+        return joint_dynamics.METHODS
+
+    def supports_joint_dynamics(self, chain: Chain, method: str) -> Support:
+        named = super().supports_joint_dynamics(chain, method)
+        problem = chain.dynamics_problem()
+        return Support.no(problem) if named.ok and problem else named
+
+    def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
+        return joint_dynamics.build(chain, method, gravity_world)
 
     def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
         named = super().supports_ik(chain, solver, position_only)

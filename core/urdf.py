@@ -1,13 +1,28 @@
-"""Serial chains from URDF files (kinematics only), read with the standard library.
+"""Serial chains from URDF files (kinematics and the mass properties dynamics needs), read with the
+standard library.
 
-Only what fixes the kinematics is read: each ``<link name>`` and each ``<joint>``'s type,
-``<parent>``, ``<child>``, ``<origin xyz rpy>``, ``<axis xyz>`` and ``<limit lower upper>``.
-Visual, collision, inertial, dynamics, transmission and other elements are ignored.
-Values follow the URDF specification: a missing ``<origin>`` is the identity, a missing
-``<axis>`` is (1, 0, 0), a missing ``lower`` / ``upper`` attribute of ``<limit>`` is 0,
-``rpy`` is roll-pitch-yaw Rz(yaw) Ry(pitch) Rx(roll) (:func:`core.rotations.rpy_to_matrix`).
+What is read: each ``<link name>`` and each ``<joint>``'s type, ``<parent>``, ``<child>``,
+``<origin xyz rpy>``, ``<axis xyz>`` and ``<limit lower upper>`` (the kinematics); each link's
+``<inertial>`` (``<origin xyz rpy>``: the inertial frame in the link frame, ``<mass value>``,
+``<inertia ixx ixy ixz iyy iyz izz>`` about the centre of mass in the inertial frame's axes), for
+links in the base link's subtree only; and the ``damping`` of ``<dynamics>`` on the chain's joints
+(its ``friction``, Coulomb friction, is not modelled). Visual, collision, transmission and other
+elements are ignored. Values follow the URDF specification: a missing ``<origin>`` is the identity,
+a missing ``<axis>`` is (1, 0, 0), a missing ``lower`` / ``upper`` attribute of ``<limit>`` is 0, a
+missing ``damping`` is 0, a link without ``<inertial>`` is massless (mass and inertia 0), ``rpy`` is
+roll-pitch-yaw Rz(yaw) Ry(pitch) Rx(roll) (:func:`core.rotations.rpy_to_matrix`).
 
-Two sets of rules, because every engine loads the whole file but only the chain is compared:
+Each chain joint's ``link`` (:class:`~core.model.scene.LinkInertia`) is everything rigidly attached
+to the joint's child link, in that link's frame: its own inertial, the links hanging from it by
+fixed joints (those on the path up to the next chain joint, and any beyond the tip link: a payload),
+and every branch off the chain below it, its movable joints held at 0 (their transform is their
+origin). The inertials are combined exactly: total mass, mass-weighted centre of mass, and the
+inertia about that centre by the parallel-axis theorem (``R I R^T`` for a rotated inertial frame).
+The held joints (the file's movable joints below the base link that are not on the chain, in file
+order) are ``Chain.held_joints``. A chain whose links are all massless loads (kinematics needs no
+mass); :meth:`core.model.scene.Chain.dynamics_problem` refuses it for dynamics.
+
+The rules, stricter on the chain because every engine loads the whole file but only the chain is compared:
 
 - The whole file must be what the engines' URDF importers accept: a well-formed tree (unique
   names, every referenced link present, one parent per link, one root), finite numbers, a
@@ -23,6 +38,14 @@ Two sets of rules, because every engine loads the whole file but only the chain 
   :data:`core.names.NAME_RULE`, numbers on the path the physical ranges of :mod:`core.ranges`
   (origins, angles, joint limits, axis norms). Joints off the path may be of any URDF type,
   mimic ones included, and their names and magnitudes are not held to those rules.
+- The inertials of links in the base link's subtree must be a complete ``<inertial>`` (``<mass
+  value>`` and all six ``<inertia>`` attributes, as urdfdom requires) of finite numbers: a mass of 0
+  or within its physical range, inertial origins within theirs, inertia entries no larger than the
+  range of moments (tiny ones are rounding: real files have 1e-35). A link that rides on a chain
+  link must have a physical inertia tensor, principal moments a <= b <= c with a + b >= c (hence
+  positive semidefinite) up to :data:`core.dynamics.inertia.INERTIA_RTOL`; links fixed to the base
+  never move and are not held to it (real files have placeholder tensors there). A chain joint's
+  ``damping`` is finite and >= 0. Links outside the base link's subtree are not read for mass.
 
 Anything else is rejected with a :class:`~core.errors.SceneError` naming the element; nothing is
 guessed. A file with a ``<!DOCTYPE>`` (hence any entity declaration) or elements nested deeper than
@@ -33,17 +56,17 @@ from __future__ import annotations
 
 import os
 import xml.etree.ElementTree as ET
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-
+from simparity.core.dynamics.inertia import INERTIA_RTOL
 from simparity.core.model.errors import SceneError
 from simparity.core.model.files import MAX_FILE_BYTES, parse_xml, read_input
 from simparity.core.model.names import NAME_RULE, name_problem
-from simparity.core.model.ranges import NORM_RANGES, RANGES, safe_norm
+from simparity.core.model.ranges import NORM_RANGES, RANGES, Range, safe_norm
+from simparity.core.model.scene import Chain, Joint, LinkInertia
 from simparity.core.rotations import rpy_to_matrix
-from simparity.core.model.scene import Chain, Joint
 
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
 _CHAIN_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed")
@@ -65,6 +88,7 @@ def chain_from_urdf(
     source: str | None = None,
     max_joints: int = MAX_MOVABLE_JOINTS,
     max_bytes: int = MAX_FILE_BYTES,
+    dynamics: bool = False,
 ) -> Chain:
     """Build the serial :class:`~core.scene.Chain` from ``base_link`` to ``tip_link``.
 
@@ -84,13 +108,18 @@ def chain_from_urdf(
         Largest number of movable joints in the file (and so on the chain).
     max_bytes : int
         Largest size of the file accepted [bytes].
+    dynamics : bool
+        Whether the chain's dynamics will be computed: then a non-physical inertia tensor on a link riding on a
+        chain link is refused (real URDFs have such placeholders, e.g. pybullet_data's xarm6, which kinematics never
+        sees: a kinematics or IK scene loads them as before).
 
     Returns
     -------
     Chain
-        Named after ``<robot name>``; one joint per movable joint on the path, the
-        end-effector frame named after ``tip_link``; ``urdf_path`` is the file (None for
-        text) and ``base_link`` the base link's name.
+        Named after ``<robot name>``; one joint per movable joint on the path (with its
+        ``link`` mass properties and ``damping``), the end-effector frame named after
+        ``tip_link``; ``urdf_path`` is the file (None for text), ``base_link`` the base link's
+        name and ``held_joints`` the movable joints below it off the chain, in file order.
 
     Raises
     ------
@@ -100,9 +129,12 @@ def chain_from_urdf(
         roots, an unknown or missing base/tip link, several leaves without ``tip_link``,
         a mimic, floating or planar joint on the path, a joint on the path that cannot move
         (lower == upper), a name on the path outside :data:`core.names.NAME_RULE`, a number on the
-        path outside its physical range (:mod:`core.ranges`), or a file that is too large, has too
-        many joints or is not a regular file. ``key`` names the element, e.g.
-        ``robot/joint[@name='j3']/mimic``.
+        path outside its physical range (:mod:`core.ranges`), an incomplete or malformed
+        ``<inertial>`` below the base link, a negative mass or damping, a mass, inertia entry or
+        inertial origin outside its physical range, a non-physical inertia tensor on a link riding
+        on a chain link, or a file that is too large, has too many joints or is not a regular
+        file. ``key`` names the element, e.g. ``robot/joint[@name='j3']/mimic`` or
+        ``robot/link[@name='l2']/inertial/mass/@value``.
     """
     root, source = _parse(path_or_text, source, max_bytes)
     _check_size(root, source, max_joints)
@@ -121,8 +153,19 @@ def chain_from_urdf(
     if robot and (problem := name_problem(robot)):
         raise SceneError(source, "robot/@name", problem, NAME_RULE)
     chain = _assemble(robot, path, tip, source)
+    child_joints = _child_joints(joints)
+    inertials = _modelled_inertials(base, links, child_joints, source)
+    movable = [joint for joint in path if joint["type"] != "fixed"]
+    chain_joints = tuple(
+        replace(chain_joint, link=_rigid_body(joint, following, inertials, child_joints, source, dynamics),
+                damping=_damping(joint, source))
+        for chain_joint, joint, following in zip(chain.joints, movable, movable[1:] + [None]))
+    on_path = {joint["name"] for joint in path}
+    held = tuple(joint["name"] for joint in joints
+                 if joint["type"] != "fixed" and joint["name"] not in on_path and joint["parent"] in inertials)
     is_file = not os.fspath(path_or_text).lstrip().startswith("<")
-    return replace(chain, urdf_path=os.fspath(path_or_text) if is_file else None, base_link=base)
+    return replace(chain, joints=chain_joints, held_joints=held,
+                   urdf_path=os.fspath(path_or_text) if is_file else None, base_link=base)
 
 
 def _parse(path_or_text: str | os.PathLike, source: str | None, max_bytes: int) -> tuple[ET.Element, str]:
@@ -149,19 +192,20 @@ def _check_size(root: ET.Element, source: str, max_joints: int) -> None:
                              f"at most {most:,} (a fixed limit)")
 
 
-def _links(root: ET.Element, source: str) -> list[str]:
-    names: dict[str, None] = {}  # ordered, with O(1) lookups
+def _links(root: ET.Element, source: str) -> dict[str, ET.Element]:
+    """Link name -> its ``<link>`` element, in file order."""
+    names: dict[str, ET.Element] = {}
     for i, link in enumerate(root.findall("link")):
         name = link.get("name")
         if not name:
             raise SceneError(source, f"robot/link[{i + 1}]/@name", "missing", "a non-empty link name")
         if name in names:
             raise SceneError(source, f"robot/link[@name='{name}']", "the link name is used twice", "unique names")
-        names[name] = None
-    return list(names)
+        names[name] = link
+    return names
 
 
-def _joints(root: ET.Element, source: str, links: list[str]) -> list[dict]:
+def _joints(root: ET.Element, source: str, links: dict[str, ET.Element]) -> list[dict]:
     joints: list[dict] = []
     seen, known_links = set(), set(links)
     for i, element in enumerate(root.findall("joint")):
@@ -243,7 +287,7 @@ def _children(joints: list[dict]) -> dict[str, list[str]]:
     return children
 
 
-def _check_tree(root_link: str, links: list[str], joints: list[dict], source: str) -> None:
+def _check_tree(root_link: str, links: dict[str, ET.Element], joints: list[dict], source: str) -> None:
     """Every link hangs below the root: a link outside its subtree is on a closed loop."""
     children = _children(joints)
     reached, stack = {root_link}, [root_link]
@@ -258,7 +302,7 @@ def _check_tree(root_link: str, links: list[str], joints: list[dict], source: st
                          f"{root_link!r}: it is on a closed loop", "a tree: every link below the one root link")
 
 
-def _pick_base(base_link: str | None, root_link: str, links: list[str], source: str) -> str:
+def _pick_base(base_link: str | None, root_link: str, links: dict[str, ET.Element], source: str) -> str:
     if base_link is None:
         return root_link
     if problem := name_problem(base_link):
@@ -268,7 +312,7 @@ def _pick_base(base_link: str | None, root_link: str, links: list[str], source: 
     return base_link
 
 
-def _pick_tip(tip_link: str | None, base: str, links: list[str], joints: list[dict], source: str) -> str:
+def _pick_tip(tip_link: str | None, base: str, links: dict[str, ET.Element], joints: list[dict], source: str) -> str:
     if tip_link is not None:
         if problem := name_problem(tip_link):
             raise SceneError(source, "tip_link", problem, NAME_RULE)
@@ -367,3 +411,137 @@ def _assemble(robot_name: str, path: list[dict], tip: str, source: str) -> Chain
                          "a path with at least one revolute, continuous or prismatic joint")
     return Chain(robot_name, tuple(chain_joints), end_effector_name=tip,
                  end_effector_xyz=position, end_effector_rotation=rotation)
+
+
+_INERTIA_ENTRIES = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+_INERTIA_INDEX = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
+
+
+@dataclass(frozen=True)
+class _Inertial:
+    """A link's ``<inertial>`` in the link frame: mass [kg], centre of mass (3,) [m] and inertia (3, 3)
+    about it in the link frame's axes [kg m^2] (``R I R^T`` of the inertial frame's); ``problem``: why the
+    tensor is not physical ("" if it is), refused only when the link rides on a chain link (``key``: its
+    ``<inertia>`` element)."""
+
+    mass: float
+    com_xyz: np.ndarray
+    inertia_com: np.ndarray
+    key: str = ""
+    problem: str = ""
+
+
+def _modelled_inertials(base: str, links: dict[str, ET.Element], children: dict[str, list[dict]],
+                        source: str) -> dict[str, _Inertial]:
+    """Link name -> its checked inertial, for the base link and every link below it (the model)."""
+    inertials: dict[str, _Inertial] = {}
+    stack = [base]
+    while stack:  # a tree (checked by _check_tree): every link is visited once
+        link = stack.pop()
+        inertials[link] = _inertial(links[link], f"robot/link[@name='{link}']/inertial", source)
+        stack.extend(joint["child"] for joint in children.get(link, []))
+    return inertials
+
+
+def _child_joints(joints: list[dict]) -> dict[str, list[dict]]:
+    """Parent link -> the joints it is the parent of."""
+    children: dict[str, list[dict]] = {}
+    for joint in joints:
+        children.setdefault(joint["parent"], []).append(joint)
+    return children
+
+
+def _inertial(link: ET.Element, key: str, source: str) -> _Inertial:
+    """The link's ``<inertial>`` (massless without one), held to the physical rules."""
+    element = link.find("inertial")
+    if element is None:
+        return _Inertial(0.0, np.zeros(3), np.zeros((3, 3)))
+    origin = element.find("origin")
+    xyz = _numbers(origin, "xyz", (0.0, 0.0, 0.0), f"{key}/origin", source)
+    rpy = _numbers(origin, "rpy", (0.0, 0.0, 0.0), f"{key}/origin", source)
+    for values, attribute, range_key in ((xyz, "xyz", "origin_xyz"), (rpy, "rpy", "origin_rpy")):
+        _hold(values, RANGES[range_key], f"{key}/origin/@{attribute}", source)
+    mass = _required_number(element.find("mass"), "value", f"{key}/mass", source)
+    if mass < 0:
+        raise SceneError(source, f"{key}/mass/@value", f"negative mass {mass:g}", "a mass >= 0 [kg]")
+    if mass != 0:
+        _hold(np.array([mass]), RANGES["mass"], f"{key}/mass/@value", source)
+    inertia, largest = np.zeros((3, 3)), RANGES["inertia_moment"]
+    for name, (row, column) in zip(_INERTIA_ENTRIES, _INERTIA_INDEX):
+        value = _required_number(element.find("inertia"), name, f"{key}/inertia", source)
+        if abs(value) > largest.high:  # tiny entries are rounding (real files have 1e-35): no lower bound
+            raise SceneError(source, f"{key}/inertia/@{name}", f"{value:.6g} is above the physical range",
+                             largest.text())
+        inertia[row, column] = inertia[column, row] = value
+    rotation = rpy_to_matrix(rpy)
+    return _Inertial(mass, xyz, rotation @ inertia @ rotation.T, f"{key}/inertia", _tensor_problem(inertia))
+
+
+def _required_number(element: ET.Element | None, attribute: str, key: str, source: str) -> float:
+    """One finite number that the URDF specification requires (urdfdom refuses a file without it)."""
+    if element is None or element.get(attribute) is None:
+        where = key if element is None else f"{key}/@{attribute}"
+        raise SceneError(source, where, "missing", "a complete <inertial>: <mass value> and all six <inertia> "
+                         "attributes (leave <inertial> out for a massless link)")
+    return float(_numbers(element, attribute, (0.0,), key, source)[0])
+
+
+def _hold(values: np.ndarray, allowed: Range, key: str, source: str) -> None:
+    """Refuse a value whose magnitude is outside ``allowed`` (a :class:`core.model.ranges.Range`)."""
+    for value in values:
+        if not allowed.allows(abs(value)):
+            raise SceneError(source, key, f"{value:.6g} is outside the physical range", allowed.text())
+
+
+def _tensor_problem(inertia: np.ndarray) -> str:
+    """Why a symmetric inertia tensor is not physical ("" if it is): principal moments a <= b <= c must
+    satisfy a + b >= c (every mass distribution does; it implies a >= 0) up to INERTIA_RTOL of c. A zero or
+    singular tensor (a point mass, a thin rod) is physical."""
+    scale = float(np.max(np.abs(inertia)))
+    if scale == 0.0:
+        return ""
+    a, b, c = np.linalg.eigvalsh(inertia / scale)  # of order one: no overflow, no lost digits
+    if a + b >= c * (1 - INERTIA_RTOL):
+        return ""
+    moments = ", ".join(f"{m * scale:.6g}" for m in (a, b, c))
+    if a < 0:
+        return f"not positive semidefinite: principal moments ({moments}) kg m^2"
+    return f"violates the triangle inequality: principal moments ({moments}) kg m^2 have a + b < c"
+
+
+def _rigid_body(joint: dict, following: dict | None, inertials: dict[str, _Inertial],
+                children: dict[str, list[dict]], source: str, dynamics: bool) -> LinkInertia:
+    """Everything rigidly attached to ``joint``'s child link, in its frame: the links below it except the
+    subtree of the next chain joint ``following``; every other joint at its zero position (its origin).
+    For ``dynamics``, a non-physical inertia tensor among them is refused."""
+    parts: list[tuple[_Inertial, np.ndarray, np.ndarray]] = []  # (inertial, position, rotation of its link)
+    stack = [(joint["child"], np.zeros(3), np.eye(3))]
+    while stack:
+        link, position, rotation = stack.pop()
+        inertial = inertials[link]
+        if inertial.problem and dynamics:
+            raise SceneError(source, inertial.key, f"on the chain: {inertial.problem}",
+                             "a physical tensor: principal moments a <= b <= c with a + b >= c (hence all >= 0)")
+        parts.append((inertial, position, rotation))
+        for child in children.get(link, []):
+            if child is not following:
+                stack.append((child["child"], position + rotation @ child["xyz"],
+                              rotation @ rpy_to_matrix(child["rpy"])))
+    mass = float(sum(inertial.mass for inertial, _, _ in parts))
+    coms = [position + rotation @ inertial.com_xyz for inertial, position, rotation in parts]
+    com = sum((inertial.mass * c for (inertial, _, _), c in zip(parts, coms)), np.zeros(3)) / mass \
+        if mass > 0 else np.zeros(3)
+    inertia = np.zeros((3, 3))
+    for (inertial, _, rotation), c in zip(parts, coms):
+        d = c - com  # parallel-axis theorem: m (|d|^2 E - d d^T) about the combined centre of mass
+        inertia += rotation @ inertial.inertia_com @ rotation.T + inertial.mass * (d @ d * np.eye(3) - np.outer(d, d))
+    return LinkInertia(mass, com, 0.5 * (inertia + inertia.T))
+
+
+def _damping(joint: dict, source: str) -> float:
+    """The chain joint's ``<dynamics damping>`` [N m s/rad or N s/m], 0 without one."""
+    key = f"{joint['key']}/dynamics"
+    damping = float(_numbers(joint["element"].find("dynamics"), "damping", (0.0,), key, source)[0])
+    if damping < 0:
+        raise SceneError(source, f"{key}/@damping", f"negative damping {damping:g}", "a damping >= 0")
+    return damping

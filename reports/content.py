@@ -42,7 +42,9 @@ from simparity.core.model.metric_catalogue import (
     APEX_HEIGHT_ERROR, CROSS_EVAL_SOLVE_RATE_MIN, ENERGY_GAIN_MAX, IMPACT_TIME_ERROR, ITERATIONS_MEDIAN,
     LIMIT_VIOLATIONS, ORIENTATION_ERROR_MAX, OWN_STOP_POSITION_TOLERANCE, PENETRATION_MAX, POSITION_ERROR_MAX,
     POSITION_RESIDUAL_MEDIAN, RESTITUTION_MEASURED, REST_TIME_ERROR, SOLVE_RATE, SOLVE_RATE_OWN_STOP, STOPPING_DISTANCE,
-    TIME_PER_FK, TIME_PER_SOLVE, TIME_PER_STEP,
+    TIME_PER_FK, TIME_PER_SOLVE, TIME_PER_STEP, MASS_MATRIX_ERROR_MAX, BIAS_FORCE_ERROR_MAX, INVERSE_DYNAMICS_ERROR_MAX,
+    FORWARD_DYNAMICS_ERROR_MAX, GRAVITY_IDENTITY_RESIDUAL, MASS_COLUMN_RESIDUAL, ROUND_TRIP_RESIDUAL,
+    MASS_MATRIX_ASYMMETRY, KINETIC_ENERGY_RESIDUAL,
 )
 
 FIGURES_DIR = "figures"
@@ -191,6 +193,8 @@ def _hard_cases(table: pd.DataFrame, info: RunInfo, groups: dict[str, str]) -> l
 def _kind(rows: pd.DataFrame) -> str:
     if (rows["metric"] == SOLVE_RATE).any():
         return "ik"
+    if (rows["metric"] == MASS_MATRIX_ERROR_MAX).any():
+        return "joint_dynamics"
     return "dynamics" if rows["dt"].notna().any() else "kinematics"
 
 
@@ -502,6 +506,31 @@ class _Builder:
                                Details("Every kinematics metric", (full,), markdown=False, open=True)]
         return blocks + _notes(rows)
 
+    def joint_dynamics(self, rows: pd.DataFrame) -> list[Block]:
+        """One section for every joint-dynamics scene: in report.md each scene's worst relative error (of M, h, tau
+        and qddot against the reference) per engine and method, and its worst identity residual; in report.html every
+        metric per scene x engine x method."""
+        scenes = list(dict.fromkeys(rows["scene"]))
+        cases = list(dict.fromkeys(zip(rows["engine"], rows["integrator"])))
+        compact = []
+        for scene in scenes:
+            own = rows[rows["scene"] == scene]
+            compact.append((scene, *(_worst_cell(own[(own["engine"] == e) & (own["integrator"] == m)])
+                                     for e, m in cases)))
+        full = tables.metric_table(rows, tables.JOINT_DYNAMICS_COLUMNS, ["scene", "engine", "integrator"])
+        blocks: list[Block] = [Heading(2, "Joint-space dynamics"),
+                Bullets(tuple(f"**{scene}**: {self.introduction(scene, rows[rows['scene'] == scene])}"
+                              for scene in scenes)),
+                Paragraph("Per engine and method: the largest relative error of the mass matrix M, the bias forces h, "
+                          "inverse dynamics tau and forward dynamics qddot against each scene's reference, then (after "
+                          "'id') the largest residual of the identities of its own outputs (RNEA(q,0,0) = g, RNEA(q,0,"
+                          "e_i) - g = M e_i, ABA(RNEA) = id, M = M^T, kinetic energy from its own link velocities); "
+                          "each metric, the energy identity qdot^T (Mdot - 2C) qdot = 0, times and the reasons for "
+                          "n/a: the HTML report."),
+                Table(("scene", *(f"{e} {m}" for e, m in cases)), tuple(compact)),
+                Details("Every joint-dynamics metric", (full,), markdown=False, open=True)]
+        return blocks + _notes(rows)
+
     def dynamics(self, scene, rows, about, reference, series) -> tuple[str, list[Block]]:
         """(the scene's verdict in one line, its blocks): figures, a row per engine in report.md (its most accurate
         scheme, its cheapest within each error budget, its orders or contact measures, its cases), and in report.html
@@ -738,6 +767,27 @@ REASON_CHARS = 160
 
 
 
+_JOINT_DYNAMICS_ERRORS = (MASS_MATRIX_ERROR_MAX, BIAS_FORCE_ERROR_MAX, INVERSE_DYNAMICS_ERROR_MAX,
+                          FORWARD_DYNAMICS_ERROR_MAX)
+_JOINT_DYNAMICS_IDENTITIES = (GRAVITY_IDENTITY_RESIDUAL, MASS_COLUMN_RESIDUAL, ROUND_TRIP_RESIDUAL,
+                              MASS_MATRIX_ASYMMETRY, KINETIC_ENERGY_RESIDUAL)
+
+
+def _worst_cell(case: pd.DataFrame) -> str:
+    """A joint-dynamics case in one cell: its worst error against the reference, then its worst identity residual
+    ("id"); the case's status where nothing of either was measured; "—" where the case did not run."""
+    if case.empty:
+        return "—"
+    ok = case[case["status"] == OK]
+    parts = []
+    for label, metrics in (("", _JOINT_DYNAMICS_ERRORS), ("id ", _JOINT_DYNAMICS_IDENTITIES)):
+        values = ok[ok["metric"].isin(metrics)]["value"]
+        parts.append(f"{label}{number(float(values.max()))}" if not values.empty else f"{label}n/a")
+    if all(part.endswith("n/a") for part in parts):
+        return str(case["status"].iloc[0]) if (case["status"] != OK).all() else "n/a"
+    return " · ".join(parts)
+
+
 def _names(names: list[str], shown: int = NAMES_SHOWN) -> str:
     """``a, b, c, d (+3 more)``: at most ``shown`` names, then the count of the rest."""
     return ", ".join(names[:shown]) + (f" (+{len(names) - shown} more)" if len(names) > shown else "")
@@ -835,8 +885,13 @@ def _blocks(builder: _Builder, table: pd.DataFrame, info: RunInfo) -> list[Block
     blocks += sweep_sections.sections(builder.sweeps, builder.figure, info.theoretical_orders, info.integrator_variants)
     kinds = {scene: _kind(rows) for scene, rows in table.groupby("scene", sort=False)}
     for scene, rows in table.groupby("scene", sort=False):
-        blocks += builder.scene(scene, rows) if kinds[scene] != "kinematics" and builder.listed(scene) else []
-    kinematics = table[(table["scene"].map(kinds) == "kinematics") & ~table["scene"].isin(builder.sweep_of)]
-    if not kinematics.empty:
-        blocks += builder.kinematics(kinematics)
+        own_section = kinds[scene] not in _TABULATED_KINDS and builder.listed(scene)
+        blocks += builder.scene(scene, rows) if own_section else []
+    for kind, section in (("joint_dynamics", builder.joint_dynamics), ("kinematics", builder.kinematics)):
+        chosen = table[(table["scene"].map(kinds) == kind) & ~table["scene"].isin(builder.sweep_of)]
+        blocks += section(chosen) if not chosen.empty else []
     return blocks
+
+
+_TABULATED_KINDS = ("kinematics", "joint_dynamics")
+"""Kinds of scene the report puts in one section of their own (a table with a row per scene), not one each."""

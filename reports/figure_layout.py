@@ -32,6 +32,10 @@ LEGEND_GAP = 0.15
 LEGEND_FONT_SIZE = 7
 """[pt] Legend text: up to ~25 schemes must fit beside a 4.8 in high axes."""
 
+MIN_PANEL_WIDTH = 2.5
+"""[in] The narrowest a panel may be: a figure whose legend leaves less (a run with many engines and schemes) is
+widened to keep it, never laid out with its axes crushed (or left of its own left edge)."""
+
 MAX_LEGEND_COLUMNS = 3
 """A legend too tall for its figure takes up to this many columns (each ~2 in of the width of the axes)."""
 
@@ -166,6 +170,10 @@ def finish(fig, column_gap: float = 0.0, row_gap: float = 0.0, margins: dict[str
         margins["right"] += widest + LEGEND_GAP
     width, height = fig.get_size_inches()
     rows, columns = fig.axes[0].get_subplotspec().get_gridspec().get_geometry()
+    narrowest = margins["left"] + margins["right"] + columns * MIN_PANEL_WIDTH + column_gap * (columns - 1)
+    if width < narrowest:
+        width = narrowest
+        fig.set_size_inches(width, height)
     inner_width = width - margins["left"] - margins["right"]
     inner_height = height - margins["top"] - margins["bottom"]
     fig.subplots_adjust(left=margins["left"] / width, right=1 - margins["right"] / width,

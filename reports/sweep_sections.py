@@ -30,7 +30,7 @@ a larger one (a 10 x 10 sweep at two time steps has 20 per engine x integrator) 
 results.csv has every value."""
 
 _COST_LABELS = {"dynamics": "median cost [s/s]", "ik": "median time per solve [s]",
-                "kinematics": "median time per FK [s]"}
+                "kinematics": "median time per FK [s]", "joint_dynamics": "median time per forward dynamics [s]"}
 _ROLES = {sweep_summary.FIRST: "the first", sweep_summary.LAST: "the last",
           sweep_summary.HARDEST: "the hardest: its errors rank worst on average over the engines and time steps"}
 _IK_ROLES = dict(_ROLES, **{sweep_summary.HARDEST: "the hardest: its solve rates rank worst on average over the "
@@ -108,7 +108,7 @@ def _across_table(sweep: Sweep, theory: dict) -> Table:
     observed order's range over the variants (dynamics) and how every case of every variant ended. A scheme not
     ok in every variant at any time step has no values, only its cases."""
     name, unit = METRICS[sweep.metric]
-    dynamics, kinematics = sweep.kind == "dynamics", sweep.kind == "kinematics"
+    dynamics, kinematics = sweep.kind == "dynamics", sweep.kind in ("kinematics", "joint_dynamics")
     ranked = sweep.across[sweep.across["status"] == OK]
     ranked = ranked.assign(_rank=ranked["value"] if sweep.lower_is_better else -ranked["value"])
     best = ranked.sort_values(["_rank", "cost"]).drop_duplicates(["engine", "integrator"])

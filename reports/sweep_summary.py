@@ -16,20 +16,23 @@ from simparity.core.model.run_info import RunInfo
 from simparity.core.model.results import OK, SWEEP_COLUMN, SWEEP_PREFIX, case_status
 from simparity.reports import summary
 from simparity.core.model.metric_catalogue import (
-    ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE, TIME_PER_FK, TIME_PER_SOLVE,
+    MASS_MATRIX_ERROR_MAX, ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE, TIME_PER_FK,
+    TIME_PER_FORWARD_DYNAMICS, TIME_PER_SOLVE,
 )
 
 METRICS = {
     POSITION_ERROR_MAX: ("position error max", "m"),
     ORIENTATION_ERROR_MAX: ("orientation error max", "rad"),
     SOLVE_RATE: ("solve rate", ""),
+    MASS_MATRIX_ERROR_MAX: ("mass matrix error max", ""),
 }
 """The metric a sweep is judged by, with its name and unit: a dynamics scene's headline error (``run.json``; the
 position error where the variants' headlines differ), an IK scene's solve rate, a kinematics scene's frame position
 error."""
 
-_KIND_METRIC = {"ik": SOLVE_RATE, "kinematics": POSITION_ERROR_MAX}
-_KIND_COST = {"dynamics": "cost", "ik": TIME_PER_SOLVE, "kinematics": TIME_PER_FK}
+_KIND_METRIC = {"ik": SOLVE_RATE, "kinematics": POSITION_ERROR_MAX, "joint_dynamics": MASS_MATRIX_ERROR_MAX}
+_KIND_COST = {"dynamics": "cost", "ik": TIME_PER_SOLVE, "kinematics": TIME_PER_FK,
+              "joint_dynamics": TIME_PER_FORWARD_DYNAMICS}
 """The price of a scheme per kind: compute per simulated second [s/s], time per solve [s], time per FK [s]. Over a
 sweep it is the median over the variants: the physics barely changes what a step costs, and one slow timing (a
 busy CPU) would decide the largest."""
@@ -86,7 +89,8 @@ def sweeps(table: pd.DataFrame, info: RunInfo) -> list[Sweep]:
         cases = variant_cases(rows, kind, metric)
         lower = _lower_is_better(metric)
         keys = ["engine", "integrator"] + (["dt"] if kind == "dynamics" else [])
-        shown = _shown(cases, variants, keys, lower) if kind != "kinematics" else {}   # kinematics: one section
+        tabulated = kind in ("kinematics", "joint_dynamics")  # their scenes share one section
+        shown = _shown(cases, variants, keys, lower) if not tabulated else {}
         out.append(Sweep(base, [c for c in columns if rows[c].notna().any()], variants, kind, metric,
                          rows["reference"].iloc[0], info.scenes.get(variants[0], {}).get("source"),
                          rows, cases, across(cases, keys, lower), shown))

@@ -11,6 +11,7 @@ import pytest  # noqa: E402
 
 from simparity.reports.figure_layout import (  # noqa: E402
     MARGINS,
+    MIN_PANEL_WIDTH,
     TITLE_LINE,
     UnicodeLogFormatter,
     finish,
@@ -58,6 +59,20 @@ def test_fixed_margins_and_room_for_the_legend():
     assert math.isclose(box.x0 * 9.0, MARGINS["left"]) and math.isclose((1 - box.y1) * 4.0, MARGINS["top"])
     fig.canvas.draw()
     assert ax.get_legend().get_window_extent().x1 <= fig.bbox.width + PIXEL   # the legend is inside the figure
+    plt.close(fig)
+
+
+def test_a_legend_wider_than_the_figure_widens_it_instead_of_crushing_the_axes():
+    """Found by a run of core beside three copies of it: dozens of schemes gave a three-column legend wider than the
+    figure, and laying it out raised (left >= right) and lost the report."""
+    fig, ax = plt.subplots(figsize=(6.0, 4.0))
+    for i in range(60):
+        ax.plot([0, 1], [0, i], label=f"mutant-copy-{i:02d} semi_implicit_euler: observed 1.00, theory 1, a long label")
+    legend(ax)
+    finish(fig)
+    fig.canvas.draw()
+    assert ax.get_position().width * fig.get_size_inches()[0] >= MIN_PANEL_WIDTH - 1e-9
+    assert ax.get_legend().get_window_extent().x1 <= fig.bbox.width + PIXEL
     plt.close(fig)
 
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import fnmatch
 import math
+from contextlib import nullcontext
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -46,7 +47,7 @@ from simparity.comparisons.invariance.transforms import FIXED_TRANSFORMS, fixed_
 from simparity.core.model.errors import TransformError
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.results import DIVERGED, FAILED, OK, ResultRow
-from simparity.core.model.scene import IKScene, KinematicsScene, Plane
+from simparity.core.model.scene import IKScene, JointDynamicsScene, KinematicsScene, Plane
 from tests.helpers import THROWN_INTO_WIND
 
 ENGINES = ("core", "analytic", "mujoco", "pybullet", "pinocchio")
@@ -69,7 +70,8 @@ contact responses with one penalty integrator and its measured stability limit);
 theirs."""
 
 IK_TARGETS, CONFIGURATIONS = 5, 20
-"""Random IK targets and kinematics configurations in the invariance profile (the hard targets all stay)."""
+"""Random IK targets and kinematics configurations (joint-dynamics states) in the invariance profile (the hard
+targets all stay)."""
 
 
 def invariance_profile(scene):
@@ -79,6 +81,8 @@ def invariance_profile(scene):
         return replace(scene, n_configurations=min(scene.n_configurations, CONFIGURATIONS))
     if isinstance(scene, IKScene):
         return replace(scene, n_targets=min(scene.n_targets, IK_TARGETS))
+    if isinstance(scene, JointDynamicsScene):
+        return replace(scene, n_states=min(scene.n_states, CONFIGURATIONS))
     others = tuple(i for e in ENGINES if e != "core" for i in make_engine(e).integrators())
     integrators = tuple(i for i in scene.integrators if i in CORE_INTEGRATORS + others)
     if scene.contact is not None:
@@ -260,11 +264,17 @@ def test_every_scene_is_compared_under_every_transform_that_applies(invariance):
                                                                             None)], ids=lambda s: s.name)
 def test_urdf_chains_refuse_frame_and_length_transforms(scene):
     """Every engine loads a URDF chain from its file: the scene cannot move its base or scale it, and says so
-    (mass, time and body order change nothing in a chain)."""
+    (mass, time and body order change nothing in a kinematic chain; a joint-dynamics scene's masses are the file's,
+    while a unit of time changes only its gravity and sampling scales)."""
     for transform in FIXED_TRANSFORMS:
-        if transform.moves_frame:
+        dynamics = isinstance(scene, JointDynamicsScene)
+        if transform.moves_frame or (dynamics and transform.mass_scale != 1.0):
             with pytest.raises(TransformError, match="URDF file"):
                 transform_scene(scene, transform)
+        elif dynamics and transform.time_scale != 1.0:
+            mixed = len({j.type for j in scene.chain.joints}) > 1  # one velocity scale cannot serve both kinds
+            with pytest.raises(TransformError, match="mixes revolute and prismatic") if mixed else nullcontext():
+                assert transform_scene(scene, transform).chain is scene.chain
         else:
             assert not transform.changes(scene)
 

@@ -39,13 +39,15 @@ def engine_lines() -> list[str]:
 
 
 def _offers(engine: Engine) -> str:
-    """``version V; dynamics: ...; IK: ...; kinematics: yes|no``, or why the engine cannot run."""
+    """``version V; dynamics: ...; IK: ...; kinematics: yes|no; joint dynamics: ...``, or why the engine cannot
+    run."""
     if isinstance(engine, UnavailableEngine):
         return f"n/a: {one_line(engine.reason, DETAIL_LIMIT)}"
     if isinstance(engine, BrokenEngine):
         return f"failed: {one_line(engine.reason, DETAIL_LIMIT)}"
     return (f"version {engine.version()}; dynamics: {', '.join(engine.integrators()) or 'none'}; "
-            f"IK: {', '.join(engine.ik_solvers()) or 'none'}; kinematics: {_kinematics(engine)}")
+            f"IK: {', '.join(engine.ik_solvers()) or 'none'}; kinematics: {_kinematics(engine)}; "
+            f"joint dynamics: {', '.join(engine.joint_dynamics_methods()) or 'none'}")
 
 
 def _kinematics(engine: Engine) -> str:

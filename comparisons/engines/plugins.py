@@ -8,7 +8,7 @@ packaged is named by its spec directly (``--engines my_module:MyEngine``). ``att
 Whatever goes wrong comes back as an engine standing in for the one asked for
 (:mod:`comparisons.placeholder_engines`), never as an exception: a module that will not import (a
 missing dependency) gives n/a rows, like a built-in engine's missing library; a module or constructor
-that raises, or an engine whose ``version()``, ``integrators()``, ``ik_solvers()``,
+that raises, or an engine whose ``version()``, ``integrators()``, ``ik_solvers()``, ``joint_dynamics_methods()``,
 ``theoretical_order()``, ``stages()`` or ``integrator_variant()`` raises or returns what the interface
 does not allow, gives failed rows with the error. How to write one: docs/plugins.md.
 """
@@ -160,7 +160,7 @@ def _instantiate(found: object, target: str) -> Engine:
 
 def _interface_problem(engine: Engine) -> str:
     """What the engine's description of itself breaks ("" when nothing): ``version()`` a str,
-    ``integrators()`` and ``ik_solvers()`` tuples of names (:data:`OFFERED_NAME`), ``theoretical_order(i)``
+    ``integrators()``, ``ik_solvers()`` and ``joint_dynamics_methods()`` tuples of names (:data:`OFFERED_NAME`), ``theoretical_order(i)``
     an int or None, ``stages(i)`` an int >= 1 or None and ``integrator_variant(i)`` two strs for each integrator.
     Their errors are problems too."""
     step = "version()"
@@ -173,6 +173,8 @@ def _interface_problem(engine: Engine) -> str:
         problem = _names_problem("integrators()", integrators)
         step = "ik_solvers()"
         problem = problem or _names_problem("ik_solvers()", engine.ik_solvers())
+        step = "joint_dynamics_methods()"
+        problem = problem or _names_problem("joint_dynamics_methods()", engine.joint_dynamics_methods())
         for integrator in () if problem else integrators:
             step = f"theoretical_order({integrator!r})"
             order = engine.theoretical_order(integrator)

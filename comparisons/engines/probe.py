@@ -71,6 +71,7 @@ class EngineDescription:
     scene_integrators : dict of str to tuple of str or str
         ``scene_integrators`` of each scene asked about, by :func:`~comparisons.cases.scene_hash`; the error
         text where it raised.
+    joint_dynamics_methods : tuple of str
     """
 
     name: str
@@ -82,6 +83,7 @@ class EngineDescription:
     variants: dict[str, tuple[str, str]]
     kinematics: str
     scene_integrators: dict[str, tuple[str, ...] | str] = field(default_factory=dict)
+    joint_dynamics_methods: tuple[str, ...] = ()
 
 
 class DescribedEngine(Engine):
@@ -100,6 +102,9 @@ class DescribedEngine(Engine):
 
     def ik_solvers(self) -> tuple[str, ...]:
         return self.description.ik_solvers
+
+    def joint_dynamics_methods(self) -> tuple[str, ...]:
+        return self.description.joint_dynamics_methods
 
     def theoretical_order(self, integrator: str) -> int | None:
         return self.description.orders.get(integrator)
@@ -154,7 +159,8 @@ def describe(engine: Engine, scenes: list) -> EngineDescription:
     return EngineDescription(engine.name, engine.version(), integrators, engine.ik_solvers(),
                              {i: engine.theoretical_order(i) for i in integrators},
                              {i: engine.stages(i) for i in integrators},
-                             {i: engine.integrator_variant(i) for i in integrators}, kinematics, by_scene)
+                             {i: engine.integrator_variant(i) for i in integrators}, kinematics, by_scene,
+                             engine.joint_dynamics_methods())
 
 
 def probe_engines(names: list[str], scenes: Sequence = ()) -> dict[str, Engine]:

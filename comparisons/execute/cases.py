@@ -26,11 +26,18 @@ import numpy as np
 from simparity.comparisons.engines.placeholders import StandInEngine
 from simparity.core.model.engine import Engine
 from simparity.core.model.results import ResultRow, SeriesRecord
-from simparity.core.model.scene import PENALTY_PREFIX, DynamicsScene, IKScene, KinematicsScene, Scene
+from simparity.core.model.scene import (
+    PENALTY_PREFIX,
+    DynamicsScene,
+    IKScene,
+    JointDynamicsScene,
+    KinematicsScene,
+    Scene,
+)
 
-DYNAMICS, STABILITY, KINEMATICS, IK = "dynamics", "stability", "kinematics", "ik"
+DYNAMICS, STABILITY, KINEMATICS, IK, JOINT_DYNAMICS = "dynamics", "stability", "kinematics", "ik", "joint_dynamics"
 """What a group computes: stepping at one dt, the penalty integrators' stability limits, FK and
-Jacobians, IK solves."""
+Jacobians, IK solves, joint-space dynamics at states."""
 
 NO_INTEGRATOR = "-"
 """The integrator of the one n/a case of an engine that offers none of the integrators a scene runs
@@ -39,7 +46,8 @@ NO_INTEGRATOR = "-"
 
 @dataclass(frozen=True)
 class CaseSpec:
-    """One case of a group: ``integrator`` holds the IK solver for IK, "" for kinematics."""
+    """One case of a group: ``integrator`` holds the IK solver for IK, the method for joint dynamics, "" for
+    kinematics."""
 
     engine: str
     integrator: str
@@ -55,7 +63,7 @@ class CaseGroup:
     scene_hash : str
         :func:`scene_hash` of ``scene``.
     kind : str
-        DYNAMICS, STABILITY, KINEMATICS or IK.
+        DYNAMICS, STABILITY, KINEMATICS, IK or JOINT_DYNAMICS.
     dt : float
         The time step [s] of a DYNAMICS group; NaN otherwise.
     cases : tuple of CaseSpec
@@ -94,6 +102,11 @@ class CaseGroup:
     def kinematics_scene(self) -> KinematicsScene:
         """The scene of a KINEMATICS group."""
         return cast(KinematicsScene, self.scene)
+
+    @property
+    def joint_dynamics_scene(self) -> JointDynamicsScene:
+        """The scene of a JOINT_DYNAMICS group."""
+        return cast(JointDynamicsScene, self.scene)
 
     @property
     def ik_scene(self) -> IKScene:
@@ -229,6 +242,14 @@ def _solvers(engine: Engine) -> tuple[str, ...]:
         return ()
 
 
+def _methods(engine: Engine) -> tuple[str, ...]:
+    """The engine's joint-dynamics methods; none when it fails to say (its one case then reports the error)."""
+    try:
+        return tuple(engine.joint_dynamics_methods())
+    except Exception:  # noqa: BLE001 - a user's engine: its case reports the error
+        return ()
+
+
 def plan_scene(scene, engines: list[Engine], reference: Engine, repeats: int,
                specs: dict[str, str] | None = None) -> list[CaseGroup]:
     """The groups of ``scene`` on ``engines`` (built engines, in the run's order) measured against
@@ -244,6 +265,9 @@ def plan_scene(scene, engines: list[Engine], reference: Engine, repeats: int,
     if isinstance(scene, IKScene):
         cases = [CaseSpec(e.name, s) for e in engines for s in _solvers(e) or (NO_INTEGRATOR,)]
         return [group(IK, math.nan, cases, f"{scene.reference}:fk")]
+    if isinstance(scene, JointDynamicsScene):
+        cases = [CaseSpec(e.name, m) for e in engines for m in _methods(e) or (NO_INTEGRATOR,)]
+        return [group(JOINT_DYNAMICS, math.nan, cases, f"{reference.name}:{(_methods(reference) or (NO_INTEGRATOR,))[0]}")]
     if not isinstance(scene, DynamicsScene):
         return [group(KINEMATICS, math.nan, [CaseSpec(e.name, "") for e in engines], f"{reference.name}:fk")]
     label = f"{reference.name}:{reference.scene_integrators(scene)[0]}"

@@ -20,14 +20,15 @@ from simparity.comparisons.execute.journal import Journal
 from simparity.comparisons.execute.runner import assemble_scene
 from simparity.core.model.engine import Engine
 from simparity.core.model.results import ResultRow, SeriesRecord
-from simparity.core.model.scene import DynamicsScene, IKScene, Scene
+from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, Scene
 
 OnCase = Callable[[str, str, str], None]
 """Called with (scene, engine, integrator or solver) after each case, in the calling process."""
 
-SECONDS_PER_UNIT = {"dynamics": 5e-4, "ik": 1.7e-3, "kinematics": 1.2e-4}
-"""Seconds per case x (steps x bodies, targets, or configurations), measured on the default suite
-(2026-11-23, 2 cores, repeats on); only their ratios matter: they order the groups."""
+SECONDS_PER_UNIT = {"dynamics": 5e-4, "ik": 1.7e-3, "kinematics": 1.2e-4, "joint_dynamics": 1e-3}
+"""Seconds per case x (steps x bodies, targets, configurations, or states), measured on the default suite
+(2026-11-23, 2 cores, repeats on; joint dynamics 2026-11-27, ~(n + 12) evaluations per state); only their ratios
+matter: they order the groups."""
 
 
 def default_jobs() -> int:
@@ -53,6 +54,8 @@ def estimated_cost(group: CaseGroup) -> float:
         return cases * steps * len(scene.bodies) * SECONDS_PER_UNIT["dynamics"]
     if isinstance(scene, IKScene):
         return cases * (scene.n_targets + len(scene.hard_targets)) * SECONDS_PER_UNIT["ik"]
+    if isinstance(scene, JointDynamicsScene):
+        return cases * scene.n_states * SECONDS_PER_UNIT["joint_dynamics"]
     return cases * scene.n_configurations * SECONDS_PER_UNIT["kinematics"]
 
 

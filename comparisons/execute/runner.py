@@ -15,13 +15,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Callable, Iterator
+from typing import Callable, Iterator, cast
 
 import numpy as np
 
 from simparity.comparisons.execute.cases import (
     DYNAMICS,
     IK,
+    JOINT_DYNAMICS,
     KINEMATICS,
     NO_INTEGRATOR,
     STABILITY,
@@ -50,14 +51,23 @@ from simparity.comparisons.measure.metrics import (
     state_validity,
     trajectory_errors,
 )
+from simparity.comparisons.measure.joint_dynamics_metrics import (
+    JOINT_DYNAMICS_METRICS,
+    REFERENCE_ERRORS,
+    identities,
+    reference_errors,
+    reference_values,
+    shape_problem,
+    timed_values,
+)
 from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, error_text, warnings_into_rows
 from simparity.comparisons.measure.series import dynamics_series
 from simparity.comparisons.measure.stability import STABILITY_METRICS, stable_dt_max
 from simparity.comparisons.execute.timing import best_of
 from simparity.core.model.engine import Engine, Simulation, Support
-from simparity.core.model.errors import DivergedError, NotBatchedError
+from simparity.core.model.errors import DivergedError, NotBatchedError, SimparityError
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
-from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
+from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, KinematicsScene
 from simparity.core.model.trajectory import Trajectory
 from simparity.core.model.metric_catalogue import (
     EVALUATIONS_PER_SECOND, STABLE_DT_MAX, TIME_PER_FK, TIME_PER_JACOBIAN, TIME_PER_STEP, TIME_PER_STEP_BATCHED, unit_of,
@@ -395,21 +405,32 @@ class _KinematicsShared:
     problem: tuple[str, str]
 
 
-def _prepare_kinematics(group: CaseGroup, engine_for: EngineFor, reference_failure: str) -> _KinematicsShared:
-    scene, label = group.kinematics_scene, group.reference_label
-    q = scene.configurations()
+def _reference_values(label: str, reference_failure: str, supports: Callable[[], Support],
+                      evaluate: Callable[[], object]) -> tuple[object | None, tuple[str, str]]:
+    """(the reference's values at a chain group's samples, ("", n/a)), or (None, (why there are none, the status
+    that gives)): its worker failed, it cannot do the chain (``supports``), or ``evaluate`` raised."""
     if reference_failure:
-        return _KinematicsShared(q, None, (f"reference {label} failed: {reference_failure}", FAILED))
+        return None, (f"reference {label} failed: {reference_failure}", FAILED)
     try:
-        reference = engine_for(scene.reference)
-        support = reference.supports_kinematics(scene.chain)
+        support = supports()
         if not support.ok:
-            return _KinematicsShared(q, None, (f"reference {label} cannot do this chain: {support.reason}",
-                                               NOT_AVAILABLE))
-        model = reference.build_kinematics(scene.chain)
-        return _KinematicsShared(q, (model.forward_kinematics(q), model.jacobian_world(q)), ("", NOT_AVAILABLE))
+            return None, (f"reference {label} cannot do this chain: {support.reason}", NOT_AVAILABLE)
+        return evaluate(), ("", NOT_AVAILABLE)
     except Exception as err:  # noqa: BLE001 - reported in the rows
-        return _KinematicsShared(q, None, (f"reference {label} failed: {error_text(err)}", FAILED))
+        return None, (f"reference {label} failed: {error_text(err)}", FAILED)
+
+
+def _prepare_kinematics(group: CaseGroup, engine_for: EngineFor, reference_failure: str) -> _KinematicsShared:
+    scene = group.kinematics_scene
+    q = scene.configurations()
+
+    def evaluate() -> tuple:
+        model = engine_for(scene.reference).build_kinematics(scene.chain)
+        return model.forward_kinematics(q), model.jacobian_world(q)
+
+    values, problem = _reference_values(group.reference_label, reference_failure,
+                                        lambda: engine_for(scene.reference).supports_kinematics(scene.chain), evaluate)
+    return _KinematicsShared(q, cast(tuple | None, values), problem)
 
 
 def _kinematics_case_at(group: CaseGroup, shared: _KinematicsShared, index: int, engine_for: EngineFor) -> CaseOutcome:
@@ -445,6 +466,76 @@ def _kinematics_case(scene: KinematicsScene, engine: Engine, case: Case, q: np.n
     return case.rows(KINEMATICS_METRICS, OK, ("this is the reference; " if is_reference else "") + model.detail, values)
 
 
+@dataclass(frozen=True)
+class _JointDynamicsShared:
+    """The states of a joint-dynamics group, the reference's values there (None when there are none) and (why
+    there are none, the status that gives)."""
+
+    states: tuple[np.ndarray, ...]
+    reference: dict | None
+    problem: tuple[str, str]
+
+
+def _prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_failure: str) -> _JointDynamicsShared:
+    scene, label = group.joint_dynamics_scene, group.reference_label
+    states, method = scene.states(), label.split(":", 1)[1]
+
+    def evaluate() -> dict:
+        model = engine_for(scene.reference).build_joint_dynamics(scene.chain, method, scene.gravity_world)
+        values = reference_values(model, states)
+        problem = shape_problem(values, len(states[0]), scene.chain.n_joints)
+        if problem:
+            raise SimparityError(f"unusable: {problem}")
+        return values
+
+    values, problem = _reference_values(label, reference_failure,
+                                        lambda: engine_for(scene.reference).supports_joint_dynamics(scene.chain,
+                                                                                                   method), evaluate)
+    return _JointDynamicsShared(states, cast(dict | None, values), problem)
+
+
+def _joint_dynamics_case_at(group: CaseGroup, shared: _JointDynamicsShared, index: int,
+                            engine_for: EngineFor) -> CaseOutcome:
+    scene, spec = group.joint_dynamics_scene, group.cases[index]
+    engine = engine_for(spec.engine)
+    case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label,
+                declared_scheme(engine, spec.integrator, scene))
+    rows: list[ResultRow] = []
+    with warnings_into_rows(rows):
+        rows += _joint_dynamics_case(scene, engine, case, shared, group.repeats,
+                                     f"{spec.engine}:{spec.integrator}" == group.reference_label)
+    return CaseOutcome(rows)
+
+
+def _joint_dynamics_case(scene: JointDynamicsScene, engine: Engine, case: Case, shared: _JointDynamicsShared,
+                         repeats: int, is_reference: bool) -> list[ResultRow]:
+    """Rows of one engine's joint-space dynamics at the scene's states: errors against the reference's values,
+    the identities of its own, its times."""
+    try:
+        support = engine.supports_joint_dynamics(scene.chain, case.integrator)
+        if not support.ok:
+            return case.rows(JOINT_DYNAMICS_METRICS, NOT_AVAILABLE, support.reason)
+        model = engine.build_joint_dynamics(scene.chain, case.integrator, scene.gravity_world)
+        own, values = timed_values(model, shared.states, lambda fn: best_of(fn, repeats))
+        problem = shape_problem(own, len(shared.states[0]), scene.chain.n_joints)
+        if problem:
+            status = DIVERGED if problem.startswith("non-finite") else FAILED
+            return case.rows(JOINT_DYNAMICS_METRICS, status, problem, values)
+        values.update(identities(model, scene, own))
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        return case.rows(JOINT_DYNAMICS_METRICS, FAILED, error_text(err))
+    detail = ("this is the reference; " if is_reference else "") + model.detail
+    if shared.reference is None:
+        problem, status = shared.problem
+        order = list(JOINT_DYNAMICS_METRICS)
+        return sorted(case.partial_rows({m: u for m, u in JOINT_DYNAMICS_METRICS.items() if m not in REFERENCE_ERRORS},
+                                        values, detail, status, problem)
+                      + case.rows({m: JOINT_DYNAMICS_METRICS[m] for m in REFERENCE_ERRORS}, status, problem),
+                      key=lambda row: order.index(row.metric))
+    values.update(reference_errors(own, shared.reference))
+    return case.rows(JOINT_DYNAMICS_METRICS, OK, detail, {m: values[m] for m in JOINT_DYNAMICS_METRICS})
+
+
 def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_label: str) -> list[ResultRow]:
     """Observed orders of convergence per engine and integrator over the scene's time steps."""
     rows = []
@@ -469,7 +560,8 @@ def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_l
 
 
 _KINDS = {DYNAMICS: _Kind(_prepare_dynamics, _dynamics_case_at), STABILITY: _Kind(_prepare_nothing, _stability_case_at),
-          KINEMATICS: _Kind(_prepare_kinematics, _kinematics_case_at), IK: _Kind(prepare_ik, ik_case)}
+          KINEMATICS: _Kind(_prepare_kinematics, _kinematics_case_at), IK: _Kind(prepare_ik, ik_case),
+          JOINT_DYNAMICS: _Kind(_prepare_joint_dynamics, _joint_dynamics_case_at)}
 
 
 def failed_outcome(group: CaseGroup, spec: CaseSpec, cause: str) -> CaseOutcome:
@@ -479,7 +571,7 @@ def failed_outcome(group: CaseGroup, spec: CaseSpec, cause: str) -> CaseOutcome:
         return failed_ik_outcome(group, spec, cause)
     scene = group.scene
     metrics = {DYNAMICS: lambda: dynamics_metrics(group.dynamics_scene), STABILITY: lambda: STABILITY_METRICS,
-               KINEMATICS: lambda: KINEMATICS_METRICS}[group.kind]()
+               KINEMATICS: lambda: KINEMATICS_METRICS, JOINT_DYNAMICS: lambda: JOINT_DYNAMICS_METRICS}[group.kind]()
     case = Case(scene.name, spec.engine, spec.integrator, group.dt, group.reference_label)
     return CaseOutcome(case.rows(metrics, FAILED, cause), harness_failure=True)
 

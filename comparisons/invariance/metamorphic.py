@@ -53,7 +53,7 @@ from simparity.core.model.engine import Engine
 from simparity.core.model.metric_catalogue import is_timing
 from simparity.core.model.errors import TransformError, UnitError, one_line
 from simparity.core.model.results import DIMENSIONLESS, FAILED, NOT_AVAILABLE, OK, ROUNDING_FLOOR, ResultRow
-from simparity.core.model.scene import DynamicsScene, Scene
+from simparity.core.model.scene import DynamicsScene, JointDynamicsScene, Scene
 
 RunScenes = Callable[[list], list[list[ResultRow]]]
 """Runs scenes on the engines being checked: the rows of each scene, in order (:func:`in_process`, or a run's
@@ -260,8 +260,8 @@ def check_invariance(scenes: list, transforms: Iterable[Transform], run: RunScen
 
 
 def _unchanged(scene) -> str:
-    what = "one body has no other order" if isinstance(scene, DynamicsScene) else \
-        "a chain has no mass, no time and no free bodies"
+    what = ("one body has no other order" if isinstance(scene, DynamicsScene) else "a chain has no free bodies"
+            if isinstance(scene, JointDynamicsScene) else "a chain has no mass, no time and no free bodies")
     return f"changes nothing in this scene ({what})"
 
 
@@ -272,6 +272,8 @@ def _unfollowed(transformed, engine_for: EngineFor) -> str:
         return ""
     if isinstance(transformed, DynamicsScene):
         support = reference.supports_dynamics(transformed, reference.scene_integrators(transformed)[0])
+    elif isinstance(transformed, JointDynamicsScene):
+        support = reference.supports_joint_dynamics(transformed.chain, reference.joint_dynamics_methods()[0])
     else:
         support = reference.supports_kinematics(transformed.chain)
     if support.ok:

@@ -16,7 +16,8 @@ the scene's data alone, as upper bounds of its state's scale:
   radius of gyration sqrt(tr I / 2m): an engine that steps a body's six velocities together (MuJoCo's free
   joint) rounds its linear motion into a spin of that order;
 - a chain: X = the distance its first joint lies from the origin plus every joint offset and the end
-  effector (its reach bound), N its joints (kinematics) or the solver's iterations (IK).
+  effector (its reach bound), N its joints (kinematics) or the solver's iterations (IK); its joint-space dynamics
+  (every metric a ratio): N its joints, times X over the chain's own extent (X less its first joint's distance).
 
 A metric of dimension L^a M^b T^c (``comparisons.units``) then has the allowance FACTOR x eps x (N + kappa) x
 its scale: m -> X, m/s -> V, rad/s -> Omega, rad and 1 (both dimensionless) -> 1 + T Omega, s -> T, others
@@ -39,7 +40,7 @@ import numpy as np
 
 from simparity.comparisons.invariance.units import Dimension
 from simparity.comparisons.measure.body_scales import contact_of
-from simparity.core.model.scene import Chain, DynamicsScene, IKScene, KinematicsScene
+from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene, KinematicsScene
 
 ALLOWANCE_FACTOR = 16.0
 """The metrics' rounding floor is 2 eps (N + kappa) x the scale (measured rounding of exact schemes stays below
@@ -143,10 +144,24 @@ def _chain_floors(scene: KinematicsScene | IKScene) -> Floors:
                   mass_scale=1.0, time_scale=1.0)
 
 
+def _joint_dynamics_floors(scene: JointDynamicsScene) -> Floors:
+    """A chain's joint-space dynamics: every metric is a ratio, rounded like the chain's frames relative to its own
+    size: N its joints, times the reach bound over the chain's own extent (a chain placed 2 km away rounds its
+    frames at 2000 x eps, its lever arms of ~1 m at eps)."""
+    unit = ALLOWANCE_FACTOR * float(np.finfo(float).eps) * scene.chain.n_joints
+    reach = _reach(scene.chain)
+    size = reach - float(np.linalg.norm(scene.chain.joints[0].origin_xyz))
+    ratio = unit * max(1.0, reach / size) if size > 0 else unit
+    return Floors(length=unit * reach, speed=0.0, spin=0.0, angle=ratio, time=0.0, generic=ratio, length_scale=reach,
+                  mass_scale=1.0, time_scale=1.0)
+
+
 def rounding_floors(scene) -> Floors:
     """What rounding alone may move ``scene``'s quantities by (module docstring)."""
     if isinstance(scene, DynamicsScene):
         return _dynamics_floors(scene)
     if isinstance(scene, (KinematicsScene, IKScene)):
         return _chain_floors(scene)
+    if isinstance(scene, JointDynamicsScene):
+        return _joint_dynamics_floors(scene)
     raise TypeError(f"no rounding allowance for a {type(scene).__name__}")

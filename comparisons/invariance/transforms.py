@@ -42,7 +42,9 @@ from simparity.core.model.scene import (
     Forces,
     IKScene,
     Joint,
+    JointDynamicsScene,
     KinematicsScene,
+    LinkInertia,
     Plane,
     PointMasses,
     RigidBody,
@@ -149,6 +151,8 @@ class Transform:
     def changes(self, scene) -> bool:
         """True when the transform changes anything of ``scene`` (a chain feels only frame and length; one
         body has no other order)."""
+        if isinstance(scene, JointDynamicsScene):  # a chain with mass, time and gravity: every scale is felt
+            return self.moves_frame or self.mass_scale != 1.0 or self.time_scale != 1.0
         if not isinstance(scene, DynamicsScene):
             return self.moves_frame
         reordered = self.order_for(len(scene.bodies)) != tuple(range(len(scene.bodies)))
@@ -201,8 +205,10 @@ def transform_scene(scene, transform: Transform):
         return _dynamics(scene, transform)
     if isinstance(scene, (KinematicsScene, IKScene)):
         return _chain_scene(scene, transform)
+    if isinstance(scene, JointDynamicsScene):
+        return _joint_dynamics_scene(scene, transform)
     raise TransformError(getattr(scene, "source", "<code>"), "kind", f"a {type(scene).__name__} has no transform",
-                         "dynamics, kinematics and IK scenes")
+                         "dynamics, kinematics, IK and joint-dynamics scenes")
 
 
 def _body(body: RigidBody, t: Transform) -> RigidBody:
@@ -267,20 +273,28 @@ def _dynamics(scene: DynamicsScene, t: Transform) -> DynamicsScene:
 
 
 def _joint(joint: Joint, t: Transform, first: bool) -> Joint:
-    """A joint with its lengths scaled; the first also placed by R and t (its origin is in the world)."""
+    """A joint with its lengths (and its link's mass properties, damping and armature) scaled; the first also placed
+    by R and t (its origin is in the world)."""
     length = t.length_scale
     prismatic = length if joint.type == "prismatic" else 1.0
     origin = t.point(joint.origin_xyz) if first else length * joint.origin_xyz
     rotation = t.rotation_matrix @ joint.origin_rotation if first else joint.origin_rotation
+    link = joint.link
+    if link is not None:  # link axes: scaled, not turned (the rotation is the first joint's placement)
+        link = LinkInertia(t.mass_scale * link.mass, length * link.com_xyz, t.factor(length=2, mass=1) * link.inertia_com)
+    # damping N m s/rad = kg m^2/s or N s/m = kg/s; armature kg m^2 or kg
+    per_rad = 0 if joint.type == "prismatic" else 2
     return replace(joint, origin_xyz=origin, origin_rotation=rotation, lower=prismatic * joint.lower,
-                   upper=prismatic * joint.upper)
+                   upper=prismatic * joint.upper, link=link,
+                   damping=t.factor(length=per_rad, mass=1, time=-1) * joint.damping,
+                   armature=t.factor(length=per_rad, mass=1) * joint.armature)
 
 
 def _chain(chain: Chain, t: Transform, source: str) -> Chain:
     if chain.urdf_path is not None:
         raise TransformError(source, f"transform {t.name}", f"chain {one_line(chain.name)} is read from the URDF file "
                              f"{one_line(chain.urdf_path)}, which every engine loads itself with its base link as the "
-                             "world: the scene cannot move its base or scale its lengths",
+                             "world: the scene cannot move its base or scale its lengths (or masses)",
                              "a chain written in the scene file (joints or dh), or the transform applied to the URDF "
                              "file itself")
     free_slides = [j.name for j in chain.joints if j.type == "prismatic" and not j.limited]
@@ -302,6 +316,25 @@ def _chain_scene(scene: KinematicsScene | IKScene, t: Transform):
     prismatic = np.array([t.length_scale if j.type == "prismatic" else 1.0 for j in scene.chain.joints])
     return replace(scene, chain=chain, q_start=prismatic * scene.q_start,
                    position_tolerance=t.length_scale * scene.position_tolerance)
+
+
+def _joint_dynamics_scene(scene: JointDynamicsScene, t: Transform) -> JointDynamicsScene:
+    """The chain placed, scaled and given mass and time units; gravity turned and scaled; the sampling scales in the
+    new units, so that the same seeded draws are the same states. One scale per quantity serves every joint: a chain
+    of revolute and prismatic joints takes no length or time scale (their velocities scale differently)."""
+    untouched = not t.moves_frame and t.mass_scale == 1.0  # time alone: a URDF chain keeps its file
+    chain = scene.chain if untouched else _chain(scene.chain, t, scene.source)
+    kinds = {j.type for j in scene.chain.joints}
+    if len(kinds) > 1 and (t.length_scale != 1.0 or t.time_scale != 1.0):
+        raise TransformError(scene.source, f"transform {t.name}", "the chain mixes revolute and prismatic joints: "
+                             "their velocities, accelerations and forces scale differently with length and time, and "
+                             "the scene samples each with one scale", "a chain of one joint type, or no L or T scale")
+    variable = 1 if kinds == {"prismatic"} else 0  # the joint variable's power of length: m, or rad
+    gravity = scene.gravity_world
+    return replace(scene, chain=chain, gravity_world=None if gravity is None else t.vector(gravity, length=1, time=-2),
+                   velocity_scale=t.factor(length=variable, time=-1) * scene.velocity_scale,
+                   acceleration_scale=t.factor(length=variable, time=-2) * scene.acceleration_scale,
+                   torque_scale=t.factor(length=2 - variable, mass=1, time=-2) * scene.torque_scale)
 
 
 FIXED_SEED = 22

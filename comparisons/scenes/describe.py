@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.comparisons.scenes.sweep import value_text
-from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
+from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, KinematicsScene
 
 
 def _vector(values) -> str:
@@ -61,6 +61,22 @@ def _contact_lines(scene: DynamicsScene) -> list[str]:
     return lines
 
 
+def _joint_dynamics_lines(scene: JointDynamicsScene) -> list[str]:
+    gravity = "none" if scene.gravity_world is None else f"{_vector(scene.gravity_world)} m/s^2"
+    lines = [f"gravity_world {gravity} (in the base frame); {scene.n_states} states (seed {scene.seed}): q within the "
+             f"limits, |qdot| <= {scene.velocity_scale:.10g}, |qddot| <= {scene.acceleration_scale:.10g}, |tau| <= "
+             f"{scene.torque_scale:.10g} per joint"]
+    for joint in scene.chain.joints:
+        link = joint.link
+        assert link is not None  # a joint-dynamics scene's chain has mass properties (checked when built)
+        lines.append(f"  {joint.name} ({joint.type}): link mass {link.mass:.10g} kg, centre of mass "
+                     f"{_vector(link.com_xyz)} m, inertia diagonal {_vector(link.inertia_com.diagonal())} kg m^2, "
+                     f"damping {joint.damping:.10g}, armature {joint.armature:.10g}")
+    if scene.chain.held_joints:
+        lines.append(f"held at 0 (their links ride on the chain): {', '.join(scene.chain.held_joints)}")
+    return lines
+
+
 def describe(scene) -> str:
     """The text ``simparity show`` prints for ``scene``."""
     head = [f"scene {scene.name} ({scene.kind}), reference {scene.reference}, suites {', '.join(scene.suites)}",
@@ -75,8 +91,10 @@ def describe(scene) -> str:
         head += [f"gravity_world {gravity}; forces {', '.join(forces.names()) or 'none'}",
                  f"duration {scene.duration:.10g} s; dt {', '.join(f'{dt:.10g}' for dt in scene.dts)} s"]
         head += _body_lines(scene) + _contact_lines(scene)
-    elif isinstance(scene, (KinematicsScene, IKScene)):
+    elif isinstance(scene, (KinematicsScene, IKScene, JointDynamicsScene)):
         chain = scene.chain
         head.append(f"chain {chain.name}: {chain.n_joints} joints ({', '.join(j.name for j in chain.joints)}), "
                     f"end effector {chain.end_effector_name}")
+    if isinstance(scene, JointDynamicsScene):
+        head += _joint_dynamics_lines(scene)
     return "\n".join(head) + "\n"

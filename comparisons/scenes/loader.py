@@ -1,4 +1,4 @@
-"""Scene files (TOML) -> :class:`core.scene.DynamicsScene` / :class:`core.scene.KinematicsScene`.
+"""Scene files (TOML) -> :class:`core.scene.DynamicsScene`, ``KinematicsScene``, ``IKScene``, ``JointDynamicsScene``.
 
 Every value is checked; a bad one raises :class:`core.errors.SceneError` naming the file,
 the key path, what was wrong and what is allowed. A file with a ``[sweep]`` is several scenes, one per
@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
@@ -38,7 +39,9 @@ from simparity.core.model.scene import (
     Forces,
     IKScene,
     Joint,
+    JointDynamicsScene,
     KinematicsScene,
+    LinkInertia,
     Material,
     Plane,
     PointMasses,
@@ -52,7 +55,7 @@ from simparity.references.common.conventions import quat_wxyz_to_matrix
 LENGTH_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "ft": 0.3048, "in": 0.0254}
 """Units a scene may declare for lengths, and their size in metres."""
 
-KINDS = ("dynamics", "kinematics", "ik")
+KINDS = ("dynamics", "kinematics", "ik", "joint_dynamics")
 JOINT_TYPES = ("revolute", "prismatic")
 
 _REQUIRED = object()  # marks a key without a default
@@ -226,7 +229,7 @@ class _Reader:
 
 _TOP = ("scene", "world", "body", "simulation", "plane", "contact", "chain", "sampling", "targets")
 _PARTS = {"dynamics": ("world", "body", "simulation", "plane", "contact"), "kinematics": ("chain", "sampling"),
-          "ik": ("chain", "targets")}
+          "ik": ("chain", "targets"), "joint_dynamics": ("chain", "world", "sampling")}
 _SCENE = ("name", "description", "kind", "reference", "length_unit", "suites")
 # Drag coefficients and the power of length in their units (for length_unit scaling).
 DRAG_KEYS = {"linear_drag": 0, "quadratic_drag": -1, "angular_linear_drag": 2, "angular_quadratic_drag": 2}
@@ -255,7 +258,9 @@ EXAMPLE_ROBOT_DATA_PREFIX = "example-robot-data:"
 ``robots`` folder (``pip install example-robot-data``)."""
 EXAMPLE_ROBOT_DATA_ROBOTS = "cmeel.prefix/share/example-robot-data/robots"
 """Where the example-robot-data wheel keeps its robots, relative to its installation."""
-_JOINT = ("name", "type", "axis", "origin_xyz", "origin_rpy", "lower", "upper")
+_LINK = ("mass", "com_xyz", "inertia")
+_JOINT = ("name", "type", "axis", "origin_xyz", "origin_rpy", "lower", "upper", "damping", "armature") + _LINK
+_JOINT_DYNAMICS_SAMPLING = ("states", "seed", "velocity_scale", "acceleration_scale", "torque_scale")
 
 # duration / dt may differ from a whole number by this much (rounding of a decimal dt).
 _STEP_COUNT_RTOL = 1e-9
@@ -521,12 +526,37 @@ def _joint(r: _Reader) -> Joint:
     upper = r.number("upper", length=length) if r.has("upper") else np.inf
     if lower >= upper:
         raise r.fail("upper", f"upper {upper:g} is not above lower {lower:g}", "lower < upper")
+    # damping [N m s/rad = kg m^2/s] or [N s/m = kg/s], armature [kg m^2] or [kg]: length^2 or length^0
+    power = 0 if kind == "prismatic" else 2
+    damping = r.number("damping", 0.0, length=power) if r.has("damping") else 0.0
+    armature = r.number("armature", 0.0, length=power) if r.has("armature") else 0.0
+    for key, value in (("damping", damping), ("armature", armature)):
+        if value < 0:
+            raise r.fail(key, f"{value:g} is negative", "a number >= 0 (0: none)")
     return Joint(
         name=r.name("name"), type=kind, axis=r.vector("axis", 3, nonzero=True),
         origin_xyz=r.vector("origin_xyz", 3, [0.0] * 3, length=1),
         origin_rotation=rpy_to_matrix(r.vector("origin_rpy", 3, [0.0] * 3)),
-        lower=lower, upper=upper,
+        lower=lower, upper=upper, link=_link(r), damping=damping, armature=armature,
     )
+
+
+def _link(r: _Reader) -> LinkInertia | None:
+    """The mass properties of a ``[[chain.joint]]``'s child link: all of mass, com_xyz, inertia, or none."""
+    given = [key for key in _LINK if r.has(key)]
+    if not given:
+        return None
+    if len(given) != len(_LINK):
+        missing = next(key for key in _LINK if key not in given)
+        raise r.fail(missing, f"missing: {', '.join(given)} given without it",
+                     "all of mass [kg], com_xyz [length] and inertia (3 x 3 about the centre of mass, in the link's "
+                     "axes) or none (a chain for kinematics only)")
+    mass = r.number("mass", positive=True)
+    inertia = r.matrix("inertia", 3, length=2)
+    problem = inertia_problem(inertia)
+    if problem:
+        raise r.fail("inertia", problem, "a symmetric positive-semidefinite tensor obeying the triangle inequality")
+    return LinkInertia(mass, r.vector("com_xyz", 3, length=1), inertia)
 
 
 def _package_root(c: _Reader, prefix: str) -> Path:
@@ -562,13 +592,13 @@ def _urdf_path(c: _Reader) -> Path:
     return path
 
 
-def _urdf_chain(c: _Reader) -> Chain:
+def _urdf_chain(c: _Reader, dynamics: bool) -> Chain:
     """The chain of a ``urdf`` scene; an error in the URDF names the scene file, and the URDF as the scene does."""
     base, tip = (c.name(key) if c.has(key) else None for key in ("base_link", "tip_link"))
     path = _urdf_path(c)
     try:
         return chain_from_urdf(str(path), base_link=base, tip_link=tip, max_joints=c.limits.max_joints,
-                               max_bytes=c.limits.max_file_bytes)
+                               max_bytes=c.limits.max_file_bytes, dynamics=dynamics)
     except SceneError as err:
         raise c.fail("urdf", f"{one_line(c.table['urdf'], 120)}: {err.key}: {err.problem}", err.allowed) from None
 
@@ -594,14 +624,15 @@ def _dh_chain(c: _Reader, name: str) -> Chain:
     return chain_from_dh(name, convention=convention, limits=limits, **values)
 
 
-def _chain(top: _Reader, name: str) -> Chain:
+def _chain(top: _Reader, name: str, dynamics: bool = False) -> Chain:
+    """The scene's ``[chain]``; for ``dynamics``, a URDF's inertia tensors must be physical."""
     c = top.subtable("chain", _CHAIN)
     sources = [key for key in ("joint", "urdf", "dh") if c.has(key)]
     if len(sources) != 1:
         raise c.fail("joint", f"give exactly one chain source, got {sources or 'none'}",
                      "one of [[chain.joint]], urdf, [chain.dh]")
     if sources == ["urdf"]:
-        return _urdf_chain(c)
+        return _urdf_chain(c, dynamics)
     if sources == ["dh"]:
         return _dh_chain(c, c.name("name", name))
     joints = tuple(_joint(r) for r in c.array_of_tables("joint", _JOINT, "max_joints"))
@@ -624,6 +655,24 @@ def _kinematics(top: _Reader, head: dict) -> KinematicsScene:
     n = sampling.integer("configurations", 100, minimum=1, maximum=limit, why=_SAMPLES_WHY) if sampling else 100
     seed = sampling.integer("seed", 0, maximum=_MAX_SEED) if sampling else 0
     return KinematicsScene(chain=chain, n_configurations=n, seed=seed, **head)
+
+
+def _joint_dynamics(top: _Reader, head: dict) -> JointDynamicsScene:
+    chain = _chain(top, head["name"], dynamics=True)
+    problem = chain.dynamics_problem()
+    if problem:
+        raise top.fail("chain", problem, "a chain whose every link has mass properties: a URDF file with <inertial> "
+                       "elements or [[chain.joint]] with mass, com_xyz and inertia ([chain.dh] declares none)")
+    world = top.optional_subtable("world", ("gravity_world",))
+    gravity = world.vector("gravity_world", 3, length=1) if world and world.has("gravity_world") else None
+    sampling = top.optional_subtable("sampling", _JOINT_DYNAMICS_SAMPLING)
+    limit = top.limits.max_samples
+    count = sampling.integer("states", 100, minimum=1, maximum=limit, why=_SAMPLES_WHY) if sampling else 100
+    seed = sampling.integer("seed", 0, maximum=_MAX_SEED) if sampling else 0
+    velocity, acceleration, torque = (sampling.number(key, 1.0, positive=True) if sampling and sampling.has(key)
+                                      else 1.0 for key in _JOINT_DYNAMICS_SAMPLING[2:])
+    return JointDynamicsScene(chain=chain, gravity_world=gravity, n_states=count, seed=seed, velocity_scale=velocity,
+                              acceleration_scale=acceleration, torque_scale=torque, **head)
 
 
 def _start(t: _Reader, chain: Chain) -> np.ndarray:
@@ -694,10 +743,16 @@ def _check_reference(top: _Reader, scene, engines: EngineSet) -> None:
     if isinstance(scene, DynamicsScene):
         integrators = engine.integrators()
         support = engine.supports_dynamics(scene, integrators[0]) if integrators else Support.no("it offers no integrator")
+    elif isinstance(scene, JointDynamicsScene):
+        methods = engine.joint_dynamics_methods()
+        support = (engine.supports_joint_dynamics(scene.chain, methods[0]) if methods
+                   else Support.no("it computes no joint-space dynamics"))
     else:
         support = engine.supports_kinematics(scene.chain)
     if not support.ok:
         allowed = ("a reference that can: core (its backup method), mujoco or pybullet for contact" if contact is not None
+                   else "a reference that computes joint-space dynamics: pinocchio, mujoco, core, or analytic for a "
+                        "planar chain of 1 or 2 joints" if isinstance(scene, JointDynamicsScene)
                    else "a reference that can: core, mujoco, pybullet, pinocchio, or tight for dynamics without a "
                         "closed form")
         raise top.fail("scene.reference", f"{scene.reference} cannot serve this scene: {support.reason}", allowed)
@@ -737,7 +792,9 @@ def _parse(data: dict, source: str, limits: Limits, engines: EngineSet):
     if kind == "dynamics":
         scene = _dynamics(top, dict(head, length_unit=unit), engines)
     else:
-        scene = _kinematics(top, head) if kind == "kinematics" else _ik(top, head)
+        readers: dict[str, Callable[[_Reader, dict], Scene]] = {"kinematics": _kinematics, "ik": _ik,
+                                                                  "joint_dynamics": _joint_dynamics}
+        scene = readers[kind](top, head)
     _check_reference(top, scene, engines)
     return scene
 

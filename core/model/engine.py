@@ -42,6 +42,10 @@ SCHEME_KINDS = {
     "penalty": "a spring-damper force on penetration, integrated by a time integrator",
     "soft": "a soft constraint (MuJoCo's solref/solimp), with no restitution coefficient",
     "impulse": "velocity-level impulses with restitution and position correction (Bullet)",
+    # How joint-space dynamics (mass matrix, bias forces, inverse and forward dynamics) are computed.
+    "recursive": "Featherstone's recursive algorithms: Newton-Euler (RNEA), composite rigid body (CRBA), "
+                 "articulated body (ABA) or a factorisation of M",
+    "jacobian_sum": "the lecture's route: M and h summed over every link's centre-of-mass Jacobians, O(n^3)",
     # How an IK solver steps.
     "jacobian_inverse": "Newton steps with J^-1 (square, invertible Jacobians only)",
     "pseudo_inverse": "Newton steps with the Moore-Penrose pseudo-inverse of J",
@@ -161,6 +165,46 @@ class KinematicsModel(abc.ABC):
         """
 
 
+class JointDynamicsModel(abc.ABC):
+    """A chain's joint-space dynamics built for one engine and method: the base fixed, its frame the world's.
+
+    Every function is batched over states: q, qdot, qddot, tau are (B, n) [rad or m, per second, per second
+    squared; N m or N]. The equation of motion is M(q) qddot + h(q, qdot) + D qdot = tau, with D the joints'
+    viscous damping (diagonal) and M including each joint's armature.
+
+    Attributes
+    ----------
+    detail : str
+        How the engine was given the chain and what it was switched to (shown in the rows).
+    """
+
+    detail: str = ""
+
+    @abc.abstractmethod
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """M(q), (B, n, n) [kg m^2, kg m, kg]: the joint-space inertia, armature included."""
+
+    @abc.abstractmethod
+    def bias_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """h(q, qdot) = C(q, qdot) qdot + g(q), (B, n): the joint forces that give zero acceleration with no
+        damping (Coriolis, centrifugal and gravity; MuJoCo's ``qfrc_bias``, Pinocchio's ``nle``)."""
+
+    @abc.abstractmethod
+    def inverse_dynamics(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
+        """tau = M qddot + h + D qdot, (B, n): the joint forces that give ``qddot``."""
+
+    @abc.abstractmethod
+    def forward_dynamics(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """qddot = M^-1 (tau - h - D qdot), (B, n)."""
+
+    @abc.abstractmethod
+    def link_kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """(B,) [J]: sum over the chain's links of 1/2 m |v_c|^2 + 1/2 omega^T I_c omega, from the engine's own
+        forward kinematics of each link (its centre-of-mass velocity and angular velocity) and its own link masses
+        and inertias, never from its mass matrix: an independent check of M (1/2 qdot^T M qdot, armature
+        aside)."""
+
+
 @dataclass(frozen=True)
 class StoppingRule:
     """The rule an IK solver stops by, in the residuals the harness measures: a solve meets it when its
@@ -265,6 +309,26 @@ class Engine(abc.ABC):
     @abc.abstractmethod
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
         """Build the model for ``chain`` (not timed). Call only when supported."""
+
+    def joint_dynamics_methods(self) -> tuple[str, ...]:
+        """Names of the ways the engine computes joint-space dynamics (each a case of a joint-dynamics scene,
+        in its ``integrator`` column); empty (the default) when it has none, and its rows are n/a."""
+        return ()
+
+    def supports_joint_dynamics(self, chain: Chain, method: str) -> Support:
+        """Whether :meth:`build_joint_dynamics` can build ``chain`` with ``method``."""
+        if method in self.joint_dynamics_methods():
+            return Support.yes()
+        if not self.joint_dynamics_methods():
+            return Support.no(f"{self.name} computes no joint-space dynamics")
+        return Support.no(f"{self.name} has no joint-dynamics method '{method}' "
+                          f"(offers: {', '.join(self.joint_dynamics_methods())})")
+
+    def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
+        """Build ``chain``'s joint-space dynamics under ``gravity_world`` ((3,) [m/s^2] in the base frame, None for
+        none) with ``method`` (not timed). Call only when supported."""
+        raise SimparityError(f"engine '{self.name}' computes no joint-space dynamics "
+                             "(allowed: an engine whose joint_dynamics_methods() is not empty)")
 
     def theoretical_order(self, integrator: str) -> int | None:
         """Global order of accuracy the integrator has in theory (None: unknown, or it depends on the

@@ -87,6 +87,21 @@ JACOBIAN_ERROR_MAX = "jacobian_error_max"
 ROTATION_ORTHONORMALITY_DEVIATION_MAX = "rotation_orthonormality_deviation_max"
 TIME_PER_FK = "time_per_fk"
 TIME_PER_JACOBIAN = "time_per_jacobian"
+# Joint-space dynamics: relative errors against the reference at the scene's states, identities of the engine's own.
+MASS_MATRIX_ERROR_MAX = "mass_matrix_error_max"
+BIAS_FORCE_ERROR_MAX = "bias_force_error_max"
+INVERSE_DYNAMICS_ERROR_MAX = "inverse_dynamics_error_max"
+FORWARD_DYNAMICS_ERROR_MAX = "forward_dynamics_error_max"
+GRAVITY_IDENTITY_RESIDUAL = "gravity_identity_residual"
+MASS_COLUMN_RESIDUAL = "mass_column_residual"
+ROUND_TRIP_RESIDUAL = "round_trip_residual"
+MASS_MATRIX_ASYMMETRY = "mass_matrix_asymmetry"
+MASS_MATRIX_DEFINITENESS_MIN = "mass_matrix_definiteness_min"
+KINETIC_ENERGY_RESIDUAL = "kinetic_energy_residual"
+CORIOLIS_SKEW_RESIDUAL = "coriolis_skew_residual"
+TIME_PER_MASS_MATRIX = "time_per_mass_matrix"
+TIME_PER_INVERSE_DYNAMICS = "time_per_inverse_dynamics"
+TIME_PER_FORWARD_DYNAMICS = "time_per_forward_dynamics"
 # Contact: events against the exact bounce sequence, slide and rest.
 IMPACT_TIME_ERROR = "impact_time_error"
 REBOUND_VELOCITY_ERROR = "rebound_velocity_error"
@@ -152,6 +167,23 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(ROTATION_ORTHONORMALITY_DEVIATION_MAX, DIMENSIONLESS, VALIDITY, theory="0 up to rounding"),
     Metric(TIME_PER_FK, "s", TIMING),
     Metric(TIME_PER_JACOBIAN, "s", TIMING),
+    Metric(MASS_MATRIX_ERROR_MAX, DIMENSIONLESS, ERROR),
+    Metric(BIAS_FORCE_ERROR_MAX, DIMENSIONLESS, ERROR),
+    Metric(INVERSE_DYNAMICS_ERROR_MAX, DIMENSIONLESS, ERROR),
+    Metric(FORWARD_DYNAMICS_ERROR_MAX, DIMENSIONLESS, ERROR),
+    Metric(GRAVITY_IDENTITY_RESIDUAL, DIMENSIONLESS, VALIDITY, theory="RNEA(q, 0, 0) = g(q): 0 up to rounding"),
+    Metric(MASS_COLUMN_RESIDUAL, DIMENSIONLESS, VALIDITY, theory="RNEA(q, 0, e_i) - g(q) = M e_i: 0 up to rounding"),
+    Metric(ROUND_TRIP_RESIDUAL, DIMENSIONLESS, VALIDITY,
+           theory="ABA(q, qdot, RNEA(q, qdot, qddot)) = qddot (in torque space): 0 up to rounding"),
+    Metric(MASS_MATRIX_ASYMMETRY, DIMENSIONLESS, VALIDITY, theory="M = M^T: 0 up to rounding"),
+    Metric(MASS_MATRIX_DEFINITENESS_MIN, DIMENSIONLESS, VALIDITY, theory="> 0: M is positive definite"),
+    Metric(KINETIC_ENERGY_RESIDUAL, DIMENSIONLESS, VALIDITY,
+           theory="1/2 qdot^T M qdot = the links' kinetic energy: 0 up to rounding"),
+    Metric(CORIOLIS_SKEW_RESIDUAL, DIMENSIONLESS, VALIDITY,
+           theory="qdot^T (Mdot - 2 C) qdot = 0: 0 up to finite differences"),
+    Metric(TIME_PER_MASS_MATRIX, "s", TIMING),
+    Metric(TIME_PER_INVERSE_DYNAMICS, "s", TIMING),
+    Metric(TIME_PER_FORWARD_DYNAMICS, "s", TIMING),
     Metric(IMPACT_TIME_ERROR, "s", CONTACT),
     Metric(REBOUND_VELOCITY_ERROR, "m/s", CONTACT),
     Metric(APEX_HEIGHT_ERROR, "m", CONTACT),

@@ -499,6 +499,42 @@ class DynamicsScene:
 
 
 @dataclass(frozen=True)
+class LinkInertia:
+    """The mass properties of one link of a chain, in the link's frame (the frame its joint moves).
+
+    Everything rigidly attached to the link is included: links hanging from it by fixed joints, and (for a
+    chain read from a URDF file) every branch off the chain below it, its joints held at 0.
+
+    Attributes
+    ----------
+    mass : float
+        [kg], >= 0 (0: a massless link, as a URDF link without ``<inertial>``).
+    com_xyz : (3,) ndarray
+        Centre of mass in the link frame [m].
+    inertia_com : (3, 3) ndarray
+        Inertia tensor about the centre of mass, in the link frame's axes [kg m^2]; symmetric.
+    """
+
+    mass: float
+    com_xyz: np.ndarray
+    inertia_com: np.ndarray
+
+    def __post_init__(self) -> None:
+        if not (np.isfinite(self.mass) and self.mass >= 0):
+            raise SceneError("<code>", "mass", f"{self.mass}", "a finite mass >= 0 [kg]")
+        object.__setattr__(self, "mass", float(self.mass))
+        object.__setattr__(self, "com_xyz", readonly(self.com_xyz, shape=(3,)))
+        object.__setattr__(self, "inertia_com", readonly(self.inertia_com, shape=(3, 3)))
+        if not np.all(np.isfinite(self.com_xyz)) or not np.all(np.isfinite(self.inertia_com)):
+            raise SceneError("<code>", "inertia", "a non-finite centre of mass or inertia", "finite numbers")
+
+    @classmethod
+    def massless(cls) -> "LinkInertia":
+        """A link with no mass (a URDF link without ``<inertial>``)."""
+        return cls(0.0, np.zeros(3), np.zeros((3, 3)))
+
+
+@dataclass(frozen=True)
 class Joint:
     """One joint of a serial chain (URDF semantics).
 
@@ -519,6 +555,13 @@ class Joint:
         Parent link frame to joint frame.
     lower, upper : float
         Limits [rad or m]; ``-inf`` / ``inf`` when unlimited.
+    link : LinkInertia or None
+        Mass properties of the child link (and all it carries), in the child link's frame; None when the
+        chain declares none (kinematics only: such a chain is refused for dynamics).
+    damping : float
+        Viscous joint damping [N m s/rad or N s/m], >= 0: the joint force -damping * qdot.
+    armature : float
+        Rotor inertia added to the joint's diagonal of the mass matrix [kg m^2 or kg], >= 0.
     """
 
     name: str
@@ -528,12 +571,20 @@ class Joint:
     origin_rotation: np.ndarray
     lower: float = -np.inf
     upper: float = np.inf
+    link: LinkInertia | None = None
+    damping: float = 0.0
+    armature: float = 0.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "axis", readonly(_unit(self.axis, 3, f"{self.name}.axis"), shape=(3,)))
         if np.isnan(self.lower) or np.isnan(self.upper) or self.lower > self.upper:
             raise SceneError("<code>", f"{self.name}.lower", f"limits ({self.lower}, {self.upper})",
                              "lower <= upper, -inf / inf for none")
+        for key in ("damping", "armature"):
+            value = getattr(self, key)
+            if not (np.isfinite(value) and value >= 0):
+                raise SceneError("<code>", f"{self.name}.{key}", f"{value}", "a finite number >= 0")
+            object.__setattr__(self, key, float(value))
         object.__setattr__(self, "origin_xyz", readonly(self.origin_xyz, shape=(3,)))
         object.__setattr__(self, "origin_rotation", readonly(self.origin_rotation, shape=(3, 3)))
 
@@ -564,6 +615,10 @@ class Chain:
         For a chain read from a URDF file: the link whose frame is the world frame (the
         file's root link unless the scene chose another); engines express every pose in
         it. None otherwise.
+    held_joints : tuple of str
+        For a chain read from a URDF file: the file's movable joints below the base link that are not on the
+        chain (fingers, branches, joints past the tip), held at 0 in the dynamics model (their links ride on
+        the chain link they hang from). Empty otherwise.
     """
 
     name: str
@@ -573,6 +628,7 @@ class Chain:
     end_effector_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
     urdf_path: str | None = None
     base_link: str | None = None
+    held_joints: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "end_effector_xyz", readonly(self.end_effector_xyz, shape=(3,)))
@@ -597,6 +653,23 @@ class Chain:
     def frame_names(self) -> tuple[str, ...]:
         """Names of the frames FK returns: one per joint (its child link), then the end effector."""
         return tuple(j.name for j in self.joints) + (self.end_effector_name,)
+
+    def dynamics_problem(self) -> str:
+        """Why the chain has no joint-space dynamics ("" when it has): a link without declared mass
+        properties, or a joint that moves no mass (its link and everything beyond it massless: the mass
+        matrix would be singular)."""
+        missing = [j.name for j in self.joints if j.link is None]
+        if missing:
+            return (f"joint {missing[0]!r}'s link declares no mass properties (mass, com_xyz, inertia): "
+                    "dynamics needs every link's; a URDF file's <inertial> or [[chain.joint]] mass keys give them")
+        carried = 0.0
+        for joint in reversed(self.joints):
+            link = joint.link
+            assert link is not None  # every link checked above
+            carried += link.mass + float(np.trace(link.inertia_com))
+            if carried <= 0 and joint.armature <= 0:
+                return f"joint {joint.name!r} moves no mass (its link and all beyond it are massless)"
+        return ""
 
 
 @dataclass(frozen=True)
@@ -634,11 +707,12 @@ class KinematicsScene:
         return sample_configurations(self.chain, self.n_configurations, self.seed)
 
 
-SUITES = ("default", "hard", "contact", "bench")
+SUITES = ("default", "hard", "contact", "bench", "articulated")
 """Named groups of built-in scenes (``simparity run --suite``): ``default`` is what ``simparity
 run`` runs; ``hard`` gathers the numerical-stability cases, each with the verdict it must earn
 in the shipped tolerances; ``contact`` every scene with planes; ``bench`` the real arms whose IK
-``simparity bench`` times (10,000 targets each). A scene may be in several."""
+``simparity bench`` times (10,000 targets each); ``articulated`` the joint-space dynamics of real robot arms and
+the crafted arm. A scene may be in several."""
 
 HARD_TARGETS = ("stretched", "beyond_reach", "at_base", "near_limits", "beyond_limits", "orientation_in_place",
                 "wrist_flip")
@@ -701,6 +775,63 @@ class IKScene:
         return sample_configurations(self.chain, self.n_targets, self.seed)
 
 
+@dataclass(frozen=True)
+class JointDynamicsScene:
+    """A chain's joint-space dynamics (mass matrix, bias forces, inverse and forward dynamics) compared at
+    seeded random states: instant by instant, no time stepping.
+
+    The chain's base link is fixed in the world and its frame is the world frame.
+
+    Attributes
+    ----------
+    name, description, reference : str
+    chain : Chain
+        With mass properties on every link (:meth:`Chain.dynamics_problem` is "").
+    gravity_world : (3,) ndarray or None
+        [m/s^2] in the base frame; None: no gravity.
+    n_states : int
+        Seeded random states (q, qdot, qddot, tau).
+    seed : int
+    velocity_scale, acceleration_scale, torque_scale : float
+        qdot, qddot and tau are uniform in [-scale, scale] per joint [rad/s or m/s, rad/s^2 or m/s^2,
+        N m or N]; q is uniform within the limits (:func:`sample_configurations`).
+    source : str
+    suites : tuple of str
+    sweep : SweepPoint or None
+    """
+
+    name: str
+    description: str
+    reference: str
+    chain: Chain
+    gravity_world: np.ndarray | None
+    n_states: int
+    seed: int
+    velocity_scale: float = 1.0
+    acceleration_scale: float = 1.0
+    torque_scale: float = 1.0
+    source: str = field(default="<code>", compare=False)
+    suites: tuple[str, ...] = ("default",)
+    sweep: SweepPoint | None = None
+    kind: str = field(default="joint_dynamics", init=False)
+
+    def __post_init__(self) -> None:
+        problem = self.chain.dynamics_problem()
+        if problem:
+            raise SceneError(self.source, "chain", problem, "a chain with mass properties on every link")
+        if self.gravity_world is not None:
+            object.__setattr__(self, "gravity_world", readonly(self.gravity_world, shape=(3,)))
+
+    def states(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(q, qdot, qddot, tau), each (n_states, n): seeded, q within the limits."""
+        rng = np.random.default_rng(self.seed)
+        q = sample_configurations(self.chain, self.n_states, rng)
+        shape = (self.n_states, self.chain.n_joints)
+        qd, qdd, tau = (scale * rng.uniform(-1.0, 1.0, size=shape)
+                        for scale in (self.velocity_scale, self.acceleration_scale, self.torque_scale))
+        return q, qd, qdd, tau
+
+
 def sample_configurations(chain: Chain, count: int, seed: int | np.random.Generator) -> np.ndarray:
     """(count, n) uniform joint values within the limits; [-pi, pi] rad or [-1, 1] m where unlimited.
 
@@ -713,4 +844,4 @@ def sample_configurations(chain: Chain, count: int, seed: int | np.random.Genera
     return rng.uniform(lo, hi, size=(count, chain.n_joints))
 
 
-Scene = DynamicsScene | KinematicsScene | IKScene
+Scene = DynamicsScene | KinematicsScene | IKScene | JointDynamicsScene

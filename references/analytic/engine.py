@@ -19,7 +19,11 @@ effector is a sum of rotated link vectors, sum_k Rz(phi_k) o_k with phi_k the cu
 angle, and the Jacobian is its closed-form derivative. IK: the planar 2-link arm solved
 geometrically (the elbow is where the circle |e| = l1 about the base meets the circle
 |p - e| = l2 about the target), a formulation of its own, independent of core's
-law-of-cosines solver that it checks. Rotations are SciPy's
+law-of-cosines solver that it checks.
+
+Joint-space dynamics: planar revolute arms of one or two links (the physical pendulum, Spong's
+planar elbow manipulator) in closed form, :mod:`simparity.references.analytic.joint_dynamics`.
+Rotations are SciPy's
 (:mod:`simparity.references.common.conventions`).
 """
 
@@ -27,12 +31,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from simparity.core.model.engine import Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.model.engine import Engine, IKModel, JointDynamicsModel, KinematicsModel, Simulation, Support
 from simparity.core.model.ik_problem import IKTolerances, check_inputs
 from simparity.core.model.ik_result import IKResult
 from simparity.core.model.scene import Chain, DynamicsScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
 from simparity.references.analytic import contact as analytic_contact
+from simparity.references.analytic import joint_dynamics as planar_dynamics
 from simparity.references.analytic import solutions as closed
 from simparity.references.common.conventions import matrix_to_quat_wxyz, principal_axes, quat_wxyz_to_matrix, rotvec_to_matrix
 
@@ -314,6 +319,18 @@ class AnalyticEngine(Engine):
 
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
         return _PlanarKinematics(chain)
+
+    def joint_dynamics_methods(self) -> tuple[str, ...]:
+        return ("closed_form",)
+
+    def supports_joint_dynamics(self, chain: Chain, method: str) -> Support:
+        named = super().supports_joint_dynamics(chain, method)
+        if not named.ok:
+            return named
+        return planar_dynamics.supports(chain)
+
+    def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
+        return planar_dynamics.build(chain, gravity_world)
 
     def ik_solvers(self) -> tuple[str, ...]:
         return ("two_link",)

@@ -18,8 +18,9 @@ What the engines are given, and why
   named by ``package://``, not one missing, and not one anywhere else on disk.
 - Other chains: ``base`` link, then one link per joint named after the joint, and a fixed
   joint to a link named after the end effector. Revolute joints without limits become
-  ``continuous``. Links (the fixed base too) get a placeholder inertial (mass 1, inertia
-  1e-3; PyBullet would otherwise invent mass 1, inertia 1), which does not affect kinematics.
+  ``continuous``. Links get the chain's declared mass properties (base and end effector massless) when it
+  declares them; otherwise a placeholder inertial (mass 1, inertia 1e-3; PyBullet would otherwise invent mass 1,
+  inertia 1), which kinematics does not see and dynamics never gets (it refuses such a chain).
 """
 
 from __future__ import annotations
@@ -29,7 +30,7 @@ from typing import TYPE_CHECKING, cast
 
 from simparity.core.model.engine import Support
 from simparity.core.model.files import parse_xml
-from simparity.core.model.scene import Chain, RigidBody
+from simparity.core.model.scene import Chain, LinkInertia, RigidBody
 from simparity.references.common.conventions import (
     PLACEHOLDER_INERTIA,
     PLACEHOLDER_MASS,
@@ -100,6 +101,29 @@ def _placeholder_link(root: ET.Element, name: str) -> None:
     _inertial(ET.SubElement(root, "link", name=name), PLACEHOLDER_MASS, [PLACEHOLDER_INERTIA] * 3, [0, 0, 0])
 
 
+def zero_inertial(link: ET.Element) -> None:
+    """An explicit massless ``<inertial>`` (a URDF link without one is massless; PyBullet would invent 1 kg)."""
+    inertial = ET.SubElement(link, "inertial")
+    ET.SubElement(inertial, "origin", xyz="0 0 0", rpy="0 0 0")
+    ET.SubElement(inertial, "mass", value="0")
+    ET.SubElement(inertial, "inertia", ixx="0", ixy="0", ixz="0", iyy="0", iyz="0", izz="0")
+
+
+def _declared_link(root: ET.Element, name: str, inertia: LinkInertia | None) -> None:
+    """A link with the chain's declared mass properties (None: massless): the centre of mass as the inertial
+    origin, the full tensor in the link's axes."""
+    link = ET.SubElement(root, "link", name=name)
+    if inertia is None:
+        zero_inertial(link)
+        return
+    inertial = ET.SubElement(link, "inertial")
+    ET.SubElement(inertial, "origin", xyz=fmt(inertia.com_xyz), rpy="0 0 0")
+    ET.SubElement(inertial, "mass", value=fmt([inertia.mass]))
+    i = inertia.inertia_com
+    ET.SubElement(inertial, "inertia", ixx=fmt([i[0, 0]]), ixy=fmt([i[0, 1]]), ixz=fmt([i[0, 2]]),
+                  iyy=fmt([i[1, 1]]), iyz=fmt([i[1, 2]]), izz=fmt([i[2, 2]]))
+
+
 def _joint(root: ET.Element, name: str, kind: str, parent: str, child: str, xyz, rotation) -> ET.Element:
     joint = ET.SubElement(root, "joint", name=name, type=kind)
     ET.SubElement(joint, "parent", link=parent)
@@ -109,19 +133,26 @@ def _joint(root: ET.Element, name: str, kind: str, parent: str, child: str, xyz,
 
 
 def exported_chain_urdf(chain: Chain) -> str:
-    """URDF text written for a chain that has no URDF file (joints inline or from DH)."""
+    """URDF text written for a chain that has no URDF file (joints inline or from DH): with the chain's declared
+    mass properties when it has them (base and end-effector links massless), else placeholder inertials, which
+    kinematics does not see (dynamics refuses such a chain: :meth:`Chain.dynamics_problem`)."""
+    declared = not chain.dynamics_problem()
+
+    def link(name: str, inertia: LinkInertia | None) -> None:
+        _declared_link(root, name, inertia) if declared else _placeholder_link(root, name)
+
     root = ET.Element("robot", name=chain.name)
-    _placeholder_link(root, "base")
+    link("base", None)
     parent = "base"
     for joint in chain.joints:
         kind = joint.type if joint.limited or joint.type == "prismatic" else "continuous"
-        _placeholder_link(root, joint.name)
+        link(joint.name, joint.link)
         element = _joint(root, joint.name, kind, parent, joint.name, joint.origin_xyz, joint.origin_rotation)
         ET.SubElement(element, "axis", xyz=fmt(joint.axis))
         if joint.limited:
             ET.SubElement(element, "limit", lower=fmt([joint.lower]), upper=fmt([joint.upper]), effort="0", velocity="0")
         parent = joint.name
-    _placeholder_link(root, chain.end_effector_name)
+    link(chain.end_effector_name, None)
     _joint(root, f"{chain.end_effector_name}_fixed", "fixed", parent, chain.end_effector_name,
            chain.end_effector_xyz, chain.end_effector_rotation)
     return _text(root)

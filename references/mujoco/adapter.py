@@ -50,10 +50,18 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from simparity.core.model.engine import BatchedRun, Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.model.engine import (
+    BatchedRun,
+    Engine,
+    IKModel,
+    JointDynamicsModel,
+    KinematicsModel,
+    Simulation,
+    Support,
+)
 from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.scene import Chain, DynamicsScene, Forces, IKScene
+from simparity.core.model.scene import Chain, DynamicsScene, Forces, IKScene, JointDynamicsScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
 from simparity.references.common import contact_params, external_forces
 from simparity.references.mujoco import ik as mujoco_ik
@@ -61,7 +69,8 @@ from simparity.references.common.base_frame import BaseFrame
 from simparity.references.common.conventions import fmt, quat_wxyz_to_matrix
 from simparity.references.mujoco.mjcf import INTEGRATORS, arena_kib, chain_mjcf, dynamics_mjcf
 from simparity.references.common.quiet import captured_output
-from simparity.references.common.urdf_export import chain_export, chain_source, chain_urdf
+from simparity.references.common.urdf_export import chain_export, chain_source, chain_urdf, urdf_support
+from simparity.references.mujoco.joint_dynamics import MujocoJointDynamics, mujoco_dynamics_problem
 
 _STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
 _RESET_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL)
@@ -336,6 +345,8 @@ class MujocoEngine(Engine):
         with planes, its soft contact drives them. Its IK (``dls``) is damped least squares."""
         if isinstance(scene, IKScene):
             return "damped_least_squares" if integrator in mujoco_ik.SOLVERS else ""
+        if isinstance(scene, JointDynamicsScene):
+            return integrator if integrator in self.joint_dynamics_methods() else ""
         kind = {"euler": "engine_euler", "rk4": "rk4", "implicit": "implicit_damping",
                 "implicitfast": "implicit_damping"}.get(integrator, "")
         return f"soft+{kind}" if kind and isinstance(scene, DynamicsScene) and scene.contact is not None else kind
@@ -351,6 +362,30 @@ class MujocoEngine(Engine):
 
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
         return MujocoChain(chain)
+
+    def joint_dynamics_methods(self) -> tuple[str, ...]:
+        """MuJoCo's smooth dynamics: CRB for M, RNE for the bias and inverse dynamics, a factorisation of M for
+        the forward (:mod:`references.mujoco.joint_dynamics`)."""
+        return ("recursive",)
+
+    def supports_joint_dynamics(self, chain: Chain, method: str) -> Support:
+        """A chain with mass properties that URDF can express and MuJoCo compiles unchanged (it refuses a moving
+        body without mass or rotational inertia, and an inertia breaking the triangle inequality); armature and
+        damping are MuJoCo's own."""
+        named = super().supports_joint_dynamics(chain, method)
+        if not named.ok:
+            return named
+        problem = chain.dynamics_problem()
+        if problem:
+            return Support.no(problem)
+        expressible = urdf_support(chain) if chain.urdf_path is None else Support.yes()
+        if not expressible.ok:
+            return expressible
+        problem = mujoco_dynamics_problem(chain)
+        return Support.no(problem) if problem else Support.yes()
+
+    def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
+        return MujocoJointDynamics(chain, gravity_world)
 
     def ik_solvers(self) -> tuple[str, ...]:
         return mujoco_ik.SOLVERS

@@ -39,17 +39,27 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from simparity.core.model.engine import BatchedRun, Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.model.engine import (
+    BatchedRun,
+    Engine,
+    IKModel,
+    JointDynamicsModel,
+    KinematicsModel,
+    Simulation,
+    Support,
+)
 from simparity.core.model.errors import NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.scene import Chain, DynamicsScene, IKScene
+from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
 from simparity.references.common import external_forces
 from simparity.references.pinocchio import ik as pinocchio_ik
 from simparity.references.common.base_frame import BaseFrame
 from simparity.references.common.conventions import matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from simparity.references.common.quiet import captured_output
-from simparity.references.common.urdf_export import UrdfChains, chain_export, chain_source, chain_urdf
+from simparity.references.pinocchio.joints import configuration
+from simparity.references.common.urdf_export import UrdfChains, chain_export, chain_source, chain_urdf, urdf_support
+from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics
 
 
 def free_body_model(body, gravity_world: np.ndarray | None) -> pin.Model:
@@ -236,13 +246,7 @@ class PinocchioChain(KinematicsModel):
 
     def configuration(self, q_row: np.ndarray) -> np.ndarray:
         """Pinocchio configuration (nq,) of joint values (n,): (cos, sin) for continuous joints."""
-        q = pin.neutral(self.model)
-        for value, at, continuous in zip(q_row, self._idx_q, self._continuous):
-            if continuous:
-                q[at], q[at + 1] = np.cos(value), np.sin(value)
-            else:
-                q[at] = value
-        return q
+        return configuration(self.model, self._idx_q, self._continuous, q_row)
 
     def joint_values(self, configuration: np.ndarray) -> np.ndarray:
         """Joint values (n,) of a configuration; atan2(sin, cos) in (-pi, pi] for continuous joints."""
@@ -294,6 +298,8 @@ class PinocchioEngine(UrdfChains, Engine):
         ``clik-documented``) is the closed-loop IK of its documentation, damped least squares on the SE(3) log."""
         if isinstance(scene, IKScene):
             return "damped_least_squares" if integrator in pinocchio_ik.SOLVERS else ""
+        if isinstance(scene, JointDynamicsScene):
+            return integrator if integrator in self.joint_dynamics_methods() else ""
         return {"euler": "engine_euler", "rk4": "rk4"}.get(integrator, "")
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
@@ -306,6 +312,23 @@ class PinocchioEngine(UrdfChains, Engine):
 
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
         return PinocchioChain(chain)
+
+    def joint_dynamics_methods(self) -> tuple[str, ...]:
+        """Pinocchio's recursive algorithms: crba, nle, rnea, aba (:mod:`references.pinocchio.joint_dynamics`)."""
+        return ("recursive",)
+
+    def supports_joint_dynamics(self, chain: Chain, method: str) -> Support:
+        """A chain with mass properties that URDF can express; armature is Pinocchio's own, damping added."""
+        named = super().supports_joint_dynamics(chain, method)
+        if not named.ok:
+            return named
+        problem = chain.dynamics_problem()
+        if problem:
+            return Support.no(problem)
+        return urdf_support(chain) if chain.urdf_path is None else Support.yes()
+
+    def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
+        return PinocchioJointDynamics(chain, gravity_world)
 
     def ik_solvers(self) -> tuple[str, ...]:
         return pinocchio_ik.SOLVERS

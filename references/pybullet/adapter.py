@@ -79,10 +79,18 @@ import tempfile
 
 import numpy as np
 
-from simparity.core.model.engine import BatchedRun, Engine, IKModel, KinematicsModel, Simulation, Support
+from simparity.core.model.engine import (
+    BatchedRun,
+    Engine,
+    IKModel,
+    JointDynamicsModel,
+    KinematicsModel,
+    Simulation,
+    Support,
+)
 from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.scene import Chain, DynamicsScene, IKScene
+from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
 from simparity.references.common import contact_params, external_forces
 from simparity.references.pybullet import ik as pybullet_ik
@@ -474,6 +482,8 @@ class PybulletEngine(UrdfChains, Engine):
         if isinstance(scene, IKScene):
             return ("damped_least_squares+nullspace" if integrator.endswith("nullspace") else
                     "damped_least_squares" if integrator in pybullet_ik.SOLVERS else "")
+        if isinstance(scene, JointDynamicsScene):
+            return integrator if integrator in self.joint_dynamics_methods() else ""
         if integrator != "euler":
             return ""
         contact = isinstance(scene, DynamicsScene) and scene.contact is not None
@@ -488,6 +498,28 @@ class PybulletEngine(UrdfChains, Engine):
 
     def build_kinematics(self, chain: Chain) -> KinematicsModel:
         return PybulletChain(chain)
+
+    def joint_dynamics_methods(self) -> tuple[str, ...]:
+        """Bullet's recursive algorithms: M and inverse dynamics from its inverse-dynamics library, forward dynamics
+        from its simulator's articulated-body algorithm (:mod:`references.pybullet.joint_dynamics`)."""
+        return ("recursive",)
+
+    def supports_joint_dynamics(self, chain: Chain, method: str) -> Support:
+        named = super().supports_joint_dynamics(chain, method)
+        problem = chain.dynamics_problem() if named.ok else ""
+        if problem:
+            return Support.no(problem)
+        armature = [j for j in chain.joints if j.armature > 0] if named.ok else []
+        if armature:
+            return Support.no(f"PyBullet has no joint armature (rotor inertia added to M's diagonal); joint "
+                              f"{armature[0].name!r} declares {armature[0].armature:g}")
+        return named
+
+    def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
+        # imported here: joint_dynamics reuses this module's client and loader
+        from simparity.references.pybullet.joint_dynamics import PybulletJointDynamics
+
+        return PybulletJointDynamics(chain, gravity_world)
 
     def ik_solvers(self) -> tuple[str, ...]:
         return pybullet_ik.SOLVERS

@@ -30,6 +30,12 @@ KINEMATICS = ("default", "hard")
 IK = ("default", "hard")
 """The iterative IK solvers: the default suite's IK scenes and the hard suite's hard targets."""
 
+ARTICULATED = ("default", "articulated")
+"""Joint-space dynamics: the default suite's planar 2-link arm and the articulated suite's 3-D arms."""
+
+ARTICULATED_3D = ("articulated",)
+"""Joint-space dynamics that a planar arm cannot show (a gyroscopic term, an axis turning out of the plane)."""
+
 MUTANTS: tuple[Mutation, ...] = (
     # --- Dynamics: integrators ------------------------------------------------------------------------------
     Mutation(
@@ -207,6 +213,25 @@ MUTANTS: tuple[Mutation, ...] = (
         "q[idx[step]] = wrap_into_limits(qa[step] + dq[step], revolute, lower, upper)",
         "each iterate is wrapped into the limits by 2 pi but never clipped: joints leave their limits",
         IK, "iiwa-ik"),
+    # --- Joint-space dynamics -------------------------------------------------------------------------------
+    Mutation(
+        "jacobian_sum_no_gyroscopic", "joint-space bias forces", "articulated/jacobian_sum.py",
+        'moment = (inertia @ (k["djw"] @ qdot[:, None, :, None]))[..., 0] + np.cross(w, spin)',
+        'moment = (inertia @ (k["djw"] @ qdot[:, None, :, None]))[..., 0]',
+        "the lecture's bias forces without the gyroscopic moment w x I w of each link (zero on a planar arm)",
+        ARTICULATED_3D, "crafted-arm-dynamics"),
+    Mutation(
+        "jacobian_sum_lever_rate_sign", "joint-space bias forces", "articulated/jacobian_sum.py",
+        "lever_rate = v_com[..., 0][:, :, None, :] - v_origin[:, None, :, :]",
+        "lever_rate = v_origin[:, None, :, :] - v_com[..., 0][:, :, None, :]",
+        "Jdot's lever-arm rate taken with the wrong sign (d(p_i - P_j)/dt as v_j - v_i): Coriolis forces wrong",
+        ARTICULATED, "lecture-2link-dynamics"),
+    Mutation(
+        "rnea_no_velocity_product", "joint-space bias forces", "articulated/recursive.py",
+        "forces.append(inertia @ acceleration + cross_force(v, inertia @ v))",
+        "forces.append(inertia @ acceleration)",
+        "RNEA's body force without v x* I v (the velocity-product term): centrifugal and gyroscopic forces lost",
+        ARTICULATED, "lecture-2link-dynamics"),
 )
 """The catalogue (issue #23 asks for at least a dozen, of the kinds listed there)."""
 

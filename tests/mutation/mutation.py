@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-SUITES = ("default", "hard", "contact")
+SUITES = ("default", "hard", "contact", "articulated")
 """The built-in suites the gate runs on the quick profile (``bench`` is timing only)."""
 
 IDENTIFIER = re.compile(r"[a-z][a-z0-9_]{0,40}")

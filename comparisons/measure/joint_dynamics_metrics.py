@@ -1,0 +1,175 @@
+"""Joint-space dynamics judged: an engine's M, h, tau and qddot against the reference's at the same states, and the
+identities every correct implementation satisfies, from the engine's own outputs alone.
+
+A judge: it imports core's data model only (never core's dynamics), so a bug in core cannot make core agree.
+
+Every value is relative and judged against its own scale, so that it means the same for a 1 kg arm and a 100 kg
+one, in any unit:
+
+- errors against the reference: max over states and entries of |A - A_ref| over the largest |A_ref| of the sample
+  (a state where the reference is near zero is not divided by it); forward dynamics as the joint force its error
+  takes, M_ref (qddot - qddot_ref) over the largest M_ref qddot_ref: solving with M amplifies rounding by M's
+  condition number (~1e4 on a 7-joint arm: xarm7), the force it corresponds to does not;
+- torque identities: over the largest |tau| the engine itself computes at the sample's states; the round trip
+  ABA(RNEA(qddot)) = qddot in the same backward form, RNEA(ABA(tau)) - tau, so that it too does not grow with M's
+  condition number;
+- the kinetic-energy identity: over the largest kinetic energy of the sample;
+- the energy identity qdot^T (Mdot - 2C) qdot = 0, i.e. qdot^T Mdot qdot = 2 qdot^T (h(q, qdot) - h(q, 0)), with
+  Mdot by central differences along qdot (:data:`DIFFERENCE_STEP`): over max |M| |qdot|^3 / (1 rad) of the sample.
+A scale of zero (a reference that is zero at every state: no gravity and no motion) has nothing to be relative to:
+the value is n/a with that reason.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simparity.comparisons.measure.rows import Measured
+from simparity.core.model.engine import JointDynamicsModel
+from simparity.core.model.metric_catalogue import (
+    BIAS_FORCE_ERROR_MAX,
+    CORIOLIS_SKEW_RESIDUAL,
+    FORWARD_DYNAMICS_ERROR_MAX,
+    GRAVITY_IDENTITY_RESIDUAL,
+    INVERSE_DYNAMICS_ERROR_MAX,
+    KINETIC_ENERGY_RESIDUAL,
+    MASS_COLUMN_RESIDUAL,
+    MASS_MATRIX_ASYMMETRY,
+    MASS_MATRIX_DEFINITENESS_MIN,
+    MASS_MATRIX_ERROR_MAX,
+    ROUND_TRIP_RESIDUAL,
+    TIME_PER_FORWARD_DYNAMICS,
+    TIME_PER_INVERSE_DYNAMICS,
+    TIME_PER_MASS_MATRIX,
+    units,
+)
+from simparity.core.model.scene import JointDynamicsScene
+
+JOINT_DYNAMICS_METRICS = units(
+    MASS_MATRIX_ERROR_MAX,
+    BIAS_FORCE_ERROR_MAX,
+    INVERSE_DYNAMICS_ERROR_MAX,
+    FORWARD_DYNAMICS_ERROR_MAX,
+    GRAVITY_IDENTITY_RESIDUAL,
+    MASS_COLUMN_RESIDUAL,
+    ROUND_TRIP_RESIDUAL,
+    MASS_MATRIX_ASYMMETRY,
+    MASS_MATRIX_DEFINITENESS_MIN,
+    KINETIC_ENERGY_RESIDUAL,
+    CORIOLIS_SKEW_RESIDUAL,
+    TIME_PER_MASS_MATRIX,
+    TIME_PER_INVERSE_DYNAMICS,
+    TIME_PER_FORWARD_DYNAMICS,
+)
+"""Every metric of a joint-dynamics case, in row order."""
+
+REFERENCE_ERRORS = (MASS_MATRIX_ERROR_MAX, BIAS_FORCE_ERROR_MAX, INVERSE_DYNAMICS_ERROR_MAX, FORWARD_DYNAMICS_ERROR_MAX)
+"""The metrics that need the reference; the others need only the engine."""
+
+DIFFERENCE_STEP = 1e-4
+"""[rad or m] The central-difference step along qdot (scaled to |qdot|_inf = 1) for Mdot: truncation ~ step^2 / 6
+~ 2e-9 of M's third derivative; rounding ~ (M's own rounding) / step: ~1e-11 near the origin, ~3e-9 for a chain
+placed 2 km away (M rounds at ~3e-13 there); the identity's bound in the tolerances says so."""
+
+
+def _relative(values: np.ndarray, reference: np.ndarray, what: str) -> Measured:
+    """max |values - reference| over the largest |reference| of the sample (n/a when that is zero)."""
+    scale = float(np.max(np.abs(reference))) if reference.size else 0.0
+    if not scale > 0:
+        return Measured(np.nan, "1", unmeasurable=f"the reference's {what} is zero at every state: nothing to be "
+                                                  "relative to")
+    return Measured(float(np.max(np.abs(values - reference))) / scale, "1")
+
+
+def _over(residual: np.ndarray, scale: float, what: str) -> Measured:
+    if not scale > 0:
+        return Measured(np.nan, "1", unmeasurable=f"{what} is zero at every state: nothing to be relative to")
+    return Measured(float(np.max(np.abs(residual))) / scale, "1")
+
+
+def reference_values(model: JointDynamicsModel, states: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
+    """The reference's M (B, n, n), h (B, n), tau (B, n) and qddot (B, n) at the scene's states."""
+    q, qd, qdd, tau = states
+    return {"M": model.mass_matrix(q), "h": model.bias_forces(q, qd), "tau": model.inverse_dynamics(q, qd, qdd),
+            "qdd": model.forward_dynamics(q, qd, tau)}
+
+
+def reference_errors(own: dict[str, np.ndarray], ref: dict[str, np.ndarray]) -> dict[str, Measured]:
+    """Relative errors of an engine's M, h, tau and qddot against the reference's (:func:`reference_values`)."""
+    return {MASS_MATRIX_ERROR_MAX: _relative(own["M"], ref["M"], "mass matrix"),
+            BIAS_FORCE_ERROR_MAX: _relative(own["h"], ref["h"], "bias force"),
+            INVERSE_DYNAMICS_ERROR_MAX: _relative(own["tau"], ref["tau"], "joint force"),
+            FORWARD_DYNAMICS_ERROR_MAX: _relative(np.einsum("bij,bj->bi", ref["M"], own["qdd"]),
+                                                  np.einsum("bij,bj->bi", ref["M"], ref["qdd"]),
+                                                  "joint acceleration")}
+
+
+def identities(model: JointDynamicsModel, scene: JointDynamicsScene, own: dict[str, np.ndarray]) -> dict[str, Measured]:
+    """The identities of the engine's own outputs ``own`` (:func:`reference_values` of the engine) at the scene's
+    states: RNEA(q, 0, 0) = g(q) = h(q, 0); RNEA(q, 0, e_i) - g = M e_i; RNEA(ABA(RNEA(qddot))) = RNEA(qddot) (the
+    round trip in torque space); M symmetric and
+    positive definite; 1/2 qdot^T M qdot (armature aside) = the links' kinetic energy from the engine's own
+    kinematics; qdot^T (Mdot - 2 C) qdot = 0."""
+    q, qd, qdd, _ = scene.states()
+    n = scene.chain.n_joints
+    mass, tau = own["M"], own["tau"]
+    torque_scale = float(np.max(np.abs(tau)))
+    zeros = np.zeros_like(q)
+    gravity = model.bias_forces(q, zeros)
+    values = {GRAVITY_IDENTITY_RESIDUAL: _over(model.inverse_dynamics(q, zeros, zeros) - gravity, torque_scale,
+                                               "the joint force")}
+    columns = np.stack([model.inverse_dynamics(q, zeros, np.broadcast_to(np.eye(n)[i], q.shape).copy()) - gravity
+                        for i in range(n)], axis=-1)
+    values[MASS_COLUMN_RESIDUAL] = _over(columns - mass, float(np.max(np.abs(mass))), "the mass matrix")
+    there = model.forward_dynamics(q, qd, tau)  # ~ qdd
+    values[ROUND_TRIP_RESIDUAL] = _over(model.inverse_dynamics(q, qd, there) - tau, torque_scale, "the joint force")
+    values[MASS_MATRIX_ASYMMETRY] = _over(mass - np.swapaxes(mass, -1, -2), float(np.max(np.abs(mass))),
+                                          "the mass matrix")
+    symmetric = 0.5 * (mass + np.swapaxes(mass, -1, -2))
+    eigen = np.linalg.eigvalsh(symmetric)
+    values[MASS_MATRIX_DEFINITENESS_MIN] = Measured(float(np.min(eigen[:, 0] / eigen[:, -1])), "1")
+    armature = np.array([joint.armature for joint in scene.chain.joints])
+    quadratic = 0.5 * np.einsum("bi,bij,bj->b", qd, mass, qd) - 0.5 * np.sum(armature * qd**2, axis=-1)
+    kinetic = model.link_kinetic_energy(q, qd)
+    values[KINETIC_ENERGY_RESIDUAL] = _over(quadratic - kinetic, float(np.max(np.abs(kinetic))),
+                                            "the links' kinetic energy")
+    values[CORIOLIS_SKEW_RESIDUAL] = _skew_residual(model, q, qd, own["h"] - gravity, mass)
+    return values
+
+
+def _skew_residual(model: JointDynamicsModel, q: np.ndarray, qd: np.ndarray, coriolis: np.ndarray,
+                   mass: np.ndarray) -> Measured:
+    """|qdot^T Mdot qdot - 2 qdot^T C qdot| over max |M| |qdot|^3, Mdot by central differences along qdot."""
+    speed = np.max(np.abs(qd), axis=-1, keepdims=True)
+    direction = np.divide(qd, speed, out=np.zeros_like(qd), where=speed > 0)
+    step = DIFFERENCE_STEP * direction
+    mass_dot = (model.mass_matrix(q + step) - model.mass_matrix(q - step)) / (2 * DIFFERENCE_STEP) * speed[..., None]
+    power = np.einsum("bi,bij,bj->b", qd, mass_dot, qd) - 2 * np.einsum("bi,bi->b", qd, coriolis)
+    scale = float(np.max(np.abs(mass))) * float(np.max(speed)) ** 3
+    return _over(power, scale, "qdot")
+
+
+def timed_values(model: JointDynamicsModel, states: tuple[np.ndarray, ...], timer) -> tuple[dict, dict[str, Measured]]:
+    """(the engine's :func:`reference_values`, its times per state): ``timer(fn)`` -> (seconds, result) times one
+    call over every state (the runner's best of its repeats)."""
+    q, qd, qdd, tau = states
+    count = len(q)
+    mass_seconds, mass = timer(lambda: model.mass_matrix(q))
+    inverse_seconds, inverse = timer(lambda: model.inverse_dynamics(q, qd, qdd))
+    forward_seconds, forward = timer(lambda: model.forward_dynamics(q, qd, tau))
+    own = {"M": np.asarray(mass, dtype=float), "h": np.asarray(model.bias_forces(q, qd), dtype=float),
+           "tau": np.asarray(inverse, dtype=float), "qdd": np.asarray(forward, dtype=float)}
+    times = {TIME_PER_MASS_MATRIX: Measured(mass_seconds / count, "s"),
+             TIME_PER_INVERSE_DYNAMICS: Measured(inverse_seconds / count, "s"),
+             TIME_PER_FORWARD_DYNAMICS: Measured(forward_seconds / count, "s")}
+    return own, times
+
+
+def shape_problem(own: dict[str, np.ndarray], count: int, n: int) -> str:
+    """Why an engine's outputs are not usable ("" when they are): a wrong shape or a non-finite value."""
+    expected = {"M": (count, n, n), "h": (count, n), "tau": (count, n), "qdd": (count, n)}
+    for key, shape in expected.items():
+        if own[key].shape != shape:
+            return f"{key} has shape {own[key].shape}, expected {shape}"
+    bad = [key for key in expected if not np.all(np.isfinite(own[key]))]
+    return f"non-finite {', '.join(bad)}" if bad else ""

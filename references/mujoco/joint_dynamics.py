@@ -1,0 +1,165 @@
+"""A chain's joint-space dynamics in MuJoCo: mass matrix, bias forces, inverse and forward dynamics (issue #27).
+
+What MuJoCo is given, and each default switched off (each pinned by ``tests/test_joint_dynamics_engines.py``)
+------------------------------------------------------------------------------------------------------------
+- The model: the URDF text of :func:`references.common.dynamics_urdf.dynamics_urdf` (the chain's file, base
+  subtree only, without geometry and ``<dynamics>``, held joints fixed, links without ``<inertial>`` given an
+  explicit zero one; or the chain's declared mass properties), read by MuJoCo's OWN URDF importer
+  (``MjSpec.from_string``). No mass property is ever taken from the chain of a file.
+- Compiler: ``fusestatic`` off (fixed-joint links stay bodies, as in the file; fusing them gives the same M to
+  rounding: measured 2e-16 relative on the crafted arm), ``balanceinertia`` off (it would change an inertia
+  that breaks the triangle inequality), ``boundmass`` = ``boundinertia`` = 0 (the kinematics adapter bounds
+  masses to ``MIN_MASS``; dynamics must not change a mass), ``inertiafromgeom`` false (an ``<inertial>`` is
+  never recomputed from geometry; there is none anyway), ``discardvisual``.
+- Massless links: a mass-0 ``<inertial>`` on a body welded to a moving one (the crafted arm's flange) compiles
+  and weighs nothing; a moving body (one with a joint) without mass or without rotational inertia of its own
+  or welded to it (a point mass included) is REFUSED by MuJoCo ("mass and inertia of moving bodies must be
+  larger than mjMINVAL"), as is an inertia breaking the triangle inequality A + B >= C. Bounding the mass or
+  balancing the inertia would change the model, so such a chain is not supported
+  (:func:`mujoco_dynamics_problem` gives MuJoCo's message); Pinocchio takes it.
+- Gravity: ``opt.gravity`` = the scene's ``gravity_world`` exactly; None is zero (MuJoCo's default is
+  (0, 0, -9.81)).
+- Constraints off (``mjDSBL_CONSTRAINT``): joint limits never act, so ``mj_forward`` and ``mj_inverse`` have no
+  constraint force, even at a state outside a limit.
+- Passive forces: ``dof_damping`` = the chain's damping, ``dof_armature`` = the chain's armature (added to M's
+  diagonal by ``mj_crb``), and zero ``dof_dampingpoly``, ``jnt_stiffness``, ``jnt_stiffnesspoly`` and
+  ``dof_frictionloss`` (MuJoCo's importer turns ``<dynamics friction>`` into Coulomb ``frictionloss`` and reads
+  ``damping``: ``dynamics_urdf`` strips ``<dynamics>``, and the adapter sets them anyway).
+- Functions, state by state after ``mj_forward``: M = ``mj_fullM`` (armature included); h = ``qfrc_bias``
+  (Coriolis, centrifugal and gravity; damping is in ``qfrc_passive``, not in it); tau = ``qfrc_inverse`` of
+  ``mj_inverse`` (continuous time: ``invdiscrete`` off), which is M qacc + qfrc_bias - qfrc_passive -
+  qfrc_constraint = M qddot + h + D qdot here (``qfrc_passive`` = -D qdot); qddot = ``qacc`` of ``mj_forward``
+  with ``qfrc_applied`` = tau, i.e. M^-1 (tau - h - D qdot).
+- Joints are mapped to MuJoCo's dofs by name (``jnt_dofadr``, ``jnt_qposadr``); a continuous joint is a hinge
+  whose qpos is the angle.
+- Kinetic energy from MuJoCo's own body velocities, not from M: every body's 6D velocity at its CENTRE OF MASS
+  (``mj_objectVelocity`` of ``mjOBJ_BODY``, world orientation: the point is ``xipos``; ``mjOBJ_XBODY`` would
+  give the body origin's), its ``body_mass`` and principal inertia ``body_inertia`` in the inertial frame
+  ``ximat``: 1/2 m |v|^2 + 1/2 w_i^T diag(I) w_i with w_i = ximat^T w. Every body is part of a chain link or
+  fixed to the world (moving at zero), so the sum over bodies is the sum over chain links.
+- Rotated inertial origins (``<inertial><origin rpy>``): MuJoCo's URDF importer lost their rotation before a
+  2026 fix; the crafted arm's rotated, off-diagonal inertials agree with Pinocchio's to rounding.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from simparity.core.model.engine import JointDynamicsModel
+from simparity.core.model.scene import Chain
+from simparity.references.common.conventions import fmt
+from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
+from simparity.references.common.quiet import captured_output
+
+
+def _compiled(chain: Chain, gravity_world: np.ndarray | None) -> mujoco.MjModel:
+    """The chain's dynamics model with the compiler options of the module docstring; raises MuJoCo's error."""
+    with captured_output():
+        spec = mujoco.MjSpec.from_string(dynamics_urdf(chain))
+        spec.compiler.fusestatic = False
+        spec.compiler.balanceinertia = False
+        spec.compiler.boundmass = 0.0
+        spec.compiler.boundinertia = 0.0
+        spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+        spec.compiler.discardvisual = True
+        spec.option.gravity = np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float)
+        spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+        return spec.compile()
+
+
+def mujoco_dynamics_problem(chain: Chain) -> str:
+    """Why MuJoCo cannot build the chain's dynamics unchanged ("" when it can): its compiler's refusal, e.g. of a
+    moving body without mass or rotational inertia, or of an inertia breaking the triangle inequality."""
+    try:
+        _compiled(chain, None)
+    except ValueError as error:
+        return (f"MuJoCo refuses the model (bounding a mass or balancing an inertia would change it): "
+                f"{' '.join(str(error).split())}")
+    return ""
+
+
+class MujocoJointDynamics(JointDynamicsModel):
+    """A chain's joint-space dynamics from MuJoCo's smooth dynamics (see the module docstring).
+
+    Attributes
+    ----------
+    model, data : mujoco.MjModel, mujoco.MjData
+    dof, qpos : (n,) int ndarray
+        The chain joints' dof and qpos addresses.
+    """
+
+    def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
+        model = _compiled(chain, gravity_world)
+        joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j.name) for j in chain.joints]
+        self.dof, self.qpos = model.jnt_dofadr[joints], model.jnt_qposadr[joints]
+        model.dof_damping[:] = 0.0
+        model.dof_damping[self.dof] = [j.damping for j in chain.joints]
+        model.dof_armature[:] = 0.0
+        model.dof_armature[self.dof] = [j.armature for j in chain.joints]
+        model.dof_dampingpoly[:] = 0.0
+        model.dof_frictionloss[:] = 0.0
+        model.jnt_stiffness[:] = 0.0
+        model.jnt_stiffnesspoly[:] = 0.0
+        self.model, self.data = model, mujoco.MjData(model)
+        gravity = "none" if gravity_world is None else fmt(gravity_world)
+        self.detail = (f"MuJoCo's URDF importer (MjSpec.from_string) on {dynamics_source(chain)}; fusestatic and "
+                       "balanceinertia off, boundmass = boundinertia = 0, inertiafromgeom false; gravity "
+                       f"{gravity}; constraints (joint limits) disabled; dof_damping and dof_armature from the "
+                       "chain, frictionloss and stiffness 0; mj_fullM, qfrc_bias, mj_inverse, mj_forward's qacc; "
+                       "kinetic energy from mj_objectVelocity at each body's centre of mass")
+
+    def _set(self, q_row: np.ndarray, qdot_row: np.ndarray, tau_row: np.ndarray | None = None) -> None:
+        """Put the state (and applied joint forces, zero if None) in, and run ``mj_forward``."""
+        d = self.data
+        d.qpos[self.qpos], d.qvel[self.dof] = q_row, qdot_row
+        d.qfrc_applied[:] = 0.0
+        if tau_row is not None:
+            d.qfrc_applied[self.dof] = tau_row
+        mujoco.mj_forward(self.model, d)
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        full = np.empty((self.model.nv, self.model.nv))
+        out = np.empty((len(q), len(self.dof), len(self.dof)))
+        for k, row in enumerate(q):
+            self._set(row, np.zeros_like(row))
+            mujoco.mj_fullM(self.model, self.data, full)
+            out[k] = full[np.ix_(self.dof, self.dof)]
+        return out
+
+    def bias_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        out = np.empty(np.shape(q))
+        for k, (row, velocity) in enumerate(zip(q, qdot)):
+            self._set(row, velocity)
+            out[k] = self.data.qfrc_bias[self.dof]
+        return out
+
+    def inverse_dynamics(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
+        out = np.empty(np.shape(q))
+        d = self.data
+        for k, (row, velocity, acceleration) in enumerate(zip(q, qdot, qddot)):
+            d.qpos[self.qpos], d.qvel[self.dof], d.qacc[self.dof] = row, velocity, acceleration
+            d.qfrc_applied[:] = 0.0
+            mujoco.mj_inverse(self.model, d)
+            out[k] = d.qfrc_inverse[self.dof]
+        return out
+
+    def forward_dynamics(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        out = np.empty(np.shape(q))
+        for k, (row, velocity, force) in enumerate(zip(q, qdot, tau)):
+            self._set(row, velocity, force)
+            out[k] = self.data.qacc[self.dof]
+        return out
+
+    def link_kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        m, d = self.model, self.data
+        velocity = np.empty(6)  # (angular, linear at the centre of mass), world orientation
+        out = np.zeros(len(q))
+        for k, (row, rates) in enumerate(zip(q, qdot)):
+            self._set(row, rates)
+            for body in range(1, m.nbody):
+                mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_BODY, body, velocity, 0)
+                omega_inertial = d.ximat[body].reshape(3, 3).T @ velocity[:3]
+                out[k] += 0.5 * (m.body_mass[body] * velocity[3:] @ velocity[3:]
+                                 + omega_inertial @ (m.body_inertia[body] * omega_inertial))
+        return out

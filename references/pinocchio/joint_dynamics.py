@@ -1,0 +1,113 @@
+"""A chain's joint-space dynamics in Pinocchio: mass matrix, bias forces, inverse and forward dynamics (issue #27).
+
+What Pinocchio is given, and each default handled (each pinned by ``tests/test_joint_dynamics_engines.py``)
+---------------------------------------------------------------------------------------------------------
+- The model: the URDF text of :func:`references.common.dynamics_urdf.dynamics_urdf` (the chain's file, base
+  subtree only, without geometry and ``<dynamics>``, held joints fixed, links without ``<inertial>`` given an
+  explicit zero one; or the chain's declared mass properties), read by Pinocchio's OWN URDF parser
+  (``buildModelFromXML``, fixed base). No mass property is ever taken from the chain of a file. Links hung by
+  fixed joints are merged into their joint's ``model.inertias`` by the parser.
+- ``model.damping`` and ``model.friction`` (read from ``<dynamics>``) are 0: ``dynamics_urdf`` strips
+  ``<dynamics>``, and no algorithm used here reads them anyway (``aba`` and ``rnea`` ignore them).
+- Gravity: ``model.gravity`` = the scene's ``gravity_world`` exactly; None is zero (Pinocchio's default is
+  (0, 0, -9.81)).
+- Damping D = diag(the chain's damping), added here: tau = ``rnea`` + D qdot, qddot = ``aba``(tau - D qdot).
+- Armature: ``model.armature`` = the chain's armature; Pinocchio 4.1's ``crba`` adds it to M's diagonal, ``rnea``
+  adds armature * qddot and ``aba`` includes it (measured, and pinned by the tests: an armature changes M by
+  exactly diag(armature)).
+- M = ``crba`` (4.1 fills both triangles; the strict lower one is taken from the upper here all the same, as
+  older Pinocchio filled only the upper); h = ``nle`` (Coriolis, centrifugal and gravity).
+- Configurations: a continuous joint has nq = 2, (cos q, sin q); velocities are indexed by each chain joint's
+  ``idx_v`` (joints found by name).
+- Kinetic energy from Pinocchio's own link kinematics, not from M: ``forwardKinematics(q, v)``, then per chain
+  joint 1/2 v_i^T I_i v_i with ``data.v[i]`` (the joint's spatial velocity in its own frame) and
+  ``model.inertias[i]`` (its spatial inertia, fixed children merged): ``Inertia.vtiv``.
+- Joint limits: Pinocchio's dynamics never applies them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from simparity.core.model.engine import JointDynamicsModel
+from simparity.core.model.scene import Chain
+from simparity.references.common.conventions import fmt
+from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
+from simparity.references.common.quiet import captured_output
+from simparity.references.pinocchio.joints import configuration
+
+
+class PinocchioJointDynamics(JointDynamicsModel):
+    """A chain's joint-space dynamics from Pinocchio's recursive algorithms (see the module docstring).
+
+    Attributes
+    ----------
+    model, data : pinocchio.Model, pinocchio.Data
+    joint_ids : list of int
+        Pinocchio's joint id of each chain joint.
+    idx_v : (n,) int ndarray
+        Velocity index of each chain joint.
+    damping : (n,) ndarray
+        The chain's joint damping [N m s/rad or N s/m].
+    """
+
+    def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
+        with captured_output():
+            model = pin.buildModelFromXML(dynamics_urdf(chain))
+        model.gravity = pin.Motion(np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float),
+                                   np.zeros(3))
+        self.joint_ids = [model.getJointId(j.name) for j in chain.joints]
+        joints = [model.joints[i] for i in self.joint_ids]
+        self._idx_q = [j.idx_q for j in joints]
+        self._continuous = [j.nq == 2 for j in joints]
+        self.idx_v = np.array([j.idx_v for j in joints])
+        armature = np.zeros(model.nv)
+        armature[self.idx_v] = [j.armature for j in chain.joints]
+        model.armature = armature
+        self.damping = np.array([j.damping for j in chain.joints])
+        self.model, self.data = model, model.createData()
+        gravity = "none" if gravity_world is None else fmt(gravity_world)
+        self.detail = (f"pinocchio.buildModelFromXML of {dynamics_source(chain)}; gravity {gravity}; armature as "
+                       "model.armature; M = crba, h = nle, tau = rnea + D qdot, qddot = aba(tau - D qdot); kinetic "
+                       "energy from forwardKinematics' joint velocities and model.inertias")
+
+    def _configuration(self, q_row: np.ndarray) -> np.ndarray:
+        """Pinocchio configuration (nq,) of joint values (n,): (cos, sin) for continuous joints."""
+        return configuration(self.model, self._idx_q, self._continuous, q_row)
+
+    def _velocity(self, qdot_row: np.ndarray) -> np.ndarray:
+        """Pinocchio velocity (nv,) of joint rates (n,)."""
+        v = np.zeros(self.model.nv)
+        v[self.idx_v] = qdot_row
+        return v
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        out = np.empty((len(q), len(self.idx_v), len(self.idx_v)))
+        for k, row in enumerate(q):
+            upper = np.triu(pin.crba(self.model, self.data, self._configuration(row)))
+            out[k] = (upper + np.triu(upper, 1).T)[np.ix_(self.idx_v, self.idx_v)]
+        return out
+
+    def bias_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        return np.array([pin.nle(self.model, self.data, self._configuration(row), self._velocity(rates))[self.idx_v]
+                         for row, rates in zip(q, qdot)]).reshape(np.shape(q))
+
+    def inverse_dynamics(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
+        tau = [pin.rnea(self.model, self.data, self._configuration(row), self._velocity(rates),
+                        self._velocity(accelerations))[self.idx_v]
+               for row, rates, accelerations in zip(q, qdot, qddot)]
+        return np.array(tau).reshape(np.shape(q)) + self.damping * qdot
+
+    def forward_dynamics(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        damped = tau - self.damping * qdot
+        return np.array([pin.aba(self.model, self.data, self._configuration(row), self._velocity(rates),
+                                 self._velocity(force))[self.idx_v]
+                         for row, rates, force in zip(q, qdot, damped)]).reshape(np.shape(q))
+
+    def link_kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        out = np.empty(len(q))
+        for k, (row, rates) in enumerate(zip(q, qdot)):
+            pin.forwardKinematics(self.model, self.data, self._configuration(row), self._velocity(rates))
+            out[k] = sum(0.5 * self.model.inertias[i].vtiv(self.data.v[i]) for i in self.joint_ids)
+        return out

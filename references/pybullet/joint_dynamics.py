@@ -1,0 +1,211 @@
+"""PyBullet's joint-space dynamics of a chain: M, h and inverse dynamics from its inverse-dynamics library, forward
+dynamics from one step of its simulator, kinetic energy from its link states.
+
+PyBullet reads :func:`references.common.dynamics_urdf.dynamics_urdf` (the chain's own file below its base link,
+without geometry and ``<dynamics>``, held joints fixed, links without ``<inertial>`` given an explicit zero one; or
+the declared mass properties of a chain without a file) with its own URDF parser, loaded from a temporary file
+(``useFixedBase``; the adapter's ``_load_urdf``, its console output kept off). Joints are found by name
+(``getJointInfo``): PyBullet counts every URDF joint, fixed ones too, and its calls take the positions of ALL movable
+joints in its own order. Each default below is switched off or set, and pinned by
+``tests/test_pybullet_joint_dynamics.py``:
+
+- Gravity defaults to 0: set to exactly the scene's ``gravity_world`` (None: zero).
+- Inertia: ``URDF_USE_INERTIA_FROM_FILE`` (else PyBullet recomputes it from collision shapes: a body without any
+  gets ~1e-6 kg m^2). A link without ``<inertial>`` would get 1 kg and a unit inertia; the export's explicit zero
+  gives it mass 0. Off-diagonal inertias are diagonalised by Bullet's Jacobi iteration
+  (``btMatrix3x3::diagonalize``, threshold 1e-6 of the trace, then one more rotation) and the remaining
+  off-diagonal terms dropped: the tensors PyBullet uses are off by up to 8e-9 relative (panda_link1), M by up to
+  1.3e-10 and qddot by 1.7e-9 against Pinocchio (Panda; arms with diagonal inertias agree to ~1e-15).
+- Non-unit axes: PyBullet keeps the URDF's axis as written; its simulator moves a joint along ``axis * qdot``
+  (``btMultiBody::setupRevolute``) while rotating positions by q about the unit axis, and its inverse-dynamics library
+  normalises it: with axis (0, 0, 2) the link turns at 2 qdot. Every ``<axis>`` is normalised here (the model's
+  meaning: q is the angle or distance along the unit axis).
+- Joint limits act by default (a limit constraint per limited joint; ``changeDynamics`` cannot remove one from
+  Python, the binding drops lower > upper): ``jointLimitForce`` 0 leaves the constraint no impulse.
+- Joint velocities are capped at 100 rad/s (``maxJointVelocity``): raised to 1e9.
+- Every revolute and prismatic joint starts with a velocity motor braking it to 0 (max impulse 1 per step):
+  ``setJointMotorControlArray(VELOCITY_CONTROL, forces=0)`` disables it; torques are given with TORQUE_CONTROL.
+- Link linear and angular damping default to 0.04 (body-wide): 0.
+- ``jointDamping`` is the chain's ``Joint.damping`` (PyBullet applies -damping qdot before each step); the URDF's
+  ``<dynamics damping friction>`` is stripped by the export. ``calculateInverseDynamics`` ignores jointDamping:
+  D qdot is added here.
+- URDF multibodies never sleep unless loaded with ``URDF_ENABLE_SLEEPING`` (not passed).
+
+Two PyBullet models, each a fresh body in a DIRECT world of its own:
+
+- ``calculateMassMatrix`` / ``calculateInverseDynamics`` run on a btInverseDynamics tree that PyBullet builds from
+  the body at the first such call and CACHES (a later ``changeDynamics`` of a mass does not reach it): it is built
+  here once the body is configured. M = calculateMassMatrix(q), h = calculateInverseDynamics(q, qdot, 0),
+  tau = calculateInverseDynamics(q, qdot, qddot) + D qdot. The tree's root is Bullet's base INERTIAL frame, and it
+  takes the world's gravity as given in that frame: a root link whose ``<inertial>`` is rotated would feel gravity
+  turned. That world is given g expressed in the root's inertial frame (R_i^T g; the stepped world gets g).
+- ``forward_dynamics`` steps the second body once: ``resetJointState`` (q, qdot), TORQUE_CONTROL tau,
+  ``stepSimulation`` with time step :data:`STEP`, qddot = (qdot' - qdot) / STEP. Bullet's step is semi-implicit:
+  qdot' = qdot + STEP * qddot(q, qdot, tau) from its articulated-body algorithm
+  (``computeAccelerationsArticulatedBodyAlgorithmMultiDof``), with the joint damping at qdot, so the difference
+  is exact up to rounding. It is the forward dynamics PyBullet simulates with, and an algorithm independent of the
+  tree: forward(inverse(qddot)) = qddot then checks Bullet's two codes against each other (measured agreement
+  ~1e-15 relative with M^-1 (tau - h - D qdot) from the tree).
+- ``link_kinetic_energy``: ``getLinkStates(computeLinkVelocity=1, computeForwardKinematics=1)`` gives each link's
+  centre-of-mass velocity, angular velocity and the world orientation R of its inertial (principal-axes) frame, all
+  double; ``getDynamicsInfo`` its mass and principal moments I; sum 1/2 m |v|^2 + 1/2 (R^T w)^T I (R^T w) over
+  every link (fixed-joint links and held branches are links of their own in PyBullet). The URDF link frames
+  ``getLinkState`` returns (``worldLinkFrameOrientation``) are FLOAT32 (composed in the client's b3Transform): R from
+  them would cost ~5e-9 relative.
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+import numpy as np
+
+from simparity.core.model.engine import JointDynamicsModel
+from simparity.core.model.scene import Chain
+from simparity.references.common.conventions import fmt, quat_wxyz_to_matrix, wxyz_from_xyzw
+from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
+from simparity.references.common.quiet import captured_output
+from simparity.references.pybullet.adapter import _MAX_VELOCITY, _Client, _load_urdf
+from simparity.references.pybullet.quiet import pybullet
+
+STEP = 1.0  # [s]
+"""Time step of the stepped body. qdot' = qdot + STEP qddot is rounded to eps max(|qdot|, STEP |qddot|), so
+(qdot' - qdot) / STEP carries eps (|qdot| / STEP + |qddot|): a long step costs nothing (the step starts from a
+reset state, and nothing else in the world acts) and keeps the estimate as precise as the tree's (at 1e-3 s a
+state with |qdot| = 1 and |qddot| = 1e-3 would lose 6 digits)."""
+
+
+def unit_axes(text: str) -> str:
+    """URDF ``text`` with every joint ``<axis>`` normalised (see the module docstring)."""
+    root = ET.fromstring(text)
+    for axis in root.iter("axis"):
+        xyz = np.array([float(v) for v in axis.get("xyz", "1 0 0").split()])
+        axis.set("xyz", fmt(xyz / np.linalg.norm(xyz)))
+    return ET.tostring(root, encoding="unicode")
+
+
+class _Body:
+    """The chain's body in a private DIRECT world with every default of the module docstring switched off.
+
+    Attributes
+    ----------
+    client, body : int
+    joints : list of int
+        PyBullet joint index of each chain joint.
+    columns : list of int
+        Position of each chain joint among the body's movable joints (PyBullet's order).
+    links : list of int
+        Every link of the body (its joints' indices; the fixed base, -1, left out).
+    """
+
+    def __init__(self, text: str, chain: Chain) -> None:
+        self._client = _Client()
+        c = self.client = self._client.id
+        pybullet.setTimeStep(STEP, physicsClientId=c)
+        pybullet.setPhysicsEngineParameter(numSubSteps=0, physicsClientId=c)
+        self.body = b = _load_urdf(c, text, useFixedBase=True)
+        info = [pybullet.getJointInfo(b, j, physicsClientId=c)
+                for j in range(pybullet.getNumJoints(b, physicsClientId=c))]
+        index = {i[1].decode(): i[0] for i in info}
+        movable = [i[0] for i in info if i[2] != pybullet.JOINT_FIXED]
+        self.joints = [index[j.name] for j in chain.joints]
+        self.columns = [movable.index(j) for j in self.joints]
+        self.links = [i[0] for i in info]
+        self._n_movable = len(movable)
+        pybullet.changeDynamics(b, -1, linearDamping=0.0, angularDamping=0.0, maxJointVelocity=_MAX_VELOCITY,
+                                physicsClientId=c)
+        for joint, j in zip(chain.joints, self.joints):
+            pybullet.changeDynamics(b, j, jointDamping=joint.damping, jointLimitForce=0.0, physicsClientId=c)
+        pybullet.setJointMotorControlArray(b, movable, pybullet.VELOCITY_CONTROL, forces=[0.0] * len(movable),
+                                           physicsClientId=c)
+
+    def movable(self, row: np.ndarray) -> list[float]:
+        """The values ``row`` (n,) of the chain's joints as PyBullet's list over all movable joints."""
+        out = np.zeros(self._n_movable)
+        out[self.columns] = row
+        return out.tolist()
+
+    def reset(self, q: np.ndarray, qdot: np.ndarray) -> None:
+        """Put the chain's joints at ``q``, ``qdot`` (n,)."""
+        for j, position, velocity in zip(self.joints, q, qdot):
+            pybullet.resetJointState(self.body, j, float(position), float(velocity), physicsClientId=self.client)
+
+
+def _rows(*arrays: np.ndarray) -> list[np.ndarray]:
+    """Each array as float (B, n): a single state (n,) becomes a batch of one."""
+    return [np.atleast_2d(np.asarray(a, dtype=float)) for a in arrays]
+
+
+class PybulletJointDynamics(JointDynamicsModel):
+    """A chain's joint-space dynamics in PyBullet (module docstring: what is set, which call gives what)."""
+
+    def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
+        text = unit_axes(dynamics_urdf(chain))
+        gravity = np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float)
+        self._tree = _Body(text, chain)
+        root_inertial = pybullet.getDynamicsInfo(self._tree.body, -1, physicsClientId=self._tree.client)[4]
+        rotation = quat_wxyz_to_matrix(wxyz_from_xyzw(np.array(root_inertial)))
+        pybullet.setGravity(*(rotation.T @ gravity), physicsClientId=self._tree.client)
+        with captured_output():  # PyBullet builds (and caches) its inverse-dynamics tree at the first call
+            pybullet.calculateMassMatrix(self._tree.body, self._tree.movable(np.zeros(chain.n_joints)),
+                                         physicsClientId=self._tree.client)
+        self._stepped = _Body(text, chain)
+        pybullet.setGravity(*gravity, physicsClientId=self._stepped.client)
+        self._damping = np.array([j.damping for j in chain.joints])
+        self.detail = (f"loadURDF(useFixedBase, URDF_USE_INERTIA_FROM_FILE) of {dynamics_source(chain)}, axes "
+                       f"normalised; gravity set; link damping 0, jointDamping = the chain's, joint limits, velocity "
+                       f"cap and braking motors off; M, h, tau from calculateMassMatrix / calculateInverseDynamics "
+                       f"(+ D qdot); qddot from one stepSimulation of {STEP:g} s under TORQUE_CONTROL; kinetic energy "
+                       f"from getLinkStates' centre-of-mass velocities and inertial frames")
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        (q,) = _rows(q)
+        t = self._tree
+        chain_block = np.ix_(t.columns, t.columns)
+        return np.stack([np.array(pybullet.calculateMassMatrix(t.body, t.movable(row), physicsClientId=t.client))
+                         [chain_block] for row in q])
+
+    def _inverse(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
+        """calculateInverseDynamics (without damping), (B, n)."""
+        t = self._tree
+        return np.stack([np.array(pybullet.calculateInverseDynamics(
+            t.body, t.movable(a), t.movable(v), t.movable(dv), physicsClientId=t.client))[t.columns]
+            for a, v, dv in zip(q, qdot, qddot)])
+
+    def bias_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        q, qdot = _rows(q, qdot)
+        return self._inverse(q, qdot, np.zeros_like(q))
+
+    def inverse_dynamics(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
+        q, qdot, qddot = _rows(q, qdot, qddot)
+        return self._inverse(q, qdot, qddot) + self._damping * qdot
+
+    def forward_dynamics(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        q, qdot, tau = _rows(q, qdot, tau)
+        s = self._stepped
+        out = np.empty_like(q)
+        for k in range(len(q)):
+            s.reset(q[k], qdot[k])
+            pybullet.setJointMotorControlArray(s.body, s.joints, pybullet.TORQUE_CONTROL, forces=tau[k].tolist(),
+                                               physicsClientId=s.client)
+            pybullet.stepSimulation(physicsClientId=s.client)
+            states = pybullet.getJointStates(s.body, s.joints, physicsClientId=s.client)
+            out[k] = (np.array([state[1] for state in states]) - qdot[k]) / STEP
+        return out
+
+    def link_kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        q, qdot = _rows(q, qdot)
+        t = self._tree
+        info = [pybullet.getDynamicsInfo(t.body, link, physicsClientId=t.client) for link in t.links]
+        mass = np.array([i[0] for i in info])
+        moments = np.array([i[2] for i in info])
+        out = np.empty(len(q))
+        for k in range(len(q)):
+            t.reset(q[k], qdot[k])
+            states = pybullet.getLinkStates(t.body, t.links, computeLinkVelocity=1, computeForwardKinematics=1,
+                                            physicsClientId=t.client)
+            velocity = np.array([s[6] for s in states])
+            rotation = quat_wxyz_to_matrix(wxyz_from_xyzw(np.array([s[1] for s in states])))
+            omega_principal = np.einsum("lji,lj->li", rotation, np.array([s[7] for s in states]))
+            out[k] = 0.5 * (mass @ np.sum(velocity**2, axis=1) + np.sum(moments * omega_principal**2))
+        return out

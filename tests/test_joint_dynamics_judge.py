@@ -1,0 +1,141 @@
+"""The judge of joint-space dynamics (comparisons/measure/joint_dynamics_metrics.py) on models written here: an exact
+physical pendulum (closed form in this file) must pass every identity to rounding, and each planted mistake must
+show in the metric that exists to catch it; errors are relative to the reference's own scale, n/a where it is 0."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from simparity.comparisons.measure.joint_dynamics_metrics import (
+    JOINT_DYNAMICS_METRICS,
+    identities,
+    reference_errors,
+    reference_values,
+    shape_problem,
+)
+from simparity.core.model.engine import JointDynamicsModel
+from simparity.core.model.metric_catalogue import (
+    BIAS_FORCE_ERROR_MAX,
+    CORIOLIS_SKEW_RESIDUAL,
+    GRAVITY_IDENTITY_RESIDUAL,
+    KINETIC_ENERGY_RESIDUAL,
+    MASS_COLUMN_RESIDUAL,
+    MASS_MATRIX_DEFINITENESS_MIN,
+    MASS_MATRIX_ERROR_MAX,
+    ROUND_TRIP_RESIDUAL,
+)
+from simparity.core.model.scene import Chain, Joint, JointDynamicsScene, LinkInertia
+
+MASS, DISTANCE, INERTIA_ZZ, GRAVITY = 2.0, 0.4, 0.05, 9.81  # [kg], [m], [kg m^2], [m/s^2]
+ROUNDING = 1e-14
+"""Identities of a closed form with a handful of operations: a few eps."""
+PLANTED = 0.01
+"""Each planted mistake is 1 %: far above rounding, so its metric must show it."""
+DETECTED = 1e-6
+"""A planted 1 % mistake must raise its metric at least this high: a million times the shipped 1e-12 bounds (a
+torque-space residual sees the 1 % of M q̈ diluted by gravity's larger torque, ~5e-4 here)."""
+
+
+def _pendulum_chain(damping: float = 0.0) -> Chain:
+    inertia = np.diag([0.01, INERTIA_ZZ, INERTIA_ZZ])
+    joint = Joint("hinge", "revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.eye(3), -np.pi, np.pi,
+                  link=LinkInertia(MASS, np.array([DISTANCE, 0.0, 0.0]), inertia), damping=damping)
+    return Chain("pendulum", (joint,))
+
+
+class Pendulum(JointDynamicsModel):
+    """q from the x axis about z, gravity along -y: M = I_c + m d^2, g(q) = m g d cos q, no Coriolis term (one
+    joint). ``mass_factor``, ``kinetic_factor``, ``inverse_factor``, ``bias_sign`` plant mistakes."""
+
+    def __init__(self, damping=0.0, mass_factor=1.0, kinetic_factor=1.0, inverse_factor=1.0, bias_sign=1.0,
+                 gravity=GRAVITY):
+        self.damping, self.mass_factor, self.kinetic_factor = damping, mass_factor, kinetic_factor
+        self.inverse_factor, self.bias_sign, self.gravity = inverse_factor, bias_sign, gravity
+
+    def mass_matrix(self, q):
+        return np.full((len(q), 1, 1), (INERTIA_ZZ + MASS * DISTANCE**2) * self.mass_factor)
+
+    def bias_forces(self, q, qdot):
+        return self.bias_sign * MASS * self.gravity * DISTANCE * np.cos(q)
+
+    def inverse_dynamics(self, q, qdot, qddot):
+        inertia = (INERTIA_ZZ + MASS * DISTANCE**2) * self.inverse_factor
+        return inertia * qddot + self.bias_forces(q, qdot) + self.damping * qdot
+
+    def forward_dynamics(self, q, qdot, tau):
+        return (tau - self.bias_forces(q, qdot) - self.damping * qdot) / self.mass_matrix(q)[:, :, 0]
+
+    def link_kinetic_energy(self, q, qdot):
+        speed = DISTANCE * qdot[:, 0]
+        return self.kinetic_factor * (0.5 * MASS * speed**2 + 0.5 * INERTIA_ZZ * qdot[:, 0] ** 2)
+
+
+def _scene(seed: int = 5, gravity=(0.0, -GRAVITY, 0.0), damping: float = 0.0) -> JointDynamicsScene:
+    return JointDynamicsScene("pendulum", "", "analytic", _pendulum_chain(damping),
+                              None if gravity is None else np.array(gravity), n_states=30, seed=seed)
+
+
+def _judged(model: JointDynamicsModel, reference: JointDynamicsModel, scene: JointDynamicsScene) -> dict:
+    states = scene.states()
+    own, ref = reference_values(model, states), reference_values(reference, states)
+    return reference_errors(own, ref) | identities(model, scene, own)
+
+
+def test_an_exact_model_passes_every_identity_and_agrees_with_itself():
+    scene = _scene(damping=0.3)
+    values = _judged(Pendulum(damping=0.3), Pendulum(damping=0.3), scene)
+    assert set(values) == set(JOINT_DYNAMICS_METRICS) - {m for m in JOINT_DYNAMICS_METRICS if m.startswith("time_")}
+    for metric, measured in values.items():
+        if metric == MASS_MATRIX_DEFINITENESS_MIN:
+            assert measured.value == 1.0  # one joint: its one eigenvalue over itself
+        else:
+            assert measured.value <= ROUNDING, metric
+
+
+@pytest.mark.parametrize(("planted", "metric"), [
+    ({"kinetic_factor": 1 + PLANTED}, KINETIC_ENERGY_RESIDUAL),  # M and the links' energy disagree
+    ({"inverse_factor": 1 + PLANTED}, MASS_COLUMN_RESIDUAL),     # RNEA's columns are not M's
+    ({"inverse_factor": 1 + PLANTED}, ROUND_TRIP_RESIDUAL),      # ABA does not undo RNEA
+])
+def test_each_planted_inconsistency_shows_in_its_identity(planted, metric):
+    scene = _scene()
+    values = _judged(Pendulum(**planted), Pendulum(), scene)
+    assert values[metric].value >= DETECTED
+
+
+def test_a_consistent_mistake_is_caught_by_the_reference_not_the_identities():
+    """A gravity torque of the wrong sign, used consistently: every identity holds, the bias error is 2 (200 %)."""
+    scene = _scene()
+    values = _judged(Pendulum(bias_sign=-1.0), Pendulum(), scene)
+    assert values[GRAVITY_IDENTITY_RESIDUAL].value <= ROUNDING
+    assert values[BIAS_FORCE_ERROR_MAX].value == pytest.approx(2.0, rel=1e-12)
+    assert values[MASS_MATRIX_ERROR_MAX].value == 0.0
+
+
+def test_errors_are_relative_to_the_reference_scale_whatever_the_units():
+    """Scaling every force by 1000 (grams to kilograms read wrongly, say) changes nothing relative; a 1 % mass error
+    is 1e-2 whatever the mass."""
+    scene = _scene()
+    light = _judged(Pendulum(mass_factor=1 + PLANTED), Pendulum(), scene)[MASS_MATRIX_ERROR_MAX].value
+    assert light == pytest.approx(PLANTED, rel=1e-9)
+
+
+def test_without_gravity_or_motion_the_bias_error_is_not_a_number():
+    """No gravity and qdot = 0 would make h_ref zero everywhere: nothing to be relative to, so n/a with the reason."""
+    scene = JointDynamicsScene("still", "", "analytic", _pendulum_chain(), None, n_states=4, seed=1,
+                               velocity_scale=1e-300)
+    values = _judged(Pendulum(gravity=0.0), Pendulum(gravity=0.0), scene)
+    assert values[BIAS_FORCE_ERROR_MAX].unmeasurable.startswith("the reference's bias force is zero")
+    assert np.isnan(values[BIAS_FORCE_ERROR_MAX].value)
+
+
+def test_the_energy_identity_has_nothing_to_see_for_one_joint_but_stays_finite():
+    values = _judged(Pendulum(), Pendulum(), _scene())
+    assert 0.0 <= values[CORIOLIS_SKEW_RESIDUAL].value <= ROUNDING
+
+
+def test_shape_and_finiteness_problems_are_named():
+    own = {"M": np.zeros((2, 1, 1)), "h": np.zeros((2, 1)), "tau": np.zeros((2, 1)), "qdd": np.full((2, 1), np.nan)}
+    assert shape_problem(own, 2, 1) == "non-finite qdd"
+    assert shape_problem(own | {"M": np.zeros((2, 1))}, 2, 1) == "M has shape (2, 1), expected (2, 1, 1)"

@@ -1,0 +1,140 @@
+"""Joint-dynamics scenes: the file format (every key checked, one-line refusals), the built-in scenes, and a run of
+one through the pipeline whose rows, verdict and report say what the engines computed."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from simparity.comparisons.scenes import library
+from simparity.comparisons.scenes.loader import parse_scene
+from simparity.core.model.errors import SceneError
+from simparity.core.model.scene import JointDynamicsScene
+
+PENDULUM = {
+    "scene": {"name": "p", "kind": "joint_dynamics", "reference": "analytic"},
+    "chain": {"joint": [{"name": "hinge", "type": "revolute", "axis": [0.0, 0.0, 1.0], "mass": 2.0,
+                         "com_xyz": [0.25, 0.0, 0.0],
+                         "inertia": [[0.001, 0.0, 0.0], [0.0, 0.04, 0.0], [0.0, 0.0, 0.04]]}]},
+    "world": {"gravity_world": [0.0, -9.81, 0.0]},
+}
+
+
+def _with(path: str, value, data=None):
+    """PENDULUM (or ``data``) with the key at ``path`` ("chain.joint.0.mass") set to ``value`` (None: removed)."""
+    import copy
+
+    data = copy.deepcopy(data or PENDULUM)
+    *heads, last = path.split(".")
+    node = data
+    for head in heads:
+        node = node[int(head)] if head.isdigit() else node.setdefault(head, {})
+    if value is None:
+        node.pop(last)
+    else:
+        node[last] = value
+    return data
+
+
+def test_a_pendulum_file_reads_its_mass_properties_in_si():
+    scene = parse_scene(_with("scene.length_unit", "cm", _with("chain.joint.0.com_xyz", [25.0, 0.0, 0.0])))
+    assert isinstance(scene, JointDynamicsScene)
+    link = scene.chain.joints[0].link
+    assert link.mass == 2.0 and link.com_xyz[0] == pytest.approx(0.25, rel=1e-15)
+    # an inertia in kg cm^2 is 1e-4 of kg m^2 (length^2): the file's 0.04 kg cm^2 is 4e-6 kg m^2
+    assert link.inertia_com[2, 2] == pytest.approx(0.04e-4, rel=1e-15)
+    assert scene.gravity_world[1] == pytest.approx(-0.0981, rel=1e-15)
+
+
+@pytest.mark.parametrize(("path", "value", "key", "words"), [
+    ("chain.joint.0.inertia", None, "chain.joint[0].inertia", "missing"),
+    ("chain.joint.0.mass", -1.0, "chain.joint[0].mass", "> 0"),
+    ("chain.joint.0.inertia", [[1.0, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]], "chain.joint[0].inertia",
+     "triangle"),
+    ("chain.joint.0.damping", -0.5, "chain.joint[0].damping", "negative"),
+    ("sampling.states", 0, "sampling.states", ""),
+    ("sampling.velocity_scale", -1.0, "sampling.velocity_scale", ""),
+    ("world.air_velocity_world", [1.0, 0.0, 0.0], "world.air_velocity_world", ""),
+])
+def test_bad_values_are_refused_naming_the_key(path, value, key, words):
+    with pytest.raises(SceneError) as caught:
+        parse_scene(_with(path, value), "pendulum.toml")
+    assert caught.value.key == key, str(caught.value)
+    assert words in str(caught.value)
+    assert "\n" not in str(caught.value)
+
+
+def test_a_chain_without_mass_properties_is_refused_for_dynamics_in_one_line():
+    data = _with("chain.joint.0.mass", None, _with("chain.joint.0.com_xyz", None, _with("chain.joint.0.inertia", None)))
+    with pytest.raises(SceneError, match="declares no mass properties") as caught:
+        parse_scene(data, "pendulum.toml")
+    assert caught.value.key == "chain"
+    dh = _with("chain", {"name": "arm", "dh": {"a": [1.0], "alpha": [0.0], "d": [0.0]}})
+    with pytest.raises(SceneError, match="declares no mass properties"):
+        parse_scene(dh, "dh.toml")
+
+
+def test_a_reference_without_joint_dynamics_is_refused_at_load():
+    with pytest.raises(SceneError, match="computes no joint-space dynamics"):
+        parse_scene(_with("scene.reference", "tight"), "pendulum.toml")
+
+
+def test_the_builtin_scenes_load_with_the_crafted_arm_in_full():
+    crafted = library.load(["crafted-arm-dynamics"])[0]
+    assert [j.name for j in crafted.chain.joints] == ["j1", "j2", "j3"]
+    assert crafted.chain.held_joints == ("finger",)
+    # URDF <dynamics damping="0.3" friction="0.7">: the damping is the joint's, the friction is not modelled
+    assert crafted.chain.joints[0].damping == 0.3
+    assert all(j.link is not None and j.link.mass > 0 for j in crafted.chain.joints)
+    names = {s.name for s in library.suite("articulated")}
+    assert {"crafted-arm-dynamics", "iiwa-dynamics", "ur5-dynamics", "panda-dynamics"} <= names
+    assert "lecture-2link-dynamics" in {s.name for s in library.suite("default")}
+
+
+def test_states_are_seeded_and_within_the_limits():
+    scene = parse_scene(_with("sampling", {"states": 7, "seed": 3, "velocity_scale": 2.0}))
+    q, qd, qdd, tau = scene.states()
+    again = scene.states()
+    assert all(np.array_equal(a, b) for a, b in zip((q, qd, qdd, tau), again))
+    assert q.shape == (7, 1) and np.all(np.abs(q) <= math.pi) and np.all(np.abs(qd) <= 2.0)
+
+
+UNTUNED_ARMS = [
+    # (URDF inside example-robot-data, base link, tip link): arms no bound or test was written for
+    ("xarm_description/urdf/xarm7.urdf", None, None),
+    ("z1_description/urdf/z1.urdf", None, "link06"),
+    ("kinova_description/robots/kinova.urdf", None, "j2s6s200_end_effector"),
+    ("so_arm_description/urdf/so100.urdf", None, None),
+]
+
+
+def _robots() -> str:
+    from importlib import metadata
+
+    from simparity.comparisons.scenes.loader import EXAMPLE_ROBOT_DATA_ROBOTS
+
+    return str(metadata.distribution("example-robot-data").locate_file(EXAMPLE_ROBOT_DATA_ROBOTS))
+
+
+@pytest.mark.parametrize(("urdf", "base", "tip"), UNTUNED_ARMS, ids=[a[0].split("/")[-1] for a in UNTUNED_ARMS])
+def test_arms_nobody_tuned_to_pass_the_shipped_gate_on_every_engine(urdf, base, tip):
+    """Every engine on a real arm from a pip wheel, through the pipeline, held to the shipped tolerances: every case
+    ok (PyBullet and MuJoCo may say n/a with a reason), core and MuJoCo within 1e-12 of Pinocchio."""
+    import simparity
+    from simparity.comparisons.gate.check import check_table
+    from simparity.comparisons.gate.tolerances import load_tolerances
+    from simparity.core.urdf import chain_from_urdf
+
+    chain = chain_from_urdf(f"{_robots()}/{urdf}", base_link=base, tip_link=tip, dynamics=True)
+    scene = JointDynamicsScene(f"{chain.name}-dynamics", "", "pinocchio", chain, np.array([0.3, -0.2, -9.81]),
+                               n_states=20, seed=4, velocity_scale=2.0)
+    table = simparity.run_scene(scene, ("core", "mujoco", "pybullet", "pinocchio"), repeats=0, isolate=False)
+    result = check_table(table, load_tolerances())
+    assert result.passed, [str(v) for v in result.violations][:3]
+    ok = table[table["status"] == "ok"]
+    for engine in ("core", "pinocchio"):
+        assert set(ok[ok["engine"] == engine]["integrator"]) >= {"recursive"}, engine
+    errors = ok[ok["metric"] == "mass_matrix_error_max"].set_index(["engine", "integrator"])["value"]
+    assert errors.loc[("core", "recursive")] <= 1e-12 and errors.loc[("core", "jacobian_sum")] <= 1e-12
