@@ -603,7 +603,8 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
 
 
 def profile_summary(batch: int, say: Callable[[str], None]) -> str:
-    """cProfile of core's rk4 on ``batch`` tumbling boxes and of its restarted IK on the iiwa, top functions."""
+    """cProfile of core's rk4 on ``batch`` tumbling boxes, of its restarted IK on the iiwa and of its ABA on ``batch``
+    iiwa states, top functions."""
     import cProfile
     import io
     import pstats
@@ -614,9 +615,14 @@ def profile_summary(batch: int, say: Callable[[str], None]) -> str:
     model = make_engine("core").build_ik(scene.chain, "damped_least_squares+restarts",
                                          IKTolerances(scene.position_tolerance, scene.orientation_tolerance,
                                                       scene.max_iterations))
+    arm = replace(library.load(["iiwa-dynamics"])[0], n_states=batch)
+    q, qd, _, tau = arm.states()
+    dynamics = make_engine("core").build_joint_dynamics(arm.chain, "recursive", arm.gravity_world)
     for title, call in ((f"core rk4, {batch:,} tumbling boxes, 20 steps", lambda: sim.run(20)),
                         (f"core damped_least_squares+restarts, {scene.n_targets:,} iiwa targets",
-                         lambda: model.solve(targets.position_world, targets.rotation_world, scene.q_start))):
+                         lambda: model.solve(targets.position_world, targets.rotation_world, scene.q_start)),
+                        (f"core recursive forward dynamics (ABA), {batch:,} iiwa states, 20 calls",
+                         lambda: [dynamics.forward_dynamics(q, qd, tau) for _ in range(20)])):
         say(f"  profiling {title}")
         profiler = cProfile.Profile()
         profiler.runcall(call)

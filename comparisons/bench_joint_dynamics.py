@@ -60,10 +60,12 @@ def _pinocchio_batched(scene, states, median_time) -> dict[str, float]:
     model = pin.buildModelFromXML(dynamics_urdf(scene.chain))
     model.gravity.linear = np.zeros(3) if scene.gravity_world is None else np.asarray(scene.gravity_world)
     q, qd, qdd, tau = states
-    if model.nq != model.nv or model.nv != scene.chain.n_joints or any(j.damping for j in scene.chain.joints):
-        return {}  # a continuous joint (nq = 2), a held joint or damping: the one-to-one mapping below does not hold
+    if model.nq != model.nv or model.nv != scene.chain.n_joints:
+        return {}  # a continuous joint (nq = 2) or a joint off the chain: the one-to-one mapping below does not hold
+    damping = np.array([j.damping for j in scene.chain.joints])
     pool = pin.ModelPool(model, 1)
-    columns = [np.asfortranarray(x.T) for x in (q, qd, qdd, tau)]
+    # Pinocchio's algorithms have no damping: ABA gets tau - D qdot (RNEA's + D qdot would be one more vector add)
+    columns = [np.asfortranarray(x.T) for x in (q, qd, qdd, tau - damping * qd)]
     out = np.zeros_like(columns[0], order="F")
     rnea = median_time(lambda: pin.rneaInParallel(1, pool, columns[0], columns[1], columns[2], out))
     aba = median_time(lambda: pin.abaInParallel(1, pool, columns[0], columns[1], columns[3], out))

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from simparity.comparisons import bench
+from simparity.comparisons import bench, bench_joint_dynamics
 from simparity.comparisons.bench import (
     MEMORY_CHILD,
     MEMORY_PROCESS,
@@ -112,8 +112,15 @@ def test_a_small_real_run_measures_every_section(monkeypatch, tmp_path):
     rows = bench.dynamics_rows([1, 3], quick=True, say=lines.append)
     rows += bench.kinematics_rows([2], say=lines.append)
     rows += bench.ik_rows(5, say=lines.append)
+    monkeypatch.setattr(bench_joint_dynamics, "ARMS", ("ur5-dynamics",))
+    monkeypatch.setattr(bench_joint_dynamics, "ENGINES", (("core", "recursive"), ("mujoco", "recursive")))
+    rows += bench_joint_dynamics.joint_dynamics_rows([2], lambda fn: bench.median_time(fn, 1), bench.BenchRow,
+                                                     lines.append)
     measured = [r for r in rows if math.isfinite(r.value)]
-    assert {r.section for r in measured} == {"dynamics", "kinematics", "ik"}
+    assert {r.section for r in measured} == {"dynamics", "kinematics", "ik", "joint_dynamics"}
+    # core and MuJoCo against Pinocchio at the same states: double-precision agreement (the shipped 1e-12 bound)
+    assert all(r.accuracy <= 1e-12 for r in measured if r.section == "joint_dynamics")
+    assert {r.engine for r in measured if r.section == "joint_dynamics"} == {"core", "mujoco", "pinocchio-pool"}
     assert all(math.isfinite(r.accuracy) for r in measured)
     assert all(r.note.startswith("n/a: ") for r in rows if not math.isfinite(r.value))
     core_rk4 = [r for r in rows if (r.engine, r.method) == ("core", "rk4")]
