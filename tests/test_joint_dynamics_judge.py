@@ -139,3 +139,54 @@ def test_shape_and_finiteness_problems_are_named():
     own = {"M": np.zeros((2, 1, 1)), "h": np.zeros((2, 1)), "tau": np.zeros((2, 1)), "qdd": np.full((2, 1), np.nan)}
     assert shape_problem(own, 2, 1) == "non-finite qdd"
     assert shape_problem(own | {"M": np.zeros((2, 1))}, 2, 1) == "M has shape (2, 1), expected (2, 1, 1)"
+
+
+M1, M2, L1, C1, C2, I1, I2 = 1.0, 2.0, 1.0, 0.5, 0.25, 0.1, 0.05  # Spong's planar elbow arm [kg, m, kg m^2]
+ENERGY_IDENTITY = 1e-11
+"""The energy identity of an exact arm at |qdot| <= 3 rad/s: Richardson-extrapolated differences leave rounding
+only (1.2e-12 measured); a plain central difference at the judge's step leaves its truncation, 3.1e-10 here."""
+
+
+class Elbow(JointDynamicsModel):
+    """The planar elbow arm in closed form (Spong, Hutchinson, Vidyasagar), no gravity; ``coriolis_sign`` plants a
+    sign error in the Coriolis and centrifugal forces."""
+
+    def __init__(self, coriolis_sign: float = 1.0):
+        self.coriolis_sign = coriolis_sign
+
+    def mass_matrix(self, q):
+        c = np.cos(q[:, 1])
+        m11 = I1 + I2 + M1 * C1**2 + M2 * (L1**2 + C2**2 + 2 * L1 * C2 * c)
+        m12 = I2 + M2 * (C2**2 + L1 * C2 * c)
+        m22 = np.full_like(c, I2 + M2 * C2**2)
+        return np.stack([np.stack([m11, m12], -1), np.stack([m12, m22], -1)], -2)
+
+    def bias_forces(self, q, qdot):
+        h = -M2 * L1 * C2 * np.sin(q[:, 1])
+        return self.coriolis_sign * np.stack([h * (2 * qdot[:, 0] * qdot[:, 1] + qdot[:, 1] ** 2),
+                                              -h * qdot[:, 0] ** 2], -1)
+
+    def inverse_dynamics(self, q, qdot, qddot):
+        return np.einsum("bij,bj->bi", self.mass_matrix(q), qddot) + self.bias_forces(q, qdot)
+
+    def forward_dynamics(self, q, qdot, tau):
+        return np.linalg.solve(self.mass_matrix(q), (tau - self.bias_forces(q, qdot))[..., None])[..., 0]
+
+    def link_kinetic_energy(self, q, qdot):
+        return 0.5 * np.einsum("bi,bij,bj->b", qdot, self.mass_matrix(q), qdot)
+
+
+def _elbow_scene() -> JointDynamicsScene:
+    link = LinkInertia(1.0, np.zeros(3), np.diag([0.1, 0.1, 0.1]))
+    joints = tuple(Joint(name, "revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.eye(3), link=link)
+                   for name in ("shoulder", "elbow"))
+    return JointDynamicsScene("elbow", "", "analytic", Chain("elbow", joints), None, n_states=40, seed=9,
+                              velocity_scale=3.0)
+
+
+def test_the_energy_identity_holds_to_rounding_for_a_fast_arm_and_catches_a_coriolis_sign():
+    scene = _elbow_scene()
+    exact = _judged(Elbow(), Elbow(), scene)[CORIOLIS_SKEW_RESIDUAL].value
+    planted = _judged(Elbow(coriolis_sign=-1.0), Elbow(), scene)[CORIOLIS_SKEW_RESIDUAL].value
+    assert exact <= ENERGY_IDENTITY
+    assert planted >= DETECTED
