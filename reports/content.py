@@ -262,6 +262,8 @@ class _Builder:
         self.cases = {scene: summary.dynamics_cases(rows, _headline(self.about(scene)))
                       for scene, rows in table.groupby("scene", sort=False)
                       if _kind(rows) == "dynamics" and scene not in self.sweep_of}
+        self.joint_dynamics_scenes = [scene for scene, rows in table.groupby("scene", sort=False)
+                                      if _kind(rows) == "joint_dynamics"]
         ranked = list(self.cases.values()) + [s.across for s in sweeps if s.kind == "dynamics"]
         self.by = summary.ranking_cost(pd.concat(ranked)) if ranked else summary.WALL
         self.findings_per_scene: Counter = Counter()
@@ -333,7 +335,20 @@ class _Builder:
                        Table(("scene", "best solve rate", f"fastest at ≥ {summary.SOLVED_ENOUGH:.0%}"),
                              tuple(ik_rows)),
                        *([_SWEEP_ROWS_IK] if any(s.kind == "ik" for s in self.sweeps) else [])]
-        return blocks + self.findings() + self.unresolved()
+        return blocks + self.joint_dynamics_summary() + self.findings() + self.unresolved()
+
+    def joint_dynamics_summary(self) -> list[Block]:
+        """One line per engine and method over the run's joint-dynamics scenes: its worst error against the references
+        and its worst identity residual (the section "Joint-space dynamics" has them per scene)."""
+        rows = self.table[self.table["scene"].isin(self.joint_dynamics_scenes)]
+        if rows.empty:
+            return []
+        cells = [f"{engine} {method} {_worst_cell(case)}"
+                 for (engine, method), case in rows.groupby(["engine", "integrator"], sort=False)]
+        return [Heading(3, "Joint-space dynamics"),
+                Paragraph(f"Over {len(self.joint_dynamics_scenes)} scenes, each engine's worst relative error of M, "
+                          "h, tau and qddot against the references, then (\"id\") its worst identity residual: "
+                          + "; ".join(cells) + ".")]
 
     def per_engine_table(self) -> list[Block]:
         """The per-engine answer over the run's dynamics scenes (sweeps have theirs in their section): how often each

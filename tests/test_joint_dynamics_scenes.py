@@ -138,3 +138,21 @@ def test_arms_nobody_tuned_to_pass_the_shipped_gate_on_every_engine(urdf, base, 
         assert set(ok[ok["engine"] == engine]["integrator"]) >= {"recursive"}, engine
     errors = ok[ok["metric"] == "mass_matrix_error_max"].set_index(["engine", "integrator"])["value"]
     assert errors.loc[("core", "recursive")] <= 1e-12 and errors.loc[("core", "jacobian_sum")] <= 1e-12
+
+
+def test_a_run_checks_and_reports_joint_dynamics(tmp_path):
+    """simparity run --check on the lecture's arm and the crafted arm: green, every engine in the report's section
+    and the summary, each row of report.md within 300 characters."""
+    from simparity.comparisons.cli.main import EXIT_OK, main
+
+    out = tmp_path / "run"
+    assert main(["run", "lecture-2link-dynamics", "crafted-arm-dynamics", "--quick", "--check", "--out", str(out)]) \
+        == EXIT_OK
+    report = (out / "report.md").read_text(encoding="utf-8")
+    at = report.index("\n## Joint-space dynamics")
+    section, before = report[at:], report[:at]
+    for case in ("core recursive", "core jacobian_sum", "analytic closed_form", "mujoco recursive",
+                 "pybullet recursive", "pinocchio recursive"):
+        assert case in section and case in before, case
+    assert "| crafted-arm-dynamics |" in section and "| lecture-2link-dynamics |" in section
+    assert max(len(line) for line in report.splitlines()) <= 300
