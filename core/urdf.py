@@ -60,7 +60,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-from simparity.core.dynamics.inertia import INERTIA_RTOL
+from simparity.core.dynamics.inertia import link_tensor_problem
 from simparity.core.model.errors import SceneError
 from simparity.core.model.files import MAX_FILE_BYTES, parse_xml, read_input
 from simparity.core.model.names import NAME_RULE, name_problem
@@ -474,7 +474,7 @@ def _inertial(link: ET.Element, key: str, source: str) -> _Inertial:
                              largest.text())
         inertia[row, column] = inertia[column, row] = value
     rotation = rpy_to_matrix(rpy)
-    return _Inertial(mass, xyz, rotation @ inertia @ rotation.T, f"{key}/inertia", _tensor_problem(inertia))
+    return _Inertial(mass, xyz, rotation @ inertia @ rotation.T, f"{key}/inertia", link_tensor_problem(inertia))
 
 
 def _required_number(element: ET.Element | None, attribute: str, key: str, source: str) -> float:
@@ -491,22 +491,6 @@ def _hold(values: np.ndarray, allowed: Range, key: str, source: str) -> None:
     for value in values:
         if not allowed.allows(abs(value)):
             raise SceneError(source, key, f"{value:.6g} is outside the physical range", allowed.text())
-
-
-def _tensor_problem(inertia: np.ndarray) -> str:
-    """Why a symmetric inertia tensor is not physical ("" if it is): principal moments a <= b <= c must
-    satisfy a + b >= c (every mass distribution does; it implies a >= 0) up to INERTIA_RTOL of c. A zero or
-    singular tensor (a point mass, a thin rod) is physical."""
-    scale = float(np.max(np.abs(inertia)))
-    if scale == 0.0:
-        return ""
-    a, b, c = np.linalg.eigvalsh(inertia / scale)  # of order one: no overflow, no lost digits
-    if a + b >= c * (1 - INERTIA_RTOL):
-        return ""
-    moments = ", ".join(f"{m * scale:.6g}" for m in (a, b, c))
-    if a < 0:
-        return f"not positive semidefinite: principal moments ({moments}) kg m^2"
-    return f"violates the triangle inequality: principal moments ({moments}) kg m^2 have a + b < c"
 
 
 def _rigid_body(joint: dict, following: dict | None, inertials: dict[str, _Inertial],

@@ -527,11 +527,15 @@ class _Builder:
         metric per scene x engine x method."""
         scenes = list(dict.fromkeys(rows["scene"]))
         cases = list(dict.fromkeys(zip(rows["engine"], rows["integrator"])))
-        compact = []
-        for scene in scenes:
-            own = rows[rows["scene"] == scene]
-            compact.append((scene, *(_worst_cell(own[(own["engine"] == e) & (own["integrator"] == m)])
-                                     for e, m in cases)))
+        cells = {(scene, case): _worst_cell(rows[(rows["scene"] == scene) & (rows["engine"] == case[0])
+                                                 & (rows["integrator"] == case[1])])
+                 for scene in scenes for case in cases}
+        labels = [f"{e} {m}" for e, m in cases]
+        if len(cases) <= len(scenes):  # the fewer of the two across, so that a row stays readable
+            table = Table(("scene", *labels), tuple((scene, *(cells[scene, c] for c in cases)) for scene in scenes))
+        else:
+            table = Table(("engine method", *scenes), tuple((label, *(cells[s, c] for s in scenes))
+                                                            for label, c in zip(labels, cases)))
         full = tables.metric_table(rows, tables.JOINT_DYNAMICS_COLUMNS, ["scene", "engine", "integrator"])
         blocks: list[Block] = [Heading(2, "Joint-space dynamics"),
                 Bullets(tuple(f"**{scene}**: {self.introduction(scene, rows[rows['scene'] == scene])}"
@@ -542,8 +546,7 @@ class _Builder:
                           "e_i) - g = M e_i, ABA(RNEA) = id, M = M^T, kinetic energy from its own link velocities); "
                           "each metric, the energy identity qdot^T (Mdot - 2C) qdot = 0, times and the reasons for "
                           "n/a: the HTML report."),
-                Table(("scene", *(f"{e} {m}" for e, m in cases)), tuple(compact)),
-                Details("Every joint-dynamics metric", (full,), markdown=False, open=True)]
+                table, Details("Every joint-dynamics metric", (full,), markdown=False, open=True)]
         return blocks + _notes(rows)
 
     def dynamics(self, scene, rows, about, reference, series) -> tuple[str, list[Block]]:

@@ -216,7 +216,8 @@ def test_mujoco_masses_are_the_files_and_gravity_the_scenes():
     mass = {model.body(b).name: model.body_mass[b] for b in range(model.nbody)}
     assert mass["base_link"] == mass["flange"] == 0.0
     assert mass["finger_link"] == 0.15 and mass["payload"] == 0.6
-    assert sum(mass.values()) == pytest.approx(2.0 + 1.7 + 1.1 + 0.8 + 0.6 + 0.15, rel=1e-15)
+    assert mass["link0"] == 0.0  # welded to the base by a fixed joint: it never moves, not part of the model
+    assert sum(mass.values()) == pytest.approx(1.7 + 1.1 + 0.8 + 0.6 + 0.15, rel=1e-15)
     np.testing.assert_array_equal(model.opt.gravity, GRAVITY)
     assert model.opt.disableflags & mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
 

@@ -11,6 +11,8 @@ import pytest
 from simparity.comparisons.scenes import library
 from simparity.comparisons.scenes.loader import parse_scene
 from simparity.core.model.errors import SceneError
+from simparity.core.articulated import model as joint_dynamics
+from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.scene import JointDynamicsScene
 
 PENDULUM = {
@@ -57,6 +59,10 @@ def test_a_pendulum_file_reads_its_mass_properties_in_si():
     ("sampling.states", 0, "sampling.states", ""),
     ("sampling.velocity_scale", -1.0, "sampling.velocity_scale", ""),
     ("world.air_velocity_world", [1.0, 0.0, 0.0], "world.air_velocity_world", ""),
+    ("chain.joint.0.inertia", [[1e20, 0.0, 0.0], [0.0, 1e20, 0.0], [0.0, 0.0, 1e20]], "chain.joint[0].inertia",
+     "physical range"),
+    ("sampling.velocity_scale", 1e200, "sampling.velocity_scale", "physical range"),
+    ("sampling.torque_scale", 1e300, "sampling.torque_scale", "physical range"),
 ])
 def test_bad_values_are_refused_naming_the_key(path, value, key, words):
     with pytest.raises(SceneError) as caught:
@@ -64,6 +70,21 @@ def test_bad_values_are_refused_naming_the_key(path, value, key, words):
     assert caught.value.key == key, str(caught.value)
     assert words in str(caught.value)
     assert "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize(("mass", "inertia"), [
+    (0.5, [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]),    # a point mass off the axis
+    (0.5, [[0.0, 0.0, 0.0], [0.0, 0.01, 0.0], [0.0, 0.0, 0.01]]),  # a thin rod along x
+    (0, [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]),      # a massless link, as a URDF link without <inertial>
+])
+def test_a_link_may_be_a_point_mass_a_rod_or_massless_as_in_a_urdf(mass, inertia):
+    import copy
+
+    data = _with("chain.joint.0.mass", mass, _with("chain.joint.0.inertia", inertia))
+    second = copy.deepcopy(PENDULUM["chain"]["joint"][0]) | {"name": "elbow", "origin_xyz": [0.5, 0.0, 0.0]}
+    data["chain"]["joint"].append(second)  # carried by the first joint: its link may be massless
+    link = parse_scene(_with("scene.reference", "pinocchio", data)).chain.joints[0].link
+    assert link.mass == mass and np.array_equal(link.inertia_com, inertia)
 
 
 def test_a_chain_without_mass_properties_is_refused_for_dynamics_in_one_line():
@@ -107,6 +128,9 @@ UNTUNED_ARMS = [
     ("z1_description/urdf/z1.urdf", None, "link06"),
     ("kinova_description/robots/kinova.urdf", None, "j2s6s200_end_effector"),
     ("so_arm_description/urdf/so100.urdf", None, None),
+    # a leg: the other three legs are branches held at 0, and the base carries a placeholder tensor MuJoCo refuses
+    # (it never moves: not part of the model)
+    ("anymal_b_simple_description/robots/anymal.urdf", "base", "LF_FOOT"),
 ]
 
 
@@ -134,7 +158,7 @@ def test_arms_nobody_tuned_to_pass_the_shipped_gate_on_every_engine(urdf, base, 
     result = check_table(table, load_tolerances())
     assert result.passed, [str(v) for v in result.violations][:3]
     ok = table[table["status"] == "ok"]
-    for engine in ("core", "pinocchio"):
+    for engine in ("core", "pinocchio", "mujoco"):
         assert set(ok[ok["engine"] == engine]["integrator"]) >= {"recursive"}, engine
     errors = ok[ok["metric"] == "mass_matrix_error_max"].set_index(["engine", "integrator"])["value"]
     assert errors.loc[("core", "recursive")] <= 1e-12 and errors.loc[("core", "jacobian_sum")] <= 1e-12
@@ -154,5 +178,31 @@ def test_a_run_checks_and_reports_joint_dynamics(tmp_path):
     for case in ("core recursive", "core jacobian_sum", "analytic closed_form", "mujoco recursive",
                  "pybullet recursive", "pinocchio recursive"):
         assert case in section and case in before, case
-    assert "| crafted-arm-dynamics |" in section and "| lecture-2link-dynamics |" in section
+    assert "crafted-arm-dynamics |" in section and "lecture-2link-dynamics |" in section
     assert max(len(line) for line in report.splitlines()) <= 300
+
+
+class Featherstone(InHouseEngine):
+    """A user's engine: core's recursive dynamics under a method name that is no scheme kind, gravity off by 3e-4."""
+
+    name = "featherstone-user"
+
+    def joint_dynamics_methods(self):
+        return ("featherstone",)
+
+    def build_joint_dynamics(self, chain, method, gravity_world):
+        return joint_dynamics.build(chain, "recursive", 1.0003 * gravity_world)
+
+
+def test_a_users_method_of_any_name_is_held_to_the_joint_dynamics_bounds():
+    """Found by review: a plugin whose method is called "featherstone" (no scheme kind) with gravity off by 3e-4 passed
+    --check, its rows unbounded. Every method computes exact dynamics: the bounds are keyed by metric."""
+    import simparity
+    from simparity.comparisons.gate.check import check_table
+    from simparity.comparisons.gate.tolerances import load_tolerances
+
+    table = simparity.run_scene(library.load(["lecture-2link-dynamics"])[0], ("analytic", Featherstone),
+                                repeats=0, isolate=False)
+    assert set(table[table["engine"] == "featherstone-user"]["integrator"]) == {"featherstone"}
+    violations = check_table(table, load_tolerances()).violations
+    assert any(v.engine == "featherstone-user" and v.metric == "bias_force_error_max" for v in violations)

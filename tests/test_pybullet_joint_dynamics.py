@@ -366,12 +366,15 @@ def test_the_inverse_dynamics_library_is_cached_at_its_first_call():
     assert np.max(np.abs(after - before)) > EFFECT
 
 
-def test_a_rotated_root_inertial_turns_the_librarys_gravity_and_the_model_turns_it_back(tmp_path):
-    """The library's root is Bullet's base inertial frame and it takes the world's gravity in that frame."""
+def test_a_rotated_root_inertial_turns_the_librarys_gravity_and_the_model_never_has_one(tmp_path):
+    """The library's root is Bullet's base inertial frame and it takes the world's gravity in that frame: the file's
+    root with a rotated inertial turns gravity in PyBullet; the model gives the base (welded: it never moves) the
+    explicit zero inertial, so its gravity is the world's."""
     root = ET.fromstring(dynamics_urdf(CRAFTED_CHAIN))
     base = next(link for link in root.iter("link") if link.get("name") == "base_link")
     base.find("inertial").find("origin").set("rpy", "0.7 -0.4 1.2")
     base.find("inertial").find("mass").set("value", "3")
+    base.find("inertial").find("inertia").set("ixx", "0.5")
     path = tmp_path / "turned-root.urdf"
     path.write_text(ET.tostring(root, encoding="unicode"), encoding="utf-8")
     chain = chain_from_urdf(str(path), tip_link="flange")
@@ -379,7 +382,7 @@ def test_a_rotated_root_inertial_turns_the_librarys_gravity_and_the_model_turns_
     reference = np.stack([Pinocchio(chain, GRAVITY).bias_forces(*s) for s in zip(q, qd)])
     model = ENGINE.build_joint_dynamics(chain, "recursive", GRAVITY)
     assert rel(model.bias_forces(q, qd), reference) < JACOBI_RTOL
-    raw = Raw(text=unit_axes(dynamics_urdf(chain)))
+    raw = Raw(text=unit_axes(path.read_text(encoding="utf-8")))
     library = np.stack([pybullet.calculateInverseDynamics(raw.body, list(a), list(v), [0.0] * 3,
                                                           physicsClientId=raw.client) for a, v in zip(q, qd)])
     assert rel(library, reference) > EFFECT

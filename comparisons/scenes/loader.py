@@ -23,7 +23,13 @@ from simparity.core.dh import chain_from_dh
 from simparity.core.model.errors import SceneError, echo, one_line
 from simparity.core.model.files import file_problem, read_toml
 from simparity.core.ik.reach import reach_upper_bound
-from simparity.core.dynamics.inertia import INERTIA_RTOL, inertia_from_point_masses, inertia_problem, mass_and_center_of_mass
+from simparity.core.dynamics.inertia import (
+    INERTIA_RTOL,
+    inertia_from_point_masses,
+    inertia_problem,
+    link_tensor_problem,
+    mass_and_center_of_mass,
+)
 from simparity.core.model.names import NAME_RULE, TEXT_RULE, name_problem, text_problem
 from simparity.core.model.ranges import NORM_RANGES, RANGES, safe_norm
 from simparity.core.rotations import rpy_to_matrix
@@ -551,11 +557,18 @@ def _link(r: _Reader) -> LinkInertia | None:
         raise r.fail(missing, f"missing: {', '.join(given)} given without it",
                      "all of mass [kg], com_xyz [length] and inertia (3 x 3 about the centre of mass, in the link's "
                      "axes) or none (a chain for kinematics only)")
-    mass = r.number("mass", positive=True)
+    massless = r.table.get("mass") == 0  # a massless link (inertia 0), as a URDF link without <inertial>
+    mass = 0.0 if massless else r.number("mass", positive=True)
     inertia = r.matrix("inertia", 3, length=2)
-    problem = inertia_problem(inertia)
+    largest, moments = float(np.max(np.abs(inertia))), RANGES["inertia_moment"]
+    if largest > moments.high:
+        raise r.fail("inertia", f"an entry of {largest:.3g} kg m^2 is outside the physical range", moments.text())
+    if massless and largest > 0:
+        raise r.fail("inertia", "a massless link with an inertia", "inertia all 0 where mass = 0")
+    problem = link_tensor_problem(inertia)
     if problem:
-        raise r.fail("inertia", problem, "a symmetric positive-semidefinite tensor obeying the triangle inequality")
+        raise r.fail("inertia", problem, "a symmetric positive-semidefinite tensor obeying the triangle inequality "
+                     "(a point mass or a thin rod is one)")
     return LinkInertia(mass, r.vector("com_xyz", 3, length=1), inertia)
 
 

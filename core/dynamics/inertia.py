@@ -246,3 +246,20 @@ def _scaled(value: float, scale: float) -> float:
 
 def _fmt(values: np.ndarray, scale: float = 1.0) -> str:
     return "(" + ", ".join(f"{_scaled(v, scale):.6g}" for v in values) + ")"
+
+
+def link_tensor_problem(inertia: np.ndarray) -> str:
+    """Why a symmetric inertia tensor is not a link's ("" if it is): principal moments a <= b <= c must satisfy
+    a + b >= c (every mass distribution does; it implies a >= 0) up to :data:`INERTIA_RTOL` of c. Unlike a free
+    body's (:func:`inertia_problem`), a zero or singular tensor (a point mass, a thin rod) is a link's: its joint
+    carries it."""
+    scale = float(np.max(np.abs(inertia)))
+    if scale == 0.0:
+        return ""
+    a, b, c = np.linalg.eigvalsh(inertia / scale)  # of order one: no overflow, no lost digits
+    if a + b >= c * (1 - INERTIA_RTOL):
+        return ""
+    moments = ", ".join(f"{m * scale:.6g}" for m in (a, b, c))
+    if a < 0:
+        return f"not positive semidefinite: principal moments ({moments}) kg m^2"
+    return f"violates the triangle inequality: principal moments ({moments}) kg m^2 have a + b < c"

@@ -16,8 +16,10 @@ only these changes, each made with :mod:`xml.etree.ElementTree` on the parsed fi
   hang from in every engine alike.
 - A link without ``<inertial>`` is massless (the URDF specification) and gets an explicit zero one: PyBullet
   would otherwise give it 1 kg and a unit inertia.
+- The base link and every link welded to it by fixed joints never move: their ``<inertial>`` is replaced by the
+  explicit zero (a placeholder tensor there, as ANYmal's base has, made MuJoCo refuse the whole model).
 
-``<inertial>`` elements are never touched. A chain without a URDF file (inline joints in a scene) is written with
+``<inertial>`` elements of links that move are never touched. A chain without a URDF file (inline joints in a scene) is written with
 its declared mass properties (centre of mass as the inertial origin, the full tensor in the link's axes).
 """
 
@@ -70,12 +72,6 @@ def original_for_dynamics(chain: Chain) -> str:
         kept = links if element.tag == "link" else joints if element.tag == "joint" else None
         if kept is not None and element.get("name") not in kept:
             root.remove(element)
-    for link in root.findall("link"):
-        for tag in REMOVED_FROM_LINKS:
-            for element in link.findall(tag):
-                link.remove(element)
-        if link.find("inertial") is None:
-            zero_inertial(link)
     for joint in root.findall("joint"):
         for element in joint.findall("dynamics"):
             joint.remove(element)
@@ -84,7 +80,33 @@ def original_for_dynamics(chain: Chain) -> str:
             for tag in HELD_JOINT_CHILDREN:
                 for element in joint.findall(tag):
                     joint.remove(element)
+    welded = _welded_to_base(root, cast(str, chain.base_link))
+    for link in root.findall("link"):
+        for tag in REMOVED_FROM_LINKS:
+            for element in link.findall(tag):
+                link.remove(element)
+        if link.get("name") in welded:  # never moves: not part of the dynamics (a placeholder there is harmless)
+            for element in link.findall("inertial"):
+                link.remove(element)
+        if link.find("inertial") is None:
+            zero_inertial(link)
     return _text(root)
+
+
+def _welded_to_base(root: ET.Element, base: str) -> set[str]:
+    """The base link and every link joined to it by fixed joints only: they never move."""
+    fixed: dict[str, list[str]] = {}
+    for joint in root.findall("joint"):
+        if joint.get("type") == "fixed":
+            parent = cast(str, cast(ET.Element, joint.find("parent")).get("link"))
+            fixed.setdefault(parent, []).append(cast(str, cast(ET.Element, joint.find("child")).get("link")))
+    welded, stack = {base}, [base]
+    while stack:
+        for child in fixed.get(stack.pop(), []):
+            if child not in welded:
+                welded.add(child)
+                stack.append(child)
+    return welded
 
 
 def declared_for_dynamics(chain: Chain) -> str:

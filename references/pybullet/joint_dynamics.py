@@ -22,7 +22,8 @@ joints in its own order. Each default below is switched off or set, and pinned b
   meaning: q is the angle or distance along the unit axis).
 - Joint limits act by default (a limit constraint per limited joint; ``changeDynamics`` cannot remove one from
   Python, the binding drops lower > upper): ``jointLimitForce`` 0 leaves the constraint no impulse.
-- Joint velocities are capped at 100 rad/s (``maxJointVelocity``): raised to 1e9.
+- Joint velocities are capped at 100 rad/s (``maxJointVelocity``): raised to :data:`MAX_VELOCITY` (1e300; a stepped
+  velocity at the cap fails the row instead of clipping qddot).
 - Every revolute and prismatic joint starts with a velocity motor braking it to 0 (max impulse 1 per step):
   ``setJointMotorControlArray(VELOCITY_CONTROL, forces=0)`` disables it; torques are given with TORQUE_CONTROL.
 - Link linear and angular damping default to 0.04 (body-wide): 0.
@@ -38,7 +39,8 @@ Two PyBullet models, each a fresh body in a DIRECT world of its own:
   here once the body is configured. M = calculateMassMatrix(q), h = calculateInverseDynamics(q, qdot, 0),
   tau = calculateInverseDynamics(q, qdot, qddot) + D qdot. The tree's root is Bullet's base INERTIAL frame, and it
   takes the world's gravity as given in that frame: a root link whose ``<inertial>`` is rotated would feel gravity
-  turned. That world is given g expressed in the root's inertial frame (R_i^T g; the stepped world gets g).
+  turned. The base never moves, so :mod:`references.common.dynamics_urdf` gives it (and every link welded to it) the
+  explicit zero ``<inertial>``, whose frame is the link's: gravity is the world's.
 - ``forward_dynamics`` steps the second body once: ``resetJointState`` (q, qdot), TORQUE_CONTROL tau,
   ``stepSimulation`` with time step :data:`STEP`, qddot = (qdot' - qdot) / STEP. Bullet's step is semi-implicit:
   qdot' = qdot + STEP * qddot(q, qdot, tau) from its articulated-body algorithm
@@ -61,11 +63,12 @@ import xml.etree.ElementTree as ET
 import numpy as np
 
 from simparity.core.model.engine import JointDynamicsModel
+from simparity.core.model.errors import SimparityError
 from simparity.core.model.scene import Chain
 from simparity.references.common.conventions import fmt, quat_wxyz_to_matrix, wxyz_from_xyzw
 from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
-from simparity.references.pybullet.adapter import _MAX_VELOCITY, _Client, _load_urdf
+from simparity.references.pybullet.adapter import _Client, _load_urdf
 from simparity.references.pybullet.quiet import pybullet
 
 STEP = 1.0  # [s]
@@ -73,6 +76,15 @@ STEP = 1.0  # [s]
 (qdot' - qdot) / STEP carries eps (|qdot| / STEP + |qddot|): a long step costs nothing (the step starts from a
 reset state, and nothing else in the world acts) and keeps the estimate as precise as the tree's (at 1e-3 s a
 state with |qdot| = 1 and |qddot| = 1e-3 would lose 6 digits)."""
+
+
+MAX_VELOCITY = 1e300  # [rad/s or m/s]
+"""PyBullet's joint velocity cap (its default 100, the stepping adapter's 1e9) for the stepped body: one step of
+STEP reaches qdot + qddot, and a cap below that clips qddot (a 1 g link of inertia 1e-10 kg m^2 at the tip of an arm
+accelerates at ~1e10 rad/s^2 under 1 N m: with the cap at 1e9 its qddot came out 14 % off). Bullet is double
+precision: 1e300 clips nothing a finite state reaches; a velocity at the cap is refused (:data:`CLIPPED`)."""
+CLIPPED = 0.5 * MAX_VELOCITY
+"""A stepped velocity this large has reached the cap: the row fails with the reason instead of a clipped qddot."""
 
 
 def unit_axes(text: str) -> str:
@@ -112,7 +124,7 @@ class _Body:
         self.columns = [movable.index(j) for j in self.joints]
         self.links = [i[0] for i in info]
         self._n_movable = len(movable)
-        pybullet.changeDynamics(b, -1, linearDamping=0.0, angularDamping=0.0, maxJointVelocity=_MAX_VELOCITY,
+        pybullet.changeDynamics(b, -1, linearDamping=0.0, angularDamping=0.0, maxJointVelocity=MAX_VELOCITY,
                                 physicsClientId=c)
         for joint, j in zip(chain.joints, self.joints):
             pybullet.changeDynamics(b, j, jointDamping=joint.damping, jointLimitForce=0.0, physicsClientId=c)
@@ -143,9 +155,7 @@ class PybulletJointDynamics(JointDynamicsModel):
         text = unit_axes(dynamics_urdf(chain))
         gravity = np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float)
         self._tree = _Body(text, chain)
-        root_inertial = pybullet.getDynamicsInfo(self._tree.body, -1, physicsClientId=self._tree.client)[4]
-        rotation = quat_wxyz_to_matrix(wxyz_from_xyzw(np.array(root_inertial)))
-        pybullet.setGravity(*(rotation.T @ gravity), physicsClientId=self._tree.client)
+        pybullet.setGravity(*gravity, physicsClientId=self._tree.client)
         with captured_output():  # PyBullet builds (and caches) its inverse-dynamics tree at the first call
             pybullet.calculateMassMatrix(self._tree.body, self._tree.movable(np.zeros(chain.n_joints)),
                                          physicsClientId=self._tree.client)
@@ -190,7 +200,11 @@ class PybulletJointDynamics(JointDynamicsModel):
                                                physicsClientId=s.client)
             pybullet.stepSimulation(physicsClientId=s.client)
             states = pybullet.getJointStates(s.body, s.joints, physicsClientId=s.client)
-            out[k] = (np.array([state[1] for state in states]) - qdot[k]) / STEP
+            stepped = np.array([state[1] for state in states])
+            if not np.all(np.abs(stepped) < CLIPPED):
+                raise SimparityError(f"PyBullet's stepped joint velocity reached its cap {MAX_VELOCITY:g} (qddot "
+                                     "would be clipped): forward dynamics not measurable at this state")
+            out[k] = (stepped - qdot[k]) / STEP
         return out
 
     def link_kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:

@@ -232,6 +232,12 @@ MUTANTS: tuple[Mutation, ...] = (
         "forces.append(inertia @ acceleration)",
         "RNEA's body force without v x* I v (the velocity-product term): centrifugal and gyroscopic forces lost",
         ARTICULATED, "lecture-2link-dynamics"),
+    Mutation(
+        "rnea_no_armature", "joint armature", "articulated/recursive.py",
+        "tau[i] = forces[i][arrays.subspace[i]] + arrays.armature[i] * qddot[i]",
+        "tau[i] = forces[i][arrays.subspace[i]]",
+        "RNEA without the joint's rotor inertia (armature): tau misses a_i qddot_i (no URDF carries armature)",
+        ARTICULATED_3D, "armature-arm-dynamics"),
 )
 """The catalogue (issue #23 asks for at least a dozen, of the kinds listed there)."""
 
