@@ -81,7 +81,7 @@ JOINT_DYNAMICS_COLUMNS = [
     (MASS_COLUMN_RESIDUAL, "RNEA(q,0,e_i) - g = M e_i"),
     (ROUND_TRIP_RESIDUAL, "ABA(RNEA) = id"),
     (MASS_MATRIX_ASYMMETRY, "M - M^T"),
-    (MASS_MATRIX_DEFINITENESS_MIN, "min eig / max eig of M"),
+    (MASS_MATRIX_DEFINITENESS_MIN, "min eig of D^-1/2 M D^-1/2"),
     (KINETIC_ENERGY_RESIDUAL, "kinetic energy vs links'"),
     (CORIOLIS_SKEW_RESIDUAL, "qdot^T (Mdot - 2C) qdot"),
     (TIME_PER_MASS_MATRIX, "time per M [s]"),

@@ -190,3 +190,14 @@ def test_the_energy_identity_holds_to_rounding_for_a_fast_arm_and_catches_a_cori
     planted = _judged(Elbow(coriolis_sign=-1.0), Elbow(), scene)[CORIOLIS_SKEW_RESIDUAL].value
     assert exact <= ENERGY_IDENTITY
     assert planted >= DETECTED
+
+
+def test_definiteness_is_unitless_joint_by_joint_and_sees_an_indefinite_mass_matrix():
+    """A prismatic joint's row and column scale with the unit of length (kg beside kg m^2): the metric must not
+    move (found by the rescale transform on a mixed chain); an indefinite M is <= 0."""
+    from simparity.comparisons.measure.joint_dynamics_metrics import _definiteness
+
+    mass = np.array([[[2.0, 0.3], [0.3, 0.5]]])
+    unit = np.diag([1.0, 3.7])  # the second joint's variable in another unit of length
+    assert _definiteness(unit @ mass @ unit).value == pytest.approx(_definiteness(mass).value, rel=1e-14)
+    assert _definiteness(np.array([[[1.0, 2.0], [2.0, 1.0]]])).value < 0

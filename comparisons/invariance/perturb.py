@@ -28,7 +28,7 @@ from dataclasses import replace
 import numpy as np
 
 from simparity.comparisons.invariance.transforms import Transform, transform_scene
-from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
+from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, KinematicsScene
 
 ULP_FACTORS = (np.nextafter(1.0, 2.0), np.nextafter(1.0, 0.0))
 """The two nearest floats to 1: a unit one ulp longer or shorter."""
@@ -70,6 +70,9 @@ def _nudged(scene, rng: np.random.Generator):
         return replace(scene, chain=chain)
     if isinstance(scene, IKScene):
         return replace(scene, chain=chain, q_start=ulp_nudge(scene.q_start, rng))
+    if isinstance(scene, JointDynamicsScene):
+        gravity = scene.gravity_world
+        return replace(scene, chain=chain, gravity_world=None if gravity is None else ulp_nudge(gravity, rng))
     raise TypeError(f"no perturbation for a {type(scene).__name__}")
 
 

@@ -319,22 +319,17 @@ def _chain_scene(scene: KinematicsScene | IKScene, t: Transform):
 
 
 def _joint_dynamics_scene(scene: JointDynamicsScene, t: Transform) -> JointDynamicsScene:
-    """The chain placed, scaled and given mass and time units; gravity turned and scaled; the sampling scales in the
-    new units, so that the same seeded draws are the same states. One scale per quantity serves every joint: a chain
-    of revolute and prismatic joints takes no length or time scale (their velocities scale differently)."""
+    """The chain placed, scaled and given mass and time units; gravity turned and scaled; each joint's sampling scales
+    in the new units (a prismatic joint's variable is a length, a revolute one's an angle), so that the same seeded
+    draws are the same states."""
     untouched = not t.moves_frame and t.mass_scale == 1.0  # time alone: a URDF chain keeps its file
     chain = scene.chain if untouched else _chain(scene.chain, t, scene.source)
-    kinds = {j.type for j in scene.chain.joints}
-    if len(kinds) > 1 and (t.length_scale != 1.0 or t.time_scale != 1.0):
-        raise TransformError(scene.source, f"transform {t.name}", "the chain mixes revolute and prismatic joints: "
-                             "their velocities, accelerations and forces scale differently with length and time, and "
-                             "the scene samples each with one scale", "a chain of one joint type, or no L or T scale")
-    variable = 1 if kinds == {"prismatic"} else 0  # the joint variable's power of length: m, or rad
+    variable = np.array([1 if j.type == "prismatic" else 0 for j in scene.chain.joints])  # power of length: m or rad
     gravity = scene.gravity_world
     return replace(scene, chain=chain, gravity_world=None if gravity is None else t.vector(gravity, length=1, time=-2),
-                   velocity_scale=t.factor(length=variable, time=-1) * scene.velocity_scale,
-                   acceleration_scale=t.factor(length=variable, time=-2) * scene.acceleration_scale,
-                   torque_scale=t.factor(length=2 - variable, mass=1, time=-2) * scene.torque_scale)
+                   velocity_scale=t.length_scale ** variable / t.time_scale * scene.velocity_scale,
+                   acceleration_scale=t.length_scale ** variable / t.time_scale ** 2 * scene.acceleration_scale,
+                   torque_scale=t.length_scale ** (2 - variable) * t.factor(mass=1, time=-2) * scene.torque_scale)
 
 
 FIXED_SEED = 22

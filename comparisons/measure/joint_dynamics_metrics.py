@@ -145,9 +145,7 @@ def identities(model: JointDynamicsModel, scene: JointDynamicsScene, own: dict[s
                                              np.maximum(np.abs(tau), _rounded_force(mass, there)), "the joint force")
     values[MASS_MATRIX_ASYMMETRY] = _over(mass - np.swapaxes(mass, -1, -2), float(np.max(np.abs(mass))),
                                           "the mass matrix")
-    symmetric = 0.5 * (mass + np.swapaxes(mass, -1, -2))
-    eigen = np.linalg.eigvalsh(symmetric)
-    values[MASS_MATRIX_DEFINITENESS_MIN] = Measured(float(np.min(eigen[:, 0] / eigen[:, -1])), "1")
+    values[MASS_MATRIX_DEFINITENESS_MIN] = _definiteness(mass)
     armature = np.array([joint.armature for joint in scene.chain.joints])
     quadratic = 0.5 * np.einsum("bi,bij,bj->b", qd, mass, qd) - 0.5 * np.sum(armature * qd**2, axis=-1)
     kinetic = model.link_kinetic_energy(q, qd)
@@ -155,6 +153,19 @@ def identities(model: JointDynamicsModel, scene: JointDynamicsScene, own: dict[s
                                             "the links' kinetic energy")
     values[CORIOLIS_SKEW_RESIDUAL] = _skew_residual(model, q, qd, own["h"] - gravity, mass)
     return values
+
+
+def _definiteness(mass: np.ndarray) -> Measured:
+    """min over states of the smallest eigenvalue of D^-1/2 M D^-1/2, D = diag(M): > 0 exactly when M is positive
+    definite, and unitless joint by joint (a prismatic joint's kg beside a revolute joint's kg m^2: lambda_min /
+    lambda_max of M itself would change with the unit of length). A diagonal entry <= 0 is not definite: 0."""
+    symmetric = 0.5 * (mass + np.swapaxes(mass, -1, -2))
+    diagonal = np.diagonal(symmetric, axis1=-2, axis2=-1)
+    if not np.all(diagonal > 0):
+        return Measured(0.0, "1")
+    inverse_root = 1.0 / np.sqrt(diagonal)
+    scaled = symmetric * inverse_root[:, :, None] * inverse_root[:, None, :]
+    return Measured(float(np.min(np.linalg.eigvalsh(scaled)[:, 0])), "1")
 
 
 def _skew_residual(model: JointDynamicsModel, q: np.ndarray, qd: np.ndarray, coriolis: np.ndarray,

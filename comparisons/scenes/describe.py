@@ -61,11 +61,17 @@ def _contact_lines(scene: DynamicsScene) -> list[str]:
     return lines
 
 
+def _scales(values) -> str:
+    """One number when every joint shares it, else the list."""
+    values = list(values)
+    return f"{values[0]:.10g}" if len(set(values)) == 1 else _vector(values)
+
+
 def _joint_dynamics_lines(scene: JointDynamicsScene) -> list[str]:
     gravity = "none" if scene.gravity_world is None else f"{_vector(scene.gravity_world)} m/s^2"
     lines = [f"gravity_world {gravity} (in the base frame); {scene.n_states} states (seed {scene.seed}): q within the "
-             f"limits, |qdot| <= {scene.velocity_scale:.10g}, |qddot| <= {scene.acceleration_scale:.10g}, |tau| <= "
-             f"{scene.torque_scale:.10g} per joint"]
+             f"limits, |qdot| <= {_scales(scene.velocity_scale)}, |qddot| <= {_scales(scene.acceleration_scale)}, "
+             f"|tau| <= {_scales(scene.torque_scale)} per joint"]
     for joint in scene.chain.joints:
         link = joint.link
         assert link is not None  # a joint-dynamics scene's chain has mass properties (checked when built)

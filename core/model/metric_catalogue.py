@@ -176,7 +176,7 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(ROUND_TRIP_RESIDUAL, DIMENSIONLESS, VALIDITY,
            theory="ABA(q, qdot, RNEA(q, qdot, qddot)) = qddot (in torque space): 0 up to rounding"),
     Metric(MASS_MATRIX_ASYMMETRY, DIMENSIONLESS, VALIDITY, theory="M = M^T: 0 up to rounding"),
-    Metric(MASS_MATRIX_DEFINITENESS_MIN, DIMENSIONLESS, VALIDITY, theory="> 0: M is positive definite"),
+    Metric(MASS_MATRIX_DEFINITENESS_MIN, DIMENSIONLESS, VALIDITY, theory="> 0: M (scaled by its diagonal) is positive definite"),
     Metric(KINETIC_ENERGY_RESIDUAL, DIMENSIONLESS, VALIDITY,
            theory="1/2 qdot^T M qdot = the links' kinetic energy: 0 up to rounding"),
     Metric(CORIOLIS_SKEW_RESIDUAL, DIMENSIONLESS, VALIDITY,

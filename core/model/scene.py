@@ -792,9 +792,11 @@ class JointDynamicsScene:
     n_states : int
         Seeded random states (q, qdot, qddot, tau).
     seed : int
-    velocity_scale, acceleration_scale, torque_scale : float
+    velocity_scale, acceleration_scale, torque_scale : float or (n,) ndarray
         qdot, qddot and tau are uniform in [-scale, scale] per joint [rad/s or m/s, rad/s^2 or m/s^2,
-        N m or N]; q is uniform within the limits (:func:`sample_configurations`).
+        N m or N]; q is uniform within the limits (:func:`sample_configurations`). One number serves every joint;
+        stored as one per joint, (n,), so that a change of units can scale a revolute and a prismatic joint's
+        differently.
     source : str
     suites : tuple of str
     sweep : SweepPoint or None
@@ -807,9 +809,9 @@ class JointDynamicsScene:
     gravity_world: np.ndarray | None
     n_states: int
     seed: int
-    velocity_scale: float = 1.0
-    acceleration_scale: float = 1.0
-    torque_scale: float = 1.0
+    velocity_scale: float | np.ndarray = 1.0
+    acceleration_scale: float | np.ndarray = 1.0
+    torque_scale: float | np.ndarray = 1.0
     source: str = field(default="<code>", compare=False)
     suites: tuple[str, ...] = ("default",)
     sweep: SweepPoint | None = None
@@ -821,6 +823,11 @@ class JointDynamicsScene:
             raise SceneError(self.source, "chain", problem, "a chain with mass properties on every link")
         if self.gravity_world is not None:
             object.__setattr__(self, "gravity_world", readonly(self.gravity_world, shape=(3,)))
+        for key in ("velocity_scale", "acceleration_scale", "torque_scale"):
+            scale = np.broadcast_to(np.asarray(getattr(self, key), dtype=float), (self.chain.n_joints,))
+            if not np.all(np.isfinite(scale) & (scale > 0)):
+                raise SceneError(self.source, key, f"{scale.tolist()}", "finite numbers > 0, one or one per joint")
+            object.__setattr__(self, key, readonly(scale, shape=(self.chain.n_joints,)))
 
     def states(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """(q, qdot, qddot, tau), each (n_states, n): seeded, q within the limits."""
