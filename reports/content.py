@@ -338,17 +338,16 @@ class _Builder:
         return blocks + self.joint_dynamics_summary() + self.findings() + self.unresolved()
 
     def joint_dynamics_summary(self) -> list[Block]:
-        """One line per engine and method over the run's joint-dynamics scenes: its worst error against the references
-        and its worst identity residual (the section "Joint-space dynamics" has them per scene)."""
+        """One line per engine and method over the run's joint-dynamics scenes (two or more): its worst error against the
+        references and its worst identity residual (the section "Joint-space dynamics" has them per scene)."""
         rows = self.table[self.table["scene"].isin(self.joint_dynamics_scenes)]
-        if rows.empty:
+        if len(self.joint_dynamics_scenes) < 2:  # one scene: its section's table says the same
             return []
         cells = [f"{engine} {method} {_worst_cell(case)}"
                  for (engine, method), case in rows.groupby(["engine", "integrator"], sort=False)]
-        return [Heading(3, "Joint-space dynamics"),
-                Paragraph(f"Over {len(self.joint_dynamics_scenes)} scenes, each engine's worst relative error of M, "
-                          "h, tau and qddot against the references, then (\"id\") its worst identity residual: "
-                          + "; ".join(cells) + ".")]
+        return [Paragraph(f"**Joint-space dynamics** over {len(self.joint_dynamics_scenes)} scenes, each engine's "
+                          "worst relative error of M, h, tau and qddot against the references, then (\"id\") its "
+                          "worst identity residual: " + "; ".join(cells) + ".")]
 
     def per_engine_table(self) -> list[Block]:
         """The per-engine answer over the run's dynamics scenes (sweeps have theirs in their section): how often each
@@ -531,21 +530,19 @@ class _Builder:
                                                  & (rows["integrator"] == case[1])])
                  for scene in scenes for case in cases}
         labels = [f"{e} {m}" for e, m in cases]
-        if len(cases) <= len(scenes):  # the fewer of the two across, so that a row stays readable
-            table = Table(("scene", *labels), tuple((scene, *(cells[scene, c] for c in cases)) for scene in scenes))
-        else:
-            table = Table(("engine method", *scenes), tuple((label, *(cells[s, c] for s in scenes))
+        by_scene = Table(("scene", *labels), tuple((scene, *(cells[scene, c] for c in cases)) for scene in scenes))
+        by_engine = Table(("engine method", *scenes), tuple((label, *(cells[s, c] for s in scenes))
                                                             for label, c in zip(labels, cases)))
+        # a row per scene when its row fits a line (few lines in a default run), else the fewer of the two across
+        fits = _row_width(by_scene) <= LINE_CHARS
+        table = by_scene if fits or len(cases) <= len(scenes) else by_engine
         full = tables.metric_table(rows, tables.JOINT_DYNAMICS_COLUMNS, ["scene", "engine", "integrator"])
         blocks: list[Block] = [Heading(2, "Joint-space dynamics"),
                 Bullets(tuple(f"**{scene}**: {self.introduction(scene, rows[rows['scene'] == scene])}"
-                              for scene in scenes)),
-                Paragraph("Per engine and method: the largest relative error of the mass matrix M, the bias forces h, "
-                          "inverse dynamics tau and forward dynamics qddot against each scene's reference, then (after "
-                          "'id') the largest residual of the identities of its own outputs (RNEA(q,0,0) = g, RNEA(q,0,"
-                          "e_i) - g = M e_i, ABA(RNEA) = id, M = M^T, kinetic energy from its own link velocities); "
-                          "each metric, the energy identity qdot^T (Mdot - 2C) qdot = 0, times and the reasons for "
-                          "n/a: the HTML report."),
+                              for scene in scenes)
+                        + ("Each cell: the largest relative error of M, h, tau (RNEA) and qddot (ABA) against the "
+                           "reference, then ('id') the largest residual of the identities of the engine's own outputs; "
+                           "each metric, times and the reasons for n/a: the HTML report (docs/metrics.md).",)),
                 table, Details("Every joint-dynamics metric", (full,), markdown=False, open=True)]
         return blocks + _notes(rows)
 
@@ -789,6 +786,11 @@ _JOINT_DYNAMICS_ERRORS = (MASS_MATRIX_ERROR_MAX, BIAS_FORCE_ERROR_MAX, INVERSE_D
                           FORWARD_DYNAMICS_ERROR_MAX)
 _JOINT_DYNAMICS_IDENTITIES = (GRAVITY_IDENTITY_RESIDUAL, MASS_COLUMN_RESIDUAL, ROUND_TRIP_RESIDUAL,
                               MASS_MATRIX_ASYMMETRY, KINETIC_ENERGY_RESIDUAL)
+
+
+def _row_width(table: Table) -> int:
+    """Characters of the table's widest markdown row ("| a | b |")."""
+    return max(sum(len(str(cell)) + 3 for cell in row) + 1 for row in (table.head, *table.rows))
 
 
 def _worst_cell(case: pd.DataFrame) -> str:
