@@ -79,7 +79,7 @@ def _scene(seed: int = 5, gravity=(0.0, -GRAVITY, 0.0), damping: float = 0.0) ->
 def _judged(model: JointDynamicsModel, reference: JointDynamicsModel, scene: JointDynamicsScene) -> dict:
     states = scene.states()
     own, ref = reference_values(model, states), reference_values(reference, states)
-    return reference_errors(own, ref) | identities(model, scene, own)
+    return reference_errors(own, ref) | identities(model, scene.chain, states, own)
 
 
 def test_an_exact_model_passes_every_identity_and_agrees_with_itself():

@@ -521,7 +521,7 @@ def _joint_dynamics_case(scene: JointDynamicsScene, engine: Engine, case: Case, 
         if problem:
             status = DIVERGED if problem.startswith("non-finite") else FAILED
             return case.rows(JOINT_DYNAMICS_METRICS, status, problem, values)
-        values.update(identities(model, scene, own))
+        values.update(identities(model, scene.chain, shared.states, own))
     except Exception as err:  # noqa: BLE001 - reported in the rows
         return case.rows(JOINT_DYNAMICS_METRICS, FAILED, error_text(err))
     detail = ("this is the reference; " if is_reference else "") + model.detail

@@ -45,7 +45,7 @@ from simparity.core.model.metric_catalogue import (
     TIME_PER_MASS_MATRIX,
     units,
 )
-from simparity.core.model.scene import JointDynamicsScene
+from simparity.core.model.scene import Chain
 
 JOINT_DYNAMICS_METRICS = units(
     MASS_MATRIX_ERROR_MAX,
@@ -123,14 +123,15 @@ def _rounded_force(mass: np.ndarray, qddot: np.ndarray) -> np.ndarray:
     return np.einsum("bij,bj->bi", np.abs(mass), np.abs(qddot))
 
 
-def identities(model: JointDynamicsModel, scene: JointDynamicsScene, own: dict[str, np.ndarray]) -> dict[str, Measured]:
-    """The identities of the engine's own outputs ``own`` (:func:`reference_values` of the engine) at the scene's
-    states: RNEA(q, 0, 0) = g(q) = h(q, 0); RNEA(q, 0, e_i) - g = M e_i; RNEA(ABA(RNEA(qddot))) = RNEA(qddot) (the
+def identities(model: JointDynamicsModel, chain: Chain, states: tuple[np.ndarray, ...],
+               own: dict[str, np.ndarray]) -> dict[str, Measured]:
+    """The identities of the engine's own outputs ``own`` (:func:`reference_values` of the engine, at ``states``) of
+    ``chain``: RNEA(q, 0, 0) = g(q) = h(q, 0); RNEA(q, 0, e_i) - g = M e_i; RNEA(ABA(RNEA(qddot))) = RNEA(qddot) (the
     round trip in torque space); M symmetric and
     positive definite; 1/2 qdot^T M qdot (armature aside) = the links' kinetic energy from the engine's own
     kinematics; qdot^T (Mdot - 2 C) qdot = 0."""
-    q, qd, qdd, _ = scene.states()
-    n = scene.chain.n_joints
+    q, qd, qdd, _ = states
+    n = chain.n_joints
     mass, tau = own["M"], own["tau"]
     torque_scale = float(np.max(np.abs(tau)))
     zeros = np.zeros_like(q)
@@ -146,7 +147,7 @@ def identities(model: JointDynamicsModel, scene: JointDynamicsScene, own: dict[s
     values[MASS_MATRIX_ASYMMETRY] = _over(mass - np.swapaxes(mass, -1, -2), float(np.max(np.abs(mass))),
                                           "the mass matrix")
     values[MASS_MATRIX_DEFINITENESS_MIN] = _definiteness(mass)
-    armature = np.array([joint.armature for joint in scene.chain.joints])
+    armature = np.array([joint.armature for joint in chain.joints])
     quadratic = 0.5 * np.einsum("bi,bij,bj->b", qd, mass, qd) - 0.5 * np.sum(armature * qd**2, axis=-1)
     kinetic = model.link_kinetic_energy(q, qd)
     values[KINETIC_ENERGY_RESIDUAL] = _over(quadratic - kinetic, float(np.max(np.abs(kinetic))),
