@@ -13,7 +13,9 @@ computed from the same run:
 3. IK on the ``bench`` suite's arms (TRAC-IK protocol), solve rate and time per solve, failures
    inside the time, limit violations;
 4. joint-space dynamics (M + h, RNEA, ABA) of the ``articulated`` suite's real arms, time per state with the largest
-   relative difference to Pinocchio (:mod:`comparisons.bench_joint_dynamics`).
+   relative difference to Pinocchio (:mod:`comparisons.bench_joint_dynamics`);
+5. joint motion of the falling arms, time per copy-step of each engine's RK4 at equal accuracy (the error against
+   DOP853 and the difference to Pinocchio's RK4) (:mod:`comparisons.bench_joint_motion`).
 
 Results go to ``benchmarks.csv`` (one tidy row per measurement) and ``BENCHMARKS.md``, with a verdict on each of
 the issue's targets that says what it compared. The targets are set for the full sizes (:data:`TARGET_BATCH` bodies
@@ -41,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from simparity.comparisons import bench_joint_dynamics
+from simparity.comparisons import bench_joint_dynamics, bench_joint_motion
 from simparity.comparisons.scenes import library
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.ik_targets import random_targets
@@ -571,6 +573,7 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
                          + f" | {_cell(max(c.accuracy for c in cells.values()), '.1e')} |")
         lines.append("")
     lines += bench_joint_dynamics.markdown_lines(rows)
+    lines += bench_joint_motion.markdown_lines(rows)
     ik = [r for r in rows if r.section == "ik"]
     if ik:
         lines += [f"## IK, TRAC-IK protocol ({ik[0].batch:,} seeded pose targets per arm from mid-range, success at "
@@ -603,8 +606,8 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
 
 
 def profile_summary(batch: int, say: Callable[[str], None]) -> str:
-    """cProfile of core's rk4 on ``batch`` tumbling boxes, of its restarted IK on the iiwa and of its ABA on ``batch``
-    iiwa states, top functions."""
+    """cProfile of core's rk4 on ``batch`` tumbling boxes, of its restarted IK on the iiwa, of its ABA on ``batch``
+    iiwa states and of its rk4 joint motion on ``batch`` falling iiwas, top functions."""
     import cProfile
     import io
     import pstats
@@ -622,7 +625,8 @@ def profile_summary(batch: int, say: Callable[[str], None]) -> str:
                         (f"core damped_least_squares+restarts, {scene.n_targets:,} iiwa targets",
                          lambda: model.solve(targets.position_world, targets.rotation_world, scene.q_start)),
                         (f"core recursive forward dynamics (ABA), {batch:,} iiwa states, 20 calls",
-                         lambda: [dynamics.forward_dynamics(q, qd, tau) for _ in range(20)])):
+                         lambda: [dynamics.forward_dynamics(q, qd, tau) for _ in range(20)]),
+                        bench_joint_motion.profile_case(batch)):
         say(f"  profiling {title}")
         profiler = cProfile.Profile()
         profiler.runcall(call)
@@ -644,6 +648,8 @@ def run_bench(out_dir: Path, quick: bool, command: str, say: Callable[[str], Non
     rows += kinematics_rows(batches, say)
     say("joint-space dynamics (time per state, with the difference to Pinocchio)")
     rows += bench_joint_dynamics.joint_dynamics_rows(batches, lambda fn: median_time(fn, REPEATS), BenchRow, say)
+    say("joint motion (time per copy-step, with the error against DOP853 and the difference to Pinocchio's RK4)")
+    rows += bench_joint_motion.joint_motion_rows(batches, median_time, BenchRow, say)
     say("IK")
     rows += ik_rows(300 if quick else None, say)
     say("memory of simparity run against the number of steps")

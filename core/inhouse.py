@@ -20,9 +20,11 @@ from simparity.core.contact.bodies import (
 )
 from simparity.core.contact.act_after import GAUSS_SEIDEL_PASSES, ActAfterStepper
 from simparity.core.contact.backup import FREE, MAX_EVENTS_PER_STEP, BackupStepper
-from simparity.core.model.engine import (BatchedRun, Engine, IKModel, JointDynamicsModel, KinematicsModel, Simulation,
-                                         Support)
+from simparity.core.model.engine import (BatchedRun, Engine, IKModel, JointDynamicsModel, JointSimulation,
+                                         KinematicsModel, Simulation, Support)
 from simparity.core.articulated import model as joint_dynamics
+from simparity.core.articulated import stepping as joint_stepping
+from simparity.core.articulated.motion import CoreJointMotion
 from simparity.core.dynamics.forces import make_wrench
 from simparity.core.ik.jacobian_solvers import METHODS, IKOptions, solve_ik, task_basis
 from simparity.core.model.ik_problem import IKTolerances
@@ -33,7 +35,7 @@ from simparity.core.dynamics.quaternion_integrators import PackedBodies, make_pa
 from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.dynamics.rigid_body import MassProperties, State, initial_state, velocities
 from simparity.core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
-from simparity.core.model.scene import PENALTY_PREFIX, Chain, DynamicsScene, IKScene
+from simparity.core.model.scene import PENALTY_PREFIX, Chain, DynamicsScene, IKScene, JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
 
 _DEFAULT_ORIENTATION = "quaternion"
@@ -304,6 +306,8 @@ class InHouseEngine(Engine):
         scene) and the contact methods (a contact's first-order or exact treatment dominates the scheme's)."""
         if integrator in CONTACT_INTEGRATORS:
             return None
+        if integrator in joint_stepping.SCHEMES:
+            return joint_stepping.ORDER[integrator]
         return ORDER.get(parse_integrator(integrator)[0])
 
     def stages(self, integrator: str) -> int | None:
@@ -321,6 +325,8 @@ class InHouseEngine(Engine):
             return STAGES[FLIGHT_SCHEME]
         if integrator in CONTACT_INTEGRATORS:
             return STAGES[integrator.removeprefix(PENALTY_PREFIX)]
+        if integrator in joint_stepping.SCHEMES:
+            return joint_stepping.STAGES[integrator]
         return STAGES.get(parse_integrator(integrator)[0])
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
@@ -373,6 +379,13 @@ class InHouseEngine(Engine):
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
         return joint_dynamics.build(chain, method, gravity_world)
+
+    def joint_motion_integrators(self) -> tuple[str, ...]:
+        """The free-body family on the joints, plus implicit damping (:mod:`core.articulated.stepping`)."""
+        return joint_stepping.SCHEMES
+
+    def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
+        return CoreJointMotion(scene, integrator, dt)
 
     def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
         named = super().supports_ik(chain, solver, position_only)

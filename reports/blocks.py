@@ -34,8 +34,13 @@ class Bullets:
 
 @dataclass(frozen=True)
 class Table:
+    """``trim_order``: for a long list (cases without a result, findings) that report.md may shorten to keep within its
+    line budget (:data:`reports.markdown.MAX_LINES`), saying how many rows the HTML has beyond it: 1 is shortened
+    first, 2 next; 0 (the default) never."""
+
     head: tuple[str, ...]
     rows: tuple[tuple[str, ...], ...]
+    trim_order: int = 0
 
 
 @dataclass(frozen=True)

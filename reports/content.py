@@ -16,6 +16,8 @@ import pandas as pd
 
 from simparity.core.model.run_info import RunInfo
 from simparity.core.model.results import (
+    DIVERGED,
+    FAILED,
     GROUND_TRUTH_ENGINES,
     HARD_VERDICT_SUFFIXES,
     NOT_AVAILABLE,
@@ -44,7 +46,7 @@ from simparity.core.model.metric_catalogue import (
     POSITION_RESIDUAL_MEDIAN, RESTITUTION_MEASURED, REST_TIME_ERROR, SOLVE_RATE, SOLVE_RATE_OWN_STOP, STOPPING_DISTANCE,
     TIME_PER_FK, TIME_PER_SOLVE, TIME_PER_STEP, MASS_MATRIX_ERROR_MAX, BIAS_FORCE_ERROR_MAX, INVERSE_DYNAMICS_ERROR_MAX,
     FORWARD_DYNAMICS_ERROR_MAX, GRAVITY_IDENTITY_RESIDUAL, MASS_COLUMN_RESIDUAL, ROUND_TRIP_RESIDUAL,
-    MASS_MATRIX_ASYMMETRY, KINETIC_ENERGY_RESIDUAL,
+    MASS_MATRIX_ASYMMETRY, KINETIC_ENERGY_RESIDUAL, JOINT_ANGLE_ERROR_MAX, REFERENCE_PARTING_TIME, SELF_PARTING_TIME,
 )
 
 FIGURES_DIR = "figures"
@@ -91,7 +93,8 @@ _DEFINITIONS = (
     "docs/metrics.md."
 )
 _HEADLINE_NAMES = {POSITION_ERROR_MAX: ("position error max", "m"),
-                   ORIENTATION_ERROR_MAX: ("orientation error max", "rad")}
+                   ORIENTATION_ERROR_MAX: ("orientation error max", "rad"),
+                   JOINT_ANGLE_ERROR_MAX: ("joint angle error max", "rad")}
 
 
 def _notes(scene_rows: pd.DataFrame) -> list[Block]:
@@ -196,6 +199,36 @@ def _kind(rows: pd.DataFrame) -> str:
     if (rows["metric"] == MASS_MATRIX_ERROR_MAX).any():
         return "joint_dynamics"
     return "dynamics" if rows["dt"].notna().any() else "kinematics"
+
+
+_UNRESOLVED_RANK = {FAILED: 0, DIVERGED: 1}
+"""The order of the rows of cases without a result: failed, then diverged, then n/a (stable within each), so that a
+report.md over its line budget keeps what broke."""
+
+
+def _predictability(rows: pd.DataFrame) -> list[Block]:
+    """A chaotic scene's predictability at its finest time step (Chung and Pollard): when each scheme's run parts
+    from its own run from a perturbed start, beside when it parts from the reference; nothing where not measured."""
+    parting = rows[rows["metric"].isin([SELF_PARTING_TIME, REFERENCE_PARTING_TIME]) & rows["dt"].notna()]
+    if parting.empty:
+        return []
+    finest = parting[parting["dt"] == parting["dt"].min()]
+    cells = {(r["engine"], r["integrator"], r["metric"]): (f"{r['value']:.3g}" if r["status"] == OK else "not within "
+                                                             "the run" if "whole run" in str(r["detail"]) else r["status"])
+             for _, r in finest.iterrows()}
+    cases = list(dict.fromkeys(zip(finest["engine"], finest["integrator"])))
+    return [Paragraph(f"Predictability at dt = {finest['dt'].iloc[0]:g} s: when each scheme's run parts (a joint 1e-3 "
+                      "rad off) from its own run from a start perturbed by the scene's perturbation, and from the "
+                      "reference's; parting from the reference no later than from itself is the chain's chaos, not a "
+                      "defect."),
+            Table(("engine", "integrator", "parts from itself [s]", "parts from the reference [s]"),
+                  tuple((e, i, cells.get((e, i, SELF_PARTING_TIME), "—"), cells.get((e, i, REFERENCE_PARTING_TIME), "—"))
+                        for e, i in cases))]
+
+
+def _heading_kind(about: dict, kind: str) -> str:
+    """What a scene section's heading calls its kind: a chain's motion is reported as dynamics, named as itself."""
+    return "joint motion" if about.get("kind") == "joint_motion" else kind
 
 
 def _headline(about: dict) -> str:
@@ -311,7 +344,7 @@ class _Builder:
             elif kind == "dynamics":
                 name, unit = _HEADLINE_NAMES[_headline(about)]
                 cases = self.cases[scene]
-                cells = [f"[{scene}](#{scene_heading(scene, kind).anchor})",
+                cells = [f"[{scene}](#{scene_heading(scene, _heading_kind(about, kind)).anchor})",
                          f"{name.removesuffix(' error max')} [{unit}] vs `{rows['reference'].iloc[0]}`"]
                 cells += [engine_summary.overall(cases, b, by) for b in summary.ERROR_BUDGETS]
                 cells += [_scheme(summary.most_accurate_within(cases, b, by), unit) for b in summary.cost_budgets(by)]
@@ -403,7 +436,7 @@ class _Builder:
         blocks: list[Block] = [Heading(3, "Flagged findings")]
         if rows:
             blocks.append(Table(("finding", "scene", "engine × scheme (or metric: cases)", "dt [s]", "largest",
-                                 "what it means"), tuple(rows)))
+                                 "what it means"), tuple(rows), trim_order=2))
         blocks.append(Paragraph(self.tolerance_line()))
         if self.verdict and self.verdict.violations:
             blocks.append(Details(f"{self.verdict.outside_count} metrics outside their bounds",
@@ -465,9 +498,10 @@ class _Builder:
                          str(g["n_cases"].sum()), _dt_range(union(g["dts"])),
                          _clip(g["reason"].iloc[0] or "no reason given", REASON_CHARS)
                          + (f" (and {g['reason'].nunique() - 1} more like it)" if g["reason"].nunique() > 1 else "")))
+        rows.sort(key=lambda row: _UNRESOLVED_RANK.get(row[0], len(_UNRESOLVED_RANK)))  # what broke first
         return [Heading(3, "Cases without a result"),
                 Table(("status", "scenes", "engine × scheme", "cases", "dt [s]", "reason (the first; others alike but for "
-                       "their numbers; each in full: its `detail` in `results.csv`)"), tuple(rows))]
+                       "their numbers; each in full: its `detail` in `results.csv`)"), tuple(rows), trim_order=1)]
 
     # -- scenes --------------------------------------------------------------------------------
 
@@ -494,7 +528,7 @@ class _Builder:
         run = self.dynamics if kind == "dynamics" else self.ik
         verdict, body = run(scene, rows, about, reference, series)
         lead = Bullets((f"**Verdict**: {verdict}", f"**Scene**: {self.introduction(scene, rows)}"))
-        return [scene_heading(scene, kind), lead, *body, *_notes(rows)]
+        return [scene_heading(scene, _heading_kind(about, kind)), lead, *body, *_notes(rows)]
 
     def kinematics(self, rows: pd.DataFrame) -> list[Block]:
         """One section for every kinematics scene: in report.md each scene's frame position error per engine (the
@@ -578,14 +612,16 @@ class _Builder:
         blocks += contact.figure if contact else []
         blocks += [self.per_engine(scene, cases, fits, unit, contact), self.per_scheme(cases, observed, about, unit)]
         blocks += contact.blocks if contact else []
-        full: list[Block] = [tables.metric_table(rows[rows["dt"].notna()], tables.DYNAMICS_COLUMNS,
-                                                 ["engine", "integrator", "dt"])]
+        blocks += _predictability(rows)
+        columns, order_columns = ((tables.JOINT_MOTION_COLUMNS, tables.JOINT_ORDER_COLUMNS)
+                                  if headline == JOINT_ANGLE_ERROR_MAX else (tables.DYNAMICS_COLUMNS, tables.ORDER_COLUMNS))
+        full: list[Block] = [tables.metric_table(rows[rows["dt"].notna()], columns, ["engine", "integrator", "dt"])]
         orders = rows[rows["dt"].isna()]
         if not orders.empty:
             explained: list[Block] = [
                 Paragraph("Observed order of convergence: slope of log(error max) against log(dt) over the finest "
                           "time steps whose local slopes agree; errors at the rounding floor or saturated are left out."),
-                tables.metric_table(orders, tables.ORDER_COLUMNS, ["engine", "integrator"])]
+                tables.metric_table(orders, order_columns, ["engine", "integrator"])]
             full += explained + _fits(orders)
         verdict = engine_summary.dynamics_verdict(cases, fits, self.findings_of(scene), unit,
                                                   engine_summary.order_alarms(rows, headline))

@@ -29,7 +29,9 @@ from simparity.core.runtime.processes import die_with_parent  # noqa: E402
 from simparity.core.model.results import SWEEP_PREFIX  # noqa: E402
 from simparity.reports.figure_layout import finish, legend, power_of_ten, title, wrap  # noqa: E402
 from simparity.reports.summary import AGREE_RELATIVE, ERROR_BUDGETS, EVALUATIONS  # noqa: E402
-from simparity.core.model.metric_catalogue import ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE, TIME_PER_SOLVE
+from simparity.core.model.metric_catalogue import (
+    JOINT_ANGLE_ERROR_MAX, ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE, TIME_PER_SOLVE,
+)
 
 _ENGINE_MARKERS = {"core": "o", "mujoco": "s", "pybullet": "^", "pinocchio": "D"}
 """The marker of a scheme without variants: its engine's."""
@@ -42,7 +44,8 @@ SLOPE_OFFSET = 4.0
 """[factor] A theoretical slope is drawn this far below the lowest line of its order (0.6 decade): beside the data,
 not over it."""
 _HEADLINE_LABELS = {POSITION_ERROR_MAX: "position error max [m]",
-                    ORIENTATION_ERROR_MAX: "orientation error max [rad]"}
+                    ORIENTATION_ERROR_MAX: "orientation error max [rad]",
+                    JOINT_ANGLE_ERROR_MAX: "joint angle error max [rad]"}
 _DRIFT_PANELS = [("energy_change", "|E(t) - E(0)| / |E(0)|"), ("angular_momentum_change", "|L(t) - L(0)| / |L(0)|"),
                  ("position_error", "position error [m]"), ("orientation_error", "orientation error [rad]")]
 _COLORS = (tuple(plt.get_cmap("tab10").colors) + tuple(plt.get_cmap("tab20").colors[1::2])  # type: ignore[attr-defined]  # ListedColormap

@@ -5,13 +5,24 @@ that would be longer has its longest cells shortened (report.html and results.cs
 from __future__ import annotations
 
 import itertools
+import math
 import re
+from typing import cast
 
 from simparity.reports.blocks import Block, Bullets, Details, Figure, Heading, Paragraph, Table
 
 LINE_CHARS = 300
 """Characters a line of report.md stays under (issue #26): a reader scanning the file in an editor or a diff, and
 a table row a reviewer can read on one screen; what is longer is said compactly, wrapped or shortened."""
+
+MAX_LINES = 400
+"""Lines report.md stays within where it can (issue #26): a pull request's reviewer reads it on a few screens. Over it,
+the tables that may be trimmed (:attr:`reports.blocks.Table.trim_order`: cases without a result, then flagged
+findings) give up their last rows, in that order, down to :data:`MIN_TRIMMED_ROWS` each, with a row saying how many
+more report.html has; every other block stays whole."""
+
+MIN_TRIMMED_ROWS = 5
+"""Rows a trimmed table keeps at least: its first rows are its most important (each table is sorted so)."""
 
 WRAP_CHARS = LINE_CHARS
 """Where text wraps: a line takes words while it stays within :data:`LINE_CHARS` (longer only for a single word
@@ -90,8 +101,7 @@ def _figures(run: list[Figure], figure_dir: str) -> list[str]:
     return _wrap(" ".join(links)) + [""]
 
 
-def to_markdown(blocks: list[Block], figure_dir: str = "figures") -> str:
-    """Markdown text of the blocks; folded blocks marked markdown=False are left out (they are in the HTML)."""
+def _render(blocks: list[Block], figure_dir: str) -> list[str]:
     lines: list[str] = []
     for is_figure, run in itertools.groupby(blocks, key=lambda b: isinstance(b, Figure)):
         if is_figure:
@@ -100,4 +110,38 @@ def to_markdown(blocks: list[Block], figure_dir: str = "figures") -> str:
             lines += [line for block in run for line in _lines(block, figure_dir)]
     while lines and not lines[-1]:
         lines.pop()
+    return lines
+
+
+def _trimmed(table: Table, keep: int) -> Table:
+    """``table`` with its first ``keep`` rows and a last one saying how many more report.html has."""
+    more = len(table.rows) - keep
+    note = (f"… {more} more rows: report.html",) + ("",) * (len(table.head) - 1)
+    return Table(table.head, table.rows[:keep] + (note,))
+
+
+def _within_budget(blocks: list[Block], excess: int) -> list[Block]:
+    """``blocks`` with the tables that may be trimmed shortened by ``excess`` lines in all where they can be: a row at
+    a time, the first in :attr:`Table.trim_order` first, each kept to at least :data:`MIN_TRIMMED_ROWS` rows (a
+    trimmed table gains a row saying so)."""
+    full = {i: len(b.rows) for i, b in enumerate(blocks) if isinstance(b, Table) and b.trim_order}
+    keep = dict(full)
+
+    def saved() -> int:
+        return sum(full[i] - keep[i] - (keep[i] < full[i]) for i in keep)
+    while saved() < excess:
+        cuttable = [i for i in keep if keep[i] > MIN_TRIMMED_ROWS]
+        if not cuttable:
+            break
+        keep[min(cuttable, key=lambda i: (cast(Table, blocks[i]).trim_order, i))] -= 1
+    return [_trimmed(b, keep[i]) if keep.get(i, math.inf) < full.get(i, 0) else b  # type: ignore[arg-type]
+            for i, b in enumerate(blocks)]
+
+
+def to_markdown(blocks: list[Block], figure_dir: str = "figures") -> str:
+    """Markdown text of the blocks; folded blocks marked markdown=False are left out (they are in the HTML). Over
+    :data:`MAX_LINES`, the tables that may be are shortened (:func:`_within_budget`)."""
+    lines = _render(blocks, figure_dir)
+    if len(lines) > MAX_LINES:
+        lines = _render(_within_budget(list(blocks), len(lines) - MAX_LINES), figure_dir)
     return "\n".join(lines) + "\n"

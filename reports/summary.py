@@ -21,8 +21,9 @@ from simparity.core.model.results import (
     UNSOLVED,
     case_status,
 )
+from simparity.core.model.engine import TRUTH_SCHEMES
 from simparity.core.model.metric_catalogue import (
-    APEX_HEIGHT_ERROR, ENERGY_GAIN_MAX, IMPACT_TIME_ERROR, ORDER_ORIENTATION, ORDER_POSITION, ORIENTATION_ERROR_MAX,
+    APEX_HEIGHT_ERROR, ENERGY_GAIN_MAX, IMPACT_TIME_ERROR, JOINT_ANGLE_ERROR_MAX, ORDER_JOINT_ANGLE, ORDER_ORIENTATION, ORDER_POSITION, ORIENTATION_ERROR_MAX,
     OWN_STOP_POSITION_TOLERANCE, PENETRATION_MAX, POSITION_ERROR_MAX, RESTITUTION_MEASURED, REST_TIME_ERROR, SOLVE_RATE,
     SOLVE_RATE_OWN_STOP, STABLE_DT_MAX, STOPPING_DISTANCE, TIME_PER_SOLVE, TIME_PER_STEP, TUNNELLED,
     EVALUATIONS_PER_SECOND, TIME_PER_STEP_BATCHED,
@@ -61,8 +62,9 @@ OVERHEAD_DOMINATED_BODIES = 100
 
 def dynamics_cases(rows: pd.DataFrame, headline: str) -> pd.DataFrame:
     """One row per scene x engine x integrator x dt of dynamics scenes (one scene, or a sweep's variants), ground
-    truths and the scene's reference scheme (core backup where core is the reference) left out: a scheme measured
-    against itself ranks nothing.
+    truths (their engines, and any engine's scheme of a truth's kind: Pinocchio's DOP853 solve of a chain) and the
+    scene's reference scheme (core backup where core is the reference) left out: a scheme measured against itself
+    ranks nothing.
 
     Columns: scene, engine, integrator, dt [s], status (the case's), error (the headline metric where it
     was measured, else NaN), time_per_step [s], cost [s of compute per simulated second], evaluations [force
@@ -71,6 +73,7 @@ def dynamics_cases(rows: pd.DataFrame, headline: str) -> pd.DataFrame:
     """
     keys = ["scene", "engine", "integrator", "dt"]
     per_dt = rows[rows["dt"].notna() & ~rows["engine"].isin(GROUND_TRUTH_ENGINES)
+                  & ~rows["scheme"].isin(TRUTH_SCHEMES)
                   & (rows["engine"] + ":" + rows["integrator"] != rows["reference"])]
     cases = per_dt.groupby(keys, sort=False)["status"].agg(case_status).rename("status").reset_index()
     columns = [headline, TIME_PER_STEP, EVALUATIONS_PER_SECOND, TIME_PER_STEP_BATCHED]
@@ -167,7 +170,8 @@ def best_per_scheme(cases: pd.DataFrame) -> pd.DataFrame:
                          how="left")
 
 
-ORDER_METRICS = {POSITION_ERROR_MAX: ORDER_POSITION, ORIENTATION_ERROR_MAX: ORDER_ORIENTATION}
+ORDER_METRICS = {POSITION_ERROR_MAX: ORDER_POSITION, ORIENTATION_ERROR_MAX: ORDER_ORIENTATION,
+                 JOINT_ANGLE_ERROR_MAX: ORDER_JOINT_ANGLE}
 """The row holding the observed order of convergence of each headline error."""
 
 

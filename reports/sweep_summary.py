@@ -16,7 +16,7 @@ from simparity.core.model.run_info import RunInfo
 from simparity.core.model.results import OK, SWEEP_COLUMN, SWEEP_PREFIX, case_status
 from simparity.reports import summary
 from simparity.core.model.metric_catalogue import (
-    MASS_MATRIX_ERROR_MAX, ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE, TIME_PER_FK,
+    JOINT_ANGLE_ERROR_MAX, MASS_MATRIX_ERROR_MAX, ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE, TIME_PER_FK,
     TIME_PER_FORWARD_DYNAMICS, TIME_PER_SOLVE,
 )
 
@@ -25,6 +25,7 @@ METRICS = {
     ORIENTATION_ERROR_MAX: ("orientation error max", "rad"),
     SOLVE_RATE: ("solve rate", ""),
     MASS_MATRIX_ERROR_MAX: ("mass matrix error max", ""),
+    JOINT_ANGLE_ERROR_MAX: ("joint angle error max", "rad"),
 }
 """The metric a sweep is judged by, with its name and unit: a dynamics scene's headline error (``run.json``; the
 position error where the variants' headlines differ), an IK scene's solve rate, a kinematics scene's frame position
@@ -108,6 +109,7 @@ def _metric(variants: list[str], info: RunInfo) -> tuple[str, str]:
     """(the kind of the variants, the metric their sweep is judged by)."""
     about = [info.scenes.get(name, {}) for name in variants]
     kind = about[0].get("kind", "dynamics")
+    kind = "dynamics" if kind == "joint_motion" else kind  # a chain's motion is summarised as dynamics
     if kind in _KIND_METRIC:
         return kind, _KIND_METRIC[kind]
     headlines = {a.get("headline_metric", POSITION_ERROR_MAX) for a in about}

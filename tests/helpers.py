@@ -274,3 +274,20 @@ def no_leftovers_within(seconds: float = LEFTOVER_SECONDS) -> bool:
             return False
         time.sleep(0.1)
     return True
+
+
+def with_key(data: dict, path: str, value) -> dict:
+    """A deep copy of parsed scene ``data`` with the key at ``path`` ("chain.joint.0.mass": a table's key, a list's
+    index) set to ``value`` (None: removed), missing tables made on the way."""
+    import copy
+
+    data = copy.deepcopy(data)
+    *heads, last = path.split(".")
+    node = data
+    for head in heads:
+        node = node[int(head)] if head.isdigit() else node.setdefault(head, {})
+    if value is None:
+        node.pop(last)
+    else:
+        node[last] = value
+    return data

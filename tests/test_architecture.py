@@ -63,7 +63,7 @@ def test_references_import_only_the_data_model_of_core(path):
 
 
 JUDGES = ("measure/metrics.py", "measure/contact_metrics.py", "measure/divergence.py", "measure/invariants.py",
-          "execute/ik_runner.py") + tuple(f"invariance/{p.name}" for p in sorted((ROOT / "comparisons" /
+          "measure/joint_motion_metrics.py", "execute/ik_runner.py") + tuple(f"invariance/{p.name}" for p in sorted((ROOT / "comparisons" /
                                                                                   "invariance").glob("*.py")))
 """The comparisons that measure and judge (the metamorphic ones included: a transform computed with core's
 rotations would agree with a bug in them): like a reference, they must not use the code they judge."""

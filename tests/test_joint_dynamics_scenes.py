@@ -11,6 +11,7 @@ import pytest
 from simparity.comparisons.scenes import library
 from simparity.comparisons.scenes.loader import parse_scene
 from simparity.core.model.errors import SceneError
+from tests.helpers import with_key
 from simparity.core.articulated import model as joint_dynamics
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.scene import JointDynamicsScene
@@ -25,19 +26,8 @@ PENDULUM = {
 
 
 def _with(path: str, value, data=None):
-    """PENDULUM (or ``data``) with the key at ``path`` ("chain.joint.0.mass") set to ``value`` (None: removed)."""
-    import copy
-
-    data = copy.deepcopy(data or PENDULUM)
-    *heads, last = path.split(".")
-    node = data
-    for head in heads:
-        node = node[int(head)] if head.isdigit() else node.setdefault(head, {})
-    if value is None:
-        node.pop(last)
-    else:
-        node[last] = value
-    return data
+    """PENDULUM (or ``data``) with the key at ``path`` set to ``value`` (None: removed)."""
+    return with_key(data or PENDULUM, path, value)
 
 
 def test_a_pendulum_file_reads_its_mass_properties_in_si():

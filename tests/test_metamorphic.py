@@ -46,7 +46,7 @@ from simparity.comparisons.invariance.transforms import FIXED_TRANSFORMS, fixed_
 from simparity.core.model.errors import TransformError
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.results import DIVERGED, FAILED, OK, ResultRow
-from simparity.core.model.scene import IKScene, JointDynamicsScene, KinematicsScene, Plane
+from simparity.core.model.scene import IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene, Plane
 from tests.helpers import THROWN_INTO_WIND
 
 ENGINES = ("core", "analytic", "mujoco", "pybullet", "pinocchio")
@@ -266,7 +266,7 @@ def test_urdf_chains_refuse_frame_and_length_transforms(scene):
     (mass, time and body order change nothing in a kinematic chain; a joint-dynamics scene's masses are the file's,
     while a unit of time changes only its gravity and sampling scales)."""
     for transform in FIXED_TRANSFORMS:
-        dynamics = isinstance(scene, JointDynamicsScene)
+        dynamics = isinstance(scene, (JointDynamicsScene, JointMotionScene))
         if transform.moves_frame or (dynamics and transform.mass_scale != 1.0):
             with pytest.raises(TransformError, match="URDF file"):
                 transform_scene(scene, transform)

@@ -57,7 +57,7 @@ from simparity.comparisons.invariance.transforms import fixed_transforms
 from simparity.core.model.errors import SimparityError, one_line
 from simparity.core.model.ranges import RANGES
 from simparity.core.model.results import RESULTS_FILE, RUN_INFO_FILE
-from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
+from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
 from simparity.reports.store import read_run
 
 EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE = 0, 1, 2
@@ -224,8 +224,11 @@ def _cost(scenes) -> str:
     steps = sum(s.n_steps(dt) * len(s.bodies) for s in scenes if isinstance(s, DynamicsScene) for dt in s.dts)
     samples = sum(s.n_configurations for s in scenes if isinstance(s, KinematicsScene))
     targets = sum(s.n_targets + len(s.hard_targets) for s in scenes if isinstance(s, IKScene))
+    states = sum(s.n_states for s in scenes if isinstance(s, JointDynamicsScene))
+    joint_steps = sum(s.n_steps(dt) * s.copies for s in scenes if isinstance(s, JointMotionScene) for dt in s.dts)
     return (f"{len(scenes)} scenes: {steps:,} body-steps per integrator, {samples:,} configurations, "
-            f"{targets:,} IK targets per solver")
+            f"{targets:,} IK targets per solver" + (f", {states:,} joint-dynamics states" if states else "")
+            + (f", {joint_steps:,} chain steps per integrator" if joint_steps else ""))
 
 
 def _baseline_table(option: str, run_dir: Path, profile: str, history_option: str | None):

@@ -189,8 +189,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     bench = sub.add_parser(
         "bench", help="measure speed with accuracy, core against the engines; write BENCHMARKS.md",
-        description="Time rigid-body stepping (B = 1, 100, 10,000 bodies), FK + Jacobian and IK (the bench suite's "
-        "arms, 10,000 targets each) for core and every engine in one run, each time with the error it reaches; "
+        description="Time rigid-body stepping (B = 1, 100, 10,000 bodies), FK + Jacobian, IK (the bench suite's "
+        "arms, 10,000 targets each), the arms' joint-space dynamics and their motion (RK4 of B = 1, 100, 10,000 "
+        "falling arms) for core and every engine in one run, each time with the error it reaches; "
         "write BENCHMARKS.md and benchmarks.csv with the ratios and the targets met or missed. About 5 minutes "
         "(--quick: about 1).")
     bench.add_argument("--out", type=Path, default=Path("."), metavar="DIR",

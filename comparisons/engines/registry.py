@@ -118,6 +118,14 @@ class EngineSet:
         minute for a slow one): see :attr:`installed_integrators`."""
         return _integrator_names(self._described)
 
+    @property
+    def joint_motion_integrators(self) -> tuple[str, ...]:
+        """Every joint-motion integrator name the built-ins and the user's engines offer."""
+        names: dict[str, None] = {}
+        for engine in self._described:
+            names.update(dict.fromkeys(getattr(engine, "joint_motion_integrators", tuple)()))
+        return tuple(names)
+
     @functools.cached_property
     def installed_integrators(self) -> tuple[str, ...]:
         """:attr:`integrators` and every installed plugin's, for a scene file that names an integrator the

@@ -24,18 +24,20 @@ from typing import cast
 import numpy as np
 
 from simparity.comparisons.engines.placeholders import StandInEngine
-from simparity.core.model.engine import Engine
+from simparity.core.model.engine import TRUTH_SCHEMES, Engine
 from simparity.core.model.results import ResultRow, SeriesRecord
 from simparity.core.model.scene import (
     PENALTY_PREFIX,
     DynamicsScene,
     IKScene,
     JointDynamicsScene,
+    JointMotionScene,
     KinematicsScene,
     Scene,
 )
 
-DYNAMICS, STABILITY, KINEMATICS, IK, JOINT_DYNAMICS = "dynamics", "stability", "kinematics", "ik", "joint_dynamics"
+DYNAMICS, STABILITY, KINEMATICS, IK, JOINT_DYNAMICS, JOINT_MOTION = (
+    "dynamics", "stability", "kinematics", "ik", "joint_dynamics", "joint_motion")
 """What a group computes: stepping at one dt, the penalty integrators' stability limits, FK and
 Jacobians, IK solves, joint-space dynamics at states."""
 
@@ -63,9 +65,9 @@ class CaseGroup:
     scene_hash : str
         :func:`scene_hash` of ``scene``.
     kind : str
-        DYNAMICS, STABILITY, KINEMATICS, IK or JOINT_DYNAMICS.
+        DYNAMICS, STABILITY, KINEMATICS, IK, JOINT_DYNAMICS or JOINT_MOTION.
     dt : float
-        The time step [s] of a DYNAMICS group; NaN otherwise.
+        The time step [s] of a DYNAMICS or JOINT_MOTION group; NaN otherwise.
     cases : tuple of CaseSpec
     engines : tuple of (str, str)
         (name, spec) of every engine of the run, in order (an IK group's judges); a worker builds an
@@ -107,6 +109,11 @@ class CaseGroup:
     def joint_dynamics_scene(self) -> JointDynamicsScene:
         """The scene of a JOINT_DYNAMICS group."""
         return cast(JointDynamicsScene, self.scene)
+
+    @property
+    def joint_motion_scene(self) -> JointMotionScene:
+        """The scene of a JOINT_MOTION group."""
+        return cast(JointMotionScene, self.scene)
 
     @property
     def ik_scene(self) -> IKScene:
@@ -250,6 +257,27 @@ def _methods(engine: Engine) -> tuple[str, ...]:
         return ()
 
 
+def _motion_integrators(scene: JointMotionScene, engine: Engine) -> list[str]:
+    """The engine's joint-motion integrators the scene runs (all it offers unless the scene names some); none when
+    the engine fails to say (its one case then reports the error)."""
+    try:
+        offered = tuple(engine.joint_motion_integrators())
+    except Exception:  # noqa: BLE001 - a user's engine: its case reports the error
+        return []
+    return [i for i in offered if not scene.integrators or i in scene.integrators]
+
+
+def motion_reference_integrator(scene: JointMotionScene, reference: Engine) -> str:
+    """The integrator a joint-motion scene's reference runs: its first of a truth's kind (:data:`TRUTH_SCHEMES`),
+    else its first; NO_INTEGRATOR when it offers none."""
+    try:
+        offered = tuple(reference.joint_motion_integrators())
+        truths = [i for i in offered if reference.scheme(i, scene) in TRUTH_SCHEMES]
+    except Exception:  # noqa: BLE001 - a user's engine as a reference: its rows say what fails
+        return NO_INTEGRATOR
+    return (truths or list(offered) or [NO_INTEGRATOR])[0]
+
+
 def plan_scene(scene, engines: list[Engine], reference: Engine, repeats: int,
                specs: dict[str, str] | None = None) -> list[CaseGroup]:
     """The groups of ``scene`` on ``engines`` (built engines, in the run's order) measured against
@@ -268,6 +296,10 @@ def plan_scene(scene, engines: list[Engine], reference: Engine, repeats: int,
     if isinstance(scene, JointDynamicsScene):
         cases = [CaseSpec(e.name, m) for e in engines for m in _methods(e) or (NO_INTEGRATOR,)]
         return [group(JOINT_DYNAMICS, math.nan, cases, f"{reference.name}:{(_methods(reference) or (NO_INTEGRATOR,))[0]}")]
+    if isinstance(scene, JointMotionScene):
+        cases = [CaseSpec(e.name, i) for e in engines for i in (_motion_integrators(scene, e) or [NO_INTEGRATOR])]
+        label = f"{reference.name}:{motion_reference_integrator(scene, reference)}"
+        return [group(JOINT_MOTION, dt, cases, label) for dt in scene.dts]
     if not isinstance(scene, DynamicsScene):
         return [group(KINEMATICS, math.nan, [CaseSpec(e.name, "") for e in engines], f"{reference.name}:fk")]
     label = f"{reference.name}:{reference.scene_integrators(scene)[0]}"

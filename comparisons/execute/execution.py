@@ -20,15 +20,16 @@ from simparity.comparisons.execute.journal import Journal
 from simparity.comparisons.execute.runner import assemble_scene
 from simparity.core.model.engine import Engine
 from simparity.core.model.results import ResultRow, SeriesRecord
-from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, Scene
+from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, Scene
 
 OnCase = Callable[[str, str, str], None]
 """Called with (scene, engine, integrator or solver) after each case, in the calling process."""
 
-SECONDS_PER_UNIT = {"dynamics": 5e-4, "ik": 1.7e-3, "kinematics": 1.2e-4, "joint_dynamics": 1e-3}
+SECONDS_PER_UNIT = {"dynamics": 5e-4, "ik": 1.7e-3, "kinematics": 1.2e-4, "joint_dynamics": 1e-3,
+                    "joint_motion": 1e-4}
 """Seconds per case x (steps x bodies, targets, configurations, or states), measured on the default suite
 (2026-11-23, 2 cores, repeats on; joint dynamics 2026-11-27, ~(n + 12) evaluations per state); only their ratios
-matter: they order the groups."""
+matter: they order the groups; joint motion per step and joint, 2026-11-27)."""
 
 
 def default_jobs() -> int:
@@ -56,6 +57,9 @@ def estimated_cost(group: CaseGroup) -> float:
         return cases * (scene.n_targets + len(scene.hard_targets)) * SECONDS_PER_UNIT["ik"]
     if isinstance(scene, JointDynamicsScene):
         return cases * scene.n_states * SECONDS_PER_UNIT["joint_dynamics"]
+    if isinstance(scene, JointMotionScene):
+        steps = scene.n_steps(group.dt) * scene.copies * (17 if scene.segments else 1)  # segments: dt and dt / 16
+        return cases * steps * scene.chain.n_joints * SECONDS_PER_UNIT["joint_motion"]
     return cases * scene.n_configurations * SECONDS_PER_UNIT["kinematics"]
 
 

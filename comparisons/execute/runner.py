@@ -23,6 +23,7 @@ from simparity.comparisons.execute.cases import (
     DYNAMICS,
     IK,
     JOINT_DYNAMICS,
+    JOINT_MOTION,
     KINEMATICS,
     NO_INTEGRATOR,
     STABILITY,
@@ -60,17 +61,22 @@ from simparity.comparisons.measure.joint_dynamics_metrics import (
     shape_problem,
     timed_values,
 )
+from simparity.comparisons.measure.joint_motion_metrics import (
+    JOINT_MOTION_ORDERS, JOINT_ORDER_SOURCES, motion_metrics,
+)
 from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, error_text, warnings_into_rows
 from simparity.comparisons.measure.series import dynamics_series
 from simparity.comparisons.measure.stability import STABILITY_METRICS, stable_dt_max
+from simparity.comparisons.execute.case_cost import case_cost, theory
+from simparity.comparisons.execute.motion_runner import motion_case, prepare_motion
 from simparity.comparisons.execute.timing import best_of
-from simparity.core.model.engine import Engine, Simulation, Support
-from simparity.core.model.errors import DivergedError, NotBatchedError, SimparityError
+from simparity.core.model.engine import TRUTH_SCHEMES, Engine, Support
+from simparity.core.model.errors import DivergedError, SimparityError
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
-from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, KinematicsScene
+from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
 from simparity.core.model.trajectory import Trajectory
 from simparity.core.model.metric_catalogue import (
-    EVALUATIONS_PER_SECOND, STABLE_DT_MAX, TIME_PER_FK, TIME_PER_JACOBIAN, TIME_PER_STEP, TIME_PER_STEP_BATCHED, unit_of,
+    STABLE_DT_MAX, TIME_PER_FK, TIME_PER_JACOBIAN, TIME_PER_STEP,
 )
 
 EngineFor = Callable[[str], Engine]
@@ -81,18 +87,6 @@ OnStart = Callable[[int | None], None]
 
 DEFAULT_REPEATS = 3
 """Timed repeats per measurement (the minimum is kept), after one warm-up run."""
-
-BATCH_COPIES = 100
-"""Copies of a scene an engine that batches steps together for ``time_per_step_batched``: at 100 a vectorised
-engine's fixed cost per call (Python dispatch: core's RK4 step costs about the same for 1 body as for 100) is
-spread over the copies, which is what batching is for, while a batch still fits in cache (100 x 13 floats) and adds
-little to a run."""
-
-BATCH_STEPS = 10
-"""Steps of the batched timing at most (the case's own when fewer), from the scene's start: 10^3 copy-steps take
-milliseconds, far above the clock's resolution. Measured on the quick profile: 9 s of batched stepping over its
-~500 batched cases, about 1.5 % of its wall time on two workers (100 steps would be ten times that). A free
-flight's steps all cost the same; a contact scene's events later in its run are not in them."""
 
 TIME_GRID_TOLERANCE = 1e-3
 """How far [steps] a trajectory's sample time may be from k * dt: a clock kept as t += dt drifts at most
@@ -197,59 +191,8 @@ def _dynamics_case_at(group: CaseGroup, shared: _DynamicsShared, index: int, eng
                                  group.repeats, is_reference)
         rows += outcome.rows
     outcome.rows = rows
-    outcome.theoretical_order = _theory(engine, spec.integrator)
+    outcome.theoretical_order = theory(engine, spec.integrator)
     return outcome
-
-
-def _theory(engine: Engine, integrator: str) -> int | None:
-    """The integrator's theoretical order as the engine declares it; None when it does not say (or fails to: a
-    user's engine whose other answers are its rows' business)."""
-    try:
-        order = engine.theoretical_order(integrator)
-    except Exception:  # noqa: BLE001 - a user's engine; its rows report what fails
-        return None
-    return order if isinstance(order, int) and not isinstance(order, bool) and order > 0 else None
-
-
-def _stages(engine: Engine, integrator: str) -> int | None:
-    """The integrator's force evaluations per step as the engine declares them; None when it does not say (or fails
-    to: a plugin's answer was checked when it loaded, :mod:`comparisons.engines.plugins`)."""
-    try:
-        stages = engine.stages(integrator)
-    except Exception:  # noqa: BLE001 - a user's engine; its rows report what fails
-        return None
-    return stages if isinstance(stages, int) and not isinstance(stages, bool) and stages >= 1 else None
-
-
-def _cost(engine: Engine, sim: Simulation, case: Case, n: int, repeats: int) -> dict[str, Measured]:
-    """A case's hardware-neutral cost and its batched timing, measured right after its own timing.
-
-    ``evaluations_per_second`` = stages / dt [1/s], the force evaluations per simulated second the engine declares
-    (n/a when it declares no stage count); ``time_per_step_batched`` [s], the wall time per copy and step of
-    :data:`BATCH_COPIES` copies of the scene's initial state stepped together for min(n, :data:`BATCH_STEPS`) steps,
-    best of ``repeats`` like the case's own (n/a with the engine's reason when it cannot batch).
-    """
-    stages = _stages(engine, case.integrator)
-    evaluations = (Measured(stages / case.dt, unit_of(EVALUATIONS_PER_SECOND)) if stages is not None else
-                   Measured(math.nan, unit_of(EVALUATIONS_PER_SECOND), unmeasurable=(
-                       f"{engine.name} declares no stage count for {case.integrator} (Engine.stages)")))
-    return {EVALUATIONS_PER_SECOND: evaluations, TIME_PER_STEP_BATCHED: _batched_time(sim, n, repeats)}
-
-
-def _batched_time(sim: Simulation, n: int, repeats: int) -> Measured:
-    """Wall time [s] per copy and step of :data:`BATCH_COPIES` copies stepped together (:meth:`Simulation.batched`,
-    built untimed) for min(n, :data:`BATCH_STEPS`) steps; n/a with the engine's reason when it cannot batch, or with
-    the error when its batched stepping raised (the case's own rows stand)."""
-    steps = min(n, BATCH_STEPS)
-    try:
-        run = sim.batched(BATCH_COPIES)
-        seconds, _ = best_of(lambda: run(steps), repeats)
-    except NotBatchedError as why:
-        return Measured(math.nan, unit_of(TIME_PER_STEP_BATCHED), unmeasurable=str(why))
-    except Exception as err:  # noqa: BLE001 - a user's engine: its batched timing is lost, not the case it ran
-        return Measured(math.nan, unit_of(TIME_PER_STEP_BATCHED),
-                        unmeasurable=f"its batched stepping raised: {error_text(err)}")
-    return Measured(seconds / (BATCH_COPIES * steps), unit_of(TIME_PER_STEP_BATCHED))
 
 
 def _no_integrator_rows(scene: DynamicsScene, engine: Engine, case: Case, metrics: dict) -> list[ResultRow]:
@@ -329,7 +272,7 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
         sim = engine.build_dynamics(scene, case.integrator, case.dt)
         with np.errstate(all="ignore"):  # a diverging run overflows; it is reported as diverged
             seconds, traj = best_of(lambda: sim.run(n), repeats)
-            cost = _cost(engine, sim, case, n, repeats)
+            cost = case_cost(engine, sim, case, n, repeats)
     except DivergedError as err:
         return CaseOutcome(case.rows(metrics, DIVERGED, str(err)))
     except Exception as err:  # noqa: BLE001 - reported in the rows
@@ -559,9 +502,28 @@ def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_l
     return rows
 
 
+def _joint_orders(scene: JointMotionScene, ladders: dict[tuple[str, str], _Ladder], ref_label: str) -> list[ResultRow]:
+    """Observed orders of convergence of the joint values and velocities per engine and integrator."""
+    rows = []
+    for (engine, integrator), ladder in ladders.items():
+        case = Case(scene.name, engine, integrator, math.nan, ref_label, ladder.scheme)
+        if ladder.scheme in TRUTH_SCHEMES:  # its error is set by a tolerance or by rounding, not by dt
+            values = {metric: Measured(math.nan, "1", unmeasurable=(
+                f"a {ladder.scheme.replace('_', ' ')} truth does not step at dt: its error has no order"))
+                for metric in JOINT_ORDER_SOURCES}
+        else:
+            values = {metric: observed_order(ladder.dts, [c.errors.get(source, math.nan) for c in ladder.cases],
+                                             [c.floors.get(source, 0.0) for c in ladder.cases],
+                                             [c.saturation.get(source, 0.0) for c in ladder.cases], ladder.theory)
+                      for metric, source in JOINT_ORDER_SOURCES.items()}
+        rows += case.rows(JOINT_MOTION_ORDERS, OK, f"against {ref_label}", values)
+    return rows
+
+
 _KINDS = {DYNAMICS: _Kind(_prepare_dynamics, _dynamics_case_at), STABILITY: _Kind(_prepare_nothing, _stability_case_at),
           KINEMATICS: _Kind(_prepare_kinematics, _kinematics_case_at), IK: _Kind(prepare_ik, ik_case),
-          JOINT_DYNAMICS: _Kind(_prepare_joint_dynamics, _joint_dynamics_case_at)}
+          JOINT_DYNAMICS: _Kind(_prepare_joint_dynamics, _joint_dynamics_case_at),
+          JOINT_MOTION: _Kind(prepare_motion, motion_case)}
 
 
 def failed_outcome(group: CaseGroup, spec: CaseSpec, cause: str) -> CaseOutcome:
@@ -571,7 +533,8 @@ def failed_outcome(group: CaseGroup, spec: CaseSpec, cause: str) -> CaseOutcome:
         return failed_ik_outcome(group, spec, cause)
     scene = group.scene
     metrics = {DYNAMICS: lambda: dynamics_metrics(group.dynamics_scene), STABILITY: lambda: STABILITY_METRICS,
-               KINEMATICS: lambda: KINEMATICS_METRICS, JOINT_DYNAMICS: lambda: JOINT_DYNAMICS_METRICS}[group.kind]()
+               KINEMATICS: lambda: KINEMATICS_METRICS, JOINT_DYNAMICS: lambda: JOINT_DYNAMICS_METRICS,
+               JOINT_MOTION: lambda: motion_metrics(group.joint_motion_scene)}[group.kind]()
     case = Case(scene.name, spec.engine, spec.integrator, group.dt, group.reference_label)
     return CaseOutcome(case.rows(metrics, FAILED, cause), harness_failure=True)
 
@@ -584,7 +547,7 @@ def assemble_scene(scene, groups: list[CaseGroup],
     ladders: dict[tuple[str, str], _Ladder] = {}
     for group, results in zip(groups, outcomes):
         for spec, outcome in zip(group.cases, results):
-            if group.kind == DYNAMICS and spec.integrator != NO_INTEGRATOR:
+            if group.kind in (DYNAMICS, JOINT_MOTION) and spec.integrator != NO_INTEGRATOR:
                 ladder = ladders.setdefault((spec.engine, spec.integrator), _Ladder())
                 ladder.dts.append(group.dt)
                 ladder.cases.append(outcome)
@@ -592,6 +555,8 @@ def assemble_scene(scene, groups: list[CaseGroup],
             for outcome in results for row in outcome.rows]
     if isinstance(scene, DynamicsScene) and len(scene.dts) > 1:
         rows += _orders(scene, ladders, groups[0].reference_label)
+    if isinstance(scene, JointMotionScene) and len(scene.dts) > 1:
+        rows += _joint_orders(scene, ladders, groups[0].reference_label)
     rows += [row for group, results in zip(groups, outcomes) if group.kind == STABILITY
              for outcome in results for row in outcome.rows]
     series = [record for results in outcomes for outcome in results for record in outcome.series]

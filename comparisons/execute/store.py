@@ -27,7 +27,8 @@ from simparity.core.model.results import (
     sweep_column,
 )
 from simparity.core.model.run_info import RunInfo
-from simparity.core.model.scene import DynamicsScene, IKScene
+from simparity.core.model.metric_catalogue import JOINT_ANGLE_ERROR_MAX
+from simparity.core.model.scene import DynamicsScene, IKScene, JointMotionScene
 
 DEFAULT_OUT_ROOT = Path("simparity-results")
 """Default parent folder of runs: each run goes to ``simparity-results/<UTC time>/``."""
@@ -88,6 +89,8 @@ def _scene_info(scene) -> dict:
             info["contact"] = {"planes": [p.name for p in scene.contact.planes],
                                "restitution": scene.contact.restitution.tolist(),
                                "methods": list(scene.contact.methods), "rest_speed": scene.contact.rest_speed}
+    if isinstance(scene, JointMotionScene):  # reported as dynamics: its schemes ranked by the joint angle error
+        info |= {"bodies": scene.copies, "headline_metric": JOINT_ANGLE_ERROR_MAX, "segments": scene.segments}
     if isinstance(scene, IKScene):
         info |= {"position_tolerance": scene.position_tolerance}
     if scene.sweep is not None:

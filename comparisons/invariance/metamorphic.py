@@ -53,7 +53,8 @@ from simparity.core.model.engine import Engine
 from simparity.core.model.metric_catalogue import is_timing
 from simparity.core.model.errors import TransformError, UnitError, one_line
 from simparity.core.model.results import DIMENSIONLESS, FAILED, NOT_AVAILABLE, OK, ROUNDING_FLOOR, ResultRow
-from simparity.core.model.scene import DynamicsScene, JointDynamicsScene, Scene
+from simparity.comparisons.execute.cases import motion_reference_integrator
+from simparity.core.model.scene import DynamicsScene, JointDynamicsScene, JointMotionScene, Scene
 
 RunScenes = Callable[[list], list[list[ResultRow]]]
 """Runs scenes on the engines being checked: the rows of each scene, in order (:func:`in_process`, or a run's
@@ -261,7 +262,8 @@ def check_invariance(scenes: list, transforms: Iterable[Transform], run: RunScen
 
 def _unchanged(scene) -> str:
     what = ("one body has no other order" if isinstance(scene, DynamicsScene) else "a chain has no free bodies"
-            if isinstance(scene, JointDynamicsScene) else "a chain has no mass, no time and no free bodies")
+            if isinstance(scene, (JointDynamicsScene, JointMotionScene))
+            else "a chain has no mass, no time and no free bodies")
     return f"changes nothing in this scene ({what})"
 
 
@@ -274,6 +276,8 @@ def _unfollowed(transformed, engine_for: EngineFor) -> str:
         support = reference.supports_dynamics(transformed, reference.scene_integrators(transformed)[0])
     elif isinstance(transformed, JointDynamicsScene):
         support = reference.supports_joint_dynamics(transformed.chain, reference.joint_dynamics_methods()[0])
+    elif isinstance(transformed, JointMotionScene):
+        support = reference.supports_joint_motion(transformed, motion_reference_integrator(transformed, reference))
     else:
         support = reference.supports_kinematics(transformed.chain)
     if support.ok:
@@ -285,7 +289,7 @@ def _unfollowed(transformed, engine_for: EngineFor) -> str:
 def _fk_resolution(scene, rows: list[ResultRow], engine_for: EngineFor) -> tuple[float, float]:
     """(position [m], orientation [rad]) the coarsest forward kinematics among the engines of ``rows`` can tell
     apart (``KinematicsModel.resolution``); (0, 0) for a dynamics scene."""
-    if isinstance(scene, DynamicsScene):
+    if isinstance(scene, (DynamicsScene, JointMotionScene)):  # errors of motion, not of frames
         return 0.0, 0.0
     position = orientation = 0.0
     for name in dict.fromkeys(row.engine for row in rows):

@@ -28,7 +28,7 @@ from dataclasses import replace
 import numpy as np
 
 from simparity.comparisons.invariance.transforms import Transform, transform_scene
-from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, KinematicsScene
+from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
 
 ULP_FACTORS = (np.nextafter(1.0, 2.0), np.nextafter(1.0, 0.0))
 """The two nearest floats to 1: a unit one ulp longer or shorter."""
@@ -73,6 +73,10 @@ def _nudged(scene, rng: np.random.Generator):
     if isinstance(scene, JointDynamicsScene):
         gravity = scene.gravity_world
         return replace(scene, chain=chain, gravity_world=None if gravity is None else ulp_nudge(gravity, rng))
+    if isinstance(scene, JointMotionScene):
+        gravity = scene.gravity_world
+        return replace(scene, chain=chain, gravity_world=None if gravity is None else ulp_nudge(gravity, rng),
+                       q0=ulp_nudge(scene.q0, rng), qdot0=ulp_nudge(scene.qdot0, rng))
     raise TypeError(f"no perturbation for a {type(scene).__name__}")
 
 

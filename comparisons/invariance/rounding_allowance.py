@@ -40,7 +40,9 @@ import numpy as np
 
 from simparity.comparisons.invariance.units import Dimension
 from simparity.comparisons.measure.body_scales import contact_of
-from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene, KinematicsScene
+from simparity.core.model.scene import (
+    Chain, DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene,
+)
 
 ALLOWANCE_FACTOR = 16.0
 """The metrics' rounding floor is 2 eps (N + kappa) x the scale (measured rounding of exact schemes stays below
@@ -156,6 +158,19 @@ def _joint_dynamics_floors(scene: JointDynamicsScene) -> Floors:
                   mass_scale=1.0, time_scale=1.0)
 
 
+def _joint_motion_floors(scene: JointMotionScene) -> Floors:
+    """A chain's motion: every metric is a ratio; each step rounds the state at eps relative to its size (its joint
+    count's operations), and N steps add up (linearly at worst), as for free bodies; with the lever arms' rounding of a
+    chain placed far away (:func:`_joint_dynamics_floors`)."""
+    steps = max(scene.n_steps(dt) for dt in scene.dts)
+    unit = ALLOWANCE_FACTOR * float(np.finfo(float).eps) * scene.chain.n_joints * steps
+    reach = _reach(scene.chain)
+    size = reach - float(np.linalg.norm(scene.chain.joints[0].origin_xyz))
+    ratio = unit * max(1.0, reach / size) if size > 0 else unit
+    return Floors(length=unit * reach, speed=0.0, spin=0.0, angle=ratio, time=unit * scene.duration, generic=ratio,
+                  length_scale=reach, mass_scale=1.0, time_scale=scene.duration)
+
+
 def rounding_floors(scene) -> Floors:
     """What rounding alone may move ``scene``'s quantities by (module docstring)."""
     if isinstance(scene, DynamicsScene):
@@ -164,4 +179,6 @@ def rounding_floors(scene) -> Floors:
         return _chain_floors(scene)
     if isinstance(scene, JointDynamicsScene):
         return _joint_dynamics_floors(scene)
+    if isinstance(scene, JointMotionScene):
+        return _joint_motion_floors(scene)
     raise TypeError(f"no rounding allowance for a {type(scene).__name__}")

@@ -43,6 +43,7 @@ from simparity.core.model.scene import (
     IKScene,
     Joint,
     JointDynamicsScene,
+    JointMotionScene,
     KinematicsScene,
     LinkInertia,
     Plane,
@@ -151,7 +152,7 @@ class Transform:
     def changes(self, scene) -> bool:
         """True when the transform changes anything of ``scene`` (a chain feels only frame and length; one
         body has no other order)."""
-        if isinstance(scene, JointDynamicsScene):  # a chain with mass, time and gravity: every scale is felt
+        if isinstance(scene, (JointDynamicsScene, JointMotionScene)):  # mass, time and gravity: every scale is felt
             return self.moves_frame or self.mass_scale != 1.0 or self.time_scale != 1.0
         if not isinstance(scene, DynamicsScene):
             return self.moves_frame
@@ -207,8 +208,10 @@ def transform_scene(scene, transform: Transform):
         return _chain_scene(scene, transform)
     if isinstance(scene, JointDynamicsScene):
         return _joint_dynamics_scene(scene, transform)
+    if isinstance(scene, JointMotionScene):
+        return _joint_motion_scene(scene, transform)
     raise TransformError(getattr(scene, "source", "<code>"), "kind", f"a {type(scene).__name__} has no transform",
-                         "dynamics, kinematics, IK and joint-dynamics scenes")
+                         "dynamics, kinematics, IK, joint-dynamics and joint-motion scenes")
 
 
 def _body(body: RigidBody, t: Transform) -> RigidBody:
@@ -330,6 +333,20 @@ def _joint_dynamics_scene(scene: JointDynamicsScene, t: Transform) -> JointDynam
                    velocity_scale=t.length_scale ** variable / t.time_scale * scene.velocity_scale,
                    acceleration_scale=t.length_scale ** variable / t.time_scale ** 2 * scene.acceleration_scale,
                    torque_scale=t.length_scale ** (2 - variable) * t.factor(mass=1, time=-2) * scene.torque_scale)
+
+
+def _joint_motion_scene(scene: JointMotionScene, t: Transform) -> JointMotionScene:
+    """The chain placed, scaled and given mass and time units as a joint-dynamics scene's; gravity turned and scaled;
+    the initial joint values, velocities and torques, the duration and the time steps in the new units."""
+    untouched = not t.moves_frame and t.mass_scale == 1.0
+    chain = scene.chain if untouched else _chain(scene.chain, t, scene.source)
+    variable = np.array([1 if j.type == "prismatic" else 0 for j in scene.chain.joints])  # power of length: m or rad
+    gravity = scene.gravity_world
+    return replace(scene, chain=chain, gravity_world=None if gravity is None else t.vector(gravity, length=1, time=-2),
+                   q0=t.length_scale ** variable * scene.q0,
+                   qdot0=t.length_scale ** variable / t.time_scale * scene.qdot0,
+                   torque=t.length_scale ** (2 - variable) * t.factor(mass=1, time=-2) * scene.torque,
+                   duration=t.time_scale * scene.duration, dts=tuple(t.time_scale * dt for dt in scene.dts))
 
 
 FIXED_SEED = 22

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.comparisons.scenes.sweep import value_text
-from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, KinematicsScene
+from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
 
 
 def _vector(values) -> str:
@@ -72,14 +72,31 @@ def _joint_dynamics_lines(scene: JointDynamicsScene) -> list[str]:
     lines = [f"gravity_world {gravity} (in the base frame); {scene.n_states} states (seed {scene.seed}): q within the "
              f"limits, |qdot| <= {_scales(scene.velocity_scale)}, |qddot| <= {_scales(scene.acceleration_scale)}, "
              f"|tau| <= {_scales(scene.torque_scale)} per joint"]
-    for joint in scene.chain.joints:
+    return lines + _link_lines(scene.chain)
+
+
+def _joint_motion_lines(scene: JointMotionScene) -> list[str]:
+    gravity = "none" if scene.gravity_world is None else f"{_vector(scene.gravity_world)} m/s^2"
+    accuracy = (f"self-consistency over {scene.segments} segments (each engine against itself at a 16 x smaller step)"
+                if scene.segments else "against the reference")
+    lines = [f"gravity_world {gravity} (in the base frame); joint torques {_vector(scene.torque)} (constant)",
+             f"q0 {_vector(scene.q0[0])}; qdot0 {_vector(scene.qdot0[0])}"
+             + (f" ({scene.copies} copies)" if scene.copies > 1 else ""),
+             f"duration {scene.duration:.10g} s; dt {', '.join(f'{dt:.10g}' for dt in scene.dts)} s; accuracy {accuracy}"]
+    return lines + _link_lines(scene.chain)
+
+
+def _link_lines(chain: Chain) -> list[str]:
+    """Each joint's link: mass, centre of mass, inertia diagonal, damping and armature; the held joints."""
+    lines = []
+    for joint in chain.joints:
         link = joint.link
         assert link is not None  # a joint-dynamics scene's chain has mass properties (checked when built)
         lines.append(f"  {joint.name} ({joint.type}): link mass {link.mass:.10g} kg, centre of mass "
                      f"{_vector(link.com_xyz)} m, inertia diagonal {_vector(link.inertia_com.diagonal())} kg m^2, "
                      f"damping {joint.damping:.10g}, armature {joint.armature:.10g}")
-    if scene.chain.held_joints:
-        lines.append(f"held at 0 (their links ride on the chain): {', '.join(scene.chain.held_joints)}")
+    if chain.held_joints:
+        lines.append(f"held at 0 (their links ride on the chain): {', '.join(chain.held_joints)}")
     return lines
 
 
@@ -97,10 +114,12 @@ def describe(scene) -> str:
         head += [f"gravity_world {gravity}; forces {', '.join(forces.names()) or 'none'}",
                  f"duration {scene.duration:.10g} s; dt {', '.join(f'{dt:.10g}' for dt in scene.dts)} s"]
         head += _body_lines(scene) + _contact_lines(scene)
-    elif isinstance(scene, (KinematicsScene, IKScene, JointDynamicsScene)):
+    elif isinstance(scene, (KinematicsScene, IKScene, JointDynamicsScene, JointMotionScene)):
         chain = scene.chain
         head.append(f"chain {chain.name}: {chain.n_joints} joints ({', '.join(j.name for j in chain.joints)}), "
                     f"end effector {chain.end_effector_name}")
     if isinstance(scene, JointDynamicsScene):
         head += _joint_dynamics_lines(scene)
+    if isinstance(scene, JointMotionScene):
+        head += _joint_motion_lines(scene)
     return "\n".join(head) + "\n"

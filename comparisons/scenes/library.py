@@ -20,7 +20,7 @@ SCENES_DIR = Path(__file__).parent
 
 def builtin_paths() -> dict[str, Path]:
     """Built-in scene name -> file, sorted by name."""
-    return {p.stem: p for p in sorted(SCENES_DIR.glob("*.toml"))}
+    return {p.stem: p for p in sorted(SCENES_DIR.glob("*.toml"), key=lambda p: p.stem)}
 
 
 PATH_SUFFIXES = (".toml", ".urdf", ".xml")

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from simparity.comparisons.engines.registry import ENGINE_NAMES, EngineSet
+from simparity.comparisons.execute.cases import NO_INTEGRATOR, motion_reference_integrator
 from simparity.core.model.engine import Support
 from simparity.comparisons.scenes.limits import DEFAULT_LIMITS, POSITION_TOLERANCE_OF_REACH, Limits, allowed_at_most
 from simparity.comparisons.scenes.sweep import SWEEP_TABLE, read_sweep
@@ -46,6 +47,7 @@ from simparity.core.model.scene import (
     IKScene,
     Joint,
     JointDynamicsScene,
+    JointMotionScene,
     KinematicsScene,
     LinkInertia,
     Material,
@@ -54,6 +56,7 @@ from simparity.core.model.scene import (
     RigidBody,
     Scene,
     Shape,
+    sample_configurations,
 )
 from simparity.core.urdf import chain_from_urdf
 from simparity.references.common.conventions import quat_wxyz_to_matrix
@@ -61,7 +64,7 @@ from simparity.references.common.conventions import quat_wxyz_to_matrix
 LENGTH_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "ft": 0.3048, "in": 0.0254}
 """Units a scene may declare for lengths, and their size in metres."""
 
-KINDS = ("dynamics", "kinematics", "ik", "joint_dynamics")
+KINDS = ("dynamics", "kinematics", "ik", "joint_dynamics", "joint_motion")
 JOINT_TYPES = ("revolute", "prismatic")
 
 _REQUIRED = object()  # marks a key without a default
@@ -233,9 +236,10 @@ class _Reader:
 
 
 
-_TOP = ("scene", "world", "body", "simulation", "plane", "contact", "chain", "sampling", "targets")
+_TOP = ("scene", "world", "body", "simulation", "plane", "contact", "chain", "sampling", "targets", "initial", "drive")
 _PARTS = {"dynamics": ("world", "body", "simulation", "plane", "contact"), "kinematics": ("chain", "sampling"),
-          "ik": ("chain", "targets"), "joint_dynamics": ("chain", "world", "sampling")}
+          "ik": ("chain", "targets"), "joint_dynamics": ("chain", "world", "sampling"),
+          "joint_motion": ("chain", "world", "initial", "drive", "simulation")}
 _SCENE = ("name", "description", "kind", "reference", "length_unit", "suites")
 # Drag coefficients and the power of length in their units (for length_unit scaling).
 DRAG_KEYS = {"linear_drag": 0, "quadratic_drag": -1, "angular_linear_drag": 2, "angular_quadratic_drag": 2}
@@ -267,6 +271,12 @@ EXAMPLE_ROBOT_DATA_ROBOTS = "cmeel.prefix/share/example-robot-data/robots"
 _LINK = ("mass", "com_xyz", "inertia")
 _JOINT = ("name", "type", "axis", "origin_xyz", "origin_rpy", "lower", "upper", "damping", "armature") + _LINK
 _JOINT_DYNAMICS_SAMPLING = ("states", "seed", "velocity_scale", "acceleration_scale", "torque_scale")
+_INITIAL = ("q", "qdot", "seed")
+_MOTION_SIMULATION = ("duration", "dt", "integrators", "segments", "perturbation")
+MAX_PERTURBATION = 1e-3
+"""[rad] The largest start perturbation for predictability: at the parting threshold itself the runs would part at once."""
+MAX_SEGMENTS = 1000
+"""Segments of a self-consistency scene at most: each is a copy stepped twice (at dt and dt / 16)."""
 
 # duration / dt may differ from a whole number by this much (rounding of a decimal dt).
 _STEP_COUNT_RTOL = 1e-9
@@ -671,11 +681,7 @@ def _kinematics(top: _Reader, head: dict) -> KinematicsScene:
 
 
 def _joint_dynamics(top: _Reader, head: dict) -> JointDynamicsScene:
-    chain = _chain(top, head["name"], dynamics=True)
-    problem = chain.dynamics_problem()
-    if problem:
-        raise top.fail("chain", problem, "a chain whose every link has mass properties: a URDF file with <inertial> "
-                       "elements or [[chain.joint]] with mass, com_xyz and inertia ([chain.dh] declares none)")
+    chain = _dynamics_chain(top, head)
     world = top.optional_subtable("world", ("gravity_world",))
     gravity = world.vector("gravity_world", 3, length=1) if world and world.has("gravity_world") else None
     sampling = top.optional_subtable("sampling", _JOINT_DYNAMICS_SAMPLING)
@@ -686,6 +692,91 @@ def _joint_dynamics(top: _Reader, head: dict) -> JointDynamicsScene:
                                       else 1.0 for key in _JOINT_DYNAMICS_SAMPLING[2:])
     return JointDynamicsScene(chain=chain, gravity_world=gravity, n_states=count, seed=seed, velocity_scale=velocity,
                               acceleration_scale=acceleration, torque_scale=torque, **head)
+
+
+def _dynamics_chain(top: _Reader, head: dict) -> Chain:
+    """The ``[chain]`` of a joint-dynamics or joint-motion scene: every link with mass properties."""
+    chain = _chain(top, head["name"], dynamics=True)
+    problem = chain.dynamics_problem()
+    if problem:
+        raise top.fail("chain", problem, "a chain whose every link has mass properties: a URDF file with <inertial> "
+                       "elements or [[chain.joint]] with mass, com_xyz and inertia ([chain.dh] declares none)")
+    return chain
+
+
+def _joint_powers(chain: Chain, revolute: int, prismatic: int) -> np.ndarray:
+    """(n,) the power of length in each joint's unit of a quantity (revolute and prismatic joints differ)."""
+    return np.array([revolute if j.type == "revolute" else prismatic for j in chain.joints], dtype=float)
+
+
+def _joint_values(r: _Reader, key: str, chain: Chain, powers: np.ndarray, default: float | None = 0.0) -> np.ndarray:
+    """(n,) one number per joint in the scene's length unit (scaled joint by joint by ``powers``)."""
+    values = r.vector(key, chain.n_joints, None if default is None else [default] * chain.n_joints)
+    return values * r.scale ** powers
+
+
+def _within_limits(r: _Reader, key: str, chain: Chain, q: np.ndarray) -> np.ndarray:
+    """``q`` (n,), refused naming ``key`` and the first joint outside its limits."""
+    outside = np.flatnonzero((q < chain.lower) | (q > chain.upper))
+    if outside.size:
+        joint = chain.joints[outside[0]]
+        raise r.fail(key, f"joint {joint.name} starts outside its limits",
+                     f"values within [{joint.lower:g}, {joint.upper:g}] for {joint.name}")
+    return q
+
+
+def _initial_q(r: _Reader, chain: Chain) -> np.ndarray:
+    """(n,) the initial joint values: a list, "zeros" or "random" (uniform within the limits, ``seed``)."""
+    value = r.table.get("q", "zeros")
+    if value == "zeros":
+        q = np.zeros(chain.n_joints)
+    elif value == "random":
+        q = sample_configurations(chain, 1, r.integer("seed", 0, maximum=_MAX_SEED))[0]
+    elif isinstance(value, list):
+        q = _joint_values(r, "q", chain, _joint_powers(chain, 0, 1), None)
+    else:
+        raise r.fail("q", f"{echo(value)} is not allowed", f'"zeros", "random" or a list of {chain.n_joints} numbers')
+    return _within_limits(r, "q", chain, q)
+
+
+def _with_damping(drive: _Reader, chain: Chain) -> Chain:
+    """``chain`` with the joint damping ``[drive] damping`` gives: one number for every joint or one per joint
+    [N m s/rad = kg m^2/s, or N s/m = kg/s], >= 0."""
+    value = drive.table["damping"]
+    if not isinstance(value, list):
+        drive.table = dict(drive.table, damping=[value] * chain.n_joints)
+    damping = _joint_values(drive, "damping", chain, _joint_powers(chain, 2, 0))
+    if np.any(damping < 0):
+        raise drive.fail("damping", f"a negative damping {float(damping.min()):g}", "numbers >= 0 (N m s/rad or N s/m)")
+    return replace(chain, joints=tuple(replace(j, damping=float(d)) for j, d in zip(chain.joints, damping)))
+
+
+def _joint_motion(top: _Reader, head: dict, engines: EngineSet) -> JointMotionScene:
+    chain = _dynamics_chain(top, head)
+    world = top.optional_subtable("world", ("gravity_world",))
+    gravity = world.vector("gravity_world", 3, length=1) if world and world.has("gravity_world") else None
+    initial = top.optional_subtable("initial", _INITIAL) or _Reader(top.source, {}, "initial", _INITIAL, top.scale,
+                                                                    top.limits)
+    q0 = _initial_q(initial, chain)
+    qdot0 = _joint_values(initial, "qdot", chain, _joint_powers(chain, 0, 1))
+    drive = top.optional_subtable("drive", ("torque", "damping"))
+    torque = (_joint_values(drive, "torque", chain, _joint_powers(chain, 2, 1)) if drive
+              else np.zeros(chain.n_joints))  # N m = kg m^2 / s^2 (mass and time fixed) or N = kg m / s^2
+    if drive and drive.has("damping"):  # replaces the chain's own (a URDF's <dynamics damping>)
+        chain = _with_damping(drive, chain)
+    sim = top.subtable("simulation", _MOTION_SIMULATION)
+    duration = sim.number("duration", positive=True)
+    dts = _ladder(sim, duration, 1)
+    segments = sim.integer("segments", 0, maximum=MAX_SEGMENTS, why="") if sim.has("segments") else 0
+    perturbation = sim.number("perturbation", 0.0) if sim.has("perturbation") else 0.0  # rad (a prismatic joint: m)
+    if not 0 <= perturbation <= MAX_PERTURBATION:
+        raise sim.fail("perturbation", f"{perturbation:g} is out of range",
+                       f"0 (none) to {MAX_PERTURBATION:g} rad: a small change of the start, for predictability")
+    integrators = (sim.strings("integrators", engines.joint_motion_integrators, "no engine steps a chain with {}")
+                   if sim.has("integrators") else ())
+    return JointMotionScene(chain=chain, gravity_world=gravity, q0=q0, qdot0=qdot0, torque=torque,
+                            duration=duration, dts=dts, integrators=integrators, segments=segments,
+                            perturbation=perturbation, **head)
 
 
 def _start(t: _Reader, chain: Chain) -> np.ndarray:
@@ -701,12 +792,7 @@ def _start(t: _Reader, chain: Chain) -> np.ndarray:
         q = np.zeros(chain.n_joints) if value == "zeros" else middle
     else:
         raise t.fail("start", f"{echo(value)} is not allowed", allowed)
-    outside = np.flatnonzero((q < chain.lower) | (q > chain.upper))
-    if outside.size:
-        joint = chain.joints[outside[0]]
-        raise t.fail("start", f"joint {joint.name} starts outside its limits",
-                     f"values within [{joint.lower:g}, {joint.upper:g}] for {joint.name}")
-    return q
+    return _within_limits(t, "start", chain, q)
 
 
 def _position_tolerance(t: _Reader, chain: Chain) -> float:
@@ -756,6 +842,10 @@ def _check_reference(top: _Reader, scene, engines: EngineSet) -> None:
     if isinstance(scene, DynamicsScene):
         integrators = engine.integrators()
         support = engine.supports_dynamics(scene, integrators[0]) if integrators else Support.no("it offers no integrator")
+    elif isinstance(scene, JointMotionScene):
+        integrator = motion_reference_integrator(scene, engine)
+        support = (engine.supports_joint_motion(scene, integrator) if integrator != NO_INTEGRATOR
+                   else Support.no("it steps no chain through time"))
     elif isinstance(scene, JointDynamicsScene):
         methods = engine.joint_dynamics_methods()
         support = (engine.supports_joint_dynamics(scene.chain, methods[0]) if methods
@@ -766,6 +856,8 @@ def _check_reference(top: _Reader, scene, engines: EngineSet) -> None:
         allowed = ("a reference that can: core (its backup method), mujoco or pybullet for contact" if contact is not None
                    else "a reference that computes joint-space dynamics: pinocchio, mujoco, core, or analytic for a "
                         "planar chain of 1 or 2 joints" if isinstance(scene, JointDynamicsScene)
+                   else "a reference that steps chains: pinocchio (its DOP853 solve), or analytic for a pendulum or a "
+                        "single damped joint" if isinstance(scene, JointMotionScene)
                    else "a reference that can: core, mujoco, pybullet, pinocchio, or tight for dynamics without a "
                         "closed form")
         raise top.fail("scene.reference", f"{scene.reference} cannot serve this scene: {support.reason}", allowed)
@@ -804,6 +896,8 @@ def _parse(data: dict, source: str, limits: Limits, engines: EngineSet):
     scene: Scene
     if kind == "dynamics":
         scene = _dynamics(top, dict(head, length_unit=unit), engines)
+    elif kind == "joint_motion":
+        scene = _joint_motion(top, head, engines)
     else:
         readers: dict[str, Callable[[_Reader, dict], Scene]] = {"kinematics": _kinematics, "ik": _ik,
                                                                   "joint_dynamics": _joint_dynamics}

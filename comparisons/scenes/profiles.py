@@ -15,7 +15,9 @@ of the order fits and of the hard cases' verdicts, the hard IK targets), but
   error jump with dt), keeps its :data:`QUICK_LADDER` coarsest, where its verdicts lie (stability
   limits, tunnelling, the hard cases' blow-ups);
 - a kinematics scene samples at most :data:`QUICK_SAMPLES` configurations, an IK scene at most
-  :data:`QUICK_TARGETS` random targets.
+  :data:`QUICK_TARGETS` random targets;
+- a joint-motion scene runs its :data:`QUICK_MOTION_LADDER` coarsest time steps (a chain's steps cost far more than a
+  free body's; three steps still give an order).
 """
 
 from __future__ import annotations
@@ -26,9 +28,11 @@ from dataclasses import replace
 import numpy as np
 
 from simparity.comparisons.engines.registry import EngineSet
-from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, KinematicsScene
+from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
 
 QUICK_MAX_STEPS = 2000
+QUICK_MOTION_LADDER = 3
+"""Time steps of a joint-motion scene the quick profile runs: its three coarsest, the fewest an order fit needs."""
 """Steps at the finest kept time step: every built-in scene but the long horizons (the
 Dzhanibekov flip and the separatrix over 10-20 s, 10^5 and 10^6 steps) runs whole, so the hard
 cases show the verdict they show in the full run and the closed-form bounds hold for the whole
@@ -94,6 +98,8 @@ def quick(scene, engines: EngineSet | None = None):
         return replace(scene, n_targets=min(scene.n_targets, QUICK_TARGETS))
     if isinstance(scene, JointDynamicsScene):
         return replace(scene, n_states=min(scene.n_states, QUICK_STATES))
+    if isinstance(scene, JointMotionScene):  # the coarsest steps: enough for an order, the fewest steps
+        return replace(scene, dts=tuple(sorted(scene.dts, reverse=True))[:QUICK_MOTION_LADDER])
     return scene
 
 

@@ -17,8 +17,8 @@ import numpy as np
 from simparity.core.model.errors import NotBatchedError, SimparityError
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.ik_result import IKResult
-from simparity.core.model.scene import Chain, DynamicsScene, KinematicsScene, Scene
-from simparity.core.model.trajectory import FramePoses, Trajectory
+from simparity.core.model.scene import Chain, DynamicsScene, JointMotionScene, KinematicsScene, Scene
+from simparity.core.model.trajectory import FramePoses, JointTrajectory, Trajectory
 
 
 SCHEME_KINDS = {
@@ -29,6 +29,8 @@ SCHEME_KINDS = {
                     "first order",
     "implicit_damping": "semi-implicit Euler with velocity-dependent forces taken implicitly (MuJoCo's "
                               "implicit, implicitfast): first order, damps stiff drag and fast spins",
+    "implicit_velocity": "semi-implicit Euler with every velocity-dependent joint force (damping and the Coriolis "
+                         "and centrifugal forces) linearised implicitly (MuJoCo's implicit on a chain): first order",
     "midpoint": "the explicit midpoint rule (RK2): second order",
     "average_velocity": "the lecture's average-velocity rule (Heun's method, RK2): second order",
     "rk4": "classical fourth-order Runge-Kutta",
@@ -60,6 +62,10 @@ calls its integrators: an engine's :meth:`Engine.scheme` answers with these name
 kind is modified (``damped_least_squares+nullspace``) or a contact treatment drives a time integrator
 (``penalty+rk4``, ``soft+rk4``). "" is an engine that does not say, which only the bounds for every scheme
 hold."""
+
+TRUTH_SCHEMES = ("closed_form", "adaptive")
+"""The kinds of scheme a truth is: a reference runs one where it has one, and no report ranks one beside the schemes
+it judges."""
 
 CONTACT_TREATMENTS = ("backup", "act_after", "penalty", "soft", "impulse")
 
@@ -124,6 +130,40 @@ class Simulation(abc.ABC):
         default, so an engine that does not say has an ``n/a`` batched timing.
         """
         raise NotBatchedError("the engine's simulation declares no batched stepping (Simulation.batched)")
+
+
+class JointSimulation(abc.ABC):
+    """A joint-motion scene built for one engine, integrator and time step.
+
+    Attributes
+    ----------
+    detail : str
+        What the engine was configured with beyond the scene (defaults switched off, how damping and the applied
+        forces reach its steps); shown in the results' ``detail`` column.
+    """
+
+    detail: str = ""
+
+    @abc.abstractmethod
+    def run(self, n_steps: int) -> JointTrajectory:
+        """Step the scene's B copies ``n_steps`` steps from their initial states (every call starts again).
+        Returns a :class:`JointTrajectory` with ``n_steps + 1`` samples at times k * dt."""
+
+    @abc.abstractmethod
+    def energy(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(kinetic, potential), each (B,) [J], at states q, qdot ((B, n) each), from the engine's own model:
+        kinetic 1/2 qdot^T M qdot (armature included), potential -sum_i m_i g . c_i(q) (c_i the centre of mass
+        of link i in the base frame, 0 without gravity). Not timed."""
+
+    @abc.abstractmethod
+    def end_effector_world(self, q: np.ndarray) -> np.ndarray:
+        """(B, 3) [m]: the chain's end-effector origin in the base frame at q ((B, n)), by the engine's own
+        forward kinematics. Not timed."""
+
+    def batched(self, copies: int) -> BatchedRun:
+        """``run(n_steps)`` stepping ``copies`` copies of the scene's first initial state together (as
+        :meth:`Simulation.batched`); raises :class:`NotBatchedError` with the reason when the engine cannot."""
+        raise NotBatchedError("the engine's joint simulation declares no batched stepping (JointSimulation.batched)")
 
 
 class KinematicsModel(abc.ABC):
@@ -329,6 +369,26 @@ class Engine(abc.ABC):
         none) with ``method`` (not timed). Call only when supported."""
         raise SimparityError(f"engine '{self.name}' computes no joint-space dynamics "
                              "(allowed: an engine whose joint_dynamics_methods() is not empty)")
+
+    def joint_motion_integrators(self) -> tuple[str, ...]:
+        """Names of the integrators the engine steps a chain's joints with (each a case of a joint-motion scene);
+        empty (the default) when it steps no chain, and its rows are n/a. :meth:`theoretical_order`,
+        :meth:`stages` and :meth:`scheme` answer for them as for the free-body integrators."""
+        return ()
+
+    def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
+        """Whether :meth:`build_joint_motion` can step ``scene`` with ``integrator``."""
+        if integrator in self.joint_motion_integrators():
+            return Support.yes()
+        if not self.joint_motion_integrators():
+            return Support.no(f"{self.name} steps no chain through time")
+        return Support.no(f"{self.name} has no joint-motion integrator '{integrator}' "
+                          f"(offers: {', '.join(self.joint_motion_integrators())})")
+
+    def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
+        """Build ``scene`` for stepping with ``integrator`` at ``dt`` [s] (not timed). Call only when supported."""
+        raise SimparityError(f"engine '{self.name}' steps no chain through time "
+                             "(allowed: an engine whose joint_motion_integrators() is not empty)")
 
     def theoretical_order(self, integrator: str) -> int | None:
         """Global order of accuracy the integrator has in theory (None: unknown, or it depends on the

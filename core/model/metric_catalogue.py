@@ -17,14 +17,15 @@ from dataclasses import dataclass
 
 from simparity.core.model.results import DIMENSIONLESS
 
-ERROR, DRIFT, ORDER, TIMING, COST, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE = (
-    "error", "drift", "order", "timing", "cost", "contact", "ik", "validity", "stability", "invariance")
-KINDS = (ERROR, DRIFT, ORDER, TIMING, COST, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE)
+ERROR, DRIFT, ORDER, TIMING, COST, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE, PREDICTABILITY = (
+    "error", "drift", "order", "timing", "cost", "contact", "ik", "validity", "stability", "invariance",
+    "predictability")
+KINDS = (ERROR, DRIFT, ORDER, TIMING, COST, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE, PREDICTABILITY)
 """What a metric measures: an error against the reference; a relative drift of a conserved quantity; an observed
 order of convergence; a wall time (never compared between runs); a hardware-neutral cost (exact, from what the
 engine declares: the same on every machine, and no measure of its numerics); a contact event's quantity; an IK
 solver's outcome; a reported state's validity (unit quaternion, orthonormal matrix); a measured stability limit; a
-metamorphic invariance check."""
+metamorphic invariance check; a chaotic motion's predictability (when two runs part)."""
 
 
 @dataclass(frozen=True)
@@ -102,6 +103,15 @@ CORIOLIS_SKEW_RESIDUAL = "coriolis_skew_residual"
 TIME_PER_MASS_MATRIX = "time_per_mass_matrix"
 TIME_PER_INVERSE_DYNAMICS = "time_per_inverse_dynamics"
 TIME_PER_FORWARD_DYNAMICS = "time_per_forward_dynamics"
+# Joint motion: unitless errors of a chain's motion against the reference, each engine's own energy balance.
+JOINT_ANGLE_ERROR_MAX = "joint_angle_error_max"
+JOINT_VELOCITY_ERROR_MAX = "joint_velocity_error_max"
+END_EFFECTOR_ERROR_MAX = "end_effector_error_max"
+POWER_BALANCE_RESIDUAL_MAX = "power_balance_residual_max"
+ORDER_JOINT_ANGLE = "order_joint_angle"
+ORDER_JOINT_VELOCITY = "order_joint_velocity"
+SELF_PARTING_TIME = "self_parting_time"
+REFERENCE_PARTING_TIME = "reference_parting_time"
 # Contact: events against the exact bounce sequence, slide and rest.
 IMPACT_TIME_ERROR = "impact_time_error"
 REBOUND_VELOCITY_ERROR = "rebound_velocity_error"
@@ -184,6 +194,16 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(TIME_PER_MASS_MATRIX, "s", TIMING),
     Metric(TIME_PER_INVERSE_DYNAMICS, "s", TIMING),
     Metric(TIME_PER_FORWARD_DYNAMICS, "s", TIMING),
+    Metric(JOINT_ANGLE_ERROR_MAX, DIMENSIONLESS, ERROR, headline=True, scale="joint_angle"),
+    Metric(JOINT_VELOCITY_ERROR_MAX, DIMENSIONLESS, ERROR, scale="joint_velocity"),
+    Metric(END_EFFECTOR_ERROR_MAX, DIMENSIONLESS, ERROR, scale="reach"),
+    Metric(POWER_BALANCE_RESIDUAL_MAX, DIMENSIONLESS, DRIFT, scale="energy",
+           theory="E(t) - E(0) = the work of the applied forces less the damping's: 0 up to the scheme's error"),
+    Metric(ORDER_JOINT_ANGLE, DIMENSIONLESS, ORDER, theory="the scheme's order", source=JOINT_ANGLE_ERROR_MAX),
+    Metric(ORDER_JOINT_VELOCITY, DIMENSIONLESS, ORDER, theory="the scheme's order", source=JOINT_VELOCITY_ERROR_MAX),
+    Metric(SELF_PARTING_TIME, "s", PREDICTABILITY,
+           theory="when the engine's runs from two starts a perturbation apart part: the chain's own horizon"),
+    Metric(REFERENCE_PARTING_TIME, "s", PREDICTABILITY, theory="not before the self-parting time, for a sound engine"),
     Metric(IMPACT_TIME_ERROR, "s", CONTACT),
     Metric(REBOUND_VELOCITY_ERROR, "m/s", CONTACT),
     Metric(APEX_HEIGHT_ERROR, "m", CONTACT),

@@ -1,4 +1,4 @@
-"""Trajectories of free bodies and kinematic results, in the project's conventions."""
+"""Trajectories of free bodies and of chains' joints, and kinematic results, in the project's conventions."""
 
 from __future__ import annotations
 
@@ -57,6 +57,40 @@ class Trajectory:
             bool(np.all(np.isfinite(a)))
             for a in (self.position_world, self.quat_wxyz, self.velocity_world, self.angular_velocity_world)
         )
+
+
+@dataclass(frozen=True)
+class JointTrajectory:
+    """Joint states of B copies of a chain at T sample times (the initial state included).
+
+    Attributes
+    ----------
+    times : (T,) ndarray
+        [s], starting at 0.
+    q : (T, B, n) ndarray
+        Joint values [rad or m].
+    qdot : (T, B, n) ndarray
+        Joint velocities [rad/s or m/s].
+    """
+
+    times: np.ndarray
+    q: np.ndarray
+    qdot: np.ndarray
+
+    def __post_init__(self) -> None:
+        n = len(self.times)
+        for name in ("q", "qdot"):
+            value = np.asarray(getattr(self, name), dtype=float)
+            if value.ndim != 3 or value.shape[0] != n:
+                raise ValueError(f"JointTrajectory.{name} has shape {value.shape}, expected ({n}, B, n)")
+            object.__setattr__(self, name, readonly(value))
+        if self.q.shape != self.qdot.shape:
+            raise ValueError(f"JointTrajectory.qdot has shape {self.qdot.shape}, q has {self.q.shape}")
+        object.__setattr__(self, "times", readonly(np.asarray(self.times, dtype=float)))
+
+    def is_finite(self) -> bool:
+        """True when every recorded value is finite."""
+        return bool(np.all(np.isfinite(self.q)) and np.all(np.isfinite(self.qdot)))
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,10 @@ law-of-cosines solver that it checks.
 
 Joint-space dynamics: planar revolute arms of one or two links (the physical pendulum, Spong's
 planar elbow manipulator) in closed form, :mod:`simparity.references.analytic.joint_dynamics`.
-Rotations are SciPy's
+
+Joint motion: a chain of one joint, the physical pendulum at any amplitude (Jacobi elliptic functions) or a joint
+under constant forces with viscous damping, :mod:`simparity.references.analytic.joint_motion` (the integrator is
+``closed_form``). Rotations are SciPy's
 (:mod:`simparity.references.common.conventions`).
 """
 
@@ -31,13 +34,22 @@ from __future__ import annotations
 
 import numpy as np
 
-from simparity.core.model.engine import Engine, IKModel, JointDynamicsModel, KinematicsModel, Simulation, Support
+from simparity.core.model.engine import (
+    Engine,
+    IKModel,
+    JointDynamicsModel,
+    JointSimulation,
+    KinematicsModel,
+    Simulation,
+    Support,
+)
 from simparity.core.model.ik_problem import IKTolerances, check_inputs
 from simparity.core.model.ik_result import IKResult
-from simparity.core.model.scene import Chain, DynamicsScene
+from simparity.core.model.scene import Chain, DynamicsScene, JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
 from simparity.references.analytic import contact as analytic_contact
 from simparity.references.analytic import joint_dynamics as planar_dynamics
+from simparity.references.analytic import joint_motion
 from simparity.references.analytic import solutions as closed
 from simparity.references.common.conventions import matrix_to_quat_wxyz, principal_axes, quat_wxyz_to_matrix, rotvec_to_matrix
 
@@ -331,6 +343,18 @@ class AnalyticEngine(Engine):
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
         return planar_dynamics.build(chain, gravity_world)
+
+    def joint_motion_integrators(self) -> tuple[str, ...]:
+        return ("closed_form",)
+
+    def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
+        named = super().supports_joint_motion(scene, integrator)
+        if not named.ok:
+            return named
+        return joint_motion.supports(scene)
+
+    def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
+        return joint_motion.build(scene, dt)
 
     def ik_solvers(self) -> tuple[str, ...]:
         return ("two_link",)

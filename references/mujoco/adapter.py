@@ -55,16 +55,18 @@ from simparity.core.model.engine import (
     Engine,
     IKModel,
     JointDynamicsModel,
+    JointSimulation,
     KinematicsModel,
     Simulation,
     Support,
 )
 from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.scene import Chain, DynamicsScene, Forces, IKScene, JointDynamicsScene
+from simparity.core.model.scene import Chain, DynamicsScene, Forces, IKScene, JointDynamicsScene, JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
 from simparity.references.common import contact_params, external_forces
 from simparity.references.mujoco import ik as mujoco_ik
+from simparity.references.mujoco import joint_motion
 from simparity.references.common.base_frame import BaseFrame
 from simparity.references.common.conventions import fmt, quat_wxyz_to_matrix
 from simparity.references.mujoco.mjcf import INTEGRATORS, arena_kib, chain_mjcf, dynamics_mjcf
@@ -329,20 +331,27 @@ class MujocoEngine(Engine):
 
     def theoretical_order(self, integrator: str) -> int | None:
         """Euler (semi-implicit), implicit and implicitfast are first order, RK4 fourth (MuJoCo's docs,
-        "Numerical integration")."""
-        return {"euler": 1, "implicit": 1, "implicitfast": 1, "rk4": 4}.get(integrator)
+        "Numerical integration"); on a chain also Euler with explicit damping (:data:`joint_motion.ORDERS`)."""
+        return {"euler": 1, "implicit": 1, "implicitfast": 1, "rk4": 4}.get(integrator,
+                                                                             joint_motion.ORDERS.get(integrator))
 
     def stages(self, integrator: str) -> int | None:
         """Force evaluations per ``mj_step``: one ``mj_forward`` for Euler, implicit and implicitfast (the implicit
         ones also take the derivative of the velocity-dependent forces and factor M - dt D once per step: work
         beyond the count), four for RK4 (``mj_RungeKutta``: the step's ``mj_forward`` and three more). Forces the
-        adapter sets from Python at each step's start are evaluated once per step whatever the integrator."""
-        return {"euler": 1, "implicit": 1, "implicitfast": 1, "rk4": 4}.get(integrator)
+        adapter sets from Python at each step's start are evaluated once per step whatever the integrator. On a
+        chain, Euler with explicit damping too is one (:data:`joint_motion.STAGES`)."""
+        return {"euler": 1, "implicit": 1, "implicitfast": 1, "rk4": 4}.get(integrator,
+                                                                             joint_motion.STAGES.get(integrator))
 
     def scheme(self, integrator: str, scene) -> str:
         """MuJoCo's Euler is semi-implicit with the orientation advanced by the exponential map (eulerdamp is
         disabled, so damping is explicit); implicit and implicitfast take velocity-dependent forces implicitly;
-        with planes, its soft contact drives them. Its IK (``dls``) is damped least squares."""
+        with planes, its soft contact drives them. Its IK (``dls``) is damped least squares. On a chain
+        (a joint-motion scene) Euler keeps eulerdamp, so it and implicitfast take the joint damping implicitly
+        (:data:`joint_motion.SCHEMES`)."""
+        if isinstance(scene, JointMotionScene):
+            return joint_motion.SCHEMES.get(integrator, "")
         if isinstance(scene, IKScene):
             return "damped_least_squares" if integrator in mujoco_ik.SOLVERS else ""
         if isinstance(scene, JointDynamicsScene):
@@ -373,19 +382,23 @@ class MujocoEngine(Engine):
         body without mass or rotational inertia, and an inertia breaking the triangle inequality); armature and
         damping are MuJoCo's own."""
         named = super().supports_joint_dynamics(chain, method)
-        if not named.ok:
-            return named
-        problem = chain.dynamics_problem()
-        if problem:
-            return Support.no(problem)
-        expressible = urdf_support(chain) if chain.urdf_path is None else Support.yes()
-        if not expressible.ok:
-            return expressible
-        problem = mujoco_dynamics_problem(chain)
-        return Support.no(problem) if problem else Support.yes()
+        return _dynamics_support(chain) if named.ok else named
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
         return MujocoJointDynamics(chain, gravity_world)
+
+    def joint_motion_integrators(self) -> tuple[str, ...]:
+        """MuJoCo's integrators stepping the joint-dynamics model (:mod:`references.mujoco.joint_motion`), Euler
+        twice: with its default implicit joint damping and with eulerdamp disabled."""
+        return tuple(joint_motion.INTEGRATORS)
+
+    def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
+        """As joint dynamics: a chain MuJoCo compiles unchanged from URDF."""
+        named = super().supports_joint_motion(scene, integrator)
+        return _dynamics_support(scene.chain) if named.ok else named
+
+    def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
+        return joint_motion.MujocoJointMotion(scene, integrator, dt)
 
     def ik_solvers(self) -> tuple[str, ...]:
         return mujoco_ik.SOLVERS
@@ -422,6 +435,19 @@ class MujocoEngine(Engine):
         if scene.contact is not None:
             extra += f"<!-- {contact_detail(scene, dt)} -->\n"
         return dynamics_mjcf(scene, integrator, dt) + velocities + extra
+
+
+def _dynamics_support(chain: Chain) -> Support:
+    """Whether MuJoCo builds the chain's dynamics model unchanged: mass properties that URDF can express and that
+    MuJoCo compiles without bounding a mass or balancing an inertia."""
+    problem = chain.dynamics_problem()
+    if problem:
+        return Support.no(problem)
+    expressible = urdf_support(chain) if chain.urdf_path is None else Support.yes()
+    if not expressible.ok:
+        return expressible
+    problem = mujoco_dynamics_problem(chain)
+    return Support.no(problem) if problem else Support.yes()
 
 
 class BatchRollout:

@@ -79,14 +79,17 @@ def mujoco_dynamics_problem(chain: Chain) -> str:
     return ""
 
 
-class MujocoJointDynamics(JointDynamicsModel):
-    """A chain's joint-space dynamics from MuJoCo's smooth dynamics (see the module docstring).
+class ChainModel:
+    """The chain's compiled MuJoCo model as the module docstring builds it (compiler options, gravity, constraints
+    off, passive forces set), shared by joint dynamics and joint motion (:mod:`references.mujoco.joint_motion`).
 
     Attributes
     ----------
-    model, data : mujoco.MjModel, mujoco.MjData
+    model : mujoco.MjModel
     dof, qpos : (n,) int ndarray
-        The chain joints' dof and qpos addresses.
+        The chain joints' dof and qpos addresses (joints mapped by name).
+    detail : str
+        What MuJoCo was given, for the rows' detail.
     """
 
     def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
@@ -101,13 +104,30 @@ class MujocoJointDynamics(JointDynamicsModel):
         model.dof_frictionloss[:] = 0.0
         model.jnt_stiffness[:] = 0.0
         model.jnt_stiffnesspoly[:] = 0.0
-        self.model, self.data = model, mujoco.MjData(model)
+        self.model = model
         gravity = "none" if gravity_world is None else fmt(gravity_world)
         self.detail = (f"MuJoCo's URDF importer (MjSpec.from_string) on {dynamics_source(chain)}; fusestatic and "
                        "balanceinertia off, boundmass = boundinertia = 0, inertiafromgeom false; gravity "
                        f"{gravity}; constraints (joint limits) disabled; dof_damping and dof_armature from the "
-                       "chain, frictionloss and stiffness 0; mj_fullM, qfrc_bias, mj_inverse, mj_forward's qacc; "
-                       "kinetic energy from mj_objectVelocity at each body's centre of mass")
+                       "chain, frictionloss and stiffness 0")
+
+
+class MujocoJointDynamics(JointDynamicsModel):
+    """A chain's joint-space dynamics from MuJoCo's smooth dynamics (see the module docstring).
+
+    Attributes
+    ----------
+    model, data : mujoco.MjModel, mujoco.MjData
+    dof, qpos : (n,) int ndarray
+        The chain joints' dof and qpos addresses.
+    """
+
+    def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
+        built = ChainModel(chain, gravity_world)
+        self.model, self.dof, self.qpos = built.model, built.dof, built.qpos
+        self.data = mujoco.MjData(self.model)
+        self.detail = (f"{built.detail}; mj_fullM, qfrc_bias, mj_inverse, mj_forward's qacc; kinetic energy from "
+                       "mj_objectVelocity at each body's centre of mass")
 
     def _set(self, q_row: np.ndarray, qdot_row: np.ndarray, tau_row: np.ndarray | None = None) -> None:
         """Put the state (and applied joint forces, zero if None) in, and run ``mj_forward``."""

@@ -44,13 +44,14 @@ from simparity.core.model.engine import (
     Engine,
     IKModel,
     JointDynamicsModel,
+    JointSimulation,
     KinematicsModel,
     Simulation,
     Support,
 )
 from simparity.core.model.errors import NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene
+from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
 from simparity.references.common import external_forces
 from simparity.references.pinocchio import ik as pinocchio_ik
@@ -59,6 +60,7 @@ from simparity.references.common.conventions import matrix_to_quat_wxyz, quat_wx
 from simparity.references.common.quiet import captured_output
 from simparity.references.pinocchio.joints import configuration
 from simparity.references.common.urdf_export import UrdfChains, chain_export, chain_source, chain_urdf, urdf_support
+from simparity.references.pinocchio import joint_motion
 from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics
 
 
@@ -274,6 +276,14 @@ class PinocchioChain(KinematicsModel):
         return self.base.jacobian(out)
 
 
+def _dynamics_support(chain: Chain) -> Support:
+    """Whether Pinocchio's dynamics model can hold ``chain``: mass properties that URDF can express."""
+    problem = chain.dynamics_problem()
+    if problem:
+        return Support.no(problem)
+    return urdf_support(chain) if chain.urdf_path is None else Support.yes()
+
+
 class PinocchioEngine(UrdfChains, Engine):
     """Pinocchio: kinematics from a chain's URDF; dynamics from aba, stepped by the harness."""
 
@@ -286,12 +296,14 @@ class PinocchioEngine(UrdfChains, Engine):
         return INTEGRATORS
 
     def theoretical_order(self, integrator: str) -> int | None:
-        """The harness's steppers: the engines' first-order scheme, classical RK4."""
-        return {"euler": 1, "rk4": 4}.get(integrator)
+        """The harness's steppers: the engines' first-order scheme, classical RK4; on a chain's joints explicit and
+        semi-implicit Euler (1), RK4 (4), the DOP853 solves none (:mod:`references.pinocchio.joint_motion`)."""
+        return {"euler": 1, "rk4": 4}.get(integrator, joint_motion.ORDERS.get(integrator))
 
     def stages(self, integrator: str) -> int | None:
-        """``pin.aba`` calls per body and step: once for the Euler step, once per stage of RK4."""
-        return {"euler": 1, "rk4": 4}.get(integrator)
+        """``pin.aba`` calls per body (or copy of a chain) and step: once for an Euler step, once per stage of RK4;
+        None for the DOP853 solves (their steps vary)."""
+        return {"euler": 1, "rk4": 4}.get(integrator, joint_motion.STAGES.get(integrator))
 
     def scheme(self, integrator: str, scene) -> str:
         """The harness's steppers on Pinocchio's dynamics: the engines' Euler step and RK4; its IK (``clik``,
@@ -300,6 +312,8 @@ class PinocchioEngine(UrdfChains, Engine):
             return "damped_least_squares" if integrator in pinocchio_ik.SOLVERS else ""
         if isinstance(scene, JointDynamicsScene):
             return integrator if integrator in self.joint_dynamics_methods() else ""
+        if isinstance(scene, JointMotionScene):
+            return joint_motion.SCHEMES.get(integrator, "")
         return {"euler": "engine_euler", "rk4": "rk4"}.get(integrator, "")
 
     def supports_dynamics(self, scene: DynamicsScene, integrator: str) -> Support:
@@ -320,15 +334,22 @@ class PinocchioEngine(UrdfChains, Engine):
     def supports_joint_dynamics(self, chain: Chain, method: str) -> Support:
         """A chain with mass properties that URDF can express; armature is Pinocchio's own, damping added."""
         named = super().supports_joint_dynamics(chain, method)
-        if not named.ok:
-            return named
-        problem = chain.dynamics_problem()
-        if problem:
-            return Support.no(problem)
-        return urdf_support(chain) if chain.urdf_path is None else Support.yes()
+        return _dynamics_support(chain) if named.ok else named
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
         return PinocchioJointDynamics(chain, gravity_world)
+
+    def joint_motion_integrators(self) -> tuple[str, ...]:
+        """The harness's steppers of ``pin.aba`` and the DOP853 solves (:mod:`references.pinocchio.joint_motion`)."""
+        return joint_motion.INTEGRATORS
+
+    def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
+        """The chains of :meth:`supports_joint_dynamics`."""
+        named = super().supports_joint_motion(scene, integrator)
+        return _dynamics_support(scene.chain) if named.ok else named
+
+    def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
+        return joint_motion.PinocchioJointMotion(scene, integrator, dt)
 
     def ik_solvers(self) -> tuple[str, ...]:
         return pinocchio_ik.SOLVERS

@@ -27,6 +27,8 @@ What Pinocchio is given, and each default handled (each pinned by ``tests/test_j
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pinocchio as pin
 
@@ -36,6 +38,67 @@ from simparity.references.common.conventions import fmt
 from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
 from simparity.references.pinocchio.joints import configuration
+
+
+@dataclass(frozen=True)
+class ChainModel:
+    """Pinocchio's model of a chain's dynamics (see the module docstring), shared by joint-space dynamics and joint
+    motion (:mod:`references.pinocchio.joint_motion`).
+
+    Attributes
+    ----------
+    model : pinocchio.Model
+        With the scene's gravity and the chain's armature.
+    joint_ids : list of int
+        Pinocchio's joint id of each chain joint.
+    idx_q : list of int
+        Configuration index of each chain joint.
+    continuous : list of bool
+        Whether each chain joint is continuous (nq = 2: (cos q, sin q) at ``idx_q``).
+    idx_v : (n,) int ndarray
+        Velocity index of each chain joint.
+    damping : (n,) ndarray
+        The chain's joint damping [N m s/rad or N s/m].
+    source : str
+        Where the model comes from and how gravity, armature and damping reach it (for the rows' detail).
+    """
+
+    model: pin.Model
+    joint_ids: list[int]
+    idx_q: list[int]
+    continuous: list[bool]
+    idx_v: np.ndarray
+    damping: np.ndarray
+    source: str
+
+    def configuration(self, q_row: np.ndarray) -> np.ndarray:
+        """Pinocchio configuration (nq,) of joint values (n,): (cos, sin) for continuous joints."""
+        return configuration(self.model, self.idx_q, self.continuous, q_row)
+
+    def velocity(self, qdot_row: np.ndarray) -> np.ndarray:
+        """Pinocchio velocity (nv,) of joint rates (n,) (or any joint-space vector: forces, accelerations)."""
+        v = np.zeros(self.model.nv)
+        v[self.idx_v] = qdot_row
+        return v
+
+
+def chain_model(chain: Chain, gravity_world: np.ndarray | None) -> ChainModel:
+    """``chain``'s dynamics model read by Pinocchio's URDF parser, ``gravity_world`` ((3,) [m/s^2] in the base
+    frame, None for none) as ``model.gravity`` and the chain's armature as ``model.armature``."""
+    with captured_output():
+        model = pin.buildModelFromXML(dynamics_urdf(chain))
+    model.gravity = pin.Motion(np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float),
+                               np.zeros(3))
+    joint_ids = [model.getJointId(j.name) for j in chain.joints]
+    joints = [model.joints[i] for i in joint_ids]
+    idx_v = np.array([j.idx_v for j in joints])
+    armature = np.zeros(model.nv)
+    armature[idx_v] = [j.armature for j in chain.joints]
+    model.armature = armature
+    gravity = "none" if gravity_world is None else fmt(gravity_world)
+    source = f"pinocchio.buildModelFromXML of {dynamics_source(chain)}; gravity {gravity}; armature as model.armature"
+    return ChainModel(model, joint_ids, [j.idx_q for j in joints], [j.nq == 2 for j in joints], idx_v,
+                      np.array([j.damping for j in chain.joints]), source)
 
 
 class PinocchioJointDynamics(JointDynamicsModel):
@@ -53,34 +116,12 @@ class PinocchioJointDynamics(JointDynamicsModel):
     """
 
     def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
-        with captured_output():
-            model = pin.buildModelFromXML(dynamics_urdf(chain))
-        model.gravity = pin.Motion(np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float),
-                                   np.zeros(3))
-        self.joint_ids = [model.getJointId(j.name) for j in chain.joints]
-        joints = [model.joints[i] for i in self.joint_ids]
-        self._idx_q = [j.idx_q for j in joints]
-        self._continuous = [j.nq == 2 for j in joints]
-        self.idx_v = np.array([j.idx_v for j in joints])
-        armature = np.zeros(model.nv)
-        armature[self.idx_v] = [j.armature for j in chain.joints]
-        model.armature = armature
-        self.damping = np.array([j.damping for j in chain.joints])
-        self.model, self.data = model, model.createData()
-        gravity = "none" if gravity_world is None else fmt(gravity_world)
-        self.detail = (f"pinocchio.buildModelFromXML of {dynamics_source(chain)}; gravity {gravity}; armature as "
-                       "model.armature; M = crba, h = nle, tau = rnea + D qdot, qddot = aba(tau - D qdot); kinetic "
-                       "energy from forwardKinematics' joint velocities and model.inertias")
-
-    def _configuration(self, q_row: np.ndarray) -> np.ndarray:
-        """Pinocchio configuration (nq,) of joint values (n,): (cos, sin) for continuous joints."""
-        return configuration(self.model, self._idx_q, self._continuous, q_row)
-
-    def _velocity(self, qdot_row: np.ndarray) -> np.ndarray:
-        """Pinocchio velocity (nv,) of joint rates (n,)."""
-        v = np.zeros(self.model.nv)
-        v[self.idx_v] = qdot_row
-        return v
+        self._chain = chain_model(chain, gravity_world)
+        self.model, self.data = self._chain.model, self._chain.model.createData()
+        self.joint_ids, self.idx_v, self.damping = self._chain.joint_ids, self._chain.idx_v, self._chain.damping
+        self._configuration, self._velocity = self._chain.configuration, self._chain.velocity
+        self.detail = (f"{self._chain.source}; M = crba, h = nle, tau = rnea + D qdot, qddot = aba(tau - D qdot); "
+                       "kinetic energy from forwardKinematics' joint velocities and model.inertias")
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         out = np.empty((len(q), len(self.idx_v), len(self.idx_v)))

@@ -84,13 +84,14 @@ from simparity.core.model.engine import (
     Engine,
     IKModel,
     JointDynamicsModel,
+    JointSimulation,
     KinematicsModel,
     Simulation,
     Support,
 )
 from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene
+from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
 from simparity.references.common import contact_params, external_forces
 from simparity.references.pybullet import ik as pybullet_ik
@@ -456,6 +457,15 @@ class PybulletChain(KinematicsModel):
         return self.base.jacobian(out)
 
 
+def _armature_support(chain: Chain) -> Support:
+    """PyBullet has no joint armature: no when a joint of ``chain`` declares one."""
+    armature = [j for j in chain.joints if j.armature > 0]
+    if armature:
+        return Support.no(f"PyBullet has no joint armature (rotor inertia added to M's diagonal); joint "
+                          f"{armature[0].name!r} declares {armature[0].armature:g}")
+    return Support.yes()
+
+
 class PybulletEngine(UrdfChains, Engine):
     """PyBullet (Bullet multibody), built from URDF the adapter writes or a chain's URDF file."""
 
@@ -468,17 +478,21 @@ class PybulletEngine(UrdfChains, Engine):
         return ("euler",)
 
     def theoretical_order(self, integrator: str) -> int | None:
-        """Bullet's semi-implicit Euler step is first order."""
+        """Bullet's semi-implicit Euler step is first order (free bodies and chains alike)."""
         return 1 if integrator == "euler" else None
 
     def stages(self, integrator: str) -> int | None:
-        """One force evaluation per ``stepSimulation`` (the adapter's forces, set before each step, are held over
-        it); the constraint solver's iterations at a contact are not counted."""
+        """One force evaluation per ``stepSimulation`` (the adapter's forces and a chain's joint torques, set before
+        each step, are held over it); the constraint solver's iterations at a contact are not counted."""
         return 1 if integrator == "euler" else None
 
     def scheme(self, integrator: str, scene) -> str:
         """Bullet steps semi-implicit Euler, the orientation by the exponential map; with planes, its velocity-level
-        impulses resolve contact. Its IK is damped least squares (``-nullspace``: with a null-space rest pose)."""
+        impulses resolve contact; a chain's joints semi-implicit Euler (q from the new qdot, joint damping explicit:
+        :mod:`references.pybullet.joint_motion`). Its IK is damped least squares (``-nullspace``: with a null-space
+        rest pose)."""
+        if isinstance(scene, JointMotionScene):
+            return "semi_implicit_euler" if integrator in self.joint_motion_integrators() else ""
         if isinstance(scene, IKScene):
             return ("damped_least_squares+nullspace" if integrator.endswith("nullspace") else
                     "damped_least_squares" if integrator in pybullet_ik.SOLVERS else "")
@@ -509,17 +523,27 @@ class PybulletEngine(UrdfChains, Engine):
         problem = chain.dynamics_problem() if named.ok else ""
         if problem:
             return Support.no(problem)
-        armature = [j for j in chain.joints if j.armature > 0] if named.ok else []
-        if armature:
-            return Support.no(f"PyBullet has no joint armature (rotor inertia added to M's diagonal); joint "
-                              f"{armature[0].name!r} declares {armature[0].armature:g}")
-        return named
+        return _armature_support(chain) if named.ok else named
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
         # imported here: joint_dynamics reuses this module's client and loader
         from simparity.references.pybullet.joint_dynamics import PybulletJointDynamics
 
         return PybulletJointDynamics(chain, gravity_world)
+
+    def joint_motion_integrators(self) -> tuple[str, ...]:
+        """Bullet's own step of the multibody, named as for free bodies (:mod:`references.pybullet.joint_motion`)."""
+        return ("euler",)
+
+    def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
+        named = super().supports_joint_motion(scene, integrator)
+        return _armature_support(scene.chain) if named.ok else named
+
+    def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
+        # imported here: joint_motion reuses this module's client, loader and chain kinematics
+        from simparity.references.pybullet.joint_motion import PybulletJointMotion
+
+        return PybulletJointMotion(scene, dt)
 
     def ik_solvers(self) -> tuple[str, ...]:
         return pybullet_ik.SOLVERS

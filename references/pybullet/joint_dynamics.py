@@ -32,7 +32,8 @@ joints in its own order. Each default below is switched off or set, and pinned b
   D qdot is added here.
 - URDF multibodies never sleep unless loaded with ``URDF_ENABLE_SLEEPING`` (not passed).
 
-Two PyBullet models, each a fresh body in a DIRECT world of its own:
+Two PyBullet models, each a fresh body in a DIRECT world of its own (:class:`ChainBodies`, which
+:mod:`references.pybullet.joint_motion` reuses with the scene's time step and a body per copy):
 
 - ``calculateMassMatrix`` / ``calculateInverseDynamics`` run on a btInverseDynamics tree that PyBullet builds from
   the body at the first such call and CACHES (a later ``changeDynamics`` of a mass does not reach it): it is built
@@ -96,26 +97,37 @@ def unit_axes(text: str) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
-class _Body:
-    """The chain's body in a private DIRECT world with every default of the module docstring switched off.
+class ChainBodies:
+    """``copies`` bodies of the chain in a private DIRECT world, every default of the module docstring switched off:
+    gravity exactly ``gravity_world`` (None: zero), time step ``time_step`` [s] without sub-steps. The bodies have no
+    collision shapes, so they never touch each other: one ``stepSimulation`` steps each as if it were alone.
 
     Attributes
     ----------
-    client, body : int
+    client : int
+    bodies : list of int
+        The bodies' unique ids, one per copy.
+    body : int
+        The first copy's.
     joints : list of int
-        PyBullet joint index of each chain joint.
+        PyBullet joint index of each chain joint (the same in every copy).
     columns : list of int
         Position of each chain joint among the body's movable joints (PyBullet's order).
     links : list of int
         Every link of the body (its joints' indices; the fixed base, -1, left out).
     """
 
-    def __init__(self, text: str, chain: Chain) -> None:
+    def __init__(self, chain: Chain, gravity_world: np.ndarray | None, time_step: float = STEP,
+                 copies: int = 1) -> None:
         self._client = _Client()
         c = self.client = self._client.id
-        pybullet.setTimeStep(STEP, physicsClientId=c)
+        pybullet.setTimeStep(time_step, physicsClientId=c)
         pybullet.setPhysicsEngineParameter(numSubSteps=0, physicsClientId=c)
-        self.body = b = _load_urdf(c, text, useFixedBase=True)
+        pybullet.setGravity(*(np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float)),
+                            physicsClientId=c)
+        text = unit_axes(dynamics_urdf(chain))
+        self.bodies = [_load_urdf(c, text, useFixedBase=True) for _ in range(copies)]
+        self.body = b = self.bodies[0]
         info = [pybullet.getJointInfo(b, j, physicsClientId=c)
                 for j in range(pybullet.getNumJoints(b, physicsClientId=c))]
         index = {i[1].decode(): i[0] for i in info}
@@ -123,24 +135,44 @@ class _Body:
         self.joints = [index[j.name] for j in chain.joints]
         self.columns = [movable.index(j) for j in self.joints]
         self.links = [i[0] for i in info]
-        self._n_movable = len(movable)
-        pybullet.changeDynamics(b, -1, linearDamping=0.0, angularDamping=0.0, maxJointVelocity=MAX_VELOCITY,
+        self._movable = movable
+        for body in self.bodies:
+            self._configure(body, chain)
+
+    def _configure(self, body: int, chain: Chain) -> None:
+        """Link damping 0, velocity cap raised, jointDamping the chain's, joint limits and braking motors off."""
+        c = self.client
+        pybullet.changeDynamics(body, -1, linearDamping=0.0, angularDamping=0.0, maxJointVelocity=MAX_VELOCITY,
                                 physicsClientId=c)
         for joint, j in zip(chain.joints, self.joints):
-            pybullet.changeDynamics(b, j, jointDamping=joint.damping, jointLimitForce=0.0, physicsClientId=c)
-        pybullet.setJointMotorControlArray(b, movable, pybullet.VELOCITY_CONTROL, forces=[0.0] * len(movable),
-                                           physicsClientId=c)
+            pybullet.changeDynamics(body, j, jointDamping=joint.damping, jointLimitForce=0.0, physicsClientId=c)
+        pybullet.setJointMotorControlArray(body, self._movable, pybullet.VELOCITY_CONTROL,
+                                           forces=[0.0] * len(self._movable), physicsClientId=c)
+
+    def build_tree(self) -> None:
+        """Have PyBullet build (and cache) the first body's inverse-dynamics tree now that it is configured."""
+        with captured_output():  # PyBullet prints while building it
+            pybullet.calculateMassMatrix(self.body, self.movable(np.zeros(len(self.joints))),
+                                         physicsClientId=self.client)
 
     def movable(self, row: np.ndarray) -> list[float]:
         """The values ``row`` (n,) of the chain's joints as PyBullet's list over all movable joints."""
-        out = np.zeros(self._n_movable)
+        out = np.zeros(len(self._movable))
         out[self.columns] = row
         return out.tolist()
 
-    def reset(self, q: np.ndarray, qdot: np.ndarray) -> None:
-        """Put the chain's joints at ``q``, ``qdot`` (n,)."""
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        """M (B, n, n) at ``q`` (B, n) from the first body's tree (:meth:`build_tree` first)."""
+        chain_block = np.ix_(self.columns, self.columns)
+        return np.stack([np.array(pybullet.calculateMassMatrix(self.body, self.movable(row),
+                                                               physicsClientId=self.client))[chain_block]
+                         for row in q])
+
+    def reset(self, q: np.ndarray, qdot: np.ndarray, copy: int = 0) -> None:
+        """Put the chain's joints of body ``copy`` at ``q``, ``qdot`` (n,)."""
         for j, position, velocity in zip(self.joints, q, qdot):
-            pybullet.resetJointState(self.body, j, float(position), float(velocity), physicsClientId=self.client)
+            pybullet.resetJointState(self.bodies[copy], j, float(position), float(velocity),
+                                     physicsClientId=self.client)
 
 
 def _rows(*arrays: np.ndarray) -> list[np.ndarray]:
@@ -152,15 +184,9 @@ class PybulletJointDynamics(JointDynamicsModel):
     """A chain's joint-space dynamics in PyBullet (module docstring: what is set, which call gives what)."""
 
     def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
-        text = unit_axes(dynamics_urdf(chain))
-        gravity = np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float)
-        self._tree = _Body(text, chain)
-        pybullet.setGravity(*gravity, physicsClientId=self._tree.client)
-        with captured_output():  # PyBullet builds (and caches) its inverse-dynamics tree at the first call
-            pybullet.calculateMassMatrix(self._tree.body, self._tree.movable(np.zeros(chain.n_joints)),
-                                         physicsClientId=self._tree.client)
-        self._stepped = _Body(text, chain)
-        pybullet.setGravity(*gravity, physicsClientId=self._stepped.client)
+        self._tree = ChainBodies(chain, gravity_world)
+        self._tree.build_tree()
+        self._stepped = ChainBodies(chain, gravity_world)
         self._damping = np.array([j.damping for j in chain.joints])
         self.detail = (f"loadURDF(useFixedBase, URDF_USE_INERTIA_FROM_FILE) of {dynamics_source(chain)}, axes "
                        f"normalised; gravity set; link damping 0, jointDamping = the chain's, joint limits, velocity "
@@ -170,10 +196,7 @@ class PybulletJointDynamics(JointDynamicsModel):
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         (q,) = _rows(q)
-        t = self._tree
-        chain_block = np.ix_(t.columns, t.columns)
-        return np.stack([np.array(pybullet.calculateMassMatrix(t.body, t.movable(row), physicsClientId=t.client))
-                         [chain_block] for row in q])
+        return self._tree.mass_matrix(q)
 
     def _inverse(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
         """calculateInverseDynamics (without damping), (B, n)."""

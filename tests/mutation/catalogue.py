@@ -36,6 +36,10 @@ ARTICULATED = ("default", "articulated")
 ARTICULATED_3D = ("articulated",)
 """Joint-space dynamics that a planar arm cannot show (a gyroscopic term, an axis turning out of the plane)."""
 
+JOINT_MOTION = ("default", "hard", "articulated")
+"""Joint-space time stepping: the default suite's pendulum and damped joint, the hard suite's stiff damping and the
+articulated suite's chains and falling arms."""
+
 MUTANTS: tuple[Mutation, ...] = (
     # --- Dynamics: integrators ------------------------------------------------------------------------------
     Mutation(
@@ -238,6 +242,31 @@ MUTANTS: tuple[Mutation, ...] = (
         "tau[i] = forces[i][arrays.subspace[i]]",
         "RNEA without the joint's rotor inertia (armature): tau misses a_i qddot_i (no URDF carries armature)",
         ARTICULATED_3D, "armature-arm-dynamics"),
+    # --- Joint-space time stepping --------------------------------------------------------------------------
+    Mutation(
+        "joint_rk4_stage_typo", "integrator weights", "articulated/stepping.py",
+        "qdot + dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)",
+        "qdot + dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a2 + a4)",
+        "the joints' RK4 velocity update sums k2 twice instead of k2 and k3 (a copy-and-paste slip: third order)",
+        JOINT_MOTION, "pendulum-large-amplitude"),
+    Mutation(
+        "joint_semi_implicit_old_velocity", "integrator stages", "articulated/stepping.py",
+        "            qdot = qdot + dt * qddot(q, qdot)\n            return q + dt * qdot, qdot\n        return semi_implicit",
+        "            new = qdot + dt * qddot(q, qdot)\n            return q + dt * qdot, new\n        return semi_implicit",
+        "semi-implicit Euler moving the joints with the old velocity: explicit Euler under the semi-implicit name",
+        JOINT_MOTION, "pendulum-large-amplitude"),
+    Mutation(
+        "joint_implicit_damping_without_dt", "joint damping", "articulated/stepping.py",
+        "replace(j, armature=j.armature + dt * j.damping)",
+        "replace(j, armature=j.armature + j.damping)",
+        "implicit damping with M + D instead of M + dt D (the step forgotten in the linearisation)",
+        JOINT_MOTION, "damped-joint"),
+    Mutation(
+        "joint_torque_dropped", "applied forces", "articulated/stepping.py",
+        "torque = scene.torque[:, None]",
+        "torque = 0.0 * scene.torque[:, None]",
+        "the scene's applied joint torques never reach the steps",
+        JOINT_MOTION, "damped-joint"),
 )
 """The catalogue (issue #23 asks for at least a dozen, of the kinds listed there)."""
 

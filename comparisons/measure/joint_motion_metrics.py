@@ -1,0 +1,343 @@
+"""Metrics of a chain's motion through time (:class:`JointMotionScene`): joint and end-effector errors against the
+reference, the energy balance of each engine's own motion, divergence. Definitions with their reasons:
+``docs/metrics.md``.
+
+Every error is unitless, so a verdict does not depend on units, on where the world's origin is or on how the
+chain is turned: a revolute joint's angle error is in radians, a prismatic joint's offset relative to the chain's
+reach (:func:`joint_scales`); joint velocities relative to the fastest joint speed of the reference's motion; the
+end effector relative to the reach; energies relative to the energy the chain exchanges (its kinetic energy plus
+the range of its potential energy: not |E|, which depends on where the origin is).
+
+Energies come from each engine's own model (:meth:`JointSimulation.energy`); nothing here is in-house code.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import cumulative_simpson
+
+from simparity.comparisons.measure.divergence import CONSERVED_GROWTH_LIMIT
+from simparity.comparisons.measure.metrics import (
+    ROUNDING_FLOOR_FACTOR, SATURATED_DRIFT, SATURATED_FRACTION, SATURATED_ORIENTATION,
+)
+from simparity.comparisons.measure.rows import Measured
+from simparity.core.model.engine import JointSimulation
+from simparity.core.model.metric_catalogue import (
+    END_EFFECTOR_ERROR_MAX, ENERGY_DRIFT_MAX, EVALUATIONS_PER_SECOND, JOINT_ANGLE_ERROR_MAX, JOINT_VELOCITY_ERROR_MAX,
+    ORDER_JOINT_ANGLE, ORDER_JOINT_VELOCITY, POWER_BALANCE_RESIDUAL_MAX, REFERENCE_PARTING_TIME, SELF_PARTING_TIME,
+    TIME_PER_STEP, TIME_PER_STEP_BATCHED, order_source, units,
+)
+from simparity.core.model.results import NOTHING_TO_MEASURE, ROUNDING_FLOOR, SATURATED
+from simparity.core.model.scene import Chain, JointMotionScene
+from simparity.core.model.trajectory import JointTrajectory
+
+JOINT_MOTION_METRICS = units(
+    JOINT_ANGLE_ERROR_MAX,
+    JOINT_VELOCITY_ERROR_MAX,
+    END_EFFECTOR_ERROR_MAX,
+    ENERGY_DRIFT_MAX,
+    POWER_BALANCE_RESIDUAL_MAX,
+    TIME_PER_STEP,
+    TIME_PER_STEP_BATCHED,
+    EVALUATIONS_PER_SECOND,
+)
+"""Every metric a joint-motion case may have; :func:`motion_metrics` those of one scene."""
+PREDICTABILITY_METRICS = units(SELF_PARTING_TIME, REFERENCE_PARTING_TIME)
+"""Of a scene with a perturbation: when each engine's two runs part, and when it parts from the reference."""
+JOINT_MOTION_ORDERS = units(ORDER_JOINT_ANGLE, ORDER_JOINT_VELOCITY)
+JOINT_ORDER_SOURCES = {order: order_source(order) for order in JOINT_MOTION_ORDERS}
+REFERENCE_ERRORS = (JOINT_ANGLE_ERROR_MAX, JOINT_VELOCITY_ERROR_MAX, END_EFFECTOR_ERROR_MAX)
+"""The metrics measured against the reference (the others are each engine's own)."""
+
+MAX_ENERGY_SAMPLES = 2001
+"""Samples (evenly spaced, the first and last included) at which an engine's energy and end effector are
+evaluated: its model is called outside the timed run, and 2,001 samples resolve any drift a scene of up to 10^6
+steps shows (drift grows smoothly between samples; a blow-up is caught on the joint states themselves)."""
+
+HORIZON_FLOOR = 1e-6
+"""[rad] The reference is trusted while its two tolerances agree to this (the tight solve's own error is then
+about a hundredth of it: its tolerance is 100 x tighter). Past the first sample where they differ by more, a
+chaotic chain has amplified the reference's own error beyond use (e^(lambda t) 1e-13), and errors are measured
+over the horizon before it only."""
+
+PARTING = 1e-3
+"""[rad] Two runs have parted when a joint differs by more than this (unitless joint values): a thousandth of a
+radian is far above any scheme's rounding and far below the saturation of a lost orbit (Chung and Pollard 2016)."""
+
+REFERENCE_FLOOR_MARGIN = 10.0
+"""An error within this factor of the reference's own floor (its two tolerances' difference over the horizon)
+is at the reference's floor: flagged, left out of order fits (the floor overestimates the tight solve's error,
+so 10 keeps clear of it)."""
+
+
+def exchanges_energy(scene: JointMotionScene) -> bool:
+    """Whether the chain is damped or driven (its energy changes by the work done on it), else conservative."""
+    return bool(np.any(np.asarray(scene.torque) != 0) or any(j.damping > 0 for j in scene.chain.joints))
+
+
+def motion_metrics(scene: JointMotionScene) -> dict[str, str]:
+    """The metrics of a case of ``scene``: its energy balance as a drift where the chain is conservative, as the
+    power balance where it is damped or driven."""
+    left_out = ENERGY_DRIFT_MAX if exchanges_energy(scene) else POWER_BALANCE_RESIDUAL_MAX
+    metrics = {m: u for m, u in JOINT_MOTION_METRICS.items() if m != left_out}
+    return metrics | (PREDICTABILITY_METRICS if scene.perturbation > 0 and not scene.segments else {})
+
+
+def joint_scales(chain: Chain) -> np.ndarray:
+    """(n,) what one unit of each joint's error is: 1 rad for a revolute joint, the chain's reach for a prismatic
+    one, so that joint errors are unitless and invariant under a change of length unit."""
+    length = reach(chain)
+    return np.array([1.0 if j.type == "revolute" else length for j in chain.joints])
+
+
+def reach(chain: Chain) -> float:
+    """[m] The chain's size: the sum of its joint offsets and end-effector offset, plus the travel of its
+    prismatic joints where limited; at least the largest link's centre-of-mass offset, never 0."""
+    offsets = sum(float(np.linalg.norm(j.origin_xyz)) for j in chain.joints)
+    offsets += float(np.linalg.norm(chain.end_effector_xyz))
+    travel = sum(j.upper - j.lower for j in chain.joints
+                 if j.type == "prismatic" and math.isfinite(j.upper - j.lower))
+    com = max((float(np.linalg.norm(j.link.com_xyz)) for j in chain.joints if j.link is not None), default=0.0)
+    return max(offsets + travel, com, np.finfo(float).tiny)
+
+
+@dataclass(frozen=True)
+class OwnReading:
+    """What the judge reads of one engine's motion from its own model, at :data:`MAX_ENERGY_SAMPLES` samples.
+
+    Attributes
+    ----------
+    index : (S,) int ndarray
+        The samples of the trajectory read.
+    kinetic, potential : (S, B) ndarray
+        [J].
+    end_effector : (S, B, 3) ndarray
+        [m].
+    """
+
+    index: np.ndarray
+    kinetic: np.ndarray
+    potential: np.ndarray
+    end_effector: np.ndarray
+
+
+def sample_index(count: int) -> np.ndarray:
+    """(S,) evenly spaced indices of ``count`` samples, the first and the last included."""
+    if count <= MAX_ENERGY_SAMPLES:
+        return np.arange(count)
+    return np.unique(np.linspace(0, count - 1, MAX_ENERGY_SAMPLES).round().astype(int))
+
+
+def read_own(sim: JointSimulation, traj: JointTrajectory) -> OwnReading:
+    """The engine's own energies and end effector along ``traj`` (:class:`OwnReading`)."""
+    index = sample_index(len(traj.times))
+    samples, copies, n = len(index), traj.q.shape[1], traj.q.shape[2]
+    q = np.ascontiguousarray(traj.q[index]).reshape(-1, n)
+    qdot = np.ascontiguousarray(traj.qdot[index]).reshape(-1, n)
+    kinetic, potential = sim.energy(q, qdot)
+    end_effector = np.asarray(sim.end_effector_world(q), dtype=float)
+    return OwnReading(index, np.asarray(kinetic, dtype=float).reshape(samples, copies),
+                      np.asarray(potential, dtype=float).reshape(samples, copies),
+                      end_effector.reshape(samples, copies, 3))
+
+
+def _work(scene: JointMotionScene, traj: JointTrajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(W, W_in, W_floor), each (T, B) [J]: the work done on the chain from t = 0 by the applied forces less the
+    damping (the power qdot^T tau - qdot^T D qdot integrated by the composite Simpson rule over every step, fourth
+    order), the work the applied forces put in at most (their positive power integrated), and what the quadrature of
+    W cannot resolve: |W - W over every other sample| (Simpson's error at twice the step is 16 x its own, so this
+    overestimates W's quadrature error some 15 times; 0 between the coarse samples' points, taken as its running
+    maximum)."""
+    damping = np.array([j.damping for j in scene.chain.joints])
+    drive = traj.qdot @ np.asarray(scene.torque)
+    power = drive - np.einsum("tbi,i,tbi->tb", traj.qdot, damping, traj.qdot)
+    zero = np.zeros_like(power)
+    if len(traj.times) < 3:
+        return zero, zero, zero
+
+    def integral(y: np.ndarray, x: np.ndarray) -> np.ndarray:
+        return np.concatenate([np.zeros((1, y.shape[1])), cumulative_simpson(y, x=x, axis=0)])
+    work = integral(power, traj.times)
+    floor = zero
+    if len(traj.times) >= 5:
+        coarse = integral(power[::2], traj.times[::2])
+        gap = np.zeros_like(power)
+        gap[::2] = np.abs(work[::2] - coarse)
+        floor = np.maximum.accumulate(gap, axis=0)
+    return work, integral(np.maximum(drive, 0.0), traj.times), floor
+
+
+def energy_budget(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading) -> np.ndarray:
+    """(B,) [J] the most kinetic energy the exact motion can have: its initial kinetic energy, the largest drop of
+    its potential energy along the run and the work the applied forces put in (damping only takes energy)."""
+    _, supplied, _ = _work(scene, traj)
+    drop = own.potential[0] - own.potential.min(axis=0)
+    return own.kinetic[0] + np.maximum(drop, 0.0) + supplied[own.index].max(axis=0)
+
+
+def divergence(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading | None) -> str:
+    """Why ``traj`` counts as diverged ("" when it does not): a non-finite state, or a kinetic energy more than
+    1 + :data:`CONSERVED_GROWTH_LIMIT` times the budget the scene can supply (:func:`energy_budget`)."""
+    if not traj.is_finite():
+        return "non-finite joint state"
+    if own is None:
+        return ""
+    budget = energy_budget(scene, traj, own)
+    peak = own.kinetic.max(axis=0)
+    limit = (1.0 + CONSERVED_GROWTH_LIMIT) * budget
+    over = np.flatnonzero(~(peak <= limit))
+    if over.size:
+        c = int(over[0])
+        if not np.isfinite(peak[c]):
+            return "kinetic energy overflows (the joint velocities grew past 1e150)"
+        return (f"kinetic energy {peak[c]:.3g} J > {1 + CONSERVED_GROWTH_LIMIT:g} x the most the scene can supply "
+                f"({budget[c]:.3g} J: initial kinetic energy, potential drop and the applied forces' work)")
+    return ""
+
+
+def _relative(value: float, scale: float, what: str) -> Measured:
+    if not scale > 0:
+        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=(
+            f"nothing moves: the chain exchanges no energy, so its {what} has no scale"))
+    ratio = value / scale
+    if ratio > SATURATED_DRIFT:
+        return Measured(ratio, "1", flag=SATURATED, unmeasurable=(
+            f"saturated: {what} {ratio:.3g} x the energy the chain exchanges (> {SATURATED_DRIFT:g})"))
+    return Measured(ratio, "1")
+
+
+def energy_metrics(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading) -> dict[str, Measured]:
+    """``energy_drift_max`` (max_t |E(t) - E(0)|) where the chain is neither damped nor driven, else
+    ``power_balance_residual_max`` (max_t |E(t) - E(0) - W(t)|, W the work of the applied forces less the
+    damping's), relative to the energy the chain exchanges: its largest kinetic energy plus the range of its
+    potential energy, maxima over copies. Reference-free."""
+    energy = own.kinetic + own.potential
+    scale = float((own.kinetic.max(axis=0) + np.ptp(own.potential, axis=0)).max())
+    work, _, quadrature = _work(scene, traj)
+    balance = float(np.abs(energy - energy[0] - work[own.index]).max())
+    if exchanges_energy(scene):
+        measured = _relative(balance, scale, "power-balance residual")
+        floor = float(quadrature[own.index].max()) / scale if scale > 0 else 0.0
+        if not measured.unmeasurable and balance / scale <= floor:
+            measured = Measured(measured.value, "1", flag=ROUNDING_FLOOR, note=(
+                f"at the quadrature floor ({floor:.2g}: the work's integral over the samples resolves no less)"))
+        return {POWER_BALANCE_RESIDUAL_MAX: measured}
+    return {ENERGY_DRIFT_MAX: _relative(float(np.abs(energy - energy[0]).max()), scale, "energy drift")}
+
+
+@dataclass(frozen=True)
+class Horizon:
+    """Where the reference can be trusted: its samples [0, ``end``) (``end`` = all of them without a chaotic
+    horizon), and its own error floor over them per error metric (0 where not known)."""
+
+    end: int
+    floors: dict[str, float]
+    note: str = ""
+
+
+def reference_horizon(scene: JointMotionScene, ref: JointTrajectory, coarse: JointTrajectory | None) -> Horizon:
+    """The reference's horizon from its run at a looser tolerance (``coarse``; None: a closed form, trusted
+    everywhere): the samples before the two differ by more than :data:`HORIZON_FLOOR` rad (unitless joint
+    values), and the differences over them as the floor of each error."""
+    if coarse is None:
+        return Horizon(len(ref.times), {})
+    scales = joint_scales(scene.chain)
+    angle = (np.abs(ref.q - coarse.q) / scales).max(axis=(1, 2))
+    speed = _speed_scale(ref, scales)
+    velocity = (np.abs(ref.qdot - coarse.qdot) / scales).max(axis=(1, 2)) / speed
+    beyond = np.flatnonzero(~(angle <= HORIZON_FLOOR))
+    end = int(beyond[0]) if beyond.size else len(ref.times)
+    floors = {JOINT_ANGLE_ERROR_MAX: float(angle[:end].max(initial=0.0)),
+              JOINT_VELOCITY_ERROR_MAX: float(velocity[:end].max(initial=0.0))}
+    note = ""
+    if end < len(ref.times):
+        note = (f"measured over the reference's horizon t < {float(ref.times[end]):.3g} s of "
+                f"{float(ref.times[-1]):.3g} s: past it its solves at two tolerances differ by more than "
+                f"{HORIZON_FLOOR:g} rad (a chaotic chain amplifies every error)")
+    return Horizon(end, floors, note)
+
+
+def _speed_scale(ref: JointTrajectory, scales: np.ndarray) -> float:
+    """The fastest unitless joint speed of the reference's motion [1/s], at least 1 / its duration."""
+    duration = max(float(ref.times[-1] - ref.times[0]), np.finfo(float).tiny)
+    return max(float((np.abs(ref.qdot) / scales).max()), 1.0 / duration)
+
+
+def reference_errors(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading, ref: JointTrajectory,
+                     ref_end_effector: np.ndarray,
+                     horizon: Horizon) -> tuple[dict[str, Measured], dict[str, float], dict[str, float]]:
+    """(errors against the reference over its horizon, each error's saturation ratio, each error's floor) — joint values (unitless,
+    saturated at a quarter turn like an orientation), joint velocities (relative to the fastest joint speed) and
+    the end effector (relative to the reach; ``ref_end_effector`` (S, B, 3) at ``own.index``), maxima over samples,
+    copies and joints. An error at or under the reference's floor (:data:`REFERENCE_FLOOR_MARGIN` x) or the rounding
+    floor is flagged ``rounding-floor``."""
+    if traj.q.shape != ref.q.shape:
+        raise ValueError(f"joint trajectory shape {traj.q.shape} != reference {ref.q.shape}")
+    if horizon.end < 2:
+        why = ("saturated: the reference's horizon ends before the first step (its two tolerances differ by more "
+               f"than {HORIZON_FLOOR:g} rad at once)")
+        return ({m: Measured(math.nan, "1", flag=SATURATED, unmeasurable=why) for m in REFERENCE_ERRORS},
+                {m: math.inf for m in REFERENCE_ERRORS}, {})
+    scales, end = joint_scales(scene.chain), horizon.end
+    speed = _speed_scale(ref, scales)
+    length = reach(scene.chain)
+    within = own.index < end
+    values = {
+        JOINT_ANGLE_ERROR_MAX: float((np.abs(traj.q[:end] - ref.q[:end]) / scales).max()),
+        JOINT_VELOCITY_ERROR_MAX: float((np.abs(traj.qdot[:end] - ref.qdot[:end]) / scales).max()) / speed,
+        END_EFFECTOR_ERROR_MAX: float(np.linalg.norm(own.end_effector[within] - ref_end_effector[within],
+                                                     axis=-1).max()) / length,
+    }
+    saturation = {JOINT_ANGLE_ERROR_MAX: SATURATED_ORIENTATION, JOINT_VELOCITY_ERROR_MAX: SATURATED_FRACTION,
+                  END_EFFECTOR_ERROR_MAX: SATURATED_FRACTION}
+    floors = _rounding_floors(scene, ref, scales, speed, end)
+    out, ratios, used = {}, {}, {}
+    for metric, value in values.items():
+        ratios[metric] = value / saturation[metric]
+        floor = used[metric] = max(floors[metric], REFERENCE_FLOOR_MARGIN * horizon.floors.get(metric, 0.0))
+        note = horizon.note
+        if ratios[metric] >= 1:
+            out[metric] = Measured(value, "1", flag=SATURATED, unmeasurable=(
+                f"saturated: {value:.3g} >= {saturation[metric]:.3g} (unitless): the run is on another orbit"))
+        elif value <= floor:
+            out[metric] = Measured(value, "1", note=("; ".join(filter(None, (note, (
+                f"at the floor ({floor:.2g}: rounding, or {REFERENCE_FLOOR_MARGIN:g} x the reference's own "
+                "error): exact up to it"))))), flag=ROUNDING_FLOOR)
+        else:
+            out[metric] = Measured(value, "1", note=note)
+    return out, ratios, used
+
+
+def _rounding_floors(scene: JointMotionScene, ref: JointTrajectory, scales: np.ndarray, speed: float,
+                     end: int) -> dict[str, float]:
+    """Rounding floor of each error after the horizon's steps: ROUNDING_FLOOR_FACTOR x eps x steps x the
+    quantity's scale (joint values: their largest size plus the duration times the speed scale; velocities: 1,
+    they are relative to the speed scale; the end effector: 1, relative to the reach)."""
+    steps = max(end - 1, 1)
+    duration = float(ref.times[end - 1] - ref.times[0])
+    unit = ROUNDING_FLOOR_FACTOR * np.finfo(float).eps * steps
+    size = float((np.abs(ref.q[:end]) / scales).max()) + duration * speed
+    return {JOINT_ANGLE_ERROR_MAX: unit * size, JOINT_VELOCITY_ERROR_MAX: unit,
+            END_EFFECTOR_ERROR_MAX: unit * max(size, 1.0)}
+
+
+def parting_times(scene: JointMotionScene, traj: JointTrajectory, perturbed: JointTrajectory | None,
+                  ref: JointTrajectory | None) -> dict[str, Measured]:
+    """When ``traj`` parts (a joint more than :data:`PARTING` off, unitless) from the engine's own run from the
+    perturbed start, and from the reference's; n/a with the reason where they never part within the run or there is
+    nothing to part from."""
+    scales = joint_scales(scene.chain)
+
+    def parting(other: JointTrajectory | None, what: str) -> Measured:
+        if other is None:
+            return Measured(math.nan, "s", unmeasurable=f"no {what} to part from")
+        apart = np.flatnonzero((np.abs(traj.q - other.q) / scales).max(axis=(1, 2)) > PARTING)
+        if not apart.size:
+            return Measured(math.nan, "s", unmeasurable=(
+                f"within {PARTING:g} rad of {what} for the whole run ({float(traj.times[-1]):.3g} s)"))
+        return Measured(float(traj.times[apart[0]]), "s")
+    return {SELF_PARTING_TIME: parting(perturbed, f"its own run from a start {scene.perturbation:g} off"),
+            REFERENCE_PARTING_TIME: parting(ref, "the reference")}

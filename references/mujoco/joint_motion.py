@@ -1,0 +1,167 @@
+"""A chain stepped through time by MuJoCo's own integrators (issue #28).
+
+What MuJoCo is given (each pinned by ``tests/test_mujoco_joint_motion.py``)
+---------------------------------------------------------------------------
+- The joint-dynamics model (the builder both share, :class:`references.mujoco.joint_dynamics.ChainModel`):
+  MuJoCo's URDF importer on :func:`references.common.dynamics_urdf.dynamics_urdf`, gravity exactly the scene's
+  (None is zero), constraints disabled (joint limits never act), ``dof_damping`` and ``dof_armature`` the chain's,
+  frictionloss, stiffness and polynomial damping 0. The model has no actuator, no contact and no fluid
+  (``density`` = ``viscosity`` = 0, no wind), no gravity compensation, and sleeping is off (``enableflags`` 0).
+- ``opt.timestep`` = dt and ``opt.integrator`` as :data:`INTEGRATORS` says. MuJoCo's Euler takes joint damping
+  implicitly unless ``eulerdamp`` is disabled: ``euler`` keeps MuJoCo's default (velocity update with M + dt D),
+  ``euler_explicit_damping`` disables it (plain semi-implicit Euler, damping explicit). ``implicitfast`` linearises
+  the damping implicitly and drops the Coriolis derivatives; ``implicit`` keeps them. ``rk4`` is the classical
+  Runge-Kutta of ``mj_RungeKutta`` (damping explicit, four ``mj_forward`` per step).
+- Applied joint forces: ``qfrc_applied`` = the scene's constant torque on the chain's dofs, given to
+  ``mujoco.rollout`` as a control of spec ``mjSTATE_QFRC_APPLIED`` (one row, held over every step and stage).
+- Stepping: ``mujoco.rollout`` from the B initial states (``mjSTATE_FULLPHYSICS``: time, qpos, qvel) in one call on
+  the calling thread, bit-identical to an ``mj_step`` loop; its rows are the states AFTER each step, the initial
+  state is prepended and the samples are at k dt. qpos and qvel are read at the chain joints' addresses (mapped by
+  name; a continuous joint is a hinge, its qpos the unwrapped angle).
+- Velocities: MuJoCo clips nothing. A state it finds bad (NaN or a magnitude above ``mjMAXVAL`` = 1e10 in qpos,
+  qvel or qacc) it would reset to the model's initial one and carry on; every MuJoCo warning while stepping raises
+  :class:`DivergedError` with MuJoCo's message instead (a chain without contact, constraints or actuators has no
+  other runtime warning).
+- Energy from MuJoCo's own model after ``mj_fwdPosition``: kinetic 1/2 qvel^T M qvel with ``mj_mulM`` (armature
+  in M), potential -sum_b body_mass_b gravity . xipos_b (MuJoCo's ``mj_energyPos`` convention, which would add
+  spring energies: there are none). Every body belongs to a chain link or is welded to the base, massless.
+- End effector: MuJoCo's forward kinematics (``mj_kinematics``), the origin ``xpos`` of the body named after the
+  chain's end effector (kept as a body: ``fusestatic`` off). The base link is MuJoCo's world frame.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from mujoco import rollout
+
+from simparity.core.model.engine import BatchedRun, JointSimulation
+from simparity.core.model.errors import DivergedError
+from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.trajectory import JointTrajectory
+from simparity.references.common.conventions import fmt
+from simparity.references.mujoco.joint_dynamics import ChainModel
+
+_STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
+
+INTEGRATORS = {
+    "euler": (mujoco.mjtIntegrator.mjINT_EULER, 0),
+    "euler_explicit_damping": (mujoco.mjtIntegrator.mjINT_EULER, int(mujoco.mjtDisableBit.mjDSBL_EULERDAMP)),
+    "implicitfast": (mujoco.mjtIntegrator.mjINT_IMPLICITFAST, 0),
+    "implicit": (mujoco.mjtIntegrator.mjINT_IMPLICIT, 0),
+    "rk4": (mujoco.mjtIntegrator.mjINT_RK4, 0),
+}
+"""simparity's joint-motion integrator -> (``opt.integrator``, disable bits added to ``opt.disableflags``)."""
+
+SCHEMES = {
+    "euler": "implicit_damping",
+    "euler_explicit_damping": "semi_implicit_euler",
+    "implicitfast": "implicit_damping",
+    "implicit": "implicit_velocity",
+    "rk4": "rk4",
+}
+"""The kind of scheme (``SCHEME_KINDS``) each integrator is on a chain: Euler with eulerdamp and implicitfast take
+the joint damping implicitly (implicitfast's other implicit terms, actuators and tendons, are absent here), implicit
+also linearises the Coriolis and centrifugal forces."""
+
+ORDERS = {"euler": 1, "euler_explicit_damping": 1, "implicitfast": 1, "implicit": 1, "rk4": 4}
+"""Global order of each integrator (MuJoCo's docs, "Numerical integration")."""
+
+STAGES = {"euler": 1, "euler_explicit_damping": 1, "implicitfast": 1, "implicit": 1, "rk4": 4}
+"""``mj_forward`` evaluations per step (the implicit ones, eulerdamp included, also factor M + dt D once a step)."""
+
+
+class MujocoJointMotion(JointSimulation):
+    """A joint-motion scene in MuJoCo for one integrator and time step (see the module docstring).
+
+    Attributes
+    ----------
+    model : mujoco.MjModel
+    detail : str
+    """
+
+    def __init__(self, scene: JointMotionScene, integrator: str, dt: float) -> None:
+        built = ChainModel(scene.chain, scene.gravity_world)
+        self.model, self._dof, self._qpos = built.model, built.dof, built.qpos
+        kind, disabled = INTEGRATORS[integrator]
+        self.model.opt.integrator, self.model.opt.timestep = kind, dt
+        self.model.opt.disableflags |= disabled
+        self._data = mujoco.MjData(self.model)
+        self._end_effector = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, scene.chain.end_effector_name)
+        self._control = np.zeros((1, 1, self.model.nv))
+        self._control[0, 0, self._dof] = scene.torque
+        self._qpos_at = mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_TIME)
+        self._qvel_at = self._qpos_at + self.model.nq
+        self._initial = self._states(scene.q0, scene.qdot0)
+        self._dt = dt
+        damping = ("eulerdamp disabled: damping explicit" if disabled else
+                   "eulerdamp on (MuJoCo's default): damping implicit" if integrator == "euler" else "")
+        self.detail = (f"{built.detail}; integrator {kind.name} at timestep {dt:g} s"
+                       + (f", {damping}" if damping else "")
+                       + f"; qfrc_applied {fmt(scene.torque)} held constant (rollout control mjSTATE_QFRC_APPLIED); "
+                       "stepped by mujoco.rollout; no velocity clipping; a MuJoCo warning (bad state, reset) raises "
+                       "DivergedError; energy by mj_mulM and -sum m g.xipos; end effector by mj_kinematics")
+
+    def _states(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """(B, nstate) full-physics states at time 0 with the chain's joints at ``q`` and ``qdot`` ((B, n) each)."""
+        template = np.empty(mujoco.mj_stateSize(self.model, _STATE))
+        mujoco.mj_getState(self.model, mujoco.MjData(self.model), template, _STATE)
+        states = np.repeat(template[None], len(q), axis=0)
+        states[:, self._qpos_at + self._qpos] = q
+        states[:, self._qvel_at + self._dof] = qdot
+        return states
+
+    def _rollout(self, initial: np.ndarray, n_steps: int) -> np.ndarray:
+        """(R, n_steps, nstate): the states after each step from each of the R initial states, one rollout call."""
+        states, _ = rollout.rollout(self.model, self._data, initial, self._control,
+                                    control_spec=mujoco.mjtState.mjSTATE_QFRC_APPLIED, nstep=n_steps)
+        return states
+
+    def run(self, n_steps: int) -> JointTrajectory:
+        for warning in self._data.warning:  # MuJoCo reports a warning only while its counter is 0
+            warning.number = 0
+        messages: list[str] = []
+        mujoco.set_mju_user_warning(messages.append)
+        try:
+            stepped = self._rollout(self._initial, n_steps)
+        finally:
+            mujoco.set_mju_user_warning(None)
+        if messages:
+            raise DivergedError(f"MuJoCo warned while stepping (it resets an unstable simulation): {messages[0]}")
+        states = np.concatenate([self._initial[:, None], stepped], axis=1).transpose(1, 0, 2)  # (T, B, nstate)
+        return JointTrajectory(np.arange(n_steps + 1) * self._dt, states[..., self._qpos_at + self._qpos],
+                               states[..., self._qvel_at + self._dof])
+
+    def batched(self, copies: int) -> BatchedRun:
+        """``copies`` rollouts of the first initial state in one ``mujoco.rollout`` call, as :meth:`run` makes; it
+        returns the (copies, n_steps, nstate) states after each step."""
+        initial = np.repeat(self._initial[:1], copies, axis=0)
+        return lambda n_steps: self._rollout(initial, n_steps)
+
+    def _position(self, q_row: np.ndarray, qdot_row: np.ndarray) -> mujoco.MjData:
+        """Data at the state, after ``mj_fwdPosition`` (kinematics, centres of mass, M with armature)."""
+        d = self._data
+        d.qpos[:], d.qvel[:] = self.model.qpos0, 0.0
+        d.qpos[self._qpos], d.qvel[self._dof] = q_row, qdot_row
+        mujoco.mj_fwdPosition(self.model, d)
+        return d
+
+    def energy(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        kinetic, potential = np.empty(len(q)), np.empty(len(q))
+        m_qvel = np.empty(self.model.nv)
+        for k, (row, rates) in enumerate(zip(q, qdot)):
+            d = self._position(row, rates)
+            mujoco.mj_mulM(self.model, d, m_qvel, d.qvel)
+            kinetic[k] = 0.5 * d.qvel @ m_qvel
+            potential[k] = -self.model.body_mass @ (d.xipos @ self.model.opt.gravity)
+        return kinetic, potential
+
+    def end_effector_world(self, q: np.ndarray) -> np.ndarray:
+        out = np.empty((len(q), 3))
+        d = self._data
+        for k, row in enumerate(q):
+            d.qpos[:] = self.model.qpos0
+            d.qpos[self._qpos] = row
+            mujoco.mj_kinematics(self.model, d)
+            out[k] = d.xpos[self._end_effector]
+        return out

@@ -1,0 +1,185 @@
+"""A chain's motion through time on Pinocchio's dynamics (issue #28), and the tight reference of joint motion.
+
+Pinocchio computes dynamics but steps nothing: the harness steps the accelerations of ``pin.aba``, and the rows'
+``detail`` says so ("harness-stepped").
+
+What Pinocchio is given, and each default handled (each pinned by ``tests/test_pinocchio_joint_motion.py``)
+------------------------------------------------------------------------------------------------------
+- The model of joint-space dynamics, :func:`references.pinocchio.joint_dynamics.chain_model`: the chain's dynamics
+  URDF read by Pinocchio's own parser, ``model.gravity`` exactly the scene's (zero for None, where Pinocchio's
+  default is (0, 0, -9.81)), the chain's armature as ``model.armature`` (``aba`` and ``crba`` include it), no
+  ``<dynamics>`` (``aba`` ignores ``model.damping`` and ``model.friction`` anyway).
+- qddot = ``aba``(q, v, tau - D v): the scene's constant joint forces tau minus the chain's damping D = diag(damping),
+  evaluated at every stage. Pinocchio's ``aba`` never applies joint or velocity limits.
+- Configurations: a continuous joint (a revolute joint without limits) has nq = 2, (cos q, sin q); the fixed-step
+  schemes move the configuration with ``pin.integrate`` and give angles unwrapped: a continuous joint's angle
+  accumulates each step's increment ``pin.difference`` (a spinning joint's q is continuous, never wrapped to
+  (-pi, pi]); every other joint's value is read from the configuration.
+- Integrators (the harness's, on (q, qdot); :data:`SCHEMES`, :data:`ORDERS`, :data:`STAGES`):
+  ``explicit_euler`` (q and qdot both from the start of the step), ``semi_implicit_euler`` (qdot first, then q
+  with the new qdot), ``rk4`` (classical RK4, the configuration stages by ``pin.integrate`` from the start of the
+  step); ``dop853`` / ``dop853_coarse``: ``scipy.integrate.solve_ivp(method="DOP853")`` at rtol = atol = 1e-13 /
+  1e-11 on (angles, qdot) with ``aba`` as the right-hand side, sampled at k dt by ``t_eval``: the tight reference
+  (none of core's code), and its own error floor (the runner takes |dop853 - dop853_coarse|).
+- B copies: each copy is stepped (or solved) alone, one after the other; no batched stepping.
+- Energy from Pinocchio: kinetic 1/2 v^T M v with M = ``crba`` (armature included), potential
+  ``computePotentialEnergy`` (-sum m g . c, with the model's gravity). The end effector is Pinocchio's frame
+  placement (``framesForwardKinematics``, ``oMf``) of the chain's end-effector link (its BODY frame); the model's
+  root is the chain's base link, so its world is the base frame.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pinocchio as pin
+from scipy.integrate import solve_ivp
+
+from simparity.core.model.engine import BatchedRun, JointSimulation
+from simparity.core.model.errors import DivergedError, NotBatchedError
+from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.trajectory import JointTrajectory
+from simparity.references.pinocchio.joint_dynamics import ChainModel, chain_model
+
+SCHEMES = {
+    "explicit_euler": "explicit_euler",
+    "semi_implicit_euler": "semi_implicit_euler",
+    "rk4": "rk4",
+    "dop853": "adaptive",
+    "dop853_coarse": "adaptive",
+}
+"""Each joint-motion integrator's kind of scheme (:data:`core.model.engine.SCHEME_KINDS`)."""
+
+INTEGRATORS = tuple(SCHEMES)
+"""The joint-motion integrators, the fixed-step ones first."""
+
+ORDERS = {"explicit_euler": 1, "semi_implicit_euler": 1, "rk4": 4}
+"""Global order of the fixed-step integrators (the adaptive solves have none)."""
+
+STAGES = {"explicit_euler": 1, "semi_implicit_euler": 1, "rk4": 4}
+"""``aba`` calls per step of the fixed-step integrators (the adaptive solves vary from step to step)."""
+
+TOLERANCES = {"dop853": 1e-13, "dop853_coarse": 1e-11}
+"""rtol = atol of each DOP853 solve: the reference, and the coarser solve that measures its error floor."""
+
+State = tuple[np.ndarray, np.ndarray]
+"""(Pinocchio configuration (nq,), velocity (nv,))."""
+
+
+class PinocchioJointMotion(JointSimulation):
+    """A chain stepped by the harness on ``pin.aba`` (fixed step), or solved by DOP853 on it (see the module
+    docstring). Every copy of the scene is stepped alone."""
+
+    def __init__(self, scene: JointMotionScene, integrator: str, dt: float) -> None:
+        self._scene, self._integrator, self._dt = scene, integrator, dt
+        self._chain: ChainModel = chain_model(scene.chain, scene.gravity_world)
+        self._model = self._chain.model
+        self._data = self._model.createData()
+        self._tau = self._chain.velocity(np.asarray(scene.torque))
+        self._damping = self._chain.velocity(self._chain.damping)
+        self._end_frame = self._model.getFrameId(scene.chain.end_effector_name, pin.BODY)
+        continuous = np.array(self._chain.continuous, dtype=bool)
+        self._cont_n = np.flatnonzero(continuous)
+        self._cont_v = self._chain.idx_v[continuous]
+        self._lin_n = np.flatnonzero(~continuous)
+        self._lin_q = np.array(self._chain.idx_q, dtype=int)[~continuous]
+        self.detail = f"{self._chain.source}; harness-stepped: " + (
+            f"scipy solve_ivp DOP853, rtol = atol = {TOLERANCES[integrator]:g}, on (q, qdot) with qddot = "
+            "pin.aba(q, v, tau - D v), sampled at k dt (t_eval)" if integrator in TOLERANCES else
+            f"{integrator} on (q, qdot), qddot = pin.aba(q, v, tau - D v), q by pin.integrate "
+            "(continuous joints' angles unwrapped)")
+
+    def batched(self, copies: int) -> BatchedRun:
+        """The harness calls aba copy by copy from Python: NotBatchedError."""
+        raise NotBatchedError("the harness steps pinocchio's aba one copy at a time from Python: no batched stepping")
+
+    def run(self, n_steps: int) -> JointTrajectory:
+        times = np.arange(n_steps + 1) * self._dt
+        b, n = self._scene.q0.shape
+        q, qdot = np.empty((n_steps + 1, b, n)), np.empty((n_steps + 1, b, n))
+        for k in range(b):
+            if self._integrator in TOLERANCES:
+                q[:, k], qdot[:, k] = self._solve(self._scene.q0[k], self._scene.qdot0[k], times)
+            else:
+                self._step_copy(self._scene.q0[k], self._scene.qdot0[k], q[:, k], qdot[:, k])
+        return JointTrajectory(times, q, qdot)
+
+    def _acceleration(self, configuration: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """(nv,) qddot = aba(q, v, tau - D v) [rad/s^2 or m/s^2] (a copy: ``aba`` returns its own array)."""
+        return pin.aba(self._model, self._data, configuration, v, self._tau - self._damping * v)
+
+    def _step_copy(self, q0: np.ndarray, qdot0: np.ndarray, q_out: np.ndarray, qdot_out: np.ndarray) -> None:
+        """Step one copy from (q0, qdot0) ((n,) each) into q_out, qdot_out ((T, n) each, T - 1 steps)."""
+        step = self._stepper()
+        configuration, v = self._chain.configuration(q0), self._chain.velocity(qdot0)
+        idx_v, model = self._chain.idx_v, self._model
+        angles = np.array(q0, dtype=float)
+        q_out[0], qdot_out[0] = q0, qdot0
+        for i in range(1, len(q_out)):
+            new_configuration, v = step(configuration, v)
+            angles[self._lin_n] = new_configuration[self._lin_q]
+            if len(self._cont_n):
+                angles[self._cont_n] += pin.difference(model, configuration, new_configuration)[self._cont_v]
+            configuration = new_configuration
+            q_out[i], qdot_out[i] = angles, v[idx_v]
+
+    def _stepper(self) -> Callable[[np.ndarray, np.ndarray], State]:
+        """One step of the fixed-step integrator: (configuration, v) -> (configuration, v) after dt."""
+        model, dt, acceleration = self._model, self._dt, self._acceleration
+        half, sixth = 0.5 * dt, dt / 6
+
+        def explicit_euler(q: np.ndarray, v: np.ndarray) -> State:
+            return pin.integrate(model, q, dt * v), v + dt * acceleration(q, v)
+
+        def semi_implicit_euler(q: np.ndarray, v: np.ndarray) -> State:
+            v = v + dt * acceleration(q, v)
+            return pin.integrate(model, q, dt * v), v
+
+        def rk4(q: np.ndarray, v: np.ndarray) -> State:
+            a1 = acceleration(q, v)
+            v2 = v + half * a1
+            a2 = acceleration(pin.integrate(model, q, half * v), v2)
+            v3 = v + half * a2
+            a3 = acceleration(pin.integrate(model, q, half * v2), v3)
+            v4 = v + dt * a3
+            a4 = acceleration(pin.integrate(model, q, dt * v3), v4)
+            return (pin.integrate(model, q, sixth * (v + v4 + 2.0 * (v2 + v3))),
+                    v + sixth * (a1 + a4 + 2.0 * (a2 + a3)))
+
+        return {"explicit_euler": explicit_euler, "semi_implicit_euler": semi_implicit_euler, "rk4": rk4}[
+            self._integrator]
+
+    def _derivative(self, t: float, y: np.ndarray) -> np.ndarray:
+        """d/dt (angles, qdot) ((2n,)) = (qdot, aba) for DOP853."""
+        n = len(y) // 2
+        v = self._chain.velocity(y[n:])
+        return np.concatenate([y[n:], self._acceleration(self._chain.configuration(y[:n]), v)[self._chain.idx_v]])
+
+    def _solve(self, q0: np.ndarray, qdot0: np.ndarray, times: np.ndarray) -> State:
+        """One copy by DOP853 from (q0, qdot0) ((n,) each): (q, qdot), (T, n) each at ``times`` (T,) [s]."""
+        tolerance = TOLERANCES[self._integrator]
+        sol = solve_ivp(self._derivative, (0.0, times[-1]), np.concatenate([q0, qdot0]), method="DOP853",
+                        t_eval=times, rtol=tolerance, atol=tolerance)
+        if not sol.success:
+            raise DivergedError(f"pinocchio {self._integrator}: DOP853 failed: {sol.message}")
+        n = len(q0)
+        return sol.y[:n].T, sol.y[n:].T
+
+    def energy(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic 1/2 v^T M v (``crba``, armature included) and ``computePotentialEnergy``, (B,) each [J]."""
+        kinetic, potential = np.empty(len(q)), np.empty(len(q))
+        for k, (row, rates) in enumerate(zip(q, qdot)):
+            configuration, v = self._chain.configuration(row), self._chain.velocity(rates)
+            upper = np.triu(pin.crba(self._model, self._data, configuration))
+            kinetic[k] = 0.5 * v @ (upper + np.triu(upper, 1).T) @ v
+            potential[k] = pin.computePotentialEnergy(self._model, self._data, configuration)
+        return kinetic, potential
+
+    def end_effector_world(self, q: np.ndarray) -> np.ndarray:
+        """(B, 3) [m]: Pinocchio's placement of the end-effector link's frame in the model's world, the base frame."""
+        out = np.empty((len(q), 3))
+        for k, row in enumerate(q):
+            pin.framesForwardKinematics(self._model, self._data, self._chain.configuration(row))
+            out[k] = self._data.oMf[self._end_frame].translation
+        return out

@@ -1,0 +1,135 @@
+"""A chain stepped through time by PyBullet's own ``stepSimulation`` (Bullet's multibody, Featherstone's
+articulated-body algorithm), for joint-motion scenes.
+
+The model is part 1's stepped body (:class:`references.pybullet.joint_dynamics.ChainBodies`, whose module docstring
+gives every default and why): the chain's dynamics URDF with its axes normalised, ``URDF_USE_INERTIA_FROM_FILE``,
+gravity exactly the scene's (None: zero), link damping 0, braking motors off (VELOCITY_CONTROL, force 0), joint limits
+without force, the velocity cap raised to 1e300, jointDamping the chain's. The world holds nothing else: no ground
+plane, and the bodies have no collision shapes (the dynamics URDF has none), so nothing collides. Each setting is
+pinned by ``tests/test_pybullet_joint_motion.py``:
+
+- Time step exactly dt (``setTimeStep``), ``numSubSteps`` 0: one ``stepSimulation`` is one step of dt (read back by
+  ``getPhysicsEngineParameters``).
+- The step (measured, one step of a damped arm at dt 0.1 s): qdot' = qdot + dt qddot(q, qdot, tau) from the
+  articulated-body algorithm at the step's start, then q' = q + dt qdot' (the NEW velocity): semi-implicit Euler,
+  first order, one force evaluation per step.
+- Joint damping is PyBullet's own ``changeDynamics(jointDamping=D)``, which Bullet applies as the joint force
+  -D qdot at the step's start: EXPLICIT (measured: the one-step velocity change of a damped joint is -dt M^-1 D qdot,
+  not the implicit -dt (M + dt D)^-1 D qdot), the same as a torque -D qdot sent before each step. It is stable only
+  while dt b / I stays below 2 on every joint: the iiwa's last link (I = 1e-3 kg m^2, b = 0.5 N m s) blows up at
+  dt = 4 ms (measured: finite at 3 ms).
+- Applied joint forces: ``setJointMotorControlArray(TORQUE_CONTROL)`` before EVERY step. Bullet clears the applied
+  joint torques after each step (measured: a torque sent once acts on one step only), so it is sent again each time.
+- PyBullet has no joint armature: a chain with armature > 0 is refused (:meth:`PybulletEngine.supports_joint_motion`).
+- B copies: one body per copy in the same world, stepped together by one ``stepSimulation``. They cannot touch (no
+  collision shapes) and every link is taken out of the broadphase (``setCollisionFilterGroupMask`` group 0, mask 0:
+  without it Bullet still pairs the links' empty colliders, all of them overlapping across copies; measured on the
+  iiwa, ``stepSimulation`` took 1.4x as long for one body and 2.7x for 100). Each copy's trajectory is bit for bit
+  the one it has alone (tested). ``batched`` steps copies of the first initial state the same way. Bullet's step
+  still costs more per copy as B grows (measured on the iiwa, per copy and step against one body alone: about 1x at
+  B = 10, 4x at B = 100, 12-14x at B = 300; the same with and without joint limits): the batched time is PyBullet's
+  one-world batching as it is, not a loop over worlds.
+- Samples: ``getJointStates`` after every step. A velocity at the cap (Bullet clamps there) means the run blew up:
+  DivergedError.
+
+Energies from PyBullet's own model of a second body (:class:`ChainBodies`, unstepped): kinetic 1/2 qdot^T M qdot with
+``calculateMassMatrix`` (Bullet's inertia tensors diagonalised by its Jacobi iteration, as its stepping uses them: M
+off by up to ~1e-10 relative from the file's tensors on the Panda, see the joint-dynamics module), potential
+-sum m g.c over every link of the body (``getLinkStates(computeForwardKinematics=True)``'s centre-of-mass positions,
+double, and ``getDynamicsInfo`` masses; the base never moves and is left out: its mass in the dynamics URDF is 0).
+The end effector by :class:`references.pybullet.adapter.PybulletChain` (``getLinkState``, float32).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simparity.core.model.engine import BatchedRun, JointSimulation
+from simparity.core.model.errors import DivergedError
+from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.trajectory import JointTrajectory
+from simparity.references.common.dynamics_urdf import dynamics_source
+from simparity.references.pybullet.adapter import PybulletChain
+from simparity.references.pybullet.joint_dynamics import CLIPPED, ChainBodies
+from simparity.references.pybullet.quiet import pybullet
+
+
+def _world(scene: JointMotionScene, dt: float, copies: int) -> ChainBodies:
+    """``copies`` bodies of the scene's chain stepping at ``dt`` [s] in one world, out of every collision pair."""
+    world = ChainBodies(scene.chain, scene.gravity_world, time_step=dt, copies=copies)
+    for body in world.bodies:
+        for link in (-1, *world.links):
+            pybullet.setCollisionFilterGroupMask(body, link, 0, 0, physicsClientId=world.client)
+    return world
+
+
+class PybulletJointMotion(JointSimulation):
+    """A joint-motion scene stepped by PyBullet (module docstring: what is set, how damping and torque act)."""
+
+    def __init__(self, scene: JointMotionScene, dt: float) -> None:
+        self._scene, self._dt = scene, dt
+        self._world = _world(scene, dt, scene.copies)
+        self._model = ChainBodies(scene.chain, scene.gravity_world)
+        self._model.build_tree()
+        self._kinematics = PybulletChain(scene.chain)
+        m = self._model
+        self._masses = np.array([pybullet.getDynamicsInfo(m.body, link, physicsClientId=m.client)[0]
+                                 for link in m.links])
+        self._gravity = np.zeros(3) if scene.gravity_world is None else np.asarray(scene.gravity_world, dtype=float)
+        self.detail = (f"stepSimulation of a fixed-base multibody per copy in one world (Featherstone ABA, "
+                       f"semi-implicit Euler: q from the new qdot), setTimeStep(dt), numSubSteps 0; "
+                       f"loadURDF(URDF_USE_INERTIA_FROM_FILE) of {dynamics_source(scene.chain)}, axes normalised, no "
+                       f"collision shapes (collision filter group and mask 0), no ground; gravity set; link damping 0, "
+                       f"joint limits, velocity cap and braking motors off; joint damping by "
+                       f"changeDynamics(jointDamping) (Bullet: -D qdot at the step's start, explicit); torque by "
+                       f"TORQUE_CONTROL re-sent before every step (Bullet clears it after each); energy from "
+                       f"calculateMassMatrix and getLinkStates; end effector by getLinkState (float32)")
+
+    def run(self, n_steps: int) -> JointTrajectory:
+        return self._step(self._world, np.asarray(self._scene.q0), np.asarray(self._scene.qdot0), n_steps)
+
+    def batched(self, copies: int) -> BatchedRun:
+        """``copies`` bodies of the first initial state in one world, one ``stepSimulation`` per step."""
+        world = _world(self._scene, self._dt, copies)
+        q0 = np.repeat(np.asarray(self._scene.q0)[:1], copies, axis=0)
+        qdot0 = np.repeat(np.asarray(self._scene.qdot0)[:1], copies, axis=0)
+        return lambda n_steps: self._step(world, q0, qdot0, n_steps)
+
+    def _step(self, world: ChainBodies, q0: np.ndarray, qdot0: np.ndarray, n_steps: int) -> JointTrajectory:
+        """Every body of ``world`` from (q0, qdot0) ((B, n) each) for ``n_steps`` steps, sampled after each."""
+        c = world.client
+        q = np.empty((n_steps + 1, len(world.bodies), len(world.joints)))
+        qdot = np.empty_like(q)
+        for k in range(len(world.bodies)):
+            world.reset(q0[k], qdot0[k], copy=k)
+        q[0], qdot[0] = q0, qdot0
+        torque = np.asarray(self._scene.torque).tolist()
+        for i in range(1, n_steps + 1):
+            for body in world.bodies:
+                pybullet.setJointMotorControlArray(body, world.joints, pybullet.TORQUE_CONTROL, forces=torque,
+                                                   physicsClientId=c)
+            pybullet.stepSimulation(physicsClientId=c)
+            for k, body in enumerate(world.bodies):
+                states = pybullet.getJointStates(body, world.joints, physicsClientId=c)
+                q[i, k] = [s[0] for s in states]
+                qdot[i, k] = [s[1] for s in states]
+        fastest = np.max(np.abs(qdot))
+        if fastest >= CLIPPED:
+            raise DivergedError(f"PyBullet clamped a joint velocity at {fastest:.3g} (its cap): the run blew up")
+        return JointTrajectory(np.arange(n_steps + 1) * self._dt, q, qdot)
+
+    def energy(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Kinetic 1/2 qdot^T M qdot (calculateMassMatrix), potential -sum m g.c (getLinkStates), each (B,) [J]."""
+        q, qdot = np.atleast_2d(q), np.atleast_2d(qdot)
+        m = self._model
+        kinetic = 0.5 * np.einsum("bi,bij,bj->b", qdot, m.mass_matrix(q), qdot)
+        potential = np.empty(len(q))
+        for k, row in enumerate(q):
+            m.reset(row, np.zeros_like(row))
+            states = pybullet.getLinkStates(m.body, m.links, computeForwardKinematics=True, physicsClientId=m.client)
+            coms = np.array([s[0] for s in states])
+            potential[k] = -self._masses @ (coms @ self._gravity)
+        return kinetic, potential
+
+    def end_effector_world(self, q: np.ndarray) -> np.ndarray:
+        return self._kinematics.end_effector_frames(np.atleast_2d(q))[0]
