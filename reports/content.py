@@ -227,8 +227,7 @@ def _predictability(rows: pd.DataFrame) -> list[Block]:
 
 
 def _heading_kind(about: dict, kind: str) -> str:
-    """What a scene section's heading calls its kind: a chain's motion is reported as dynamics, named as itself."""
-    return "joint motion" if about.get("kind") == "joint_motion" else kind
+    return summary.heading_kind(kind, about.get("headline_metric", ""))
 
 
 def _headline(about: dict) -> str:

@@ -175,6 +175,12 @@ ORDER_METRICS = {POSITION_ERROR_MAX: ORDER_POSITION, ORIENTATION_ERROR_MAX: ORDE
 """The row holding the observed order of convergence of each headline error."""
 
 
+def heading_kind(kind: str, headline: str) -> str:
+    """What a scene section's heading calls its kind: a chain's motion (ranked by its joint angle error) is
+    summarised as dynamics and named as itself."""
+    return "joint motion" if headline == JOINT_ANGLE_ERROR_MAX else kind
+
+
 def orders(rows: pd.DataFrame, headline: str) -> dict[tuple[str, str], float]:
     """Observed order of the headline error per (engine, integrator), where it was fitted."""
     metric = ORDER_METRICS[headline]

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from simparity.core.model.results import GROUND_TRUTH_ENGINES, NOT_AVAILABLE, OK, SWEEP_PREFIX
-from simparity.reports import figures, sweep_summary, tables
+from simparity.reports import figures, summary, sweep_summary, tables
 from simparity.reports.blocks import Block, Details, Heading, Paragraph, Table, number, scene_heading
 from simparity.reports.sweep_summary import METRICS, Sweep
 from simparity.reports.tables import swept_value
@@ -181,7 +181,8 @@ def _intro(sweep: Sweep) -> Paragraph:
     label = sweep_summary.metric_label(sweep.metric)
     swept = "; ".join(f"`{key.removeprefix(SWEEP_PREFIX)}` " + ", ".join(swept_value(v) for v in dict.fromkeys(
         sweep.rows.drop_duplicates("scene").set_index("scene").loc[sweep.variants, key])) for key in sweep.keys)
-    shown = ", ".join(f"[variant {k + 1}](#{scene_heading(name, sweep.kind).anchor}) ({roles(sweep, name)})"
+    kind = summary.heading_kind(sweep.kind, sweep.metric)
+    shown = ", ".join(f"[variant {k + 1}](#{scene_heading(name, kind).anchor}) ({roles(sweep, name)})"
                       for k, name in enumerate(sweep.variants) if name in sweep.shown)
     return Paragraph(f"{len(sweep.variants)} variants" + (f" of `{sweep.source}`" if sweep.source else "")
                      + f": {swept}. {label[:1].upper() + label[1:]} against `{sweep.reference}`."

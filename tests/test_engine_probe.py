@@ -43,6 +43,13 @@ def test_a_probe_describes_an_engine_as_it_describes_itself():
         assert described.scene_integrators(scene) == real.scene_integrators(scene)
     assert described.scene_integrators(scenes[0]) != described.scene_integrators(scenes[1])
     assert described.supports_kinematics(PROBE_CHAIN).ok
+    # found by the mutation suite: a described engine offered no joint-motion integrator, so a plugin's chains in
+    # motion were n/a in every run (and a planted bug in them passed the gate)
+    assert described.joint_motion_integrators() == real.joint_motion_integrators() != ()
+    assert described.joint_dynamics_methods() == real.joint_dynamics_methods()
+    for integrator in real.joint_motion_integrators():
+        assert described.theoretical_order(integrator) == real.theoretical_order(integrator)
+        assert described.stages(integrator) == real.stages(integrator)
 
 
 @pytest.mark.slow

@@ -127,15 +127,19 @@ def test_errors_are_unitless_and_saturate():
                                        jm.read_own(_Sim(), ref).end_effector, horizon)
     assert errors[JOINT_ANGLE_ERROR_MAX].value == pytest.approx(0.01, rel=1e-9)  # rad
     assert errors[JOINT_VELOCITY_ERROR_MAX].value == pytest.approx(0.02 / 1.0, rel=1e-9)  # of the fastest speed
-    reach = jm.reach(revolute.chain)  # 1 m offset of the end effector
-    assert errors[END_EFFECTOR_ERROR_MAX].value == pytest.approx(2 * math.sin(0.005) / reach, rel=1e-6)
+    # over the larger of the reach (the 1 m end-effector offset) and the tip's travel, a chord of 2 rad: 2 sin(1) m
+    size = max(jm.reach(revolute.chain), 2 * math.sin(1.0))
+    assert errors[END_EFFECTOR_ERROR_MAX].value == pytest.approx(2 * math.sin(0.005) / size, rel=1e-6)
     lost = _trajectory(TIMES + 2.0, np.ones_like(TIMES), TIMES)
     saturated, ratios, _ = jm.reference_errors(revolute, lost, jm.read_own(_Sim(), lost), ref,
                                                jm.read_own(_Sim(), ref).end_effector, horizon)
     assert saturated[JOINT_ANGLE_ERROR_MAX].flag == SATURATED and ratios[JOINT_ANGLE_ERROR_MAX] >= 1
-    # a prismatic joint's offset is relative to the chain's reach: 1 m offset + 4 m travel = 5 m
+    # a prismatic joint's offset is relative to the larger of the chain's reach (its 1 m end-effector offset) and the
+    # joint's own travel in the reference's motion, never its limits (+-2 m here: they do not act)
     prismatic = _scene(prismatic=True)
-    assert jm.joint_scales(prismatic.chain)[0] == pytest.approx(5.0)
+    assert jm.joint_scales(prismatic.chain, _trajectory(0.1 * TIMES, TIMES, TIMES))[0] == pytest.approx(1.0)
+    assert jm.joint_scales(prismatic.chain, _trajectory(3.0 * TIMES, TIMES, TIMES))[0] == pytest.approx(6.0)
+    assert jm.reach(prismatic.chain) == pytest.approx(1.0)
 
 
 def test_metrics_of_a_scene_name_its_energy_balance():

@@ -47,7 +47,8 @@ def _offers(engine: Engine) -> str:
         return f"failed: {one_line(engine.reason, DETAIL_LIMIT)}"
     return (f"version {engine.version()}; dynamics: {', '.join(engine.integrators()) or 'none'}; "
             f"IK: {', '.join(engine.ik_solvers()) or 'none'}; kinematics: {_kinematics(engine)}; "
-            f"joint dynamics: {', '.join(engine.joint_dynamics_methods()) or 'none'}")
+            f"joint dynamics: {', '.join(engine.joint_dynamics_methods()) or 'none'}; "
+            f"joint motion: {', '.join(engine.joint_motion_integrators()) or 'none'}")
 
 
 def _kinematics(engine: Engine) -> str:

@@ -8,7 +8,7 @@ packaged is named by its spec directly (``--engines my_module:MyEngine``). ``att
 Whatever goes wrong comes back as an engine standing in for the one asked for
 (:mod:`comparisons.placeholder_engines`), never as an exception: a module that will not import (a
 missing dependency) gives n/a rows, like a built-in engine's missing library; a module or constructor
-that raises, or an engine whose ``version()``, ``integrators()``, ``ik_solvers()``, ``joint_dynamics_methods()``,
+that raises, or an engine whose ``version()``, ``integrators()``, ``ik_solvers()``, ``joint_dynamics_methods()``, ``joint_motion_integrators()``,
 ``theoretical_order()``, ``stages()`` or ``integrator_variant()`` raises or returns what the interface
 does not allow, gives failed rows with the error. How to write one: docs/plugins.md.
 """
@@ -160,8 +160,9 @@ def _instantiate(found: object, target: str) -> Engine:
 
 def _interface_problem(engine: Engine) -> str:
     """What the engine's description of itself breaks ("" when nothing): ``version()`` a str,
-    ``integrators()``, ``ik_solvers()`` and ``joint_dynamics_methods()`` tuples of names (:data:`OFFERED_NAME`), ``theoretical_order(i)``
-    an int or None, ``stages(i)`` an int >= 1 or None and ``integrator_variant(i)`` two strs for each integrator.
+    ``integrators()``, ``ik_solvers()``, ``joint_dynamics_methods()`` and ``joint_motion_integrators()`` tuples of names
+    (:data:`OFFERED_NAME`), ``theoretical_order(i)`` an int or None, ``stages(i)`` an int >= 1 or None and
+    ``integrator_variant(i)`` two strs for each integrator of either kind.
     Their errors are problems too."""
     step = "version()"
     try:
@@ -175,7 +176,10 @@ def _interface_problem(engine: Engine) -> str:
         problem = problem or _names_problem("ik_solvers()", engine.ik_solvers())
         step = "joint_dynamics_methods()"
         problem = problem or _names_problem("joint_dynamics_methods()", engine.joint_dynamics_methods())
-        for integrator in () if problem else integrators:
+        step = "joint_motion_integrators()"
+        motion = engine.joint_motion_integrators()
+        problem = problem or _names_problem("joint_motion_integrators()", motion)
+        for integrator in () if problem else dict.fromkeys(integrators + motion):
             step = f"theoretical_order({integrator!r})"
             order = engine.theoretical_order(integrator)
             if order is not None and (isinstance(order, bool) or not isinstance(order, int)):

@@ -71,7 +71,8 @@ class EngineDescription:
     scene_integrators : dict of str to tuple of str or str
         ``scene_integrators`` of each scene asked about, by :func:`~comparisons.cases.scene_hash`; the error
         text where it raised.
-    joint_dynamics_methods : tuple of str
+    joint_dynamics_methods, joint_motion_integrators : tuple of str
+        (``orders``, ``stages`` and ``variants`` cover the joint-motion integrators too.)
     """
 
     name: str
@@ -84,6 +85,7 @@ class EngineDescription:
     kinematics: str
     scene_integrators: dict[str, tuple[str, ...] | str] = field(default_factory=dict)
     joint_dynamics_methods: tuple[str, ...] = ()
+    joint_motion_integrators: tuple[str, ...] = ()
 
 
 class DescribedEngine(Engine):
@@ -105,6 +107,9 @@ class DescribedEngine(Engine):
 
     def joint_dynamics_methods(self) -> tuple[str, ...]:
         return self.description.joint_dynamics_methods
+
+    def joint_motion_integrators(self) -> tuple[str, ...]:
+        return self.description.joint_motion_integrators
 
     def theoretical_order(self, integrator: str) -> int | None:
         return self.description.orders.get(integrator)
@@ -145,6 +150,7 @@ def describe(engine: Engine, scenes: list) -> EngineDescription:
     checks of :func:`~comparisons.plugins.load_engine`, so only ``scene_integrators`` and kinematics support
     may still raise)."""
     integrators = engine.integrators()
+    every = tuple(dict.fromkeys(integrators + tuple(engine.joint_motion_integrators())))
     kinematics = "unknown"
     try:
         kinematics = "yes" if engine.supports_kinematics(PROBE_CHAIN).ok else "no"
@@ -157,10 +163,10 @@ def describe(engine: Engine, scenes: list) -> EngineDescription:
         except Exception as err:  # noqa: BLE001 - its case in that scene fails with the error
             by_scene[scene_hash(scene)] = f"scene_integrators({scene.name}) raised {one_line(error_text(err))}"
     return EngineDescription(engine.name, engine.version(), integrators, engine.ik_solvers(),
-                             {i: engine.theoretical_order(i) for i in integrators},
-                             {i: engine.stages(i) for i in integrators},
-                             {i: engine.integrator_variant(i) for i in integrators}, kinematics, by_scene,
-                             engine.joint_dynamics_methods())
+                             {i: engine.theoretical_order(i) for i in every},
+                             {i: engine.stages(i) for i in every},
+                             {i: engine.integrator_variant(i) for i in every}, kinematics, by_scene,
+                             engine.joint_dynamics_methods(), tuple(engine.joint_motion_integrators()))
 
 
 def probe_engines(names: list[str], scenes: Sequence = ()) -> dict[str, Engine]:

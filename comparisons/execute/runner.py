@@ -509,7 +509,7 @@ def _joint_orders(scene: JointMotionScene, ladders: dict[tuple[str, str], _Ladde
         case = Case(scene.name, engine, integrator, math.nan, ref_label, ladder.scheme)
         if ladder.scheme in TRUTH_SCHEMES:  # its error is set by a tolerance or by rounding, not by dt
             values = {metric: Measured(math.nan, "1", unmeasurable=(
-                f"a {ladder.scheme.replace('_', ' ')} truth does not step at dt: its error has no order"))
+                f"a truth ({ladder.scheme.replace('_', ' ')}) does not step at dt: its error has no order"))
                 for metric in JOINT_ORDER_SOURCES}
         else:
             values = {metric: observed_order(ladder.dts, [c.errors.get(source, math.nan) for c in ladder.cases],

@@ -44,7 +44,8 @@ from typing import Callable, Iterable, NamedTuple, cast
 import numpy as np
 
 from simparity.comparisons.invariance.engine_constants import constants_exposed
-from simparity.comparisons.measure.metrics import ORDER_SOURCES
+from simparity.comparisons.measure.joint_motion_metrics import JOINT_ORDER_SOURCES
+from simparity.comparisons.measure.metrics import ORDER_SOURCES as BODY_ORDER_SOURCES
 from simparity.comparisons.invariance.perturb import ulp_perturbed
 from simparity.comparisons.invariance.rounding_allowance import rounding_floors
 from simparity.comparisons.invariance.transforms import Transform, transform_scene
@@ -84,6 +85,8 @@ JOINT_UNIT, REVOLUTE_UNIT = "rad or m", "rad"
 RATIO_METRIC, CHANGES_METRIC = "invariance_ratio_", "invariance_status_changes_"
 """Prefixes of the invariance rows' metrics; the transform's name follows."""
 
+ORDER_SOURCES = BODY_ORDER_SOURCES | JOINT_ORDER_SOURCES
+"""Each observed order's error (a free body's and a chain's motion)."""
 ORDER_SOURCES_OF = {source: order for order, source in ORDER_SOURCES.items()}
 """The observed order fitted over each error metric."""
 
@@ -407,7 +410,7 @@ def _row_unit(scene, unit: str) -> str:
 def _keyed(scene, rows, transform: Transform | None) -> dict:
     """{key: _Row} of ``rows``, timing left out; ``transform``: the rows are of ``scene`` transformed by it (its
     time steps and values are carried back), None: of ``scene`` itself."""
-    steps = list(scene.dts) if isinstance(scene, DynamicsScene) else []
+    steps = list(scene.dts) if isinstance(scene, (DynamicsScene, JointMotionScene)) else []
     scale = transform.time_scale if transform else 1.0
     out = {}
     for row in rows:

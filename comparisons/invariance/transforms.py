@@ -321,12 +321,20 @@ def _chain_scene(scene: KinematicsScene | IKScene, t: Transform):
                    position_tolerance=t.length_scale * scene.position_tolerance)
 
 
+def _timed_chain(chain: Chain, t: Transform, source: str) -> Chain:
+    """A chain with mass and time: placed and scaled (:func:`_chain`); under a change of the unit of time alone, only
+    its joints' damping (N m s/rad: per second) changes, and a URDF chain keeps its file (the engines take damping
+    from the chain, never from the file's ``<dynamics>``)."""
+    if t.moves_frame or t.mass_scale != 1.0:
+        return _chain(chain, t, source)
+    return replace(chain, joints=tuple(replace(j, damping=j.damping / t.time_scale) for j in chain.joints))
+
+
 def _joint_dynamics_scene(scene: JointDynamicsScene, t: Transform) -> JointDynamicsScene:
     """The chain placed, scaled and given mass and time units; gravity turned and scaled; each joint's sampling scales
     in the new units (a prismatic joint's variable is a length, a revolute one's an angle), so that the same seeded
     draws are the same states."""
-    untouched = not t.moves_frame and t.mass_scale == 1.0  # time alone: a URDF chain keeps its file
-    chain = scene.chain if untouched else _chain(scene.chain, t, scene.source)
+    chain = _timed_chain(scene.chain, t, scene.source)
     variable = np.array([1 if j.type == "prismatic" else 0 for j in scene.chain.joints])  # power of length: m or rad
     gravity = scene.gravity_world
     return replace(scene, chain=chain, gravity_world=None if gravity is None else t.vector(gravity, length=1, time=-2),
@@ -338,8 +346,7 @@ def _joint_dynamics_scene(scene: JointDynamicsScene, t: Transform) -> JointDynam
 def _joint_motion_scene(scene: JointMotionScene, t: Transform) -> JointMotionScene:
     """The chain placed, scaled and given mass and time units as a joint-dynamics scene's; gravity turned and scaled;
     the initial joint values, velocities and torques, the duration and the time steps in the new units."""
-    untouched = not t.moves_frame and t.mass_scale == 1.0
-    chain = scene.chain if untouched else _chain(scene.chain, t, scene.source)
+    chain = _timed_chain(scene.chain, t, scene.source)
     variable = np.array([1 if j.type == "prismatic" else 0 for j in scene.chain.joints])  # power of length: m or rad
     gravity = scene.gravity_world
     return replace(scene, chain=chain, gravity_world=None if gravity is None else t.vector(gravity, length=1, time=-2),

@@ -27,7 +27,8 @@ from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointSimulation
 from simparity.core.model.metric_catalogue import (
     END_EFFECTOR_ERROR_MAX, ENERGY_DRIFT_MAX, EVALUATIONS_PER_SECOND, JOINT_ANGLE_ERROR_MAX, JOINT_VELOCITY_ERROR_MAX,
-    ORDER_JOINT_ANGLE, ORDER_JOINT_VELOCITY, POWER_BALANCE_RESIDUAL_MAX, REFERENCE_PARTING_TIME, SELF_PARTING_TIME,
+    ORDER_JOINT_ANGLE, ORDER_JOINT_VELOCITY, POWER_BALANCE_RESIDUAL_MAX, REFERENCE_PARTING_TIME,
+    SEGMENT_REFERENCE_ERROR_MAX, SELF_PARTING_TIME,
     TIME_PER_STEP, TIME_PER_STEP_BATCHED, order_source, units,
 )
 from simparity.core.model.results import NOTHING_TO_MEASURE, ROUNDING_FLOOR, SATURATED
@@ -83,25 +84,30 @@ def motion_metrics(scene: JointMotionScene) -> dict[str, str]:
     power balance where it is damped or driven."""
     left_out = ENERGY_DRIFT_MAX if exchanges_energy(scene) else POWER_BALANCE_RESIDUAL_MAX
     metrics = {m: u for m, u in JOINT_MOTION_METRICS.items() if m != left_out}
-    return metrics | (PREDICTABILITY_METRICS if scene.perturbation > 0 and not scene.segments else {})
+    if scene.segments:
+        return metrics | units(SEGMENT_REFERENCE_ERROR_MAX)
+    return metrics | (PREDICTABILITY_METRICS if scene.perturbation > 0 else {})
 
 
-def joint_scales(chain: Chain) -> np.ndarray:
-    """(n,) what one unit of each joint's error is: 1 rad for a revolute joint, the chain's reach for a prismatic
-    one, so that joint errors are unitless and invariant under a change of length unit."""
+def joint_scales(chain: Chain, motion: JointTrajectory) -> np.ndarray:
+    """(n,) what one unit of each joint's error is: 1 rad for a revolute joint; for a prismatic one the larger of the
+    chain's reach and the joint's own range of motion in ``motion`` (the reference's), so that joint errors are
+    unitless, invariant under a change of length unit, and never scaled by joint limits (which do not act)."""
+    travel = np.ptp(np.asarray(motion.q), axis=0).max(axis=0)  # (n,) over samples and copies
     length = reach(chain)
-    return np.array([1.0 if j.type == "revolute" else length for j in chain.joints])
+    return np.array([1.0 if j.type == "revolute" else max(length, float(travel[k]), np.finfo(float).tiny)
+                     for k, j in enumerate(chain.joints)])
 
 
 def reach(chain: Chain) -> float:
-    """[m] The chain's size: the sum of its joint offsets and end-effector offset, plus the travel of its
-    prismatic joints where limited; at least the largest link's centre-of-mass offset, never 0."""
-    offsets = sum(float(np.linalg.norm(j.origin_xyz)) for j in chain.joints)
+    """[m] The chain's size: the sum of its joint offsets after the first joint and its end-effector offset; at
+    least the largest link's centre-of-mass offset, never 0. Where the first joint sits in the base frame is left out
+    (moving the chain's mount, a base 2 km away, changes no distance the chain can cover), and so are joint limits
+    (they do not act on the motion)."""
+    offsets = sum(float(np.linalg.norm(j.origin_xyz)) for j in chain.joints[1:])
     offsets += float(np.linalg.norm(chain.end_effector_xyz))
-    travel = sum(j.upper - j.lower for j in chain.joints
-                 if j.type == "prismatic" and math.isfinite(j.upper - j.lower))
     com = max((float(np.linalg.norm(j.link.com_xyz)) for j in chain.joints if j.link is not None), default=0.0)
-    return max(offsets + travel, com, np.finfo(float).tiny)
+    return max(offsets, com, np.finfo(float).tiny)
 
 
 @dataclass(frozen=True)
@@ -201,7 +207,8 @@ def divergence(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading |
 def _relative(value: float, scale: float, what: str) -> Measured:
     if not scale > 0:
         return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=(
-            f"nothing moves: the chain exchanges no energy, so its {what} has no scale"))
+            f"the engine's own energies show no exchange (kinetic energy and the range of potential energy 0), so "
+            f"its {what} has no scale"))
     ratio = value / scale
     if ratio > SATURATED_DRIFT:
         return Measured(ratio, "1", flag=SATURATED, unmeasurable=(
@@ -244,7 +251,7 @@ def reference_horizon(scene: JointMotionScene, ref: JointTrajectory, coarse: Joi
     values), and the differences over them as the floor of each error."""
     if coarse is None:
         return Horizon(len(ref.times), {})
-    scales = joint_scales(scene.chain)
+    scales = joint_scales(scene.chain, ref)
     angle = (np.abs(ref.q - coarse.q) / scales).max(axis=(1, 2))
     speed = _speed_scale(ref, scales)
     velocity = (np.abs(ref.qdot - coarse.qdot) / scales).max(axis=(1, 2)) / speed
@@ -281,9 +288,10 @@ def reference_errors(scene: JointMotionScene, traj: JointTrajectory, own: OwnRea
                f"than {HORIZON_FLOOR:g} rad at once)")
         return ({m: Measured(math.nan, "1", flag=SATURATED, unmeasurable=why) for m in REFERENCE_ERRORS},
                 {m: math.inf for m in REFERENCE_ERRORS}, {})
-    scales, end = joint_scales(scene.chain), horizon.end
+    scales, end = joint_scales(scene.chain, ref), horizon.end
     speed = _speed_scale(ref, scales)
-    length = reach(scene.chain)
+    travel = np.linalg.norm(ref_end_effector - ref_end_effector[:1], axis=-1).max()
+    length = max(reach(scene.chain), float(travel))  # a slider's tip may travel farther than the chain is long
     within = own.index < end
     values = {
         JOINT_ANGLE_ERROR_MAX: float((np.abs(traj.q[:end] - ref.q[:end]) / scales).max()),
@@ -329,7 +337,7 @@ def parting_times(scene: JointMotionScene, traj: JointTrajectory, perturbed: Joi
     """When ``traj`` parts (a joint more than :data:`PARTING` off, unitless) from the engine's own run from the
     perturbed start, and from the reference's; n/a with the reason where they never part within the run or there is
     nothing to part from."""
-    scales = joint_scales(scene.chain)
+    scales = joint_scales(scene.chain, traj if ref is None else ref)
 
     def parting(other: JointTrajectory | None, what: str) -> Measured:
         if other is None:

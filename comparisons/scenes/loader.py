@@ -711,8 +711,8 @@ def _joint_powers(chain: Chain, revolute: int, prismatic: int) -> np.ndarray:
 
 def _joint_values(r: _Reader, key: str, chain: Chain, powers: np.ndarray, default: float | None = 0.0) -> np.ndarray:
     """(n,) one number per joint in the scene's length unit (scaled joint by joint by ``powers``)."""
-    values = r.vector(key, chain.n_joints, None if default is None else [default] * chain.n_joints)
-    return values * r.scale ** powers
+    values = r.vector(key, chain.n_joints, None if default is None else [default] * chain.n_joints) * r.scale ** powers
+    return np.array([r._in_range(f"{key}[{i}]", float(v)) for i, v in enumerate(values)])
 
 
 def _within_limits(r: _Reader, key: str, chain: Chain, q: np.ndarray) -> np.ndarray:
@@ -768,6 +768,11 @@ def _joint_motion(top: _Reader, head: dict, engines: EngineSet) -> JointMotionSc
     duration = sim.number("duration", positive=True)
     dts = _ladder(sim, duration, 1)
     segments = sim.integer("segments", 0, maximum=MAX_SEGMENTS, why="") if sim.has("segments") else 0
+    for i, dt in enumerate(dts if segments else ()):  # each segment a whole number of every step
+        steps = duration / segments / dt
+        if abs(steps - round(steps)) > _STEP_COUNT_RTOL * max(steps, 1.0) or round(steps) < 1:
+            raise sim.fail("segments", f"{segments} segments of {duration / segments:g} s are not a whole number of "
+                           f"steps of dt[{i}] = {dt:g} s", "a count of segments each a whole number of every dt")
     perturbation = sim.number("perturbation", 0.0) if sim.has("perturbation") else 0.0  # rad (a prismatic joint: m)
     if not 0 <= perturbation <= MAX_PERTURBATION:
         raise sim.fail("perturbation", f"{perturbation:g} is out of range",

@@ -110,6 +110,7 @@ END_EFFECTOR_ERROR_MAX = "end_effector_error_max"
 POWER_BALANCE_RESIDUAL_MAX = "power_balance_residual_max"
 ORDER_JOINT_ANGLE = "order_joint_angle"
 ORDER_JOINT_VELOCITY = "order_joint_velocity"
+SEGMENT_REFERENCE_ERROR_MAX = "segment_reference_error_max"
 SELF_PARTING_TIME = "self_parting_time"
 REFERENCE_PARTING_TIME = "reference_parting_time"
 # Contact: events against the exact bounce sequence, slide and rest.
@@ -201,6 +202,8 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
            theory="E(t) - E(0) = the work of the applied forces less the damping's: 0 up to the scheme's error"),
     Metric(ORDER_JOINT_ANGLE, DIMENSIONLESS, ORDER, theory="the scheme's order", source=JOINT_ANGLE_ERROR_MAX),
     Metric(ORDER_JOINT_VELOCITY, DIMENSIONLESS, ORDER, theory="the scheme's order", source=JOINT_VELOCITY_ERROR_MAX),
+    Metric(SEGMENT_REFERENCE_ERROR_MAX, DIMENSIONLESS, ERROR, scale="joint_angle",
+           theory="the model against the reference's: the scheme's error at dt / 16 and nothing else"),
     Metric(SELF_PARTING_TIME, "s", PREDICTABILITY,
            theory="when the engine's runs from two starts a perturbation apart part: the chain's own horizon"),
     Metric(REFERENCE_PARTING_TIME, "s", PREDICTABILITY, theory="not before the self-parting time, for a sound engine"),
