@@ -75,6 +75,16 @@ def is_scheme_label(label: str) -> bool:
     return label == "" or all(part in SCHEME_KINDS for part in label.split("+"))
 
 
+def _offered(offered: tuple[str, ...], name: str, none: str, not_this: str) -> Support:
+    """Support for ``name`` among what an engine ``offered``: yes, ``none`` when it offers nothing, else
+    ``not_this 'name' (offers: ...)``."""
+    if name in offered:
+        return Support.yes()
+    if not offered:
+        return Support.no(none)
+    return Support.no(f"{not_this} '{name}' (offers: {', '.join(offered)})")
+
+
 @dataclass(frozen=True)
 class Support:
     """Whether an engine can do what a scene asks, and why not when it cannot."""
@@ -357,12 +367,8 @@ class Engine(abc.ABC):
 
     def supports_joint_dynamics(self, chain: Chain, method: str) -> Support:
         """Whether :meth:`build_joint_dynamics` can build ``chain`` with ``method``."""
-        if method in self.joint_dynamics_methods():
-            return Support.yes()
-        if not self.joint_dynamics_methods():
-            return Support.no(f"{self.name} computes no joint-space dynamics")
-        return Support.no(f"{self.name} has no joint-dynamics method '{method}' "
-                          f"(offers: {', '.join(self.joint_dynamics_methods())})")
+        return _offered(self.joint_dynamics_methods(), method, f"{self.name} computes no joint-space dynamics",
+                        f"{self.name} has no joint-dynamics method")
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
         """Build ``chain``'s joint-space dynamics under ``gravity_world`` ((3,) [m/s^2] in the base frame, None for
@@ -378,12 +384,8 @@ class Engine(abc.ABC):
 
     def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
         """Whether :meth:`build_joint_motion` can step ``scene`` with ``integrator``."""
-        if integrator in self.joint_motion_integrators():
-            return Support.yes()
-        if not self.joint_motion_integrators():
-            return Support.no(f"{self.name} steps no chain through time")
-        return Support.no(f"{self.name} has no joint-motion integrator '{integrator}' "
-                          f"(offers: {', '.join(self.joint_motion_integrators())})")
+        return _offered(self.joint_motion_integrators(), integrator, f"{self.name} steps no chain through time",
+                        f"{self.name} has no joint-motion integrator")
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         """Build ``scene`` for stepping with ``integrator`` at ``dt`` [s] (not timed). Call only when supported."""
@@ -429,11 +431,8 @@ class Engine(abc.ABC):
 
     def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
         """Whether :meth:`build_ik` can build ``solver`` for ``chain`` and this kind of target."""
-        if solver in self.ik_solvers():
-            return Support.yes()
-        if not self.ik_solvers():
-            return Support.no(f"{self.name} offers no IK solver")
-        return Support.no(f"{self.name} has no IK solver '{solver}' (offers: {', '.join(self.ik_solvers())})")
+        return _offered(self.ik_solvers(), solver, f"{self.name} offers no IK solver",
+                        f"{self.name} has no IK solver")
 
     def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
         """Build ``solver`` for ``chain`` with the scene's tolerances and iteration cap (not timed)."""
