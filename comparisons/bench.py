@@ -316,22 +316,44 @@ def run_peak_memory(arguments: list[str], run: Path, cwd: Path | None = None) ->
     return peak, seconds, done.stderr[-300:]
 
 
+CHEAP_MEMORY = f"{MEMORY_SCENE} (core taylor2, analytic exact)"
+"""The workload of the memory rows that reach 10^7 steps: :data:`MEMORY_SCENE` with the cheapest stepping there is,
+core's particle rule and the closed form (its reference streamed beside each case)."""
+CHEAP_MEMORY_STEPS = (100_000, 1_000_000, 3_000_000, 10_000_000)
+"""Steps of the cheap memory rows: the slope between them says whether memory grows with the steps; the last is
+run by the closed form alone (core's Python loop would take ten minutes)."""
+WORKER_LIMIT_MIB = 1024
+"""[MiB] What a worker may hold for :data:`CHEAP_MEMORY_STEPS`' largest run."""
+
+
 def memory_rows(quick: bool, folder: Path, say: Callable[[str], None]) -> list[BenchRow]:
-    """Peak memory of ``simparity run --jobs 1`` on :data:`MEMORY_SCENE` cut to 10^5 and 10^6 steps (10^4 and 10^5
-    quick), each in its own process: a :data:`MEMORY_PROCESS` and a :data:`MEMORY_CHILD` row per number of steps
-    [MiB], read from the run's ``run.json``, with the run's wall time [s] as accuracy."""
+    """Peak memory of ``simparity run --jobs 1``, each run in its own process: on :data:`MEMORY_SCENE` with every
+    default engine cut to 10^5 and 10^6 steps, and on :data:`CHEAP_MEMORY` at :data:`CHEAP_MEMORY_STEPS` (a tenth
+    of each quick). A :data:`MEMORY_PROCESS` and a :data:`MEMORY_CHILD` row per run [MiB], read from the run's
+    ``run.json``, with the run's wall time [s] as accuracy."""
     text = library.resolve(MEMORY_SCENE).read_text(encoding="utf-8")
+    scale = 10 if quick else 1
+    runs: list[tuple[str, int, str | None, list[str]]] = [
+        (MEMORY_SCENE, steps // scale, None, []) for steps in (100_000, TARGET_MEMORY_STEPS)]
+    runs += [(CHEAP_MEMORY, steps // scale, '["taylor2", "exact"]', ["--engines", "core,analytic"])
+             for steps in CHEAP_MEMORY_STEPS[:-1]]
+    runs.append((CHEAP_MEMORY, CHEAP_MEMORY_STEPS[-1] // scale, '["exact"]', ["--engines", "analytic"]))
     rows = []
-    for steps in ((10_000, 100_000) if quick else (100_000, TARGET_MEMORY_STEPS)):
-        scene = folder / f"memory-{steps}.toml"
-        scene.write_text(text.replace("duration = 100.0", f"duration = {steps * 1e-4!r}"), encoding="utf-8")
-        peak, seconds, stderr = run_peak_memory([str(scene), "--repeats", "0", "--jobs", "1"], folder / f"run-{steps}")
+    for index, (workload, steps, integrators, engines) in enumerate(runs):
+        scene = folder / f"memory-{index}.toml"
+        scene_text = text.replace("duration = 100.0", f"duration = {steps * 1e-4!r}")
+        if integrators:
+            scene_text = scene_text.replace('integrators = ["taylor2", "semi_implicit_euler+matrix", "euler", "exact"]',
+                                            f"integrators = {integrators}")
+        scene.write_text(scene_text, encoding="utf-8")
+        peak, seconds, stderr = run_peak_memory([str(scene), "--repeats", "0", "--jobs", "1", "--max-steps",
+                                                 str(steps), *engines], folder / f"run-{index}")
         note = "" if peak else f"n/a: the run recorded no peak memory: {stderr}"
+        method_of = "simparity run --jobs 1" + (f" {' '.join(engines)}" if engines else "")
         for method, mib in ((MEMORY_PROCESS, peak.this_process_bytes / 2**20 if peak else math.nan),
                             (MEMORY_CHILD, peak.largest_child_bytes / 2**20 if peak else math.nan)):
-            rows.append(BenchRow("memory", MEMORY_SCENE, "simparity run --jobs 1", method, steps, mib, "MiB", seconds,
-                                 "s", note))
-        say(f"  {MEMORY_SCENE} cut to {steps:,} steps: peak {rows[-2].value:,.0f} MiB in this process, "
+            rows.append(BenchRow("memory", workload, method_of, method, steps, mib, "MiB", seconds, "s", note))
+        say(f"  {workload} cut to {steps:,} steps: peak {rows[-2].value:,.0f} MiB in this process, "
             f"{rows[-1].value:,.0f} MiB in its largest child, in {seconds:.0f} s")
     return rows
 
@@ -493,9 +515,9 @@ def targets(rows: list[BenchRow]) -> list[Verdict]:
 def _memory_targets(rows: list[BenchRow]) -> list[Verdict]:
     """The memory targets: the whole run within :data:`MEMORY_LIMIT_MIB` (this process plus its largest child), and
     the largest child, which holds the trajectories, flat in the number of steps."""
-    def measured(method: str) -> list[BenchRow]:
-        return sorted((r for r in rows if r.section == "memory" and r.method == method and math.isfinite(r.value)),
-                      key=lambda r: r.batch)
+    def measured(method: str, workload: str = MEMORY_SCENE) -> list[BenchRow]:
+        return sorted((r for r in rows if r.section == "memory" and r.method == method and r.workload == workload
+                       and math.isfinite(r.value)), key=lambda r: r.batch)
 
     own = {r.batch: r.value for r in measured(MEMORY_PROCESS)}
     child = measured(MEMORY_CHILD)
@@ -517,10 +539,32 @@ def _memory_targets(rows: list[BenchRow]) -> list[Verdict]:
                           f"{FLAT_GROWTH - 1:.0%}",
                           f"largest child process {low.value:,.0f} -> {most.value:,.0f} MiB ({low.batch:,} -> "
                           f"{most.batch:,} steps), {per_step:,.0f} bytes per step" + (
-                              "" if flat else ": every step of the engine's and the reference's trajectories is held "
-                              "for the metrics (no streaming yet)"), flat,
+                              "" if flat else ": something holds every step (an engine that does not stream, a "
+                              "contact scene)"), flat,
                           f"{low.batch:,} -> {most.batch:,} steps",
                           f"{TARGET_MEMORY_STEPS // 10:,} -> {TARGET_MEMORY_STEPS:,} steps"))
+    return out + _cheap_memory_targets(measured(MEMORY_CHILD, CHEAP_MEMORY))
+
+
+def _cheap_memory_targets(child: list[BenchRow]) -> list[Verdict]:
+    """On :data:`CHEAP_MEMORY`: the largest child flat from the first to the last of its core runs (the slope in
+    bytes per step between each two), and within :data:`WORKER_LIMIT_MIB` at the largest run."""
+    if len(child) < 2:
+        return []
+    cored = [r for r in child if "core" in r.engine]
+    low, high = cored[0], cored[-1]
+    slopes = ", ".join(f"{(b.value - a.value) * 2**20 / (b.batch - a.batch):,.1f} bytes per step from {a.batch:,}"
+                       for a, b in zip(cored, cored[1:]))
+    measured_at = f"{low.batch:,} -> {high.batch:,} steps"
+    set_for = f"{CHEAP_MEMORY_STEPS[0]:,} -> {CHEAP_MEMORY_STEPS[-2]:,} steps"
+    out = [_sized(f"memory flat in the number of steps on the cheap scene ({set_for}): the largest child process's "
+                  f"peak grows <= {FLAT_GROWTH - 1:.0%}",
+                  f"largest child process {low.value:,.0f} -> {high.value:,.0f} MiB; {slopes}",
+                  high.value <= FLAT_GROWTH * low.value, measured_at, set_for)]
+    last = child[-1]
+    out.append(_sized(f"{CHEAP_MEMORY_STEPS[-1]:,} steps within {WORKER_LIMIT_MIB:,} MiB per worker",
+                      f"largest child process {last.value:,.0f} MiB at {last.batch:,} steps ({last.engine})",
+                      last.value <= WORKER_LIMIT_MIB, f"{last.batch:,} steps", f"{CHEAP_MEMORY_STEPS[-1]:,} steps"))
     return out
 
 
@@ -586,17 +630,17 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
         lines.append("")
     memory = [r for r in rows if r.section == "memory"]
     if memory:
-        lines += [f"## Memory of `simparity run --jobs 1` against the number of steps ({MEMORY_SCENE})", "",
+        lines += ["## Memory of `simparity run --jobs 1` against the number of steps", "",
                   ("Peak resident memory of the run's own process and of its largest child process (a case worker or "
                    "a child it forked to run one engine's cases, which holds the trajectories), from the run's "
                    "`run.json`. A child's figure is its ru_maxrss: at least the run's own size when the worker was "
                    "started, which Linux carries over exec."), "",
-                  f"| steps | {MEMORY_PROCESS} [MiB] | {MEMORY_CHILD} [MiB] | wall time [s] | note |",
-                  "|---|---|---|---|---|"]
-        for steps in dict.fromkeys(r.batch for r in memory):
-            by_method = {r.method: r for r in memory if r.batch == steps}
+                  f"| scene | steps | {MEMORY_PROCESS} [MiB] | {MEMORY_CHILD} [MiB] | wall time [s] | note |",
+                  "|---|---|---|---|---|---|"]
+        for workload, steps in dict.fromkeys((r.workload, r.batch) for r in memory):
+            by_method = {r.method: r for r in memory if (r.workload, r.batch) == (workload, steps)}
             first = next(iter(by_method.values()))
-            lines.append(f"| {steps:,} | " + " | ".join(_cell(by_method[m].value, ",.0f") if m in by_method else "n/a"
+            lines.append(f"| {workload} | {steps:,} | " + " | ".join(_cell(by_method[m].value, ",.0f") if m in by_method else "n/a"
                                                          for m in (MEMORY_PROCESS, MEMORY_CHILD))
                          + f" | {_cell(first.accuracy, '.0f')} | {first.note} |")
         lines.append("")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import platform
+from collections.abc import Iterator
 from dataclasses import asdict, replace
 
 import numpy as np
@@ -21,7 +22,7 @@ from simparity.core.contact.bodies import (
 from simparity.core.contact.act_after import GAUSS_SEIDEL_PASSES, ActAfterStepper
 from simparity.core.contact.backup import FREE, MAX_EVENTS_PER_STEP, BackupStepper
 from simparity.core.model.engine import (BatchedRun, Engine, IKModel, JointDynamicsModel, JointSimulation,
-                                         KinematicsModel, Simulation, Support)
+                                         KinematicsModel, PieceSimulation, Simulation, Support)
 from simparity.core.articulated import model as joint_dynamics
 from simparity.core.articulated import stepping as joint_stepping
 from simparity.core.articulated.motion import CoreJointMotion
@@ -36,7 +37,7 @@ from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.dynamics.rigid_body import MassProperties, State, initial_state, velocities
 from simparity.core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
 from simparity.core.model.scene import PENALTY_PREFIX, Chain, DynamicsScene, IKScene, JointMotionScene
-from simparity.core.model.trajectory import FramePoses, Trajectory
+from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
 
 _DEFAULT_ORIENTATION = "quaternion"
 _SINGLE_ORIENTATION_SCHEMES = ("engine_euler",)
@@ -77,7 +78,7 @@ PARTICLE_STAGES = 1
 whatever the rule (``constant_velocity`` discards it)."""
 
 
-class _InHouseSimulation(Simulation):
+class _InHouseSimulation(PieceSimulation):
     """Core's simulations, vectorised over bodies: copies of a scene step together as one scene of their bodies."""
 
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
@@ -105,32 +106,37 @@ class _RigidBodySimulation(_InHouseSimulation):
             self._step = make_step(scheme, orientation, self._props, wrench)
         self.detail = f"in-house {scheme}, orientation update: {orientation}"
 
-    def run(self, n_steps: int) -> Trajectory:
-        times = np.arange(n_steps + 1) * self._dt
-        return Trajectory(times, *(self._run_packed(n_steps) if self._packed else self._run_matrix(n_steps)))
+    def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
+        pieces = self._packed_pieces if self._packed else self._matrix_pieces
+        for (start, stop), samples in zip(piece_bounds(n_steps, samples_per_piece),
+                                          pieces(n_steps, samples_per_piece)):
+            yield Trajectory(np.arange(start, stop) * self._dt, *samples)
 
-    def _run_packed(self, n_steps: int) -> tuple[np.ndarray, ...]:
-        """(x, q, v, omega) at every step, each (T, B, k), from the packed state."""
+    def _packed_pieces(self, n_steps: int, samples_per_piece: int) -> Iterator[tuple[np.ndarray, ...]]:
+        """(x, q, v, omega) of each piece's samples, each (T, B, k), from the packed state."""
         state, dt = pack(self._state0), self._dt
-        record = np.empty((n_steps + 1,) + state.shape)
-        record[0] = state
-        for i in range(1, n_steps + 1):
-            state = record[i] = self._packed_step((i - 1) * dt, state, dt)
-        return self._bodies.samples(record.transpose(1, 0, 2))
+        for start, stop in piece_bounds(n_steps, samples_per_piece):
+            record = np.empty((stop - start,) + state.shape)
+            for j, i in enumerate(range(start, stop)):
+                if i:
+                    state = self._packed_step((i - 1) * dt, state, dt)
+                record[j] = state
+            yield self._bodies.samples(record.transpose(1, 0, 2))
 
-    def _run_matrix(self, n_steps: int) -> tuple[np.ndarray, ...]:
-        """(x, q, v, omega) at every step, each (T, B, k), from rotation-matrix states."""
+    def _matrix_pieces(self, n_steps: int, samples_per_piece: int) -> Iterator[tuple[np.ndarray, ...]]:
+        """(x, q, v, omega) of each piece's samples, each (T, B, k), from rotation-matrix states."""
         state, dt = self._state0, self._dt
-        pos, mom, ang = (np.empty((n_steps + 1,) + state.position_world.shape) for _ in range(3))
-        ori = np.empty((n_steps + 1,) + state.orientation.shape)
-        for i in range(n_steps + 1):
-            if i:
-                state = self._step((i - 1) * dt, state, dt)
-            pos[i], ori[i], mom[i], ang[i] = (state.position_world, state.orientation, state.momentum_world,
-                                              state.angular_momentum_world)
-        # Velocities and quaternions of all samples at once, broadcast over (T, B).
-        vel, omg = velocities(State(pos, ori, mom, ang), self._props)
-        return pos, matrix_to_quat_wxyz(ori), vel, omg
+        for start, stop in piece_bounds(n_steps, samples_per_piece):
+            pos, mom, ang = (np.empty((stop - start,) + state.position_world.shape) for _ in range(3))
+            ori = np.empty((stop - start,) + state.orientation.shape)
+            for j, i in enumerate(range(start, stop)):
+                if i:
+                    state = self._step((i - 1) * dt, state, dt)
+                pos[j], ori[j], mom[j], ang[j] = (state.position_world, state.orientation, state.momentum_world,
+                                                  state.angular_momentum_world)
+            # Velocities and quaternions of the piece's samples at once, broadcast over (T, B).
+            vel, omg = velocities(State(pos, ori, mom, ang), self._props)
+            yield pos, matrix_to_quat_wxyz(ori), vel, omg
 
 
 class _ParticleSimulation(_InHouseSimulation):
@@ -150,18 +156,19 @@ class _ParticleSimulation(_InHouseSimulation):
         self._r0 = quat_wxyz_to_matrix(np.stack([b.quat_wxyz for b in scene.bodies]))
         self.detail = f"in-house particle rule {integrator} (lecture, Bodies in Free Fall)"
 
-    def run(self, n_steps: int) -> Trajectory:
+    def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
         x, v, dt = self._x0, self._v0, self._dt
-        pos, vel = np.empty((n_steps + 1,) + x.shape), np.empty((n_steps + 1,) + x.shape)
-        pos[0], vel[0] = x, v
         zero = np.zeros_like(x)
-        for i in range(1, n_steps + 1):
-            force, _ = self._wrench((i - 1) * dt, x, self._r0, v, zero)
-            x, v = self._rule(x, v, force / self._mass, dt)
-            pos[i], vel[i] = x, v
-        quat = np.broadcast_to(self._q0, (n_steps + 1,) + self._q0.shape)
-        omg = np.zeros((n_steps + 1,) + x.shape)
-        return Trajectory(np.arange(n_steps + 1) * dt, pos, quat, vel, omg)
+        for start, stop in piece_bounds(n_steps, samples_per_piece):
+            pos, vel = np.empty((stop - start,) + x.shape), np.empty((stop - start,) + x.shape)
+            for j, i in enumerate(range(start, stop)):
+                if i:
+                    force, _ = self._wrench((i - 1) * dt, x, self._r0, v, zero)
+                    x, v = self._rule(x, v, force / self._mass, dt)
+                pos[j], vel[j] = x, v
+            quat = np.broadcast_to(self._q0, (stop - start,) + self._q0.shape)
+            omg = np.zeros((stop - start,) + x.shape)
+            yield Trajectory(np.arange(start, stop) * dt, pos, quat, vel, omg)
 
 
 class _ContactSimulation(_InHouseSimulation):
@@ -207,22 +214,24 @@ class _ContactSimulation(_InHouseSimulation):
                            f"restitution and rest_speed not used; in theory an undamped linear spring is "
                            + (f"stable below {undamped:.3g} s" if undamped > 0 else "unstable at every step"))
 
-    def run(self, n_steps: int) -> Trajectory:
+    def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
         state, dt = self._state0, self._dt
         self.events = EventLog()
         resting = np.full(len(self._props.mass), FREE)
-        pos, mom, ang = (np.empty((n_steps + 1,) + state.position_world.shape) for _ in range(3))
-        ori = np.empty((n_steps + 1,) + state.orientation.shape)
-        for i in range(n_steps + 1):
-            if i and self._method == "backup":
-                state, resting = self._backup.step((i - 1) * dt, state, resting, dt, self.events)
-            elif i:
-                state = self._step((i - 1) * dt, state, dt)
-            pos[i], ori[i], mom[i], ang[i] = (state.position_world, state.orientation, state.momentum_world,
-                                              state.angular_momentum_world)
-        vel, omg = velocities(State(pos, ori, mom, ang), self._props)
-        self._report_caps()
-        return Trajectory(np.arange(n_steps + 1) * dt, pos, ori, vel, omg)
+        for start, stop in piece_bounds(n_steps, samples_per_piece):
+            pos, mom, ang = (np.empty((stop - start,) + state.position_world.shape) for _ in range(3))
+            ori = np.empty((stop - start,) + state.orientation.shape)
+            for j, i in enumerate(range(start, stop)):
+                if i and self._method == "backup":
+                    state, resting = self._backup.step((i - 1) * dt, state, resting, dt, self.events)
+                elif i:
+                    state = self._step((i - 1) * dt, state, dt)
+                pos[j], ori[j], mom[j], ang[j] = (state.position_world, state.orientation, state.momentum_world,
+                                                  state.angular_momentum_world)
+            vel, omg = velocities(State(pos, ori, mom, ang), self._props)
+            if stop == n_steps + 1:
+                self._report_caps()
+            yield Trajectory(np.arange(start, stop) * dt, pos, ori, vel, omg)
 
     def _report_caps(self) -> None:
         """Say in the detail how often a body hit the per-step event cap and was put at rest (never silently)."""

@@ -4,7 +4,8 @@ The proof that a change which must not move a number did not (a redesign, a move
 suites before and after it (``simparity run --suite S --quick --out DIR`` at each commit) and compare. Every
 column of ``results.csv`` must be equal, row for row and in the same order, except the value and detail of the
 timing metrics (``time_per_*``: wall time), and where a detail names a file an engine read from an installed package
-(``.../site-packages/pybullet_data/...``): two environments install it in two places. Prints one line per difference (at most :data:`SHOWN`) and a count;
+(``.../site-packages/pybullet_data/...``): two environments install it in two places. The sampled series
+(``series.csv.gz``) must be equal too, every value as written. Prints one line per difference (at most :data:`SHOWN`) and a count;
 exit 0 when the runs are the same, 1 when not.
 """
 
@@ -17,7 +18,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from simparity.core.model.results import RESULTS_FILE
+from simparity.core.model.results import RESULTS_FILE, SERIES_FILE
 
 TIMING_PREFIX = "time_per_"
 """Metrics measuring wall time: their value and detail differ between any two runs."""
@@ -56,16 +57,35 @@ def differences(before_dir: Path, after_dir: Path) -> list[str]:
     return found
 
 
+def series_differences(before_dir: Path, after_dir: Path) -> list[str]:
+    """Every difference between the two runs' sampled series, as one line each (none when neither has any)."""
+    found = [Path(d) / SERIES_FILE for d in (before_dir, after_dir) if (Path(d) / SERIES_FILE).exists()]
+    if not found:
+        return []
+    if len(found) == 1:
+        return [f"only {found[0].parent} has {SERIES_FILE}"]
+    before, after = (pd.read_csv(path, dtype=str, keep_default_na=False) for path in found)
+    if list(before.columns) != list(after.columns) or len(before) != len(after):
+        return [f"series differ in shape: {before.shape} vs {after.shape}"]
+    out = []
+    for column in before.columns:
+        for index in (before[column] != after[column]).to_numpy().nonzero()[0]:
+            row = before.iloc[index]
+            out.append(f"series row {index} ({' '.join(str(v) for v in row.iloc[:5])}) {column}: "
+                       f"{before[column].iloc[index]!r} -> {after[column].iloc[index]!r}")
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m tests.same_results", description=__doc__.splitlines()[0])
     parser.add_argument("before", type=Path)
     parser.add_argument("after", type=Path)
     args = parser.parse_args(argv)
-    found = differences(args.before, args.after)
+    found = differences(args.before, args.after) + series_differences(args.before, args.after)
     for line in found[:SHOWN]:
         print(line)
     rows = len(_read(args.before))
-    print(f"{rows} rows compared, {len(found)} differences (timing aside)")
+    print(f"{rows} rows and their series compared, {len(found)} differences (timing aside)")
     return 0 if not found else 1
 
 

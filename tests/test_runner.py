@@ -254,13 +254,13 @@ def test_warnings_raised_in_a_case_go_into_its_rows_not_the_console(recwarn):
     class _Warning(InHouseEngine):
         def build_dynamics(self, scene, integrator, dt):
             sim = super().build_dynamics(scene, integrator, dt)
-            run = sim.run
+            stream = sim.stream
 
-            def noisy(n):
+            def noisy(n, samples_per_piece):
                 _warnings.warn("overflow encountered in multiply", RuntimeWarning)
-                return run(n)
+                yield from stream(n, samples_per_piece)
 
-            sim.run = noisy
+            sim.stream = noisy
             return sim
 
     _Warning.name = "warning"

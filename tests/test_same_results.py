@@ -2,8 +2,8 @@
 
 import pandas as pd
 
-from simparity.core.model.results import RESULTS_FILE
-from tests.same_results import differences
+from simparity.core.model.results import RESULTS_FILE, SERIES_FILE
+from tests.same_results import differences, series_differences
 
 
 def _run(folder, values, detail="x"):
@@ -31,3 +31,14 @@ def test_where_an_environment_installed_a_package_is_not_a_difference(tmp_path):
         table.loc[0, "detail"] = f"loadURDF of {prefix}/lib/python3.11/site-packages/pybullet_data/kuka_iiwa/model.urdf"
         table.to_csv(folder / RESULTS_FILE, index=False)
     assert differences(before, after) == []
+
+
+def test_a_sampled_series_that_moved_is_found(tmp_path):
+    """The series are compared too (a redesign of how runs are read must keep the envelopes the report draws)."""
+    before, after = _run(tmp_path / "a", ["1e-3", "2e-6"]), _run(tmp_path / "b", ["1e-3", "2e-6"])
+    for folder, value in ((before, "0.25"), (after, "0.2500000000000001")):
+        pd.DataFrame({"scene": ["s"], "engine": ["core"], "integrator": ["rk4"], "dt": ["0.1"], "quantity": ["x"],
+                      "value": [value]}).to_csv(folder / SERIES_FILE, index=False)
+    found = series_differences(before, after)
+    assert len(found) == 1 and "value: '0.25' -> '0.2500000000000001'" in found[0]
+    assert series_differences(before, before) == []

@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.engines.registry import make_engine
-from simparity.comparisons.measure.metrics import conserved_changes
 from simparity.comparisons.measure.rows import Case
 from simparity.comparisons.execute.session import run_in_process as run_scene
 from simparity.comparisons.measure.series import dynamics_series, envelope
@@ -52,7 +51,7 @@ def test_dynamics_series_from_a_hand_made_trajectory():
     scene = _free_body_scene()
     case = Case("free", "core", "rk4", 0.5, "analytic:exact")
     traj = _trajectory([1, 2, 1], [0, 1, 2])
-    records = dynamics_series(case, traj, _trajectory([1, 2, 1], [0, 0.75, 2]), conserved_changes(scene, traj))
+    records = dynamics_series(case, scene, traj, _trajectory([1, 2, 1], [0, 0.75, 2]))
     by_quantity = {r.quantity: r for r in records}
     assert np.allclose(by_quantity["energy_change"].value, [0, 3, 0])
     assert np.allclose(by_quantity["position_error"].value, [0, 0.25, 0])

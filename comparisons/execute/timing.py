@@ -29,23 +29,34 @@ REPEAT_BUDGET_SECONDS = 0.3
 
 def best_of(fn: Callable[[], T], repeats: int) -> tuple[float, T]:
     """(minimum wall time [s] over up to ``repeats`` timed calls, the last call's result).
-
     ``repeats = 0`` times the warm-up call itself (a cold, indicative time: the quick profile's).
     """
+    results: list[T] = []
+
+    def call() -> None:
+        results[:] = [fn()]
+
     start = time.perf_counter()
-    result = fn()  # warm-up: caches, lazy allocations
-    best = time.perf_counter() - start
-    if best >= LONG_CALL_SECONDS or repeats == 0:
-        return best, result
+    call()  # warm-up: caches, lazy allocations
+    best = best_after(time.perf_counter() - start, call, repeats)
+    return best, results[0]
+
+
+def best_after(first: float, fn: Callable[[], object], repeats: int) -> float:
+    """The wall time [s] :func:`best_of` gives a call whose warm-up (already made) took ``first``: ``first`` itself
+    when it is at least :data:`LONG_CALL_SECONDS` or ``repeats = 0``, else the minimum over up to ``repeats``
+    timed calls of ``fn`` (fewer once they used :data:`REPEAT_BUDGET_SECONDS`)."""
+    if first >= LONG_CALL_SECONDS or repeats == 0:
+        return first
     best, spent = float("inf"), 0.0
     for _ in range(repeats):
         start = time.perf_counter()
-        result = fn()
+        fn()
         elapsed = time.perf_counter() - start
         best, spent = min(best, elapsed), spent + elapsed
         if spent >= REPEAT_BUDGET_SECONDS:
             break
-    return best, result
+    return best
 
 
 def status_bytes(field: str, pid: int | str = "self") -> int | None:

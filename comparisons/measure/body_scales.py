@@ -73,12 +73,14 @@ def lift_energies(scene: DynamicsScene) -> np.ndarray:
     return mass * gravity_magnitude(scene) * body_sizes(scene)
 
 
-def energy_scales(scene: DynamicsScene, kinetic: np.ndarray, potential: np.ndarray) -> np.ndarray:
+def energy_scales(scene: DynamicsScene, kinetic0: np.ndarray, potential0: np.ndarray,
+                  potential_min: np.ndarray) -> np.ndarray:
     """(B,) the energy a body has to trade over a run [J]: its kinetic energy at the start plus the largest drop
     of its potential energy along the run, KE(0) + PE(0) - min_t PE(t) (the kinetic energy it would have at the
     lowest point it reaches, were energy conserved), at least :func:`lift_energies`.
 
     Unlike |E(0)|, it does not depend on where the potential is zero (the origin); without gravity it is KE(0),
-    which is |E(0)|. ``kinetic``, ``potential``: (T, B) [J] over the run."""
-    drop = potential[0] - potential.min(axis=0)
-    return np.maximum(kinetic[0] + drop, lift_energies(scene))
+    which is |E(0)|. ``kinetic0``, ``potential0``: (B,) [J] at the start; ``potential_min``: (B,) [J] the least
+    potential energy over the run."""
+    drop = potential0 - potential_min
+    return np.maximum(kinetic0 + drop, lift_energies(scene))

@@ -22,10 +22,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from simparity.comparisons.measure.body_scales import body_sizes, energy_scales
+from simparity.comparisons.measure.body_scales import body_sizes
 from simparity.comparisons.measure.contact_metrics import ContactReading, contact_blow_up, read_contact
+from simparity.comparisons.measure.extents import RunExtents
 from simparity.comparisons.measure.invariants import angular_momentum_world
-from simparity.comparisons.measure.metrics import energies
+from simparity.comparisons.measure.metrics import energy_scale
 from simparity.core.model.scene import DynamicsScene
 from simparity.core.model.trajectory import Trajectory
 from simparity.references.common.conventions import quat_wxyz_to_matrix
@@ -76,52 +77,59 @@ def _speed_bounds(scene: DynamicsScene) -> tuple[np.ndarray, np.ndarray]:
     return np.array(linear), np.array(angular)
 
 
-def _conserved_growth(scene: DynamicsScene, traj: Trajectory) -> str:
-    if scene.forces.conserves_energy:
-        energy, kinetic, potential = energies(scene, traj)
-        scale = energy_scales(scene, kinetic, potential)
-        growth = (energy - energy[0]).max(axis=0)
+def _conserved_growth(scene: DynamicsScene, run: RunExtents) -> str:
+    if run.energy is not None:
+        scale = energy_scale(scene, run.energy)
+        growth = run.energy.change_max
         grown = (scale > 0) & (growth > CONSERVED_GROWTH_LIMIT * scale)
         if grown.any():
             b = int(np.argmax(np.where(grown, growth / np.where(scale > 0, scale, 1.0), -np.inf)))
             return (f"energy of {scene.bodies[b].name} rose by {growth[b] / scale[b]:.3g} x its energy scale "
                     f"{scale[b]:.3g} J (KE(0) + the largest drop of its potential, at least m |g| size; conserved, "
                     f"limit {CONSERVED_GROWTH_LIMIT:g} x)")
-    if scene.forces.conserves_angular_momentum and scene.contact is None:
-        inertia = np.stack([b.inertia_body for b in scene.bodies])
-        size = np.linalg.norm(angular_momentum_world(
-            inertia, traj.angular_velocity_world, quat_wxyz_to_matrix(traj.quat_wxyz)), axis=-1)
-        grown = (size[0] > 0) & (size.max(axis=0) > (1 + CONSERVED_GROWTH_LIMIT) * size[0])
+    if run.momentum is not None and scene.contact is None:
+        size0, size_max = run.momentum.size0, run.momentum.size_max
+        grown = (size0 > 0) & (size_max > (1 + CONSERVED_GROWTH_LIMIT) * size0)
         if grown.any():
             b = int(np.argmax(grown))
-            return (f"|L| of {scene.bodies[b].name} grew to {size[:, b].max() / size[0, b]:.3g} x |L(0)| "
+            return (f"|L| of {scene.bodies[b].name} grew to {size_max[b] / size0[b]:.3g} x |L(0)| "
                     f"(conserved; limit {1 + CONSERVED_GROWTH_LIMIT:g} x)")
     return ""
 
 
 def divergence(scene: DynamicsScene, traj: Trajectory) -> str:
-    """Why a finite trajectory counts as diverged (see the module's bounds), or "" when it does not."""
+    """:func:`divergence_of` the whole trajectory ``traj``."""
+    return divergence_of(scene, RunExtents.of(scene, traj))
+
+
+def divergence_of(scene: DynamicsScene, run: RunExtents) -> str:
+    """Why a finite run counts as diverged (see the module's bounds), or "" when it does not."""
     linear, angular = _speed_bounds(scene)
     duration = max(scene.duration, np.finfo(float).tiny)
-    for quantity, values, bound, rounding in (
-            ("speed", traj.velocity_world, linear, AT_REST * body_sizes(scene) / duration),
-            ("angular speed", traj.angular_velocity_world, angular, AT_REST / duration)):
-        peak = np.linalg.norm(values, axis=-1).max(axis=0)
+    for quantity, peak, bound, rounding in (
+            ("speed", run.speed_max, linear, AT_REST * body_sizes(scene) / duration),
+            ("angular speed", run.spin_max, angular, AT_REST / duration)):
         limit = DIVERGENCE_MARGIN * bound + rounding
         over = peak > limit
         if over.any():
             b = int(np.argmax(peak / limit))
             return (f"{quantity} of {scene.bodies[b].name} reached {peak[b]:.3g}, more than {DIVERGENCE_MARGIN:g} x "
                     f"the {bound[b]:.3g} its forces allow")
-    return _conserved_growth(scene, traj)
+    return _conserved_growth(scene, run)
 
 
 def blow_up(scene: DynamicsScene, traj: Trajectory) -> tuple[str, ContactReading | None]:
     """(why ``traj`` counts as diverged, "" if it does not; its contact reading, None without contact or when
     it blew up before one was taken). Non-finite, :func:`divergence`, or with contact energy gained across
     one beyond :data:`comparisons.contact_metrics.UNSTABLE_ENERGY_GAIN`."""
-    blown = "non-finite state" if not traj.is_finite() else divergence(scene, traj)
+    blown = blow_up_of(scene, RunExtents.of(scene, traj))
     if blown or scene.contact is None:
         return blown, None
     reading = read_contact(scene, traj)
     return contact_blow_up(scene, reading), reading
+
+
+def blow_up_of(scene: DynamicsScene, run: RunExtents) -> str:
+    """Why a run whose extents are ``run`` counts as diverged without looking at its contacts: non-finite, or
+    :func:`divergence_of`; "" when it does not."""
+    return "non-finite state" if not run.finite else divergence_of(scene, run)

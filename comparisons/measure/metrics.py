@@ -17,7 +17,9 @@ import numpy as np
 
 from simparity.comparisons.measure.body_scales import body_sizes, energy_scales
 from simparity.comparisons.measure.contact_metrics import CONTACT_METRICS
-from simparity.comparisons.measure.invariants import angular_momentum_world, kinetic_energy, potential_energy
+from simparity.comparisons.measure.extents import (
+    EnergyExtents, ErrorExtents, ReferenceExtents, RunExtents, energies,
+)
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.results import (
     BELOW_THEORY,
@@ -30,7 +32,7 @@ from simparity.core.model.results import (
 )
 from simparity.core.model.scene import DynamicsScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
-from simparity.references.common.conventions import quat_wxyz_angle, quat_wxyz_to_matrix, rotation_angle
+from simparity.references.common.conventions import rotation_angle
 from simparity.core.model.metric_catalogue import (
     order_source,
     units,
@@ -151,6 +153,11 @@ class SaturationScale:
 
 
 def saturation_scales(scene: DynamicsScene, ref: Trajectory) -> dict[str, SaturationScale]:
+    """:func:`saturation_scales_of` the whole reference trajectory ``ref``."""
+    return saturation_scales_of(scene, ReferenceExtents.of(scene, ref))
+
+
+def saturation_scales_of(scene: DynamicsScene, ref: ReferenceExtents) -> dict[str, SaturationScale]:
     """Per error metric, the scale of its own quantity over the reference trajectory, each with a physical
     floor so it never collapses to zero (a box spinning in place has no range of motion, a body at rest no
     speed), per body:
@@ -165,17 +172,14 @@ def saturation_scales(scene: DynamicsScene, ref: Trajectory) -> dict[str, Satura
     units; the order of the bodies is theirs.
     """
     mass = np.array([b.mass for b in scene.bodies])
-    inertia = np.stack([b.inertia_body for b in scene.bodies])
-    duration = max(float(ref.times[-1] - ref.times[0]), np.finfo(float).tiny)
-    rotation = quat_wxyz_to_matrix(ref.quat_wxyz)
-    kinetic = kinetic_energy(mass, inertia, ref.velocity_world, ref.angular_velocity_world, rotation).max(axis=0)
-    travel = np.linalg.norm(ref.position_world - ref.position_world[:1], axis=-1).max(axis=0)
+    duration = max(float(ref.end - ref.start), np.finfo(float).tiny)
+    kinetic, travel = ref.kinetic_max, ref.travel_max
     length = SaturationScale(np.maximum(travel, body_sizes(scene)), {"range of motion": travel,
                                                                       "size": body_sizes(scene)}, "m")
-    speed = np.linalg.norm(ref.velocity_world, axis=-1).max(axis=0)
+    speed = ref.speed_max
     energy_speed = np.sqrt(2 * kinetic / mass)
     velocity_parts = {"|v|": speed, "sqrt(2 KE/m)": energy_speed, "position scale/T": length.value / duration}
-    spin = np.linalg.norm(ref.angular_velocity_world, axis=-1).max(axis=0)
+    spin = ref.spin_max
     spin_parts = {"|omega|": spin, "1/T": np.full(len(mass), 1.0 / duration)}
     if scene.contact is not None:  # an impact can turn a body's speed into spin
         spin_parts["velocity scale/size"] = np.maximum.reduce(list(velocity_parts.values())) / body_sizes(scene)
@@ -226,41 +230,35 @@ def trajectory_errors(traj: Trajectory, ref: Trajectory,
     """Position, orientation (geodesic angle) and velocity errors of ``traj`` against ``ref``, maxima over
     bodies; with ``scales`` (:func:`saturation_scales`) an error at or above :data:`SATURATED_FRACTION` of its
     body's scale is saturated (n/a, the scale in its reason). :func:`saturation_ratios` gives how near each is."""
-    return {metric: measured for metric, (measured, _) in _errors(traj, ref, scales).items()}
+    return judged_errors(ErrorExtents.of(traj, ref), scales)
 
 
-def saturation_ratios(traj: Trajectory, ref: Trajectory, scales: dict[str, SaturationScale]) -> dict[str, float]:
+def judged_errors(errors: ErrorExtents, scales: dict[str, SaturationScale] | None = None) -> dict[str, Measured]:
+    """:func:`trajectory_errors` of a run's per-body errors ``errors``."""
+    return {metric: measured for metric, (measured, _) in _errors(errors, scales).items()}
+
+
+def saturation_ratios(errors: ErrorExtents, scales: dict[str, SaturationScale]) -> dict[str, float]:
     """Per error metric, its largest error over the bodies' saturation thresholds (>= 1: saturated)."""
-    return {metric: ratio for metric, (_, ratio) in _errors(traj, ref, scales).items()}
+    return {metric: ratio for metric, (_, ratio) in _errors(errors, scales).items()}
 
 
-def _errors(traj: Trajectory, ref: Trajectory,
-            scales: dict[str, SaturationScale] | None) -> dict[str, tuple[Measured, float]]:
-    if traj.position_world.shape != ref.position_world.shape:
-        raise ValueError(f"trajectory shape {traj.position_world.shape} != reference {ref.position_world.shape}")
-    position = _distance(traj.position_world, ref.position_world)
-    per_body = {
-        POSITION_ERROR_MAX: position.max(axis=0),
-        POSITION_ERROR_FINAL: position[-1],
-        VELOCITY_ERROR_MAX: _distance(traj.velocity_world, ref.velocity_world).max(axis=0),
-        ANGULAR_VELOCITY_ERROR_MAX: _distance(traj.angular_velocity_world, ref.angular_velocity_world).max(axis=0),
-    }
+def _errors(errors: ErrorExtents, scales: dict[str, SaturationScale] | None) -> dict[str, tuple[Measured, float]]:
     out = {}
-    for metric, errors in per_body.items():
-        measured, ratio = _saturating_error(metric, errors, None if scales is None else scales[metric])
+    for metric in (POSITION_ERROR_MAX, POSITION_ERROR_FINAL, VELOCITY_ERROR_MAX, ANGULAR_VELOCITY_ERROR_MAX):
+        measured, ratio = _saturating_error(metric, errors.per_body[metric], None if scales is None else scales[metric])
         out[metric] = (Measured(measured.value, _ERROR_UNITS[metric], measured.unmeasurable, flag=measured.flag),
                        ratio)
-    out[ORIENTATION_ERROR_MAX] = _orientation_error(quat_wxyz_angle(traj.quat_wxyz, ref.quat_wxyz).max(axis=0))
+    out[ORIENTATION_ERROR_MAX] = _orientation_error(errors.per_body[ORIENTATION_ERROR_MAX])
     return {m: out[m] for m in (POSITION_ERROR_MAX, POSITION_ERROR_FINAL, ORIENTATION_ERROR_MAX,
                                 VELOCITY_ERROR_MAX, ANGULAR_VELOCITY_ERROR_MAX)}
 
 
-def state_validity(traj: Trajectory) -> dict[str, Measured]:
+def state_validity(run: RunExtents) -> dict[str, Measured]:
     """Whether the states an engine reports are states: ``quaternion_norm_deviation_max`` = max | |q| - 1 | over
     samples and bodies (a unit quaternion up to rounding; an orientation that is not one is no rotation at all,
     whatever its angle to the reference's)."""
-    norm = np.linalg.norm(np.asarray(traj.quat_wxyz, dtype=float), axis=-1)
-    return {QUATERNION_NORM_DEVIATION_MAX: Measured(float(np.abs(norm - 1.0).max()), "1")}
+    return {QUATERNION_NORM_DEVIATION_MAX: Measured(run.quaternion_deviation_max, "1")}
 
 
 def frame_validity(poses: FramePoses) -> dict[str, Measured]:
@@ -301,91 +299,54 @@ def headline_metric(scene: DynamicsScene) -> str:
     return ORIENTATION_ERROR_MAX if turns else POSITION_ERROR_MAX
 
 
-def energies(scene: DynamicsScene, traj: Trajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(total E, kinetic, potential) [J] per sample and body, each (T, B); potential -m g.x, zero at
-    the world origin (0 without gravity)."""
-    mass = np.array([b.mass for b in scene.bodies])
-    inertia = np.stack([b.inertia_body for b in scene.bodies])
-    rotation = quat_wxyz_to_matrix(traj.quat_wxyz)
-    kinetic = kinetic_energy(mass, inertia, traj.velocity_world, traj.angular_velocity_world, rotation)
-    potential = (np.zeros_like(kinetic) if scene.forces.gravity_world is None
-                 else potential_energy(mass, scene.forces.gravity_world, traj.position_world))
-    return kinetic + potential, kinetic, potential
-
-
-def _relative_drift(change: np.ndarray, scale: np.ndarray, quantity: str) -> Measured:
-    """Largest change / scale over bodies with a non-zero scale; change (T, B), scale (B,)."""
+def _relative_drift(change_max: np.ndarray, scale: np.ndarray, quantity: str) -> Measured:
+    """Largest change / scale over bodies with a non-zero scale; change_max (B,) the largest change over the run,
+    scale (B,)."""
     measurable = scale > 0
     if not measurable.any():
         return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE,
                         unmeasurable=f"nothing to measure {quantity} drift against: it is 0")
-    drift = float((change[:, measurable] / scale[measurable]).max())
+    drift = float((change_max[measurable] / scale[measurable]).max())
     if drift > SATURATED_DRIFT:
         return Measured(drift, "1", flag=SATURATED, unmeasurable=(
             f"saturated: {quantity} changed by {drift:.3g} x its scale (> {SATURATED_DRIFT:.0%})"))
     return Measured(drift, "1")
 
 
-@dataclass(frozen=True)
-class ConservedChanges:
-    """How far what a scene conserves moved, per sample and body; None where the scene does not
-    conserve it (:func:`dynamics_metrics`). Computed once per case, read by the drift metrics and
-    the sampled series.
-
-    Attributes
-    ----------
-    energy : (T, B) ndarray or None
-        E(t) - E(0) [J], signed.
-    energy_scale : (B,) ndarray or None
-        What energy drift is relative to (:func:`comparisons.body_scales.energy_scales`).
-    angular_momentum : (T, B) ndarray or None
-        |L(t) - L(0)| [kg m^2/s], L about the COM.
-    angular_momentum_size : (B,) ndarray or None
-        |L(0)|.
-    """
-
-    energy: np.ndarray | None = None
-    energy_scale: np.ndarray | None = None
-    angular_momentum: np.ndarray | None = None
-    angular_momentum_size: np.ndarray | None = None
+def energy_scale(scene: DynamicsScene, energy: EnergyExtents) -> np.ndarray:
+    """(B,) [J] what a body's energy drift is relative to (:func:`comparisons.body_scales.energy_scales`)."""
+    return energy_scales(scene, energy.kinetic0, energy.potential0, energy.potential_min)
 
 
-def conserved_changes(scene: DynamicsScene, traj: Trajectory) -> ConservedChanges:
-    """Energy and angular momentum changes of ``traj`` where the scene conserves them."""
-    wanted = dynamics_metrics(scene)
-    out: dict[str, np.ndarray] = {}
-    if ENERGY_DRIFT_MAX in wanted:
-        energy, kinetic, potential = energies(scene, traj)
-        out |= {"energy": energy - energy[0], "energy_scale": energy_scales(scene, kinetic, potential)}
-    if ANGULAR_MOMENTUM_DRIFT_MAX in wanted:
-        inertia = np.stack([b.inertia_body for b in scene.bodies])
-        momentum = angular_momentum_world(inertia, traj.angular_velocity_world, quat_wxyz_to_matrix(traj.quat_wxyz))
-        out |= {"angular_momentum": np.linalg.norm(momentum - momentum[0], axis=-1),
-                "angular_momentum_size": np.linalg.norm(momentum[0], axis=-1)}
-    return ConservedChanges(**out)
+def drifts(scene: DynamicsScene, traj: Trajectory) -> dict[str, Measured]:
+    """:func:`drifts_of` the whole trajectory ``traj``."""
+    return drifts_of(scene, RunExtents.of(scene, traj))
 
 
-def drifts(scene: DynamicsScene, traj: Trajectory, changes: ConservedChanges | None = None) -> dict[str, Measured]:
-    """Relative drifts of what the scene conserves, the worst body's:
+def drifts_of(scene: DynamicsScene, run: RunExtents) -> dict[str, Measured]:
+    """Relative drifts of what the scene conserves (:func:`dynamics_metrics`), the worst body's:
 
     - ``energy_drift_max`` = max_t |E(t) - E(0)| / the body's energy scale
       (:func:`comparisons.body_scales.energy_scales`: |E(0)| without gravity; with gravity not |E(0)|, which
       depends on where the origin is, but the kinetic energy the body has to trade);
     - ``angular_momentum_drift_max`` = max_t |L(t) - L(0)| / |L(0)|, L about the COM.
-
-    ``changes``: :func:`conserved_changes` of ``traj`` when already computed.
     """
-    changes = changes or conserved_changes(scene, traj)
+    wanted = dynamics_metrics(scene)
     out = {}
-    if changes.energy is not None and changes.energy_scale is not None:
-        out[ENERGY_DRIFT_MAX] = _relative_drift(np.abs(changes.energy), changes.energy_scale, "energy")
-    if changes.angular_momentum is not None and changes.angular_momentum_size is not None:
-        out[ANGULAR_MOMENTUM_DRIFT_MAX] = _relative_drift(changes.angular_momentum, changes.angular_momentum_size,
+    if ENERGY_DRIFT_MAX in wanted and run.energy is not None:
+        out[ENERGY_DRIFT_MAX] = _relative_drift(run.energy.change_abs_max, energy_scale(scene, run.energy), "energy")
+    if ANGULAR_MOMENTUM_DRIFT_MAX in wanted and run.momentum is not None:
+        out[ANGULAR_MOMENTUM_DRIFT_MAX] = _relative_drift(run.momentum.change_max, run.momentum.size0,
                                                             "angular momentum")
     return out
 
 
 def rounding_floors(scene: DynamicsScene, traj: Trajectory, n_steps: int) -> dict[str, float]:
+    """:func:`rounding_floors_of` the whole trajectory ``traj``."""
+    return rounding_floors_of(scene, RunExtents.of(scene, traj), n_steps)
+
+
+def rounding_floors_of(scene: DynamicsScene, run: RunExtents, n_steps: int) -> dict[str, float]:
     """The rounding floor of each error metric after ``n_steps`` steps (see :data:`ROUNDING_FLOOR_FACTOR`).
 
     The state's scale: |x| + T |v| for positions [m] (a velocity rounded at each step moves the
@@ -393,11 +354,11 @@ def rounding_floors(scene: DynamicsScene, traj: Trajectory, n_steps: int) -> dic
     [rad], |omega| for angular velocities [rad/s]; maxima over the run. With contact, the velocity's floor adds
     what rounding the impacts' timing adds (:func:`event_velocity_floor`).
     """
-    duration = float(traj.times[-1] - traj.times[0])
-    speed = float(np.linalg.norm(traj.velocity_world, axis=-1).max())
-    spin = float(np.linalg.norm(traj.angular_velocity_world, axis=-1).max())
+    duration = run.duration
+    speed = float(run.speed_max.max())
+    spin = float(run.spin_max.max())
     scales = {
-        POSITION_ERROR_MAX: float(np.linalg.norm(traj.position_world, axis=-1).max()) + duration * speed,
+        POSITION_ERROR_MAX: float(run.position_norm_max.max()) + duration * speed,
         VELOCITY_ERROR_MAX: speed,
         ORIENTATION_ERROR_MAX: 1.0 + duration * spin,
         ANGULAR_VELOCITY_ERROR_MAX: spin,

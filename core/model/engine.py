@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import abc
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -18,7 +18,7 @@ from simparity.core.model.errors import NotBatchedError, SimparityError
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.ik_result import IKResult
 from simparity.core.model.scene import Chain, DynamicsScene, JointMotionScene, KinematicsScene, Scene
-from simparity.core.model.trajectory import FramePoses, JointTrajectory, Trajectory
+from simparity.core.model.trajectory import FramePoses, JointTrajectory, Trajectory, joined, trajectory_pieces
 
 
 SCHEME_KINDS = {
@@ -131,6 +131,18 @@ class Simulation(abc.ABC):
         ``n_steps + 1`` samples.
         """
 
+    def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
+        """The ``n_steps + 1`` samples of :meth:`run` in consecutive pieces of at most ``samples_per_piece``
+        samples, the first starting at the initial state, each yielded as soon as it is stepped: the runner
+        measures a piece and drops it, so an engine that steps in pieces holds memory flat in the number of steps.
+
+        Every call starts again from the initial state. The default runs the whole trajectory and cuts it: an
+        engine that only implements :meth:`run` still runs, its memory growing with the steps (the run says so;
+        :func:`streams_in_pieces`). Override it (and :meth:`run` as the one-piece stream: :class:`PieceSimulation`)
+        to stream.
+        """
+        yield from trajectory_pieces(self.run(n_steps), samples_per_piece)
+
     def batched(self, copies: int) -> BatchedRun:
         """``run(n_steps)`` stepping ``copies`` copies of the scene's initial state together, the same model and
         options as :meth:`run` (built here, untimed; the runner times its calls, each from the initial state, and
@@ -140,6 +152,24 @@ class Simulation(abc.ABC):
         default, so an engine that does not say has an ``n/a`` batched timing.
         """
         raise NotBatchedError("the engine's simulation declares no batched stepping (Simulation.batched)")
+
+
+class PieceSimulation(Simulation):
+    """A simulation that steps in pieces: subclasses implement :meth:`stream`; :meth:`run` is its one-piece
+    stream."""
+
+    def run(self, n_steps: int) -> Trajectory:
+        return joined(self.stream(n_steps, n_steps + 1))
+
+    @abc.abstractmethod
+    def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
+        """See :meth:`Simulation.stream`."""
+
+
+def streams_in_pieces(sim: Simulation) -> bool:
+    """Whether ``sim`` steps in pieces (overrides :meth:`Simulation.stream`): False for an engine that returns only
+    whole trajectories, whose memory grows with the steps."""
+    return type(sim).stream is not Simulation.stream
 
 
 class JointSimulation(abc.ABC):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,6 +58,31 @@ class Trajectory:
             bool(np.all(np.isfinite(a)))
             for a in (self.position_world, self.quat_wxyz, self.velocity_world, self.angular_velocity_world)
         )
+
+
+def piece_bounds(n_steps: int, samples_per_piece: int) -> Iterator[tuple[int, int]]:
+    """The sample ranges [start, stop) of ``n_steps`` steps' ``n_steps + 1`` samples in consecutive pieces of at most
+    ``samples_per_piece`` samples (the first starts at the initial state, sample 0)."""
+    size = max(int(samples_per_piece), 1)
+    for start in range(0, n_steps + 1, size):
+        yield start, min(start + size, n_steps + 1)
+
+
+def trajectory_pieces(traj: Trajectory, samples_per_piece: int) -> Iterator[Trajectory]:
+    """``traj`` in consecutive pieces of at most ``samples_per_piece`` samples (views, no copies)."""
+    for start, stop in piece_bounds(len(traj.times) - 1, samples_per_piece):
+        part = slice(start, stop)
+        yield Trajectory(traj.times[part], traj.position_world[part], traj.quat_wxyz[part], traj.velocity_world[part],
+                         traj.angular_velocity_world[part])
+
+
+def joined(pieces: Iterable[Trajectory]) -> Trajectory:
+    """One trajectory of consecutive ``pieces`` (the only one itself, not a copy)."""
+    parts = list(pieces)
+    if len(parts) == 1:
+        return parts[0]
+    return Trajectory(*(np.concatenate([getattr(p, name) for p in parts]) for name in (
+        "times", "position_world", "quat_wxyz", "velocity_world", "angular_velocity_world")))
 
 
 @dataclass(frozen=True)

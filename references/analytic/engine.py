@@ -32,6 +32,8 @@ under constant forces with viscous damping, :mod:`simparity.references.analytic.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 
 from simparity.core.model.engine import (
@@ -40,13 +42,14 @@ from simparity.core.model.engine import (
     JointDynamicsModel,
     JointSimulation,
     KinematicsModel,
+    PieceSimulation,
     Simulation,
     Support,
 )
 from simparity.core.model.ik_problem import IKTolerances, check_inputs
 from simparity.core.model.ik_result import IKResult
 from simparity.core.model.scene import Chain, DynamicsScene, JointMotionScene
-from simparity.core.model.trajectory import FramePoses, Trajectory
+from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
 from simparity.references.analytic import contact as analytic_contact
 from simparity.references.analytic import joint_dynamics as planar_dynamics
 from simparity.references.analytic import joint_motion
@@ -142,22 +145,24 @@ def _rotation(scene: DynamicsScene, k: int, kind: str, times: np.ndarray) -> tup
     return matrix_to_quat_wxyz(quat_wxyz_to_matrix(quat_p) @ axes.T), omega_world
 
 
-class _Simulation(Simulation):
+class _Simulation(PieceSimulation):
     def __init__(self, scene: DynamicsScene, dt: float, kinds: list[tuple[str, str]]) -> None:
         self._scene, self._dt, self._kinds = scene, dt, kinds
         self.detail = "closed form: " + ", ".join(sorted({f"{t}/{r}" for t, r in kinds}))
 
-    def run(self, n_steps: int) -> Trajectory:
-        times = np.arange(n_steps + 1) * self._dt
-        pos, vel, quat, omg = [], [], [], []
-        for k, (translation, rotation) in enumerate(self._kinds):
-            p, v = _translation(self._scene, k, translation, times)
-            q, w = _rotation(self._scene, k, rotation, times)
-            pos.append(p)
-            vel.append(v)
-            quat.append(q)
-            omg.append(w)
-        return Trajectory(times, *(np.stack(a, axis=1) for a in (pos, quat, vel, omg)))
+    def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
+        """The closed forms at each piece's times k dt (each sample a function of its time alone)."""
+        for start, stop in piece_bounds(n_steps, samples_per_piece):
+            times = np.arange(start, stop) * self._dt
+            pos, vel, quat, omg = [], [], [], []
+            for k, (translation, rotation) in enumerate(self._kinds):
+                p, v = _translation(self._scene, k, translation, times)
+                q, w = _rotation(self._scene, k, rotation, times)
+                pos.append(p)
+                vel.append(v)
+                quat.append(q)
+                omg.append(w)
+            yield Trajectory(times, *(np.stack(a, axis=1) for a in (pos, quat, vel, omg)))
 
 
 def _planar(chain: Chain) -> Support:

@@ -18,13 +18,15 @@ on output. Results name it ``tight:dop853``.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 import scipy
 from scipy.integrate import solve_ivp
 
-from simparity.core.model.engine import Engine, KinematicsModel, Simulation, Support
+from simparity.core.model.engine import Engine, KinematicsModel, PieceSimulation, Simulation, Support
 from simparity.core.model.scene import Chain, DynamicsScene
-from simparity.core.model.trajectory import Trajectory
+from simparity.core.model.trajectory import Trajectory, piece_bounds
 from simparity.references.common import external_forces
 
 TOLERANCE = 1e-13
@@ -50,7 +52,7 @@ def _quaternion_rate(q: np.ndarray, omega: np.ndarray) -> np.ndarray:
     return 0.5 * np.concatenate([-np.sum(omega * v, axis=1, keepdims=True), w * omega + np.cross(omega, v)], axis=1)
 
 
-class _Simulation(Simulation):
+class _Simulation(PieceSimulation):
     def __init__(self, scene: DynamicsScene, dt: float) -> None:
         bodies = scene.bodies
         self._forces = scene.forces
@@ -86,17 +88,21 @@ class _Simulation(Simulation):
         torque = external_forces.drag_torque_world(self._forces, omega) + applied_torque
         return np.concatenate([v, _quaternion_rate(y[:, 3:7], omega), force, torque], axis=1).ravel()
 
-    def run(self, n_steps: int) -> Trajectory:
-        times = np.arange(n_steps + 1) * self._dt
-        sol = solve_ivp(self._derivative, (0.0, times[-1]), self._y0, method="DOP853", t_eval=times,
+    def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
+        """One DOP853 solve over the run; each piece's samples from its dense output (the interpolant of the
+        step each time falls in, as ``t_eval`` would pick it: the same values), so memory grows with DOP853's
+        steps, not the run's."""
+        sol = solve_ivp(self._derivative, (0.0, n_steps * self._dt), self._y0, method="DOP853", dense_output=True,
                         rtol=TOLERANCE, atol=TOLERANCE)
         if not sol.success:
             raise RuntimeError(f"DOP853 failed: {sol.message}")
-        y = sol.y.T.reshape(len(times), -1, _STATE)
-        samples = [self._velocities(row) for row in y]
-        quat = y[..., 3:7] / np.linalg.norm(y[..., 3:7], axis=-1, keepdims=True)
-        return Trajectory(times, y[..., :3], quat, np.array([v for v, _, _ in samples]),
-                          np.array([w for _, w, _ in samples]))
+        for start, stop in piece_bounds(n_steps, samples_per_piece):
+            times = np.arange(start, stop) * self._dt
+            y = sol.sol(times).T.reshape(len(times), -1, _STATE)
+            samples = [self._velocities(row) for row in y]
+            quat = y[..., 3:7] / np.linalg.norm(y[..., 3:7], axis=-1, keepdims=True)
+            yield Trajectory(times, y[..., :3], quat, np.array([v for v, _, _ in samples]),
+                             np.array([w for _, w, _ in samples]))
 
 
 class TightSolveEngine(Engine):

@@ -44,6 +44,7 @@ Conversions (each pinned by a test in ``tests/test_mujoco_adapter.py``)
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import replace
 
 import mujoco
@@ -57,13 +58,14 @@ from simparity.core.model.engine import (
     JointDynamicsModel,
     JointSimulation,
     KinematicsModel,
+    PieceSimulation,
     Simulation,
     Support,
 )
 from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.scene import Chain, DynamicsScene, Forces, IKScene, JointDynamicsScene, JointMotionScene
-from simparity.core.model.trajectory import FramePoses, Trajectory
+from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
 from simparity.references.common import contact_params, external_forces
 from simparity.references.mujoco import ik as mujoco_ik
 from simparity.references.mujoco import joint_motion
@@ -108,7 +110,7 @@ def _wind_force(forces: Forces) -> np.ndarray | None:
     return forces.linear_drag[:, None] * forces.air_velocity_world
 
 
-class _Simulation(Simulation):
+class _Simulation(PieceSimulation):
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
         self.model = mujoco.MjModel.from_xml_string(dynamics_mjcf(scene, integrator, dt))
         self._n_bodies = len(scene.bodies)
@@ -187,8 +189,8 @@ class _Simulation(Simulation):
             mujoco.mj_applyFT(m, d, applied.force_world, np.zeros(3), point, body, d.qfrc_applied)
 
     def _loop(self, n_steps: int) -> np.ndarray:
+        """The states after each of ``n_steps`` further steps of the data as it stands, (n_steps, nstate)."""
         m, d = self.model, self._data
-        mujoco.mj_setState(m, d, self._state0, _STATE)
         states = np.empty((n_steps, len(self._state0)))
         for i in range(n_steps):
             self._apply_forces()
@@ -196,26 +198,42 @@ class _Simulation(Simulation):
             mujoco.mj_getState(m, d, states[i], _STATE)
         return states
 
-    def run(self, n_steps: int) -> Trajectory:
+    def _steps(self, initial: np.ndarray, n_steps: int, first: bool) -> np.ndarray:
+        """The states after each of ``n_steps`` steps from the state ``initial`` (the data's own state unless
+        ``first``: the mj_step loop carries on), (n_steps, nstate); raises DivergedError when MuJoCo reset the
+        simulation."""
         warnings = [self._data.warning[w] for w in _RESET_WARNINGS]
         for warning in warnings:
             warning.number = 0
         messages: list[str] = []
         mujoco.set_mju_user_warning(messages.append)
         try:
-            stepped = self._loop(n_steps) if self._stepwise else self._rollout(self._state0[None], n_steps)[0]
+            if self._stepwise and first:
+                mujoco.mj_setState(self.model, self._data, initial, _STATE)
+            if self._stepwise:
+                stepped = self._loop(n_steps)
+            else:
+                stepped = self._rollout(initial[None], n_steps)[0] if n_steps else np.empty((0, len(initial)))
         finally:
             mujoco.set_mju_user_warning(None)
         if any(warning.number for warning in warnings):
             raise DivergedError(f"MuJoCo reset the unstable simulation: {messages[0] if messages else 'bad state'}")
-        states = np.concatenate([self._state0[None], stepped], axis=0)
-        nq, b = self.model.nq, self._n_bodies
-        qpos = states[:, self._qpos_at : self._qpos_at + nq].reshape(-1, b, 7)
-        qvel = states[:, self._qpos_at + nq : self._qpos_at + nq + self.model.nv].reshape(-1, b, 6)
-        quat = qpos[..., 3:]
-        omega_world = np.einsum("tbij,tbj->tbi", quat_wxyz_to_matrix(quat), qvel[..., 3:])
-        times = np.arange(n_steps + 1) * self._dt
-        return Trajectory(times, qpos[..., :3], quat, qvel[..., :3], omega_world)
+        return stepped
+
+    def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
+        """Each piece's steps from the last state of the one before (``mujoco.rollout`` from that full physics
+        state, or the mj_step loop carried on)."""
+        state = self._state0
+        for start, stop in piece_bounds(n_steps, samples_per_piece):
+            stepped = self._steps(state, stop - max(start, 1), start == 0)
+            states = np.concatenate([self._state0[None], stepped], axis=0) if start == 0 else stepped
+            state = states[-1]
+            nq, b = self.model.nq, self._n_bodies
+            qpos = states[:, self._qpos_at : self._qpos_at + nq].reshape(-1, b, 7)
+            qvel = states[:, self._qpos_at + nq : self._qpos_at + nq + self.model.nv].reshape(-1, b, 6)
+            quat = qpos[..., 3:]
+            omega_world = np.einsum("tbij,tbj->tbi", quat_wxyz_to_matrix(quat), qvel[..., 3:])
+            yield Trajectory(np.arange(start, stop) * self._dt, qpos[..., :3], quat, qvel[..., :3], omega_world)
 
 
 def contact_detail(scene: DynamicsScene, dt: float) -> str:

@@ -36,6 +36,8 @@ Conversions (each pinned by a test in ``tests/test_pinocchio_adapter.py``)
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 import pinocchio as pin
 
@@ -46,13 +48,14 @@ from simparity.core.model.engine import (
     JointDynamicsModel,
     JointSimulation,
     KinematicsModel,
+    PieceSimulation,
     Simulation,
     Support,
 )
 from simparity.core.model.errors import NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene
-from simparity.core.model.trajectory import FramePoses, Trajectory
+from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
 from simparity.references.common import external_forces
 from simparity.references.pinocchio import ik as pinocchio_ik
 from simparity.references.common.base_frame import BaseFrame
@@ -97,7 +100,7 @@ _RK4_B = (1 / 6, 1 / 3, 1 / 3, 1 / 6)
 _RK4_C = (0.0, 0.5, 0.5, 1.0)
 
 
-class _Simulation(Simulation):
+class _Simulation(PieceSimulation):
     """Free bodies stepped by the harness on aba's accelerations.
 
     State per body: COM position p and velocity v (world), rotation R, angular velocity w
@@ -137,17 +140,17 @@ class _Simulation(Simulation):
         raise NotBatchedError("the harness steps pinocchio's aba one body at a time from Python: no batched "
                               "stepping")
 
-    def run(self, n_steps: int) -> Trajectory:
+    def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
         dt, b = self._dt, len(self._position0)
         state = (self._position0, self._rotation0, self._velocity0, self._omega_local0)
-        pos, rot, vel, omg = (np.empty((n_steps + 1, b) + s) for s in ((3,), (3, 3), (3,), (3,)))
-        for i in range(n_steps + 1):
-            if i:
-                state = self._step((i - 1) * dt, state, dt)
-            p, r, v, w = state
-            pos[i], rot[i], vel[i], omg[i] = p, r, v, np.einsum("bij,bj->bi", r, w)
-        times = np.arange(n_steps + 1) * dt
-        return Trajectory(times, pos, matrix_to_quat_wxyz(rot), vel, omg)
+        for start, stop in piece_bounds(n_steps, samples_per_piece):
+            pos, rot, vel, omg = (np.empty((stop - start, b) + s) for s in ((3,), (3, 3), (3,), (3,)))
+            for j, i in enumerate(range(start, stop)):
+                if i:
+                    state = self._step((i - 1) * dt, state, dt)
+                p, r, v, w = state
+                pos[j], rot[j], vel[j], omg[j] = p, r, v, np.einsum("bij,bj->bi", r, w)
+            yield Trajectory(np.arange(start, stop) * dt, pos, matrix_to_quat_wxyz(rot), vel, omg)
 
     def _fext(self, r: np.ndarray, v: np.ndarray, w_local: np.ndarray) -> list[pin.StdVec_Force]:
         """aba's external forces of each body's model (universe, then its joint), LOCAL frame, about the COM."""

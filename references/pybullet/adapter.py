@@ -76,6 +76,7 @@ from __future__ import annotations
 import importlib.metadata
 import os
 import tempfile
+from collections.abc import Iterator
 
 import numpy as np
 
@@ -86,13 +87,14 @@ from simparity.core.model.engine import (
     JointDynamicsModel,
     JointSimulation,
     KinematicsModel,
+    PieceSimulation,
     Simulation,
     Support,
 )
 from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene
-from simparity.core.model.trajectory import FramePoses, Trajectory
+from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
 from simparity.references.common import contact_params, external_forces
 from simparity.references.pybullet import ik as pybullet_ik
 from simparity.references.common.base_frame import BaseFrame
@@ -214,7 +216,7 @@ real-time flag and gravity; restitutionVelocityThreshold, contactERP, contactSlo
 breaking threshold cannot be read back: tests check their effect instead)."""
 
 
-class _Simulation(Simulation):
+class _Simulation(PieceSimulation):
     """A scene in a private PyBullet world.
 
     Attributes
@@ -294,7 +296,7 @@ class _Simulation(Simulation):
         """PyBullet has no batch API: NotBatchedError."""
         raise NotBatchedError("pybullet steps one world per stepSimulation call: no batched stepping")
 
-    def run(self, n_steps: int) -> Trajectory:
+    def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
         c = self._client.id
         if self._contact is not None:  # Bullet's breaking threshold is process-global: another world may have set it
             pybullet.setPhysicsEngineParameter(contactBreakingThreshold=BREAKING_FACTOR, physicsClientId=c)
@@ -302,21 +304,23 @@ class _Simulation(Simulation):
             pybullet.resetBasePositionAndOrientation(uid, pos, quat, physicsClientId=c)
             pybullet.resetBaseVelocity(uid, vel, omega, physicsClientId=c)
         b = len(self._bodies)
-        raw = np.empty((n_steps + 1, b, 13))  # position 3, quat xyzw 4, velocity 3, omega 3
-        for i in range(n_steps + 1):
-            if i:
-                self._apply(raw[i - 1])
-                pybullet.stepSimulation(physicsClientId=c)
-            for k, uid in enumerate(self._bodies):
-                pos, quat = pybullet.getBasePositionAndOrientation(uid, physicsClientId=c)
-                vel, omega = pybullet.getBaseVelocity(uid, physicsClientId=c)
-                raw[i, k] = (*pos, *quat, *vel, *omega)
-        speeds = np.abs(raw[..., 7:13]).max()
-        if speeds >= _CLAMPED:
-            raise DivergedError(f"PyBullet clamped a velocity at {speeds:.3g} (its cap): the run blew up")
-        quat_body = self._body_quat(raw[..., 3:7])
-        times = np.arange(n_steps + 1) * self._dt
-        return Trajectory(times, raw[..., :3], quat_body, raw[..., 7:10], raw[..., 10:13])
+        last = np.empty((b, 13))
+        for start, stop in piece_bounds(n_steps, samples_per_piece):
+            raw = np.empty((stop - start, b, 13))  # position 3, quat xyzw 4, velocity 3, omega 3
+            for j, i in enumerate(range(start, stop)):
+                if i:
+                    self._apply(raw[j - 1] if j else last)
+                    pybullet.stepSimulation(physicsClientId=c)
+                for k, uid in enumerate(self._bodies):
+                    pos, quat = pybullet.getBasePositionAndOrientation(uid, physicsClientId=c)
+                    vel, omega = pybullet.getBaseVelocity(uid, physicsClientId=c)
+                    raw[j, k] = (*pos, *quat, *vel, *omega)
+            last = raw[-1]
+            speeds = np.abs(raw[..., 7:13]).max()
+            if speeds >= _CLAMPED:
+                raise DivergedError(f"PyBullet clamped a velocity at {speeds:.3g} (its cap): the run blew up")
+            quat_body = self._body_quat(raw[..., 3:7])
+            yield Trajectory(np.arange(start, stop) * self._dt, raw[..., :3], quat_body, raw[..., 7:10], raw[..., 10:13])
 
     def _body_quat(self, quat_xyzw_inertial: np.ndarray) -> np.ndarray:
         """Body-frame quaternions from PyBullet's inertial-frame ones: R_body = R_inertial Q^T."""

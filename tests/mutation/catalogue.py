@@ -75,8 +75,8 @@ MUTANTS: tuple[Mutation, ...] = (
         DYNAMICS, "lecture-projectile"),
     Mutation(
         "samples_lag_one_step", "time bookkeeping", "inhouse.py",
-        "state = record[i] = self._packed_step((i - 1) * dt, state, dt)",
-        "record[i], state = state, self._packed_step((i - 1) * dt, state, dt)",
+        "if i:\n                    state = self._packed_step((i - 1) * dt, state, dt)\n                record[j] = state",
+        "record[j] = state\n                if i:\n                    state = self._packed_step((i - 1) * dt, state, dt)",
         "each sample records the state from before its step: the trajectory lags one step behind its times",
         DYNAMICS, "lecture-projectile"),
     # --- Dynamics: rotation, inertia, forces -----------------------------------------------------------------
