@@ -270,8 +270,12 @@ class _InHouseIK(IKModel):
         self.detail = (f"in-house {self._method} (batched), max step {options.max_step:g} rad, hard joint limits"
                        + ("; null-space term H = sum a (q - q_start)^2 toward the start pose" if self._nullspace else "")
                        + (f"; failed targets restarted from up to {restarts.attempts} seeded random configurations "
-                          f"({restarts.starts_per_round} per round, seed {restarts.seed}), each attempt at most "
-                          f"{restarts.max_iterations} iterations" if restarts else ""))
+                          f"({restarts.starts_per_round} per round, more when fewer than {restarts.min_round_rows} "
+                          f"would make the round, seed {restarts.seed}), each attempt at most "
+                          f"{restarts.max_iterations} iterations with Levenberg-Marquardt damping lambda^2 = "
+                          f"{restarts.error_damping:g} |e|^2 + {restarts.damping_floor:g}^2, abandoned after "
+                          f"{restarts.stall_window} iterations without a {restarts.stall_ratio:.0%} fall of |e|"
+                          if restarts else ""))
 
     def solve(self, target_position_world, target_rotation_world, q_start) -> IKResult:
         options = replace(self._options, rest_pose=np.asarray(q_start, dtype=float)) if self._nullspace else self._options

@@ -359,6 +359,8 @@ def test_options_are_checked():
         IKOptions(position_tolerance=0.0)
     with pytest.raises(ValueError, match="rest_exponent"):
         IKOptions(rest_exponent=0.5)
+    with pytest.raises(ValueError, match="error_damping"):
+        IKOptions(error_damping=-0.01)
 
 
 def test_methods_listed():
@@ -393,6 +395,34 @@ def test_damped_least_squares_is_the_svd_formula():
         expected = np.einsum("bkn,bk,bmk,bm->bn", vt, gain, u, err)
         got = steps.damped_least_squares_step(jac, err, 1e-2, 1e-3)
         np.testing.assert_allclose(got, expected, rtol=PINV_TOLERANCE, atol=PINV_TOLERANCE * np.abs(expected).max())
+
+
+def test_error_damped_least_squares_is_the_svd_formula_with_levenberg_marquardt_damping():
+    """lambda^2 = c |e|^2 + floor^2 in V diag(sigma / (sigma^2 + lambda^2)) U^T e: wide, square, tall (a 5-DOF arm's
+    6 x 5) and rank-deficient J, in batches solved by the entry-by-entry Cholesky and by LU (below its batch)."""
+    rng = np.random.default_rng(5)
+    error_damping, floor = 0.01, 1e-5
+    for m, n in ((6, 7), (6, 6), (6, 5), (3, 7)):
+        for batch in (steps.CHOLESKY_MIN_BATCH, 20):
+            jac = rng.normal(size=(batch, m, n)) * rng.uniform(0.001, 1, size=(batch, 1, 1))
+            jac[:10, :, 0] = 0.0  # rank-deficient
+            err = rng.normal(size=(batch, m))
+            u, sigma, vt = np.linalg.svd(jac, full_matrices=False)
+            lam2 = error_damping * np.sum(err**2, axis=1) + floor**2
+            expected = np.einsum("bkn,bk,bmk,bm->bn", vt, sigma / (sigma**2 + lam2[:, None]), u, err)
+            got = steps.error_damped_least_squares_step(jac, err, error_damping, floor)
+            np.testing.assert_allclose(got, expected, rtol=PINV_TOLERANCE,
+                                       atol=PINV_TOLERANCE * np.abs(expected).max())
+
+
+def test_an_abandoned_stall_stops_at_the_same_iteration_unclassified():
+    """IKOptions.abandon_stalled (the restarts' attempts): a target beyond reach stops when it stalls, as the
+    default rules stop it, but as "iteration_cap", without the singular values of the classification."""
+    far = np.array([[5.0, 0.0, 0.0]])  # the iiwa reaches ~1.3 m
+    judged = solve_ik(IIWA, far, options=IKOptions(stall_window=5))
+    abandoned = solve_ik(IIWA, far, options=IKOptions(stall_window=5, abandon_stalled=True))
+    assert (judged.reason[0], abandoned.reason[0]) == ("unreachable", "iteration_cap")
+    assert abandoned.iterations[0] == judged.iterations[0] < IKOptions().max_iterations
 
 
 def test_a_target_astronomically_far_is_refused_with_the_allowed_range():

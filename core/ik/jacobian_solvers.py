@@ -35,7 +35,8 @@ reach bound is ``"unreachable"`` also when the iteration cap stops it):
 - ``"singular"``: sigma_min of the task Jacobian is below ``singular_threshold`` (any
   other singularity, e.g. folded onto the base);
 - ``"iteration_cap"``: the cap came while the target was still making progress, or it
-  had stalled without any of these causes (such a target keeps going until the cap).
+  had stalled without any of these causes (such a target keeps going until the cap), or it
+  stalled with ``IKOptions.abandon_stalled`` (restarts' attempts: stopped at once, not classified).
 
 A stalled target is judged at its current iterate, and where that names no cause, at its
 best configuration (an iterate can oscillate about a singular best one).
@@ -79,11 +80,19 @@ class IKOptions(IKTolerances):
         sigma_min below which damped least squares damps and a stalled target counts as
         singular [the Jacobian's units: m/rad for position rows, 1 for rotation rows].
     damping_max : float
-        Damping lambda reached at sigma_min = 0 [same units].
+        Damping lambda reached at sigma_min = 0 [same units]; with ``error_damping``, the damping at e = 0.
+    error_damping : float
+        0: damped least squares damps by sigma_min (the lecture's rule); c > 0: by the error instead,
+        lambda^2 = c |e|^2 + damping_max^2 (Levenberg-Marquardt, :func:`core.ik.steps.error_damped_least_squares_step`)
+        [1].
     stall_window : int
         Iterations without progress that make a stall.
     stall_ratio : float
         Progress: the best |e| fell by more than this fraction [1].
+    abandon_stalled : bool
+        False: the stall rules of the module docstring. True: a stalled target stops at once (after its gap
+        escapes), unclassified, as ``"iteration_cap"``: for restarts (:mod:`core.ik.restarts`), which start it
+        again elsewhere and judge only the best attempt; the classification's singular values are not computed.
     gap_crossings : int
         Escapes through a narrow limit gap allowed per target (see the module docstring).
     rest_pose : (n,) array_like or None
@@ -108,8 +117,10 @@ class IKOptions(IKTolerances):
     rank_rcond: float = 1e-6
     singular_threshold: float = 1e-2
     damping_max: float = 1e-3
+    error_damping: float = 0.0
     stall_window: int = 30
     stall_ratio: float = 1e-3
+    abandon_stalled: bool = False
     gap_crossings: int = 2
     rest_pose: np.ndarray | None = None
     rest_gain: float | np.ndarray = 0.1
@@ -130,6 +141,8 @@ class IKOptions(IKTolerances):
             raise ValueError(f"IKOptions.rest_exponent must be >= 1, got {self.rest_exponent}")
         if not (self.limit_gain >= 0 and np.all(np.asarray(self.rest_gain) >= 0)):
             raise ValueError("IKOptions.limit_gain and rest_gain must be >= 0")
+        if not (np.isfinite(self.error_damping) and self.error_damping >= 0):
+            raise ValueError(f"IKOptions.error_damping must be finite and >= 0, got {self.error_damping}")
 
 
 def solve_ik(
@@ -212,38 +225,45 @@ def solve_ik(
         best_q[idx[keep]] = qa[keep]
         best_merit[idx[better]] = merit[better]
         reason[idx[solved]] = ""
+        active[idx[solved]] = False
+        go = ~solved  # only the unsolved targets are updated
+        idx, qa, err, end_world = idx[go], qa[go], err[go], end_world[go]
+        if idx.size == 0:
+            break
 
-        jac = jacobian_of_frames(chain, frames)[:, :rows]
+        jac = jacobian_of_frames(chain, frames)[go, :rows]
         if basis is None:
             dq, locked = _update(method, jac, err, qa, lower, upper, revolute, options)
         else:  # the task's directions the chain moves in: a planar arm's x, y and turn about the plane's normal
             dq, locked = _update(method, basis.T @ jac, err @ basis, qa, lower, upper, revolute, options)
         # Only a target that has not progressed for stall_window iterations can stop unsolved: only those are
-        # classified (the singular values cost more than the rest of the iteration).
-        cause = np.full(len(idx), "iteration_cap", dtype=object)
-        due = np.flatnonzero((since_best[idx] >= options.stall_window) & ~solved)
-        if due.size:
-            cause[due] = _classify(jac[due], locked[due], end_world[due], target_position[idx[due]], center,
-                                   beyond_reach[idx[due]], options)
-        # A stalled iterate that oscillates about a singular best configuration (the
-        # pseudo-inverse at a stretched arm) is judged at that configuration, which it returns.
-        waiting = due[cause[due] == "iteration_cap"]
-        if waiting.size:
-            w = idx[waiting]
-            best = packed_frames(chain, best_q[w])
-            cause[waiting] = _classify(jacobian_of_frames(chain, best)[:, :rows],
-                                       locked[waiting], best.positions[-1].T, target_position[w], center,
-                                       beyond_reach[w], options)
-        stalled = (since_best[idx] >= options.stall_window) & (cause != "iteration_cap") & ~solved
-        escape = stalled & (cause == "limit_blocked") & np.any(locked & crossable, axis=1) & (crossings_left[idx] > 0)
-        stalled &= ~escape
+        # classified (the singular values cost more than the rest of the iteration), and none when abandoned.
+        due = np.flatnonzero(since_best[idx] >= options.stall_window)
+        cause = np.full(due.size, "iteration_cap", dtype=object)
+        if due.size and not options.abandon_stalled:
+            cause[:] = _classify(jac[due], locked[due], end_world[due], target_position[idx[due]], center,
+                                 beyond_reach[idx[due]], options)
+            # A stalled iterate that oscillates about a singular best configuration (the
+            # pseudo-inverse at a stretched arm) is judged at that configuration, which it returns.
+            waiting = np.flatnonzero(cause == "iteration_cap")
+            if waiting.size:
+                w = idx[due[waiting]]
+                best = packed_frames(chain, best_q[w])
+                cause[waiting] = _classify(jacobian_of_frames(chain, best)[:, :rows],
+                                           locked[due[waiting]], best.positions[-1].T, target_position[w], center,
+                                           beyond_reach[w], options)
+        crossable_due = np.any(locked[due] & crossable, axis=1) & (crossings_left[idx[due]] > 0)
+        escapes = crossable_due & ((cause == "limit_blocked") | options.abandon_stalled)
+        stops = ~escapes & ((cause != "iteration_cap") | options.abandon_stalled)
+        stalled, escape = np.zeros(idx.size, bool), np.zeros(idx.size, bool)
+        stalled[due[stops]], escape[due[escapes]] = True, True
         last = it == options.max_iterations
         if last:
-            capped = ~solved & ~stalled
+            capped = ~stalled
             reason[idx[capped]] = np.where(beyond_reach[idx[capped]], "unreachable", "iteration_cap")
-        reason[idx[stalled]] = cause[stalled]
+        reason[idx[due[stops]]] = cause[stops]
 
-        step = ~(solved | stalled | escape) & (not last)
+        step = ~(stalled | escape) & (not last)
         q[idx[step]] = np.clip(wrap_into_limits(qa[step] + dq[step], revolute, lower, upper), lower, upper)
         escape &= not last
         q[idx[escape]] = cross_gap(qa[escape], locked[escape] & crossable, lower, upper)
@@ -316,7 +336,7 @@ def _update(method, jac, err, q, lower, upper, revolute, options):
 
 def _direction(method, jac, err, z, locked, options):
     """The method's update with the ``locked`` joints' columns zeroed, plus the null-space term of ``z``."""
-    reduced = jac * ~locked[:, None, :]
+    reduced = jac * ~locked[:, None, :] if locked.any() else jac
     dq = _rule(method, reduced, err, options)
     if z is not None:
         dq = dq + nullspace_term(reduced, np.where(locked, 0.0, z), options.rank_rcond)
@@ -330,6 +350,8 @@ def _rule(method, jac, err, options):
         return steps.pseudo_inverse_step(jac, err, options.rank_rcond)
     if method == "transpose":
         return steps.transpose_step(jac, err)
+    if options.error_damping > 0:
+        return steps.error_damped_least_squares_step(jac, err, options.error_damping, options.damping_max)
     return steps.damped_least_squares_step(jac, err, options.singular_threshold, options.damping_max)
 
 

@@ -3,15 +3,18 @@
 The recipe of TRAC-IK (Beeson and Ames, 2015): a local Jacobian iteration that stalls (a joint
 limit, a singularity, a local minimum of the error) is tried again from a random configuration
 within the limits. The lecture's solvers (:func:`core.ik.jacobian_solvers.solve_ik`) are used as
-they are; this module only chooses where they start:
+they are, with the settings of a short attempt (:meth:`Restarts.attempt_options`: for damped least
+squares, Levenberg-Marquardt damping; an attempt abandoned as soon as it stalls); this module chooses
+where they start:
 
 1. every target is solved from the given start, for at most ``max_iterations``;
 2. the targets that failed are solved again, all at once, each from ``starts_per_round`` fresh
-   uniform draws within the limits ([-pi, pi] rad or [-1, 1] m where unlimited), round after
-   round until ``attempts`` draws per target are used;
+   uniform draws within the limits ([-pi, pi] rad or [-1, 1] m where unlimited), or from more when
+   fewer than ``min_round_rows`` attempts would make the round, round after round until
+   ``attempts`` draws per target are used;
 3. each target keeps a success, or else its best attempt (smallest
    sqrt(position_residual^2 + orientation_residual^2)) with that attempt's reason; where that
-   reason is only "iteration_cap" (a short attempt ends at its cap before it can stall), the
+   reason is only "iteration_cap" (an attempt is abandoned unclassified, or ends at its cap), the
    target is judged at its best configuration by the solver's stall rules
    (:func:`core.ik.jacobian_solvers.failure_causes`: e.g. "unreachable" for an arm stretched
    toward a target beyond it).
@@ -56,17 +59,40 @@ class Restarts:
         problem's); a start that has not converged by then is better replaced by a fresh one.
     seed : int
         Seed of the random starts.
+    min_round_rows : int
+        Attempts a round holds at least, while the targets have attempts left: a round's iteration costs
+        about the same below this many rows (NumPy's per-call overhead), so the last hard targets get more
+        starts each at no extra cost, in fewer rounds.
+    error_damping, damping_floor : float
+        Each attempt's damping lambda^2 = error_damping |e|^2 + damping_floor^2
+        (:func:`core.ik.steps.error_damped_least_squares_step`) [1; the Jacobian's units].
+    stall_window, stall_ratio : int, float
+        An attempt whose best |e| has not fallen by the fraction ``stall_ratio`` in ``stall_window``
+        iterations is abandoned (``IKOptions.abandon_stalled``) [iterations; 1].
     """
 
-    # 10 restarts: on the iiwa, UR5 and Panda (10,000 TRAC-IK targets each, BENCHMARKS.md) the last target
-    # that restarts solve needed fewer than half of them.
-    # Measured on the bench suite (10,000 TRAC-IK targets per arm, BENCHMARKS.md): 16 starts of at most 60
-    # iterations, 4 per round, solve 99.94-99.99 % of the iiwa, UR5 and Panda targets; uncapped attempts
-    # solved no more and took 1.4-2x as long (a start still crawling after 60 iterations is better replaced).
-    attempts: int = 16
+    # Measured on the bench suite (10,000 TRAC-IK targets per arm: iiwa, Panda, UR5) and on the 5-DOF SO-100
+    # (comparisons/bench.py five_dof_scene), each setting against its neighbours in one run:
+    # - error damping c = 0.01 (Sugihara's LM): an attempt solves 97-99 % of what it solves in 60 iterations by its
+    #   25th (90 % on the UR5 under the lecture's sigma_min damping), in 1.3-2x fewer iterations; c = 0.003 and
+    #   0.03 needed within 8 % of its iterations per target, c = 1 needed 1.3-1.7x as many;
+    # - a damping floor of 1e-5: at 1e-3 (the lecture's damping_max) a target whose solution is near a
+    #   singularity converges linearly at lambda^2 / (sigma^2 + lambda^2) and runs out of iterations (the UR5
+    #   lost 12 of 10,000 targets); 1e-5 and 1e-7 solved all;
+    # - abandoning after 5 iterations without a 10 % fall of the best |e| saves 28-45 % of the iterations of
+    #   random starts on the Panda and the SO-100, and abandons 0.8-2.6 % of the attempts that would have
+    #   succeeded (they are restarted); 3 iterations abandoned up to 9 %;
+    # - 32 attempts of at most 25 iterations: 99.99-100 % of the targets of all four arms, in 0.4-0.9x the time
+    #   of 16 of at most 60 (which solved 99.5 % of the SO-100's).
+    attempts: int = 32
     starts_per_round: int = 4
-    max_iterations: int | None = 60
+    max_iterations: int | None = 25
     seed: int = 0
+    min_round_rows: int = 256
+    error_damping: float = 0.01
+    damping_floor: float = 1e-5
+    stall_window: int = 5
+    stall_ratio: float = 0.1
 
     def __post_init__(self) -> None:
         def whole(value) -> bool:
@@ -78,10 +104,18 @@ class Restarts:
                   ("max_iterations", self.max_iterations is None or (whole(self.max_iterations)
                                                                      and self.max_iterations >= 1),
                    "None or a whole number >= 1"),
-                  ("seed", whole(self.seed) and self.seed >= 0, "a whole number >= 0 (results are deterministic)"))
+                  ("seed", whole(self.seed) and self.seed >= 0, "a whole number >= 0 (results are deterministic)"),
+                  ("min_round_rows", whole(self.min_round_rows) and self.min_round_rows >= 1, "a whole number >= 1"))
         for name, ok, allowed in checks:
             if not ok:
                 raise ValueError(f"Restarts.{name} is {getattr(self, name)!r} (allowed: {allowed})")
+
+    def attempt_options(self, options: IKOptions) -> IKOptions:
+        """The problem's ``options`` with this attempt's iteration cap, damping and stall rule."""
+        cap = options.max_iterations if self.max_iterations is None else min(options.max_iterations,
+                                                                             self.max_iterations)
+        return replace(options, max_iterations=cap, error_damping=self.error_damping, damping_max=self.damping_floor,
+                       stall_window=self.stall_window, stall_ratio=self.stall_ratio, abandon_stalled=True)
 
 
 _FIELDS = ("q", "success", "iterations", "position_residual", "orientation_residual", "limit_violation", "reason")
@@ -101,8 +135,7 @@ def solve_ik_with_restarts(
     Same parameters and result as ``solve_ik``; ``restarts`` says how many and from which seed.
     """
     target_position, target_rotation, q_start = check_inputs(chain, target_position, target_rotation, q_start)
-    attempt = options if restarts.max_iterations is None else replace(
-        options, max_iterations=min(options.max_iterations, restarts.max_iterations))
+    attempt = restarts.attempt_options(options)
     result = solve_ik(chain, target_position, target_rotation, q_start, method, attempt)
     best = {name: np.array(getattr(result, name)) for name in _FIELDS}
     best["reason"] = best["reason"].astype(object)  # a later attempt's reason may be longer than any so far
@@ -114,7 +147,7 @@ def solve_ik_with_restarts(
         todo = np.flatnonzero(retry & ~best["success"])
         if not todo.size:
             break
-        starts = min(restarts.starts_per_round, left)
+        starts = min(max(restarts.starts_per_round, -(-restarts.min_round_rows // todo.size)), left)
         left -= starts
         rows = np.repeat(todo, starts)  # every failed target from `starts` random configurations at once
         again = solve_ik(chain, target_position[rows], None if target_rotation is None else target_rotation[rows],

@@ -11,6 +11,11 @@ from __future__ import annotations
 import numpy as np
 
 
+CHOLESKY_MIN_BATCH = 512
+"""Batch from which :func:`cholesky_solve` factorises entry by entry: measured at k = 5-7, it took 1.3x
+``np.linalg.solve``'s time at 300 matrices and 0.4-0.5x at 10,000."""
+
+
 def _solve(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.linalg.solve(a, b[..., None])[..., 0]
 
@@ -117,3 +122,71 @@ def damped_least_squares_step(jac: np.ndarray, err: np.ndarray, threshold: float
         return np.einsum("bnm,bm->bn", jt, _solve(gram, err))
     return _solve(gram, np.einsum("bnm,bm->bn", jt, err))
 
+
+
+def error_damped_least_squares_step(jac: np.ndarray, err: np.ndarray, error_damping: float,
+                                    damping_floor: float) -> np.ndarray:
+    """dq = J^T (J J^T + lambda^2 I)^-1 e with Levenberg-Marquardt damping lambda^2 = c |e|^2 + floor^2.
+
+    The damping follows the error instead of sigma_min (Sugihara 2011, "Solvability-unconcerned inverse
+    kinematics by the Levenberg-Marquardt method"): far from the target the step is damped toward the
+    gradient J^T e, which keeps it from jumping across the workspace on a linearisation that no longer
+    holds; near the target lambda^2 falls to floor^2 and the step becomes the pseudo-inverse's, which
+    converges quadratically. lambda^2 >= floor^2 > 0, so the Gram matrix is positive definite everywhere
+    (a zero Jacobian included) and no singular value is computed. As :func:`damped_least_squares_step`,
+    solved on the smaller Gram matrix: J J^T (m x m) for a wide or square J, J^T J (n x n) for a tall one
+    (an under-actuated chain), the same matrix.
+
+    Parameters
+    ----------
+    jac : (B, m, n) ndarray
+    err : (B, m) ndarray
+        Task error, position [m] then rotation vector [rad].
+    error_damping : float
+        c [1: lambda^2 is in the Jacobian's units squared, |e|^2 in m^2 or rad^2, added unweighted].
+    damping_floor : float
+        lambda at e = 0 [the Jacobian's units].
+
+    Returns
+    -------
+    (B, n) ndarray
+    """
+    _, m, n = jac.shape
+    jt = np.swapaxes(jac, 1, 2)
+    wide = m <= n
+    gram = jac @ jt if wide else jt @ jac
+    lam2 = error_damping * np.einsum("bm,bm->b", err, err) + damping_floor**2
+    gram += lam2[:, None, None] * np.eye(gram.shape[-1])
+    if wide:
+        return np.einsum("bnm,bm->bn", jt, cholesky_solve(gram, err))
+    return cholesky_solve(gram, np.einsum("bnm,bm->bn", jt, err))
+
+
+def cholesky_solve(spd: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """x = A^-1 b for symmetric positive definite A (B, k, k) and b (B, k), by Cholesky A = L L^T.
+
+    The factorisation and the two triangular solves run entry by entry over the whole batch, on
+    contiguous (B,) arrays: ~k^3 / 6 + k^2 element-wise operations, 2-4x less time than
+    ``np.linalg.solve``'s LU per matrix at B = 10,000 and k = 3-7; below :data:`CHOLESKY_MIN_BATCH`
+    matrices its ~k^3 / 6 NumPy calls cost more than LU, which solves them instead. Positive definiteness is
+    the caller's promise (a pivot <= 0 gives non-finite x).
+    """
+    if len(spd) < CHOLESKY_MIN_BATCH:
+        return _solve(spd, rhs)
+    k = spd.shape[-1]
+    a = np.ascontiguousarray(spd.transpose(1, 2, 0))  # (k, k, B): a[i, j] is one contiguous (B,) array
+    lower: list[list[np.ndarray]] = [[] for _ in range(k)]  # lower[i][j] = L_ij, j < i
+    inv_diag = []
+    for j in range(k):
+        pivot = a[j, j] - sum(lower[j][p] * lower[j][p] for p in range(j))
+        inv_diag.append(1.0 / np.sqrt(pivot))
+        for i in range(j + 1, k):
+            lower[i].append((a[i, j] - sum(lower[i][p] * lower[j][p] for p in range(j))) * inv_diag[j])
+    b = rhs.T
+    y: list[np.ndarray] = []
+    for i in range(k):  # L y = b
+        y.append((b[i] - sum(lower[i][p] * y[p] for p in range(i))) * inv_diag[i])
+    x: list[np.ndarray] = [np.empty(0)] * k
+    for i in reversed(range(k)):  # L^T x = y
+        x[i] = (y[i] - sum(lower[p][i] * x[p] for p in range(i + 1, k))) * inv_diag[i]
+    return np.stack(x, axis=1)
