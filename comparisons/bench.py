@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from simparity.comparisons import bench_joint_dynamics, bench_joint_motion
+from simparity.comparisons import bench_joint_dynamics, bench_joint_motion, bench_sweep
 from simparity.comparisons.scenes import library
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.ik_targets import random_targets
@@ -644,6 +644,7 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
         lines.append("")
     lines += bench_joint_dynamics.markdown_lines(rows)
     lines += bench_joint_motion.markdown_lines(rows)
+    lines += bench_sweep.markdown_lines(rows)
     ik = [r for r in rows if r.section == "ik"]
     if ik:
         lines += [f"## IK, TRAC-IK protocol ({ik[0].batch:,} seeded pose targets per arm from mid-range, success at "
@@ -725,6 +726,8 @@ def run_bench(out_dir: Path, quick: bool, command: str, say: Callable[[str], Non
     say("memory of simparity run against the number of steps")
     with tempfile.TemporaryDirectory() as folder:
         rows += memory_rows(quick, Path(folder), say)
+    say("sweeps: simparity run's wall time and client memory against the number of variants")
+    rows += bench_sweep.sweep_rows(quick, run_peak_memory, BenchRow, say)
     say("profile")
     profile = profile_summary(batches[-1], say)
     write_csv(rows, out_dir / "benchmarks.csv")

@@ -380,6 +380,37 @@ def sweep_figure(base: str, cases: pd.DataFrame, x: str, panels: list[str], labe
     return finish(fig, row_gap=_PANEL_GAP)
 
 
+def sweep_parameter_figure(base: str, panels: list[tuple[str, pd.DataFrame]], key: str, reference: str):
+    """Headline metrics (one panel each) against one swept ``key`` (x) over a sweep of many variants: per engine x
+    integrator the median over the variants sharing each value of ``key`` (the other swept keys varying), a pale band
+    from their least to their largest; None when no panel holds a value.
+
+    ``panels``: (the metric's label, its values: columns engine, integrator, value and the sweep's key columns;
+    :func:`reports.sweep_compact.parameter_cases`)."""
+    panels = [(label, cases) for label, cases in panels if not cases.empty]
+    if not panels:
+        return None
+    xs = pd.concat([cases[key] for _, cases in panels]).astype(float)
+    log_x = bool((xs > 0).all() and xs.max() >= 10 * xs.min())
+    fig, axes = plt.subplots(len(panels), 1, figsize=(_WIDTH, 2.6 * len(panels) + 0.8), sharex=True, squeeze=False)
+    for ax, (label, cases) in zip(axes[:, 0], panels):
+        schemes = list(dict.fromkeys(zip(cases["engine"], cases["integrator"])))
+        for i, (engine, integrator) in enumerate(schemes):
+            mine = cases[(cases["engine"] == engine) & (cases["integrator"] == integrator)]
+            spread = mine.groupby(mine[key].astype(float))["value"].agg(["min", "median", "max"]).sort_index()
+            style = _style(i, engine)
+            ax.fill_between(spread.index, spread["min"], spread["max"], color=style["color"], alpha=0.15, linewidth=0)
+            ax.plot(spread.index, spread["median"], label=f"{engine} {integrator}", **style)
+        log_y = bool((cases["value"] > 0).all())
+        ax.set(yscale="log" if log_y else "linear", ylabel=label)
+        ax.grid(True, which="major", alpha=0.3)
+    name = key.removeprefix(SWEEP_PREFIX)
+    title(axes[0, 0], f"{base}: against {name}, median and range over the other swept values (against {reference})")
+    axes[-1, 0].set(xlabel=name, xscale="log" if log_x else "linear")
+    legend(axes[0, 0])
+    return finish(fig, row_gap=_PANEL_GAP)
+
+
 def save(fig, folder: Path, name: str) -> str:
     """Write ``name.svg`` and ``name.png`` into ``folder``; return the SVG text (for embedding)."""
     folder.mkdir(parents=True, exist_ok=True)

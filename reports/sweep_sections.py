@@ -8,14 +8,16 @@ sweep has none.
 from __future__ import annotations
 
 import math
+import re
 from typing import Callable
 
 import numpy as np
 import pandas as pd
 
 from simparity.core.model.results import GROUND_TRUTH_ENGINES, NOT_AVAILABLE, OK, SWEEP_PREFIX
-from simparity.reports import figures, summary, sweep_summary, tables
+from simparity.reports import figures, summary, sweep_compact, sweep_summary, tables
 from simparity.reports.blocks import Block, Details, Heading, Paragraph, Table, number, scene_heading
+from simparity.reports.sweep_compact import COMPACT_SWEEP_VARIANTS
 from simparity.reports.sweep_summary import METRICS, Sweep
 from simparity.reports.tables import swept_value
 
@@ -88,10 +90,12 @@ def _grid(cases: pd.DataFrame, keys: list[str], dt_axis: bool) -> Table:
 
 def _at(sweep: Sweep, scene) -> str:
     """A variant by its swept values ("9, -10"), in the order of the sweep's keys."""
-    if not isinstance(scene, str):
-        return "—"
-    values = sweep.rows.loc[sweep.rows["scene"] == scene, sweep.keys].iloc[0]
-    return ", ".join(swept_value(v) for v in values)
+    return ", ".join(_values_at(sweep, scene)) if isinstance(scene, str) else "—"
+
+
+def _values_at(sweep: Sweep, scene: str) -> list[str]:
+    """A variant's swept values as cells, in the order of the sweep's keys."""
+    return [swept_value(v) for v in sweep.rows.loc[sweep.rows["scene"] == scene, sweep.keys].iloc[0]]
 
 
 def _order_cell(orders: dict, theory: dict, engine: str, integrator: str) -> str:
@@ -175,12 +179,20 @@ def _every_value(sweep: Sweep) -> Details:
     return Details(f"{sweep.base}: every metric of every variant", tuple(full), markdown=False)
 
 
+def _swept(sweep: Sweep, key: str) -> str:
+    """The values ``key`` takes over the variants, in the sweep's order: every one, or in a compact sweep
+    (:data:`COMPACT_SWEEP_VARIANTS`) how many from which to which."""
+    values = list(dict.fromkeys(sweep.rows.drop_duplicates("scene").set_index("scene").loc[sweep.variants, key]))
+    if len(sweep.variants) > COMPACT_SWEEP_VARIANTS and len(values) > 2:
+        return f"{len(values)} values from {swept_value(min(values))} to {swept_value(max(values))}"
+    return ", ".join(swept_value(v) for v in values)
+
+
 def _intro(sweep: Sweep) -> Paragraph:
     """How many variants of which file, the values swept, the metric and its reference, and links to the variants
     with a section of their own."""
     label = sweep_summary.metric_label(sweep.metric)
-    swept = "; ".join(f"`{key.removeprefix(SWEEP_PREFIX)}` " + ", ".join(swept_value(v) for v in dict.fromkeys(
-        sweep.rows.drop_duplicates("scene").set_index("scene").loc[sweep.variants, key])) for key in sweep.keys)
+    swept = "; ".join(f"`{key.removeprefix(SWEEP_PREFIX)}` {_swept(sweep, key)}" for key in sweep.keys)
     kind = summary.heading_kind(sweep.kind, sweep.metric)
     shown = ", ".join(f"[variant {k + 1}](#{scene_heading(name, kind).anchor}) ({roles(sweep, name)})"
                       for k, name in enumerate(sweep.variants) if name in sweep.shown)
@@ -202,6 +214,8 @@ def _section(sweep: Sweep, figure: Callable[..., list[Block]], theory: dict, var
                          f"{sweep.base}-sweep-work-precision",
                          f"Work-precision over the {count} variants: {label} of each engine × integrator at its worst "
                          "variant against its median cost, one point per dt; the band reaches its best variant.")
+    if len(sweep.variants) > COMPACT_SWEEP_VARIANTS:
+        return blocks + _compact(sweep, figure)
     cases = sweep_cases(sweep.rows, sweep.keys, sweep.metric, sweep.kind)
     dt_axis = bool(sweep.kind == "dynamics" and (cases.groupby("scene")["dt"].nunique() > 1).any())
     order = {name: k for k, name in enumerate(sweep.variants)}
@@ -218,6 +232,38 @@ def _section(sweep: Sweep, figure: Callable[..., list[Block]], theory: dict, var
         grid = Details(f"{sweep.base}: {label} of every engine × integrator × variant" + (" × dt" if dt_axis else "")
                        + f" ({len(table.rows)} rows)", (table,), markdown=False)
     return blocks + [grid, _every_value(sweep)]
+
+
+def _compact(sweep: Sweep, figure: Callable[..., list[Block]]) -> list[Block]:
+    """A sweep of more than :data:`COMPACT_SWEEP_VARIANTS` variants after its table over them: the quantiles of its
+    metrics over the variants, its worst variants, and per swept key a figure of the headline metrics against it."""
+    values = sweep_compact.metric_cases(sweep)
+    metrics = sweep_compact.shown_metrics(values)
+    names = ", ".join(m.replace("_", " ") for m in metrics) or "no headline metric"
+    dynamics = " at each scheme's finest time step" if sweep.kind == "dynamics" else ""
+    blocks: list[Block] = [
+        Paragraph(f"Over the {len(sweep.variants)} variants (more than {COMPACT_SWEEP_VARIANTS}: their distribution, "
+                  f"not a row each): the quantiles of {names}{dynamics} per engine × integrator; every metric's are "
+                  "in report.html, every value in `results.csv`."),
+        *sweep_compact.quantile_blocks(sweep, values),
+        Paragraph(f"The {sweep_compact.WORST_VARIANTS} worst variants: each case's "
+                  f"{sweep.metric.replace('_', ' ')} ranked among the variants within its engine × integrator"
+                  + (" × dt" if sweep.kind == "dynamics" else "") + ", the ranks averaged."),
+        sweep_compact.worst_table(sweep, lambda scene: _values_at(sweep, scene))]
+    panels = [(sweep_compact.metric_label(m), m) for m in metrics]
+    for key in sweep.keys:
+        name = key.removeprefix(SWEEP_PREFIX)
+        blocks += figure(figures.sweep_parameter_figure(
+            sweep.base, [(label, sweep_compact.parameter_cases(sweep, values, m)) for label, m in panels], key,
+            sweep.reference), f"{sweep.base}-sweep-{_file_part(name)}",
+            f"{names[:1].upper() + names[1:]} against `{name}`{dynamics}: per engine × integrator the median over the "
+            "variants at each value, the band from the least to the largest.")
+    return blocks
+
+
+def _file_part(key: str) -> str:
+    """A swept key as part of a figure's file name (letters, digits, ``-``, ``_``, ``.``)."""
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", key)
 
 
 def sections(all_sweeps: list[Sweep], figure: Callable[..., list[Block]], theory: dict,
@@ -240,7 +286,9 @@ def sections(all_sweeps: list[Sweep], figure: Callable[..., list[Block]], theory
                   "and a row that is n/a throughout is left out. The summary ranks a sweep by its worst variant. "
                   "Only the first, the last and the hardest variant have a section of their own; every value of "
                   "every variant is in `results.csv`, its swept values in the `sweep:KEY` columns (the numbers "
-                  "written into the file, in its length unit).")]
+                  f"written into the file, in its length unit). A sweep of more than {COMPACT_SWEEP_VARIANTS} variants "
+                  "shows their distribution (quantiles, the worst variants, the headline metrics against each swept "
+                  "key) instead of a row or a cell per variant.")]
     for sweep in all_sweeps:
         blocks += _section(sweep, figure, theory, variants)
     return blocks

@@ -5,6 +5,9 @@ from __future__ import annotations
 import dataclasses
 import math
 import os
+import signal
+import subprocess
+import sys
 import time
 
 import numpy as np
@@ -291,3 +294,25 @@ def with_key(data: dict, path: str, value) -> dict:
     else:
         node[last] = value
     return data
+
+
+def killed_and_resumed(command: list[str], killed, total: int, wait_seconds: float) -> int:
+    """Start ``simparity run`` (``command``, writing the folder ``killed``), kill it with SIGKILL (its process group: a
+    lost node, the OOM killer; no chance to clean up) once half of its ``total`` cases are kept, check that half to all
+    but one were kept, and resume it (``simparity run --resume``), which must say how many it kept and succeed.
+    Returns how many were kept."""
+    from simparity.comparisons.execute.journal import CASES_FOLDER, Journal
+
+    run = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.monotonic() + wait_seconds
+    while (not (killed / CASES_FOLDER).is_dir() or len(Journal(killed)) < total // 2) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    os.killpg(run.pid, signal.SIGKILL)
+    run.wait()
+    finished = len(Journal(killed))
+    assert total // 2 <= finished < total
+    resumed = subprocess.run([sys.executable, "-m", "simparity.comparisons.cli", "run", "--resume", str(killed)],
+                             capture_output=True, text=True)
+    assert resumed.returncode == 0, resumed.stderr
+    assert f"resuming {finished} finished cases" in resumed.stdout
+    return finished

@@ -202,6 +202,9 @@ def _every_figure() -> dict:
                                                                     REFERENCE, 100, VARIANTS),
         "sweep": figures.sweep_figure("b", _sweep_cases(), "sweep:speed", ["sweep:mass", "dt"],
                                       "orientation error max [rad]", REFERENCE),
+        "sweep parameter": figures.sweep_parameter_figure("b", [("position error max [m]", _sweep_cases()),
+                                                                ("orientation error max [rad]", _sweep_cases())],
+                                                          "sweep:speed", REFERENCE),
     }
 
 
@@ -289,6 +292,21 @@ def test_the_sweeps_work_precision_figure_draws_the_worst_variant_and_a_band_to_
     assert "over 100 variants" in ax.get_title(loc="left")
     figures.plt.close(fig)
     assert figures.sweep_work_precision_figure("b", _across(("diverged", "n/a")), "e", REFERENCE, 2) is None
+
+
+def test_the_sweep_parameter_figure_draws_the_median_over_the_other_keys_and_their_range():
+    """Issue #29: per engine x integrator, at each value of the key, the median over the variants sharing it and a
+    band from their least to their largest; a panel per metric given values, none drawn without any."""
+    cases = pd.DataFrame({"engine": "core", "integrator": "rk4", "value": [1.0, 3.0, 2.0, 8.0, 4.0, 6.0],
+                          "sweep:x": [0.1, 0.1, 0.2, 0.2, 0.2, 0.2]})
+    fig = figures.sweep_parameter_figure("b", [("error [m]", cases), ("other", cases.iloc[:0])], "sweep:x", REFERENCE)
+    (ax,) = fig.axes
+    line = ax.get_lines()[0]
+    assert list(line.get_xdata()) == [0.1, 0.2] and list(line.get_ydata()) == [2.0, 5.0]
+    band = ax.collections[0].get_paths()[0].vertices[:, 1]
+    assert band.min() == 1.0 and band.max() == 8.0 and ax.get_xlabel() == "x"
+    figures.plt.close(fig)
+    assert figures.sweep_parameter_figure("b", [("error [m]", cases.iloc[:0])], "sweep:x", REFERENCE) is None
 
 
 def test_the_sweep_figure_draws_a_panel_per_combination_it_is_given():

@@ -6,10 +6,8 @@ from __future__ import annotations
 import dataclasses
 import os
 import pickle
-import signal
 import subprocess
 import sys
-import time
 
 import pandas as pd
 import pytest
@@ -22,7 +20,7 @@ from simparity.comparisons.execute.journal import CASES_FOLDER, Journal, run_loc
 from simparity.comparisons.scenes.profiles import apply_profile
 from simparity.core.model.results import RESULTS_FILE, ResultRow
 from simparity.comparisons.scenes import library
-from tests.helpers import THROWN_BALL, InProcess, builtin
+from tests.helpers import THROWN_BALL, InProcess, builtin, killed_and_resumed
 
 SCENES = ("ball-bounce-k05", "lecture-2link-ik", "ur5-kinematics")
 KILL_WAIT_SECONDS = 240
@@ -53,18 +51,7 @@ def test_a_run_killed_halfway_and_resumed_writes_the_same_results(tmp_path):
                             make_engine))
     whole, killed = tmp_path / "whole", tmp_path / "killed"
     subprocess.run(_command(whole), check=True, capture_output=True)
-    run = subprocess.Popen(_command(killed), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    deadline = time.monotonic() + KILL_WAIT_SECONDS
-    while len(list((killed / CASES_FOLDER).glob("*.pickle"))) < total // 2 and time.monotonic() < deadline:
-        time.sleep(0.05)
-    os.kill(run.pid, signal.SIGKILL)  # no chance to clean up: a lost node, the OOM killer
-    run.wait()
-    finished = len(Journal(killed))
-    assert total // 2 <= finished < total
-    resumed = subprocess.run([sys.executable, "-m", "simparity.comparisons.cli", "run", "--resume", str(killed)],
-                             capture_output=True, text=True)
-    assert resumed.returncode == 0, resumed.stderr
-    assert f"resuming {finished} finished cases" in resumed.stdout
+    killed_and_resumed(_command(killed), killed, total, KILL_WAIT_SECONDS)
     pd.testing.assert_frame_equal(_table(killed), _table(whole))
 
 

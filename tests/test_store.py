@@ -2,7 +2,9 @@
 
 import json
 import math
+import sys
 
+import pandas as pd
 import pytest
 
 from simparity.comparisons.engines.registry import make_engine
@@ -11,6 +13,7 @@ from simparity.comparisons.execute.store import RunWriter
 from simparity.core.model.errors import ResultsError
 from simparity.core.model.files import tomllib
 from simparity.core.model.results import COLUMNS, RESULTS_FILE, ResultRow
+from simparity.reports import store
 from simparity.reports.store import read_run
 from tests.helpers import builtin
 from tests.test_scene_loader import VALID_DYNAMICS, VALID_KINEMATICS
@@ -95,3 +98,67 @@ def test_a_damaged_sweep_column_is_a_results_error(tmp_path):
     path.write_text(path.read_text(encoding="utf-8").replace(",drop,1.0", ",drop,heavy"), encoding="utf-8")
     with pytest.raises(ResultsError, match="unreadable stored run"):
         read_run(tmp_path)
+
+
+def _finished_sweep(tmp_path):
+    """A finished run of swept scenes (floats, whole numbers, NaN, n/a and empty cells) with its results.parquet."""
+    scenes = _swept_scenes()
+    writer = RunWriter(tmp_path, [], "simparity run", scenes)
+    writer.append([_row(s.name) for s in scenes])
+    writer.append([ResultRow(scenes[0].name, "mujoco", "", math.nan, "position_error_max", math.nan, "m",
+                             "analytic:exact", "n/a", "no such integrator, \"quoted\"", "saturated", "rk")])
+    writer.finish()
+    return scenes
+
+
+def test_results_parquet_holds_the_csv_table_typed(tmp_path):
+    """Issue #29: results.parquet beside results.csv (pyarrow installed) gives read_run the same table as the CSV,
+    value for value and type for type; its key columns are stored as categories, its numbers as numbers."""
+    import pyarrow.parquet
+
+    _finished_sweep(tmp_path)
+    parquet = tmp_path / store.RESULTS_PARQUET_FILE
+    assert parquet.is_file()
+    from_parquet, _ = read_run(tmp_path)
+    parquet.rename(tmp_path / "aside.parquet")
+    from_csv, _ = read_run(tmp_path)
+    pd.testing.assert_frame_equal(from_parquet, from_csv)
+    schema = pyarrow.parquet.read_schema(tmp_path / "aside.parquet")
+    assert all(str(schema.field(c).type).startswith("dictionary") for c in ("scene", "engine", "metric", "status"))
+    assert str(schema.field("value").type) == "double" and str(schema.field("sweep:targets.seed").type) == "int64"
+
+
+def test_without_pyarrow_runs_are_stored_and_read_as_csv(tmp_path, monkeypatch):
+    """pyarrow is optional (simparity[parquet]): without it no results.parquet is written, and one already there is
+    passed over for the CSV."""
+    _finished_sweep(tmp_path / "both")
+    csv = tmp_path / "both" / RESULTS_FILE
+    csv.write_text(csv.read_text(encoding="utf-8").replace("no such integrator", "edited"), encoding="utf-8")
+    with monkeypatch.context() as uninstalled:
+        uninstalled.setitem(sys.modules, "pyarrow", None)  # import pyarrow raises ImportError
+        assert not store.parquet_available()
+    # pandas, imported with pyarrow here, keeps using it for its own strings: the check above is what stands for it
+    monkeypatch.setattr(store, "parquet_available", lambda: False)
+    _finished_sweep(tmp_path / "plain")
+    assert not (tmp_path / "plain" / store.RESULTS_PARQUET_FILE).exists()
+    assert (tmp_path / "both" / store.RESULTS_PARQUET_FILE).exists()
+    table, _ = read_run(tmp_path / "both")
+    assert table["detail"].str.startswith("edited").sum() == 1
+
+
+def test_a_csv_edited_after_its_parquet_is_read_instead(tmp_path):
+    """results.csv is the record: one changed by hand after the run (rows removed) is what read_run gives."""
+    _finished_sweep(tmp_path)
+    csv = tmp_path / RESULTS_FILE
+    lines = csv.read_text(encoding="utf-8").splitlines(keepends=True)
+    csv.write_text("".join(lines[:-1]), encoding="utf-8")
+    assert (tmp_path / store.RESULTS_PARQUET_FILE).is_file() and len(read_run(tmp_path)[0]) == len(lines) - 2
+
+
+def test_a_run_that_starts_writing_again_drops_its_parquet(tmp_path):
+    """A new run or a resumed one in the folder rewrites results.csv from its first row: the parquet of the run before
+    is removed at once, so read_run never reads rows the CSV no longer has."""
+    scenes = _finished_sweep(tmp_path)
+    RunWriter(tmp_path, [], "simparity run --resume", scenes).append([_row(scenes[0].name)])
+    assert not (tmp_path / store.RESULTS_PARQUET_FILE).exists()
+    assert len(read_run(tmp_path)[0]) == 1

@@ -143,7 +143,7 @@ def test_an_index_naming_another_entry_is_ambiguous_but_the_entry_itself_is_not(
     ({"start": "a", "stop": 0.9, "num": 3}, "range start: expected a number"),
     ({"restitution": [0.5]}, "TOML reads a bare dotted key"),   # [sweep] contact.restitution = [...], unquoted
     ({}, "the range has no start"),
-    (list(range(MAX_VARIANTS + 1)), f"{MAX_VARIANTS + 1} values"),
+    (list(range(MAX_VARIANTS + 1)), f"{MAX_VARIANTS + 1:,} values"),
 ])
 def test_bad_values_are_refused_with_what_is_allowed(spec, words):
     err = _refused({"contact.restitution": spec})
@@ -163,8 +163,8 @@ def test_the_unquoted_dotted_key_is_answered_with_the_quoted_one():
     ({"contact.restitution": [0.1, 0.2], "body[0].mass": [1.0], "combine": "zip"}, "zips keys of 2, 1 values"),
     ({"contact.restitution": [0.1], "body[ball].restitution": [0.2], "body[0].mass": [1.0], "body[1].mass": [1.0],
       "simulation.duration": [2.0], "simulation.dt[0]": [0.001], "targets.seed": [1]}, "7 keys"),
-    ({"contact.restitution": [k / 20 for k in range(11)], "body[0].mass": [1.0 + k for k in range(10)]},
-     "11 x 10 = 110 variants"),
+    ({"contact.restitution": [k / 20 for k in range(11)], "body[0].mass": [1.0 + k for k in range(10)],
+      "body[0].position_world[0]": [float(k) for k in range(10)]}, "11 x 10 x 10 = 1,100 variants"),
     ({"body[0].mass": [1.0], "body[ball].mass": [2.0]}, "the key body[0].mass sweeps too"),
 ])
 def test_bad_tables_are_refused(table, words):
@@ -173,9 +173,17 @@ def test_bad_tables_are_refused(table, words):
 
 
 def test_the_limits_are_the_documented_ones():
-    """docs/scenes.md ("Limits") promises 100 variants and 6 keys."""
-    assert (MAX_VARIANTS, MAX_KEYS) == (100, 6)
-    assert len(_sweep({"contact.restitution": [k / 100 for k in range(100)]}).combinations()) == MAX_VARIANTS
+    """docs/scenes.md ("Limits") promises 1,000 variants and 6 keys (issue #29: sweeps of a thousand variants)."""
+    assert (MAX_VARIANTS, MAX_KEYS) == (1000, 6)
+    assert len(_sweep({"contact.restitution": [k / 1000 for k in range(1000)]}).combinations()) == MAX_VARIANTS
+    assert len(_sweep({"contact.restitution": {"start": 0.0, "stop": 1.0, "num": 1000}}).combinations()) == 1000
+
+
+def test_a_sweep_past_the_limit_is_refused_naming_the_limit_and_why():
+    err = _refused({"contact.restitution": [k / 1000 for k in range(40)], "body[0].mass": [1.0 + k for k in range(26)]})
+    text = str(err)
+    assert "40 x 26 = 1,040 variants" in err.problem and "at most 1,000 variants" in err.allowed
+    assert "each variant is a whole scene run by every engine" in err.allowed and "\n" not in text
 
 
 def test_keys_combine_as_a_product_first_key_slowest_and_name_their_variants():

@@ -4,6 +4,7 @@ only, read from a stored run; a run without a sweep has no such section."""
 
 import math
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -14,7 +15,9 @@ from simparity.core.model.files import tomllib
 from simparity.core.model.results import REPORT_FILE, SERIES_COLUMNS, ResultRow
 from simparity.reports.blocks import Details, Figure, Heading, Paragraph, Table
 from simparity.reports.content import build
-from simparity.reports.markdown import to_markdown
+from simparity.reports.blocks import number
+from simparity.reports.markdown import LINE_CHARS, MAX_LINES, to_markdown
+from simparity.reports.sweep_compact import COMPACT_SWEEP_VARIANTS, QUANTILE_LABELS, WORST_VARIANTS, worst_variants
 from simparity.reports.store import read_run
 from simparity.reports.sweep_sections import SWEEP_PANELS, TABLE_ROWS, _figure_cases, sections, sweep_cases
 from simparity.reports.sweep_summary import sweeps
@@ -230,3 +233,92 @@ def test_a_sweep_file_runs_end_to_end(tmp_path):
     assert "Variant 2 of 2 of the [sweep of drop](#sweep-of-drop) (the last" in report
     for name in ("drop-sweep", "drop-sweep-work-precision", "drop_mass-1.0-work-precision"):
         assert (out / "figures" / f"{name}.svg").is_file()
+
+
+MANY = 40
+"""Variants of the compact sweep below: more than COMPACT_SWEEP_VARIANTS."""
+MANY_SWEEP = (VALID_DYNAMICS + '[sweep]\n"body[ball].mass" = [' + ", ".join(f"{1.0 + k:.1f}" for k in range(MANY // 4))
+              + ']\n"world.gravity_world[2]" = [-9.81, -5.0, -3.0, -1.62]\n')
+
+
+def _many(tmp_path):
+    """MANY variants, core rk4 with error k * 1e-9 in variant k (0-based; variant 0 is ok with error 0: rounding), and
+    MuJoCo euler with 1e-3 except in the third variant, which diverged; a time per step beside."""
+    scenes = parse_scenes(tomllib.loads(MANY_SWEEP))
+    rows = []
+    for k, scene in enumerate(scenes):
+        rows += _case(scene.name, "core", "rk4", k * 1e-9, 1e-6)
+        rows += _case(scene.name, "mujoco", "euler", 1e-3, 2e-6, "diverged" if k == 2 else "ok")
+    return scenes, *_stored(tmp_path, scenes, rows)
+
+
+def test_past_the_compact_limit_a_sweep_shows_its_distribution_not_a_row_per_variant(tmp_path):
+    """Issue #29: a sweep of more than COMPACT_SWEEP_VARIANTS variants has, after its table over the variants, the
+    quantiles of its headline metrics per engine x integrator, its worst variants and a figure per swept key; no
+    grid of every variant and no table of every metric of every variant."""
+    scenes, table, info = _many(tmp_path)
+    assert MANY > COMPACT_SWEEP_VARIANTS
+    drawn = []
+    blocks = sections(sweeps(table, info), _recorded(drawn), {})
+    tables_ = [b for b in blocks if isinstance(b, Table)]
+    assert not any(any(" = " in h for h in t.head) for t in tables_)          # no grid of every value
+    assert "`body[ball].mass` 10 values from 1 to 10; `world.gravity_world[2]` 4 values from -9.81 to -1.62" in (
+        blocks[3].text)
+    quantile = next(t for t in tables_ if t.head[-6:] == QUANTILE_LABELS + ("variants",))
+    rows = {(r[0], r[1], r[2]): r[3:] for r in quantile.rows}
+    core = rows[("position error max [m]", "core", "rk4")]
+    assert core == ("0", number(np.quantile(np.arange(MANY) * 1e-9, 0.05)), number(19.5e-9), number(
+        np.quantile(np.arange(MANY) * 1e-9, 0.95)), number(39e-9), str(MANY))
+    assert rows[("position error max [m]", "mujoco", "euler")][-1] == str(MANY - 1)  # the diverged variant left out
+    worst = next(t for t in tables_ if t.head[0] == "variant")
+    assert len(worst.rows) == WORST_VARIANTS and worst.rows[0][:3] == ("40", "10", "-1.62")
+    folded = [b for b in blocks if isinstance(b, Details)]
+    assert [d.summary for d in folded] == [f"drop: every metric's quantiles over the {MANY} variants, at every time step"]
+    every = folded[0].blocks[0]
+    assert {r[0] for r in every.rows} == {"position error max [m]", "time per step [s]"}
+    names = [name for _, name in drawn]
+    assert names == ["drop-sweep-work-precision", "drop-sweep-body_ball_.mass", "drop-sweep-world.gravity_world_2_"]
+    assert all(fig is not None for fig, _ in drawn)
+
+
+def test_a_compact_sweep_keeps_the_report_within_its_lines(tmp_path):
+    _, table, info = _many(tmp_path)
+    report = _report(tmp_path, table, info)
+    lines = report.splitlines()
+    assert len(lines) <= MAX_LINES and max(map(len, lines)) <= LINE_CHARS
+    assert "| metric | engine | integrator | min | 5 % | median | 95 % | max | variants |" in report
+
+
+def test_the_worst_variants_rank_by_the_sweeps_metric_within_each_case():
+    """A variant worst in every case ranks 1; the worst value it had and where are named."""
+    cases = pd.DataFrame({"scene": ["a", "b", "c"] * 2, "engine": ["core"] * 3 + ["mujoco"] * 3,
+                          "integrator": ["rk4"] * 3 + ["euler"] * 3, "dt": [0.01] * 6, "status": ["ok"] * 6,
+                          "value": [1.0, 3.0, 2.0, 10.0, 30.0, 20.0], "cost": [1.0] * 6})
+
+    class Stub:
+        kind, lower_is_better, variants = "dynamics", True, ["a", "b", "c"]
+
+    Stub.cases = cases
+    worst = worst_variants(Stub())
+    assert list(worst["scene"]) == ["b", "c", "a"] and list(worst["rank"]) == [1.0, pytest.approx(2 / 3),
+                                                                              pytest.approx(1 / 3)]
+    assert worst.iloc[0]["value"] == 30.0 and worst.iloc[0]["where"] == "mujoco euler, dt = 0.01 s"
+
+
+def test_a_compact_ik_sweep_ranks_its_worst_variants_by_the_lowest_solve_rate(tmp_path):
+    """A higher solve rate is better: the worst variants are those that solve least, quantiles per solver."""
+    text = IK_SWEEP.replace('"targets.seed" = [4, 7]', '"targets.seed" = {start = 0, stop = 29, num = 30}')
+    scenes = parse_scenes(tomllib.loads(text))
+    rates = [1.0 - (k % 7) / 100 for k in range(len(scenes))]
+    rows = [_rows(s.name, "core", "pseudo_inverse", rate, dt=math.nan, metric="solve_rate")
+            for s, rate in zip(scenes, rates)]
+    table, info = _stored(tmp_path, scenes, rows)
+    drawn = []
+    blocks = sections(sweeps(table, info), _recorded(drawn), {})
+    tables_ = [b for b in blocks if isinstance(b, Table)]
+    quantile = next(t for t in tables_ if t.head[0] == "metric")
+    assert quantile.rows == (("solve rate", "core", "pseudo_inverse", "0.94", "0.94", "0.97", "1", "1", "30"),)
+    worst = next(t for t in tables_ if t.head[0] == "variant")
+    assert [r[1] for r in worst.rows] == ["6", "13", "20", "27", "5"] and worst.rows[0][2:] == ("0.95", "0.94",
+                                                                                              "core pseudo_inverse")
+    assert [name for _, name in drawn] == ["arm-sweep-targets.seed"]

@@ -11,7 +11,8 @@ Outcomes stream back case by case, as on the local executor: the task puts each 
 ``Queue`` of the run, so the progress bar moves and the journal keeps every finished case while its group is
 still running (an interrupted run resumes without computing it again). A group whose Dask worker is lost
 is retried elsewhere by Dask; a case it sends twice is taken once, and the cases of a group lost for good
-that never came back fail with that cause.
+that never came back fail with that cause. A finished task's future is let go at once, so neither the client nor the
+scheduler keeps one per group of a run of thousands.
 """
 
 from __future__ import annotations
@@ -162,7 +163,8 @@ class DaskExecutor:
                         received[rank].add(index)
                         yield jobs[rank].key, index, outcome
                 for future in finished:
-                    yield from self._lost(jobs[futures[future]], received[futures[future]], future)
+                    rank = futures.pop(future)  # released: the cluster forgets the finished task
+                    yield from self._lost(jobs[rank], received[rank], future)
                 pending -= finished
                 if not messages and not finished:
                     time.sleep(POLL_SECONDS)

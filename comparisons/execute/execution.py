@@ -5,7 +5,8 @@ Every scene is planned into groups of cases (:mod:`comparisons.cases`); cases al
 executor — local worker processes (:class:`~comparisons.isolation.IsolatedPool`) or a Dask cluster
 (:mod:`comparisons.dask_executor`) — costliest group first. Each case is journaled as it finishes;
 a scene's rows come back as soon as it and every scene before it are complete, so the stored run
-keeps the suite's order whatever finished first, and is the same whatever executed it.
+keeps the suite's order whatever finished first, and is the same whatever executed it. A scene's outcomes are let
+go once its rows are handed back, so the caller holds the cases of the scenes still incomplete, not the run's.
 """
 
 from __future__ import annotations
@@ -75,6 +76,11 @@ class _Scene:
     def complete(self) -> bool:
         return all(o is not None for group in self.outcomes for o in group)
 
+    def release(self) -> None:
+        """Forget the outcomes once the scene's rows and series were handed back: a run holds the cases of the scenes
+        not yet complete, never every case of a sweep of a thousand variants."""
+        self.outcomes = []
+
 
 def plan_run(scenes: list, engines: list[Engine], make_engine: Callable[[str], Engine], repeats: int,
              specs: dict[str, str] | None = None) -> list[_Scene]:
@@ -125,6 +131,7 @@ def run_scenes(scenes: list, engines: list[Engine], make_engine: Callable[[str],
             on_case(item.scene.name, group.cases[c].engine, group.cases[c].integrator)
             while emitted < len(planned) and planned[emitted].complete:
                 yield _assembled(planned[emitted])
+                planned[emitted].release()
                 emitted += 1
     except KeyboardInterrupt:  # hand back every finished case of the scenes not complete, then stop
         for item in planned[emitted:]:
@@ -135,6 +142,7 @@ def run_scenes(scenes: list, engines: list[Engine], make_engine: Callable[[str],
         raise
     while emitted < len(planned):  # scenes restored whole from the journal after the last case run
         yield _assembled(planned[emitted])
+        planned[emitted].release()
         emitted += 1
 
 

@@ -223,7 +223,8 @@ class Session:
         bar = ProgressBar(sum(sizes), self.progress) if self.progress is not None else None
         failed = 0
         try:
-            with contextlib.closing(executor):  # the workers stop as soon as the cases do, before the report
+            # the workers stop as soon as the cases do, before the report; the store then writes its typed copy
+            with contextlib.closing(executor), contextlib.closing(store):
                 base_rows = []
                 for k, (scene, rows, series) in enumerate(run_scenes(
                         self.scenes, self.engines, make_engine, self.repeats, executor, journal,
@@ -235,7 +236,8 @@ class Session:
                         bar.scene_done(sum(sizes[:k + 1]))
                     self.say(f"{scene.name}: {sum(counts.values())} cases ("
                              + ", ".join(f"{s} {c}" for s, c in counts.items() if c) + ")")
-                    base_rows.append(rows)
+                    if self.transforms:  # the invariance rows need them; else they are in the store alone
+                        base_rows.append(rows)
                 if self.transforms:
                     if bar is not None:
                         bar.clear()
@@ -305,6 +307,11 @@ class _Store:
             self.writer.append(rows, series)
         else:
             self.rows += rows
+
+    def close(self) -> None:
+        """Every row is in: the stored run's typed copy (``results.parquet``), when it has a folder."""
+        if self.writer is not None:
+            self.writer.finish()
 
     def table(self) -> pd.DataFrame:
         if self.writer is not None:

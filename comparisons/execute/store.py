@@ -17,6 +17,7 @@ from simparity.core.model.engine import Engine
 from simparity.core.model.results import (
     COLUMNS,
     RESULTS_FILE,
+    RESULTS_PARQUET_FILE,
     RUN_INFO_FILE,
     SCHEMA_VERSION,
     SERIES_COLUMNS,
@@ -124,14 +125,15 @@ def _series_frame(series: Sequence[SeriesRecord]) -> pd.DataFrame:
 
 class RunWriter:
     """Appends rows to ``results.csv`` and series to ``series.csv.gz`` as they are produced, so nothing
-    computed is lost. A run of swept scenes (``scenes``) has the sweep columns of :func:`sweep_cells` after the
-    fixed ones, filled from each row's scene."""
+    computed is lost; :meth:`finish` adds ``results.parquet`` (pyarrow installed). A run of swept scenes
+    (``scenes``) has the sweep columns of :func:`sweep_cells` after the fixed ones, filled from each row's scene."""
 
     def __init__(self, out_dir: Path, engines: list[Engine], command: str, scenes: list, profile: str = "") -> None:
         self.out_dir = Path(out_dir)
         self.out_dir.mkdir(parents=True, exist_ok=True)
         self.results_path = self.out_dir / RESULTS_FILE
         self.series_path = self.out_dir / SERIES_FILE
+        (self.out_dir / RESULTS_PARQUET_FILE).unlink(missing_ok=True)  # a new (or resumed) run's CSV starts afresh
         self._sweep_columns, self._sweep_cells = sweep_cells(scenes)
         pd.DataFrame(columns=list(COLUMNS) + self._sweep_columns).to_csv(self.results_path, index=False)
         pd.DataFrame(columns=list(SERIES_COLUMNS)).to_csv(self.series_path, index=False)
@@ -158,3 +160,10 @@ class RunWriter:
             # Each append is one more gzip member; readers (gzip, pandas) read the members as one file.
             points = _series_frame(series)
             points.to_csv(self.series_path, mode="a", header=False, index=False, float_format="%.9g")
+
+    def finish(self) -> None:
+        """The run's rows are all appended (it ended, or was interrupted): ``results.parquet``, the typed copy of
+        ``results.csv``, when pyarrow is installed."""
+        from simparity.reports.store import write_parquet
+
+        write_parquet(self.out_dir)

@@ -308,6 +308,9 @@ class BoundIndex:
     def __init__(self, bounds: list[Bound]) -> None:
         self.exact: dict[tuple[str, str, str, str], list[Bound]] = {}
         self.patterned: list[Bound] = []
+        self._by_metric: dict[str, list[Bound]] = {}
+        """The patterned bounds that may match a metric, in their order: those naming it or a pattern (a run of
+        20,000 rows, a sweep of 1,000 variants, matched every row against every bound: a minute)."""
         for bound in bounds:
             key = (bound.scene, bound.engine, bound.integrator, bound.metric)
             if all(_weight(p) == 2 for p in key):
@@ -315,10 +318,15 @@ class BoundIndex:
             else:
                 self.patterned.append(bound)
 
+    def _patterned(self, metric: str) -> list[Bound]:
+        if metric not in self._by_metric:
+            self._by_metric[metric] = [b for b in self.patterned if _weight(b.metric) < 2 or b.metric == metric]
+        return self._by_metric[metric]
+
     def matching(self, scene: str, engine: str, integrator: str, metric: str, dt: float = math.nan,
                  scheme: str = "") -> list[Bound]:
         """Every bound that matches a row, the deciding one first (highest :attr:`Bound.precedence`)."""
-        candidates = self.exact.get((scene, engine, integrator, metric), []) + self.patterned
+        candidates = self.exact.get((scene, engine, integrator, metric), []) + self._patterned(metric)
         matching = [b for b in candidates if b.matches(scene, engine, integrator, metric, dt, scheme)]
         return sorted(matching, key=lambda b: b.precedence, reverse=True)
 

@@ -28,16 +28,23 @@ COMBINE_KEY = "combine"
 COMBINES = ("product", "zip")
 """How the entries of a ``[sweep]`` combine (``combine = ...``, default ``product``)."""
 
-MAX_VARIANTS = 100
-"""Variants one file may expand into. Each is a whole scene run by every engine and integrator, with a
-section and figures of its own in the report: the 4 variants of the built-in ``restitution-sweep`` (a ball
-bouncing for 2 s at three time steps, one of the cheapest scenes) took 9 s on 2 cores with the report, a
-real arm's IK scene takes minutes, so 100 variants are already a long run and a 300-figure report; a bigger
-study is several files."""
+MAX_VARIANTS = 1000
+"""Variants one file may expand into. Each is a whole scene run by every engine and integrator: a run streams its
+cases back one by one and keeps only those of the scenes not yet stored, and past
+:data:`reports.sweep_compact.COMPACT_SWEEP_VARIANTS` variants the report shows their distribution, not a row each,
+so the client's memory and the report stay bounded (``simparity bench``'s sweep rows: 1,000 variants of a thrown
+ball, 2,000 cases, in 154 s on 2 cores, the client's peak 483 MiB). The limit is what a run's cost still justifies:
+the 4 variants of the built-in ``restitution-sweep`` took 9 s on 2 cores, a real arm's IK scene takes minutes per
+variant, so 1,000 of those are already a day; a bigger study is several files."""
 
 MAX_KEYS = 6
-"""Keys one ``[sweep]`` may name: each is a column of ``results.csv`` and an axis of the report's sweep
-table, and 7 keys of two values each would already be 128 variants, past :data:`MAX_VARIANTS`."""
+"""Keys one ``[sweep]`` may name: each is a column of ``results.csv`` and an axis of the report's figures (one
+figure per headline metric and swept key), and 6 keys of three values each are already 729 variants, near
+:data:`MAX_VARIANTS`."""
+
+_WHY_LIMIT = ("a fixed limit: each variant is a whole scene run by every engine and integrator; a bigger study is "
+              "several files")
+"""Why a sweep past :data:`MAX_VARIANTS` is refused, in its one-line message."""
 
 RANGE_KEYS = ("start", "stop", "num", "spacing")
 SPACINGS = ("linear", "log")
@@ -228,7 +235,7 @@ def _range(fail, spec: dict, integer: bool) -> tuple:
     stop = _number(fail, "range stop: ", spec["stop"], integer)
     num = spec["num"]
     if isinstance(num, bool) or not isinstance(num, int) or not 2 <= num <= MAX_VARIANTS:
-        raise fail("range num: ", f"{echo(num)} values", f"a whole number from 2 to {MAX_VARIANTS}")
+        raise fail("range num: ", f"{echo(num)} values", f"a whole number from 2 to {MAX_VARIANTS:,} ({_WHY_LIMIT})")
     spacing = spec.get("spacing", "linear")
     if spacing not in SPACINGS:
         raise fail("range spacing: ", f"{echo(spacing)} is not a spacing", ", ".join(SPACINGS))
@@ -273,7 +280,7 @@ def _values(source: str, path: str, spec, integer: bool) -> tuple:
         if not spec:
             raise fail("", "an empty list", VALUES_RULE)
         if len(spec) > MAX_VARIANTS:
-            raise fail("", f"{len(spec):,} values", f"at most {MAX_VARIANTS} (a fixed limit)")
+            raise fail("", f"{len(spec):,} values", f"at most {MAX_VARIANTS:,} ({_WHY_LIMIT})")
         values = tuple(_number(fail, f"value {i + 1} of the list: ", v, integer) for i, v in enumerate(spec))
     else:
         raise fail("", f"expected a list of numbers or a range table, got {echo(spec)}", VALUES_RULE)
@@ -401,7 +408,8 @@ def read_sweep(table, data: dict, source: str, base: str) -> Sweep:
         raise SceneError(source, SWEEP_TABLE, "sweeps no key",
                          'one or more entries like "contact.restitution" = [0.5, 0.8]')
     if len(paths) > MAX_KEYS:
-        raise SceneError(source, SWEEP_TABLE, f"{len(paths)} keys", f"at most {MAX_KEYS} (a fixed limit)")
+        raise SceneError(source, SWEEP_TABLE, f"{len(paths)} keys", f"at most {MAX_KEYS} (a fixed limit: each key is "
+                         "a column of results.csv and an axis of the report's figures)")
     entries: list = []
     seen: dict = {}
     for path in paths:
@@ -425,5 +433,5 @@ def read_sweep(table, data: dict, source: str, base: str) -> Sweep:
     total = counts[0] if combine == "zip" else math.prod(counts)
     if total > MAX_VARIANTS:
         raise SceneError(source, SWEEP_TABLE, f"{' x '.join(map(str, counts))} = {total:,} variants",
-                         f"at most {MAX_VARIANTS} (a fixed limit: each variant is a whole scene run by every engine)")
+                         f"at most {MAX_VARIANTS:,} variants ({_WHY_LIMIT})")
     return Sweep(source, base, tuple(entries), combine)

@@ -20,6 +20,10 @@ solver, ``core.engine.SCHEME_KINDS``). Version 1 runs, without them, are read wi
 READ_SCHEMA_VERSIONS = (1, 2)
 """Stored runs this simparity reads."""
 RESULTS_FILE = "results.csv"
+RESULTS_PARQUET_FILE = "results.parquet"
+"""The same rows as :data:`RESULTS_FILE`, typed (categorical keys, float64 values), beside it when pyarrow is
+installed (``simparity[parquet]``): written when the run ends, removed when a run (or ``--resume``) starts writing
+the CSV again, so it never holds fewer rows than the CSV; a CSV changed after it is read instead."""
 RUN_INFO_FILE = "run.json"
 REPORT_FILE = "report.md"
 REPORT_HTML_FILE = "report.html"
