@@ -49,12 +49,6 @@ def _norm_max(values: np.ndarray) -> np.ndarray:
     return np.linalg.norm(values, axis=-1).max(axis=0)
 
 
-def _first(traj: Trajectory) -> Trajectory:
-    """The first sample of ``traj`` as a one-sample trajectory."""
-    return Trajectory(traj.times[:1], traj.position_world[:1], traj.quat_wxyz[:1], traj.velocity_world[:1],
-                      traj.angular_velocity_world[:1])
-
-
 @dataclass(frozen=True)
 class EnergyExtents:
     """A body's energy over a run, each (B,) [J]: its energy, kinetic and potential energy at the first sample, the

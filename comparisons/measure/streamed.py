@@ -76,19 +76,9 @@ class AlignedPieces:
             self._held.append(piece)
             self._count += len(piece.times)
         whole = joined(self._held)
-        head, tail = _cut(whole, count)
-        self._held, self._count = ([tail] if tail is not None else []), self._count - count
-        return head
-
-
-def _cut(traj: Trajectory, count: int) -> tuple[Trajectory, Trajectory | None]:
-    """(the first ``count`` samples of ``traj``, the rest or None)."""
-    n = len(traj.times)
-    if count == n:
-        return traj, None
-    fields = ("times", "position_world", "quat_wxyz", "velocity_world", "angular_velocity_world")
-    head = Trajectory(*(getattr(traj, name)[:count] for name in fields))
-    return head, Trajectory(*(getattr(traj, name)[count:] for name in fields))
+        self._count -= count
+        self._held = [whole.sliced(slice(count, None))] if self._count else []
+        return whole.sliced(slice(None, count))
 
 
 class CaseReading:

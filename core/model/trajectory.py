@@ -52,12 +52,20 @@ class Trajectory:
     def n_bodies(self) -> int:
         return self.position_world.shape[1]
 
+    def sliced(self, samples: slice) -> Trajectory:
+        """The samples ``samples`` of this trajectory (views, no copies)."""
+        return Trajectory(*(getattr(self, name)[samples] for name in TRAJECTORY_FIELDS))
+
     def is_finite(self) -> bool:
         """True when every recorded value is finite."""
         return all(
             bool(np.all(np.isfinite(a)))
             for a in (self.position_world, self.quat_wxyz, self.velocity_world, self.angular_velocity_world)
         )
+
+
+TRAJECTORY_FIELDS = ("times", "position_world", "quat_wxyz", "velocity_world", "angular_velocity_world")
+"""A :class:`Trajectory`'s arrays, in its constructor's order."""
 
 
 def piece_bounds(n_steps: int, samples_per_piece: int) -> Iterator[tuple[int, int]]:
@@ -71,9 +79,7 @@ def piece_bounds(n_steps: int, samples_per_piece: int) -> Iterator[tuple[int, in
 def trajectory_pieces(traj: Trajectory, samples_per_piece: int) -> Iterator[Trajectory]:
     """``traj`` in consecutive pieces of at most ``samples_per_piece`` samples (views, no copies)."""
     for start, stop in piece_bounds(len(traj.times) - 1, samples_per_piece):
-        part = slice(start, stop)
-        yield Trajectory(traj.times[part], traj.position_world[part], traj.quat_wxyz[part], traj.velocity_world[part],
-                         traj.angular_velocity_world[part])
+        yield traj.sliced(slice(start, stop))
 
 
 def joined(pieces: Iterable[Trajectory]) -> Trajectory:
@@ -81,8 +87,7 @@ def joined(pieces: Iterable[Trajectory]) -> Trajectory:
     parts = list(pieces)
     if len(parts) == 1:
         return parts[0]
-    return Trajectory(*(np.concatenate([getattr(p, name) for p in parts]) for name in (
-        "times", "position_world", "quat_wxyz", "velocity_world", "angular_velocity_world")))
+    return Trajectory(*(np.concatenate([getattr(p, name) for p in parts]) for name in TRAJECTORY_FIELDS))
 
 
 @dataclass(frozen=True)
