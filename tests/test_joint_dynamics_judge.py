@@ -14,6 +14,7 @@ from simparity.comparisons.measure.joint_dynamics_metrics import (
     reference_values,
     shape_problem,
 )
+from simparity.comparisons.measure.joint_force_scale import force_scale
 from simparity.core.model.engine import JointDynamicsModel
 from simparity.core.model.metric_catalogue import (
     BIAS_FORCE_ERROR_MAX,
@@ -46,18 +47,21 @@ def _pendulum_chain(damping: float = 0.0) -> Chain:
 
 class Pendulum(JointDynamicsModel):
     """q from the x axis about z, gravity along -y: M = I_c + m d^2, g(q) = m g d cos q, no Coriolis term (one
-    joint). ``mass_factor``, ``kinetic_factor``, ``inverse_factor``, ``bias_sign`` plant mistakes."""
+    joint); ``gravity`` a magnitude along -y or a vector (3,). ``mass_factor``, ``kinetic_factor``,
+    ``inverse_factor``, ``bias_sign`` plant mistakes."""
 
     def __init__(self, damping=0.0, mass_factor=1.0, kinetic_factor=1.0, inverse_factor=1.0, bias_sign=1.0,
                  gravity=GRAVITY):
         self.damping, self.mass_factor, self.kinetic_factor = damping, mass_factor, kinetic_factor
-        self.inverse_factor, self.bias_sign, self.gravity = inverse_factor, bias_sign, gravity
+        self.inverse_factor, self.bias_sign = inverse_factor, bias_sign
+        self.gravity = np.array([0.0, -gravity, 0.0]) if np.ndim(gravity) == 0 else np.asarray(gravity, dtype=float)
 
     def mass_matrix(self, q):
         return np.full((len(q), 1, 1), (INERTIA_ZZ + MASS * DISTANCE**2) * self.mass_factor)
 
     def bias_forces(self, q, qdot):
-        return self.bias_sign * MASS * self.gravity * DISTANCE * np.cos(q)
+        # -m g . dp/dq for the centre of mass p = d (cos q, sin q, 0)
+        return self.bias_sign * MASS * DISTANCE * (self.gravity[0] * np.sin(q) - self.gravity[1] * np.cos(q))
 
     def inverse_dynamics(self, q, qdot, qddot):
         inertia = (INERTIA_ZZ + MASS * DISTANCE**2) * self.inverse_factor
@@ -79,7 +83,9 @@ def _scene(seed: int = 5, gravity=(0.0, -GRAVITY, 0.0), damping: float = 0.0) ->
 def _judged(model: JointDynamicsModel, reference: JointDynamicsModel, scene: JointDynamicsScene) -> dict:
     states = scene.states()
     own, ref = reference_values(model, states), reference_values(reference, states)
-    return reference_errors(own, ref) | identities(model, scene.chain, states, own)
+    scale = force_scale(reference, lambda gravity: Pendulum(damping=reference.damping, gravity=gravity),
+                        scene.gravity_world, states, ref)
+    return reference_errors(own, ref, scale) | identities(model, scene.chain, states, own, scale)
 
 
 def test_an_exact_model_passes_every_identity_and_agrees_with_itself():
@@ -121,13 +127,17 @@ def test_errors_are_relative_to_the_reference_scale_whatever_the_units():
     assert light == pytest.approx(PLANTED, rel=1e-9)
 
 
-def test_without_gravity_or_motion_the_bias_error_is_not_a_number():
-    """No gravity and qdot = 0 would make h_ref zero everywhere: nothing to be relative to, so n/a with the reason."""
+def test_without_gravity_or_motion_the_bias_error_is_relative_to_the_chains_inertia():
+    """No gravity and qdot = 0 make h_ref zero everywhere: the bias error is measured against the force the chain's
+    inertia takes at the sampled accelerations (issue #38), and the row says so; a bias an engine invents there is an
+    error of its size over that force."""
     scene = JointDynamicsScene("still", "", "analytic", _pendulum_chain(), None, n_states=4, seed=1,
                                velocity_scale=1e-300)
     values = _judged(Pendulum(gravity=0.0), Pendulum(gravity=0.0), scene)
-    assert values[BIAS_FORCE_ERROR_MAX].unmeasurable.startswith("the reference's bias force is zero")
-    assert np.isnan(values[BIAS_FORCE_ERROR_MAX].value)
+    assert values[BIAS_FORCE_ERROR_MAX].value == 0.0
+    assert "force scale" in values[BIAS_FORCE_ERROR_MAX].note
+    invented = _judged(Pendulum(gravity=(PLANTED, 0.0, 0.0)), Pendulum(gravity=0.0), scene)
+    assert invented[BIAS_FORCE_ERROR_MAX].value >= DETECTED
 
 
 def test_the_energy_identity_has_nothing_to_see_for_one_joint_but_stays_finite():

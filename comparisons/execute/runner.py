@@ -62,6 +62,7 @@ from simparity.comparisons.measure.joint_dynamics_metrics import (
     shape_problem,
     timed_values,
 )
+from simparity.comparisons.measure.joint_force_scale import ForceScale, force_scale
 from simparity.comparisons.measure.joint_motion_metrics import (
     JOINT_MOTION_ORDERS, JOINT_ORDER_SOURCES, motion_metrics,
 )
@@ -73,7 +74,9 @@ from simparity.comparisons.measure.streamed import (
 from simparity.comparisons.execute.case_cost import case_cost, theory
 from simparity.comparisons.execute.motion_runner import motion_case, prepare_motion
 from simparity.comparisons.execute.timing import best_after, best_of
-from simparity.core.model.engine import TRUTH_SCHEMES, Engine, Simulation, Support, streams_in_pieces
+from simparity.core.model.engine import (
+    TRUTH_SCHEMES, Engine, JointDynamicsModel, Simulation, Support, streams_in_pieces,
+)
 from simparity.core.model.errors import DivergedError, SimparityError
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
 from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
@@ -533,30 +536,41 @@ def _kinematics_case(scene: KinematicsScene, engine: Engine, case: Case, q: np.n
 
 @dataclass(frozen=True)
 class _JointDynamicsShared:
-    """The states of a joint-dynamics group, the reference's values there (None when there are none) and (why
-    there are none, the status that gives)."""
+    """The states of a joint-dynamics group, the reference's values there and its force scale (None when there are
+    none) and (why there are none, the status that gives)."""
 
     states: tuple[np.ndarray, ...]
     reference: dict | None
     problem: tuple[str, str]
+    scale: ForceScale | None = None
 
 
 def _prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_failure: str) -> _JointDynamicsShared:
     scene, label = group.joint_dynamics_scene, group.reference_label
     states, method = scene.states(), label.split(":", 1)[1]
 
-    def evaluate() -> dict:
+    def evaluate() -> tuple[dict, ForceScale]:
         model = engine_for(scene.reference).build_joint_dynamics(scene.chain, method, scene.gravity_world)
         values = reference_values(model, states)
         problem = shape_problem(values, len(states[0]), scene.chain.n_joints)
         if problem:
             raise SimparityError(f"unusable: {problem}")
-        return values
+        return values, _force_scale(scene, engine_for(scene.reference), method, model, states, values)
 
-    values, problem = _reference_values(label, reference_failure,
-                                        lambda: engine_for(scene.reference).supports_joint_dynamics(scene.chain,
-                                                                                                   method), evaluate)
-    return _JointDynamicsShared(states, cast(dict | None, values), problem)
+    evaluated, problem = _reference_values(label, reference_failure,
+                                           lambda: engine_for(scene.reference).supports_joint_dynamics(scene.chain,
+                                                                                                      method), evaluate)
+    if evaluated is None:
+        return _JointDynamicsShared(states, None, problem)
+    values, scale = cast(tuple[dict, ForceScale], evaluated)
+    return _JointDynamicsShared(states, values, problem, scale)
+
+
+def _force_scale(scene: JointDynamicsScene, engine: Engine, method: str, model: JointDynamicsModel,
+                 states: tuple[np.ndarray, ...], values: dict) -> ForceScale:
+    """The chain's force scale by ``engine``'s ``model`` (method ``method``) and its ``values`` at ``states``."""
+    return force_scale(model, lambda gravity: engine.build_joint_dynamics(scene.chain, method, gravity),
+                       scene.gravity_world, states, values)
 
 
 def _joint_dynamics_case_at(group: CaseGroup, shared: _JointDynamicsShared, index: int,
@@ -586,7 +600,9 @@ def _joint_dynamics_case(scene: JointDynamicsScene, engine: Engine, case: Case, 
         if problem:
             status = DIVERGED if problem.startswith("non-finite") else FAILED
             return case.rows(JOINT_DYNAMICS_METRICS, status, problem, values)
-        values.update(identities(model, scene.chain, shared.states, own))
+        scale = (shared.scale if shared.scale is not None  # else its own: identities need no reference
+                 else _force_scale(scene, engine, case.integrator, model, shared.states, own))
+        values.update(identities(model, scene.chain, shared.states, own, scale))
     except Exception as err:  # noqa: BLE001 - reported in the rows
         return case.rows(JOINT_DYNAMICS_METRICS, FAILED, error_text(err))
     detail = ("this is the reference; " if is_reference else "") + model.detail
@@ -597,7 +613,7 @@ def _joint_dynamics_case(scene: JointDynamicsScene, engine: Engine, case: Case, 
                                         values, detail, status, problem)
                       + case.rows({m: JOINT_DYNAMICS_METRICS[m] for m in REFERENCE_ERRORS}, status, problem),
                       key=lambda row: order.index(row.metric))
-    values.update(reference_errors(own, shared.reference))
+    values.update(reference_errors(own, shared.reference, scale))
     return case.rows(JOINT_DYNAMICS_METRICS, OK, detail, {m: values[m] for m in JOINT_DYNAMICS_METRICS})
 
 

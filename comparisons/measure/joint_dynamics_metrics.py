@@ -18,14 +18,21 @@ one, in any unit:
 - the kinetic-energy identity: over the largest kinetic energy of the sample;
 - the energy identity qdot^T (Mdot - 2C) qdot = 0, i.e. qdot^T Mdot qdot = 2 qdot^T (h(q, qdot) - h(q, 0)), with
   Mdot by Richardson-extrapolated central differences along qdot (:data:`DIFFERENCE_STEP`): over max |M| |qdot|^3 / (1 rad) of the sample.
-A scale of zero (a reference that is zero at every state: no gravity and no motion) has nothing to be relative to:
-the value is n/a with that reason.
+Every joint-force scale above (h, tau, the forward-dynamics force, the gravity identity's and the round trip's) is
+floored at a tenth of the chain's physical force scale (:mod:`comparisons.measure.joint_force_scale`: what its
+inertia, weight, speeds and damping produce at the sampled states), so that a force that vanishes at every state
+(prismatic joints across gravity, no velocity-dependent term) is judged against the chain's forces, not against its
+own rounding; a row whose scale is the floor says so. M (positive definite: its largest entry is a diagonal one, a sum
+of non-negative link terms) and the kinetic energy (a sum of non-negative terms) round relative to themselves and
+need no floor; the energy identity's scale, |M| |qdot|^3, is homogeneous in qdot like the identity itself. A scale of
+zero (a massless chain at rest) has nothing to be relative to: the value is n/a with that reason.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from simparity.comparisons.measure.joint_force_scale import ForceScale
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointDynamicsModel
 from simparity.core.model.metric_catalogue import (
@@ -76,19 +83,22 @@ near the origin, ~1e-8 for a chain placed 2 km away (M rounds at ~3e-13 there); 
 tolerances says so."""
 
 
-def _relative(values: np.ndarray, reference: np.ndarray, what: str) -> Measured:
-    """max |values - reference| over the largest |reference| of the sample (n/a when that is zero)."""
-    scale = float(np.max(np.abs(reference))) if reference.size else 0.0
-    if not scale > 0:
-        return Measured(np.nan, "1", unmeasurable=f"the reference's {what} is zero at every state: nothing to be "
-                                                  "relative to")
-    return Measured(float(np.max(np.abs(values - reference))) / scale, "1")
+def _relative(values: np.ndarray, reference: np.ndarray, floor: float, what: str, scale: ForceScale | None = None
+              ) -> Measured:
+    """max |values - reference| over the largest |reference| of the sample, floored at ``floor`` (0: none; the
+    floor of ``scale``, which the row then describes); n/a when both are zero."""
+    own = float(np.max(np.abs(reference))) if reference.size else 0.0
+    return _over(values - reference, own, floor, what, scale)
 
 
-def _over(residual: np.ndarray, scale: float, what: str) -> Measured:
-    if not scale > 0:
+def _over(residual: np.ndarray, own: float, floor: float, what: str, scale: ForceScale | None = None) -> Measured:
+    """max |residual| over the larger of ``own`` (the quantity's own largest magnitude) and ``floor``."""
+    if not max(own, floor) > 0:
         return Measured(np.nan, "1", unmeasurable=f"{what} is zero at every state: nothing to be relative to")
-    return Measured(float(np.max(np.abs(residual))) / scale, "1")
+    value = float(np.max(np.abs(residual))) / max(own, floor)
+    if floor > own and scale is not None:
+        return Measured(value, "1", note=f"relative to {scale.describe()}: {what} is at most {own:.3g}")
+    return Measured(value, "1")
 
 
 def reference_values(model: JointDynamicsModel, states: tuple[np.ndarray, ...]) -> dict[str, np.ndarray]:
@@ -98,23 +108,34 @@ def reference_values(model: JointDynamicsModel, states: tuple[np.ndarray, ...]) 
             "qdd": model.forward_dynamics(q, qd, tau)}
 
 
-def reference_errors(own: dict[str, np.ndarray], ref: dict[str, np.ndarray]) -> dict[str, Measured]:
-    """Relative errors of an engine's M, h, tau and qddot against the reference's (:func:`reference_values`)."""
-    return {MASS_MATRIX_ERROR_MAX: _relative(own["M"], ref["M"], "mass matrix"),
-            BIAS_FORCE_ERROR_MAX: _relative(own["h"], ref["h"], "bias force"),
-            INVERSE_DYNAMICS_ERROR_MAX: _relative(own["tau"], ref["tau"], "joint force"),
+def reference_errors(own: dict[str, np.ndarray], ref: dict[str, np.ndarray], scale: ForceScale) -> dict[str, Measured]:
+    """Relative errors of an engine's M, h, tau and qddot against the reference's (:func:`reference_values`), the
+    joint forces' floored at the reference's force ``scale``."""
+    return {MASS_MATRIX_ERROR_MAX: _relative(own["M"], ref["M"], 0.0, "the reference's mass matrix"),
+            BIAS_FORCE_ERROR_MAX: _relative(own["h"], ref["h"], scale.floor, "the reference's bias force", scale),
+            INVERSE_DYNAMICS_ERROR_MAX: _relative(own["tau"], ref["tau"], scale.floor, "the reference's joint force",
+                                                  scale),
             FORWARD_DYNAMICS_ERROR_MAX: _per_joint(np.einsum("bij,bj->bi", ref["M"], own["qdd"] - ref["qdd"]),
-                                                   _rounded_force(ref["M"], ref["qdd"]), "the joint acceleration")}
+                                                   _rounded_force(ref["M"], ref["qdd"]), scale,
+                                                   "the force of the reference's joint acceleration")}
 
 
-def _per_joint(residual: np.ndarray, scale: np.ndarray, what: str) -> Measured:
-    """max over joints i of (max over states of |residual_i|) / (max over states of scale_i): each joint's force
-    against its own scale ((B, n) both); n/a when every scale is zero."""
-    largest = np.max(np.abs(scale), axis=0)
-    used = largest > 0
-    if not np.any(used):
+def _per_joint(residual: np.ndarray, own: np.ndarray, scale: ForceScale, what: str) -> Measured:
+    """max over joints i of (max over states of |residual_i|) / (max over states of own_i, floored at joint i's
+    floor of ``scale``): each joint's force against its own scale ((B, n) both); n/a when every scale is zero."""
+    largest = np.max(np.abs(own), axis=0)
+    floors = scale.floors
+    used = np.maximum(largest, floors)
+    if not np.any(used > 0):
         return Measured(np.nan, "1", unmeasurable=f"{what} is zero at every state: nothing to be relative to")
-    return Measured(float(np.max(np.max(np.abs(residual), axis=0)[used] / largest[used])), "1")
+    measured = used > 0
+    value = float(np.max(np.max(np.abs(residual), axis=0)[measured] / used[measured]))
+    floored = np.flatnonzero(floors > largest)
+    if floored.size:
+        joints = ", ".join(str(i + 1) for i in floored)
+        return Measured(value, "1", note=f"joints {joints} relative to {scale.describe()}: {what} there is at most "
+                                         f"{float(np.max(largest[floored])):.3g}")
+    return Measured(value, "1")
 
 
 def _rounded_force(mass: np.ndarray, qddot: np.ndarray) -> np.ndarray:
@@ -124,12 +145,12 @@ def _rounded_force(mass: np.ndarray, qddot: np.ndarray) -> np.ndarray:
 
 
 def identities(model: JointDynamicsModel, chain: Chain, states: tuple[np.ndarray, ...],
-               own: dict[str, np.ndarray]) -> dict[str, Measured]:
+               own: dict[str, np.ndarray], scale: ForceScale) -> dict[str, Measured]:
     """The identities of the engine's own outputs ``own`` (:func:`reference_values` of the engine, at ``states``) of
     ``chain``: RNEA(q, 0, 0) = g(q) = h(q, 0); RNEA(q, 0, e_i) - g = M e_i; RNEA(ABA(RNEA(qddot))) = RNEA(qddot) (the
     round trip in torque space); M symmetric and
     positive definite; 1/2 qdot^T M qdot (armature aside) = the links' kinetic energy from the engine's own
-    kinematics; qdot^T (Mdot - 2 C) qdot = 0."""
+    kinematics; qdot^T (Mdot - 2 C) qdot = 0. The joint-force identities are floored at the chain's force ``scale``."""
     q, qd, qdd, _ = states
     n = chain.n_joints
     mass, tau = own["M"], own["tau"]
@@ -137,20 +158,21 @@ def identities(model: JointDynamicsModel, chain: Chain, states: tuple[np.ndarray
     zeros = np.zeros_like(q)
     gravity = model.bias_forces(q, zeros)
     values = {GRAVITY_IDENTITY_RESIDUAL: _over(model.inverse_dynamics(q, zeros, zeros) - gravity, torque_scale,
-                                               "the joint force")}
+                                               scale.floor, "the joint force", scale)}
     columns = np.stack([model.inverse_dynamics(q, zeros, np.broadcast_to(np.eye(n)[i], q.shape).copy()) - gravity
                         for i in range(n)], axis=-1)
-    values[MASS_COLUMN_RESIDUAL] = _over(columns - mass, float(np.max(np.abs(mass))), "the mass matrix")
+    values[MASS_COLUMN_RESIDUAL] = _over(columns - mass, float(np.max(np.abs(mass))), 0.0, "the mass matrix")
     there = model.forward_dynamics(q, qd, tau)  # ~ qdd
     values[ROUND_TRIP_RESIDUAL] = _per_joint(model.inverse_dynamics(q, qd, there) - tau,
-                                             np.maximum(np.abs(tau), _rounded_force(mass, there)), "the joint force")
-    values[MASS_MATRIX_ASYMMETRY] = _over(mass - np.swapaxes(mass, -1, -2), float(np.max(np.abs(mass))),
+                                             np.maximum(np.abs(tau), _rounded_force(mass, there)), scale,
+                                             "the joint force")
+    values[MASS_MATRIX_ASYMMETRY] = _over(mass - np.swapaxes(mass, -1, -2), float(np.max(np.abs(mass))), 0.0,
                                           "the mass matrix")
     values[MASS_MATRIX_DEFINITENESS_MIN] = _definiteness(mass)
     armature = np.array([joint.armature for joint in chain.joints])
     quadratic = 0.5 * np.einsum("bi,bij,bj->b", qd, mass, qd) - 0.5 * np.sum(armature * qd**2, axis=-1)
     kinetic = model.link_kinetic_energy(q, qd)
-    values[KINETIC_ENERGY_RESIDUAL] = _over(quadratic - kinetic, float(np.max(np.abs(kinetic))),
+    values[KINETIC_ENERGY_RESIDUAL] = _over(quadratic - kinetic, float(np.max(np.abs(kinetic))), 0.0,
                                             "the links' kinetic energy")
     values[CORIOLIS_SKEW_RESIDUAL] = _skew_residual(model, q, qd, own["h"] - gravity, mass)
     return values
@@ -182,7 +204,7 @@ def _skew_residual(model: JointDynamicsModel, q: np.ndarray, qd: np.ndarray, cor
     mass_dot = (4 * central(DIFFERENCE_STEP / 2) - central(DIFFERENCE_STEP)) / 3 * speed[..., None]
     power = np.einsum("bi,bij,bj->b", qd, mass_dot, qd) - 2 * np.einsum("bi,bi->b", qd, coriolis)
     scale = float(np.max(np.abs(mass))) * float(np.max(speed)) ** 3
-    return _over(power, scale, "qdot")
+    return _over(power, scale, 0.0, "qdot")
 
 
 def timed_values(model: JointDynamicsModel, states: tuple[np.ndarray, ...], timer) -> tuple[dict, dict[str, Measured]]:

@@ -242,6 +242,13 @@ MUTANTS: tuple[Mutation, ...] = (
         "tau[i] = forces[i][arrays.subspace[i]]",
         "RNEA without the joint's rotor inertia (armature): tau misses a_i qddot_i (no URDF carries armature)",
         ARTICULATED_3D, "armature-arm-dynamics"),
+    Mutation(
+        "rnea_tip_velocity_product", "joint-space bias forces", "articulated/recursive.py",
+        "forces.append(inertia @ acceleration + cross_force(v, inertia @ v))",
+        "forces.append(inertia @ acceleration + (cross_force(v, inertia @ v) if i < arrays.n - 1 else 0.0))",
+        "RNEA's velocity-product term v x* I v skipped for the last body (an off-by-one bound): only the light last "
+        "link's Coriolis and centrifugal force is lost, on a chain whose bias forces are small (issue #38)",
+        ARTICULATED, "scara-slow-dynamics"),
     # --- Joint-space time stepping --------------------------------------------------------------------------
     Mutation(
         "joint_rk4_stage_typo", "integrator weights", "articulated/stepping.py",
