@@ -211,3 +211,20 @@ def test_definiteness_is_unitless_joint_by_joint_and_sees_an_indefinite_mass_mat
     unit = np.diag([1.0, 3.7])  # the second joint's variable in another unit of length
     assert _definiteness(unit @ mass @ unit).value == pytest.approx(_definiteness(mass).value, rel=1e-14)
     assert _definiteness(np.array([[[1.0, 2.0], [2.0, 1.0]]])).value < 0
+
+
+def test_the_force_scale_of_a_pendulum_is_its_weight_inertia_and_damping_in_closed_form():
+    """The floor's parts (comparisons/measure/joint_force_scale.py) against the pendulum's closed form: its weight can
+    exert m |g| d whichever way gravity points (here 0.8 of it along the joint axis z: only 0.6 |g| turns it), its
+    inertia takes (I + m d^2) |qddot|, its damping D |qdot|; one joint has no velocity-dependent term."""
+    gravity = 9.81 * np.array([0.0, 0.6, 0.8])
+    scene = _scene(gravity=gravity, damping=0.3)
+    states = scene.states()
+    _, qd, qdd, _ = states
+    model = Pendulum(damping=0.3, gravity=gravity)
+    scale = force_scale(model, lambda g: Pendulum(damping=0.3, gravity=g), gravity, states,
+                        reference_values(model, states))
+    assert scale.weight[0] == pytest.approx(MASS * 9.81 * DISTANCE, rel=ROUNDING)
+    assert scale.inertia[0] == pytest.approx((INERTIA_ZZ + MASS * DISTANCE**2) * np.abs(qdd).max(), rel=ROUNDING)
+    assert scale.damping[0] == pytest.approx(0.3 * np.abs(qd).max(), rel=1e-12)
+    assert scale.velocity[0] <= ROUNDING * scale.weight[0]

@@ -78,7 +78,10 @@ IK_METRICS = units(
 
 RANK_TOLERANCE = 1e-9
 """A singular value below this fraction of the largest one counts as zero when the rank of a
-Jacobian is taken (relative, so it holds for arms of any size); rounding leaves ~1e-16."""
+Jacobian is taken (relative, so it holds for arms of any size); rounding leaves ~1e-16. The largest one
+never vanishes at one pose only, so rounding is never read as rank (issue #38): the joint nearest the tip
+that moves the end effector at all keeps a constant lever to it (a prismatic joint's column is its unit axis,
+a revolute joint's angular rows are), and that column's norm bounds the largest singular value from below."""
 
 
 def _summary(result: IKResult, q_start: np.ndarray, seconds: float) -> dict[str, float]:
