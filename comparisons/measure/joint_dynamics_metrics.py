@@ -7,11 +7,11 @@ Every value is relative and judged against its own scale, so that it means the s
 one, in any unit:
 
 - errors against the reference: max over states and entries of |A - A_ref| over the largest |A_ref| of the sample
-  (a state where the reference is near zero is not divided by it); forward dynamics as the joint force its error
-  takes, joint by joint: [M_ref (qddot - qddot_ref)]_i over the largest sum_j |M_ref,ij| |qddot_ref,j| (what a
-  backward-stable solve rounds joint i's force by). Solving with M amplifies rounding by M's condition number (~1e4
-  on a 7-joint arm: xarm7; ~1e9 with a 1 g dummy link at the tip), the force does not; a 1 % error in any joint's
-  qddot is still ~1 % of that joint's force;
+  (a state where the reference is near zero is not divided by it, nor a sample where it is zero everywhere: below);
+  forward dynamics as the joint force its error takes, joint by joint: [M_ref (qddot - qddot_ref)]_i over the
+  largest sum_j |M_ref,ij| |qddot_ref,j| (what a backward-stable solve rounds joint i's force by). Solving with M
+  amplifies rounding by M's condition number (~1e4 on a 7-joint arm: xarm7; ~1e9 with a 1 g dummy link at the tip),
+  the force does not; a 1 % error in any joint's qddot is still ~1 % of that joint's force;
 - torque identities: over the largest |tau| the engine itself computes at the sample's states; the round trip
   ABA(RNEA(qddot)) = qddot in the same backward form, RNEA(ABA(tau)) - tau, joint by joint over the larger of
   |tau_i| and sum_j |M_ij| |qddot_j|, so that it too does not grow with M's condition number;
