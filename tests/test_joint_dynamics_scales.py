@@ -104,3 +104,15 @@ def test_a_bug_only_in_the_last_links_coriolis_term_fails_on_a_chain_whose_bias_
         assert (copy.engine_name, "jacobian_sum", BIAS_FORCE_ERROR_MAX) not in violations  # RNEA's bug only
     else:
         assert not violations
+
+
+def test_without_a_reference_the_identities_are_floored_at_the_engines_own_force_scale():
+    """A reference that cannot do the chain (the closed form is for 1 or 2 joints): each engine's identities still
+    run, floored at the force scale of its own model (the weight of the slides, which their forces never feel)."""
+    scene = JointDynamicsScene("slides-dynamics", "", "analytic", _slides(), np.array([0.0, -6.0, -8.0]),
+                               n_states=20, seed=3)
+    table = simparity.run_scene(scene, ("core", "analytic"), repeats=0, isolate=False)
+    rows = table[(table["engine"] == "core") & (table["metric"] == "gravity_identity_residual")]
+    assert set(rows["status"]) == {"ok"} and (rows["value"] <= ROUNDING).all()
+    assert rows["detail"].str.contains("force scale").all()
+    assert set(table[(table["engine"] == "core") & (table["metric"] == BIAS_FORCE_ERROR_MAX)]["status"]) == {"n/a"}
