@@ -622,7 +622,8 @@ class Joint:
         The roll-pitch-yaw [rad] a scene file gave ``origin_rotation`` as (URDF order: Rz(yaw) Ry(pitch)
         Rx(roll)): the raw numbers core turned into the matrix, kept so that every reference turns them with its
         own code (``references.common.scene_inputs``). None when the rotation was given as a matrix (in code,
-        from a URDF file or a DH table).
+        from a URDF file or a DH table). Code that changes ``origin_rotation`` changes this with it
+        (``comparisons.transforms``), or sets it to None.
     """
 
     name: str
