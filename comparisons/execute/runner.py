@@ -80,6 +80,7 @@ from simparity.core.model.engine import (
 from simparity.core.model.errors import DivergedError, SimparityError
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
 from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
+from simparity.references.common.scene_inputs import as_given
 from simparity.core.model.trajectory import Trajectory, joined, trajectory_pieces
 from simparity.core.model.metric_catalogue import (
     STABLE_DT_MAX, TIME_PER_FK, TIME_PER_JACOBIAN, TIME_PER_STEP,
@@ -307,9 +308,10 @@ def _dynamics_case(scene, engine: Engine, case: Case, metrics: dict, n: int, ref
         sim = engine.build_dynamics(scene, case.integrator, case.dt)
     except Exception as err:  # noqa: BLE001 - reported in the rows
         return CaseOutcome(case.rows(metrics, FAILED, error_text(err)))
+    measured = as_given(scene)  # judged by the physics the references derive from the file's numbers, not core's
     if scene.contact is None and streams_in_pieces(sim):
-        return _streamed_case(scene, engine, sim, case, metrics, n, ref, ref_problem, repeats, is_reference)
-    return _whole_case(scene, engine, sim, case, metrics, n, ref, ref_problem, repeats, is_reference)
+        return _streamed_case(measured, engine, sim, case, metrics, n, ref, ref_problem, repeats, is_reference)
+    return _whole_case(measured, engine, sim, case, metrics, n, ref, ref_problem, repeats, is_reference)
 
 
 def _whole_case(scene: DynamicsScene, engine: Engine, sim: Simulation, case: Case, metrics: dict, n: int,

@@ -19,6 +19,9 @@ threshold.
   same way, and a projectile's velocity error is bit-identical under it.
 
 A chain read from a URDF file is loaded from the file by the engines: only its start configuration moves.
+The numbers a file gave, from which the references derive what core derived for the state and geometry above (a DH
+table's lengths ``a`` and ``d``, the frame a body's point masses were given in), move by one ulp too, with signs from
+a stream of their own (:data:`INPUTS_STREAM`), so that a scene without them is perturbed exactly as before.
 """
 
 from __future__ import annotations
@@ -35,6 +38,10 @@ ULP_FACTORS = (np.nextafter(1.0, 2.0), np.nextafter(1.0, 0.0))
 
 UNITS_STREAM = 1
 """Second seed word of the units' signs: drawn independently of the state's (stream 0)."""
+
+INPUTS_STREAM = 2
+"""Second seed word of the signs of the numbers as given (:func:`_nudged_inputs`): drawn independently of the
+state's, so that a scene without them is perturbed as before."""
 
 
 def ulp_nudge(values: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -80,8 +87,25 @@ def _nudged(scene, rng: np.random.Generator):
     raise TypeError(f"no perturbation for a {type(scene).__name__}")
 
 
+def _nudged_inputs(scene, rng: np.random.Generator):
+    """``scene`` with the numbers its file gave, from which core derived what ``_nudged`` moves, moved too: the
+    references derive those quantities from these (``references.common.scene_inputs``). A DH table's lengths for
+    its joint origins, a point-mass body's frame for its position."""
+    if isinstance(scene, DynamicsScene):
+        bodies = tuple(b if b.point_masses is None or b.point_masses.frame_position_world is None else
+                       replace(b, point_masses=replace(b.point_masses, frame_position_world=ulp_nudge(
+                           b.point_masses.frame_position_world, rng))) for b in scene.bodies)
+        return replace(scene, bodies=bodies)
+    table = scene.chain.dh
+    if table is None:
+        return scene
+    table = replace(table, a=ulp_nudge(table.a, rng), d=ulp_nudge(table.d, rng))
+    return replace(scene, chain=replace(scene.chain, dh=table))
+
+
 def ulp_perturbed(scene, seed: int) -> tuple[object, Transform]:
     """(``scene`` perturbed by one ulp with signs drawn from ``seed`` (module docstring), the change of units its
     results are carried back with); same name."""
     units = ulp_transform(seed, scene)
-    return transform_scene(_nudged(scene, np.random.default_rng(seed)), units), units
+    nudged = _nudged_inputs(_nudged(scene, np.random.default_rng(seed)), np.random.default_rng([seed, INPUTS_STREAM]))
+    return transform_scene(nudged, units), units

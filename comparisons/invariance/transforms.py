@@ -20,7 +20,11 @@ What a kind of scene can express:
   as it is. A chain read from a URDF file is loaded from that file by every engine, so neither its base
   nor its lengths can be changed in the scene: :class:`~simparity.core.model.errors.TransformError`.
 
-Rotations are SciPy's (:mod:`references.conventions`), never core's.
+Rotations are SciPy's (:mod:`references.conventions`), never core's. The numbers a file gave, which the references
+derive their quantities from (:mod:`references.common.scene_inputs`), are transformed with the rest: a point-mass
+body's points are scaled and the frame they were given in placed; the first joint's roll-pitch-yaw becomes that of
+R times its rotation (as a file in the transformed frame would write it); a DH table's lengths are scaled and its
+base placed by R and t.
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ from simparity.core.model.scene import (
     AppliedForce,
     Chain,
     Contact,
+    DHTable,
     DynamicsScene,
     Forces,
     IKScene,
@@ -51,7 +56,13 @@ from simparity.core.model.scene import (
     RigidBody,
     Shape,
 )
-from simparity.references.common.conventions import matrix_to_quat_wxyz, quat_wxyz_multiply, quat_wxyz_to_matrix
+from simparity.references.common.conventions import (
+    matrix_to_quat_wxyz,
+    matrix_to_rpy,
+    quat_wxyz_multiply,
+    quat_wxyz_to_matrix,
+    rpy_to_matrix,
+)
 
 IDENTITY_QUAT = (1.0, 0.0, 0.0, 0.0)
 
@@ -217,9 +228,11 @@ def transform_scene(scene, transform: Transform):
 def _body(body: RigidBody, t: Transform) -> RigidBody:
     rotation_quat = quat_wxyz_multiply(t.quat_wxyz, body.quat_wxyz)
     points = body.point_masses
-    if points is not None:
+    if points is not None:  # body axes: scaled, not turned; the frame the points were given in placed
+        given, frame = points.positions_given, points.frame_position_world
         points = PointMasses(t.mass_scale * points.masses, t.length_scale * points.points_body,
-                             t.length_scale * points.center_of_mass_given)  # body axes: scaled, not turned
+                             t.length_scale * points.center_of_mass_given,
+                             None if given is None else t.length_scale * given, None if frame is None else t.point(frame))
     return replace(body, mass=t.mass_scale * body.mass, inertia_body=t.factor(length=2, mass=1) * body.inertia_body,
                    position_world=t.point(body.position_world), quat_wxyz=rotation_quat,
                    velocity_world=t.vector(body.velocity_world, length=1, time=-1),
@@ -282,12 +295,15 @@ def _joint(joint: Joint, t: Transform, first: bool) -> Joint:
     prismatic = length if joint.type == "prismatic" else 1.0
     origin = t.point(joint.origin_xyz) if first else length * joint.origin_xyz
     rotation = t.rotation_matrix @ joint.origin_rotation if first else joint.origin_rotation
+    rpy = joint.origin_rpy  # as a file in the transformed frame would write it (SciPy's, as the references read it)
+    if first and rpy is not None:
+        rpy = matrix_to_rpy(t.rotation_matrix @ rpy_to_matrix(rpy))
     link = joint.link
     if link is not None:  # link axes: scaled, not turned (the rotation is the first joint's placement)
         link = LinkInertia(t.mass_scale * link.mass, length * link.com_xyz, t.factor(length=2, mass=1) * link.inertia_com)
     # damping N m s/rad = kg m^2/s or N s/m = kg/s; armature kg m^2 or kg
     per_rad = 0 if joint.type == "prismatic" else 2
-    return replace(joint, origin_xyz=origin, origin_rotation=rotation, lower=prismatic * joint.lower,
+    return replace(joint, origin_xyz=origin, origin_rotation=rotation, origin_rpy=rpy, lower=prismatic * joint.lower,
                    upper=prismatic * joint.upper, link=link,
                    damping=t.factor(length=per_rad, mass=1, time=-1) * joint.damping,
                    armature=t.factor(length=per_rad, mass=1) * joint.armature)
@@ -307,7 +323,14 @@ def _chain(chain: Chain, t: Transform, source: str) -> Chain:
                              "(core.scene.sample_configurations), so a length scale changes which configurations "
                              "are drawn", "limits on every prismatic joint, or no length scale")
     joints = tuple(_joint(j, t, k == 0) for k, j in enumerate(chain.joints))
-    return replace(chain, joints=joints, end_effector_xyz=t.length_scale * chain.end_effector_xyz)
+    return replace(chain, joints=joints, end_effector_xyz=t.length_scale * chain.end_effector_xyz,
+                   dh=None if chain.dh is None else _dh(chain.dh, t))
+
+
+def _dh(table: DHTable, t: Transform) -> DHTable:
+    """A DH table with its lengths scaled and its base placed by R and t (the first joint's placement)."""
+    return replace(table, a=t.length_scale * table.a, d=t.length_scale * table.d, base_xyz=t.point(table.base_xyz),
+                   base_rotation=t.rotation_matrix @ table.base_rotation)
 
 
 def _chain_scene(scene: KinematicsScene | IKScene, t: Transform):

@@ -42,6 +42,7 @@ from simparity.core.model.scene import (
     AppliedForce,
     Chain,
     Contact,
+    DHTable,
     DynamicsScene,
     Forces,
     IKScene,
@@ -322,8 +323,9 @@ def _inertia(r: _Reader) -> np.ndarray:
     return inertia
 
 
-def _point_masses(r: _Reader) -> tuple[float, np.ndarray, PointMasses]:
-    """(M, inertia about the COM, the points) of a body built from ``[[body.point_mass]]``."""
+def _point_masses(r: _Reader, frame_position_world: np.ndarray) -> tuple[float, np.ndarray, PointMasses]:
+    """(M, inertia about the COM, the points) of a body built from ``[[body.point_mass]]`` whose points are given
+    in a frame at ``frame_position_world`` [m]; the points keep the numbers as given, for the references."""
     for key in ("mass", "inertia_body", "inertia_body_diagonal"):
         if r.has(key):
             raise r.fail(key, "given with point_mass: the mass and inertia are computed from the point masses",
@@ -343,14 +345,14 @@ def _point_masses(r: _Reader) -> tuple[float, np.ndarray, PointMasses]:
         raise r.fail("point_mass", "the points lie in one plane: their tensor sits on the edge of the triangle "
                      "inequality (A + B = C), which MuJoCo refuses after rounding and PyBullet turns wrongly",
                      "at least four points, one of them off the plane of the others")
-    return float(total), inertia, PointMasses(masses, relative, center)
+    return float(total), inertia, PointMasses(masses, relative, center, given, frame_position_world)
 
 
 def _body(r: _Reader) -> RigidBody:
     quat = r.vector("quat_wxyz", 4, [1.0, 0.0, 0.0, 0.0], nonzero=True)
     position = r.vector("position_world", 3, [0.0] * 3, length=1)
     if r.has("point_mass"):
-        mass, inertia, points = _point_masses(r)
+        mass, inertia, points = _point_masses(r, position)
         # position_world places the frame the points are given in; the body's state is its COM's.
         position = position + quat_wxyz_to_matrix(quat) @ points.center_of_mass_given
     else:
@@ -549,11 +551,11 @@ def _joint(r: _Reader) -> Joint:
     for key, value in (("damping", damping), ("armature", armature)):
         if value < 0:
             raise r.fail(key, f"{value:g} is negative", "a number >= 0 (0: none)")
+    rpy = r.vector("origin_rpy", 3, [0.0] * 3)
     return Joint(
         name=r.name("name"), type=kind, axis=r.vector("axis", 3, nonzero=True),
-        origin_xyz=r.vector("origin_xyz", 3, [0.0] * 3, length=1),
-        origin_rotation=rpy_to_matrix(r.vector("origin_rpy", 3, [0.0] * 3)),
-        lower=lower, upper=upper, link=_link(r), damping=damping, armature=armature,
+        origin_xyz=r.vector("origin_xyz", 3, [0.0] * 3, length=1), origin_rotation=rpy_to_matrix(rpy),
+        lower=lower, upper=upper, link=_link(r), damping=damping, armature=armature, origin_rpy=rpy,
     )
 
 
@@ -644,7 +646,8 @@ def _dh_chain(c: _Reader, name: str) -> Chain:
         if bad.size:
             raise dh.fail(f"upper[{bad[0]}]", f"the upper limit of joint {bad[0]} is not above its lower limit",
                           "lower < upper for every joint")
-    return chain_from_dh(name, convention=convention, limits=limits, **values)
+    table = DHTable(convention, **values)  # the numbers as given, for the references (core derives the frames)
+    return replace(chain_from_dh(name, convention=convention, limits=limits, **values), dh=table)
 
 
 def _chain(top: _Reader, name: str, dynamics: bool = False) -> Chain:
@@ -664,10 +667,11 @@ def _chain(top: _Reader, name: str, dynamics: bool = False) -> Chain:
     if len(set(names + [end_effector])) != len(names) + 1:
         repeated = next(n for i, n in enumerate(names + [end_effector]) if n in names[:i])
         raise c.fail("joint", f"the name {repeated!r} is given to two frames", "distinct joint and end-effector names")
+    tip_rpy = c.vector("end_effector_rpy", 3, [0.0] * 3)
     return Chain(
         name=c.name("name", name), joints=joints, end_effector_name=end_effector,
         end_effector_xyz=c.vector("end_effector_xyz", 3, [0.0] * 3, length=1),
-        end_effector_rotation=rpy_to_matrix(c.vector("end_effector_rpy", 3, [0.0] * 3)),
+        end_effector_rotation=rpy_to_matrix(tip_rpy), end_effector_rpy=tip_rpy,
     )
 
 

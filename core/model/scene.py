@@ -380,16 +380,32 @@ class PointMasses:
         Positions relative to the centre of mass, body axes [m] (the loader subtracts the COM).
     center_of_mass_given : (3,) ndarray
         The COM sum m_i q_i / M in the frame the points were given in [m].
+    positions_given : (N, 3) ndarray or None
+        The points as the scene file gave them, in its frame [m]: the raw numbers ``points_body``, the COM and
+        the body's mass and tensor were computed from (by core, in the loader), kept so that every reference
+        computes them again with its own code (``references.common.scene_inputs``). None for a body built in code.
+    frame_position_world : (3,) ndarray or None
+        Where the file's ``position_world`` put the frame the points were given in [m] (the body's
+        ``position_world`` is this plus its rotation times the COM); None with ``positions_given``. Code that moves
+        such a body moves this too (``comparisons.transforms``, ``comparisons.perturb``).
     """
 
     masses: np.ndarray
     points_body: np.ndarray
     center_of_mass_given: np.ndarray
+    positions_given: np.ndarray | None = None
+    frame_position_world: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "masses", readonly(self.masses, shape=(-1,)))
         object.__setattr__(self, "points_body", readonly(self.points_body, shape=(-1, 3)))
         object.__setattr__(self, "center_of_mass_given", readonly(self.center_of_mass_given, shape=(3,)))
+        if (self.positions_given is None) != (self.frame_position_world is None):
+            raise SceneError("<code>", "point_mass", "positions_given without frame_position_world or the reverse",
+                             "both (a body read from a scene file) or neither (a body built in code)")
+        if self.positions_given is not None:
+            object.__setattr__(self, "positions_given", readonly(self.positions_given, shape=self.points_body.shape))
+            object.__setattr__(self, "frame_position_world", readonly(self.frame_position_world, shape=(3,)))
 
 
 @dataclass(frozen=True)
@@ -535,6 +551,46 @@ class LinkInertia:
 
 
 @dataclass(frozen=True)
+class DHTable:
+    """A Denavit-Hartenberg table as a scene file gave it (``[chain.dh]``), lengths in metres: the raw numbers a
+    chain's joint frames were computed from (by core, in the loader: ``core.dh``), kept so that every reference
+    builds the frames again with its own code (``references.common.dh_frames``). Conventions as ``core.dh``'s:
+    ``"standard"`` rows T_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i), ``"modified"`` (Craig) rows
+    Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i) Tz(d_i); every joint revolute about its z axis.
+
+    Attributes
+    ----------
+    convention : str
+        ``"standard"`` or ``"modified"``.
+    a, alpha, d, theta_offset : (n,) ndarray
+        [m, rad, m, rad], the table at q = 0.
+    base_xyz : (3,) ndarray
+        [m] The table's base frame in the chain's base frame: zero as a file writes it; a transformed scene
+        (``comparisons.transforms``) places the table there.
+    base_rotation : (3, 3) ndarray
+        Table base frame to chain base frame: the identity as a file writes it.
+    """
+
+    convention: str
+    a: np.ndarray
+    alpha: np.ndarray
+    d: np.ndarray
+    theta_offset: np.ndarray
+    base_xyz: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    base_rotation: np.ndarray = field(default_factory=lambda: np.eye(3))
+
+    def __post_init__(self) -> None:
+        if self.convention not in ("standard", "modified"):
+            raise SceneError("<code>", "dh.convention", f"{self.convention!r}", "standard, modified")
+        for key in ("a", "alpha", "d", "theta_offset"):
+            object.__setattr__(self, key, readonly(getattr(self, key), shape=(-1,)))
+        if len({len(self.a), len(self.alpha), len(self.d), len(self.theta_offset)}) != 1:
+            raise SceneError("<code>", "dh", "columns of different lengths", "a, alpha, d, theta_offset of one length")
+        object.__setattr__(self, "base_xyz", readonly(self.base_xyz, shape=(3,)))
+        object.__setattr__(self, "base_rotation", readonly(self.base_rotation, shape=(3, 3)))
+
+
+@dataclass(frozen=True)
 class Joint:
     """One joint of a serial chain (URDF semantics).
 
@@ -562,6 +618,12 @@ class Joint:
         Viscous joint damping [N m s/rad or N s/m], >= 0: the joint force -damping * qdot.
     armature : float
         Rotor inertia added to the joint's diagonal of the mass matrix [kg m^2 or kg], >= 0.
+    origin_rpy : (3,) ndarray or None
+        The roll-pitch-yaw [rad] a scene file gave ``origin_rotation`` as (URDF order: Rz(yaw) Ry(pitch)
+        Rx(roll)): the raw numbers core turned into the matrix, kept so that every reference turns them with its
+        own code (``references.common.scene_inputs``). None when the rotation was given as a matrix (in code,
+        from a URDF file or a DH table). Code that changes ``origin_rotation`` changes this with it
+        (``comparisons.transforms``), or sets it to None.
     """
 
     name: str
@@ -574,9 +636,12 @@ class Joint:
     link: LinkInertia | None = None
     damping: float = 0.0
     armature: float = 0.0
+    origin_rpy: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "axis", readonly(_unit(self.axis, 3, f"{self.name}.axis"), shape=(3,)))
+        if self.origin_rpy is not None:
+            object.__setattr__(self, "origin_rpy", readonly(self.origin_rpy, shape=(3,)))
         if np.isnan(self.lower) or np.isnan(self.upper) or self.lower > self.upper:
             raise SceneError("<code>", f"{self.name}.lower", f"limits ({self.lower}, {self.upper})",
                              "lower <= upper, -inf / inf for none")
@@ -619,6 +684,12 @@ class Chain:
         For a chain read from a URDF file: the file's movable joints below the base link that are not on the
         chain (fingers, branches, joints past the tip), held at 0 in the dynamics model (their links ride on
         the chain link they hang from). Empty otherwise.
+    end_effector_rpy : (3,) ndarray or None
+        The roll-pitch-yaw [rad] a scene file gave ``end_effector_rotation`` as (see :attr:`Joint.origin_rpy`);
+        None when the rotation was given as a matrix.
+    dh : DHTable or None
+        For a chain a scene file gave as a DH table: the table, from which every joint origin and the end
+        effector were computed (by core); None otherwise.
     """
 
     name: str
@@ -629,12 +700,19 @@ class Chain:
     urdf_path: str | None = None
     base_link: str | None = None
     held_joints: tuple[str, ...] = ()
+    end_effector_rpy: np.ndarray | None = None
+    dh: DHTable | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "end_effector_xyz", readonly(self.end_effector_xyz, shape=(3,)))
         object.__setattr__(
             self, "end_effector_rotation", readonly(self.end_effector_rotation, shape=(3, 3))
         )
+        if self.end_effector_rpy is not None:
+            object.__setattr__(self, "end_effector_rpy", readonly(self.end_effector_rpy, shape=(3,)))
+        if self.dh is not None and len(self.dh.a) != len(self.joints):
+            raise SceneError("<code>", "dh", f"{len(self.dh.a)} rows for {len(self.joints)} joints",
+                             "one row per joint")
 
     @property
     def n_joints(self) -> int:

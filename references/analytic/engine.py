@@ -55,6 +55,7 @@ from simparity.references.analytic import joint_dynamics as planar_dynamics
 from simparity.references.analytic import joint_motion
 from simparity.references.analytic import solutions as closed
 from simparity.references.common.conventions import matrix_to_quat_wxyz, principal_axes, quat_wxyz_to_matrix, rotvec_to_matrix
+from simparity.references.common.scene_inputs import derives_own_inputs
 
 # Relative tolerance deciding that principal moments are equal, or omega lies on a
 # principal axis: such scenes are built exactly so; 1e-12 only absorbs rounding.
@@ -298,6 +299,7 @@ class _TwoLinkIK(IKModel):
         return IKResult(q, success, np.zeros(len(p), int), residual, np.zeros(len(p)), violation, reason)
 
 
+@derives_own_inputs
 class AnalyticEngine(Engine):
     """Closed-form ground truths; ``n/a`` wherever no closed form is implemented."""
 

@@ -28,6 +28,7 @@ from simparity.core.model.engine import Engine, KinematicsModel, PieceSimulation
 from simparity.core.model.scene import Chain, DynamicsScene
 from simparity.core.model.trajectory import Trajectory, piece_bounds
 from simparity.references.common import external_forces
+from simparity.references.common.scene_inputs import derives_own_inputs
 
 TOLERANCE = 1e-13
 """rtol = atol of the solve. Against the elliptic-function solution of a tumbling box it measured
@@ -105,6 +106,7 @@ class _Simulation(PieceSimulation):
                              np.array([w for _, w, _ in samples]))
 
 
+@derives_own_inputs
 class TightSolveEngine(Engine):
     """DOP853 at tolerance 1e-13 on the rigid-body ODE: a reference, not an engine under test."""
 

@@ -17,7 +17,9 @@ What the engines are given, and why
   need no geometry ("model only what a scene needs"), so no engine opens a mesh: not one
   named by ``package://``, not one missing, and not one anywhere else on disk.
 - Other chains: ``base`` link, then one link per joint named after the joint, and a fixed
-  joint to a link named after the end effector. Revolute joints without limits become
+  joint to a link named after the end effector. Their frames are the ones the references derive from the
+  scene file's numbers (roll-pitch-yaw, a DH table: :mod:`references.common.scene_inputs`, through which every
+  reference engine is given its chains), never core's. Revolute joints without limits become
   ``continuous``. Links get the chain's declared mass properties (base and end effector massless) when it
   declares them; otherwise a placeholder inertial (mass 1, inertia 1e-3; PyBullet would otherwise invent mass 1,
   inertia 1), which kinematics does not see and dynamics never gets (it refuses such a chain).

@@ -75,6 +75,7 @@ from simparity.references.mujoco.mjcf import INTEGRATORS, arena_kib, chain_mjcf,
 from simparity.references.common.quiet import captured_output
 from simparity.references.common.urdf_export import chain_export, chain_source, chain_urdf, urdf_support
 from simparity.references.mujoco.joint_dynamics import MujocoJointDynamics, mujoco_dynamics_problem
+from simparity.references.common.scene_inputs import derives_own_inputs
 
 _STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
 _RESET_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL)
@@ -336,6 +337,7 @@ class MujocoChain(KinematicsModel):
         return self.base.jacobian(out)
 
 
+@derives_own_inputs
 class MujocoEngine(Engine):
     """MuJoCo, built from MJCF the adapter writes (see :mod:`references.mjcf`) or from a chain's URDF file."""
 

@@ -65,6 +65,7 @@ from simparity.references.pinocchio.joints import configuration
 from simparity.references.common.urdf_export import UrdfChains, chain_export, chain_source, chain_urdf, urdf_support
 from simparity.references.pinocchio import joint_motion
 from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics
+from simparity.references.common.scene_inputs import derives_own_inputs
 
 
 def free_body_model(body, gravity_world: np.ndarray | None) -> pin.Model:
@@ -287,6 +288,7 @@ def _dynamics_support(chain: Chain) -> Support:
     return urdf_support(chain) if chain.urdf_path is None else Support.yes()
 
 
+@derives_own_inputs
 class PinocchioEngine(UrdfChains, Engine):
     """Pinocchio: kinematics from a chain's URDF; dynamics from aba, stepped by the harness."""
 

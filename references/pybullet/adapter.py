@@ -116,6 +116,7 @@ from simparity.references.common.urdf_export import (
     chain_urdf,
     movable_joints_above_base,
 )
+from simparity.references.common.scene_inputs import derives_own_inputs
 
 _MAX_VELOCITY = 1e9  # [rad/s or m/s]: effectively no clamping
 _CLAMPED = 0.999 * _MAX_VELOCITY  # a velocity this large has hit the cap: the run blew up
@@ -470,6 +471,7 @@ def _armature_support(chain: Chain) -> Support:
     return Support.yes()
 
 
+@derives_own_inputs
 class PybulletEngine(UrdfChains, Engine):
     """PyBullet (Bullet multibody), built from URDF the adapter writes or a chain's URDF file."""
 
