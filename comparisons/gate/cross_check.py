@@ -101,6 +101,76 @@ def nullspace_checks(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Viol
     return out
 
 
+AGREEMENT_METRICS = (JOINT_ANGLE_ERROR_MAX, JOINT_VELOCITY_ERROR_MAX, END_EFFECTOR_ERROR_MAX,
+                     POWER_BALANCE_RESIDUAL_MAX)
+"""A chain's errors of motion, on which the built-in engines of one kind of scheme are held to each other: each kind
+is one discretisation of one ODE (the joint equations of motion), which core, MuJoCo, Pinocchio and PyBullet compute
+with no shared code, so at the same step their errors are the same up to rounding (measured alike to 4-7 digits on
+every built-in chain and on held-out robots). On a chain no bound names (a user's own robot) this is what holds a
+scheme whose order cannot be measured (its coarse steps on another orbit): a built-in whose error no other built-in
+of its kind shares within :data:`CROSS_CHECK_FACTOR` is a violation (two that disagree are both named)."""
+
+TRUTH_KINDS = ("adaptive", "closed_form")
+"""Kinds of the references themselves: held by their own bounds, never to another engine's error."""
+
+
+def agreement_checks(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Violation]:
+    """Every measured row of a built-in engine in :data:`AGREEMENT_METRICS` whose value is not within
+    :data:`CROSS_CHECK_FACTOR` of the same metric of some other built-in engine of its kind, on the same scene and
+    step (rows at their rounding floor are exact up to rounding: left out)."""
+    out = []
+    for row, others in _agreement_groups(table, builtin):
+        value = float(row["value"])
+        if any(value <= CROSS_CHECK_FACTOR * o and o <= CROSS_CHECK_FACTOR * value for o in others["value"]):
+            continue
+        listed = ", ".join(f"{o['engine']} {o['integrator']} {float(o['value']):.4g}" for o in others.to_dict("records"))
+        out.append(Violation(row["scene"], row["engine"], row["integrator"], float(row["dt"]), row["metric"],
+                             f"{value:.4g} {row['unit']}", f"within {CROSS_CHECK_FACTOR:g} x another built-in "
+                             f"{row['scheme']}",
+                             f"agreement: the built-in {row['scheme']} schemes compute one discretisation at this step, "
+                             f"but none agrees with this one ({listed})"))
+    return out
+
+
+def _agreement_groups(table: pd.DataFrame, builtin: tuple[str, ...]):
+    """(row, the other built-in engines' rows of its kind, scene, step and metric) for every measured built-in row
+    in :data:`AGREEMENT_METRICS` that has such others."""
+    if "scheme" not in table.columns:
+        return
+    flag = table["flag"].fillna("") if "flag" in table.columns else pd.Series("", index=table.index)
+    rows = table[table["engine"].isin(builtin) & table["metric"].isin(AGREEMENT_METRICS) & (table["status"] == OK)
+                 & (flag != ROUNDING_FLOOR) & (table["scheme"].fillna("") != "") & ~table["scheme"].isin(TRUTH_KINDS)]
+    rows = rows.assign(dt_key=rows["dt"].map(_dt_key))
+    for _, group in rows.groupby(["scene", "scheme", "dt_key", "metric"]):
+        if group["engine"].nunique() < 2:
+            continue
+        for row in group.to_dict("records"):
+            yield row, group[group["engine"] != row["engine"]]
+
+
+def held_series(table: pd.DataFrame, builtin: tuple[str, ...]) -> set[tuple[str, str, str]]:
+    """The series (scene, engine, integrator) a cross-check or the built-ins' agreement holds to a value: a user's
+    engine with a row compared with a built-in scheme of its kind that measured one, a built-in with a row compared
+    with another built-in of its kind (:func:`agreement_checks`)."""
+    held = {(row["scene"], row["engine"], row["integrator"]) for row, _ in _agreement_groups(table, builtin)}
+    if "scheme" not in table.columns:
+        return held
+    flag = table["flag"].fillna("") if "flag" in table.columns else pd.Series("", index=table.index)
+    watched = table[table["metric"].isin(ERROR_METRICS + RATE_METRICS) & (table["scheme"].fillna("") != "")]
+    measured = watched[watched["engine"].isin(builtin) & (watched["status"] == OK)]
+    kinds = set(zip(measured["scene"], measured["scheme"], measured["dt"].map(_dt_key), measured["metric"]))
+    users = watched[~watched["engine"].isin(builtin) & (watched["status"] == OK) & (flag[watched.index] != ROUNDING_FLOOR)]
+    for row in users.to_dict("records"):
+        if (row["scene"], row["scheme"], _dt_key(row["dt"]), row["metric"]) in kinds:
+            held.add((row["scene"], row["engine"], row["integrator"]))
+    return held
+
+
+def _dt_key(dt) -> str:
+    """A time step as a grouping key (NaN, an IK or kinematics row's, as "nan": NaN equals nothing)."""
+    return "nan" if pd.isna(dt) else repr(float(dt))
+
+
 def _builtin_rows(table: pd.DataFrame, builtin: tuple[str, ...]) -> pd.DataFrame:
     return table[table["engine"].isin(builtin) & (table["scheme"] != "")]
 
@@ -109,14 +179,15 @@ def cross_check(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Violation
     """Every row of an engine not in ``builtin`` with a declared scheme that the built-in rows of the same scene,
     scheme, time step and metric show to be beyond :data:`CROSS_CHECK_FACTOR` (errors), below
     :data:`SOLVE_RATE_FRACTION` (solve rates) or below the least (declared work, :data:`WORK_METRICS`), or saturated (unsolved) where the built-ins of its kind measured a
-    number; and every null-space solver of such an engine that does worse than its solver without the term
-    (:func:`nullspace_checks`)."""
+    number; every null-space solver of such an engine that does worse than its solver without the term
+    (:func:`nullspace_checks`); and every built-in's chain in motion that no other built-in of its kind agrees with
+    (:func:`agreement_checks`)."""
     if "scheme" not in table.columns:
         return []
     keys = ["scene", "scheme", "dt_key", "metric"]
-    table = table.assign(dt_key=table["dt"].map(lambda d: "nan" if pd.isna(d) else repr(float(d))),
+    table = table.assign(dt_key=table["dt"].map(_dt_key),
                          flag=table["flag"].fillna("") if "flag" in table.columns else "")
-    out = nullspace_checks(table, builtin)
+    out = nullspace_checks(table, builtin) + agreement_checks(table, builtin)
     watched = table[table["metric"].isin(ERROR_METRICS + RATE_METRICS + WORK_METRICS)]
     users = watched[~watched["engine"].isin(builtin) & (watched["scheme"].fillna("") != "")]
     if users.empty:  # no user's engine: no frame per group of the built-ins' rows (a sweep's thousands: 200 MB)
