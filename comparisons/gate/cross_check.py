@@ -104,11 +104,21 @@ def nullspace_checks(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Viol
 AGREEMENT_METRICS = (JOINT_ANGLE_ERROR_MAX, JOINT_VELOCITY_ERROR_MAX, END_EFFECTOR_ERROR_MAX,
                      POWER_BALANCE_RESIDUAL_MAX)
 """A chain's errors of motion, on which the built-in engines of one kind of scheme are held to each other: each kind
-is one discretisation of one ODE (the joint equations of motion), which core, MuJoCo, Pinocchio and PyBullet compute
-with no shared code, so at the same step their errors are the same up to rounding (measured alike to 4-7 digits on
-every built-in chain and on held-out robots). On a chain no bound names (a user's own robot) this is what holds a
-scheme whose order cannot be measured (its coarse steps on another orbit): a built-in whose error no other built-in
-of its kind shares within :data:`CROSS_CHECK_FACTOR` is a violation (two that disagree are both named)."""
+is one discretisation of one ODE (the joint equations of motion in (q, qdot)), which core, MuJoCo, Pinocchio and
+PyBullet compute with no shared code, so at the same step their errors are the same up to rounding. On a chain no
+bound names (a user's own robot) this is what holds a scheme whose order cannot be measured (its coarse steps on
+another orbit): a built-in whose error no other built-in of its kind shares within :data:`JOINT_AGREEMENT_FACTOR` is
+a violation (two that disagree are both named); a user's engine is held to them as closely."""
+
+JOINT_AGREEMENT_FACTOR = 1.25
+"""How far apart two errors of one kind of scheme on one chain at one step may be. Measured (quick profile, every
+engine pair): within 0.1 % on the default suite's chains (the worst at an error of 6e-13, near rounding), within
+3e-6 relative on held-out robots (SO-100, Kinova Gen2) from PyBullet's float32 link states; in a chaotic chain the
+engines' rounding grows like the reference's own error, and an error is measured only where it is more than 10 x
+that (else it is at the reference's floor), so rounding stays ~1e-4 of it. 25 % is 250 x the worst spread measured,
+while a scheme degraded into another (semi-implicit Euler moving the joints with the old velocity: 2 x on a falling
+arm; a stage weight off) moves the error by a factor of 1.5 and more: the free bodies' :data:`CROSS_CHECK_FACTOR` of
+2, set for representations that differ ((x, q, P, L) against MuJoCo's qpos), let such bugs through at 1.0-1.3 x."""
 
 TRUTH_KINDS = ("adaptive", "closed_form")
 """Kinds of the references themselves: held by their own bounds, never to another engine's error."""
@@ -116,16 +126,16 @@ TRUTH_KINDS = ("adaptive", "closed_form")
 
 def agreement_checks(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Violation]:
     """Every measured row of a built-in engine in :data:`AGREEMENT_METRICS` whose value is not within
-    :data:`CROSS_CHECK_FACTOR` of the same metric of some other built-in engine of its kind, on the same scene and
+    :data:`JOINT_AGREEMENT_FACTOR` of the same metric of some other built-in engine of its kind, on the same scene and
     step (rows at their rounding floor are exact up to rounding: left out)."""
     out = []
     for row, others in _agreement_groups(table, builtin):
         value = float(row["value"])
-        if any(value <= CROSS_CHECK_FACTOR * o and o <= CROSS_CHECK_FACTOR * value for o in others["value"]):
+        if any(value <= JOINT_AGREEMENT_FACTOR * o and o <= JOINT_AGREEMENT_FACTOR * value for o in others["value"]):
             continue
         listed = ", ".join(f"{o['engine']} {o['integrator']} {float(o['value']):.4g}" for o in others.to_dict("records"))
         out.append(Violation(row["scene"], row["engine"], row["integrator"], float(row["dt"]), row["metric"],
-                             f"{value:.4g} {row['unit']}", f"within {CROSS_CHECK_FACTOR:g} x another built-in "
+                             f"{value:.4g} {row['unit']}", f"within {JOINT_AGREEMENT_FACTOR:g} x another built-in "
                              f"{row['scheme']}",
                              f"agreement: the built-in {row['scheme']} schemes compute one discretisation at this step, "
                              f"but none agrees with this one ({listed})"))
@@ -237,11 +247,12 @@ def _judge(row: dict, builtin: pd.DataFrame) -> tuple[str, str, str] | None:
             return "0 (unsolved)", f">= {limit:.3g}", why
         return None
     largest = measured.loc[measured["value"].idxmax()]
-    limit = CROSS_CHECK_FACTOR * float(largest["value"])
+    factor = JOINT_AGREEMENT_FACTOR if row["metric"] in AGREEMENT_METRICS else CROSS_CHECK_FACTOR
+    limit = factor * float(largest["value"])
     side = f"{largest['engine']} {largest['integrator']} ({float(largest['value']):.4g} {row['unit']})"
     if row["status"] == OK and float(row["value"]) > limit and math.isfinite(limit):
         return (f"{float(row['value']):.4g} {row['unit']}", f"<= {limit:.3g} {row['unit']}",
-                f"cross-check: {CROSS_CHECK_FACTOR:g} x the largest built-in {kind} at this step, {side}")
+                f"cross-check: {factor:g} x the largest built-in {kind} at this step, {side}")
     if row["status"] == NOT_AVAILABLE and row["flag"] == SATURATED and (builtin["status"] == OK).all():
         return ("saturated", f"a number like the built-in {kind}",
                 f"cross-check: saturated where every built-in {kind} at this step measured one, e.g. {side}")
