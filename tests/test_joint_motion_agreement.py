@@ -8,9 +8,13 @@ each is held to the others (and a user's engine to them, by the cross-check), an
 
 from __future__ import annotations
 
-import pandas as pd
+import sys
 
-from simparity.comparisons.gate.check import check_table
+import pandas as pd
+import pytest
+
+from simparity.comparisons.cli.main import main
+from simparity.comparisons.gate.check import UNBOUNDED_SHARE_MAX, check_table
 from simparity.comparisons.gate.cross_check import JOINT_AGREEMENT_FACTOR, agreement_checks, held_series
 from simparity.comparisons.engines.registry import ENGINE_NAMES
 from simparity.comparisons.gate.tolerances import load_tolerances
@@ -18,6 +22,13 @@ from simparity.core.model.metric_catalogue import (
     END_EFFECTOR_ERROR_MAX, ENERGY_DRIFT_MAX, JOINT_ANGLE_ERROR_MAX, ORDER_JOINT_ANGLE,
 )
 from simparity.core.model.results import DIMENSIONLESS, NOT_AVAILABLE, OK, ROUNDING_FLOOR, SATURATED
+from simparity.reports.store import read_run
+from tests.mutation.catalogue import MUTANTS
+from tests.mutation.copy_of_core import materialise
+
+MARGIN = 1.5
+"""How far over its bound the planted bug must be on at least one line: the engines of one kind agree to 0.1 %, an
+explicit step under the semi-implicit name is 2 x off."""
 
 SCENE = "my-arm-falling"
 """A scene name no shipped bound names: a user's own robot."""
@@ -96,3 +107,48 @@ def test_a_user_engine_held_by_the_cross_check_counts_as_held_and_a_bug_in_it_is
     buggy.loc[planted, "value"] = 1.5 * ERROR  # a scheme degraded into another of its order, say
     found = check_table(buggy, load_tolerances()).violations
     assert [v.engine for v in found] == ["mine"]
+
+
+USER_ARM = """
+[scene]
+name = "my-so100-falling"
+kind = "joint_motion"
+reference = "pinocchio"
+[chain]
+urdf = "example-robot-data:so_arm_description/urdf/so100.urdf"
+[world]
+gravity_world = [0.0, 0.0, -9.81]
+[initial]
+q = "random"
+seed = 7
+[simulation]
+duration = 0.25
+dt = [0.001, 0.0005, 0.00025]
+"""
+"""A user's own robot (the SO-100 arm of the example-robot-data wheel) falling from a random pose under gravity, its
+damping as the file gives it: no shipped bound names it."""
+
+OLD_VELOCITY = next(m for m in MUTANTS if m.id == "joint_semi_implicit_old_velocity")
+"""Semi-implicit Euler moving the joints with the old velocity (explicit Euler under the semi-implicit name): of the
+same order, so only its error tells it."""
+
+
+@pytest.mark.slow
+def test_a_user_s_robot_falling_is_checked_passes_when_right_and_names_a_planted_bug(tmp_path, monkeypatch, capsys):
+    """Before: 'unbounded: 13 of 21 series', check FAILED with 0 metrics outside their bounds, whatever the engines
+    did; the planted bug's cross-check lines at 1.01-1.03 x their bound."""
+    monkeypatch.setenv("PYTHONPATH", f"{tmp_path}:{':'.join(sys.path)}")  # the probes and workers import the copies
+    faithful, mutant = materialise(None, tmp_path), materialise(OLD_VELOCITY, tmp_path)
+    scene = tmp_path / "my-arm.toml"
+    scene.write_text(USER_ARM, encoding="utf-8")
+    code = main(["run", str(scene), "--quick", "--check", "--engines", f"core,pinocchio,{faithful.spec},{mutant.spec}",
+                 "--out", str(tmp_path / "run"), "--history", str(tmp_path / "h.db")])
+    lines = capsys.readouterr().out.splitlines()
+    violations = [line for line in lines if line.startswith("violation: ")]
+    assert code == 1 and not [line for line in lines if line.startswith("unbounded: ")]
+    assert {line.split()[2] for line in violations} == {mutant.engine_name}  # "violation: scene engine ..."
+    table, _ = read_run(tmp_path / "run")
+    result = check_table(table[table.engine != mutant.engine_name], load_tolerances())
+    assert result.passed and result.unbounded_share <= UNBOUNDED_SHARE_MAX  # right: passes, and checked
+    planted = [v for v in check_table(table, load_tolerances()).violations if v.engine == mutant.engine_name]
+    assert any(float(v.found.split()[0]) > MARGIN * float(v.bound.split()[1]) for v in planted)
