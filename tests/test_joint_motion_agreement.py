@@ -137,6 +137,7 @@ same order, so only its error tells it."""
 def test_a_user_s_robot_falling_is_checked_passes_when_right_and_names_a_planted_bug(tmp_path, monkeypatch, capsys):
     """Before: 'unbounded: 13 of 21 series', check FAILED with 0 metrics outside their bounds, whatever the engines
     did; the planted bug's cross-check lines at 1.01-1.03 x their bound."""
+    monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.setenv("PYTHONPATH", f"{tmp_path}:{':'.join(sys.path)}")  # the probes and workers import the copies
     faithful, mutant = materialise(None, tmp_path), materialise(OLD_VELOCITY, tmp_path)
     scene = tmp_path / "my-arm.toml"
@@ -145,7 +146,7 @@ def test_a_user_s_robot_falling_is_checked_passes_when_right_and_names_a_planted
                  "--out", str(tmp_path / "run"), "--history", str(tmp_path / "h.db")])
     lines = capsys.readouterr().out.splitlines()
     violations = [line for line in lines if line.startswith("violation: ")]
-    assert code == 1 and not [line for line in lines if line.startswith("unbounded: ")]
+    assert code == 1 and not [line for line in lines if line.startswith("unbounded: ")], "\n".join(lines[-20:])
     assert {line.split()[2] for line in violations} == {mutant.engine_name}  # "violation: scene engine ..."
     table, _ = read_run(tmp_path / "run")
     result = check_table(table[table.engine != mutant.engine_name], load_tolerances())
