@@ -78,6 +78,15 @@ def test_a_built_in_that_no_other_of_its_kind_agrees_with_is_named():
     assert "pinocchio" in found[0].reason and check_table(table, load_tolerances()).violations
 
 
+def test_a_chain_s_energy_drift_is_held_alike_and_a_free_body_s_is_not():
+    drifted = [dict(r, value=0.3) if r["engine"] == "core" and r["metric"] == ENERGY_DRIFT_MAX else r
+               for r in _falling()]
+    assert [(v.engine, v.metric) for v in agreement_checks(pd.DataFrame(drifted), ENGINE_NAMES)] == [
+        ("core", ENERGY_DRIFT_MAX)]
+    free = [r for r in drifted if r["metric"] == ENERGY_DRIFT_MAX]  # no joint errors: free bodies, held by bounds
+    assert agreement_checks(pd.DataFrame(free), ENGINE_NAMES) == []
+
+
 def test_two_built_ins_that_disagree_are_both_named_and_agreement_is_within_the_factor():
     two = [r for r in _falling({"core": ERROR, "pinocchio": 0.99 * JOINT_AGREEMENT_FACTOR * ERROR})
            if r["engine"] in ("core", "pinocchio")]
