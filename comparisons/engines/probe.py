@@ -21,8 +21,8 @@ import sys
 import tempfile
 import time
 from collections.abc import Sequence
-from typing import cast
 from dataclasses import dataclass, field, replace
+from typing import cast
 
 import numpy as np
 

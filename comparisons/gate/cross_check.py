@@ -148,9 +148,8 @@ def _agreement_groups(table: pd.DataFrame, builtin: tuple[str, ...]):
     in :data:`AGREEMENT_METRICS` that has such others."""
     if "scheme" not in table.columns:
         return
-    flag = table["flag"].fillna("") if "flag" in table.columns else pd.Series("", index=table.index)
     rows = table[table["engine"].isin(builtin) & _in_motion(table) & (table["status"] == OK)
-                 & (flag != ROUNDING_FLOOR) & (table["scheme"].fillna("") != "") & ~table["scheme"].isin(TRUTH_KINDS)]
+                 & (_flags(table) != ROUNDING_FLOOR) & (table["scheme"].fillna("") != "") & ~table["scheme"].isin(TRUTH_KINDS)]
     rows = rows.assign(dt_key=rows["dt"].map(_dt_key))
     for _, group in rows.groupby(["scene", "scheme", "dt_key", "metric"]):
         if group["engine"].nunique() < 2:
@@ -174,15 +173,19 @@ def held_series(table: pd.DataFrame, builtin: tuple[str, ...]) -> set[tuple[str,
     held = {(row["scene"], row["engine"], row["integrator"]) for row, _ in _agreement_groups(table, builtin)}
     if "scheme" not in table.columns:
         return held
-    flag = table["flag"].fillna("") if "flag" in table.columns else pd.Series("", index=table.index)
     watched = table[table["metric"].isin(ERROR_METRICS + RATE_METRICS) & (table["scheme"].fillna("") != "")]
     measured = watched[watched["engine"].isin(builtin) & (watched["status"] == OK)]
     kinds = set(zip(measured["scene"], measured["scheme"], measured["dt"].map(_dt_key), measured["metric"]))
-    users = watched[~watched["engine"].isin(builtin) & (watched["status"] == OK) & (flag[watched.index] != ROUNDING_FLOOR)]
+    users = watched[~watched["engine"].isin(builtin) & (watched["status"] == OK) & (_flags(watched) != ROUNDING_FLOOR)]
     for row in users.to_dict("records"):
         if (row["scene"], row["scheme"], _dt_key(row["dt"]), row["metric"]) in kinds:
             held.add((row["scene"], row["engine"], row["integrator"]))
     return held
+
+
+def _flags(table: pd.DataFrame) -> pd.Series:
+    """(rows,) str: each row's flag ("" for none, and for a table without flags)."""
+    return table["flag"].fillna("") if "flag" in table.columns else pd.Series("", index=table.index)
 
 
 def _dt_key(dt) -> str:
@@ -204,8 +207,7 @@ def cross_check(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Violation
     if "scheme" not in table.columns:
         return []
     keys = ["scene", "scheme", "dt_key", "metric"]
-    table = table.assign(dt_key=table["dt"].map(_dt_key), in_motion=_in_motion(table),
-                         flag=table["flag"].fillna("") if "flag" in table.columns else "")
+    table = table.assign(dt_key=table["dt"].map(_dt_key), in_motion=_in_motion(table), flag=_flags(table))
     out = nullspace_checks(table, builtin) + agreement_checks(table, builtin)
     watched = table[table["metric"].isin(ERROR_METRICS + RATE_METRICS + WORK_METRICS)]
     users = watched[~watched["engine"].isin(builtin) & (watched["scheme"].fillna("") != "")]
