@@ -21,7 +21,8 @@ import sys
 import tempfile
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
+from typing import cast
 
 import numpy as np
 
@@ -185,6 +186,36 @@ def probe_engines(names: list[str], scenes: Sequence = ()) -> dict[str, Engine]:
     finally:
         for probe in probes.values():
             probe.close()
+
+
+def asked_about(engines: Sequence[Engine], scenes: Sequence, specs: dict[str, str] | None = None) -> list[Engine]:
+    """``engines`` with every :class:`DescribedEngine` also asked about those of ``scenes`` its description does
+    not hold (a run's transformed and one-ulp perturbed scenes, made after the engines were described), as
+    :func:`probe_engines` asks: one probe per such engine, all at once. ``specs`` maps an engine's name to what
+    it is built from, when that is not its name. A probe that cannot answer (a crash, a hang) leaves its error
+    as each new scene's answer: those cases fail with it. Other engines are returned as they are."""
+    hashes = {scene_hash(scene): scene for scene in scenes}
+    asking = {engine.name: [h for h in hashes if h not in engine.description.scene_integrators]
+              for engine in engines if isinstance(engine, DescribedEngine)}
+    asking = {name: missing for name, missing in asking.items() if missing}
+    if not asking:
+        return list(engines)
+    spec_of = {name: (specs or {}).get(name, name) for name in asking}
+    probed = probe_engines(list(spec_of.values()), [hashes[h] for h in dict.fromkeys(sum(asking.values(), []))])
+    out: list[Engine] = []
+    for engine in engines:
+        if engine.name not in asking:
+            out.append(engine)
+            continue
+        assert isinstance(engine, DescribedEngine)  # only described engines are asked
+        answer = probed[spec_of[engine.name]]
+        found = (answer.description.scene_integrators if isinstance(answer, DescribedEngine) else
+                 {h: f"asking it about scene {hashes[h].name}: {cast(StandInEngine, answer).reason}"
+                  for h in asking[engine.name]})
+        scene_integrators = {**engine.description.scene_integrators,
+                             **{h: found[h] for h in asking[engine.name] if h in found}}
+        out.append(DescribedEngine(replace(engine.description, scene_integrators=scene_integrators)))
+    return out
 
 
 def _memory_limit() -> int:

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from simparity.comparisons.gate.cross_check import CROSS_CHECK_FACTOR, SOLVE_RATE_FRACTION, cross_check
+from simparity.comparisons.gate.cross_check import CROSS_CHECK_FACTOR, SOLVE_RATE_FRACTION, cross_check, held_series
 from simparity.comparisons.gate.violation import Violation, row_label
 from simparity.comparisons.engines.registry import ENGINE_NAMES
 from simparity.comparisons.gate.tolerances import Bound, BoundIndex
@@ -138,6 +138,9 @@ def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = 
         result.violations.append(violation)
         result.cases.setdefault(_case_key(violation.scene, violation.engine, violation.integrator, violation.dt),
                                 []).append(violation)
+    for series in held_series(table, ENGINE_NAMES) if cross_checked else ():  # held to another engine's value
+        if series in result.series:
+            result.series[series] = True
     result.unmeasured = {key: reason for key, reason in measured.items() if reason is not None and not result.cases[key]}
     return result
 

@@ -10,6 +10,7 @@ compared.
 
 from __future__ import annotations
 
+from simparity.comparisons.engines.probe import asked_about
 from simparity.comparisons.engines.registry import ENGINE_NAMES, make_engine
 from simparity.comparisons.execute.execution import Executor, run_scenes
 from simparity.comparisons.execute.journal import Journal
@@ -34,7 +35,8 @@ def invariance_rows(scenes: list, base_rows: list[list[ResultRow]], transforms: 
     """The invariance rows of each scene (in order) under ``transforms``, given its rows ``base_rows``; ``say``
     hears one line per scene."""
     def run(batch: list) -> list[list[ResultRow]]:
-        return [rows for _, rows, _ in run_scenes(batch, engines, make_engine, INVARIANCE_REPEATS, executor, journal,
+        described = asked_about(engines, batch, specs)  # a user's engine knows only the run's own scenes
+        return [rows for _, rows, _ in run_scenes(batch, described, make_engine, INVARIANCE_REPEATS, executor, journal,
                                                  None, specs)]
 
     out = []
