@@ -4,6 +4,7 @@ reference's horizon, unitless errors."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -147,3 +148,31 @@ def test_metrics_of_a_scene_name_its_energy_balance():
     assert POWER_BALANCE_RESIDUAL_MAX not in jm.motion_metrics(_scene())
     assert POWER_BALANCE_RESIDUAL_MAX in jm.motion_metrics(_scene(torque=0.1))
     assert ENERGY_DRIFT_MAX not in jm.motion_metrics(_scene(damping=0.1))
+
+
+def test_a_chain_resting_in_equilibrium_is_judged_against_a_physical_energy_floor_not_its_rounding():
+    """A 1 kg pendulum hanging at rest under gravity moves by rounding alone (qdot ~ 1e-16 rad/s): the energy it
+    exchanges is itself rounding (5e-33 J), so a drift relative to it reads 100 % and a budget of 0 J calls it
+    diverged. Against the chain's physical floor (1e-9 x m |g| reach) the drift is rounding-level and the run is not
+    diverged; the detail states the floor."""
+    scene = dataclasses.replace(_scene(), gravity_world=np.array([9.81, 0.0, 0.0]), qdot0=np.zeros(1))
+    sim = _Sim(potential=lambda q: -9.81 * np.cos(q))  # the COM 1 m along the link, hanging at q = 0
+    still = _trajectory(1e-17 * np.sin(TIMES), 1e-16 * np.cos(TIMES) ** 2, TIMES)
+    own = jm.read_own(sim, still)
+    drift = jm.energy_metrics(scene, still, own)[ENERGY_DRIFT_MAX]
+    floor = 1e-9 * 9.81 * 1.0  # m |g| reach: 1 kg, 1 m to the end effector
+    assert drift.value == pytest.approx(0.5e-32 / floor, rel=1e-6)
+    assert "energy floor" in drift.note
+    assert jm.divergence(scene, still, own) == ""
+
+
+def test_a_chain_whose_joints_sit_at_one_point_has_its_links_size_as_its_reach():
+    """A slider whose joint, centre of mass and end effector all sit at its origin has no offset to measure its
+    reach by: its reach is its link's radius of gyration sqrt(tr I / 2m), not the smallest float (which turns a
+    rounding-level offset into a saturated error)."""
+    link = LinkInertia(2.0, np.zeros(3), np.diag([0.1, 0.2, 0.3]))
+    joint = Joint("j", "prismatic", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.eye(3), lower=-1.0, upper=1.0, link=link)
+    chain = Chain("c", (joint,), end_effector_xyz=np.zeros(3))
+    assert jm.reach(chain) == pytest.approx(math.sqrt(0.6 / 4.0), rel=1e-12)
+    resting = _trajectory(np.zeros_like(TIMES), np.zeros_like(TIMES), TIMES)
+    assert jm.joint_scales(chain, resting)[0] == pytest.approx(math.sqrt(0.6 / 4.0), rel=1e-12)

@@ -33,7 +33,7 @@ from simparity.core.model.metric_catalogue import (
     END_EFFECTOR_ERROR_MAX, JOINT_ANGLE_ERROR_MAX, JOINT_VELOCITY_ERROR_MAX, SEGMENT_REFERENCE_ERROR_MAX,
     SELF_PARTING_TIME, TIME_PER_STEP,
 )
-from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
+from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, SATURATED, ResultRow
 from simparity.core.model.scene import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 
@@ -226,6 +226,10 @@ def _measured(scene: JointMotionScene, engine: Engine, sim: JointSimulation, cas
         rows += case.rows({m: metrics[m] for m in REFERENCE_ERRORS}, status, problem)
         order = list(metrics)
         return CaseOutcome(sorted(rows, key=lambda row: order.index(row.metric)))
+    if errors[JOINT_ANGLE_ERROR_MAX].flag == SATURATED:  # on another orbit: did the energy carry it there?
+        pumped = divergence(scene, traj, own, saturated=True)
+        if pumped:
+            return CaseOutcome(case.rows(metrics, DIVERGED, f"{pumped}; {sim.detail}", values))
     values.update(errors)
     if SELF_PARTING_TIME in metrics:
         values.update(_predictability(scene, engine, case, traj, shared.trajectory))

@@ -258,6 +258,9 @@ class ContactReading:
         least the energy that lifts it by its own size (a body resting on a plane has no other).
     energy_kept : dict of (body, plane) to (N,) ndarray
         Per impact, the energy it keeps (:func:`_energy_kept`); NaN where the outcome is unknown.
+    impact_budgets : dict of (body, plane) to dict of int to float
+        Per impact, keyed by the sample before its episode: its energy budget [J], the body's energy above the plane
+        there (kinetic + m |g_n| height of its support), what it may keep at most.
     touch_gap : (B,) ndarray
         The support distance within which each body touches a plane [m].
     """
@@ -272,6 +275,7 @@ class ContactReading:
     energy_scale: np.ndarray
     energy_kept: dict[tuple[int, int], np.ndarray]
     touch_gap: np.ndarray
+    impact_budgets: dict[tuple[int, int], dict[int, float]]
 
     def starts_on_plane(self) -> np.ndarray:
         """(B,) bool: bodies that touch a plane at the first sample."""
@@ -353,7 +357,7 @@ def read_contact(scene: DynamicsScene, traj: Trajectory) -> ContactReading:
     kinetic = kinetic_energy(mass, inertia, traj.velocity_world, traj.angular_velocity_world, rotation)
     potential = (np.zeros_like(kinetic) if scene.forces.gravity_world is None
                  else potential_energy(mass, scene.forces.gravity_world, traj.position_world))
-    found, episodes, kept = {}, {}, {}
+    found, episodes, kept, budgets = {}, {}, {}, {}
     least = least_impact_speeds(scene)
     gaps = touch_gaps(scene)
     spin = np.linalg.norm(traj.angular_velocity_world, axis=-1) * shape_reach(scene)
@@ -368,9 +372,10 @@ def read_contact(scene: DynamicsScene, traj: Trajectory) -> ContactReading:
             above = kinetic[:, b] + mass[b] * abs(g_n) * np.maximum(distance[:, b, p], 0.0)
             kept[b, p] = _energy_kept(found[b, p], episodes[b, p], kinetic[:, b] + potential[:, b], above,
                                       distance[:, b, p])
+            budgets[b, p] = {int(before): float(above[before]) for before in found[b, p].before}
     scale = np.maximum(kinetic.max(axis=0), lift_energies(scene))
     return ContactReading(found, episodes, distance, highest, _rest_times(scene, traj), kinetic + potential, kinetic,
-                          scale, kept, gaps)
+                          scale, kept, gaps, budgets)
 
 
 def _nothing(unit: str, why: str) -> Measured:
@@ -482,32 +487,41 @@ def _rest_jitter(scene: DynamicsScene, reading: ContactReading, traj: Trajectory
                                               "in which the body rests")
 
 
-def contact_energy_gains(reading: ContactReading) -> np.ndarray:
+def contact_energy_gains(reading: ContactReading, per_impact: bool = False) -> np.ndarray:
     """(B,) the largest rise of kinetic + potential energy across a contact episode of each body (from the
     sample before it to the sample after it), relative to the body's energy scale (its largest kinetic energy
     of the run, at least the energy that lifts it by its own size); 0 where it has none. Contact and friction
     only take energy away; a free flight's own drift between episodes is the integrator's, not the contact's,
-    and is not counted."""
+    and is not counted.
+
+    ``per_impact``: an impact's rise is relative to its own budget instead, the body's energy above the plane
+    before it (:attr:`ContactReading.impact_budgets`, what ``energy_kept`` is relative to), so that both read one
+    impact alike; an episode that is no impact (a touch slower than one: settling, resting, sliding) keeps the
+    body's energy scale, the physical floor of a body whose energy above the plane is all but 0."""
     scale = reading.energy_scale
     gains = np.zeros(reading.energy.shape[1])
-    for (b, _), bounds in reading.episodes.items():
+    for (b, p), bounds in reading.episodes.items():
         if bounds and scale[b] > 0:
-            rise = max(reading.energy[after, b] - reading.energy[before, b] for before, after in bounds)
-            gains[b] = max(gains[b], rise / scale[b])
+            budgets = reading.impact_budgets[b, p] if per_impact else {}
+            rise = max(((reading.energy[after, b] - reading.energy[before, b]) / budgets.get(before, scale[b])
+                        for before, after in bounds if budgets.get(before, scale[b]) > 0), default=0.0)
+            gains[b] = max(gains[b], rise)
     return gains
 
 
 def _energy_gain(reading: ContactReading) -> Measured:
-    """:func:`contact_energy_gains`, the worst body's."""
+    """:func:`contact_energy_gains` per impact, the worst body's."""
     if not any(reading.episodes.values()):
         return _nothing("1", "no contact: no energy to gain at one")
     if not (reading.energy_scale > 0).any():
         return _nothing("1", "no body moved and none has weight: no energy to gain")
-    gain = float(contact_energy_gains(reading).max())
+    gain = float(contact_energy_gains(reading, per_impact=True).max())
     if gain <= ENERGY_GAIN_ROUNDING:
         return Measured(0.0, "1", note=f"rises below {ENERGY_GAIN_ROUNDING:g} of the energy scale are rounding")
-    return Measured(gain, "1", note="across a contact episode, relative to the body's largest kinetic energy (at least "
-                                   "m |g| size)")
+    return Measured(gain, "1", note=(
+        "across a contact episode, relative to the impact's budget (the body's energy above the plane before it, "
+        "as energy_kept); a touch that is no impact relative to the body's largest kinetic energy (at least "
+        "m |g| size)"))
 
 
 UNSTABLE_ENERGY_GAIN = 0.1
@@ -524,42 +538,78 @@ look free (PyBullet's speculative contacts at coarse steps) makes the normal reb
 is kept."""
 
 SUSTAINED_GAIN_IMPACTS = 3
-"""Successive impacts of one body on one plane that each gain more than :data:`REBOUND_GAIN_TOLERANCE` allows
-are a contact that pumps energy in (a penalty spring past its integrator's stability limit), not an error:
-diverged. One or two such impacts stay numbers (``energy_kept_max``, ``restitution_max``, ``energy_gain_max``):
-a grazing impact spread over steps of comparable gravity can gain once."""
+"""Impacts of one body on one plane that each gain more than :data:`REBOUND_GAIN_TOLERANCE` allows, at least this
+many and either in succession or at most of its impacts (more than half of those with a known outcome), are a
+contact that pumps energy in (a penalty spring past its integrator's stability limit), not an error: diverged. One
+or two such impacts, or a few among many that lose energy, stay numbers (``energy_kept_max``, ``restitution_max``,
+``energy_gain_max``): a grazing impact spread over steps of comparable gravity can gain once."""
 
 
-def sustained_gain(reading: ContactReading) -> tuple[int, int, int, list[float]]:
-    """(impacts, body, plane, the energy each kept) of the longest run of successive impacts of one body on one
-    plane each keeping more than (1 + :data:`REBOUND_GAIN_TOLERANCE`)^2 of the body's energy above the plane;
-    (0, -1, -1, []) when there is none."""
-    best: tuple[int, int, int, list[float]] = (0, -1, -1, [])
+@dataclass(frozen=True)
+class SustainedGain:
+    """The impacts of one body on one plane that gain energy (each keeps more than (1 +
+    :data:`REBOUND_GAIN_TOLERANCE`)^2 of its budget, the body's energy above the plane before it).
+
+    Attributes
+    ----------
+    body, plane : int
+        -1 when no impact gains.
+    gaining : int
+        How many gain.
+    impacts : int
+        How many have a known outcome.
+    successive : int
+        The longest run of successive gaining impacts.
+    kept : list of float
+        The energy each gaining impact kept, in time order.
+    """
+
+    body: int = -1
+    plane: int = -1
+    gaining: int = 0
+    impacts: int = 0
+    successive: int = 0
+    kept: tuple[float, ...] = ()
+
+    @property
+    def sustained(self) -> bool:
+        """At least :data:`SUSTAINED_GAIN_IMPACTS` gain, in succession or at more than half of the impacts."""
+        return self.gaining >= SUSTAINED_GAIN_IMPACTS and (self.successive >= SUSTAINED_GAIN_IMPACTS
+                                                           or 2 * self.gaining > self.impacts)
+
+
+def sustained_gain(reading: ContactReading) -> SustainedGain:
+    """The body and plane whose impacts gain energy the most sustainedly (:attr:`SustainedGain.sustained` first,
+    then the most gaining impacts); an empty :class:`SustainedGain` when none gains."""
+    best = SustainedGain()
     for (b, p), found in reading.impacts.items():
-        run: list[float] = []
-        for kept in reading.energy_kept[b, p][found.measured].tolist() + [0.0]:
-            if kept > (1 + REBOUND_GAIN_TOLERANCE) ** 2:
-                run.append(kept)
-                continue
-            if len(run) > best[0]:
-                best = (len(run), b, p, run)
-            run = []
+        kept = reading.energy_kept[b, p][found.measured]
+        gains = kept > (1 + REBOUND_GAIN_TOLERANCE) ** 2
+        if not gains.any():
+            continue
+        runs = np.diff(np.flatnonzero(np.diff(np.concatenate([[0], gains.astype(int), [0]]))))[::2]
+        here = SustainedGain(b, p, int(gains.sum()), len(kept), int(runs.max()), tuple(kept[gains].tolist()))
+        if (here.sustained, here.gaining) > (best.sustained, best.gaining):
+            best = here
     return best
 
 
 def contact_blow_up(scene: DynamicsScene, reading: ContactReading) -> str:
     """Why a run counts as diverged at a contact, or "": energy gained across one contact beyond
-    :data:`UNSTABLE_ENERGY_GAIN`, or a gain sustained over :data:`SUSTAINED_GAIN_IMPACTS` successive impacts."""
+    :data:`UNSTABLE_ENERGY_GAIN` of the body's energy scale, or a gain sustained over its impacts
+    (:attr:`SustainedGain.sustained`), each judged against the impact's own budget."""
     gains = contact_energy_gains(reading)
     if gains.max(initial=0.0) > UNSTABLE_ENERGY_GAIN:
         b = int(np.argmax(gains))
         return (f"energy of {scene.bodies[b].name} rose by {gains[b]:.3g} of its energy scale across a contact "
                 f"(limit {UNSTABLE_ENERGY_GAIN:.0%}: contact only takes energy away)")
-    count, b, p, kept = sustained_gain(reading)
-    if count >= SUSTAINED_GAIN_IMPACTS:
-        shown = ", ".join(f"{k:.3g}" for k in kept[:6]) + (", ..." if count > 6 else "")
-        return (f"{scene.bodies[b].name} gained energy at {count} successive impacts on {contact_of(scene).planes[p].name} "
-                f"(energy kept {shown} > (1 + {REBOUND_GAIN_TOLERANCE:g})^2: contact only takes energy away)")
+    gain = sustained_gain(reading)
+    if gain.sustained:
+        shown = ", ".join(f"{k:.3g}" for k in gain.kept[:6]) + (", ..." if gain.gaining > 6 else "")
+        return (f"{scene.bodies[gain.body].name} gained energy at {gain.gaining} of its {gain.impacts} impacts on "
+                f"{contact_of(scene).planes[gain.plane].name} ({gain.successive} in succession; energy kept {shown} "
+                f"> (1 + {REBOUND_GAIN_TOLERANCE:g})^2 of the energy above the plane before each: contact only "
+                "takes energy away)")
     return ""
 
 

@@ -101,13 +101,35 @@ def joint_scales(chain: Chain, motion: JointTrajectory) -> np.ndarray:
 
 def reach(chain: Chain) -> float:
     """[m] The chain's size: the sum of its joint offsets after the first joint and its end-effector offset; at
-    least the largest link's centre-of-mass offset, never 0. Where the first joint sits in the base frame is left out
-    (moving the chain's mount, a base 2 km away, changes no distance the chain can cover), and so are joint limits
-    (they do not act on the motion)."""
+    least the largest link's centre-of-mass offset and its radius of gyration sqrt(tr I_c / 2m) (a physical size of
+    the chain itself, so that a chain whose joints all sit at one point still has one), never 0. Where the first
+    joint sits in the base frame is left out (moving the chain's mount, a base 2 km away, changes no distance the
+    chain can cover), and so are joint limits (they do not act on the motion)."""
     offsets = sum(float(np.linalg.norm(j.origin_xyz)) for j in chain.joints[1:])
     offsets += float(np.linalg.norm(chain.end_effector_xyz))
-    com = max((float(np.linalg.norm(j.link.com_xyz)) for j in chain.joints if j.link is not None), default=0.0)
-    return max(offsets, com, np.finfo(float).tiny)
+    links = [j.link for j in chain.joints if j.link is not None]
+    com = max((float(np.linalg.norm(link.com_xyz)) for link in links), default=0.0)
+    gyration = max((math.sqrt(max(float(np.trace(link.inertia_com)), 0.0) / (2 * link.mass)) for link in links
+                    if link.mass > 0), default=0.0)
+    return max(offsets, com, gyration, np.finfo(float).tiny)
+
+
+ENERGY_SCALE_FLOOR = 1e-9
+"""[1] The least energy a chain under gravity is judged to exchange, as a fraction of its weight lifted by its reach
+(:func:`energy_floor`): the scale of its energy balance and its energy budget are never below it. A chain resting in
+equilibrium exchanges only rounding (its energies are rounded at eps of their size, 2e-16 of that weight's energy
+for a mount within a reach), which over the floor stays a rounding-level fraction, never a 100 % drift or a
+diverged run; a swing of 1e-4 rad already exchanges 5e-9 of it, so no motion a scene is written to show is
+judged against the floor."""
+
+
+def energy_floor(scene: JointMotionScene) -> float:
+    """[J] :data:`ENERGY_SCALE_FLOOR` x the chain's mass x |g| x :func:`reach`; 0 without gravity (a chain at rest
+    without gravity has exact energies of 0: nothing to measure)."""
+    if scene.gravity_world is None:
+        return 0.0
+    mass = sum(j.link.mass for j in scene.chain.joints if j.link is not None)
+    return ENERGY_SCALE_FLOOR * mass * float(np.linalg.norm(scene.gravity_world)) * reach(scene.chain)
 
 
 @dataclass(frozen=True)
@@ -178,15 +200,19 @@ def _work(scene: JointMotionScene, traj: JointTrajectory) -> tuple[np.ndarray, n
 
 def energy_budget(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading) -> np.ndarray:
     """(B,) [J] the most kinetic energy the exact motion can have: its initial kinetic energy, the largest drop of
-    its potential energy along the run and the work the applied forces put in (damping only takes energy)."""
+    its potential energy along the run and the work the applied forces put in (damping only takes energy); at least
+    :func:`energy_floor`."""
     _, supplied, _ = _work(scene, traj)
     drop = own.potential[0] - own.potential.min(axis=0)
-    return own.kinetic[0] + np.maximum(drop, 0.0) + supplied[own.index].max(axis=0)
+    return np.maximum(own.kinetic[0] + np.maximum(drop, 0.0) + supplied[own.index].max(axis=0), energy_floor(scene))
 
 
-def divergence(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading | None) -> str:
-    """Why ``traj`` counts as diverged ("" when it does not): a non-finite state, or a kinetic energy more than
-    1 + :data:`CONSERVED_GROWTH_LIMIT` times the budget the scene can supply (:func:`energy_budget`)."""
+def divergence(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading | None, saturated: bool = False) -> str:
+    """Why ``traj`` counts as diverged ("" when it does not): a non-finite state, a kinetic energy more than
+    1 + :data:`CONSERVED_GROWTH_LIMIT` times the budget the scene can supply (:func:`energy_budget`), or, when the
+    run's joint values are ``saturated`` (on another orbit), a potential energy beyond what the exact motion can reach by more than
+    :data:`UNREACHABLE_CLIMB` of that budget (:func:`climb`): the energy it left its bound by put it on another orbit,
+    so the run is diverged, not an error too large to measure, whatever the amplitude at which it went there."""
     if not traj.is_finite():
         return "non-finite joint state"
     if own is None:
@@ -201,10 +227,42 @@ def divergence(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading |
             return "kinetic energy overflows (the joint velocities grew past 1e150)"
         return (f"kinetic energy {peak[c]:.3g} J > {1 + CONSERVED_GROWTH_LIMIT:g} x the most the scene can supply "
                 f"({budget[c]:.3g} J: initial kinetic energy, potential drop and the applied forces' work)")
+    if saturated:
+        climbed = climb(scene, traj, own)
+        beyond = np.flatnonzero(climbed > UNREACHABLE_CLIMB * budget)
+        if beyond.size:
+            c = int(beyond[np.argmax(climbed[beyond] / budget[beyond])])
+            return (f"its error saturated where its energy cannot take it: its potential energy rose {climbed[c]:.3g} J "
+                    f"({climbed[c] / budget[c]:.3g} x the budget {budget[c]:.3g} J; limit {UNREACHABLE_CLIMB:g} x) "
+                    "above the most the exact motion can reach (its initial energy and the applied forces' work): "
+                    "energy pumped in carried the run to another orbit")
     return ""
 
 
-def _relative(value: float, scale: float, what: str) -> Measured:
+UNREACHABLE_CLIMB = 0.05
+"""The exact motion's potential energy never exceeds its initial energy plus the work the applied forces put in (its
+kinetic energy is never negative). A run whose joint values' error saturated (it is on another orbit: a configuration,
+what the potential energy is of) after its potential rose above that by more than this fraction of
+:func:`energy_budget` went where the scene's energy cannot take it: energy pumped in carried it there (over the top of
+a swing, past a barrier), and it is diverged, not an error too large to measure. Explicit Euler at 0.01-0.04 s on a rod released 2.5 rad from hanging climbs 0.10-0.11 of its budget, over
+the top; released 0.3 rad from hanging at 0.02 s its kinetic energy passes twice the budget: both diverged. A run
+that lost its orbit by its phase alone (chaos, a long run) does not climb, whatever energy it gains as speed: of the
+built-in chains' saturated runs, the midpoint rule's on the double pendulum and every Euler's on the falling Panda
+climb 0, MuJoCo's implicit on the double pendulum 0.013-0.026 (it gains 0.14-0.87 of the budget as speed, not
+height); those that climb are pumped (explicit Euler at 10 ms on the large-amplitude pendulum 0.061, semi-implicit
+Euler at 4 ms on the falling iiwa 0.24, both now diverged). A twentieth lies between."""
+
+
+def climb(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading) -> np.ndarray:
+    """(B,) [J] how far the engine's own potential energy rose above the most the exact motion can reach, max_t (V(t)
+    - T(0) - V(0) - W_in(t)) with W_in the work the applied forces put in up to t, at the samples :func:`read_own`
+    read (0 when it stayed below)."""
+    _, supplied, _ = _work(scene, traj)
+    reachable = own.kinetic[0] + own.potential[0] + supplied[own.index]
+    return np.maximum((own.potential - reachable).max(axis=0), 0.0)
+
+
+def _relative(value: float, scale: float, what: str, note: str = "") -> Measured:
     if not scale > 0:
         return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=(
             f"the engine's own energies show no exchange (kinetic energy and the range of potential energy 0), so "
@@ -212,27 +270,33 @@ def _relative(value: float, scale: float, what: str) -> Measured:
     ratio = value / scale
     if ratio > SATURATED_DRIFT:
         return Measured(ratio, "1", flag=SATURATED, unmeasurable=(
-            f"saturated: {what} {ratio:.3g} x the energy the chain exchanges (> {SATURATED_DRIFT:g})"))
-    return Measured(ratio, "1")
+            f"saturated: {what} {ratio:.3g} x the energy the chain exchanges (> {SATURATED_DRIFT:g})"
+            + (f"; {note}" if note else "")))
+    return Measured(ratio, "1", note=note)
 
 
 def energy_metrics(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading) -> dict[str, Measured]:
     """``energy_drift_max`` (max_t |E(t) - E(0)|) where the chain is neither damped nor driven, else
     ``power_balance_residual_max`` (max_t |E(t) - E(0) - W(t)|, W the work of the applied forces less the
     damping's), relative to the energy the chain exchanges: its largest kinetic energy plus the range of its
-    potential energy, maxima over copies. Reference-free."""
+    potential energy, maxima over copies, at least :func:`energy_floor` (the detail says when the floor acts).
+    Reference-free."""
     energy = own.kinetic + own.potential
-    scale = float((own.kinetic.max(axis=0) + np.ptp(own.potential, axis=0)).max())
+    exchanged, floor_energy = float((own.kinetic.max(axis=0) + np.ptp(own.potential, axis=0)).max()), energy_floor(scene)
+    scale = max(exchanged, floor_energy)
+    floored = (f"relative to the chain's energy floor {floor_energy:.3g} J ({ENERGY_SCALE_FLOOR:g} x m |g| reach): it "
+               f"exchanges only {exchanged:.3g} J" if floor_energy > exchanged else "")
     work, _, quadrature = _work(scene, traj)
     balance = float(np.abs(energy - energy[0] - work[own.index]).max())
     if exchanges_energy(scene):
-        measured = _relative(balance, scale, "power-balance residual")
+        measured = _relative(balance, scale, "power-balance residual", floored)
         floor = float(quadrature[own.index].max()) / scale if scale > 0 else 0.0
         if not measured.unmeasurable and balance / scale <= floor:
-            measured = Measured(measured.value, "1", flag=ROUNDING_FLOOR, note=(
-                f"at the quadrature floor ({floor:.2g}: the work's integral over the samples resolves no less)"))
+            measured = Measured(measured.value, "1", flag=ROUNDING_FLOOR, note="; ".join(filter(None, (
+                f"at the quadrature floor ({floor:.2g}: the work's integral over the samples resolves no less)",
+                floored))))
         return {POWER_BALANCE_RESIDUAL_MAX: measured}
-    return {ENERGY_DRIFT_MAX: _relative(float(np.abs(energy - energy[0]).max()), scale, "energy drift")}
+    return {ENERGY_DRIFT_MAX: _relative(float(np.abs(energy - energy[0]).max()), scale, "energy drift", floored)}
 
 
 @dataclass(frozen=True)

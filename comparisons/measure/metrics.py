@@ -102,7 +102,8 @@ convergence (it is saturation, or the errors do not converge)."""
 
 THEORY_BAND = 0.5
 """An observed order more than this away from the scheme's theoretical order is flagged (``superconvergent``
-above it, ``below-theory`` under it): half the gap between neighbouring integer orders."""
+above it, n/a: no scheme converges faster than its order in its asymptotic range; ``below-theory`` under it, ok, for
+the gate to judge): half the gap between neighbouring integer orders."""
 
 SATURATED_DRIFT = 1.0
 """A relative drift above 100 % of its scale says the quantity has nothing left in common with its start,
@@ -428,8 +429,12 @@ def observed_order(dts, errors, floors=0.0, saturation=0.0, theory: int | None =
     largest log residual. What the fit shows is typed in the flag (:data:`core.results.FLAGS`): n/a when
     saturated, at the rounding floor, pre-asymptotic or not converging (a clean fit below
     :data:`MIN_CONSISTENT_ORDER`: saturating when its errors reach :data:`NEAR_SATURATION` of saturation,
-    rounding when they stay within :data:`ROUNDING_MARGIN` of the floor, else ``not-converging``, an alarm);
-    ok but flagged ``superconvergent`` or ``below-theory`` more than :data:`THEORY_BAND` from ``theory``.
+    rounding when they stay within :data:`ROUNDING_MARGIN` of the floor, else ``not-converging``, an alarm).
+    Against ``theory`` the fit is bounded on both sides: more than :data:`THEORY_BAND` above it, n/a flagged
+    ``superconvergent`` (the fitted value kept for the harness, the local slopes in the reason: the steps are not in
+    the scheme's asymptotic range, whose order is its theory); more than :data:`THEORY_BAND` below it, ok but flagged
+    ``below-theory`` (a scheme that is not what it claims: the gate's lower bound decides). So an ``ok`` order with a
+    known theory lies within :data:`THEORY_BAND` of it or under it, never above.
     """
     dts, errors = np.asarray(dts, dtype=float), np.asarray(errors, dtype=float)
     floors = np.broadcast_to(np.asarray(floors, dtype=float), dts.shape)
@@ -476,9 +481,9 @@ def observed_order(dts, errors, floors=0.0, saturation=0.0, theory: int | None =
         return _inconsistent_fit(float(slope), note, fit_ratios[fitted], y[fitted] / np.maximum(fit_floors[fitted],
                                                                                                  np.finfo(float).tiny))
     if theory is not None and slope > theory + THEORY_BAND:
-        return Measured(float(slope), "1", flag=SUPERCONVERGENT, note=(
-            f"superconvergent: {slope:.3g} > theory {theory} + {THEORY_BAND:g} (error terms cancel, or the steps "
-            f"are before the asymptotic range); {note}"))
+        return Measured(float(slope), "1", flag=SUPERCONVERGENT, unmeasurable=(
+            f"superconvergent: {slope:.3g} > theory {theory} + {THEORY_BAND:g}, outside the asymptotic range (the "
+            f"steps are before it, or error terms cancel): no order of the scheme; {note}"))
     if theory is not None and slope < theory - THEORY_BAND:
         return Measured(float(slope), "1", flag=BELOW_THEORY, note=(
             f"below theory: {slope:.3g} < theory {theory} - {THEORY_BAND:g}; {note}"))

@@ -31,7 +31,7 @@ class Measured:
         it goes first in the row's detail.
     flag : str
         The row's typed qualifier (:data:`core.results.FLAGS`): why it is unmeasurable (saturated, at the
-        rounding floor, ...), or what an ok value shows beside theory (superconvergent, ...); "" for a plain
+        rounding floor, superconvergent, ...), or what an ok value shows beside theory (below-theory); "" for a plain
         measurement.
     """
 

@@ -63,8 +63,9 @@ FLAGS = {
     ROUNDING_FLOOR: "an error at the rounding floor of its run (ok: a number, exact up to rounding), or an order fit "
                     "of such errors (n/a)",
     PRE_ASYMPTOTIC: "n/a: an order whose local slopes disagree: the time steps are not in the asymptotic range",
-    SUPERCONVERGENT: "ok: a clean order fit above the scheme's theoretical order + 0.5 (error terms cancel, or "
-                     "the steps are before the asymptotic range); the detail gives the local slopes",
+    SUPERCONVERGENT: "n/a: a clean order fit above the scheme's theoretical order + 0.5: outside the scheme's "
+                     "asymptotic range (the steps are before it, or error terms cancel), so no order of the scheme; "
+                     "the detail gives the fitted value and the local slopes",
     BELOW_THEORY: "ok: a clean order fit below the scheme's theoretical order - 0.5: the scheme is not the one it "
                   "claims to be, or the steps are before the asymptotic range",
     NOT_CONVERGING: "n/a, and an alarm: a clean fit of order below 0.5 on errors far from saturation: the errors do "
