@@ -134,3 +134,55 @@ def test_a_long_branch_is_named_in_one_readable_line():
         chain_from_urdf(f'<robot name="hand">{body}</robot>', dynamics=True)
     assert "link 'l11' on the branch l0 > l1 > l2 > ... 5 more ... > l8 > l9 > l10 > l11" in caught.value.problem
     assert "\n" not in str(caught.value)
+
+
+def test_an_axis_a_rounding_away_from_minus_z_is_aligned_without_cancelling():
+    """iCub's knee axis (0, 1.2e-16, -1): Rodrigues' 1 / (1 + a_z) divided by zero and core's dynamics came out
+    non-finite. The alignment maps e_z onto the axis, is a rotation, and the chain's M matches the exact -e_z one."""
+    from simparity.core.articulated.chain_arrays import z_alignment
+
+    axis = np.array([0.0, 1.22465e-16, -1.0])
+    alignment = z_alignment(axis)
+    np.testing.assert_allclose(alignment @ [0.0, 0.0, 1.0], axis, rtol=0, atol=4 * np.finfo(float).eps)
+    np.testing.assert_allclose(alignment.T @ alignment, np.eye(3), rtol=0, atol=4 * np.finfo(float).eps)
+    assert np.linalg.det(alignment) > 0
+
+
+DYNAMICS_FILE = """<robot name="arm">
+  <link name="base"><inertial><mass value="3"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="plate"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="upper"><inertial><origin xyz="0.1 0 0"/><mass value="1"/><inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="1e-3"/></inertial></link>
+  <link name="sensor_frame"/>
+  <link name="rotor"><inertial><mass value="0"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+  <link name="finger"><inertial><mass value="0.1"/><inertia ixx="1e-5" ixy="0" ixz="0" iyy="1e-5" iyz="0" izz="1e-5"/></inertial></link>
+  <link name="tool"><inertial><origin xyz="0.1 0 0"/><mass value="0.5"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
+  <joint name="mount" type="fixed"><parent link="base"/><child link="plate"/></joint>
+  <joint name="shoulder" type="revolute"><parent link="plate"/><child link="upper"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1"/><dynamics damping="0.1" friction="0.4"/></joint>
+  <joint name="sensor" type="fixed"><parent link="upper"/><child link="sensor_frame"/></joint>
+  <joint name="spin" type="fixed"><parent link="upper"/><child link="rotor"/></joint>
+  <joint name="grip" type="prismatic"><parent link="upper"/><child link="finger"/><limit lower="0" upper="0.1"/></joint>
+  <joint name="elbow" type="revolute"><parent link="upper"/><child link="tool"/><origin xyz="0.2 0 0"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1"/></joint>
+</robot>
+"""
+
+
+def test_what_every_engine_is_given_is_named_link_by_link_in_show_and_the_rows_detail(tmp_path):
+    """Before: 'links without <inertial> massless' and 'held at 0', whatever the file. Now each change names its
+    links or joints, in ``simparity show`` and in the detail every adapter's rows carry (dynamics_source)."""
+    from simparity.comparisons.scenes.describe import describe
+    from simparity.comparisons.scenes.loader import load_scene
+    from simparity.references.common.dynamics_urdf import dynamics_source
+
+    (tmp_path / "arm.urdf").write_text(DYNAMICS_FILE, encoding="utf-8")
+    (tmp_path / "arm.toml").write_text('[scene]\nname = "arm"\nkind = "joint_dynamics"\nreference = "pinocchio"\n'
+                                       '[chain]\nurdf = "arm.urdf"\ntip_link = "tool"\n', encoding="utf-8")
+    scene = load_scene(tmp_path / "arm.toml")
+    expected = {"given an explicit massless one": "sensor_frame", "welded to the fixed base": "base, plate",
+                "held at 0 as fixed joints": "grip", "friction": "shoulder",
+                "mass 0 with a rotational inertia": "rotor"}
+    for text in (describe(scene), dynamics_source(scene.chain)):
+        for what, names in expected.items():
+            assert any(what in part and part.endswith(f": {names}") for part in text.replace("\n", "; ").split("; ")), \
+                (what, text)
