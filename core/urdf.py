@@ -32,20 +32,29 @@ The rules, stricter on the chain because every engine loads the whole file but o
 - The chain is the path from ``base_link`` to ``tip_link``; joints on that path must be
   revolute, continuous (an unlimited revolute joint) or prismatic, or fixed (merged into the
   next movable joint's origin, or into the end-effector transform after the last movable
-  joint). A revolute or prismatic joint on the path must be able to move: lower < upper (a
-  ``<limit>`` without bounds is lower = upper = 0: use ``type='fixed'`` for a joint that does
-  not move, as in scene files). Names on the path (and the robot's) follow
+  joint). A revolute or prismatic joint with lower == upper (a ``<limit>`` without bounds is
+  lower = upper = 0; real files have such knees and wheels) loads: no limit acts in joint dynamics
+  or motion, and where limits act (sampled configurations, IK) it is held at that value. Names
+  on the path (and the robot's) follow
   :data:`core.names.NAME_RULE`, numbers on the path the physical ranges of :mod:`core.ranges`
   (origins, angles, joint limits, axis norms). Joints off the path may be of any URDF type,
   mimic ones included, and their names and magnitudes are not held to those rules.
 - The inertials of links in the base link's subtree must be a complete ``<inertial>`` (``<mass
   value>`` and all six ``<inertia>`` attributes, as urdfdom requires) of finite numbers: a mass of 0
   or within its physical range, inertial origins within theirs, inertia entries no larger than the
-  range of moments (tiny ones are rounding: real files have 1e-35). A link that rides on a chain
-  link must have a physical inertia tensor, principal moments a <= b <= c with a + b >= c (hence
-  positive semidefinite) up to :data:`core.dynamics.inertia.INERTIA_RTOL`; links fixed to the base
-  never move and are not held to it (real files have placeholder tensors there). A chain joint's
-  ``damping`` is finite and >= 0. Links outside the base link's subtree are not read for mass.
+  range of moments (tiny ones are rounding: real files have 1e-35). A mass of 0 with a non-zero
+  inertia loads (a rotor's inertia whose mass is counted elsewhere: pybullet_data's Panda flange),
+  as it does from a scene file. A link that rides on a chain link must have a physical inertia
+  tensor, principal moments a <= b <= c with a + b >= c (hence positive semidefinite), judged
+  against the link's own scale (:func:`core.dynamics.inertia.link_tensor_problem`: the written
+  decimals' rounding and floating point's on the link's inertia about its frame origin); links
+  fixed to the base never move and are not held to it (real files have placeholder tensors there).
+  A chain joint's ``damping`` is finite and >= 0. Links outside the base link's subtree are not
+  read for mass.
+
+Every refusal about a link or a joint names it and its branch from the tree's root, e.g. ``(link
+'head' on the branch root_link > torso_1 > ... > head)``, the middle elided past
+:data:`BRANCH_NAMES` links.
 
 Anything else is rejected with a :class:`~core.errors.SceneError` naming the element; nothing is
 guessed. A file with a ``<!DOCTYPE>`` (hence any entity declaration) or elements nested deeper than
@@ -127,8 +136,8 @@ def chain_from_urdf(
         For malformed XML or numbers, a ``<!DOCTYPE>`` (DTDs and entities are refused), elements
         nested deeper than :data:`core.model.files.MAX_XML_DEPTH`, missing links, a link with two parents, several
         roots, an unknown or missing base/tip link, several leaves without ``tip_link``,
-        a mimic, floating or planar joint on the path, a joint on the path that cannot move
-        (lower == upper), a name on the path outside :data:`core.names.NAME_RULE`, a number on the
+        a mimic, floating or planar joint on the path, a joint with lower > upper, a name on the
+        path outside :data:`core.names.NAME_RULE`, a number on the
         path outside its physical range (:mod:`core.ranges`), an incomplete or malformed
         ``<inertial>`` below the base link, a negative mass or damping, a mass, inertia entry or
         inertial origin outside its physical range, a non-physical inertia tensor on a link riding

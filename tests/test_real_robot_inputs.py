@@ -186,3 +186,17 @@ def test_what_every_engine_is_given_is_named_link_by_link_in_show_and_the_rows_d
         for what, names in expected.items():
             assert any(what in part and part.endswith(f": {names}") for part in text.replace("\n", "; ").split("; ")), \
                 (what, text)
+
+
+def test_pybullets_nullspace_ik_is_not_offered_on_a_joint_with_lower_equal_to_upper(tmp_path):
+    """calculateInverseKinematics' null-space solve never returned on such a chain (example-robot-data's quadruped,
+    whose knees have lower == upper == 0, hit the 900 s case limit): the solver is n/a naming the joint, the others
+    are offered."""
+    from simparity.comparisons.engines.registry import make_engine
+
+    (tmp_path / "walker.urdf").write_text(_urdf(1.0, HEAD_COM, np.diag([1e-3] * 3), knee=(0.3, 0.3)), encoding="utf-8")
+    chain = chain_from_urdf(str(tmp_path / "walker.urdf"), tip_link="shin")
+    pybullet = make_engine("pybullet")
+    support = pybullet.supports_ik(chain, "calculateInverseKinematics-tuned-nullspace", True)
+    assert not support.ok and "knee" in support.reason
+    assert pybullet.supports_ik(chain, "calculateInverseKinematics-tuned", True).ok

@@ -19,7 +19,11 @@ only these changes, each made with :mod:`xml.etree.ElementTree` on the parsed fi
 - The base link and every link welded to it by fixed joints never move: their ``<inertial>`` is replaced by the
   explicit zero (a placeholder tensor there, as ANYmal's base has, made MuJoCo refuse the whole model).
 
-``<inertial>`` elements of links that move are never touched. A chain without a URDF file (inline joints in a scene) is written with
+``<inertial>`` elements of links that move are never touched (one of mass 0 with a non-zero inertia included: every
+engine keeps its rotational inertia). :class:`ModelChanges` names each change link by link (joint by joint) for the
+rows' detail (:func:`dynamics_source`) and ``simparity show``.
+
+A chain without a URDF file (inline joints in a scene) is written with
 its declared mass properties (centre of mass as the inertial origin, the full tensor in the link's axes).
 """
 
@@ -115,7 +119,8 @@ def _changed(chain: Chain) -> tuple[ET.Element, ModelChanges]:
         root = parse_xml(handle.read(), path, "robot")
     links, joints = _subtree(root, cast(str, chain.base_link))
     held = set(chain.held_joints)
-    removed = tuple(cast(str, element.get("name")) for element in root.findall("link") if element.get("name") not in links)
+    removed = tuple(cast(str, element.get("name")) for element in root.findall("link")
+                    if element.get("name") not in links)
     for element in list(root):
         kept = links if element.tag == "link" else joints if element.tag == "joint" else None
         if kept is not None and element.get("name") not in kept:
