@@ -200,3 +200,13 @@ def test_pybullets_nullspace_ik_is_not_offered_on_a_joint_with_lower_equal_to_up
     support = pybullet.supports_ik(chain, "calculateInverseKinematics-tuned-nullspace", True)
     assert not support.ok and "knee" in support.reason
     assert pybullet.supports_ik(chain, "calculateInverseKinematics-tuned", True).ok
+
+
+def test_pybullet_names_the_joints_whose_axis_it_normalises():
+    """The crafted arm's three movable joints have non-unit axes (0 0 -2, 0.3 -0.5 0.8, 1 1 0): each is named; its
+    fixed joints (whose axis means nothing) are not."""
+    from simparity.comparisons.scenes import library
+    from simparity.references.pybullet.joint_dynamics import axes_changed
+
+    chain = library.load(["crafted-arm-dynamics"])[0].chain
+    assert axes_changed(chain) == "axes normalised (non-unit: j1, j2, j3)"
