@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.core.model.errors import SceneError
+from simparity.core.model.ranges import RANGES
 
 # Relative tolerance of inertia_problem's symmetry and triangle-inequality checks, as a
 # fraction of the largest principal moment. Scene files quote inertias to ~6 significant
@@ -257,9 +258,9 @@ few eps m |d|^2 whatever the tensor's own size: iCub's head (m = 1.34 kg, |d| = 
 of the scale covers a chain of such operations and is far below any physical violation (the smallest in the
 installed robot files, pybullet_data's TwoJointRobot link_1, breaks a + b >= c by 0.8 % of c)."""
 
-MOMENT_FLOOR = 1e-15  # [kg m^2]
-"""The smallest moment of inertia that is physical (a microgram bead of 1 mm; the low end of
-``core.model.ranges.RANGES['inertia_moment']``): the floating-point scale of :func:`link_tensor_problem` never falls
+MOMENT_FLOOR = RANGES["inertia_moment"].low  # [kg m^2]
+"""The smallest moment of inertia that is physical (1e-15 kg m^2, a microgram bead of 1 mm: the low end of
+:data:`core.model.ranges.RANGES`' ``inertia_moment``): the floating-point scale of :func:`link_tensor_problem` never falls
 below it, so a point mass at its link's origin written with a residue of 1e-35 is judged as the point mass it is."""
 
 
