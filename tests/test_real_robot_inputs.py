@@ -121,6 +121,10 @@ def test_a_massless_link_with_an_inertia_is_treated_alike_on_both_routes():
     from_urdf, from_scene = chain.joints[0].link, scene.chain.joints[1].link
     assert from_urdf.mass == from_scene.mass == 0.0
     assert np.array_equal(from_urdf.inertia_com, from_scene.inertia_com)
+    from simparity.references.common.dynamics_urdf import dynamics_source
+
+    assert dynamics_source(scene.chain).endswith("links of mass 0 with a rotational inertia, kept as written in every "
+                                                 "engine (a rotor's inertia whose mass is counted elsewhere): knee")
 
 
 def test_a_long_branch_is_named_in_one_readable_line():

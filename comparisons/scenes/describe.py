@@ -97,12 +97,11 @@ def _link_lines(chain: Chain) -> list[str]:
         lines.append(f"  {joint.name} ({joint.type}): link mass {link.mass:.10g} kg, centre of mass "
                      f"{_vector(link.com_xyz)} m, inertia diagonal {_vector(link.inertia_com.diagonal())} kg m^2, "
                      f"damping {joint.damping:.10g}, armature {joint.armature:.10g}")
+    changes = model_changes(chain).sentences(str(chain.base_link))
     if chain.urdf_path is not None:
-        changes = model_changes(chain).sentences(str(chain.base_link))
         lines.append(f"every engine reads {chain.urdf_path} below {chain.base_link} without geometry and <dynamics>"
                      + (", and:" if changes else ", nothing else changed"))
-        lines += [f"  {sentence}" for sentence in changes]
-    return lines
+    return lines + [f"  {sentence}" for sentence in changes]
 
 
 def describe(scene) -> str:

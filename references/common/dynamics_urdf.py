@@ -33,6 +33,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from typing import cast
 
+import numpy as np
+
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.files import parse_xml
 from simparity.core.model.scene import Chain
@@ -170,8 +172,13 @@ def original_for_dynamics(chain: Chain) -> str:
 
 
 def model_changes(chain: Chain) -> ModelChanges:
-    """What every engine's model of ``chain``'s file changes, link by link (none for a chain without a file)."""
-    return ModelChanges() if chain.urdf_path is None else _changed(chain)[1]
+    """What every engine's model of ``chain``'s file changes, link by link; for a chain without a file (its links
+    written after its joints), only its links of mass 0 with an inertia, named after their joints."""
+    if chain.urdf_path is not None:
+        return _changed(chain)[1]
+    return ModelChanges(massless_with_inertia=tuple(
+        joint.name for joint in chain.joints
+        if joint.link is not None and joint.link.mass == 0 and bool(np.any(joint.link.inertia_com))))
 
 
 def _welded_to_base(root: ET.Element, base: str) -> set[str]:
@@ -207,8 +214,8 @@ def dynamics_urdf(chain: Chain) -> str:
 
 def dynamics_source(chain: Chain) -> str:
     """Where an engine's dynamics model of ``chain`` comes from, for the rows' detail."""
+    changes = model_changes(chain).sentences(str(chain.base_link))
     if chain.urdf_path is None:
-        return "the chain's declared mass properties written as URDF"
-    changes = model_changes(chain).sentences(cast(str, chain.base_link))
+        return "; ".join(["the chain's declared mass properties written as URDF"] + changes)
     return (f"{chain.urdf_path} below {chain.base_link}, without geometry and <dynamics>, moving links' inertials "
             f"untouched; " + ("; ".join(changes) if changes else "nothing else changed"))
