@@ -32,20 +32,29 @@ The rules, stricter on the chain because every engine loads the whole file but o
 - The chain is the path from ``base_link`` to ``tip_link``; joints on that path must be
   revolute, continuous (an unlimited revolute joint) or prismatic, or fixed (merged into the
   next movable joint's origin, or into the end-effector transform after the last movable
-  joint). A revolute or prismatic joint on the path must be able to move: lower < upper (a
-  ``<limit>`` without bounds is lower = upper = 0: use ``type='fixed'`` for a joint that does
-  not move, as in scene files). Names on the path (and the robot's) follow
+  joint). A revolute or prismatic joint with lower == upper (a ``<limit>`` without bounds is
+  lower = upper = 0; real files have such knees and wheels) loads: no limit acts in joint dynamics
+  or motion, and where limits act (sampled configurations, IK) it is held at that value. Names
+  on the path (and the robot's) follow
   :data:`core.names.NAME_RULE`, numbers on the path the physical ranges of :mod:`core.ranges`
   (origins, angles, joint limits, axis norms). Joints off the path may be of any URDF type,
   mimic ones included, and their names and magnitudes are not held to those rules.
 - The inertials of links in the base link's subtree must be a complete ``<inertial>`` (``<mass
   value>`` and all six ``<inertia>`` attributes, as urdfdom requires) of finite numbers: a mass of 0
   or within its physical range, inertial origins within theirs, inertia entries no larger than the
-  range of moments (tiny ones are rounding: real files have 1e-35). A link that rides on a chain
-  link must have a physical inertia tensor, principal moments a <= b <= c with a + b >= c (hence
-  positive semidefinite) up to :data:`core.dynamics.inertia.INERTIA_RTOL`; links fixed to the base
-  never move and are not held to it (real files have placeholder tensors there). A chain joint's
-  ``damping`` is finite and >= 0. Links outside the base link's subtree are not read for mass.
+  range of moments (tiny ones are rounding: real files have 1e-35). A mass of 0 with a non-zero
+  inertia loads (a rotor's inertia whose mass is counted elsewhere: pybullet_data's Panda flange),
+  as it does from a scene file. A link that rides on a chain link must have a physical inertia
+  tensor, principal moments a <= b <= c with a + b >= c (hence positive semidefinite), judged
+  against the link's own scale (:func:`core.dynamics.inertia.link_tensor_problem`: the written
+  decimals' rounding and floating point's on the link's inertia about its frame origin); links
+  fixed to the base never move and are not held to it (real files have placeholder tensors there).
+  A chain joint's ``damping`` is finite and >= 0. Links outside the base link's subtree are not
+  read for mass.
+
+Every refusal about a link or a joint names it and its branch from the tree's root, e.g. ``(link
+'head' on the branch root_link > torso_1 > ... > head)``, the middle elided past
+:data:`BRANCH_NAMES` links.
 
 Anything else is rejected with a :class:`~core.errors.SceneError` naming the element; nothing is
 guessed. A file with a ``<!DOCTYPE>`` (hence any entity declaration) or elements nested deeper than
@@ -61,7 +70,7 @@ from typing import Any
 
 import numpy as np
 from simparity.core.dynamics.inertia import link_tensor_problem
-from simparity.core.model.errors import SceneError
+from simparity.core.model.errors import SceneError, one_line
 from simparity.core.model.files import MAX_FILE_BYTES, parse_xml, read_input
 from simparity.core.model.names import NAME_RULE, name_problem
 from simparity.core.model.ranges import NORM_RANGES, RANGES, Range, safe_norm
@@ -127,8 +136,8 @@ def chain_from_urdf(
         For malformed XML or numbers, a ``<!DOCTYPE>`` (DTDs and entities are refused), elements
         nested deeper than :data:`core.model.files.MAX_XML_DEPTH`, missing links, a link with two parents, several
         roots, an unknown or missing base/tip link, several leaves without ``tip_link``,
-        a mimic, floating or planar joint on the path, a joint on the path that cannot move
-        (lower == upper), a name on the path outside :data:`core.names.NAME_RULE`, a number on the
+        a mimic, floating or planar joint on the path, a joint with lower > upper, a name on the
+        path outside :data:`core.names.NAME_RULE`, a number on the
         path outside its physical range (:mod:`core.ranges`), an incomplete or malformed
         ``<inertial>`` below the base link, a negative mass or damping, a mass, inertia entry or
         inertial origin outside its physical range, a non-physical inertia tensor on a link riding
@@ -146,19 +155,20 @@ def chain_from_urdf(
         raise SceneError(source, "robot/link", f"the tree has {len(roots)} root links {roots}",
                          "exactly one link that is no joint's child")
     _check_tree(roots[0], links, joints, source)
+    _check_limits(joints, parent_joint, source)
     base = _pick_base(base_link, roots[0], links, source)
     tip = _pick_tip(tip_link, base, links, joints, source)
     path = _path(base, tip, parent_joint, source)
     robot = root.get("name", "")
     if robot and (problem := name_problem(robot)):
         raise SceneError(source, "robot/@name", problem, NAME_RULE)
-    chain = _assemble(robot, path, tip, source)
+    chain = _assemble(robot, path, tip, parent_joint, source)
     child_joints = _child_joints(joints)
-    inertials = _modelled_inertials(base, links, child_joints, source)
+    inertials = _modelled_inertials(base, links, child_joints, parent_joint, source)
     movable = [joint for joint in path if joint["type"] != "fixed"]
     chain_joints = tuple(
         replace(chain_joint, link=_rigid_body(joint, following, inertials, child_joints, source, dynamics),
-                damping=_damping(joint, source))
+                damping=_damping(joint, parent_joint, source))
         for chain_joint, joint, following in zip(chain.joints, movable, movable[1:] + [None]))
     on_path = {joint["name"] for joint in path}
     held = tuple(joint["name"] for joint in joints
@@ -262,9 +272,38 @@ def _limits(element: ET.Element, kind: str, key: str, source: str) -> tuple[floa
         raise SceneError(source, f"{key}/limit", f"a {kind} joint has no <limit>",
                          "<limit lower='...' upper='...'/> (use type='continuous' for an unlimited joint)")
     lower, upper = (_numbers(limit, bound, (0.0,), f"{key}/limit", source)[0] for bound in ("lower", "upper"))
-    if lower > upper:
-        raise SceneError(source, f"{key}/limit", f"lower {lower} is above upper {upper}", "lower <= upper")
     return lower, upper
+
+
+def _check_limits(joints: list[dict], parent_joint: dict[str, dict], source: str) -> None:
+    """Refuse a joint whose lower limit is above its upper one (lower == upper is a joint held at that value where
+    limits act: it loads)."""
+    for joint in joints:
+        lower, upper = joint["limits"]
+        if lower > upper:
+            raise SceneError(source, f"{joint['key']}/limit", f"lower {lower:g} is above upper {upper:g} "
+                             f"({_where(joint, parent_joint)})", "lower <= upper")
+
+
+BRANCH_NAMES = 8
+"""Links a message lists on a branch before eliding its middle: a humanoid's finger is ~15 links from the root,
+and a message stays one readable line."""
+
+
+def _branch(link: str, parent_joint: dict[str, dict]) -> str:
+    """The links from the tree's root to ``link`` ('root > a > b'), the middle elided past :data:`BRANCH_NAMES`."""
+    names = [link]
+    while names[-1] in parent_joint:  # a tree (checked by _check_tree): the walk ends at the root
+        names.append(parent_joint[names[-1]]["parent"])
+    names = [one_line(name, 40) for name in reversed(names)]
+    if len(names) > BRANCH_NAMES:
+        names = names[:3] + [f"... {len(names) - 7} more ..."] + names[-4:]
+    return " > ".join(names)
+
+
+def _where(joint: dict, parent_joint: dict[str, dict]) -> str:
+    """'joint 'j' on the branch root > ... > its child link', for messages."""
+    return f"joint {one_line(joint['name'], 40)!r} on the branch {_branch(joint['child'], parent_joint)}"
 
 
 def _parent_joints(joints: list[dict], source: str) -> dict[str, dict]:
@@ -350,50 +389,48 @@ def _path(base: str, tip: str, parent_joint: dict[str, dict], source: str) -> li
 _MAGNITUDES = (("xyz", "origin_xyz", "origin/@xyz"), ("rpy", "origin_rpy", "origin/@rpy"))
 
 
-def _check_magnitudes(joint: dict, source: str) -> None:
-    """Hold a joint on the chain to the physical ranges of :mod:`core.ranges`."""
+def _check_magnitudes(joint: dict, where: str, source: str) -> None:
+    """Hold a joint on the chain (``where``: its name and branch, for messages) to the physical ranges of
+    :mod:`core.ranges`."""
     key = joint["key"]
-    for field, range_key, where in _MAGNITUDES:
+    for field, range_key, element in _MAGNITUDES:
         allowed = RANGES[range_key]
         for value in joint[field]:
             if not allowed.allows(abs(value)):
-                raise SceneError(source, f"{key}/{where}", f"on the chain: {value:.6g} is outside the physical range",
+                raise SceneError(source, f"{key}/{element}", f"{value:.6g} is outside the physical range ({where})",
                                  allowed.text())
     if joint["type"] == "fixed":
         return
     norm, allowed = safe_norm(joint["axis"]), NORM_RANGES["axis"]
     if not allowed.allows(norm):
-        raise SceneError(source, f"{key}/axis/@xyz", f"on the chain: its norm {norm:.3g} is outside the usable range",
+        raise SceneError(source, f"{key}/axis/@xyz", f"its norm {norm:.3g} is outside the usable range ({where})",
                          allowed.text())
     for bound, value in zip(("lower", "upper"), joint["limits"]):
         if np.isfinite(value) and not RANGES[bound].allows(abs(value)):
-            raise SceneError(source, f"{key}/limit/@{bound}", f"on the chain: {value:.6g} is outside the physical range",
+            raise SceneError(source, f"{key}/limit/@{bound}", f"{value:.6g} is outside the physical range ({where})",
                              RANGES[bound].text())
 
 
-def _assemble(robot_name: str, path: list[dict], tip: str, source: str) -> Chain:
+def _assemble(robot_name: str, path: list[dict], tip: str, parent_joint: dict[str, dict], source: str) -> Chain:
     # (position, rotation) of the frame reached so far, in the last movable joint's
     # child-link frame (or the base frame before the first movable joint).
     position, rotation = np.zeros(3), np.eye(3)
     chain_joints: list[Joint] = []
     for joint in path:
-        key = joint["key"]
+        key, where = joint["key"], f"on the chain: {_where(joint, parent_joint)}"
         if joint["type"] not in _CHAIN_JOINT_TYPES:
-            raise SceneError(source, f"{key}/@type", f"a {joint['type']} joint on the chain", _ALLOWED_ON_PATH)
+            raise SceneError(source, f"{key}/@type", f"a {joint['type']} joint ({where})", _ALLOWED_ON_PATH)
         if joint["element"].find("mimic") is not None:
-            raise SceneError(source, f"{key}/mimic", "a mimic joint on the chain", _ALLOWED_ON_PATH)
+            raise SceneError(source, f"{key}/mimic", f"a mimic joint ({where})", _ALLOWED_ON_PATH)
         for name in (joint["name"], joint["child"]):
             if name_problem(name):
-                raise SceneError(source, key, f"on the chain: {name_problem(name)}", NAME_RULE)
-        _check_magnitudes(joint, source)
+                raise SceneError(source, key, f"{name_problem(name)} ({where})", NAME_RULE)
+        _check_magnitudes(joint, where, source)
         position = position + rotation @ joint["xyz"]
         rotation = rotation @ rpy_to_matrix(joint["rpy"])
         if joint["type"] == "fixed":
             continue
-        lower, upper = joint["limits"]
-        if not lower < upper:
-            raise SceneError(source, f"{key}/limit", f"on the chain with lower {lower:g} == upper {upper:g}: it cannot move",
-                             "lower < upper, or type='fixed' for a joint that does not move (as in scene files)")
+        lower, upper = joint["limits"]  # lower == upper: a joint held at that value where limits act (IK, sampling)
         chain_joints.append(Joint(
             name=joint["name"],
             type="prismatic" if joint["type"] == "prismatic" else "revolute",
@@ -422,23 +459,25 @@ class _Inertial:
     """A link's ``<inertial>`` in the link frame: mass [kg], centre of mass (3,) [m] and inertia (3, 3)
     about it in the link frame's axes [kg m^2] (``R I R^T`` of the inertial frame's); ``problem``: why the
     tensor is not physical ("" if it is), refused only when the link rides on a chain link (``key``: its
-    ``<inertia>`` element)."""
+    ``<inertia>`` element; ``where``: the link's name and branch)."""
 
     mass: float
     com_xyz: np.ndarray
     inertia_com: np.ndarray
     key: str = ""
     problem: str = ""
+    where: str = ""
 
 
 def _modelled_inertials(base: str, links: dict[str, ET.Element], children: dict[str, list[dict]],
-                        source: str) -> dict[str, _Inertial]:
+                        parent_joint: dict[str, dict], source: str) -> dict[str, _Inertial]:
     """Link name -> its checked inertial, for the base link and every link below it (the model)."""
     inertials: dict[str, _Inertial] = {}
     stack = [base]
     while stack:  # a tree (checked by _check_tree): every link is visited once
         link = stack.pop()
-        inertials[link] = _inertial(links[link], f"robot/link[@name='{link}']/inertial", source)
+        where = f"link {one_line(link, 40)!r} on the branch {_branch(link, parent_joint)}"
+        inertials[link] = _inertial(links[link], f"robot/link[@name='{link}']/inertial", where, source)
         stack.extend(joint["child"] for joint in children.get(link, []))
     return inertials
 
@@ -451,8 +490,10 @@ def _child_joints(joints: list[dict]) -> dict[str, list[dict]]:
     return children
 
 
-def _inertial(link: ET.Element, key: str, source: str) -> _Inertial:
-    """The link's ``<inertial>`` (massless without one), held to the physical rules."""
+def _inertial(link: ET.Element, key: str, where: str, source: str) -> _Inertial:
+    """The link's ``<inertial>`` (massless without one), held to the physical rules; ``where`` (the link's name and
+    branch) ends every message. A mass of 0 with a non-zero inertia loads: real files have it (pybullet_data's
+    Panda flange, Bolt's feet) and every engine keeps the rotational inertia as written."""
     element = link.find("inertial")
     if element is None:
         return _Inertial(0.0, np.zeros(3), np.zeros((3, 3)))
@@ -460,37 +501,38 @@ def _inertial(link: ET.Element, key: str, source: str) -> _Inertial:
     xyz = _numbers(origin, "xyz", (0.0, 0.0, 0.0), f"{key}/origin", source)
     rpy = _numbers(origin, "rpy", (0.0, 0.0, 0.0), f"{key}/origin", source)
     for values, attribute, range_key in ((xyz, "xyz", "origin_xyz"), (rpy, "rpy", "origin_rpy")):
-        _hold(values, RANGES[range_key], f"{key}/origin/@{attribute}", source)
-    mass = _required_number(element.find("mass"), "value", f"{key}/mass", source)
+        _hold(values, RANGES[range_key], f"{key}/origin/@{attribute}", where, source)
+    mass = _required_number(element.find("mass"), "value", f"{key}/mass", where, source)
     if mass < 0:
-        raise SceneError(source, f"{key}/mass/@value", f"negative mass {mass:g}", "a mass >= 0 [kg]")
+        raise SceneError(source, f"{key}/mass/@value", f"negative mass {mass:g} ({where})", "a mass >= 0 [kg]")
     if mass != 0:
-        _hold(np.array([mass]), RANGES["mass"], f"{key}/mass/@value", source)
+        _hold(np.array([mass]), RANGES["mass"], f"{key}/mass/@value", where, source)
     inertia, largest = np.zeros((3, 3)), RANGES["inertia_moment"]
     for name, (row, column) in zip(_INERTIA_ENTRIES, _INERTIA_INDEX):
-        value = _required_number(element.find("inertia"), name, f"{key}/inertia", source)
+        value = _required_number(element.find("inertia"), name, f"{key}/inertia", where, source)
         if abs(value) > largest.high:  # tiny entries are rounding (real files have 1e-35): no lower bound
-            raise SceneError(source, f"{key}/inertia/@{name}", f"{value:.6g} is above the physical range",
+            raise SceneError(source, f"{key}/inertia/@{name}", f"{value:.6g} is above the physical range ({where})",
                              largest.text())
         inertia[row, column] = inertia[column, row] = value
     rotation = rpy_to_matrix(rpy)
-    return _Inertial(mass, xyz, rotation @ inertia @ rotation.T, f"{key}/inertia", link_tensor_problem(inertia))
+    return _Inertial(mass, xyz, rotation @ inertia @ rotation.T, f"{key}/inertia",
+                     link_tensor_problem(inertia, mass, xyz), where)
 
 
-def _required_number(element: ET.Element | None, attribute: str, key: str, source: str) -> float:
+def _required_number(element: ET.Element | None, attribute: str, key: str, where: str, source: str) -> float:
     """One finite number that the URDF specification requires (urdfdom refuses a file without it)."""
     if element is None or element.get(attribute) is None:
-        where = key if element is None else f"{key}/@{attribute}"
-        raise SceneError(source, where, "missing", "a complete <inertial>: <mass value> and all six <inertia> "
-                         "attributes (leave <inertial> out for a massless link)")
+        missing = key if element is None else f"{key}/@{attribute}"
+        raise SceneError(source, missing, f"missing ({where})", "a complete <inertial>: <mass value> and all six "
+                         "<inertia> attributes (leave <inertial> out for a massless link)")
     return float(_numbers(element, attribute, (0.0,), key, source)[0])
 
 
-def _hold(values: np.ndarray, allowed: Range, key: str, source: str) -> None:
+def _hold(values: np.ndarray, allowed: Range, key: str, where: str, source: str) -> None:
     """Refuse a value whose magnitude is outside ``allowed`` (a :class:`core.model.ranges.Range`)."""
     for value in values:
         if not allowed.allows(abs(value)):
-            raise SceneError(source, key, f"{value:.6g} is outside the physical range", allowed.text())
+            raise SceneError(source, key, f"{value:.6g} is outside the physical range ({where})", allowed.text())
 
 
 def _rigid_body(joint: dict, following: dict | None, inertials: dict[str, _Inertial],
@@ -504,7 +546,7 @@ def _rigid_body(joint: dict, following: dict | None, inertials: dict[str, _Inert
         link, position, rotation = stack.pop()
         inertial = inertials[link]
         if inertial.problem and dynamics:
-            raise SceneError(source, inertial.key, f"on the chain: {inertial.problem}",
+            raise SceneError(source, inertial.key, f"{inertial.problem} ({inertial.where}, riding on the chain)",
                              "a physical tensor: principal moments a <= b <= c with a + b >= c (hence all >= 0)")
         parts.append((inertial, position, rotation))
         for child in children.get(link, []):
@@ -522,10 +564,11 @@ def _rigid_body(joint: dict, following: dict | None, inertials: dict[str, _Inert
     return LinkInertia(mass, com, 0.5 * (inertia + inertia.T))
 
 
-def _damping(joint: dict, source: str) -> float:
+def _damping(joint: dict, parent_joint: dict[str, dict], source: str) -> float:
     """The chain joint's ``<dynamics damping>`` [N m s/rad or N s/m], 0 without one."""
     key = f"{joint['key']}/dynamics"
     damping = float(_numbers(joint["element"].find("dynamics"), "damping", (0.0,), key, source)[0])
     if damping < 0:
-        raise SceneError(source, f"{key}/@damping", f"negative damping {damping:g}", "a damping >= 0")
+        raise SceneError(source, f"{key}/@damping", f"negative damping {damping:g} ({_where(joint, parent_joint)})",
+                         "a damping >= 0")
     return damping

@@ -155,7 +155,8 @@ def test_urdf_in_another_declared_encoding_loads(tmp_path, capsys, encoding, cod
 
 
 @pytest.mark.parametrize("name, urdf, extra, words", [
-    ("URDF joint that cannot move", URDF.format(encoding="UTF-8", tip="tip", lower=0, upper=0), "", "cannot move"),
+    ("URDF joint with lower above upper", URDF.format(encoding="UTF-8", tip="tip", lower=1, upper=0), "",
+     "above upper"),
     ("URDF tip name injected", URDF.format(encoding="UTF-8", tip="ti&quot;p", lower=-1, upper=1), "",
      "outside the allowed set"),
     ("URDF of 1,000 joints", _many_joints(1000), "", "1,000 movable joints"),

@@ -103,7 +103,7 @@ BROKEN = [
     ("bad joint type", VALID_KINEMATICS, 'type = "revolute"', 'type = "spherical"', "chain.joint[0].type",
      "allowed: revolute, prismatic"),
     ("lower without upper", VALID_KINEMATICS, "upper = 1.0\n", "", "chain.joint[0].upper", "need both"),
-    ("inverted limits", VALID_KINEMATICS, "upper = 1.0", "upper = -2.0", "chain.joint[0].upper", "not above lower"),
+    ("inverted limits", VALID_KINEMATICS, "upper = 1.0", "upper = -2.0", "chain.joint[0].upper", "is below lower"),
     ("zero axis", VALID_KINEMATICS, "axis = [0.0, 0.0, 1.0]", "axis = [0.0, 0.0, 0.0]", "chain.joint[0].axis",
      "all zeros"),
     ("no joints", VALID_KINEMATICS, '[[chain.joint]]\nname = "j1"\ntype = "revolute"\naxis = [0.0, 0.0, 1.0]\n'

@@ -224,8 +224,8 @@ ON_PATH_REJECTED = [
     ("tiny axis", _joint("j1", "a", "b").replace('xyz="0 0 1"', 'xyz="0 0 1e-200"'), "j1']/axis/@xyz", "usable range"),
     ("huge axis", _joint("j1", "a", "b").replace('xyz="0 0 1"', 'xyz="1e200 1e200 1e200"'), "j1']/axis/@xyz",
      "usable range"),
-    ("immovable", _joint("j1", "a", "b").replace('lower="-1" upper="1"', 'effort="1" velocity="1"'), "j1']/limit",
-     "cannot move"),
+    ("inverted limits", _joint("j1", "a", "b").replace('lower="-1" upper="1"', 'lower="1" upper="-1"'), "j1']/limit",
+     "above upper"),
     ("injected name", _joint('j1&quot;/&gt;&lt;x', "a", "b"), "robot/joint[@name='j1\"/><x']", "allowed set"),
 ]
 

@@ -11,6 +11,7 @@ import numpy as np
 
 from simparity.comparisons.scenes.sweep import value_text
 from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
+from simparity.references.common.dynamics_urdf import model_changes
 
 
 def _vector(values) -> str:
@@ -87,7 +88,8 @@ def _joint_motion_lines(scene: JointMotionScene) -> list[str]:
 
 
 def _link_lines(chain: Chain) -> list[str]:
-    """Each joint's link: mass, centre of mass, inertia diagonal, damping and armature; the held joints."""
+    """Each joint's link: mass, centre of mass, inertia diagonal, damping and armature; what every engine's model of
+    the chain's URDF file changes, link by link (:func:`references.common.dynamics_urdf.model_changes`)."""
     lines = []
     for joint in chain.joints:
         link = joint.link
@@ -95,9 +97,11 @@ def _link_lines(chain: Chain) -> list[str]:
         lines.append(f"  {joint.name} ({joint.type}): link mass {link.mass:.10g} kg, centre of mass "
                      f"{_vector(link.com_xyz)} m, inertia diagonal {_vector(link.inertia_com.diagonal())} kg m^2, "
                      f"damping {joint.damping:.10g}, armature {joint.armature:.10g}")
-    if chain.held_joints:
-        lines.append(f"held at 0 (their links ride on the chain): {', '.join(chain.held_joints)}")
-    return lines
+    changes = model_changes(chain).sentences(str(chain.base_link))
+    if chain.urdf_path is not None:
+        lines.append(f"every engine reads {chain.urdf_path} below {chain.base_link} without geometry and <dynamics>"
+                     + (", and:" if changes else ", nothing else changed"))
+    return lines + [f"  {sentence}" for sentence in changes]
 
 
 def describe(scene) -> str:

@@ -534,7 +534,10 @@ def _ladder(sim: _Reader, duration: float, n_bodies: int) -> tuple[float, ...]:
     return dts
 
 
-def _joint(r: _Reader) -> Joint:
+def _joint(r: _Reader, before: tuple[str, ...]) -> Joint:
+    """One ``[[chain.joint]]``; ``before``: the names of the joints before it (its branch from the base)."""
+    name = r.name("name")
+    where = f"joint {name!r} on the branch {' > '.join(('base',) + before + (name,))}"
     kind = r.string("type", choices=JOINT_TYPES)
     length = 1 if kind == "prismatic" else 0
     if r.has("lower") != r.has("upper"):
@@ -542,46 +545,50 @@ def _joint(r: _Reader) -> Joint:
                      "both lower and upper, or neither for an unlimited joint")
     lower = r.number("lower", length=length) if r.has("lower") else -np.inf
     upper = r.number("upper", length=length) if r.has("upper") else np.inf
-    if lower >= upper:
-        raise r.fail("upper", f"upper {upper:g} is not above lower {lower:g}", "lower < upper")
+    if lower > upper:  # lower == upper: a joint held at that value where limits act (as in a URDF)
+        raise r.fail("upper", f"upper {upper:g} is below lower {lower:g} ({where})", "lower <= upper")
     # damping [N m s/rad = kg m^2/s] or [N s/m = kg/s], armature [kg m^2] or [kg]: length^2 or length^0
     power = 0 if kind == "prismatic" else 2
     damping = r.number("damping", 0.0, length=power) if r.has("damping") else 0.0
     armature = r.number("armature", 0.0, length=power) if r.has("armature") else 0.0
     for key, value in (("damping", damping), ("armature", armature)):
         if value < 0:
-            raise r.fail(key, f"{value:g} is negative", "a number >= 0 (0: none)")
+            raise r.fail(key, f"{value:g} is negative ({where})", "a number >= 0 (0: none)")
     rpy = r.vector("origin_rpy", 3, [0.0] * 3)
     return Joint(
-        name=r.name("name"), type=kind, axis=r.vector("axis", 3, nonzero=True),
+        name=name, type=kind, axis=r.vector("axis", 3, nonzero=True),
         origin_xyz=r.vector("origin_xyz", 3, [0.0] * 3, length=1), origin_rotation=rpy_to_matrix(rpy),
-        lower=lower, upper=upper, link=_link(r), damping=damping, armature=armature, origin_rpy=rpy,
+        lower=lower, upper=upper, link=_link(r, where), damping=damping, armature=armature, origin_rpy=rpy,
     )
 
 
-def _link(r: _Reader) -> LinkInertia | None:
-    """The mass properties of a ``[[chain.joint]]``'s child link: all of mass, com_xyz, inertia, or none."""
+def _link(r: _Reader, where: str) -> LinkInertia | None:
+    """The mass properties of a ``[[chain.joint]]``'s child link: all of mass, com_xyz, inertia, or none. The same
+    rules as a URDF's ``<inertial>`` (:func:`core.urdf.chain_from_urdf`): a mass of 0 with a non-zero inertia loads
+    (a rotor's inertia whose mass is counted elsewhere: real URDFs have it, and every engine keeps it as written);
+    the tensor's rounding is judged against the link's own scale (:func:`core.dynamics.inertia.link_tensor_problem`).
+    ``where`` (the joint's name and branch) ends every message."""
     given = [key for key in _LINK if r.has(key)]
     if not given:
         return None
     if len(given) != len(_LINK):
         missing = next(key for key in _LINK if key not in given)
-        raise r.fail(missing, f"missing: {', '.join(given)} given without it",
+        raise r.fail(missing, f"missing: {', '.join(given)} given without it ({where})",
                      "all of mass [kg], com_xyz [length] and inertia (3 x 3 about the centre of mass, in the link's "
                      "axes) or none (a chain for kinematics only)")
-    massless = r.table.get("mass") == 0  # a massless link (inertia 0), as a URDF link without <inertial>
+    massless = r.table.get("mass") == 0  # a massless link, as a URDF link without <inertial> or with mass 0
     mass = 0.0 if massless else r.number("mass", positive=True)
     inertia = r.matrix("inertia", 3, length=2)
     largest, moments = float(np.max(np.abs(inertia))), RANGES["inertia_moment"]
     if largest > moments.high:
-        raise r.fail("inertia", f"an entry of {largest:.3g} kg m^2 is outside the physical range", moments.text())
-    if massless and largest > 0:
-        raise r.fail("inertia", "a massless link with an inertia", "inertia all 0 where mass = 0")
-    problem = link_tensor_problem(inertia)
+        raise r.fail("inertia", f"an entry of {largest:.3g} kg m^2 is outside the physical range ({where})",
+                     moments.text())
+    com = r.vector("com_xyz", 3, length=1)
+    problem = link_tensor_problem(inertia, mass, com)
     if problem:
-        raise r.fail("inertia", problem, "a symmetric positive-semidefinite tensor obeying the triangle inequality "
-                     "(a point mass or a thin rod is one)")
-    return LinkInertia(mass, r.vector("com_xyz", 3, length=1), inertia)
+        raise r.fail("inertia", f"{problem} ({where})", "a symmetric positive-semidefinite tensor obeying the "
+                     "triangle inequality (a point mass or a thin rod is one)")
+    return LinkInertia(mass, com, inertia)
 
 
 def _package_root(c: _Reader, prefix: str) -> Path:
@@ -642,10 +649,10 @@ def _dh_chain(c: _Reader, name: str) -> Chain:
     limits = None
     if dh.has("lower") or dh.has("upper"):
         limits = np.stack([dh.vector("lower", size), dh.vector("upper", size)], axis=1)
-        bad = np.flatnonzero(limits[:, 0] >= limits[:, 1])
+        bad = np.flatnonzero(limits[:, 0] > limits[:, 1])
         if bad.size:
-            raise dh.fail(f"upper[{bad[0]}]", f"the upper limit of joint {bad[0]} is not above its lower limit",
-                          "lower < upper for every joint")
+            raise dh.fail(f"upper[{bad[0]}]", f"the upper limit of joint {bad[0]} is below its lower limit (branch "
+                          f"{' > '.join(f'joint {i}' for i in range(bad[0] + 1))})", "lower <= upper for every joint")
     table = DHTable(convention, **values)  # the numbers as given, for the references (core derives the frames)
     return replace(chain_from_dh(name, convention=convention, limits=limits, **values), dh=table)
 
@@ -661,7 +668,9 @@ def _chain(top: _Reader, name: str, dynamics: bool = False) -> Chain:
         return _urdf_chain(c, dynamics)
     if sources == ["dh"]:
         return _dh_chain(c, c.name("name", name))
-    joints = tuple(_joint(r) for r in c.array_of_tables("joint", _JOINT, "max_joints"))
+    joints: tuple[Joint, ...] = ()
+    for r in c.array_of_tables("joint", _JOINT, "max_joints"):
+        joints += (_joint(r, tuple(joint.name for joint in joints)),)
     names = [j.name for j in joints]
     end_effector = c.name("end_effector", "end_effector")
     if len(set(names + [end_effector])) != len(names) + 1:

@@ -49,6 +49,8 @@ def z_alignment(axis: np.ndarray) -> np.ndarray:
         return np.eye(3)
     if np.array_equal(axis, [0.0, 0.0, -1.0]):
         return np.diag([1.0, -1.0, -1.0])
+    if axis[2] < -0.5:  # 1 + axis[2] below loses a bit per halving, all at 1e-16 from -e_z (iCub's knee axis
+        return z_alignment(-axis) @ np.diag([1.0, -1.0, -1.0])  # (0, 1.2e-16, -1)): align -axis, turn e_z over
     v = np.cross([0.0, 0.0, 1.0], axis)  # rotation about e_z x axis by the angle between them (Rodrigues)
     k = skew(v)
     return np.eye(3) + k + k @ k / (1.0 + axis[2])

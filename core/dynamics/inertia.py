@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.core.model.errors import SceneError
+from simparity.core.model.ranges import RANGES
 
 # Relative tolerance of inertia_problem's symmetry and triangle-inequality checks, as a
 # fraction of the largest principal moment. Scene files quote inertias to ~6 significant
@@ -248,18 +249,54 @@ def _fmt(values: np.ndarray, scale: float = 1.0) -> str:
     return "(" + ", ".join(f"{_scaled(v, scale):.6g}" for v in values) + ")"
 
 
-def link_tensor_problem(inertia: np.ndarray) -> str:
+ROUNDING_ULPS = 64
+"""Floating-point residue a link's inertia tensor may carry, in units of eps times the link's inertia scale about
+its frame origin (c + m |d|^2: its largest centroidal moment plus the parallel-axis term). Exporters compute the
+centroidal tensor by taking m (|d|^2 E - d d^T) off an inertia about the link origin, which leaves residues of a
+few eps m |d|^2 whatever the tensor's own size: iCub's head (m = 1.34 kg, |d| = 0.11 m) is written as ixz =
+2.4e-35 kg m^2 and nothing else, principal moments (-2.4e-35, 0, 2.4e-35), 1e-33 of its scale. 64 eps = 1.4e-14
+of the scale covers a chain of such operations and is far below any physical violation (the smallest in the
+installed robot files, pybullet_data's TwoJointRobot link_1, breaks a + b >= c by 0.8 % of c)."""
+
+MOMENT_FLOOR = RANGES["inertia_moment"].low  # [kg m^2]
+"""The smallest moment of inertia that is physical (1e-15 kg m^2, a microgram bead of 1 mm: the low end of
+:data:`core.model.ranges.RANGES`' ``inertia_moment``): the floating-point scale of :func:`link_tensor_problem` never falls
+below it, so a point mass at its link's origin written with a residue of 1e-35 is judged as the point mass it is."""
+
+
+def link_tensor_problem(inertia: np.ndarray, mass: float = 0.0, com_xyz: np.ndarray | None = None) -> str:
     """Why a symmetric inertia tensor is not a link's ("" if it is): principal moments a <= b <= c must satisfy
-    a + b >= c (every mass distribution does; it implies a >= 0) up to :data:`INERTIA_RTOL` of c. Unlike a free
-    body's (:func:`inertia_problem`), a zero or singular tensor (a point mass, a thin rod) is a link's: its joint
-    carries it."""
-    scale = float(np.max(np.abs(inertia)))
-    if scale == 0.0:
+    a + b >= c (every mass distribution does; it implies a >= 0). Unlike a free body's (:func:`inertia_problem`), a
+    zero or singular tensor (a point mass, a thin rod) is a link's: its joint carries it.
+
+    A violation is rounding, not physics, when it is within either of two tolerances: the written decimals'
+    (:data:`INERTIA_RTOL` of c) or floating point's (:data:`ROUNDING_ULPS` eps of the link's inertia scale about its
+    frame origin, c + ``mass`` |``com_xyz``|^2, at least :data:`MOMENT_FLOOR`).
+
+    Parameters
+    ----------
+    inertia : (3, 3) ndarray
+        About the centre of mass [kg m^2], entries within the physical range (at most 1e12).
+    mass : float
+        [kg], >= 0.
+    com_xyz : (3,) ndarray, optional
+        The centre of mass in the link frame [m]; None: at its origin.
+
+    Returns
+    -------
+    str
+        "" or one sentence with the principal moments.
+    """
+    largest = float(np.max(np.abs(inertia)))
+    if largest == 0.0:
         return ""
-    a, b, c = np.linalg.eigvalsh(inertia / scale)  # of order one: no overflow, no lost digits
-    if a + b >= c * (1 - INERTIA_RTOL):
+    a, b, c = np.linalg.eigvalsh(inertia / largest) * largest  # of order one inside: no lost digits
+    offset = 0.0 if com_xyz is None else float(np.dot(com_xyz, com_xyz))
+    scale = max(abs(c) + mass * offset, MOMENT_FLOOR)
+    rounding = max(INERTIA_RTOL * abs(c), ROUNDING_ULPS * np.finfo(float).eps * scale)
+    if a + b >= c - rounding:
         return ""
-    moments = ", ".join(f"{m * scale:.6g}" for m in (a, b, c))
-    if a < 0:
+    moments = ", ".join(f"{m:.6g}" for m in (a, b, c))
+    if a < -rounding:
         return f"not positive semidefinite: principal moments ({moments}) kg m^2"
     return f"violates the triangle inequality: principal moments ({moments}) kg m^2 have a + b < c"

@@ -19,14 +19,21 @@ only these changes, each made with :mod:`xml.etree.ElementTree` on the parsed fi
 - The base link and every link welded to it by fixed joints never move: their ``<inertial>`` is replaced by the
   explicit zero (a placeholder tensor there, as ANYmal's base has, made MuJoCo refuse the whole model).
 
-``<inertial>`` elements of links that move are never touched. A chain without a URDF file (inline joints in a scene) is written with
+``<inertial>`` elements of links that move are never touched (one of mass 0 with a non-zero inertia included: every
+engine keeps its rotational inertia). :class:`ModelChanges` names each change link by link (joint by joint) for the
+rows' detail (:func:`dynamics_source`) and ``simparity show``.
+
+A chain without a URDF file (inline joints in a scene) is written with
 its declared mass properties (centre of mass as the inertial origin, the full tensor in the link's axes).
 """
 
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass
 from typing import cast
+
+import numpy as np
 
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.files import parse_xml
@@ -61,17 +68,67 @@ def _subtree(root: ET.Element, base: str) -> tuple[set[str], set[str]]:
     return links, joints
 
 
-def original_for_dynamics(chain: Chain) -> str:
-    """The chain's URDF file as every engine reads it for dynamics (see the module docstring)."""
+@dataclass(frozen=True)
+class ModelChanges:
+    """What :func:`original_for_dynamics` changes in a chain's file to make it mean the same in every engine, named
+    link by link and joint by joint (file order), for the rows' detail and ``simparity show``.
+
+    Attributes
+    ----------
+    removed : tuple of str
+        Links not below the base link, left out.
+    held : tuple of str
+        Movable joints off the chain, made fixed at their zero position.
+    welded : tuple of str
+        Links welded to the fixed base (the base included): they never move, and get the explicit zero
+        ``<inertial>`` in place of theirs.
+    no_inertial : tuple of str
+        Moving links without ``<inertial>``: given the explicit zero one (PyBullet's default would be 1 kg).
+    friction : tuple of str
+        Joints whose ``<dynamics friction>`` (Coulomb) no engine is given.
+    massless_with_inertia : tuple of str
+        Moving links of mass 0 with a non-zero inertia: kept as written (not a change; every engine keeps the
+        rotational inertia, a rotor's whose mass is counted elsewhere).
+    """
+
+    removed: tuple[str, ...] = ()
+    held: tuple[str, ...] = ()
+    welded: tuple[str, ...] = ()
+    no_inertial: tuple[str, ...] = ()
+    friction: tuple[str, ...] = ()
+    massless_with_inertia: tuple[str, ...] = ()
+
+    def sentences(self, base: str) -> list[str]:
+        """One sentence per kind of change that names its links or joints (none: an empty list)."""
+        said = [
+            (self.no_inertial, "links without <inertial> given an explicit massless one (the URDF's meaning, where "
+                               "PyBullet's default would be 1 kg and a unit inertia)"),
+            (self.welded, "links welded to the fixed base (they never move) given the explicit massless <inertial> "
+                          "(in place of theirs where they have one)"),
+            (self.held, "joints off the chain held at 0 as fixed joints (their links ride on the chain)"),
+            (self.friction, "<dynamics friction> (Coulomb) not modelled, no engine is given it"),
+            (self.massless_with_inertia, "links of mass 0 with a rotational inertia, kept as written in every engine "
+                                         "(a rotor's inertia whose mass is counted elsewhere)"),
+            (self.removed, f"links not below the base link {base} left out"),
+        ]
+        return [f"{what}: {', '.join(names)}" for names, what in said if names]
+
+
+def _changed(chain: Chain) -> tuple[ET.Element, ModelChanges]:
+    """The chain's file as every engine reads it for dynamics (see the module docstring), and what was changed."""
     path = cast(str, chain.urdf_path)
     with open(path, "rb") as handle:
         root = parse_xml(handle.read(), path, "robot")
     links, joints = _subtree(root, cast(str, chain.base_link))
     held = set(chain.held_joints)
+    removed = tuple(cast(str, element.get("name")) for element in root.findall("link")
+                    if element.get("name") not in links)
     for element in list(root):
         kept = links if element.tag == "link" else joints if element.tag == "joint" else None
         if kept is not None and element.get("name") not in kept:
             root.remove(element)
+    friction = tuple(cast(str, joint.get("name")) for joint in root.findall("joint")
+                     if any(float(d.get("friction", "0")) != 0 for d in joint.findall("dynamics")))
     for joint in root.findall("joint"):
         for element in joint.findall("dynamics"):
             joint.remove(element)
@@ -81,16 +138,47 @@ def original_for_dynamics(chain: Chain) -> str:
                 for element in joint.findall(tag):
                     joint.remove(element)
     welded = _welded_to_base(root, cast(str, chain.base_link))
+    no_inertial, massless_with_inertia = [], []
     for link in root.findall("link"):
+        name = cast(str, link.get("name"))
         for tag in REMOVED_FROM_LINKS:
             for element in link.findall(tag):
                 link.remove(element)
-        if link.get("name") in welded:  # never moves: not part of the dynamics (a placeholder there is harmless)
+        if name in welded:  # never moves: not part of the dynamics (a placeholder there is harmless)
             for element in link.findall("inertial"):
                 link.remove(element)
+        elif link.find("inertial") is None:
+            no_inertial.append(name)
+        elif _massless_with_inertia(cast(ET.Element, link.find("inertial"))):
+            massless_with_inertia.append(name)
         if link.find("inertial") is None:
             zero_inertial(link)
-    return _text(root)
+    order = [cast(str, link.get("name")) for link in root.findall("link")]
+    return root, ModelChanges(removed, chain.held_joints, tuple(n for n in order if n in welded),
+                              tuple(no_inertial), friction, tuple(massless_with_inertia))
+
+
+def _massless_with_inertia(inertial: ET.Element) -> bool:
+    """Whether an ``<inertial>`` has mass 0 and a non-zero ``<inertia>`` entry (the file loaded: numbers are valid)."""
+    mass, inertia = inertial.find("mass"), inertial.find("inertia")
+    if mass is None or inertia is None or float(mass.get("value", "0")) != 0:
+        return False
+    return any(float(inertia.get(entry, "0")) != 0 for entry in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"))
+
+
+def original_for_dynamics(chain: Chain) -> str:
+    """The chain's URDF file as every engine reads it for dynamics (see the module docstring)."""
+    return _text(_changed(chain)[0])
+
+
+def model_changes(chain: Chain) -> ModelChanges:
+    """What every engine's model of ``chain``'s file changes, link by link; for a chain without a file (its links
+    written after its joints), only its links of mass 0 with an inertia, named after their joints."""
+    if chain.urdf_path is not None:
+        return _changed(chain)[1]
+    return ModelChanges(massless_with_inertia=tuple(
+        joint.name for joint in chain.joints
+        if joint.link is not None and joint.link.mass == 0 and bool(np.any(joint.link.inertia_com))))
 
 
 def _welded_to_base(root: ET.Element, base: str) -> set[str]:
@@ -126,8 +214,8 @@ def dynamics_urdf(chain: Chain) -> str:
 
 def dynamics_source(chain: Chain) -> str:
     """Where an engine's dynamics model of ``chain`` comes from, for the rows' detail."""
+    changes = model_changes(chain).sentences(str(chain.base_link))
     if chain.urdf_path is None:
-        return "the chain's declared mass properties written as URDF"
-    held = f"; held at 0: {', '.join(chain.held_joints)}" if chain.held_joints else ""
-    return (f"{chain.urdf_path} below {chain.base_link}, inertials untouched, without geometry and <dynamics>, "
-            f"links without <inertial> massless{held}")
+        return "; ".join(["the chain's declared mass properties written as URDF"] + changes)
+    return (f"{chain.urdf_path} below {chain.base_link}, without geometry and <dynamics>, moving links' inertials "
+            f"untouched; " + ("; ".join(changes) if changes else "nothing else changed"))

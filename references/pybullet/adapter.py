@@ -560,6 +560,10 @@ class PybulletEngine(UrdfChains, Engine):
         if above:
             return Support.no(f"calculateInverseKinematics moves every joint of the body, and {', '.join(above)} "
                               f"above the chain's base link {chain.base_link} would move the base")
+        held = [joint.name for joint in chain.joints if joint.lower == joint.upper]
+        if named.ok and solver.endswith("-nullspace") and held:
+            return Support.no(f"calculateInverseKinematics' null-space solve hangs on a joint with lower == upper "
+                              f"({', '.join(held)}; measured: no answer within the 900 s case limit)")
         return named
 
     def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:

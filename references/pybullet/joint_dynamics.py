@@ -88,13 +88,28 @@ CLIPPED = 0.5 * MAX_VELOCITY
 """A stepped velocity this large has reached the cap: the row fails with the reason instead of a clipped qddot."""
 
 
+def _axes(root: ET.Element) -> list[tuple[ET.Element, ET.Element, np.ndarray]]:
+    """(``<joint>``, its ``<axis>`` element, the axis' xyz (3,)) of every joint with an ``<axis>``, in file order."""
+    found = []
+    for joint in root.iter("joint"):
+        for axis in joint.findall("axis"):
+            found.append((joint, axis, np.array([float(v) for v in axis.get("xyz", "1 0 0").split()])))
+    return found
+
+
 def unit_axes(text: str) -> str:
     """URDF ``text`` with every joint ``<axis>`` normalised (see the module docstring)."""
     root = ET.fromstring(text)
-    for axis in root.iter("axis"):
-        xyz = np.array([float(v) for v in axis.get("xyz", "1 0 0").split()])
+    for _, axis, xyz in _axes(root):
         axis.set("xyz", fmt(xyz / np.linalg.norm(xyz)))
     return ET.tostring(root, encoding="unicode")
+
+
+def axes_changed(chain: Chain) -> str:
+    """Which joints :func:`unit_axes` changes in ``chain``'s dynamics URDF, named for the rows' detail."""
+    names = [joint.get("name", "") for joint, _, xyz in _axes(ET.fromstring(dynamics_urdf(chain)))
+             if joint.get("type") != "fixed" and np.linalg.norm(xyz) != 1.0]  # a fixed joint's axis means nothing
+    return f"axes normalised ({'non-unit: ' + ', '.join(names) if names else 'all unit already'})"
 
 
 class ChainBodies:
@@ -188,10 +203,10 @@ class PybulletJointDynamics(JointDynamicsModel):
         self._tree.build_tree()
         self._stepped = ChainBodies(chain, gravity_world)
         self._damping = np.array([j.damping for j in chain.joints])
-        self.detail = (f"loadURDF(useFixedBase, URDF_USE_INERTIA_FROM_FILE) of {dynamics_source(chain)}, axes "
-                       f"normalised; gravity set; link damping 0, jointDamping = the chain's, joint limits, velocity "
-                       f"cap and braking motors off; M, h, tau from calculateMassMatrix / calculateInverseDynamics "
-                       f"(+ D qdot); qddot from one stepSimulation of {STEP:g} s under TORQUE_CONTROL; kinetic energy "
+        self.detail = (f"loadURDF(useFixedBase, URDF_USE_INERTIA_FROM_FILE) of {dynamics_source(chain)}; "
+                       f"{axes_changed(chain)}; gravity set; link damping 0, jointDamping = the chain's, joint limits, "
+                       f"velocity cap and braking motors off; M, h, tau from calculateMassMatrix / "
+                       f"calculateInverseDynamics (+ D qdot); qddot from one stepSimulation of {STEP:g} s under TORQUE_CONTROL; kinetic energy "
                        f"from getLinkStates' centre-of-mass velocities and inertial frames")
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:

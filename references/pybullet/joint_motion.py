@@ -50,7 +50,7 @@ from simparity.core.model.scene import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common.dynamics_urdf import dynamics_source
 from simparity.references.pybullet.adapter import PybulletChain
-from simparity.references.pybullet.joint_dynamics import CLIPPED, ChainBodies
+from simparity.references.pybullet.joint_dynamics import CLIPPED, ChainBodies, axes_changed
 from simparity.references.pybullet.quiet import pybullet
 
 
@@ -78,10 +78,10 @@ class PybulletJointMotion(JointSimulation):
         self._gravity = np.zeros(3) if scene.gravity_world is None else np.asarray(scene.gravity_world, dtype=float)
         self.detail = (f"stepSimulation of a fixed-base multibody per copy in one world (Featherstone ABA, "
                        f"semi-implicit Euler: q from the new qdot), setTimeStep(dt), numSubSteps 0; "
-                       f"loadURDF(URDF_USE_INERTIA_FROM_FILE) of {dynamics_source(scene.chain)}, axes normalised, no "
-                       f"collision shapes (collision filter group and mask 0), no ground; gravity set; link damping 0, "
-                       f"joint limits, velocity cap and braking motors off; joint damping by "
-                       f"changeDynamics(jointDamping) (Bullet: -D qdot at the step's start, explicit); torque by "
+                       f"loadURDF(URDF_USE_INERTIA_FROM_FILE) of {dynamics_source(scene.chain)}; "
+                       f"{axes_changed(scene.chain)}; no collision shapes (collision filter group and mask 0), no "
+                       f"ground; gravity set; link damping 0, joint limits, velocity cap and braking motors off; joint "
+                       f"damping by changeDynamics(jointDamping) (Bullet: -D qdot at the step's start, explicit); torque by "
                        f"TORQUE_CONTROL re-sent before every step (Bullet clears it after each); energy from "
                        f"calculateMassMatrix and getLinkStates; end effector by getLinkState (float32)")
 
