@@ -31,7 +31,8 @@ IK = ("default", "hard")
 """The iterative IK solvers: the default suite's IK scenes and the hard suite's hard targets."""
 
 ARTICULATED = ("default", "articulated")
-"""Joint-space dynamics: the default suite's planar 2-link arm and the articulated suite's 3-D arms."""
+"""Joint-space dynamics: the default suite's planar 2-link arm and 3-D oblique arm, and the articulated suite's 3-D
+arms."""
 
 ARTICULATED_3D = ("articulated",)
 """Joint-space dynamics that a planar arm cannot show (a gyroscopic term, an axis turning out of the plane)."""
@@ -217,6 +218,13 @@ MUTANTS: tuple[Mutation, ...] = (
         "q[idx[step]] = wrap_into_limits(qa[step] + dq[step], revolute, lower, upper)",
         "each iterate is wrapped into the limits by 2 pi but never clipped: joints leave their limits",
         IK, "iiwa-ik"),
+    Mutation(
+        "nullspace_projector_transpose", "null-space term", "ik/nullspace.py",
+        'row_space = np.einsum("bkn,bk,bk->bn", vt, kept, np.einsum("bkn,bn->bk", vt, z))',
+        'row_space = np.einsum("bmn,bm->bn", jacobian, np.einsum("bmn,bn->bm", jacobian, z))',
+        "the null-space projector built with J^T J for J+ J (the same only when J's rows are orthonormal): the "
+        "secondary term moves the end effector and no longer descends the rest-pose penalty",
+        IK, "iiwa-ik"),
     # --- Joint-space dynamics -------------------------------------------------------------------------------
     Mutation(
         "jacobian_sum_no_gyroscopic", "joint-space bias forces", "articulated/jacobian_sum.py",
@@ -242,6 +250,13 @@ MUTANTS: tuple[Mutation, ...] = (
         "tau[i] = forces[i][arrays.subspace[i]]",
         "RNEA without the joint's rotor inertia (armature): tau misses a_i qddot_i (no URDF carries armature)",
         ARTICULATED_3D, "armature-arm-dynamics"),
+    Mutation(
+        "link_inertia_transposed_alignment", "inertia frame", "articulated/chain_arrays.py",
+        "inertia_com.append(align.T @ np.asarray(link.inertia_com) @ align)",
+        "inertia_com.append(align @ np.asarray(link.inertia_com) @ align.T)",
+        "each link's inertia turned into its joint frame by the transposed rotation (A I A^T for A^T I A): the "
+        "same on an axis along z, wrong on any other with products of inertia",
+        ARTICULATED, "oblique-arm-dynamics"),
     # --- Joint-space time stepping --------------------------------------------------------------------------
     Mutation(
         "joint_rk4_stage_typo", "integrator weights", "articulated/stepping.py",
