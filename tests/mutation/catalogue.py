@@ -35,11 +35,11 @@ ARTICULATED = ("default", "articulated")
 arms."""
 
 ARTICULATED_3D = ("articulated",)
-"""Joint-space dynamics that a planar arm cannot show (a gyroscopic term, an axis turning out of the plane)."""
+"""Joint-space dynamics that only the articulated suite's arms show (armature, which no URDF carries)."""
 
 JOINT_MOTION = ("default", "hard", "articulated")
-"""Joint-space time stepping: the default suite's pendulum and damped joint, the hard suite's stiff damping and the
-articulated suite's chains and falling arms."""
+"""Joint-space time stepping: the default suite's pendulum, damped joint and oblique arm, the hard suite's stiff
+damping and the articulated suite's chains and falling arms."""
 
 MUTANTS: tuple[Mutation, ...] = (
     # --- Dynamics: integrators ------------------------------------------------------------------------------
@@ -231,7 +231,7 @@ MUTANTS: tuple[Mutation, ...] = (
         'moment = (inertia @ (k["djw"] @ qdot[:, None, :, None]))[..., 0] + np.cross(w, spin)',
         'moment = (inertia @ (k["djw"] @ qdot[:, None, :, None]))[..., 0]',
         "the lecture's bias forces without the gyroscopic moment w x I w of each link (zero on a planar arm)",
-        ARTICULATED_3D, "crafted-arm-dynamics"),
+        ARTICULATED, "oblique-arm-dynamics"),
     Mutation(
         "jacobian_sum_lever_rate_sign", "joint-space bias forces", "articulated/jacobian_sum.py",
         "lever_rate = v_com[..., 0][:, :, None, :] - v_origin[:, None, :, :]",
