@@ -5,5 +5,6 @@
   one mutation, its engine under a name of its own; the data model stays the real ``simparity.core``;
 - :mod:`.catalogue`: the planted bugs, and the faithful copy;
 - :mod:`.gate`: ``simparity run --quick --check`` with copies beside core, and its verdict on each of them;
-- :mod:`.score`: the mutation score table (``python -m tests.mutation.score``).
+- :mod:`.score`: the mutation score table (``python -m tests.mutation.score``);
+- :mod:`.margin`: how wide each catch is, value / bound, scene by scene (``python -m tests.mutation.margin``).
 """

@@ -31,14 +31,15 @@ IK = ("default", "hard")
 """The iterative IK solvers: the default suite's IK scenes and the hard suite's hard targets."""
 
 ARTICULATED = ("default", "articulated")
-"""Joint-space dynamics: the default suite's planar 2-link arm and the articulated suite's 3-D arms."""
+"""Joint-space dynamics: the default suite's planar 2-link arm and 3-D oblique arm, and the articulated suite's 3-D
+arms."""
 
 ARTICULATED_3D = ("articulated",)
-"""Joint-space dynamics that a planar arm cannot show (a gyroscopic term, an axis turning out of the plane)."""
+"""Joint-space dynamics that only the articulated suite's arms show (armature, which no URDF carries)."""
 
 JOINT_MOTION = ("default", "hard", "articulated")
-"""Joint-space time stepping: the default suite's pendulum and damped joint, the hard suite's stiff damping and the
-articulated suite's chains and falling arms."""
+"""Joint-space time stepping: the default suite's pendulum, damped joint and oblique arm, the hard suite's stiff
+damping and the articulated suite's chains and falling arms."""
 
 MUTANTS: tuple[Mutation, ...] = (
     # --- Dynamics: integrators ------------------------------------------------------------------------------
@@ -217,13 +218,20 @@ MUTANTS: tuple[Mutation, ...] = (
         "q[idx[step]] = wrap_into_limits(qa[step] + dq[step], revolute, lower, upper)",
         "each iterate is wrapped into the limits by 2 pi but never clipped: joints leave their limits",
         IK, "iiwa-ik"),
+    Mutation(
+        "nullspace_projector_transpose", "null-space term", "ik/nullspace.py",
+        'row_space = np.einsum("bkn,bk,bk->bn", vt, kept, np.einsum("bkn,bn->bk", vt, z))',
+        'row_space = np.einsum("bmn,bm->bn", jacobian, np.einsum("bmn,bn->bm", jacobian, z))',
+        "the null-space projector built with J^T J for J+ J (the same only when J's rows are orthonormal): the "
+        "secondary term moves the end effector and no longer descends the rest-pose penalty",
+        IK, "iiwa-ik"),
     # --- Joint-space dynamics -------------------------------------------------------------------------------
     Mutation(
         "jacobian_sum_no_gyroscopic", "joint-space bias forces", "articulated/jacobian_sum.py",
         'moment = (inertia @ (k["djw"] @ qdot[:, None, :, None]))[..., 0] + np.cross(w, spin)',
         'moment = (inertia @ (k["djw"] @ qdot[:, None, :, None]))[..., 0]',
         "the lecture's bias forces without the gyroscopic moment w x I w of each link (zero on a planar arm)",
-        ARTICULATED_3D, "crafted-arm-dynamics"),
+        ARTICULATED, "oblique-arm-dynamics"),
     Mutation(
         "jacobian_sum_lever_rate_sign", "joint-space bias forces", "articulated/jacobian_sum.py",
         "lever_rate = v_com[..., 0][:, :, None, :] - v_origin[:, None, :, :]",
@@ -249,6 +257,13 @@ MUTANTS: tuple[Mutation, ...] = (
         "RNEA's velocity-product term v x* I v skipped for the last body (an off-by-one bound): only the light last "
         "link's Coriolis and centrifugal force is lost, on a chain whose bias forces are small (issue #38)",
         ARTICULATED, "scara-slow-dynamics"),
+    Mutation(
+        "link_inertia_transposed_alignment", "inertia frame", "articulated/chain_arrays.py",
+        "inertia_com.append(align.T @ np.asarray(link.inertia_com) @ align)",
+        "inertia_com.append(align @ np.asarray(link.inertia_com) @ align.T)",
+        "each link's inertia turned into its joint frame by the transposed rotation (A I A^T for A^T I A): the "
+        "same on an axis along z, wrong on any other with products of inertia",
+        ARTICULATED, "oblique-arm-dynamics"),
     # --- Joint-space time stepping --------------------------------------------------------------------------
     Mutation(
         "joint_rk4_stage_typo", "integrator weights", "articulated/stepping.py",
