@@ -33,7 +33,6 @@ from simparity.comparisons.execute.progress import ProgressBar
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS, run_group
 from simparity.comparisons.execute.store import RunWriter
 from simparity.comparisons.gate.check import CheckResult, check_table
-from simparity.comparisons.gate.violation import grouped
 from simparity.comparisons.gate.history import record_run
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, Bound, load_tolerances
 from simparity.comparisons.invariance.invariance_run import invariance_rows
@@ -325,14 +324,13 @@ def write_run_report(out_dir: Path, say: Say, bounds: list[Bound] | None = None)
     """report.md, report.html and figures/ of the run in ``out_dir``; its metrics are held to ``bounds`` (default:
     the shipped tolerances) for the report's flagged findings, which never changes an exit code. Returns that
     verdict."""
-    from simparity.reports.content import ToleranceVerdict
+    from simparity.comparisons.gate.check_output import report_verdict
     from simparity.reports.render import write_report
     from simparity.reports.store import read_run
 
     table, _ = read_run(out_dir)
     result = check_table(table, bounds if bounds is not None else load_tolerances(DEFAULT_TOLERANCES))
-    verdict = ToleranceVerdict(result.checked, result.unchecked, tuple(g.line() for g in grouped(result.violations)),
-                               len(result.violations))
+    verdict = report_verdict(result)
     markdown, page = write_report(out_dir, verdict)
     say(f"results: {Path(out_dir) / RESULTS_FILE}\nreport:  {markdown}\n         {page}")
     return result

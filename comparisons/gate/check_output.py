@@ -5,9 +5,13 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from typing import TYPE_CHECKING
 
 from simparity.comparisons.gate.check import BaselineDiff, CheckResult
 from simparity.comparisons.gate.violation import GROUP_METRICS_SHOWN, Violation, grouped
+
+if TYPE_CHECKING:  # the report's modules draw figures: imported when a report is written, not by every check
+    from simparity.reports.content import ToleranceVerdict
 
 
 MESSAGE_CHARS = 500
@@ -36,6 +40,17 @@ def held_line(result: CheckResult) -> str:
     if others:
         text += f" (not held: {', '.join(others)}, {len(result.findings)} findings, never blocking)"
     return text
+
+
+def report_verdict(result: CheckResult) -> ToleranceVerdict:
+    """The verdict as the report shows it: counts, one line per case and reason with the engine it is about, and the
+    engines the gate holds."""
+    from simparity.reports.content import ToleranceVerdict
+
+    groups = grouped(result.violations + result.findings)
+    return ToleranceVerdict(result.checked, result.unchecked, tuple(g.line() for g in groups),
+                            len(result.violations) + len(result.findings),
+                            tuple(g.violations[0].engine for g in groups), result.held)
 
 
 def _case_name(key: tuple) -> tuple[str, str]:
