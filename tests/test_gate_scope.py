@@ -214,3 +214,20 @@ gravity_world = [0.0, 0.0, -9.81]
 states = 5
 seed = 1
 """
+
+
+def test_the_report_s_verdict_names_each_finding_s_engine_and_the_engines_held(tmp_path):
+    """What the report's "is my engine right?" sections are built from: each line's engine, and whom the gate holds
+    (``simparity run --check --check-engines`` passes its names through the session to the report)."""
+    from simparity.comparisons.gate.check import check_table, held_to
+    from simparity.comparisons.gate.check_output import report_verdict
+    from simparity.comparisons.gate.tolerances import EngineNames
+    from simparity.reports.store import read_run
+
+    run = _stored(tmp_path / "run", _rows("mine", factor=WRONG) + _rows("theirs", factor=WRONG))
+    result = check_table(read_run(run)[0], load_tolerances(_file(tmp_path, BOUND)))
+    verdict = report_verdict(result, ("mine",))
+    assert verdict.held == ("mine",) and set(verdict.engines) == {"mine", "theirs"}
+    assert all(line.split()[1] == engine for line, engine in zip(verdict.violations, verdict.engines))
+    narrowed = report_verdict(held_to(result, EngineNames(("theirs",), "--check-engines")))
+    assert narrowed.held == ("theirs",) and narrowed.outside_count == verdict.outside_count  # findings still listed

@@ -183,6 +183,7 @@ def cmd_run(args, out) -> int:
     gate = load_gate(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
     if gate is None and (args.check_engines or args.require_engines):
         raise SimparityError("--check-engines or --require-engines without --check (allowed: add --check)")
+    held = _engine_names(gate, args)[0] if gate is not None else None
     out_dir = _out_dir(args)
 
     def say(line: str) -> None:
@@ -190,7 +191,7 @@ def cmd_run(args, out) -> int:
 
     session = Session(chosen, engines, profile="quick" if args.quick else "full", repeats=repeats,
                       execution=execution, out_dir=out_dir, history=history_path(args.history),
-                      bounds=gate.bounds if gate is not None else None,
+                      bounds=gate.bounds if gate is not None else None, held=held.names if held else None,
                       transforms=transforms, command=" ".join(["simparity"] + sys.argv[1:]),
                       request=_request(args, engines.names, repeats), resume=args.resume is not None, say=say,
                       warn=lambda line: print(line, file=sys.stderr), progress=sys.stderr)
@@ -200,7 +201,6 @@ def cmd_run(args, out) -> int:
             raise SimparityError(f"--resume {one_line(args.resume)}: engine(s) {one_line(', '.join(stand_ins))} of "
                                  "that run cannot be built here (allowed: resume where the run's engines import, e.g. "
                                  "from the folder a module:Class engine was found in)")
-    held = _engine_names(gate, args)[0] if gate is not None else None
     if held is not None:  # before the run: a name no engine of it has would hold nothing
         refuse_strangers(held, tuple(session.specs))
     where = (f"{jobs} worker processes" if args.executor == "local" else
@@ -261,9 +261,18 @@ def _engine_names(gate: Gate, args) -> tuple[EngineNames | None, EngineNames | N
     return check, require
 
 
-FINDINGS_SHOWN = 20
-"""Findings (violations of engines the gate does not hold) printed at most, one per case and reason; the rest
-counted (--verbose: every one)."""
+LINES_SHOWN = 20
+"""Non-blocking lines of one kind the check prints at most (findings about engines the gate does not hold, one per
+case and reason; a user's bounds that matched no row, which a blessed file checked on part of its run has by the
+thousand); the rest counted (--verbose: every one)."""
+
+
+def _say_some(label: str, lines: list[str], verbose: bool, out) -> None:
+    """``label: line`` for each of ``lines``, at most :data:`LINES_SHOWN` unless ``verbose``, the rest counted."""
+    for line in lines if verbose else lines[:LINES_SHOWN]:
+        print(f"{label}: {one_line(line, MESSAGE_LIMIT)}", file=out)
+    if len(lines) > LINES_SHOWN and not verbose:
+        print(f"{label}: ... and {len(lines) - LINES_SHOWN} more (--verbose for each)", file=out)
 
 
 def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = None) -> int:
@@ -280,12 +289,8 @@ def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = No
     for violation in shown:
         print(f"violation: {one_line(violation.line(), MESSAGE_LIMIT)}", file=out)
     findings = result.findings if args.verbose else grouped(result.findings)
-    for finding in findings[:len(findings) if args.verbose else FINDINGS_SHOWN]:
-        print(f"finding (not held): {one_line(finding.line(), MESSAGE_LIMIT)}", file=out)
-    if len(findings) > FINDINGS_SHOWN and not args.verbose:
-        print(f"finding (not held): ... and {len(findings) - FINDINGS_SHOWN} more (--verbose for each)", file=out)
-    for line in result.unmatched:
-        print(f"tolerances: {one_line(line, MESSAGE_LIMIT)}", file=out)
+    _say_some("finding (not held)", [finding.line() for finding in findings], args.verbose, out)
+    _say_some("tolerances", result.unmatched, args.verbose, out)
     for line in result.absent:
         print(f"required: {one_line(line, MESSAGE_LIMIT)}", file=out)
     if diff is not None:

@@ -42,15 +42,15 @@ def held_line(result: CheckResult) -> str:
     return text
 
 
-def report_verdict(result: CheckResult) -> ToleranceVerdict:
+def report_verdict(result: CheckResult, held: tuple[str, ...] | None = None) -> ToleranceVerdict:
     """The verdict as the report shows it: counts, one line per case and reason with the engine it is about, and the
-    engines the gate holds."""
+    engines the gate holds (``held``, else the result's; None: every one)."""
     from simparity.reports.content import ToleranceVerdict
 
     groups = grouped(result.violations + result.findings)
     return ToleranceVerdict(result.checked, result.unchecked, tuple(g.line() for g in groups),
                             len(result.violations) + len(result.findings),
-                            tuple(g.violations[0].engine for g in groups), result.held)
+                            tuple(g.violations[0].engine for g in groups), held if held is not None else result.held)
 
 
 def _case_name(key: tuple) -> tuple[str, str]:
