@@ -26,6 +26,11 @@ FINDINGS_SHOWN = 12
 """Findings about an engine its section lists, in the gate's order; the rest are counted (the section "Flagged
 findings" folds every one)."""
 
+TRIM_ORDER = 3
+"""Where an engine's table stands among those report.md may shorten to stay within its line budget
+(:attr:`reports.blocks.Table.trim_order`): after the cases without a result and the flagged findings (its rows are
+sorted worst first, so what it keeps is what matters most)."""
+
 DT_MATCH = 1e-9
 """Relative difference under which two rows' time steps are one [s]."""
 
@@ -70,7 +75,7 @@ def beside_builtins(table: pd.DataFrame, engine: str, headlines: dict[str, str])
                       f"ratio of {engine}'s error to the largest built-in's at the same step first. A ratio far above "
                       "1 is a scheme that errs more than any built-in of its kind."),
             Table(("scene", "scheme (kind) vs built-in", f"dt [s]: {engine} vs built-in", "worst ratio"),
-                  tuple(cells for _, cells in rows[:ROWS_SHOWN])), *counted]
+                  tuple(cells for _, cells in rows[:ROWS_SHOWN]), trim_order=TRIM_ORDER), *counted]
 
 
 def _row(scene: str, integrator: str, kind: str, own: pd.DataFrame, same: pd.DataFrame) -> tuple[float, tuple[str, ...]]:

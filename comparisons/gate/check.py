@@ -5,7 +5,9 @@ no bound matches is unchecked (counted, never a pass in disguise: the count is p
 that allows ``ok`` (the shipped catch-all) checks that a case ran, not what it found: a series (scene x
 engine x integrator or solver) none of whose rows is held to a value or a verdict is *without a value
 bound*, and a run where more than :data:`UNBOUNDED_SHARE_MAX` of the series measured are fails the gate
-unless the user allows it. :func:`compare_with_baseline` lists every metric that moved by more than a
+unless the user allows it. :func:`held_to` narrows the verdict to the engines the user holds (the others'
+violations become findings, never blocking) and fails it for each required engine that measured nothing; a bound of
+the user's file that matched no row is said (:func:`unmatched_bounds`). :func:`compare_with_baseline` lists every metric that moved by more than a
 relative threshold since another run among the scenes x engines both runs ran, every row that appeared or
 disappeared there, and timing changes apart, one summary per scene (non-blocking: these machines are noisy).
 """
