@@ -231,3 +231,11 @@ def test_the_report_s_verdict_names_each_finding_s_engine_and_the_engines_held(t
     assert all(line.split()[1] == engine for line, engine in zip(verdict.violations, verdict.engines))
     narrowed = report_verdict(held_to(result, EngineNames(("theirs",), "--check-engines")))
     assert narrowed.held == ("theirs",) and narrowed.outside_count == verdict.outside_count  # findings still listed
+
+
+def test_run_check_refuses_a_held_engine_it_does_not_run_before_running(tmp_path, capsys):
+    out = tmp_path / "o"
+    code = main(["run", "wind", "--quick", "--engines", "core", "--out", str(out), "--check", "--check-engines",
+                 "core,mine"])
+    assert code == EXIT_USAGE and "--check-engines: mine: not an engine of the run" in capsys.readouterr().err
+    assert not (out / "results.csv").exists()
