@@ -239,3 +239,13 @@ def test_run_check_refuses_a_held_engine_it_does_not_run_before_running(tmp_path
                  "core,mine"])
     assert code == EXIT_USAGE and "--check-engines: mine: not an engine of the run" in capsys.readouterr().err
     assert not (out / "results.csv").exists()
+
+
+@pytest.mark.slow
+def test_the_report_opens_with_the_users_engine_only_when_the_gate_holds_it(tmp_path, capsys):
+    run = _stored(tmp_path / "run", _rows("mine") + _rows("core"))
+    assert main(["report", str(run)]) == EXIT_OK
+    assert "\n## Is mine right?\n" in (run / "report.md").read_text(encoding="utf-8")
+    held = _file(tmp_path, 'check_engines = ["core"]\n' + BOUND, "held.toml")
+    assert main(["report", str(run), "--tolerances", str(held)]) == EXIT_OK
+    assert "## Is mine right?" not in (run / "report.md").read_text(encoding="utf-8")

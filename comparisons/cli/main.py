@@ -417,8 +417,9 @@ def cmd_bench(args, out) -> int:
 
 
 def cmd_report(args, out) -> int:
-    write_run_report(args.run_dir, lambda line: print(line, file=out),
-                     load_tolerances(args.tolerances) if args.tolerances else None)
+    gate = load_gate(args.tolerances) if args.tolerances else None
+    held = gate.check_engines.names if gate is not None and gate.check_engines is not None else None
+    write_run_report(args.run_dir, lambda line: print(line, file=out), gate.bounds if gate else None, held)
     return EXIT_OK
 
 

@@ -210,5 +210,6 @@ def build_parser() -> argparse.ArgumentParser:
         "series.csv.gz and run.json; runs no engine. Flagged findings hold the run to --tolerances.")
     report.add_argument("run_dir", type=Path, metavar="DIR")
     report.add_argument("--tolerances", type=Path, default=None, metavar="FILE",
-                        help=f"bounds for the flagged findings (default: the shipped {DEFAULT_TOLERANCES.name})")
+                        help=f"bounds for the flagged findings (default: the shipped {DEFAULT_TOLERANCES.name}); its "
+                        "check_engines, if any, say which of your engines open the report with 'Is ENGINE right?'")
     return parser
