@@ -256,7 +256,7 @@ def _ranking_text(by: str) -> str:
                 f"engines it also measures each one's overhead per call. {truths}")
     return ("Ranked by force evaluations per simulated second (stages / dt: Hairer's hardware-neutral work, blind to "
             "per-call overhead), ties by wall time: \"cheapest\" counts force evaluations, never the clock, and each "
-            "pick shows them (\"400/s\") beside its measured wall time per simulated second (\"2.1 ms wall\"; "
+            "pick shows them (\"400/s\") beside its measured wall time per simulated second (\"2.1 ms\"; "
             "report.html has it per scheme, and the batched time). "
             f"{truths[:-1]}; schemes without a stage count only within their engine.")
 
