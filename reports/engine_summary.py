@@ -126,8 +126,26 @@ def pick(case: Choice, by: str, show_error: bool) -> str:
 
 
 def cost_text(case: pd.Series, by: str) -> str:
-    """A case's cost as the ranking counts it: ``400/s`` (evaluations) or ``0.0021 s/s`` (wall time)."""
-    return f"{number(case[by])}/s" if by == summary.EVALUATIONS else f"{number(case[by])} s/s"
+    """A case's cost as the ranking counts it, beside its measured wall time so neither passes for the other (the
+    column head says which is which, :func:`cheapest_head`): ``400/s, 2.1 ms`` (force evaluations per simulated
+    second, ranked by them; then milliseconds of wall time per simulated second) or ``2.1 ms`` (ranked by wall
+    time)."""
+    wall = case.get(summary.WALL)
+    wall_text = f"{milliseconds(wall)} ms" if wall is not None and pd.notna(wall) else "wall n/a"
+    return f"{number(case[by])}/s, {wall_text}" if by == summary.EVALUATIONS else wall_text
+
+
+def milliseconds(seconds: float) -> str:
+    """A wall time in milliseconds, two significant digits (whole milliseconds from 10 on): a cell's aside."""
+    value = seconds * 1e3
+    return f"{value:.0f}" if value >= 10 else f"{value:.2g}"
+
+
+def cheapest_head(by: str, budget: float) -> str:
+    """A column head of the cheapest scheme within an error ``budget``, saying what it counts and what its cells
+    show (:func:`cost_text`): ``cheapest at error ≤ 0.001 (force evals/s; wall ms/s)``."""
+    counted = "force evals/s; wall ms/s" if by == summary.EVALUATIONS else "wall ms/s"
+    return f"cheapest at error ≤ {budget:g} ({counted})"
 
 
 def overall(cases: pd.DataFrame, budget: float, by: str) -> str:

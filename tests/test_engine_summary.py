@@ -49,11 +49,11 @@ def test_each_engine_picks_its_own_cheapest_by_evaluations_and_its_most_accurate
 def test_overall_best_names_the_least_work_and_counts_schemes_doing_the_same_work():
     # Within 1e-6 the least work is core RK4 at dt 0.02 (200/s) alone; within 1e-7 three RK4s do 400/s, MuJoCo's
     # the quickest on the clock, so it is named and the two others counted.
-    assert engine_summary.overall(CASES, 1e-6, summary.EVALUATIONS) == "core rk4 @ 0.02 (200/s)"
-    assert engine_summary.overall(CASES, 1e-7, summary.EVALUATIONS) == "mujoco rk4 @ 0.01 (400/s; +2 as cheap)"
+    assert engine_summary.overall(CASES, 1e-6, summary.EVALUATIONS) == "core rk4 @ 0.02 (200/s, 20 ms)"
+    assert engine_summary.overall(CASES, 1e-7, summary.EVALUATIONS) == "mujoco rk4 @ 0.01 (400/s, 1 ms; +2 as cheap)"
     assert engine_summary.overall(CASES, 1e-12, summary.EVALUATIONS) == "none"
     # By wall time MuJoCo's Euler is cheapest within 0.1.
-    assert engine_summary.overall(CASES, 0.1, summary.WALL) == "mujoco euler @ 0.01 (0.0003 s/s)"
+    assert engine_summary.overall(CASES, 0.1, summary.WALL) == "mujoco euler @ 0.01 (0.3 ms)"
 
 
 def test_ranking_falls_back_to_wall_time_when_nothing_counted_its_evaluations():
@@ -66,10 +66,10 @@ def test_an_engine_without_stage_counts_is_not_ranked_overall_but_ranks_its_own_
     """A plugin that declares no stages: left out of the overall ranking by work, but its own choice per error
     budget is still made (by its wall time: fair within one engine), and no work budget is said to bind it."""
     uncounted = CASES.assign(**{summary.EVALUATIONS: CASES[summary.EVALUATIONS].where(CASES["engine"] != "mujoco")})
-    assert engine_summary.overall(uncounted, 1e-7, summary.EVALUATIONS) == "core rk4 @ 0.01 (400/s; +1 as cheap)"
+    assert engine_summary.overall(uncounted, 1e-7, summary.EVALUATIONS) == "core rk4 @ 0.01 (400/s, 40 ms; +1 as cheap)"
     mujoco = engine_summary.choices(uncounted, summary.EVALUATIONS)["mujoco"]
     assert mujoco["error ≤ 0.001"]["integrator"] == "rk4"      # Euler's 1e-2 misses it; RK4 is within, by wall time
-    assert engine_summary.pick(mujoco["error ≤ 0.001"], summary.WALL, show_error=False) == "rk4 @ 0.01 (0.001 s/s)"
+    assert engine_summary.pick(mujoco["error ≤ 0.001"], summary.WALL, show_error=False) == "rk4 @ 0.01 (1 ms)"
     assert mujoco["≤ 100 evaluations/s"] == engine_summary.NO_STAGE_COUNT
     tallied = engine_summary.tally([engine_summary.choices(uncounted, summary.EVALUATIONS)] * 2)["mujoco"]
     assert tallied["≤ 100 evaluations/s"] == engine_summary.NO_STAGE_COUNT and tallied["error ≤ 0.001"] == "rk4 ×2"

@@ -30,6 +30,30 @@ def test_broken(simparity):
     result.stdout.fnmatch_lines(["falling-linear-drag core rk4 order_velocity: 4.0*, bound in *"])
 
 
+@pytest.mark.slow
+def test_check_engines_leaves_the_others_findings_out_and_require_engines_fails_without_one(pytester):
+    """Issue #38: a bound MuJoCo's RK4 breaks does not fail a test that holds core alone; a required engine that is
+    not in the run fails it, naming it."""
+    pytester.makefile(".toml", tight='[[bound]]\nengine = "mujoco"\nintegrator = "rk4"\nmetric = "order_velocity"\n'
+                                     'expected = 5.0\nband = 0.01\nstatus = ["ok", "n/a"]\nreason = "impossible"\n')
+    pytester.makepyfile(test_held="""
+def test_core_alone(simparity):
+    simparity.check("falling-linear-drag", engines=["core", "mujoco"], tolerances="tight.toml", profile="quick",
+                    check_engines=["core"])
+
+def test_both_held(simparity):
+    simparity.check("falling-linear-drag", engines=["core", "mujoco"], tolerances="tight.toml", profile="quick")
+
+def test_a_ghost_required(simparity):
+    simparity.check("falling-linear-drag", engines=["core"], profile="quick", require_engines=["core", "ghost"])
+""")
+    result = pytester.runpytest_subprocess("-v")
+    result.assert_outcomes(passed=1, failed=2)
+    result.stdout.fnmatch_lines(["*test_core_alone PASSED*", "*test_both_held FAILED*"])
+    result.stdout.fnmatch_lines(["*falling-linear-drag mujoco rk4 order_velocity: 4.0*(impossible)*"])
+    result.stdout.fnmatch_lines(["*ghost (require_engines=): no rows in this run*"])
+
+
 @pytest.fixture(scope="module")
 def example_run():
     """The example's scene as it checks it (quick, core) and the table run_scene gives for it: one run of ~10 s for

@@ -100,7 +100,7 @@ def test_scene_sections_lead_with_a_verdict_and_a_row_per_engine(run_dir):
     assert section.splitlines()[1].startswith("- **Verdict**: most accurate: core ")
     assert "Reference: `analytic:exact`" in section
     head = _md_row(section, "| engine |")
-    assert head[:3] == ["engine", "most accurate [rad]", "cheapest at error ≤ 0.001"]
+    assert head[:3] == ["engine", "most accurate [rad]", "cheapest at error ≤ 0.001 (force evals/s; wall ms/s)"]
     engines = [line.split("|")[1].strip() for line in section.splitlines() if line.startswith("| ")][1:]
     assert engines == ["core", "mujoco", "pybullet", "pinocchio"]    # the user's engine first, no ground truth
     assert _md_row(section, "| mujoco |")[1].startswith("rk4 @ ")      # MuJoCo's most accurate is its RK4

@@ -67,30 +67,30 @@ def test_limits_scale_with_dt_and_combine_band_and_rel(tmp_path):
     """expected 29.2608 dt^1 with rel 1e-9 at dt = 1/30: 0.97536 +- 9.75e-10; expected 4 +- 0.5."""
     bounds = load_tolerances(_write(tmp_path, """
 [[bound]]
-metric = "e"
+metric = "position_error_final"
 expected = 29.2608
 dt_power = 1.0
 rel = 1e-9
 reason = "g T dt / 2"
 [[bound]]
-metric = "o"
+metric = "order_position"
 expected = 4.0
 band = 0.5
 reason = "order 4"
 """))
-    low, high = bound_for(bounds, "s", "e", "i", "e", 1 / 30).limits(1 / 30)
+    low, high = bound_for(bounds, "s", "e", "i", "position_error_final", 1 / 30).limits(1 / 30)
     assert low == pytest.approx(0.97536 * (1 - 1e-9), rel=1e-15) and high == pytest.approx(0.97536 * (1 + 1e-9), rel=1e-15)
-    assert bound_for(bounds, "s", "e", "i", "o").limits(math.nan) == (3.5, 4.5)
+    assert bound_for(bounds, "s", "e", "i", "order_position").limits(math.nan) == (3.5, 4.5)
 
 
 @pytest.mark.parametrize("text, key, words", [
-    ('[[bound]]\nmetric = "m"\nmax = 1.0\n', "bound[0].reason", "needs its reason"),
-    ('[[bound]]\nmetric = "m"\nmaximum = 1.0\nreason = "r"\n', "bound[0].maximum", "unknown key"),
-    ('[[bound]]\nmetric = "m"\nstatus = "great"\nreason = "r"\n', "bound[0].status", "not a status"),
-    ('[[bound]]\nmetric = "m"\nband = 0.1\nreason = "r"\n', "bound[0].band", "need an expected"),
-    ('[[bound]]\nmetric = "m"\nmax = nan\nreason = "r"\n', "bound[0].max", "finite number"),
-    ('[[bound]]\nmetric = "m"\nreason = "r"\n', "bound[0]", "bounds nothing"),
-    ('[[bound]]\nmetric = "m"\ndt = -1.0\nmax = 1.0\nreason = "r"\n', "bound[0].dt", "not a time step"),
+    ('[[bound]]\nmetric = "solve_rate"\nmax = 1.0\n', "bound[0].reason", "needs its reason"),
+    ('[[bound]]\nmetric = "solve_rate"\nmaximum = 1.0\nreason = "r"\n', "bound[0].maximum", "unknown key"),
+    ('[[bound]]\nmetric = "solve_rate"\nstatus = "great"\nreason = "r"\n', "bound[0].status", "not a status"),
+    ('[[bound]]\nmetric = "solve_rate"\nband = 0.1\nreason = "r"\n', "bound[0].band", "need an expected"),
+    ('[[bound]]\nmetric = "solve_rate"\nmax = nan\nreason = "r"\n', "bound[0].max", "finite number"),
+    ('[[bound]]\nmetric = "solve_rate"\nreason = "r"\n', "bound[0]", "bounds nothing"),
+    ('[[bound]]\nmetric = "solve_rate"\ndt = -1.0\nmax = 1.0\nreason = "r"\n', "bound[0].dt", "not a time step"),
     ('[[bounds]]\nmetric = "m"\n', "bounds", "unknown table"),
     ('[[bound]\n', "line 2, column 8", "not valid TOML"),  # line 1 is _write's extends
 ])

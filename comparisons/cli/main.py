@@ -23,10 +23,12 @@ from simparity.comparisons.gate.check import (
     explain,
     explain_lines,
     explain_rows,
+    held_to,
+    refuse_strangers,
 )
 from simparity.comparisons.gate.bless import bless, write_blessed
 from simparity.comparisons.gate.violation import grouped
-from simparity.comparisons.gate.check_output import junit_xml, summary_markdown
+from simparity.comparisons.gate.check_output import held_line, junit_xml, summary_markdown
 from simparity.comparisons.scenes.describe import describe
 from simparity.comparisons.cli.console import EXIT_INTERRUPTED
 from simparity.comparisons.engines.registry import (
@@ -52,7 +54,7 @@ from simparity.comparisons.cli.parser import build_parser
 from simparity.comparisons.scenes.limits import Limits
 from simparity.comparisons.execute.store import default_out_dir
 from simparity.comparisons.execute.timing import record_peak_memory, resource_line
-from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, load_tolerances
+from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, EngineNames, Gate, load_gate, load_tolerances
 from simparity.comparisons.invariance.transforms import fixed_transforms
 from simparity.core.model.errors import SimparityError, one_line
 from simparity.core.model.ranges import RANGES
@@ -178,14 +180,18 @@ def cmd_run(args, out) -> int:
                              "or --suite)")
     chosen = (library.load(args.scenes, run_limits, engines) if args.scenes
               else library.suite(args.suite or "default", run_limits, engines))
-    bounds = load_tolerances(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
+    gate = load_gate(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
+    if gate is None and (args.check_engines or args.require_engines):
+        raise SimparityError("--check-engines or --require-engines without --check (allowed: add --check)")
+    held = _engine_names(gate, args)[0] if gate is not None else None
     out_dir = _out_dir(args)
 
     def say(line: str) -> None:
         print(line, file=out, flush=True)
 
     session = Session(chosen, engines, profile="quick" if args.quick else "full", repeats=repeats,
-                      execution=execution, out_dir=out_dir, history=history_path(args.history), bounds=bounds,
+                      execution=execution, out_dir=out_dir, history=history_path(args.history),
+                      bounds=gate.bounds if gate is not None else None, held=held.names if held else None,
                       transforms=transforms, command=" ".join(["simparity"] + sys.argv[1:]),
                       request=_request(args, engines.names, repeats), resume=args.resume is not None, say=say,
                       warn=lambda line: print(line, file=sys.stderr), progress=sys.stderr)
@@ -195,6 +201,8 @@ def cmd_run(args, out) -> int:
             raise SimparityError(f"--resume {one_line(args.resume)}: engine(s) {one_line(', '.join(stand_ins))} of "
                                  "that run cannot be built here (allowed: resume where the run's engines import, e.g. "
                                  "from the folder a module:Class engine was found in)")
+    if held is not None:  # before the run: a name no engine of it has would hold nothing
+        refuse_strangers(held, tuple(session.specs))
     where = (f"{jobs} worker processes" if args.executor == "local" else
              f"Dask at {args.scheduler}" if args.scheduler else f"a local Dask cluster of {jobs} workers")
 
@@ -207,8 +215,8 @@ def cmd_run(args, out) -> int:
         if result.interrupted:
             return EXIT_INTERRUPTED
         code = EXIT_FAILED_CASES if result.failed_cases else EXIT_OK
-        if result.check is not None:
-            code = max(code, _check(out_dir, bounds, args, out, result.check))
+        if result.check is not None and gate is not None:
+            code = max(code, _check(out_dir, gate, args, out, result.check))
         return code
     finally:  # what the run cost, also when it was interrupted or stopped by an error
         print(resource_line(time.perf_counter() - start), file=out, flush=True)
@@ -246,11 +254,32 @@ def _baseline_table(option: str, run_dir: Path, profile: str, history_option: st
     return table
 
 
-def _check(run_dir: Path, bounds, args, out, result: CheckResult | None = None) -> int:
+def _engine_names(gate: Gate, args) -> tuple[EngineNames | None, EngineNames | None]:
+    """The engines the gate holds and requires: the command line's, else the tolerances file's (None: not named)."""
+    check = EngineNames(args.check_engines, "--check-engines") if args.check_engines else gate.check_engines
+    require = EngineNames(args.require_engines, "--require-engines") if args.require_engines else gate.require_engines
+    return check, require
+
+
+LINES_SHOWN = 20
+"""Non-blocking lines of one kind the check prints at most (findings about engines the gate does not hold, one per
+case and reason; a user's bounds that matched no row, which a blessed file checked on part of its run has by the
+thousand); the rest counted (--verbose: every one)."""
+
+
+def _say_some(label: str, lines: list[str], verbose: bool, out) -> None:
+    """``label: line`` for each of ``lines``, at most :data:`LINES_SHOWN` unless ``verbose``, the rest counted."""
+    for line in lines if verbose else lines[:LINES_SHOWN]:
+        print(f"{label}: {one_line(line, MESSAGE_LIMIT)}", file=out)
+    if len(lines) > LINES_SHOWN and not verbose:
+        print(f"{label}: ... and {len(lines) - LINES_SHOWN} more (--verbose for each)", file=out)
+
+
+def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = None) -> int:
     """Print the verdict on a stored run (and the moves since the baseline); 0 passed, 1 not.
-    ``result``: the run already held to ``bounds``."""
+    ``result``: the run already held to ``gate``'s bounds."""
     table, info = read_run(run_dir)
-    result = check_table(table, bounds) if result is None else result
+    result = held_to(check_table(table, gate.bounds) if result is None else result, *_engine_names(gate, args))
     diff = None
     if args.baseline:
         if not math.isfinite(args.baseline_rel) or args.baseline_rel < 0:
@@ -259,6 +288,11 @@ def _check(run_dir: Path, bounds, args, out, result: CheckResult | None = None) 
     shown = result.violations if args.verbose else grouped(result.violations)
     for violation in shown:
         print(f"violation: {one_line(violation.line(), MESSAGE_LIMIT)}", file=out)
+    findings = result.findings if args.verbose else grouped(result.findings)
+    _say_some("finding (not held)", [finding.line() for finding in findings], args.verbose, out)
+    _say_some("tolerances", result.unmatched, args.verbose, out)
+    for line in result.absent:
+        print(f"required: {one_line(line, MESSAGE_LIMIT)}", file=out)
     if diff is not None:
         for label, items in (("moved", diff.moved), ("missing", diff.missing), ("new", diff.new),
                              ("timing (not blocking)", diff.timing)):
@@ -276,7 +310,7 @@ def _check(run_dir: Path, bounds, args, out, result: CheckResult | None = None) 
     moved = "" if diff is None else (f"; since the baseline {len(diff.moved)} moved, {len(diff.missing)} missing, "
                                      f"{len(diff.new)} new" + (f" ({diff.scope_line()})" if diff.scope_line() else ""))
     cases = "" if args.verbose or len(shown) == len(result.violations) else f" ({len(shown)} lines: --verbose for each)"
-    print(f"check {'passed' if passed else 'FAILED'}: {result.checked} metrics checked, {len(result.violations)} "
+    print(f"check {'passed' if passed else 'FAILED'}: {held_line(result)}, {len(result.violations)} "
           f"outside their bounds{cases}, {result.unchecked} without a bound, {result.value_bounded} held to a value or "
           f"verdict; {len(result.unbounded_series)} of {len(result.series)} series without a value bound{moved}",
           file=out)
@@ -284,7 +318,8 @@ def _check(run_dir: Path, bounds, args, out, result: CheckResult | None = None) 
 
 
 def cmd_check(args, out) -> int:
-    bounds = load_tolerances(args.tolerances or DEFAULT_TOLERANCES)
+    gate = load_gate(args.tolerances or DEFAULT_TOLERANCES)
+    bounds = gate.bounds
     run_dir = args.run_dir
     if run_dir is None:
         _, latest = latest_before(history_path(args.history))
@@ -299,7 +334,7 @@ def cmd_check(args, out) -> int:
         return _explain(run_dir, bounds, args.explain, narrowed, out)
     if args.bless is not None:
         return _bless(run_dir, args.bless, args.spread, args.tolerances, out)
-    return _check(run_dir, bounds, args, out)
+    return _check(run_dir, gate, args, out)
 
 
 def _bless(run_dir: Path, path: Path, spread: Path | None, tolerances: Path | None, out) -> int:
@@ -382,8 +417,9 @@ def cmd_bench(args, out) -> int:
 
 
 def cmd_report(args, out) -> int:
-    write_run_report(args.run_dir, lambda line: print(line, file=out),
-                     load_tolerances(args.tolerances) if args.tolerances else None)
+    gate = load_gate(args.tolerances) if args.tolerances else None
+    held = gate.check_engines.names if gate is not None and gate.check_engines is not None else None
+    write_run_report(args.run_dir, lambda line: print(line, file=out), gate.bounds if gate else None, held)
     return EXIT_OK
 
 

@@ -39,6 +39,12 @@ def _add_check_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--tolerances", type=Path, default=None, metavar="FILE",
                         help=f"bounds to hold the run to: your file extends the shipped {DEFAULT_TOLERANCES.name} "
                         "(extends = \"none\" in it starts empty) and its bounds win where they match")
+    parser.add_argument("--check-engines", type=_engine_list, default=None, metavar="A,B,...",
+                        help="the engines the gate holds (default: every engine of the run, or the tolerances file's "
+                        "check_engines): the others' violations are printed as findings and never fail the check")
+    parser.add_argument("--require-engines", type=_engine_list, default=None, metavar="A,B,...",
+                        help="fail the check when one of these engines measured nothing: not in the run, or every "
+                        "row n/a or failed (default: the tolerances file's require_engines, else none)")
     parser.add_argument("--allow-unbounded", action="store_true",
                         help=f"pass although more than {UNBOUNDED_SHARE_MAX * 100:.0f}%% of the series (scene x engine x "
                         "integrator) have no bound on any value, only on their status")
@@ -204,5 +210,6 @@ def build_parser() -> argparse.ArgumentParser:
         "series.csv.gz and run.json; runs no engine. Flagged findings hold the run to --tolerances.")
     report.add_argument("run_dir", type=Path, metavar="DIR")
     report.add_argument("--tolerances", type=Path, default=None, metavar="FILE",
-                        help=f"bounds for the flagged findings (default: the shipped {DEFAULT_TOLERANCES.name})")
+                        help=f"bounds for the flagged findings (default: the shipped {DEFAULT_TOLERANCES.name}); its "
+                        "check_engines, if any, say which of your engines open the report with 'Is ENGINE right?'")
     return parser

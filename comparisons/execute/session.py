@@ -33,7 +33,6 @@ from simparity.comparisons.execute.progress import ProgressBar
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS, run_group
 from simparity.comparisons.execute.store import RunWriter
 from simparity.comparisons.gate.check import CheckResult, check_table
-from simparity.comparisons.gate.violation import grouped
 from simparity.comparisons.gate.history import record_run
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, Bound, load_tolerances
 from simparity.comparisons.invariance.invariance_run import invariance_rows
@@ -164,12 +163,14 @@ class Session:
     stored there as it goes (``results.csv``, the journal of finished cases, ``report.md``/``.html`` when
     ``report``), recorded in ``history`` (a database path; None: not recorded) and, with ``request``,
     resumable (``resume.json``). ``resume``: keep the folder's finished cases. ``bounds``: tolerances the
-    finished run is held to. ``say`` hears one line per scene and what the run wrote, ``warn`` what went wrong
+    finished run is held to; ``held``: the engines that gate holds (None: every one), whose report opens with "is
+    my engine right?" for each of the user's. ``say`` hears one line per scene and what the run wrote, ``warn`` what went wrong
     beside the run (default: ``say``); ``progress`` is a stream for the progress bar (None: no bar)."""
 
     def __init__(self, scenes: list, engines: EngineSet, *, profile: str = "full", repeats: int = DEFAULT_REPEATS,
                  execution: Execution = Execution(), out_dir: Path | None = None, history: Path | None = None,
-                 bounds: list[Bound] | None = None, transforms: tuple = (), command: str = "", report: bool = True,
+                 bounds: list[Bound] | None = None, held: tuple[str, ...] | None = None, transforms: tuple = (),
+                 command: str = "", report: bool = True,
                  request: dict | None = None, resume: bool = False, say: Say = _silent, warn: Say | None = None,
                  progress=None) -> None:
         self.names = check_engine_names(engines.names)
@@ -178,6 +179,7 @@ class Session:
         self.scenes, self.profile = apply_profile(list(scenes), profile, engines), profile
         self.repeats, self.execution, self.out_dir = repeats, execution, out_dir
         self.history, self.bounds, self.transforms, self.command = history, bounds, tuple(transforms), command
+        self.held = held
         self.report, self.request, self.resume, self.say, self.progress = report, request, resume, say, progress
         self.warn = warn or say
         if execution.where == IN_PROCESS:
@@ -280,7 +282,7 @@ class Session:
         bounds (default: the shipped tolerances) for the report's flagged findings. Returns that verdict."""
         if self.out_dir is None or not self.report:
             return None
-        return write_run_report(self.out_dir, self.say, self.bounds)
+        return write_run_report(self.out_dir, self.say, self.bounds, self.held)
 
     def _record(self, table: pd.DataFrame) -> None:
         """Copy a stored run into the history database; a database problem is one line, never a lost run."""
@@ -321,18 +323,18 @@ class _Store:
         return pd.DataFrame([r.as_dict() for r in self.rows], columns=list(COLUMNS))
 
 
-def write_run_report(out_dir: Path, say: Say, bounds: list[Bound] | None = None) -> CheckResult:
+def write_run_report(out_dir: Path, say: Say, bounds: list[Bound] | None = None,
+                     held: tuple[str, ...] | None = None) -> CheckResult:
     """report.md, report.html and figures/ of the run in ``out_dir``; its metrics are held to ``bounds`` (default:
     the shipped tolerances) for the report's flagged findings, which never changes an exit code. Returns that
     verdict."""
-    from simparity.reports.content import ToleranceVerdict
+    from simparity.comparisons.gate.check_output import report_verdict
     from simparity.reports.render import write_report
     from simparity.reports.store import read_run
 
     table, _ = read_run(out_dir)
     result = check_table(table, bounds if bounds is not None else load_tolerances(DEFAULT_TOLERANCES))
-    verdict = ToleranceVerdict(result.checked, result.unchecked, tuple(g.line() for g in grouped(result.violations)),
-                               len(result.violations))
+    verdict = report_verdict(result, held)
     markdown, page = write_report(out_dir, verdict)
     say(f"results: {Path(out_dir) / RESULTS_FILE}\nreport:  {markdown}\n         {page}")
     return result

@@ -5,7 +5,9 @@ no bound matches is unchecked (counted, never a pass in disguise: the count is p
 that allows ``ok`` (the shipped catch-all) checks that a case ran, not what it found: a series (scene x
 engine x integrator or solver) none of whose rows is held to a value or a verdict is *without a value
 bound*, and a run where more than :data:`UNBOUNDED_SHARE_MAX` of the series measured are fails the gate
-unless the user allows it. :func:`compare_with_baseline` lists every metric that moved by more than a
+unless the user allows it. :func:`held_to` narrows the verdict to the engines the user holds (the others'
+violations become findings, never blocking) and fails it for each required engine that measured nothing; a bound of
+the user's file that matched no row is said (:func:`unmatched_bounds`). :func:`compare_with_baseline` lists every metric that moved by more than a
 relative threshold since another run among the scenes x engines both runs ran, every row that appeared or
 disappeared there, and timing changes apart, one summary per scene (non-blocking: these machines are noisy).
 """
@@ -15,7 +17,7 @@ from __future__ import annotations
 import fnmatch
 import math
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -23,9 +25,10 @@ import pandas as pd
 from simparity.comparisons.gate.cross_check import CROSS_CHECK_FACTOR, SOLVE_RATE_FRACTION, cross_check, held_series
 from simparity.comparisons.gate.violation import Violation, row_label
 from simparity.comparisons.engines.registry import ENGINE_NAMES
-from simparity.comparisons.gate.tolerances import Bound, BoundIndex
+from simparity.comparisons.gate.tolerances import Bound, BoundIndex, EngineNames
+from simparity.core.model.errors import SimparityError, one_line
 from simparity.core.model.metric_catalogue import is_cost, is_timing
-from simparity.core.model.results import ALARM_FLAGS, DIMENSIONLESS, NOT_AVAILABLE, OK, ROUNDING_FLOOR
+from simparity.core.model.results import ALARM_FLAGS, DIMENSIONLESS, FAILED, NOT_AVAILABLE, OK, ROUNDING_FLOOR
 
 CASE_KEYS = ("scene", "engine", "integrator", "dt")
 ROW_KEYS = CASE_KEYS + ("metric",)
@@ -55,10 +58,39 @@ class CheckResult:
     value_bounded: int = 0
     series: dict[tuple[str, str, str], bool] = field(default_factory=dict)
     unmeasured: dict[tuple, str] = field(default_factory=dict)
+    engines: tuple[str, ...] = ()
+    """Every engine with rows in the run, in the run's order."""
+    held: tuple[str, ...] | None = None
+    """The engines the gate holds (:func:`held_to`); None: every engine of the run."""
+    findings: list[Violation] = field(default_factory=list)
+    """Violations of the engines the gate does not hold: reported, never blocking."""
+    absent: list[str] = field(default_factory=list)
+    """One line per engine the gate requires that measured nothing (:func:`held_to`): each fails the gate."""
+    measured_engines: set[str] = field(default_factory=set)
+    """The engines with at least one ok row of a measured quantity (not a wall time or a declared cost)."""
+    checked_of: Counter[str] = field(default_factory=Counter)
+    """Per engine, its rows held to a bound."""
+    refusals: dict[str, str] = field(default_factory=dict)
+    """Per engine, the detail of its first n/a or failed row: why it measured nothing, in its own words."""
+    unmatched: list[str] = field(default_factory=list)
+    """One line per bound of a user's tolerances file that matched no row of the run (printed, not blocking)."""
 
     @property
     def passed(self) -> bool:
-        return not self.violations
+        return not self.violations and not self.absent
+
+    @property
+    def held_engines(self) -> tuple[str, ...]:
+        """The run's engines the gate holds, in the run's order."""
+        return self.engines if self.held is None else tuple(e for e in self.engines if e in self.held)
+
+    @property
+    def held_checked(self) -> int:
+        """Rows of the engines the gate holds that were held to a bound."""
+        return sum(self.checked_of[e] for e in self.held_engines)
+
+    def is_held(self, engine: str) -> bool:
+        return self.held is None or engine in self.held
 
     @property
     def unbounded_series(self) -> list[tuple[str, str, str]]:
@@ -109,8 +141,9 @@ def _judge(bound: Bound, row) -> tuple[str, str] | None:
 def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = True) -> CheckResult:
     """Hold every row of a results table to the bound that decides it, and (``cross_checked``) every user engine's
     row to the built-in schemes of its kind (:mod:`comparisons.gate.cross_check`)."""
-    result, index = CheckResult(), BoundIndex(bounds)
+    result, index = CheckResult(engines=tuple(dict.fromkeys(table["engine"]))), BoundIndex(bounds)
     measured: dict[tuple, str | None] = {}  # case -> the reason nothing was measured (None: something was)
+    matched: set[str] = set()  # the bounds (by where) that matched some row
     for row in table.to_dict("records"):
         key = _case_key(row["scene"], row["engine"], row["integrator"], float(row["dt"]))
         result.cases.setdefault(key, [])
@@ -118,12 +151,16 @@ def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = 
             measured[key] = None
         elif key not in measured:
             measured[key] = str(row["detail"] or NOT_AVAILABLE)
-        bound = _row_bound(index, row)
+        _note_engine(result, row)
+        matching = index.matching(*_row_key(row))
+        matched.update(b.where for b in matching)
+        bound = matching[0] if matching else None
         _count_series(result, row, bound)
         if bound is None:
             result.unchecked += 1
             continue
         result.checked += 1
+        result.checked_of[row["engine"]] += 1
         result.value_bounded += bound.bounds_the_value
         broken = _judge(bound, row)
         if broken:
@@ -142,7 +179,72 @@ def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = 
         if series in result.series:
             result.series[series] = True
     result.unmeasured = {key: reason for key, reason in measured.items() if reason is not None and not result.cases[key]}
+    result.unmatched = unmatched_bounds(table, [b for b in bounds if not b.shipped and b.where not in matched])
     return result
+
+
+def held_to(result: CheckResult, check: EngineNames | None, require: EngineNames | None = None) -> CheckResult:
+    """``result`` with the gate holding only ``check``'s engines (None: every engine of the run): the others'
+    violations become findings (reported, never blocking) and their series leave the share without a value bound;
+    and failing once for each of ``require``'s engines that measured nothing (no rows in the run, or none ok: every
+    row n/a or failed, the engine's own words quoted). An engine ``check`` names that has no rows in the run is bad
+    input: raises :class:`SimparityError` naming where it was named."""
+    if check is not None:
+        refuse_strangers(check, result.engines)
+    narrowed = replace(result, held=None if check is None else check.names)
+    absent = [] if require is None else [f"{name} ({require.where}): {_absence(result, name)}" for name in require.names
+                                         if name not in result.measured_engines]
+    return replace(narrowed, violations=[v for v in result.violations if narrowed.is_held(v.engine)],
+                   findings=result.findings + [v for v in result.violations if not narrowed.is_held(v.engine)],
+                   series={key: bounded for key, bounded in result.series.items() if narrowed.is_held(key[1])},
+                   absent=absent)
+
+
+def refuse_strangers(check: EngineNames, engines: tuple[str, ...]) -> None:
+    """Raise :class:`SimparityError` when ``check`` names an engine not among ``engines`` (the run's): the gate would
+    hold nothing of it."""
+    strangers = [name for name in check.names if name not in engines]
+    if strangers:
+        raise SimparityError(f"{check.where}: {one_line(', '.join(strangers), 200)}: not an engine of the run, the "
+                             f"gate would hold nothing of it (allowed: the run's engines, {', '.join(engines) or 'none'})")
+
+
+def _absence(result: CheckResult, engine: str) -> str:
+    """Why a required engine measured nothing, in one line."""
+    if engine not in result.engines:
+        return "no rows in this run (not run, or not installed)"
+    return f"no measured ok row; {one_line(result.refusals.get(engine, 'none of its rows measured a quantity'), 300)}"
+
+
+def _note_engine(result: CheckResult, row: dict) -> None:
+    """Note whether ``row``'s engine measured something (an ok row of a quantity, not a wall time or a declared
+    cost), else the first reason it gave for measuring nothing (an n/a or failed row's detail)."""
+    engine = row["engine"]
+    if row["status"] == OK and not (is_timing(row["metric"]) or is_cost(row["metric"])):
+        result.measured_engines.add(engine)
+    elif row["status"] in (NOT_AVAILABLE, FAILED) and engine not in result.refusals:
+        detail = row["detail"] if isinstance(row["detail"], str) else ""
+        result.refusals[engine] = f"{row['status']}: {detail or 'no detail'}"
+
+
+UNMATCHED_KEYS = ("scene", "engine", "integrator", "metric")
+"""A bound's patterns a run's rows are searched for, in this order, to say why the bound matched no row."""
+
+
+def unmatched_bounds(table: pd.DataFrame, bounds: list[Bound]) -> list[str]:
+    """One line per bound (of a user's file) that matched no row: the first of its patterns that matches none of the
+    run's values of that column, else that no row matches them together (a time step, a kind of scheme)."""
+    values = {key: sorted(set(table[key].fillna("").astype(str))) for key in UNMATCHED_KEYS}
+    lines = []
+    for bound in bounds:
+        why = "no row matches its keys together (scene, engine, integrator, metric, dt, scheme)"
+        for key in UNMATCHED_KEYS:
+            pattern = getattr(bound, key)
+            if not any(fnmatch.fnmatchcase(value, pattern) for value in values[key]):
+                why = f"its {key} {pattern!r:.80} matches none of the run's {len(values[key])} {key}s"
+                break
+        lines.append(f"{bound.where} matched no row of this run: {why}; it held nothing")
+    return lines
 
 
 def _count_series(result: CheckResult, row: dict, bound: Bound | None) -> None:

@@ -5,13 +5,52 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
+from typing import TYPE_CHECKING
 
 from simparity.comparisons.gate.check import BaselineDiff, CheckResult
-from simparity.comparisons.gate.violation import GROUP_METRICS_SHOWN, grouped
+from simparity.comparisons.gate.violation import GROUP_METRICS_SHOWN, Violation, grouped
+
+if TYPE_CHECKING:  # the report's modules draw figures: imported when a report is written, not by every check
+    from simparity.reports.content import ToleranceVerdict
 
 
 MESSAGE_CHARS = 500
 """Characters of a JUnit message attribute (CI viewers show it on one line; the text holds every line)."""
+
+
+ENGINES_NAMED = 6
+"""Engines the verdict line names before it counts the rest."""
+
+
+def _engine_list(engines: tuple[str, ...]) -> str:
+    named = ", ".join(engines[:ENGINES_NAMED]) + (f", +{len(engines) - ENGINES_NAMED}" if len(engines) > ENGINES_NAMED
+                                                   else "")
+    return f"{len(engines)} engine{'s' if len(engines) != 1 else ''} ({named or 'none'})"
+
+
+def held_line(result: CheckResult) -> str:
+    """What the gate held, for the verdict line: ``1140 metrics of 3 engines (core, mujoco, myengine) checked``, the
+    held engines that measured nothing, and the engines it did not hold with their findings."""
+    held = result.held_engines
+    others = tuple(e for e in result.engines if e not in held)
+    text = f"{result.held_checked} metrics of {_engine_list(held)} checked"
+    idle = [e for e in held if e not in result.measured_engines]
+    if idle:  # held, but nothing of theirs was measured: a gate with an engine fewer than it says
+        text += f" ({', '.join(idle)} measured nothing: every row n/a or failed)"
+    if others:
+        text += f" (not held: {', '.join(others)}, {len(result.findings)} findings, never blocking)"
+    return text
+
+
+def report_verdict(result: CheckResult, held: tuple[str, ...] | None = None) -> ToleranceVerdict:
+    """The verdict as the report shows it: counts, one line per case and reason with the engine it is about, and the
+    engines the gate holds (``held``, else the result's; None: every one)."""
+    from simparity.reports.content import ToleranceVerdict
+
+    groups = grouped(result.violations + result.findings)
+    return ToleranceVerdict(result.checked, result.unchecked, tuple(g.line() for g in groups),
+                            len(result.violations) + len(result.findings),
+                            tuple(g.violations[0].engine for g in groups), held if held is not None else result.held)
 
 
 def _case_name(key: tuple) -> tuple[str, str]:
@@ -35,6 +74,12 @@ def junit_xml(result: CheckResult, diff: BaselineDiff | None = None, unbounded: 
         if key in result.unmeasured:
             skipped += 1
             ET.SubElement(case, "skipped", message=f"n/a: {result.unmeasured[key]}"[:MESSAGE_CHARS])
+        elif violations and not result.is_held(key[1]):  # a finding about an engine the gate does not hold
+            skipped += 1
+            reasons = "; ".join(g.line() for g in grouped(violations))
+            ET.SubElement(case, "skipped", message=(f"not held by the gate, {len(violations)} finding(s), never "
+                                                    f"blocking: {reasons}")[:MESSAGE_CHARS]).text = "\n".join(
+                v.line() for v in violations)
         elif violations:
             failures += 1
             reasons = "; ".join(g.line() for g in grouped(violations))
@@ -49,6 +94,12 @@ def junit_xml(result: CheckResult, diff: BaselineDiff | None = None, unbounded: 
             failures += 1
             failure = ET.SubElement(case, "failure", message="numerics moved since the baseline", type="baseline")
             failure.text = "\n".join(diff.moved + [f"missing: {m}" for m in diff.missing])
+    if result.absent:
+        tests += 1
+        failures += 1
+        case = ET.SubElement(suite, "testcase", classname="engines", name="required engines measured", time="0")
+        ET.SubElement(case, "failure", message="; ".join(result.absent)[:MESSAGE_CHARS],
+                      type="required").text = "\n".join(result.absent)
     tests += 1
     case = ET.SubElement(suite, "testcase", classname="tolerances", name="series held to a value", time="0")
     if unbounded:
@@ -67,24 +118,22 @@ def _cell(text: str) -> str:
 
 
 def summary_markdown(result: CheckResult, diff: BaselineDiff | None = None, unbounded: str = "") -> str:
-    """A short Markdown verdict: counts, then each violation and each move (``unbounded``: the reason the run
-    fails for too few value bounds, "" when it does not)."""
+    """A short Markdown verdict: counts, then each violation, each finding about an engine the gate does not hold
+    (never blocking) and each move (``unbounded``: the reason the run fails for too few value bounds, "" when it
+    does not)."""
     verdict = "passed" if result.passed and not (diff and diff.blocking) and not unbounded else "failed"
     lines = [f"## simparity check: {verdict}", "",
-             f"{result.checked} metrics checked, {len(result.violations)} outside their bounds, "
+             f"{held_line(result)}, {len(result.violations)} outside their bounds, "
              f"{result.unchecked} without a bound; {len(result.cases)} cases, {len(result.unmeasured)} without a "
              f"result (n/a); {len(result.unbounded_series)} of {len(result.series)} series without a value bound.", ""]
     if unbounded:
         lines += [f"**Too few value bounds:** {_cell(unbounded)}", ""]
-    if result.violations:
-        lines += ["| scene | engine | integrator | dt | metrics | found | bound | reason |", "|---|---|---|---|---|---|---|---|"]
-        for group in grouped(result.violations):
-            v, metrics = group.violations[0], [m.metric for m in group.violations]
-            shown = ", ".join(metrics[:GROUP_METRICS_SHOWN]) + (f" (+{len(metrics) - GROUP_METRICS_SHOWN})"
-                                                                 if len(metrics) > GROUP_METRICS_SHOWN else "")
-            lines.append("| " + " | ".join(_cell(str(x)) for x in (
-                v.scene, v.engine, v.integrator or "-", "" if math.isnan(v.dt) else f"{v.dt:g}", shown, v.found,
-                v.bound, v.reason)) + " |")
+    lines += [f"**Required engine without a measured row:** {_cell(line)}" for line in result.absent]
+    lines += [f"- tolerances: {_cell(line)}" for line in result.unmatched]
+    lines += _violation_table(result.violations)
+    if result.findings:
+        lines += ["", "Findings about engines the gate does not hold (never blocking):", ""]
+        lines += _violation_table(result.findings)
     if diff is not None:
         lines += ["", f"Since the baseline: {len(diff.moved)} moved, {len(diff.missing)} missing, "
                       f"{len(diff.new)} new; timing changed in {len(diff.timing)} scenes (not blocking). "
@@ -92,3 +141,18 @@ def summary_markdown(result: CheckResult, diff: BaselineDiff | None = None, unbo
         lines += [f"- moved: {_cell(m)}" for m in diff.moved] + [f"- missing: {_cell(m)}" for m in diff.missing]
         lines += [f"- new: {_cell(m)}" for m in diff.new]
     return "\n".join(lines) + "\n"
+
+
+def _violation_table(violations: list[Violation]) -> list[str]:
+    """One table row per case and reason (none: no table)."""
+    if not violations:
+        return []
+    lines = ["| scene | engine | integrator | dt | metrics | found | bound | reason |", "|---|---|---|---|---|---|---|---|"]
+    for group in grouped(violations):
+        v, metrics = group.violations[0], [m.metric for m in group.violations]
+        shown = ", ".join(metrics[:GROUP_METRICS_SHOWN]) + (f" (+{len(metrics) - GROUP_METRICS_SHOWN})"
+                                                             if len(metrics) > GROUP_METRICS_SHOWN else "")
+        lines.append("| " + " | ".join(_cell(str(x)) for x in (
+            v.scene, v.engine, v.integrator or "-", "" if math.isnan(v.dt) else f"{v.dt:g}", shown, v.found,
+            v.bound, v.reason)) + " |")
+    return lines

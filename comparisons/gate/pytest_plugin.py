@@ -45,8 +45,13 @@ class SimparityChecker:
         return beside if beside is not None and beside.is_file() else name
 
     def check(self, scene, engines=("core",), tolerances: str | Path | None = None, profile: str = "full",
-              repeats: int = 0, isolate: bool = True, allow_unbounded: bool = False):
+              repeats: int = 0, isolate: bool = True, allow_unbounded: bool = False,
+              check_engines: tuple[str, ...] | None = None, require_engines: tuple[str, ...] | None = None):
         """Run ``scene`` on ``engines``, fail the calling test on any violation; returns the results table.
+
+        ``check_engines``: the engines the check holds (default: the tolerances file's ``check_engines``, else
+        every engine run); the others' violations never fail the test. ``require_engines``: fail the test when one of
+        these measured nothing (default: the tolerances file's ``require_engines``), as ``simparity check`` does.
 
         As ``simparity check``, the test also fails when more than a small share of the scene's series have no
         bound on any value (only on their status), unless ``allow_unbounded``.
@@ -57,18 +62,20 @@ class SimparityChecker:
         from simparity.core.model.errors import SimparityError, one_line
 
         try:
-            return self._check(scene, engines, tolerances, profile, repeats, isolate, allow_unbounded)
+            return self._check(scene, engines, tolerances, profile, repeats, isolate, allow_unbounded,
+                               check_engines, require_engines)
         except SimparityError as err:
             problem = f"simparity: {one_line(err, 1000)}"
         pytest.fail(problem, pytrace=False)  # outside the except: one message, no chained traceback
 
-    def _check(self, scene, engines, tolerances, profile: str, repeats: int, isolate: bool, allow_unbounded: bool):
+    def _check(self, scene, engines, tolerances, profile: str, repeats: int, isolate: bool, allow_unbounded: bool,
+               check_engines, require_engines):
         from simparity.comparisons.api import load_scene
         from simparity.comparisons.engines.registry import EngineSet, check_engine_names
         from simparity.comparisons.execute.session import (IN_PROCESS, ISOLATED, Execution, Session,
                                                              engine_specs)
-        from simparity.comparisons.gate.check import BASELINE_RELATIVE, compare_with_baseline
-        from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, load_tolerances
+        from simparity.comparisons.gate.check import BASELINE_RELATIVE, compare_with_baseline, held_to
+        from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, EngineNames, load_gate
         from simparity.comparisons.gate.violation import grouped
         from simparity.core.model.errors import SimparityError
         from simparity.reports.store import read_run
@@ -83,13 +90,16 @@ class SimparityChecker:
             raise SimparityError(f"scene {scene!r:.60}: not a scene (allowed: a built-in name, a scene file's path, "
                                  "or a loaded scene)")
         loaded = load_scene(self._path(scene)) if isinstance(scene, (str, Path)) else scene
-        bounds = load_tolerances(self._path(tolerances) if tolerances else DEFAULT_TOLERANCES)
+        gate = load_gate(self._path(tolerances) if tolerances else DEFAULT_TOLERANCES)
         session = Session([loaded], EngineSet(check_engine_names(engine_specs(engines))), profile=profile,
-                          repeats=repeats, execution=Execution(ISOLATED if isolate else IN_PROCESS), bounds=bounds)
+                          repeats=repeats, execution=Execution(ISOLATED if isolate else IN_PROCESS), bounds=gate.bounds)
         result = session.run()
         table = result.table
-        problems = [g.line() for g in grouped(result.check.violations)] if result.check is not None else []
-        unbounded = "" if allow_unbounded or result.check is None else result.check.too_unbounded()
+        held = EngineNames(tuple(check_engines), "check_engines=") if check_engines else gate.check_engines
+        required = EngineNames(tuple(require_engines), "require_engines=") if require_engines else gate.require_engines
+        check = held_to(result.check, held, required) if result.check is not None else None
+        problems = [g.line() for g in grouped(check.violations)] + check.absent if check is not None else []
+        unbounded = "" if allow_unbounded or check is None else check.too_unbounded()
         problems += [f"unbounded: {unbounded} (here: allow_unbounded=True)"] if unbounded else []
         if self._baseline:
             before, info = read_run(self._baseline)

@@ -36,6 +36,11 @@ the most specific: a key written out exactly counts 2, a pattern other than ``*`
 summed over scene, engine, integrator, scheme, metric and dt; among equally specific bounds the later one in
 the file wins. ``simparity check --explain ENGINE --metric M`` lists, for each row, every bound that matched
 and which one decided.
+
+Every bound's ``metric`` is checked against the metric catalogue (:mod:`comparisons.gate.metric_names`): a name
+no run can write is refused with the closest names. Top-level ``check_engines = [...]`` names the engines the gate
+holds (the others' violations are findings, never blocking) and ``require_engines = [...]`` those that must have
+measured something (:func:`load_gate`; the nearest file of an ``extends`` chain that names them wins).
 """
 
 from __future__ import annotations
@@ -46,6 +51,7 @@ from typing import Any
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from simparity.comparisons.gate.metric_names import allowed_text, unknown_metric
 from simparity.core.model.errors import SceneError, ToleranceError, one_line
 from simparity.core.model.files import read_toml
 from simparity.core.model.results import FLAGS, OK, STATUSES
@@ -94,6 +100,10 @@ class Bound:
     layer : int
         The file's place in its ``extends`` chain: 0 for the first file extended (the shipped one), one more
         for each file that extends it; a higher layer wins whatever the specificity.
+    shipped : bool
+        Whether the bound is the shipped file's (:data:`DEFAULT_TOLERANCES`): a bound of a user's file that
+        matches no row of a run is said so (:func:`comparisons.gate.check.unmatched_bounds`), a shipped one not
+        (it holds every built-in scene, most of which a run leaves out).
     """
 
     scene: str
@@ -114,6 +124,7 @@ class Bound:
     order: int
     na_when: tuple[str, ...] = ()
     layer: int = 0
+    shipped: bool = False
 
     @property
     def specificity(self) -> int:
@@ -205,6 +216,9 @@ def _bound(source: str, index: int, table) -> Bound:
             raise ToleranceError(source, f"{where}.{key}", f"expected a non-empty pattern, got {value!r:.60}",
                                  "a name or an fnmatch pattern such as rk4*")
         patterns[key] = value
+    unknown_why = unknown_metric(patterns["metric"])
+    if unknown_why:
+        raise ToleranceError(source, f"{where}.metric", unknown_why, allowed_text(patterns["metric"]))
     scheme = table.get("scheme", "*")
     schemes = (scheme,) if isinstance(scheme, str) else tuple(scheme) if isinstance(scheme, list) else ()
     if not schemes or not all(isinstance(p, str) and p for p in schemes):
@@ -246,28 +260,69 @@ def _bound(source: str, index: int, table) -> Bound:
     return bound
 
 
+CHECK_ENGINES, REQUIRE_ENGINES = "check_engines", "require_engines"
+"""Top-level keys of a tolerances file naming engines: those the gate holds (the others' violations are findings,
+never blocking; default: every engine of the run) and those it requires to have measured something."""
+ENGINE_KEYS = (CHECK_ENGINES, REQUIRE_ENGINES)
+
+
+@dataclass(frozen=True)
+class EngineNames:
+    """Engines named for the gate (:data:`ENGINE_KEYS`), and where: ``file: check_engines`` or ``--check-engines``."""
+
+    names: tuple[str, ...]
+    where: str
+
+
+@dataclass(frozen=True)
+class Gate:
+    """What a tolerances file asks: its bounds (with those of the files it extends), and the engines it holds and
+    requires (the nearest file in the ``extends`` chain that names them; None: not named)."""
+
+    bounds: list[Bound]
+    check_engines: EngineNames | None = None
+    require_engines: EngineNames | None = None
+
+
 def load_tolerances(path: str | Path = DEFAULT_TOLERANCES) -> list[Bound]:
     """The bounds of a tolerances file and of the files it extends (module docstring), each with its layer;
     raises :class:`ToleranceError` naming the file and key."""
+    return load_gate(path).bounds
+
+
+def load_gate(path: str | Path = DEFAULT_TOLERANCES) -> Gate:
+    """A tolerances file's bounds (:func:`load_tolerances`) and the engines it holds and requires."""
     return _load(Path(path), ())
 
 
-def _load(path: Path, chain: tuple[Path, ...]) -> list[Bound]:
+def _load(path: Path, chain: tuple[Path, ...]) -> Gate:
     source = str(path)
     try:
         data = read_toml(source, what="tolerances file")
     except SceneError as err:  # the file itself: missing, not a regular file, too large, not TOML
         raise ToleranceError(err.source, err.key, err.problem, err.allowed) from None
-    unknown = sorted(set(data) - {"bound", "extends"})
+    unknown = sorted(set(data) - {"bound", "extends", *ENGINE_KEYS})
     if unknown:
         kind = "table" if isinstance(data[unknown[0]], (dict, list)) else "key"
-        raise ToleranceError(source, unknown[0][:80], f"unknown {kind}", "[[bound]] tables and extends = ...")
+        raise ToleranceError(source, unknown[0][:80], f"unknown {kind}",
+                             "[[bound]] tables, extends = ..., " + " = [...], ".join(ENGINE_KEYS) + " = [...]")
     base = _extended(path, data.get("extends", _default_extends(path)), chain + (_resolved(path),))
     tables = data.get("bound", [])
-    if not isinstance(tables, list) or not (tables or ("extends" in data and base)):
+    inherits = "extends" in data or any(key in data for key in ENGINE_KEYS)
+    if not isinstance(tables, list) or not (tables or (inherits and base.bounds)):
         raise ToleranceError(source, "bound", "no bounds", "one or more [[bound]] tables, or extends = a file that has some")
-    layer = max((b.layer for b in base), default=-1) + 1
-    return base + [replace(_bound(source, i, table), layer=layer) for i, table in enumerate(tables)]
+    layer, shipped = max((b.layer for b in base.bounds), default=-1) + 1, _resolved(path) == _resolved(DEFAULT_TOLERANCES)
+    bounds = [replace(_bound(source, i, table), layer=layer, shipped=shipped) for i, table in enumerate(tables)]
+    named = {key: _engine_names(source, key, data[key]) if key in data else getattr(base, key) for key in ENGINE_KEYS}
+    return Gate(base.bounds + bounds, **named)
+
+
+def _engine_names(source: str, key: str, value) -> EngineNames:
+    """A list of engine names (as the run's ``engine`` column spells them)."""
+    if not isinstance(value, list) or not value or not all(isinstance(n, str) and n.strip() for n in value):
+        raise ToleranceError(source, key, f"expected a list of engine names, got {value!r:.60}",
+                             'a non-empty list of engine names as the run\'s rows spell them, e.g. ["core", "myengine"]')
+    return EngineNames(tuple(dict.fromkeys(n.strip() for n in value)), f"{source}: {key}")
 
 
 def _resolved(path: Path) -> Path:
@@ -282,13 +337,13 @@ def _default_extends(path: Path) -> str:
     return EXTENDS_NONE if _resolved(path) == _resolved(DEFAULT_TOLERANCES) else EXTENDS_DEFAULT
 
 
-def _extended(path: Path, extends, chain: tuple[Path, ...]) -> list[Bound]:
-    """The bounds of the file ``extends`` names (relative to ``path``'s folder), [] for ``none``."""
+def _extended(path: Path, extends, chain: tuple[Path, ...]) -> Gate:
+    """What the file ``extends`` names asks (relative to ``path``'s folder); nothing for ``none``."""
     allowed = f'"{EXTENDS_DEFAULT}" (the shipped tolerances), "{EXTENDS_NONE}" or a tolerances file\'s path'
     if not isinstance(extends, str) or not extends.strip():
         raise ToleranceError(str(path), "extends", f"expected text, got {extends!r:.60}", allowed)
     if extends == EXTENDS_NONE:
-        return []
+        return Gate([])
     target = DEFAULT_TOLERANCES if extends == EXTENDS_DEFAULT else path.parent / extends
     if _resolved(target) in chain:
         raise ToleranceError(str(path), "extends", f"{extends!r:.80} closes a loop of extends", allowed)
