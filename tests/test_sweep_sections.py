@@ -110,8 +110,8 @@ def test_a_scheme_is_judged_by_its_worst_variant(tmp_path):
     row = next(line for line in report.splitlines() if line.startswith("| [sweep of drop](#sweep-of-drop)"))
     cells = [cell.strip() for cell in row.split("|")[1:-1]]
     assert cells[0] == "[sweep of drop](#sweep-of-drop) (4 variants)"
-    # within 1e-3, not 1e-6; ranked by wall time: these rows count no force evaluations
-    assert cells[2] == "core rk4 @ 0.01 (0.025 s/s)" and cells[3] == "none"
+    # within 1e-3, not 1e-6; ranked by wall time (0.025 s per simulated second): these rows count no force evaluations
+    assert cells[2] == "core rk4 @ 0.01 (25 ms)" and cells[3] == "none"
 
 
 @pytest.mark.slow
