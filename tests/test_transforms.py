@@ -250,3 +250,19 @@ def test_a_transform_then_another_is_both_in_turn():
         transform_scene(transform_scene(scene, GENERAL), units).bodies[0].position_world, rtol=1e-15, atol=1e-12)
     with pytest.raises(TransformError, match="reorders bodies"):
         GENERAL.then(FIXED["permute"])
+
+
+URDF_SCENES = ("oblique-arm-swing", "oblique-arm-dynamics")
+"""Built-in scenes whose chain every engine reads from a URDF file (its lengths and masses are the file's)."""
+
+
+@pytest.mark.parametrize("name", URDF_SCENES)
+def test_a_urdf_chain_is_perturbed_in_its_unit_of_time_alone(name):
+    """The ulp perturbation a failing invariance comparison asks for changes only what a URDF chain's scene can say
+    (its state and its unit of time): before, a mass unit one ulp off made it raise TransformError, and a
+    `simparity run --transform` of a user's URDF arm ended in exit 2 after running every case."""
+    scene = _scene(name)
+    for seed in range(8):  # the mass factor is drawn +-1 ulp for each seed: some draw it off 1
+        perturbed, units = ulp_perturbed(scene, seed)
+        assert units.length_scale == 1.0 and units.mass_scale == 1.0
+        assert perturbed.chain.urdf_path == scene.chain.urdf_path

@@ -54,10 +54,11 @@ def ulp_nudge(values: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 
 
 def ulp_transform(seed: int, scene) -> Transform:
-    """The one-ulp change of units of perturbation ``seed`` for ``scene`` (a URDF chain keeps its lengths)."""
+    """The one-ulp change of units of perturbation ``seed`` for ``scene`` (a URDF chain keeps its lengths and masses:
+    every engine reads both from the file, so only the unit of time can change)."""
     length, mass, time = np.random.default_rng([seed, UNITS_STREAM]).choice(ULP_FACTORS, size=3)
     if getattr(getattr(scene, "chain", None), "urdf_path", None) is not None:
-        length = 1.0
+        length = mass = 1.0
     return Transform(f"ulp-{seed}", length_scale=float(length), mass_scale=float(mass), time_scale=float(time),
                      description="units one ulp off")
 
