@@ -18,8 +18,9 @@ What Pinocchio is given, and each default handled (each pinned by ``tests/test_p
 - Integrators (the harness's, on (q, qdot); :data:`SCHEMES`, :data:`ORDERS`, :data:`STAGES`):
   ``explicit_euler`` (q and qdot both from the start of the step), ``semi_implicit_euler`` (qdot first, then q
   with the new qdot), ``rk4`` (classical RK4, the configuration stages by ``pin.integrate`` from the start of the
-  step); ``dop853`` / ``dop853_coarse``: ``scipy.integrate.solve_ivp(method="DOP853")`` at rtol = atol = 1e-13 /
-  1e-11 on (angles, qdot) with ``aba`` as the right-hand side, sampled at k dt by ``t_eval``: the tight reference
+  step); ``dop853`` / ``dop853_coarse``: ``scipy.integrate.solve_ivp(method="DOP853")`` at rtol 1e-13 /
+  1e-11 (atol the same on the angles, and per the scene's duration on qdot: the same solve in any unit of time) on
+  (angles, qdot) with ``aba`` as the right-hand side, sampled at k dt by ``t_eval``: the tight reference
   (none of core's code), and its own error floor (the runner takes |dop853 - dop853_coarse|).
 - B copies: each copy is stepped (or solved) alone, one after the other; no batched stepping.
 - Energy from Pinocchio: kinetic 1/2 v^T M v with M = ``crba`` (armature included), potential
@@ -61,7 +62,8 @@ STAGES = {"explicit_euler": 1, "semi_implicit_euler": 1, "rk4": 4}
 """``aba`` calls per step of the fixed-step integrators (the adaptive solves vary from step to step)."""
 
 TOLERANCES = {"dop853": 1e-13, "dop853_coarse": 1e-11}
-"""rtol = atol of each DOP853 solve: the reference, and the coarser solve that measures its error floor."""
+"""rtol of each DOP853 solve, and its atol on the joint values (on their rates: per the scene's duration): the
+reference, and the coarser solve that measures its error floor."""
 
 State = tuple[np.ndarray, np.ndarray]
 """(Pinocchio configuration (nq,), velocity (nv,))."""
@@ -85,7 +87,8 @@ class PinocchioJointMotion(JointSimulation):
         self._lin_n = np.flatnonzero(~continuous)
         self._lin_q = np.array(self._chain.idx_q, dtype=int)[~continuous]
         self.detail = f"{self._chain.source}; harness-stepped: " + (
-            f"scipy solve_ivp DOP853, rtol = atol = {TOLERANCES[integrator]:g}, on (q, qdot) with qddot = "
+            f"scipy solve_ivp DOP853, rtol = {TOLERANCES[integrator]:g}, atol the same on q and per duration on qdot, "
+            "on (q, qdot) with qddot = "
             "pin.aba(q, v, tau - D v), sampled at k dt (t_eval)" if integrator in TOLERANCES else
             f"{integrator} on (q, qdot), qddot = pin.aba(q, v, tau - D v), q by pin.integrate "
             "(continuous joints' angles unwrapped)")
@@ -159,12 +162,19 @@ class PinocchioJointMotion(JointSimulation):
     def _solve(self, q0: np.ndarray, qdot0: np.ndarray, times: np.ndarray) -> State:
         """One copy by DOP853 from (q0, qdot0) ((n,) each): (q, qdot), (T, n) each at ``times`` (T,) [s]."""
         tolerance = TOLERANCES[self._integrator]
+        n = len(q0)
         sol = solve_ivp(self._derivative, (0.0, times[-1]), np.concatenate([q0, qdot0]), method="DOP853",
-                        t_eval=times, rtol=tolerance, atol=tolerance)
+                        t_eval=times, rtol=tolerance, atol=self._absolute_tolerance(tolerance, n, times[-1]))
         if not sol.success:
             raise DivergedError(f"pinocchio {self._integrator}: DOP853 failed: {sol.message}")
-        n = len(q0)
         return sol.y[:n].T, sol.y[n:].T
+
+    @staticmethod
+    def _absolute_tolerance(tolerance: float, n: int, duration: float) -> np.ndarray:
+        """DOP853's atol per component of (q, qdot) ((2n,)): ``tolerance`` on the joint values and ``tolerance`` per
+        ``duration`` [s] on their rates, so that the solve's error control is the same in any unit of time (a scene in
+        milliseconds, whose rates are a thousandth, is solved as closely as in seconds)."""
+        return np.concatenate([np.full(n, tolerance), np.full(n, tolerance / duration)])
 
     def energy(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Kinetic 1/2 v^T M v (``crba``, armature included) and ``computePotentialEnergy``, (B,) each [J]."""
