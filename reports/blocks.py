@@ -41,6 +41,8 @@ class Table:
     head: tuple[str, ...]
     rows: tuple[tuple[str, ...], ...]
     trim_order: int = 0
+    keep_at_least: int | None = None
+    """Rows a trimmed table keeps at least (None: :data:`reports.markdown.MIN_TRIMMED_ROWS`)."""
 
 
 @dataclass(frozen=True)

@@ -75,6 +75,13 @@ class ToleranceVerdict:
         return len(self.violations) if self.outside is None else self.outside
 
 
+SCENE_SUMMARY_TRIM_ORDER = 4
+"""Where the summary's row per scene stands among the tables report.md may shorten to stay within its line budget
+(:attr:`reports.blocks.Table.trim_order`): last, after a user's engine's table, and down to no row if it must, since
+every scene's own section below opens with the same verdict (a suite past ~26 scenes outgrew 400 lines with every
+other table at its minimum)."""
+
+
 _IK_COMPACT = (SOLVE_RATE, POSITION_RESIDUAL_MEDIAN, ITERATIONS_MEDIAN, TIME_PER_SOLVE, LIMIT_VIOLATIONS,
                CROSS_EVAL_SOLVE_RATE_MIN)
 _IK_PROTOCOL = (
@@ -377,7 +384,7 @@ class _Builder:
                        Table(("scene", "error (reference)") + tuple(engine_summary.cheapest_head(by, b)
                                                                     for b in summary.ERROR_BUDGETS)
                              + tuple(f"most accurate at {summary.cost_label(by, b)}" for b in summary.cost_budgets(by)),
-                             tuple(dyn_rows)),
+                             tuple(dyn_rows), trim_order=SCENE_SUMMARY_TRIM_ORDER, keep_at_least=0),
                        *([_SWEEP_ROWS_DYNAMICS] if any(s.kind == "dynamics" for s in self.sweeps) else [])]
         if ik_rows:
             blocks += [Heading(3, "Which IK solver?"),

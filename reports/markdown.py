@@ -122,15 +122,17 @@ def _trimmed(table: Table, keep: int) -> Table:
 
 def _within_budget(blocks: list[Block], excess: int) -> list[Block]:
     """``blocks`` with the tables that may be trimmed shortened by ``excess`` lines in all where they can be: a row at
-    a time, the first in :attr:`Table.trim_order` first, each kept to at least :data:`MIN_TRIMMED_ROWS` rows (a
-    trimmed table gains a row saying so)."""
+    a time, the first in :attr:`Table.trim_order` first, each kept to at least its :attr:`Table.keep_at_least` rows
+    (:data:`MIN_TRIMMED_ROWS` unless it says) (a trimmed table gains a row saying so)."""
     full = {i: len(b.rows) for i, b in enumerate(blocks) if isinstance(b, Table) and b.trim_order}
     keep = dict(full)
+    least = {i: MIN_TRIMMED_ROWS if b.keep_at_least is None else b.keep_at_least
+             for i, b in enumerate(blocks) if i in full and isinstance(b, Table)}
 
     def saved() -> int:
         return sum(full[i] - keep[i] - (keep[i] < full[i]) for i in keep)
     while saved() < excess:
-        cuttable = [i for i in keep if keep[i] > MIN_TRIMMED_ROWS]
+        cuttable = [i for i in keep if keep[i] > least[i]]
         if not cuttable:
             break
         keep[min(cuttable, key=lambda i: (cast(Table, blocks[i]).trim_order, i))] -= 1

@@ -57,3 +57,18 @@ def test_figures_share_a_line_with_short_alt_texts_and_html_only_blocks_stay_out
               Details("every value", (Paragraph("only in the HTML"),), markdown=False, open=True)]
     text = to_markdown(blocks)
     assert text == "![s-work-precision](figures/s-work-precision.svg) ![s-drift](figures/s-drift.svg)\n"
+
+
+def test_a_table_trimmed_last_may_give_up_every_row_and_the_report_keeps_its_budget():
+    """A suite whose every shortenable table is at its minimum still outgrew report.md's budget (28 scenes: 414 lines);
+    a table that may give up every row (``keep_at_least=0``) is shortened last, down to the line saying how many rows
+    report.html has, and never below another table's minimum."""
+    from simparity.reports.blocks import Paragraph, Table
+    from simparity.reports.markdown import MAX_LINES, MIN_TRIMMED_ROWS, to_markdown
+    findings = Table(("finding",), tuple((f"f{i}",) for i in range(40)), trim_order=1)
+    per_scene = Table(("scene",), tuple((f"s{i}",) for i in range(40)), trim_order=4, keep_at_least=0)
+    filler = [Paragraph(f"line {i}") for i in range((MAX_LINES - 12) // 2)]  # 2 lines each, the last 1: 387 of 400
+    lines = to_markdown([findings, per_scene, *filler]).splitlines()
+    assert len(lines) <= MAX_LINES
+    assert "| f4 |" in lines and "| f5 |" not in lines  # the first table at its minimum
+    assert "| s0 |" not in lines and "| … 40 more rows: report.html |" in lines  # the last one gave up every row
