@@ -28,7 +28,11 @@ The rules, stricter on the chain because every engine loads the whole file but o
   names, every referenced link present, one parent per link, one root), finite numbers, a
   non-zero axis on every moving joint, a ``<limit>`` on every revolute and prismatic joint with
   lower <= upper (urdfdom, hence Pinocchio, refuses a file with a revolute joint without one),
-  at most :data:`MAX_MOVABLE_JOINTS` movable and :data:`MAX_URDF_JOINTS` joints in all.
+  at most :data:`MAX_MOVABLE_JOINTS` movable and :data:`MAX_URDF_JOINTS` joints in all; no element of
+  :data:`SINGLE_CHILDREN` twice in its parent (MuJoCo refuses a repeat, PyBullet and urdfdom take the first);
+  the numbers the engines read and core does not model finite (:data:`READ_BY_ENGINES`: ``<limit effort
+  velocity>``, ``<dynamics friction>``, ``<mimic multiplier offset>``); every ``<mimic>`` naming another joint of
+  the file; no number subnormal (:data:`core.model.ranges.SMALLEST_NORMAL`).
 - The chain is the path from ``base_link`` to ``tip_link``; joints on that path must be
   revolute, continuous (an unlimited revolute joint) or prismatic, or fixed (merged into the
   next movable joint's origin, or into the end-effector transform after the last movable
@@ -42,15 +46,15 @@ The rules, stricter on the chain because every engine loads the whole file but o
 - The inertials of links in the base link's subtree must be a complete ``<inertial>`` (``<mass
   value>`` and all six ``<inertia>`` attributes, as urdfdom requires) of finite numbers: a mass of 0
   or within its physical range, inertial origins within theirs, inertia entries no larger than the
-  range of moments (tiny ones are rounding: real files have 1e-35). A mass of 0 with a non-zero
-  inertia loads (a rotor's inertia whose mass is counted elsewhere: pybullet_data's Panda flange),
+  range of moments (tiny ones only as rounding of the link's scale: real files have 1e-35). A mass
+  of 0 with a non-zero inertia loads (a rotor's inertia whose mass is counted elsewhere: pybullet_data's Panda flange),
   as it does from a scene file. A link that rides on a chain link must have a physical inertia
-  tensor, principal moments a <= b <= c with a + b >= c (hence positive semidefinite), judged
+  tensor, symmetric with principal moments a <= b <= c, a + b >= c (hence positive semidefinite), judged
   against the link's own scale (:func:`core.dynamics.inertia.link_tensor_problem`: the written
   decimals' rounding and floating point's on the link's inertia about its frame origin); links
   fixed to the base never move and are not held to it (real files have placeholder tensors there).
-  A chain joint's ``damping`` is finite and >= 0. Links outside the base link's subtree are not
-  read for mass.
+  A chain joint's ``damping`` is >= 0 and within its physical range. Links outside the base link's
+  subtree are not read for mass.
 
 Every refusal about a link or a joint names it and its branch from the tree's root, e.g. ``(link
 'head' on the branch root_link > torso_1 > ... > head)``, the middle elided past
@@ -69,11 +73,11 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-from simparity.core.dynamics.inertia import link_tensor_problem
+from simparity.core.dynamics.inertia import LINK_TENSOR_RULE, link_tensor_problem
 from simparity.core.model.errors import SceneError, one_line
 from simparity.core.model.files import MAX_FILE_BYTES, parse_xml, read_input
 from simparity.core.model.names import NAME_RULE, name_problem
-from simparity.core.model.ranges import NORM_RANGES, RANGES, Range, safe_norm
+from simparity.core.model.ranges import NORM_RANGES, RANGES, SUBNORMAL_RULE, Range, safe_norm, subnormal
 from simparity.core.model.scene import Chain, Joint, LinkInertia
 from simparity.core.rotations import rpy_to_matrix
 
@@ -147,8 +151,10 @@ def chain_from_urdf(
     """
     root, source = _parse(path_or_text, source, max_bytes)
     _check_size(root, source, max_joints)
+    _check_single(root, source)
     links = _links(root, source)
     joints = _joints(root, source, links)
+    _check_mimics(joints, source)
     parent_joint = _parent_joints(joints, source)
     roots = [name for name in links if name not in parent_joint]
     if len(roots) != 1:
@@ -202,6 +208,34 @@ def _check_size(root: ET.Element, source: str, max_joints: int) -> None:
                              f"at most {most:,} (a fixed limit)")
 
 
+SINGLE_CHILDREN = {"link": ("inertial",), "inertial": ("origin", "mass", "inertia"),
+                   "joint": ("parent", "child", "origin", "axis", "limit", "dynamics", "mimic")}
+"""Elements that may appear at most once in their parent element. The engines disagree on a repeat: MuJoCo's URDF
+importer refuses the file ("repeated element"), PyBullet's and urdfdom's (Pinocchio's) take the first and ignore the
+rest (tried with each: two <inertial>, <origin>, <mass>, <inertia>, <axis>, <limit>, <dynamics>, <mimic>, <parent>,
+<child>). A repeat is refused wherever it is in the file, since every engine loads the whole file. ``<visual>`` and
+``<collision>`` repeat by design; ``<calibration>`` and ``<safety_controller>`` repeat in every importer."""
+
+
+def _check_single(root: ET.Element, source: str) -> None:
+    """Refuse an element of :data:`SINGLE_CHILDREN` given twice in its parent, naming it and the rule."""
+    for kind in ("link", "joint"):
+        for i, element in enumerate(root.findall(kind)):
+            where = f"robot/{kind}[@name='{one_line(element.get('name') or f'#{i + 1}', 80)}']"
+            _single_children(element, SINGLE_CHILDREN[kind], where, source)
+            for inertial in element.findall("inertial"):  # a link's one <inertial>, checked above
+                _single_children(inertial, SINGLE_CHILDREN["inertial"], f"{where}/inertial", source)
+
+
+def _single_children(element: ET.Element, tags: tuple[str, ...], where: str, source: str) -> None:
+    for tag in tags:
+        count = len(element.findall(tag))
+        if count > 1:
+            raise SceneError(source, f"{where}/{tag}", f"{count} <{tag}> elements in one <{element.tag}> (MuJoCo "
+                             "refuses the file, PyBullet and Pinocchio take the first)",
+                             f"at most one <{tag}> per <{element.tag}>")
+
+
 def _links(root: ET.Element, source: str) -> dict[str, ET.Element]:
     """Link name -> its ``<link>`` element, in file order."""
     names: dict[str, ET.Element] = {}
@@ -245,8 +279,35 @@ def _joints(root: ET.Element, source: str, links: dict[str, ET.Element]) -> list
         if kind in ("revolute", "continuous", "prismatic") and not np.any(joint["axis"]):
             raise SceneError(source, f"{key}/axis/@xyz", "the axis is zero", "a non-zero vector")
         joint["limits"] = _limits(element, kind, key, source)
+        for tag, attributes in READ_BY_ENGINES.items():  # urdfdom refuses the file if one is not a finite number
+            for attribute in attributes:
+                _numbers(element.find(tag), attribute, (0.0,), f"{key}/{tag}", source)
         joints.append(joint)
     return joints
+
+
+READ_BY_ENGINES = {"limit": ("effort", "velocity"), "dynamics": ("damping", "friction"),
+                   "mimic": ("multiplier", "offset")}
+"""Joint attributes core does not model but the engines' importers read: each must be a finite number (urdfdom, hence
+Pinocchio, refuses a file where one is nan, inf or text; MuJoCo refuses text)."""
+
+
+def _check_mimics(joints: list[dict], source: str) -> None:
+    """Every ``<mimic>`` names another joint of the file (MuJoCo and urdfdom refuse one without a name, MuJoCo one
+    naming its own joint, Pinocchio's mimic model one naming no joint); its multiplier and offset are finite
+    (:data:`READ_BY_ENGINES`). A mimic joint is held at 0 off the chain and refused on it (:func:`_assemble`)."""
+    names = {joint["name"] for joint in joints}
+    for joint in joints:
+        mimic = joint["element"].find("mimic")
+        if mimic is None:
+            continue
+        target = mimic.get("joint")
+        if not target or target not in names or target == joint["name"]:
+            problem = ("names no joint" if not target else f"names its own joint {one_line(target, 80)!r}"
+                       if target == joint["name"] else
+                       f"names joint {one_line(target, 80)!r}, which the file does not have")
+            raise SceneError(source, f"{joint['key']}/mimic/@joint", problem,
+                             "the name of another <joint> of the file")
 
 
 def _numbers(element: ET.Element | None, attribute: str, default: tuple[float, ...], key: str,
@@ -261,6 +322,9 @@ def _numbers(element: ET.Element | None, attribute: str, default: tuple[float, .
     if values.shape != (len(default),) or not np.all(np.isfinite(values)):
         raise SceneError(source, f"{key}/@{attribute}", f"malformed number list {text!r}",
                          f"{len(default)} finite numbers separated by spaces")
+    tiny = next((value for value in values if subnormal(value)), None)
+    if tiny is not None:
+        raise SceneError(source, f"{key}/@{attribute}", f"{tiny:.3g} is a subnormal number", SUBNORMAL_RULE)
     return values
 
 
@@ -510,7 +574,7 @@ def _inertial(link: ET.Element, key: str, where: str, source: str) -> _Inertial:
     inertia, largest = np.zeros((3, 3)), RANGES["inertia_moment"]
     for name, (row, column) in zip(_INERTIA_ENTRIES, _INERTIA_INDEX):
         value = _required_number(element.find("inertia"), name, f"{key}/inertia", where, source)
-        if abs(value) > largest.high:  # tiny entries are rounding (real files have 1e-35): no lower bound
+        if abs(value) > largest.high:  # tiny entries: only as rounding of the link's scale (link_tensor_problem)
             raise SceneError(source, f"{key}/inertia/@{name}", f"{value:.6g} is above the physical range ({where})",
                              largest.text())
         inertia[row, column] = inertia[column, row] = value
@@ -547,7 +611,7 @@ def _rigid_body(joint: dict, following: dict | None, inertials: dict[str, _Inert
         inertial = inertials[link]
         if inertial.problem and dynamics:
             raise SceneError(source, inertial.key, f"{inertial.problem} ({inertial.where}, riding on the chain)",
-                             "a physical tensor: principal moments a <= b <= c with a + b >= c (hence all >= 0)")
+                             LINK_TENSOR_RULE)
         parts.append((inertial, position, rotation))
         for child in children.get(link, []):
             if child is not following:
@@ -565,10 +629,12 @@ def _rigid_body(joint: dict, following: dict | None, inertials: dict[str, _Inert
 
 
 def _damping(joint: dict, parent_joint: dict[str, dict], source: str) -> float:
-    """The chain joint's ``<dynamics damping>`` [N m s/rad or N s/m], 0 without one."""
+    """The chain joint's ``<dynamics damping>`` [N m s/rad or N s/m], 0 without one; >= 0 and within its physical
+    range (:data:`core.model.ranges.RANGES`)."""
     key = f"{joint['key']}/dynamics"
     damping = float(_numbers(joint["element"].find("dynamics"), "damping", (0.0,), key, source)[0])
     if damping < 0:
         raise SceneError(source, f"{key}/@damping", f"negative damping {damping:g} ({_where(joint, parent_joint)})",
                          "a damping >= 0")
+    _hold(np.array([damping]), RANGES["damping"], f"{key}/@damping", _where(joint, parent_joint), source)
     return damping

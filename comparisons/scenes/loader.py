@@ -26,13 +26,14 @@ from simparity.core.model.files import file_problem, read_toml
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.dynamics.inertia import (
     INERTIA_RTOL,
+    LINK_TENSOR_RULE,
     inertia_from_point_masses,
     inertia_problem,
     link_tensor_problem,
     mass_and_center_of_mass,
 )
 from simparity.core.model.names import NAME_RULE, TEXT_RULE, name_problem, text_problem
-from simparity.core.model.ranges import NORM_RANGES, RANGES, safe_norm
+from simparity.core.model.ranges import NORM_RANGES, RANGES, SUBNORMAL_RULE, safe_norm, subnormal
 from simparity.core.rotations import rpy_to_matrix
 from simparity.core.model.scene import (
     CONTACT_METHODS,
@@ -142,6 +143,8 @@ class _Reader:
             finite = False
         if not finite:
             raise self.fail(key, f"{value!s:.30} is not finite", "finite numbers")
+        if subnormal(value):
+            raise self.fail(key, f"{value:.3g} is a subnormal number", SUBNORMAL_RULE)
         if positive and value <= 0:
             raise self.fail(key, f"{value} is not positive", "numbers > 0")
         return float(value)
@@ -586,8 +589,7 @@ def _link(r: _Reader, where: str) -> LinkInertia | None:
     com = r.vector("com_xyz", 3, length=1)
     problem = link_tensor_problem(inertia, mass, com)
     if problem:
-        raise r.fail("inertia", f"{problem} ({where})", "a symmetric positive-semidefinite tensor obeying the "
-                     "triangle inequality (a point mass or a thin rod is one)")
+        raise r.fail("inertia", f"{problem} ({where})", LINK_TENSOR_RULE)
     return LinkInertia(mass, com, inertia)
 
 

@@ -16,14 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.core.model.errors import SceneError
-from simparity.core.model.ranges import RANGES
-
-# Relative tolerance of inertia_problem's symmetry and triangle-inequality checks, as a
-# fraction of the largest principal moment. Scene files quote inertias to ~6 significant
-# digits; rounding a, b and c by half a unit in the 6th digit breaks a thin plate's exact
-# a + b = c (or the symmetry of a tensor typed twice) by a few 1e-6 relative. Physically
-# meaningful violations are far larger.
-INERTIA_RTOL = 1e-5
+from simparity.core.model.ranges import INERTIA_RTOL, RANGES
 
 _SOURCE = "<scene>"
 
@@ -264,19 +257,26 @@ MOMENT_FLOOR = RANGES["inertia_moment"].low  # [kg m^2]
 below it, so a point mass at its link's origin written with a residue of 1e-35 is judged as the point mass it is."""
 
 
-def link_tensor_problem(inertia: np.ndarray, mass: float = 0.0, com_xyz: np.ndarray | None = None) -> str:
-    """Why a symmetric inertia tensor is not a link's ("" if it is): principal moments a <= b <= c must satisfy
-    a + b >= c (every mass distribution does; it implies a >= 0). Unlike a free body's (:func:`inertia_problem`), a
-    zero or singular tensor (a point mass, a thin rod) is a link's: its joint carries it.
+LINK_TENSOR_RULE = (f"a symmetric tensor with non-zero entries of at least {MOMENT_FLOOR:g} kg m^2 (smaller only as "
+                    "rounding) and principal moments a <= b <= c with a + b >= c (a point mass or a thin rod is one)")
+"""What :func:`link_tensor_problem` allows, for the allowed part of a refusal."""
 
-    A violation is rounding, not physics, when it is within either of two tolerances: the written decimals'
-    (:data:`INERTIA_RTOL` of c) or floating point's (:data:`ROUNDING_ULPS` eps of the link's inertia scale about its
-    frame origin, c + ``mass`` |``com_xyz``|^2, at least :data:`MOMENT_FLOOR`).
+
+def link_tensor_problem(inertia: np.ndarray, mass: float = 0.0, com_xyz: np.ndarray | None = None) -> str:
+    """Why an inertia tensor is not a link's ("" if it is): it must be symmetric, each non-zero entry at least
+    :data:`MOMENT_FLOOR` (the smallest physical moment), and its principal moments a <= b <= c must satisfy a + b >= c
+    (every mass distribution does; it implies a >= 0). Unlike a free body's (:func:`inertia_problem`), a zero or
+    singular tensor (a point mass, a thin rod) is a link's: its joint carries it.
+
+    An asymmetry, a smaller entry or a violation is rounding, not physics, when it is within either of two
+    tolerances: the written decimals' (:data:`INERTIA_RTOL` of c) or floating point's (:data:`ROUNDING_ULPS` eps of
+    the link's inertia scale about its frame origin, c + ``mass`` |``com_xyz``|^2, at least :data:`MOMENT_FLOOR`):
+    exporters write residues like iCub head's 2.4e-35 kg m^2.
 
     Parameters
     ----------
     inertia : (3, 3) ndarray
-        About the centre of mass [kg m^2], entries within the physical range (at most 1e12).
+        About the centre of mass [kg m^2], finite entries of magnitude at most 1e12.
     mass : float
         [kg], >= 0.
     com_xyz : (3,) ndarray, optional
@@ -290,10 +290,19 @@ def link_tensor_problem(inertia: np.ndarray, mass: float = 0.0, com_xyz: np.ndar
     largest = float(np.max(np.abs(inertia)))
     if largest == 0.0:
         return ""
-    a, b, c = np.linalg.eigvalsh(inertia / largest) * largest  # of order one inside: no lost digits
+    unit = inertia / largest  # of order one: no lost digits, no overflow
+    a, b, c = np.linalg.eigvalsh(0.5 * (unit + unit.T)) * largest
     offset = 0.0 if com_xyz is None else float(np.dot(com_xyz, com_xyz))
     scale = max(abs(c) + mass * offset, MOMENT_FLOOR)
     rounding = max(INERTIA_RTOL * abs(c), ROUNDING_ULPS * np.finfo(float).eps * scale)
+    asymmetry = float(np.max(np.abs(unit - unit.T))) * largest
+    if asymmetry > rounding:
+        return f"not symmetric: max |I - I^T| = {asymmetry:.3g} kg m^2, more than rounding ({rounding:.3g})"
+    magnitudes = np.abs(inertia)
+    tiny = magnitudes[(magnitudes > 0) & (magnitudes < MOMENT_FLOOR)]
+    if tiny.size and tiny.max() > rounding:
+        return (f"an entry of {tiny.max():.3g} kg m^2 is below the smallest physical moment ({MOMENT_FLOOR:g}) "
+                f"and more than rounding ({rounding:.3g})")
     if a + b >= c - rounding:
         return ""
     moments = ", ".join(f"{m:.6g}" for m in (a, b, c))

@@ -10,6 +10,7 @@ scene loader (``comparisons.scene_loader``) and the URDF reader (:mod:`core.urdf
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 
 
@@ -41,11 +42,13 @@ class Range:
 
 
 _LENGTH = Range(0.0, 1e6, "m", "a scene within 1000 km")
+RANGE_INERTIA_HIGH = 1e12
+"""[kg m^2] The largest moment of inertia (a ship's), and so the largest rotor inertia a joint's armature adds."""
 _ANGLE = Range(0.0, 1e3, "rad", "an angle; larger is a typo")
 _JOINT = Range(0.0, 1e4, "rad or m", "a joint range; leave the limits out (URDF: type='continuous') for none")
 RANGES = {
     "mass": Range(1e-9, 1e9, "kg", "a microgram to a million tonnes"),
-    "inertia_moment": Range(1e-15, 1e12, "kg m^2", "a microgram bead of 1 mm to a ship"),
+    "inertia_moment": Range(1e-15, RANGE_INERTIA_HIGH, "kg m^2", "a microgram bead of 1 mm to a ship"),
     "position_world": _LENGTH, "origin_xyz": _LENGTH, "end_effector_xyz": _LENGTH, "point_body": _LENGTH,
     "a": _LENGTH, "d": _LENGTH,
     "velocity_world": Range(0.0, 1e6, "m/s", "slower than 1000 km/s"),
@@ -67,6 +70,11 @@ RANGES = {
     "q": Range(0.0, 1e4, "rad or m", "a joint value"),
     "qdot": Range(0.0, 1e6, "rad/s or m/s", "a joint speed below a million per second"),
     "torque": Range(0.0, 1e9, "N m or N", "a joint force up to 1e9"),
+    "damping": Range(0.0, 1e9, "N m s/rad or N s/m", "a joint's viscous damping, like a drag coefficient (real "
+                     "arms: 0.01 to 100; PR2's torso lift 2e4 N s/m)"),
+    "armature": Range(0.0, RANGE_INERTIA_HIGH, "kg m^2 or kg", "a rotor's inertia through its gearing, at most "
+                      "the largest moment of inertia"),
+    "com_xyz": _LENGTH,
     "origin_rpy": _ANGLE, "end_effector_rpy": _ANGLE, "alpha": _ANGLE, "theta_offset": _ANGLE,
     "position_tolerance": Range(1e-15, 1e6, "m", "a tolerance above rounding, and at most a tenth of the reach"),
     "orientation_tolerance": Range(1e-15, 0.5, "rad", "a tolerance, not a quarter turn"),
@@ -80,6 +88,28 @@ RANGES = {
     "friction_kinetic": Range(0.0, 1e2, "1", "a Coulomb coefficient (rubber on rough concrete is ~1)"),
 }
 """By key name (the last component of a key path). Vectors are held to the range entry by entry."""
+
+INERTIA_RTOL = 1e-5
+"""Relative tolerance of an inertia tensor's symmetry and triangle-inequality checks, as a fraction of its largest
+principal moment (:func:`core.dynamics.inertia.inertia_problem`, ``link_tensor_problem``, and the data model's
+symmetry check). Scene files quote inertias to ~6 significant digits; rounding a, b and c by half a unit in the 6th
+digit breaks a thin plate's exact a + b = c (or the symmetry of a tensor typed twice) by a few 1e-6 relative.
+Physically meaningful violations are far larger."""
+
+SMALLEST_NORMAL = sys.float_info.min
+"""The smallest magnitude a non-zero number may have (2.2e-308). Below it a float64 is subnormal: it keeps fewer than
+16 significant digits (5e-324 keeps one), and code built with flush-to-zero (fast-math, SSE FTZ/DAZ) reads it as 0
+where other code reads it as given: one input, two meanings. No physical value is written so (the smallest number in
+the installed robot files is an inertia residue of 2.4e-35)."""
+
+
+def subnormal(value: float) -> bool:
+    """True for a non-zero number of magnitude below :data:`SMALLEST_NORMAL` (refused wherever a number is read)."""
+    return value != 0 and abs(value) < SMALLEST_NORMAL
+
+
+SUBNORMAL_RULE = f"0, or magnitudes of at least {SMALLEST_NORMAL:.3g} (no subnormal numbers)"
+"""The allowed part of a message refusing a subnormal number."""
 
 NORM_RANGES = {
     "quat_wxyz": Range(1e-6, 1e6, "", "a quaternion is normalised on loading; its norm must survive that"),

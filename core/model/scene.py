@@ -17,6 +17,7 @@ import numpy as np
 
 from simparity.core.model.arrays import readonly
 from simparity.core.model.errors import SceneError
+from simparity.core.model.ranges import INERTIA_RTOL
 
 _SAFE_NORM = (1e-150, 1e150)
 """Norms whose square neither under- nor overflows in float64; outside, a vector is first scaled
@@ -35,6 +36,16 @@ def _unit(vector, size: int, what: str) -> np.ndarray:
         v = v / largest
         norm = float(np.linalg.norm(v))
     return v / norm
+
+
+def _symmetric(tensor: np.ndarray, what: str) -> None:
+    """SceneError unless the (3, 3) ``tensor`` is symmetric to :data:`~core.model.ranges.INERTIA_RTOL` of its largest
+    entry (a rotated tensor, R I R^T, is symmetric to rounding): engines read one triangle or the other."""
+    largest = float(np.max(np.abs(tensor)))
+    asymmetry = float(np.max(np.abs(tensor / largest - tensor.T / largest))) if largest > 0 else 0.0
+    if asymmetry > INERTIA_RTOL:
+        raise SceneError("<code>", what, f"not symmetric: max |I - I^T| = {asymmetry * largest:.3g} kg m^2",
+                         f"a symmetric tensor (to {INERTIA_RTOL:g} of its largest entry)")
 
 
 @dataclass(frozen=True)
@@ -73,6 +84,8 @@ class RigidBody:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "inertia_body", readonly(self.inertia_body, shape=(3, 3)))
+        if np.all(np.isfinite(self.inertia_body)):
+            _symmetric(self.inertia_body, f"{self.name}.inertia_body")
         object.__setattr__(self, "position_world", readonly(self.position_world, shape=(3,)))
         object.__setattr__(self, "quat_wxyz", readonly(_unit(self.quat_wxyz, 4, f"{self.name}.quat_wxyz"), shape=(4,)))
         object.__setattr__(self, "velocity_world", readonly(self.velocity_world, shape=(3,)))
@@ -543,6 +556,7 @@ class LinkInertia:
         object.__setattr__(self, "inertia_com", readonly(self.inertia_com, shape=(3, 3)))
         if not np.all(np.isfinite(self.com_xyz)) or not np.all(np.isfinite(self.inertia_com)):
             raise SceneError("<code>", "inertia", "a non-finite centre of mass or inertia", "finite numbers")
+        _symmetric(self.inertia_com, "inertia")
 
     @classmethod
     def massless(cls) -> "LinkInertia":
