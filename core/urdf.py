@@ -31,7 +31,8 @@ The rules, stricter on the chain because every engine loads the whole file but o
   at most :data:`MAX_MOVABLE_JOINTS` movable and :data:`MAX_URDF_JOINTS` joints in all; no element of
   :data:`SINGLE_CHILDREN` twice in its parent (MuJoCo refuses a repeat, PyBullet and urdfdom take the first);
   the numbers the engines read and core does not model finite (:data:`READ_BY_ENGINES`: ``<limit effort
-  velocity>``, ``<dynamics friction>``, ``<mimic multiplier offset>``); every ``<mimic>`` naming another joint of
+  velocity>``, ``<dynamics friction>`` and ``<mimic multiplier offset>`` among them; effort, velocity and friction
+  >= 0, as Pinocchio requires); every ``<mimic>`` naming another joint of
   the file; no number subnormal (:data:`core.model.ranges.SMALLEST_NORMAL`).
 - The chain is the path from ``base_link`` to ``tip_link``; joints on that path must be
   revolute, continuous (an unlimited revolute joint) or prismatic, or fixed (merged into the
@@ -68,6 +69,7 @@ guessed. A file with a ``<!DOCTYPE>`` (hence any entity declaration) or elements
 from __future__ import annotations
 
 import os
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, replace
 from typing import Any
@@ -279,17 +281,35 @@ def _joints(root: ET.Element, source: str, links: dict[str, ET.Element]) -> list
         if kind in ("revolute", "continuous", "prismatic") and not np.any(joint["axis"]):
             raise SceneError(source, f"{key}/axis/@xyz", "the axis is zero", "a non-zero vector")
         joint["limits"] = _limits(element, kind, key, source)
-        for tag, attributes in READ_BY_ENGINES.items():  # urdfdom refuses the file if one is not a finite number
-            for attribute in attributes:
-                _numbers(element.find(tag), attribute, (0.0,), f"{key}/{tag}", source)
+        _check_read_by_engines(element, key, source)
         joints.append(joint)
     return joints
 
 
 READ_BY_ENGINES = {"limit": ("effort", "velocity"), "dynamics": ("damping", "friction"),
-                   "mimic": ("multiplier", "offset")}
+                   "mimic": ("multiplier", "offset"), "calibration": ("rising", "falling"),
+                   "safety_controller": ("soft_lower_limit", "soft_upper_limit", "k_position", "k_velocity")}
 """Joint attributes core does not model but the engines' importers read: each must be a finite number (urdfdom, hence
 Pinocchio, refuses a file where one is nan, inf or text; MuJoCo refuses text)."""
+
+NON_NEGATIVE = (("limit", "effort"), ("limit", "velocity"), ("dynamics", "friction"))
+"""Of those, the ones Pinocchio refuses a file for when negative ("min_effort greater than max_effort")."""
+
+REQUIRED = (("safety_controller", "k_velocity"),)
+"""Attributes urdfdom refuses a file without when their element is there."""
+
+
+def _check_read_by_engines(element: ET.Element, key: str, source: str) -> None:
+    """The joint ``element``'s numbers of :data:`READ_BY_ENGINES` as its importers need them (``key``: the joint)."""
+    for tag, attributes in READ_BY_ENGINES.items():
+        child = element.find(tag)
+        for attribute in attributes:
+            value = float(_numbers(child, attribute, (0.0,), f"{key}/{tag}", source)[0])
+            if (tag, attribute) in NON_NEGATIVE and value < 0:
+                raise SceneError(source, f"{key}/{tag}/@{attribute}", f"{value:g} is negative", "a number >= 0")
+            if child is not None and (tag, attribute) in REQUIRED and child.get(attribute) is None:
+                raise SceneError(source, f"{key}/{tag}/@{attribute}", "missing", f"<{tag} {attribute}='...'> "
+                                 "(urdfdom refuses the file without it)")
 
 
 def _check_mimics(joints: list[dict], source: str) -> None:
@@ -310,18 +330,27 @@ def _check_mimics(joints: list[dict], source: str) -> None:
                              "the name of another <joint> of the file")
 
 
+DECIMAL = re.compile(r"[+-]?([0-9]+(\.[0-9]*)?|\.[0-9]+)([eE][+-]?[0-9]+)?\Z")
+"""A number as every engine's URDF importer reads it alike: ASCII decimal digits, an optional point and exponent.
+Python's ``float`` reads more than the engines do, differently: ``1_0`` is 10 to it (MuJoCo refuses it, Pinocchio
+reads 0), ``0x10`` is 16 to MuJoCo (Pinocchio: 0), ``infinity`` inf to MuJoCo (Pinocchio: 0), Arabic-Indic digits are
+digits to Python only, and a single number followed by a space is 0 to Pinocchio. Numbers of a vector are separated
+by spaces (Pinocchio refuses tabs); no installed robot file writes a number any other way."""
+
+
 def _numbers(element: ET.Element | None, attribute: str, default: tuple[float, ...], key: str,
              source: str) -> np.ndarray:
+    """The attribute's numbers (``default`` without it): ``len(default)`` :data:`DECIMAL` numbers, finite, none
+    subnormal; a single number without spaces around it."""
     text = None if element is None else element.get(attribute)
     if text is None:
         return np.array(default)
-    try:
-        values = np.array([float(word) for word in text.split()])
-    except ValueError:
-        values = np.array([np.nan])
-    if values.shape != (len(default),) or not np.all(np.isfinite(values)):
+    words = [word for word in text.split(" ") if word]
+    if (len(words) != len(default) or not all(DECIMAL.match(word) for word in words)
+            or (len(default) == 1 and text != words[0])
+            or not np.all(np.isfinite(values := np.array([float(word) for word in words])))):
         raise SceneError(source, f"{key}/@{attribute}", f"malformed number list {text!r}",
-                         f"{len(default)} finite numbers separated by spaces")
+                         f"{len(default)} finite decimal numbers (like -1.5e-3) separated by spaces")
     tiny = next((value for value in values if subnormal(value)), None)
     if tiny is not None:
         raise SceneError(source, f"{key}/@{attribute}", f"{tiny:.3g} is a subnormal number", SUBNORMAL_RULE)

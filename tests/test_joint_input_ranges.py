@@ -266,6 +266,18 @@ URDF_CASES = [
     ("mass 1e308", ('<mass value="1.5"/>', '<mass value="1e308"/>'), "inertial/mass/@value", "1e+09"),
     ("inertia subnormal", ('ixx="0.002"', 'ixx="5e-324"'), "inertial/inertia/@ixx", "subnormal"),
     ("inertia 1e308", ('ixx="0.002"', 'ixx="1e308"'), "inertial/inertia/@ixx", "1e+12"),
+    ("friction negative", ('friction="0"', 'friction="-1"'), "dynamics/@friction", ">= 0"),
+    ("effort negative", ('effort="10"', 'effort="-10"'), "limit/@effort", ">= 0"),
+    ("calibration nan", (FINGER, FINGER.replace("/>", '/><calibration rising="nan"/>', 1)), "calibration/@rising",
+     "finite"),
+    ("safety controller inf", (FINGER, FINGER.replace("/>", '/><safety_controller k_velocity="inf"/>', 1)),
+     "safety_controller/@k_velocity", "finite"),
+    ("safety controller without k_velocity", (FINGER, FINGER.replace("/>", '/><safety_controller k_position="1"/>', 1)),
+     "safety_controller/@k_velocity", "urdfdom"),
+    ("mass 1_0", ('<mass value="1.5"/>', '<mass value="1_0"/>'), "inertial/mass/@value", "decimal"),
+    ("mass hexadecimal", ('<mass value="1.5"/>', '<mass value="0x10"/>'), "inertial/mass/@value", "decimal"),
+    ("mass with a trailing space", ('<mass value="1.5"/>', '<mass value="2 "/>'), "inertial/mass/@value", "decimal"),
+    ("origin with a tab", ('xyz="0.2 0 0"', 'xyz="0.2&#9;0 0"'), "inertial/origin/@xyz", "decimal"),
     ("mimic nowhere", (FINGER, _mimic('joint="nowhere"')), "joint[@name='finger']/mimic/@joint", "does not have"),
     ("mimic itself", (FINGER, _mimic('joint="finger"')), "mimic/@joint", "its own joint"),
     ("mimic unnamed", (FINGER, _mimic('multiplier="2"')), "mimic/@joint", "names no joint"),
@@ -338,7 +350,8 @@ def test_the_data_model_refuses_an_asymmetric_tensor_built_in_code():
 
 HOSTILE_NUMBERS = ["1e308", "-1e308", "nan", "inf", "-inf", "5e-324", "-5e-324", "1e-320", "1e13", "-1"]
 """TOML values no joint input may take (each is out of range, non-finite, subnormal or negative for these keys)."""
-HOSTILE_ATTRIBUTES = ["1e308", "nan", "inf", "-inf", "5e-324", "1e-320", "x", "1 2", ""]
+HOSTILE_ATTRIBUTES = ["1e308", "nan", "inf", "-inf", "5e-324", "1e-320", "x", "1 2", "", "1_0", "0x1", "\u0661", "1e999",
+                      "-1"]
 """URDF attribute values none of the fuzzed attributes may take."""
 
 
