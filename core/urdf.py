@@ -313,21 +313,34 @@ def _check_read_by_engines(element: ET.Element, key: str, source: str) -> None:
 
 
 def _check_mimics(joints: list[dict], source: str) -> None:
-    """Every ``<mimic>`` names another joint of the file (MuJoCo and urdfdom refuse one without a name, MuJoCo one
-    naming its own joint, Pinocchio's mimic model one naming no joint); its multiplier and offset are finite
-    (:data:`READ_BY_ENGINES`). A mimic joint is held at 0 off the chain and refused on it (:func:`_assemble`)."""
-    names = {joint["name"] for joint in joints}
+    """Every ``<mimic>`` names another joint of the file that moves and mimics none (MuJoCo and urdfdom refuse a mimic
+    without a name, MuJoCo one naming its own joint; Pinocchio's mimic model refuses one naming no joint, a fixed joint
+    or another mimic, chains and cycles of mimics included; no installed robot file has any of them); its multiplier
+    and offset are finite (:data:`READ_BY_ENGINES`). A mimic joint is held at 0 off the chain and refused on it
+    (:func:`_assemble`); a fixed joint with a ``<mimic>`` loads (real grippers have it: every importer ignores it)."""
+    by_name = {joint["name"]: joint for joint in joints}
     for joint in joints:
         mimic = joint["element"].find("mimic")
-        if mimic is None:
-            continue
-        target = mimic.get("joint")
-        if not target or target not in names or target == joint["name"]:
-            problem = ("names no joint" if not target else f"names its own joint {one_line(target, 80)!r}"
-                       if target == joint["name"] else
-                       f"names joint {one_line(target, 80)!r}, which the file does not have")
+        problem = "" if mimic is None else _mimic_problem(joint, mimic.get("joint"), by_name)
+        if problem:
             raise SceneError(source, f"{joint['key']}/mimic/@joint", problem,
-                             "the name of another <joint> of the file")
+                             "the name of another revolute, continuous or prismatic <joint> of the file, not a mimic")
+
+
+def _mimic_problem(joint: dict, name: str | None, by_name: dict[str, dict]) -> str:
+    """What is wrong with ``joint``'s ``<mimic joint=name>`` ("" if nothing)."""
+    if not name:
+        return "names no joint"
+    target, shown = by_name.get(name), repr(one_line(name, 80))
+    if target is None:
+        return f"names joint {shown}, which the file does not have"
+    if target is joint:
+        return f"names its own joint {shown}"
+    if target["type"] not in ("revolute", "continuous", "prismatic"):
+        return f"names the {target['type']} joint {shown}, which does not move"
+    if target["element"].find("mimic") is not None:
+        return f"names joint {shown}, itself a mimic"
+    return ""
 
 
 DECIMAL = re.compile(r"[+-]?([0-9]+(\.[0-9]*)?|\.[0-9]+)([eE][+-]?[0-9]+)?\Z")

@@ -6,6 +6,7 @@ the key or element, the value and what is allowed; through the CLI, exit 2 and n
 
 from __future__ import annotations
 
+import random
 import re
 import warnings
 
@@ -296,6 +297,20 @@ def test_out_of_range_urdf_values_are_refused(tmp_path, capsys, replace, element
     _refused_by_cli(capsys, scene)
 
 
+@pytest.mark.parametrize("elbow", ['<mimic joint="shoulder"/>', '<mimic joint="finger"/>'], ids=["chain", "cycle"])
+def test_a_mimic_names_a_joint_that_moves_and_mimics_none(tmp_path, elbow):
+    """Pinocchio's mimic model refuses a chain or a cycle of mimics; a fixed joint is refused as a target."""
+    urdf = URDF.replace('<dynamics damping="0.05"/>', f'<dynamics damping="0.05"/>{elbow}', 1)
+    _write(tmp_path, urdf.replace(FINGER, _mimic('joint="elbow"')), "arm.urdf")
+    err = str(_refusal(_write(tmp_path, URDF_SCENE)))
+    assert "/mimic/@joint" in err and "itself a mimic" in err, err
+    fixed = URDF.replace('<joint name="finger" type="revolute">', '<joint name="finger" type="fixed">', 1)
+    fixed = fixed.replace('</robot>', '<joint name="toe" type="revolute"><parent link="nail"/><child link="toe"/>'
+                          '<mimic joint="finger"/><limit lower="-1" upper="1"/></joint><link name="toe"/></robot>')
+    _write(tmp_path, fixed, "arm.urdf")
+    assert "names the fixed joint 'finger', which does not move" in str(_refusal(_write(tmp_path, URDF_SCENE)))
+
+
 def test_the_valid_files_load_and_a_mimic_that_names_a_joint_is_held(tmp_path):
     for text in (JOINTS, MOTION):
         load_scene(_write(tmp_path, text))
@@ -336,6 +351,15 @@ def test_the_engines_disagree_on_a_repeated_element():
         mujoco.MjModel.from_xml_string(twice)
     model = pinocchio.buildModelFromXML(twice)
     assert model.inertias[1].mass == 1.5
+
+
+def test_the_public_api_refuses_what_the_loader_refuses(tmp_path):
+    import simparity
+
+    path = _write(tmp_path, _joint_key(JOINTS, "shoulder", "armature", "1e308"))
+    for load in (simparity.load_scene, simparity.load_scenes):
+        with pytest.raises(SceneError, match=r"chain\.joint\[0\]\.armature"):
+            load(str(path))
 
 
 def test_the_data_model_refuses_an_asymmetric_tensor_built_in_code():
@@ -394,3 +418,69 @@ def test_fuzzed_joint_inputs_are_each_refused_on_one_line(tmp_path, capsys):
     for what, scene, urdf in variants[::10]:  # and through the CLI: exit 2, one line
         _write(tmp_path, urdf, "arm.urdf")
         _refused_by_cli(capsys, _write(tmp_path, scene))
+
+
+RANDOM_VARIANTS = 400
+"""Seeded random variants of the random fuzz (each one or two mutations of a scene file's joints or of the URDF)."""
+RANDOM_VALUES = HOSTILE_NUMBERS + ["0", "-0.0", "1e-300", "1e-20", "true", '"x"', "[]", "[1]", "{}", "0.1", "1e9",
+                                   "[1e308, 0, 0]", "[0.1, 1e-320, 0]", "[[1, 2, 3], [4, 5, 6], [7, 8, 9]]",
+                                   "[[0, 0, 0], [0, 0, 0], [0, 0, 0]]", "[[1e-20, 0, 0], [0, 1e-20, 0], [0, 0, 1e-20]]",
+                                   "123456789012345678901234567890"]
+RANDOM_KEYS = ("damping", "armature", "mass", "com_xyz", "inertia", "axis", "origin_xyz", "lower", "upper")
+RANDOM_SPOTS = ('damping="0.1"', 'friction="0"', 'effort="10"', 'velocity="3"', 'value="1.5"', 'ixx="0.002"',
+                'ixy="0"', 'xyz="0.2 0 0"', 'lower="-2"', 'upper="2"', 'xyz="0 0 1"', 'damping="0.05"')
+RANDOM_ELEMENTS = ('<mimic joint="nowhere"/>', '<mimic joint="elbow" multiplier="nan"/>', '<mimic/>',
+                   '<mimic joint="shoulder"/>', '<dynamics damping="1"/>', '<limit lower="0" upper="1"/>',
+                   '<origin xyz="0 0 0"/>', '<axis xyz="0 1 0"/>', '<mass value="2"/>', '<calibration rising="nan"/>',
+                   '<inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>',
+                   '<safety_controller k_velocity="inf"/>')
+
+
+def _random_variant(rng: random.Random) -> tuple[str, str]:
+    """(scene text, URDF text) with one or two random mutations of the joints' inputs."""
+    if rng.random() < 0.5:
+        scene = rng.choice([JOINTS, MOTION])
+        for _ in range(rng.randint(1, 2)):
+            scene = _joint_key(scene, rng.choice(["shoulder", "slide"]), rng.choice(RANDOM_KEYS),
+                               rng.choice(RANDOM_VALUES))
+        if rng.random() < 0.3:
+            scene += f'\n[sweep]\n"chain.joint[0].damping" = [0.1, {rng.choice(["1e308", "5e-324", "-1", "0.2"])}]\n'
+        return scene, URDF
+    urdf = URDF
+    for _ in range(rng.randint(1, 2)):
+        if rng.random() < 0.6:
+            spot = rng.choice(RANDOM_SPOTS)
+            urdf = urdf.replace(spot, f'{spot.split("=")[0]}="{rng.choice(HOSTILE_ATTRIBUTES + ["0", " 0.1 "])}"', 1)
+        else:
+            closing = rng.choice(["</joint>", "</inertial>", "</link>"])
+            parts = urdf.split(closing)
+            k = rng.randrange(len(parts) - 1)
+            urdf = closing.join(parts[:k + 1]) + rng.choice(RANDOM_ELEMENTS) + closing + closing.join(parts[k + 1:])
+    kind, tables = rng.choice(list(KIND_TABLES.items()))
+    return URDF_SCENE.replace("joint_dynamics", kind) + tables, urdf
+
+
+KIND_TABLES = {"joint_dynamics": "", "kinematics": "", "ik": "[targets]\ncount = 2\n",
+               "joint_motion": "[simulation]\nduration = 0.1\ndt = [0.01]\n"}
+"""Each kind of scene a URDF chain serves, and the tables it needs beside [chain]."""
+
+
+@pytest.mark.sweep
+@pytest.mark.slow
+def test_random_joint_inputs_load_or_are_refused_on_one_line(tmp_path):
+    """Seeded random mutations of joint inputs, valid or not: each loads or is refused with one line naming the file
+    and what is allowed; nothing else escapes, nothing warns."""
+    rng, refused = random.Random(39), 0
+    for k in range(RANDOM_VARIANTS):
+        scene, urdf = _random_variant(rng)
+        _write(tmp_path, urdf, "arm.urdf")
+        path = _write(tmp_path, scene)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            try:
+                load_scenes(path)
+            except SceneError as err:
+                refused += 1
+                text = str(err)
+                assert "\n" not in text and "(allowed: " in text and text.startswith(str(path)), (k, text)
+    assert RANDOM_VARIANTS // 2 < refused < RANDOM_VARIANTS  # both outcomes drawn, mostly refusals
