@@ -177,6 +177,7 @@ SCENE_CASES = [
     ("slide", "damping", "1e10", ("chain.joint[1].damping", "1e+10")),
     ("shoulder", "armature", "1e308", ("chain.joint[0].armature", "1e+308", "1e+12")),
     ("slide", "armature", "5e-324", ("chain.joint[1].armature", "subnormal")),
+    ("slide", "armature", "1e-20", ("chain.joint[1].armature", "0 (none), or magnitudes 1e-15")),
     ("shoulder", "com_xyz", "[1e308, 0.0, 0.0]", ("chain.joint[0].com_xyz[0]", "1e+308", "1e+06")),
     ("slide", "com_xyz", "[0.0, 0.0, 2e6]", ("chain.joint[1].com_xyz[2]", "2e+06")),
     ("shoulder", "inertia", "[[5e-324, 0.0, 0.0], [0.0, 5e-324, 0.0], [0.0, 0.0, 5e-324]]",

@@ -25,30 +25,35 @@ class Range:
     unit : str
     why : str
         What the range admits, for the error message.
+    zero : bool
+        Whether 0 (none) is allowed besides [low, high].
     """
 
     low: float
     high: float
     unit: str
     why: str
+    zero: bool = False
 
     def allows(self, magnitude: float) -> bool:
-        """True for a magnitude inside [low, high] (False for NaN)."""
-        return self.low <= magnitude <= self.high
+        """True for a magnitude inside [low, high], or 0 where :attr:`zero` (False for NaN)."""
+        return self.low <= magnitude <= self.high or (self.zero and magnitude == 0)
 
     def text(self) -> str:
         low = "0" if self.low == 0 else f"{self.low:g}"
-        return f"magnitudes {low} to {self.high:g} {self.unit}: {self.why}".strip()
+        none = "0 (none), or " if self.zero and self.low > 0 else ""
+        return f"{none}magnitudes {low} to {self.high:g} {self.unit}: {self.why}".strip()
 
 
 _LENGTH = Range(0.0, 1e6, "m", "a scene within 1000 km")
-RANGE_INERTIA_HIGH = 1e12
-"""[kg m^2] The largest moment of inertia (a ship's), and so the largest rotor inertia a joint's armature adds."""
+RANGE_INERTIA_LOW, RANGE_INERTIA_HIGH = 1e-15, 1e12
+"""[kg m^2] The smallest and largest moments of inertia (a microgram bead of 1 mm, a ship), and so of the rotor
+inertia a joint's armature adds."""
 _ANGLE = Range(0.0, 1e3, "rad", "an angle; larger is a typo")
 _JOINT = Range(0.0, 1e4, "rad or m", "a joint range; leave the limits out (URDF: type='continuous') for none")
 RANGES = {
     "mass": Range(1e-9, 1e9, "kg", "a microgram to a million tonnes"),
-    "inertia_moment": Range(1e-15, RANGE_INERTIA_HIGH, "kg m^2", "a microgram bead of 1 mm to a ship"),
+    "inertia_moment": Range(RANGE_INERTIA_LOW, RANGE_INERTIA_HIGH, "kg m^2", "a microgram bead of 1 mm to a ship"),
     "position_world": _LENGTH, "origin_xyz": _LENGTH, "end_effector_xyz": _LENGTH, "point_body": _LENGTH,
     "a": _LENGTH, "d": _LENGTH,
     "velocity_world": Range(0.0, 1e6, "m/s", "slower than 1000 km/s"),
@@ -72,8 +77,8 @@ RANGES = {
     "torque": Range(0.0, 1e9, "N m or N", "a joint force up to 1e9"),
     "damping": Range(0.0, 1e9, "N m s/rad or N s/m", "a joint's viscous damping, like a drag coefficient (real "
                      "arms: 0.01 to 100; PR2's torso lift 2e4 N s/m)"),
-    "armature": Range(0.0, RANGE_INERTIA_HIGH, "kg m^2 or kg", "a rotor's inertia through its gearing, at most "
-                      "the largest moment of inertia"),
+    "armature": Range(RANGE_INERTIA_LOW, RANGE_INERTIA_HIGH, "kg m^2 or kg", "a rotor's inertia through its "
+                      "gearing, within the moments of inertia", zero=True),
     "com_xyz": _LENGTH,
     "origin_rpy": _ANGLE, "end_effector_rpy": _ANGLE, "alpha": _ANGLE, "theta_offset": _ANGLE,
     "position_tolerance": Range(1e-15, 1e6, "m", "a tolerance above rounding, and at most a tenth of the reach"),
