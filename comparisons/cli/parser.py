@@ -56,6 +56,13 @@ def name_list(known: tuple[str, ...] = (), kind: str = "name"):
     return parse
 
 
+def name_argument(text: str) -> str:
+    """An argparse type: a name or pattern, never the empty string (which would read as the option not given)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"{echo(text)} names nothing (allowed: a non-empty name)")
+    return text
+
+
 def path_argument(text: str) -> Path:
     """An argparse type: a path, never the empty string (which ``Path`` would read as the current folder)."""
     if not text.strip():
@@ -92,7 +99,7 @@ def _add_check_options(parser: argparse.ArgumentParser) -> None:
 
 
 def _add_history_option(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--history", default=None, metavar="PATH",
+    parser.add_argument("--history", type=path_argument, default=None, metavar="PATH",
                         help=f"run history database (default: $SIMPARITY_HISTORY or {DEFAULT_OUT_ROOT}/history.sqlite)")
 
 
@@ -146,7 +153,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--executor", choices=EXECUTORS, default="local",
                      help="where cases run: local worker processes (default), or a Dask distributed cluster (a "
                      "LocalCluster on this machine unless --scheduler is given; needs pip install 'simparity[dask]')")
-    run.add_argument("--scheduler", default=None, metavar="ADDRESS",
+    run.add_argument("--scheduler", type=name_argument, default=None, metavar="ADDRESS",
                      help="with --executor dask: the scheduler of a running cluster, e.g. tcp://10.0.0.5:8786")
     run.add_argument("--case-timeout", type=float, default=DEFAULT_CASE_SECONDS, metavar="SECONDS",
                      help="a case still running after this long is killed and becomes a failed row (default: "
@@ -182,12 +189,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     check.add_argument("run_dir", nargs="?", type=path_argument, default=None, metavar="RUN_DIR",
                        help="a folder written by 'simparity run' (default: the latest run in the history)")
-    check.add_argument("--explain", default=None, metavar="ENGINE",
+    check.add_argument("--explain", type=name_argument, default=None, metavar="ENGINE",
                        help="print, per scene, every bound that holds ENGINE's rows (which rows, to what, and why) "
                        "instead of checking; your engine is held to the bounds of its schemes' kinds. With --scene, "
                        "--integrator or --metric: for each row, every bound that matched, its file, and which decided")
     for key in ("scene", "integrator", "metric"):
-        check.add_argument(f"--{key}", default=None, metavar="PATTERN",
+        check.add_argument(f"--{key}", type=name_argument, default=None, metavar="PATTERN",
                            help=f"with --explain: only rows whose {key} matches (fnmatch, e.g. 'order_*')")
     check.add_argument("--bless", type=path_argument, default=None, metavar="FILE",
                        help="write a tolerances file from the run instead of checking: each row held to its measured "
@@ -201,9 +208,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     history = sub.add_parser("history", help="how metrics moved across recorded runs",
                              description="Show one metric (or all) across the runs recorded in the history database.")
-    history.add_argument("scene", nargs="?", default=None, metavar="SCENE")
-    history.add_argument("--engine", default=None)
-    history.add_argument("--metric", default=None)
+    history.add_argument("scene", nargs="?", type=name_argument, default=None, metavar="SCENE")
+    history.add_argument("--engine", type=name_argument, default=None)
+    history.add_argument("--metric", type=name_argument, default=None)
     _add_history_option(history)
 
     export = sub.add_parser(
@@ -212,7 +219,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     export.add_argument("scene", metavar="SCENE|FILE")
     export.add_argument("--engine", required=True, choices=EXPORTABLE)
-    export.add_argument("--integrator", default=None, help="dynamics only (default: the engine's first)")
+    export.add_argument("--integrator", type=name_argument, default=None, help="dynamics only (default: the engine's first)")
     export.add_argument("--dt", type=float, default=None, help="dynamics only, [s] (default: the scene's first)")
 
     show = sub.add_parser(
