@@ -31,8 +31,15 @@ from simparity.comparisons.gate.bless import bless, write_blessed
 from simparity.comparisons.gate.violation import grouped
 from simparity.comparisons.gate.check_output import held_line, junit_xml, summary_markdown
 from simparity.comparisons.scenes.describe import describe
+from simparity.comparisons.cli.check_options import (
+    CHECK_OPTIONS,
+    baseline_run,
+    baseline_table,
+    checked_check_options,
+    refuse_check_options,
+)
 from simparity.comparisons.cli.console import EXIT_INTERRUPTED
-from simparity.comparisons.cli.destinations import writable_file, writable_folder, write_file
+from simparity.comparisons.cli.destinations import writable_folder, write_file
 from simparity.comparisons.engines.registry import (
     ENGINE_NAMES,
     EngineSet,
@@ -44,7 +51,6 @@ from simparity.comparisons.gate.history import (
     latest_before,
     metric_history,
     recorded_scenes,
-    run_table,
 )
 from simparity.comparisons.execute.execution import default_jobs
 from simparity.comparisons.execute.isolation import GIB, MIN_CASE_MEMORY_BYTES, CaseLimits
@@ -58,7 +64,7 @@ from simparity.comparisons.execute.store import default_out_dir
 from simparity.comparisons.execute.timing import record_peak_memory, resource_line
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, EngineNames, Gate, load_gate, load_tolerances
 from simparity.comparisons.invariance.transforms import fixed_transforms
-from simparity.core.model.errors import SimparityError, echo, one_line
+from simparity.core.model.errors import SimparityError, one_line
 from simparity.core.model.ranges import RANGES
 from simparity.core.model.results import RESULTS_FILE, RUN_INFO_FILE
 from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
@@ -187,11 +193,11 @@ def cmd_run(args, out) -> int:
               else library.suite(args.suite or "default", run_limits, engines))
     gate = load_gate(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
     if gate is None:
-        _refuse_check_options(args, CHECK_OPTIONS, "without --check", "add --check, or drop them")
+        refuse_check_options(args, CHECK_OPTIONS, "without --check", "add --check, or drop them")
     else:
-        _checked_check_options(args)
+        checked_check_options(args)
         if args.baseline not in (None, "latest"):  # read now: a baseline that is no run must not cost the run
-            _baseline_run(args.baseline)
+            baseline_run(args.baseline)
     held = _engine_names(gate, args)[0] if gate is not None else None
     out_dir = _out_dir(args)
 
@@ -248,82 +254,6 @@ def _cost(scenes) -> str:
             + (f", {joint_steps:,} chain steps per integrator" if joint_steps else ""))
 
 
-CHECK_OPTIONS = ("tolerances", "check_engines", "require_engines", "allow_unbounded", "verbose", "baseline",
-                 "baseline_rel", "junit", "summary")
-"""The options of the check (:func:`parser._add_check_options`): on ``run``, they act only with ``--check``."""
-
-
-def _refuse_check_options(args, names: tuple[str, ...], where: str, allowed: str) -> None:
-    """Refuse the check's options (``names`` of them) where no check runs (a run without ``--check``, ``check
-    --bless`` or ``--explain``): they would be read and silently do nothing."""
-    given = [name for name in names if getattr(args, name) not in (None, False)]
-    if given:
-        flags = ", ".join("--" + name.replace("_", "-") for name in given)
-        raise SimparityError(f"{flags} {where}: they act only on the check (allowed: {allowed})")
-
-
-def _checked_check_options(args) -> None:
-    """Refuse, before any work, the check's options that mean nothing or cannot be reached: --baseline-rel without
-    --baseline or not a finite number >= 0, --baseline that is no folder, --junit or --summary where no file can
-    be written."""
-    if args.baseline_rel is not None:
-        if args.baseline is None:
-            raise SimparityError(f"--baseline-rel {args.baseline_rel:g} without --baseline (allowed: add --baseline "
-                                 "DIR|latest, or drop --baseline-rel)")
-        if not (math.isfinite(args.baseline_rel) and args.baseline_rel >= 0):
-            raise SimparityError(f"--baseline-rel {args.baseline_rel:g}: out of range (allowed: a finite relative "
-                                 "change >= 0; 0: any change is a move)")
-    if args.baseline is not None and args.baseline != "latest":
-        _baseline_folder(args.baseline)
-    for option, path in (("--junit", args.junit), ("--summary", args.summary)):
-        if path is not None:
-            writable_file(option, path)
-
-
-def _baseline_folder(option: str) -> Path:
-    """``--baseline``'s folder, refused in one line when it is no folder at all (what a folder holds is
-    :func:`reports.store.read_run`'s to check)."""
-    allowed = "allowed: the folder of a stored run, or 'latest'"
-    if not option.strip():
-        raise SimparityError(f"--baseline {echo(option)}: no folder named ({allowed})")
-    path = Path(option)
-    try:
-        if not path.exists():
-            raise SimparityError(f"--baseline {one_line(option)}: no such folder ({allowed})")
-        if not path.is_dir():
-            raise SimparityError(f"--baseline {one_line(option)}: a file, not a folder ({allowed})")
-    except (OSError, ValueError) as err:  # a name the system rejects: too long, a NUL byte
-        raise SimparityError(f"--baseline {one_line(option)}: {getattr(err, 'strerror', None) or err} "
-                             f"({allowed})") from None
-    return path
-
-
-def _baseline_run(option: str):
-    """(results table, run information) of the run in ``--baseline``'s folder; what is wrong with it is one line
-    naming the option."""
-    try:
-        return read_run(_baseline_folder(option))
-    except SimparityError as err:
-        if str(err).startswith("--baseline "):
-            raise
-        raise SimparityError(f"--baseline {one_line(option)}: {err}") from None
-
-
-def _baseline_table(option: str, run_dir: Path, profile: str, history_option: str | None):
-    """The baseline's rows: a stored run's folder, or ``latest``, the latest earlier run of ``profile`` (this run's)
-    in the history; a baseline of another profile is refused (its rows are of other time steps and horizons)."""
-    if option == "latest":
-        path = history_path(history_option)
-        run_id, _ = latest_before(path, run_dir.resolve(), profile)  # of this profile, or of none recorded
-        return run_table(path, run_id)
-    table, info = _baseline_run(option)
-    if profile and info.profile and info.profile != profile:
-        raise SimparityError(f"--baseline {one_line(option)}: a {info.profile}-profile run, this one is {profile} "
-                             f"(allowed: a baseline of the {profile} profile; its rows have other time steps and "
-                             "horizons)")
-    return table
-
-
 def _engine_names(gate: Gate, args) -> tuple[EngineNames | None, EngineNames | None]:
     """The engines the gate holds and requires: the command line's, else the tolerances file's (None: not named)."""
     check = EngineNames(args.check_engines, "--check-engines") if args.check_engines else gate.check_engines
@@ -353,7 +283,7 @@ def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = No
     diff = None
     if args.baseline is not None:
         relative = BASELINE_RELATIVE if args.baseline_rel is None else args.baseline_rel
-        diff = compare_with_baseline(table, _baseline_table(args.baseline, run_dir, info.profile, args.history),
+        diff = compare_with_baseline(table, baseline_table(args.baseline, run_dir, info.profile, args.history),
                                      relative)
     shown = result.violations if args.verbose else grouped(result.violations)
     for violation in shown:
@@ -400,10 +330,10 @@ def cmd_check(args, out) -> int:
     if args.spread is not None and args.bless is None:
         raise SimparityError("--spread without --bless (allowed: --bless FILE --spread RUN_DIR)")
     if args.explain is not None or args.bless is not None:
-        _refuse_check_options(args, tuple(n for n in CHECK_OPTIONS if n != "tolerances"),
+        refuse_check_options(args, tuple(n for n in CHECK_OPTIONS if n != "tolerances"),
                               f"with --{'explain' if args.explain is not None else 'bless'}",
                               "drop them, or check the run without --bless and --explain")
-    _checked_check_options(args)
+    checked_check_options(args)
     if args.explain is not None:
         return _explain(run_dir, bounds, args.explain, narrowed, out)
     if args.bless is not None:
