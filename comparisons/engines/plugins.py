@@ -23,7 +23,7 @@ import re
 import sys
 from dataclasses import dataclass
 from importlib import metadata
-from typing import cast
+from typing import Callable, cast
 
 from simparity.comparisons.engines.placeholders import BrokenEngine, NotAnEngine
 from simparity.comparisons.measure.rows import error_text
@@ -145,7 +145,7 @@ def load_engine(target: str, name: str | None = None, taken: frozenset[str] = fr
     except (Exception, SystemExit) as err:  # noqa: BLE001 - a user's code: its cases fail with the error
         return BrokenEngine(label, f"importing {target} raised {one_line(error_text(err))}")
     try:
-        found = functools.reduce(getattr, (entry.attr or "").split(".") if entry.attr else (), module)
+        found: object = functools.reduce(getattr, entry.attr.split(".") if entry.attr else (), module)
     except AttributeError as err:  # the module imported: the name after the colon is the mistake
         return NotAnEngine(label, f"{target}: {entry.module} has no attribute {entry.attr} (AttributeError: "
                            f"{one_line(err)}; {MAKER_RULE})")
@@ -155,7 +155,7 @@ def load_engine(target: str, name: str | None = None, taken: frozenset[str] = fr
     if mistake:
         return NotAnEngine(label, mistake)
     try:
-        engine = found()
+        engine = cast(Callable[[], object], found)()  # callable: _not_an_engine_maker said so
     except (Exception, SystemExit) as err:  # noqa: BLE001 - a user's code: its cases fail with the error
         return BrokenEngine(label, f"constructing {target} raised {one_line(error_text(err))}")
     if not isinstance(engine, Engine):

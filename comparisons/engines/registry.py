@@ -98,14 +98,19 @@ class EngineSet:
         return tuple(n for n in dict.fromkeys(self.names) if n not in _ENGINES)
 
     @functools.cached_property
+    def _users_described(self) -> list[Engine]:
+        return describe_engines(self.users) if self.users else []
+
+    @functools.cached_property
     def _described(self) -> list[Engine]:
-        return list(_built_ins()) + (describe_engines(self.users) if self.users else [])
+        return list(_built_ins()) + self._users_described
 
     def refuse_non_engines(self) -> None:
         """Raise UnknownEngineError, before anything runs, when one of the user's engines names no engine at all
         (:class:`~comparisons.engines.placeholders.NotAnEngine`: ``os:path``, ``json:dumps``, a class that is not an
-        Engine, an attribute the module lacks); a user's engine whose own code fails still runs, its rows failed."""
-        mistakes = [engine for engine in self._described if isinstance(engine, NotAnEngine)]
+        Engine, an attribute the module lacks); a user's engine whose own code fails still runs, its rows failed.
+        Only the user's engines are described for it (each in a process of its own), once per set."""
+        mistakes = [engine for engine in self._users_described if isinstance(engine, NotAnEngine)]
         if mistakes:
             raise UnknownEngineError(f"--engines: {one_line(mistakes[0].mistake)}")
 
