@@ -10,6 +10,7 @@ import subprocess
 import sys
 import textwrap
 
+import numpy as np
 import pytest
 
 from simparity.comparisons.cli.main import EXIT_USAGE, main
@@ -253,7 +254,7 @@ def test_engines_naming_no_engine_are_refused_before_the_run(capsys, tmp_path, s
     ("--junit", "DIR", "is a folder"), ("--junit", "MISSING/j.xml", "No such file or directory"),
     ("--junit", "/proc/j.xml", "cannot write"), ("--junit", "FILE/j.xml", "Not a directory"),
     ("--summary", "DIR", "is a folder"), ("--summary", "/proc/s.md", "cannot write"),
-    ("--bless", "DIR", "Is a directory"), ("--bless", "MISSING/b.toml", "No such file or directory"),
+    ("--bless", "DIR", "is a folder"), ("--bless", "MISSING/b.toml", "No such file or directory"),
     ("--bless", "/dev/full", "No space left on device"),
 ])
 def test_a_check_destination_that_cannot_be_written_is_one_line(capsys, stored_run, tmp_path, option, target, words):
@@ -318,3 +319,81 @@ def test_a_run_whose_summary_cannot_be_written_keeps_the_run_and_names_it(capsys
     assert code == EXIT_USAGE and f"the results are kept in {out}" in captured.err
     assert (out / "results.csv").is_file() and (out / "report.md").is_file()
     assert main(["check", str(out)]) != EXIT_USAGE  # the kept run checks
+
+
+# --- A fuzz pass over the options ---------------------------------------------------------------------------------------
+
+FUZZ_SEED = 39
+"""The seed of the option fuzz's generated comma lists (one seeded generator, passed explicitly)."""
+
+LIST_TOKENS = ("core", "mujoco", "", " ", "core", "translate", "rotate", "\t", "é", "x" * 80, "a:b", "-", "*")
+NUMBERS = {  # value: meaningless for the option (refused naming it) or not
+    "--case-timeout": {"nan": True, "inf": True, "-inf": True, "0": True, "-1": True, "1e309": True, "0x10": True,
+                       "": True, "1e-320": False, "5": False},
+    "--case-memory": {"nan": True, "inf": True, "0": True, "-0": True, "0.1": True, "1e6": False, "1e7": True,
+                      "1": False, "١": False},  # an Arabic-Indic one is a number to Python: taken, as 1
+    "--repeats": {"-1": True, "101": True, "1.0": True, "nan": True, "0": False, "3": False, "1_0": False},
+    "--jobs": {"0": True, "-1": True, "257": True, "2.5": True, "1": False},
+    "--max-steps": {"0": True, "-3": True, "1e3": True, "1": False, str(10 ** 30): False},
+    "--max-samples": {"0": True, "-1": True, "": True, "7": False},
+    "--max-joints": {"0": True, "nan": True, "2": False},
+}
+RUN_PATHS = ["", "/proc", "/proc/x/y", "/dev/null", "/dev/full", "/dev/null/x", "FILE", "FILE/x", "x" * 5000,
+             "a\0b", "/sys/x"]
+CHECK_PATHS = ["", "/", "/proc/x", "/dev/null/x", "DIR", "MISSING/x", "FILE/x", "x" * 5000, "a\0b", "/dev/full"]
+
+
+def _lists(rng) -> list[str]:
+    """Comma lists of 1 to 4 tokens, drawn with ``rng``: empty, blank, repeated, unknown, long names."""
+    return [",".join(rng.choice(LIST_TOKENS, size=rng.integers(1, 5))) for _ in range(64)]
+
+
+def _fuzz_inputs(rng, stored, tmp_path) -> list[tuple[list[str], str | None]]:
+    """(argv, the option its refusal must name, or None when the value is allowed)."""
+    inputs: list[tuple[list[str], str | None]] = []
+    for text in _lists(rng):
+        names = [n.strip() for n in text.split(",")]
+        hostile = "" in names or len(set(names)) < len(names)
+        inputs.append((["run", "no-such-scene", "--engines", text], "--engines" if hostile else None))
+        transform_hostile = hostile or not set(names) <= {"translate", "rotate"}
+        inputs.append((["run", "no-such-scene", "--transform", text], "--transform" if transform_hostile else None))
+        inputs.append((["check", str(stored), "--require-engines", text], "--require-engines" if hostile else None))
+    for option, values in NUMBERS.items():
+        for value, hostile in values.items():
+            inputs.append((["run", "no-such-scene", f"{option}={value}"], option if hostile else None))
+    for value in ["nan", "-1", "inf", "-inf", "", "1e309", "0", "1e-3"]:
+        hostile = value not in ("0", "1e-3")
+        inputs.append((["check", str(stored), "--baseline", str(stored), f"--baseline-rel={value}"],
+                       "--baseline-rel" if hostile else None))
+    places = {"FILE": str(stored / "run.json"), "DIR": str(tmp_path), "MISSING": str(tmp_path / "missing")}
+
+    def place(path: str) -> str:
+        return next((path.replace(k, v) for k, v in places.items() if path.startswith(k)), path)
+
+    for path in RUN_PATHS:
+        inputs.append((["run", SCENE, "--engines", "core", "--out", place(path)], "--out"))
+        inputs.append((["bench", "--out", place(path)], "--out"))
+    for path in CHECK_PATHS:
+        for option in ("--junit", "--summary", "--bless", "--baseline"):
+            inputs.append((["check", str(stored), option, place(path)], option))
+    return inputs
+
+
+@pytest.mark.sweep
+@pytest.mark.slow
+def test_a_fuzz_pass_over_the_options_ends_without_a_traceback_or_a_silent_pass(capsys, stored_run, tmp_path):
+    """Some 300 generated inputs: each hostile one is one line naming its option, exit 2, and nothing is written
+    (the stored run unchanged, no folder made); an allowed one goes on to the next mistake or the check."""
+    before = _digest(stored_run)
+    inputs = _fuzz_inputs(np.random.default_rng(FUZZ_SEED), stored_run, tmp_path)
+    assert len(inputs) >= 300
+    for argv, option in inputs:
+        code = main(argv)
+        captured = capsys.readouterr()
+        assert "Traceback" not in captured.err, argv
+        if option is not None:
+            assert code == EXIT_USAGE and captured.err.count("\n") == 1, (argv, captured.err)
+            assert option in captured.err, (argv, captured.err)
+        else:
+            assert code in (0, 1, EXIT_USAGE) and captured.err.count("\n") <= 1, (argv, captured.err)
+    assert _digest(stored_run) == before and not (tmp_path / "missing").exists()

@@ -18,10 +18,10 @@ def _reason(err: Exception) -> str:
 def writable_folder(option: str, folder: Path) -> Path:
     """``folder``, created if missing, once a file could be made in it (and removed): a path through a file, a
     read-only file system, a name the system rejects are refused here in one line, before any work."""
-    if folder.exists() and not folder.is_dir():
-        raise SimparityError(f"{option} {one_line(folder)}: exists and is not a folder (allowed: a folder you "
-                             "can write)")
     try:
+        if folder.exists() and not folder.is_dir():
+            raise SimparityError(f"{option} {one_line(folder)}: exists and is not a folder (allowed: a folder you "
+                                 "can write)")
         folder.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=folder):
             pass
@@ -35,11 +35,11 @@ def writable_file(option: str, path: Path) -> Path:
     """``path`` once it could be opened for appending (nothing written or truncated; a file the probe created is
     removed again): a folder, a missing or read-only parent folder, a name the system rejects are refused here in
     one line, before any work. A full device is found only by writing: :func:`write_file` says so."""
-    if path.is_dir():
-        raise SimparityError(f"{option} {one_line(path)}: is a folder (allowed: a file path in a folder you can "
-                             "write)")
-    existed = path.exists()
     try:
+        if path.is_dir():
+            raise SimparityError(f"{option} {one_line(path)}: is a folder (allowed: a file path in a folder you can "
+                                 "write)")
+        existed = path.exists()
         os.close(os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT | os.O_NONBLOCK, 0o666))
         if not existed:
             path.unlink()

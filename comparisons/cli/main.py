@@ -39,7 +39,7 @@ from simparity.comparisons.cli.check_options import (
     refuse_check_options,
 )
 from simparity.comparisons.cli.console import EXIT_INTERRUPTED
-from simparity.comparisons.cli.destinations import writable_folder, write_file
+from simparity.comparisons.cli.destinations import writable_file, writable_folder, write_file
 from simparity.comparisons.engines.registry import (
     ENGINE_NAMES,
     EngineSet,
@@ -337,7 +337,7 @@ def cmd_check(args, out) -> int:
     if args.explain is not None:
         return _explain(run_dir, bounds, args.explain, narrowed, out)
     if args.bless is not None:
-        return _bless(run_dir, args.bless, args.spread, args.tolerances, out)
+        return _bless(run_dir, writable_file("--bless", args.bless), args.spread, args.tolerances, out)
     return _check(run_dir, gate, args, out)
 
 

@@ -64,9 +64,10 @@ def name_argument(text: str) -> str:
 
 
 def path_argument(text: str) -> Path:
-    """An argparse type: a path, never the empty string (which ``Path`` would read as the current folder)."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError(f"{echo(text)} is no path (allowed: a file or folder path)")
+    """An argparse type: a path, never the empty string (which ``Path`` would read as the current folder) nor one
+    holding a NUL byte."""
+    if not text.strip() or "\0" in text:  # no system takes a NUL byte in a path
+        raise argparse.ArgumentTypeError(f"{echo(text)} is no path (allowed: a file or folder path, no NUL byte)")
     return Path(text)
 
 
