@@ -228,7 +228,8 @@ def user_module(tmp_path, monkeypatch):
 ])
 def test_a_spec_naming_no_engine_is_not_an_engine(user_module, attr, words):
     engine = load_engine(f"{user_module}:{attr}")
-    assert isinstance(engine, NotAnEngine) and words in engine.mistake and "allowed: an Engine subclass" in engine.mistake
+    assert isinstance(engine, NotAnEngine) and words in engine.mistake
+    assert "allowed: an Engine subclass" in engine.mistake
 
 
 def test_an_engine_whose_own_code_raises_stays_a_broken_engine_that_runs(user_module):
@@ -321,7 +322,7 @@ def test_a_run_whose_summary_cannot_be_written_keeps_the_run_and_names_it(capsys
     assert main(["check", str(out)]) != EXIT_USAGE  # the kept run checks
 
 
-# --- A fuzz pass over the options ---------------------------------------------------------------------------------------
+# --- A fuzz pass over the options -------------------------------------------------------------------------------
 
 FUZZ_SEED = 39
 """The seed of the option fuzz's generated comma lists (one seeded generator, passed explicitly)."""

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from simparity.comparisons.engines.registry import DEFAULT_ENGINES, allowed_engines
 from simparity.comparisons.execute.execution import default_jobs
-from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS
+from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS, GIB, MIN_CASE_MEMORY_BYTES
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS
 from simparity.comparisons.execute.store import DEFAULT_OUT_ROOT
 from simparity.comparisons.gate.check import BASELINE_RELATIVE, UNBOUNDED_SHARE_MAX
@@ -161,7 +161,8 @@ def build_parser() -> argparse.ArgumentParser:
                      f"{DEFAULT_CASE_SECONDS:g})")
     run.add_argument("--case-memory", type=float, default=None, metavar="GIB",
                      help="a case whose worker's resident memory passes this is killed and becomes a failed row "
-                     f"(default: {MEMORY_HELP})")
+                     f"(default: {MEMORY_HELP}; at least {MIN_CASE_MEMORY_BYTES / GIB:.3g}, what an idle worker with "
+                     "the engines imported holds)")
     run.add_argument("--resume", type=path_argument, default=None, metavar="DIR",
                      help="finish the interrupted run in DIR: its finished cases are kept, the rest run; give no "
                      "scenes, --suite, --engines, --out, --quick, --repeats or --max-* (the run's own are used)")
