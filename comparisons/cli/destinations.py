@@ -1,6 +1,6 @@
-"""Where a command writes (``--out``, ``--junit``, ``--summary``, ``bench --out``): each destination probed before
-the work starts, cheaply and without writing anything, and each later write's failure (a full device, a folder
-removed meanwhile) one line naming the option, what went wrong and where the results already computed are kept."""
+"""Where a command writes (``--out``, ``--junit``, ``--summary``, ``--bless``, ``bench --out``): each destination
+probed before the work starts, cheaply and without writing anything, and each later write's failure (a full device,
+a folder removed meanwhile) one line naming the option and what went wrong."""
 
 from __future__ import annotations
 
@@ -49,12 +49,11 @@ def writable_file(option: str, path: Path) -> Path:
     return path
 
 
-def write_file(option: str, path: Path, text: str, kept: Path, append: bool = False) -> None:
-    """Write ``text`` to ``path`` (appended when ``append``); a failure is one line saying that the results it was
-    made from are kept in ``kept``."""
+def write_file(option: str, path: Path, text: str, append: bool = False) -> None:
+    """Write ``text`` to ``path`` (appended when ``append``); a failure is one line naming ``option``."""
     try:
         with open(path, "a" if append else "w", encoding="utf-8") as handle:
             handle.write(text)
     except (OSError, ValueError) as err:
         raise SimparityError(f"{option} {one_line(path)}: cannot write: {_reason(err)} (allowed: a file path you can "
-                             f"write); the results are kept in {one_line(kept)}") from None
+                             "write)") from None

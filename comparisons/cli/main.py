@@ -231,7 +231,11 @@ def cmd_run(args, out) -> int:
             return EXIT_INTERRUPTED
         code = EXIT_FAILED_CASES if result.failed_cases else EXIT_OK
         if result.check is not None and gate is not None:
-            code = max(code, _check(out_dir, gate, args, out, result.check))
+            try:
+                code = max(code, _check(out_dir, gate, args, out, result.check))
+            except SimparityError as err:  # after the run (a full device, the history): the run itself is whole
+                raise SimparityError(f"the run's results are kept in {one_line(out_dir)} ('simparity check "
+                                     f"{one_line(out_dir)}' checks them again), its check stopped: {err}") from None
         return code
     finally:  # what the run cost, also when it was interrupted or stopped by an error
         print(resource_line(time.perf_counter() - start), file=out, flush=True)
@@ -310,9 +314,9 @@ def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = No
           f"verdict; {len(result.unbounded_series)} of {len(result.series)} series without a value bound{moved}",
           file=out, flush=True)
     if args.junit:  # after the verdict: a file that cannot be written loses nothing printed
-        write_file("--junit", args.junit, junit_xml(result, diff, unbounded), run_dir)
+        write_file("--junit", args.junit, junit_xml(result, diff, unbounded))
     if args.summary:
-        write_file("--summary", args.summary, summary_markdown(result, diff, unbounded), run_dir, append=True)
+        write_file("--summary", args.summary, summary_markdown(result, diff, unbounded), append=True)
     return EXIT_OK if passed else EXIT_FAILED_CASES
 
 
