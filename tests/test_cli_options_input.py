@@ -22,6 +22,7 @@ from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.invariance.transforms import TRANSFORM_NAMES
 from simparity.core.model.results import OK, ResultRow
 from tests.helpers import builtin
+from tests.test_plugins import site  # noqa: F401 - the fixture: fake installed plugins
 
 SCENE = "lecture-projectile"
 
@@ -399,3 +400,10 @@ def test_a_fuzz_pass_over_the_options_ends_without_a_traceback_or_a_silent_pass(
         else:
             assert code in (0, 1, EXIT_USAGE) and captured.err.count("\n") <= 1, (argv, captured.err)
     assert _digest(stored_run) == before and not (tmp_path / "missing").exists()
+
+
+def test_an_installed_plugin_naming_no_engine_is_refused_before_the_run(site, capsys, tmp_path):
+    """An entry point is a module:attr too: one naming a function of the standard library is refused like a spec."""
+    site.install({"notanengine": "json:dumps"})
+    err = _refused(capsys, ["run", SCENE, "--engines", "core,notanengine", "--out", str(tmp_path / "o")])
+    assert "--engines: json:dumps cannot be called without arguments" in err and not (tmp_path / "o").exists()
