@@ -239,6 +239,7 @@ def test_an_engine_whose_own_code_raises_stays_a_broken_engine_that_runs(user_mo
     assert isinstance(engine, BrokenEngine) and not isinstance(engine, NotAnEngine) and "boom" in engine.reason
 
 
+@pytest.mark.slow  # a process of its own describes the engine, or runs the command
 @pytest.mark.parametrize("spec, words", [
     ("os:path", "os:path is a value of type module"), ("json:dumps", "json:dumps cannot be called without arguments"),
     ("json:JSONDecoder", "not a simparity.core.engine.Engine subclass"), ("json:nothere", "has no attribute nothere"),
@@ -303,6 +304,7 @@ def test_a_junit_file_of_a_run_that_cannot_be_written_is_refused_before_the_run(
     assert "--junit" in err and not (tmp_path / "o").exists()
 
 
+@pytest.mark.slow  # a process of its own describes the engine, or runs the command
 def test_the_console_script_exits_2_on_a_full_device_without_a_traceback(stored_run):
     """As CI calls it: a process, its exit code and its standard error."""
     done = subprocess.run([sys.executable, "-m", "simparity.comparisons.cli", "check", str(stored_run), "--summary",
@@ -402,6 +404,7 @@ def test_a_fuzz_pass_over_the_options_ends_without_a_traceback_or_a_silent_pass(
     assert _digest(stored_run) == before and not (tmp_path / "missing").exists()
 
 
+@pytest.mark.slow  # a process of its own describes the engine, or runs the command
 def test_an_installed_plugin_naming_no_engine_is_refused_before_the_run(site, capsys, tmp_path):
     """An entry point is a module:attr too: one naming a function of the standard library is refused like a spec."""
     site.install({"notanengine": "json:dumps"})
