@@ -50,7 +50,7 @@ from simparity.comparisons.execute.ik_targets import random_targets
 from simparity.comparisons.scenes.loader import EXAMPLE_ROBOT_DATA_ROBOTS
 from simparity.comparisons.execute.timing import PeakMemory
 from simparity.comparisons.measure.metrics import kinematics_errors, trajectory_errors
-from simparity.core.model.errors import ResultsError
+from simparity.core.model.errors import ResultsError, SimparityError, one_line
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix
 from simparity.core.model.scene import DynamicsScene, Forces, IKScene, RigidBody, sample_configurations
@@ -730,10 +730,14 @@ def run_bench(out_dir: Path, quick: bool, command: str, say: Callable[[str], Non
     rows += bench_sweep.sweep_rows(quick, run_peak_memory, BenchRow, say)
     say("profile")
     profile = profile_summary(batches[-1], say)
-    write_csv(rows, out_dir / "benchmarks.csv")
-    path = out_dir / "BENCHMARKS.md"
-    path.write_text(markdown(rows, machine(), command, profile, time.perf_counter() - start))
-    for verdict in targets(rows):
+    for verdict in targets(rows):  # before the files: a write that fails loses no verdict
         reason = verdict.label.removeprefix(verdict.status).strip()
         say(f"{verdict.status:<14} {verdict.target}: {verdict.compared}" + (f" {reason}" if reason else ""))
+    path = out_dir / "BENCHMARKS.md"
+    try:
+        write_csv(rows, out_dir / "benchmarks.csv")
+        path.write_text(markdown(rows, machine(), command, profile, time.perf_counter() - start))
+    except OSError as err:  # a full device, a folder removed meanwhile: the folder was probed before the bench
+        raise SimparityError(f"--out {one_line(out_dir)}: cannot write the benchmarks: {err.strerror or err} "
+                             "(allowed: a folder you can write); the targets met or missed are printed above") from None
     return path

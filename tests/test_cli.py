@@ -109,7 +109,7 @@ def test_broken_scene_exits_2_with_one_line(tmp_path, capsys, name, base, old, n
         (["run", "no-such-scene"], "'no-such-scene' is not a built-in scene or an existing file"),
         (["run", "lecture-projectile", "--engines", "core,havok"], "unknown engine(s): havok"),
         (["run", "lecture-projectile", "--repeats", "-1"], "--repeats -1"),
-        (["run", "lecture-projectile", "--engines", ","], "no engine named"),
+        (["run", "lecture-projectile", "--engines", ","], "argument --engines: ',' names nothing"),
         (["run", "lecture-projectile", "--out", "/dev/null"], "exists and is not a folder"),
         (["report", "/nonexistent/run"], "missing"),
         (["export", "lecture-projectile", "--engine", "mujoco", "--integrator", "verlet"], "no integrator 'verlet'"),
@@ -177,13 +177,10 @@ def test_urdf_with_an_unsupported_element_exits_2_naming_it(tmp_path, capsys):
     assert err.count("\n") == 1 and "mimic" in err and "j2" in err
 
 
-@pytest.mark.slow
-def test_repeated_engine_names_run_once(tmp_path):
-    """--engines core,core runs core once."""
-    code, _ = _run(["run", "lecture-planar-arm", "--engines", "core,core", "--out", str(tmp_path), "--repeats", "1"])
-    table, _ = read_run(tmp_path)
-    assert code == EXIT_OK and len(table[table["engine"] == "core"]) == len(table)
-    assert table.duplicated(["engine", "metric"]).sum() == 0
+def test_repeated_engine_names_are_refused(tmp_path, capsys):
+    """--engines core,core is one line, exit 2, before anything runs (it ran core once before #39)."""
+    assert main(["run", "lecture-planar-arm", "--engines", "core,core", "--out", str(tmp_path / "o")]) == EXIT_USAGE
+    assert "core named twice" in capsys.readouterr().err and not (tmp_path / "o").exists()
 
 
 @pytest.mark.slow

@@ -272,8 +272,8 @@ def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(si
     ("NoVersion", "version() raised RuntimeError: no version here"),
     ("ListedIntegrators", "integrators() returned ['rk4'] (allowed: a tuple of str)"),
     ("RaisingOrder", "theoretical_order('rk4') raised KeyError: 'rk4'"),
-    ("NotAnEngine", "plugin_engines_b:NotAnEngine() returned a value of type NotAnEngine, not a "
-                    "simparity.core.engine.Engine"),
+    ("NotAnEngine", "plugin_engines_b:NotAnEngine is the class NotAnEngine, not a simparity.core.engine.Engine "
+                    "subclass"),  # told without constructing it (#39)
     ("NoSuchClass", "AttributeError"),
 ])
 def test_an_engine_that_breaks_the_interface_fails_its_rows_with_the_reason(site, scene_file, attr, reason):

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from simparity.comparisons.scenes import library
 from simparity.comparisons.gate.check import (
+    BASELINE_RELATIVE,
     CheckResult,
     check_table,
     compare_with_baseline,
@@ -30,7 +31,15 @@ from simparity.comparisons.gate.bless import bless, write_blessed
 from simparity.comparisons.gate.violation import grouped
 from simparity.comparisons.gate.check_output import held_line, junit_xml, summary_markdown
 from simparity.comparisons.scenes.describe import describe
+from simparity.comparisons.cli.check_options import (
+    CHECK_OPTIONS,
+    baseline_run,
+    baseline_table,
+    checked_check_options,
+    refuse_check_options,
+)
 from simparity.comparisons.cli.console import EXIT_INTERRUPTED
+from simparity.comparisons.cli.destinations import writable_file, writable_folder, write_file
 from simparity.comparisons.engines.registry import (
     ENGINE_NAMES,
     EngineSet,
@@ -42,10 +51,9 @@ from simparity.comparisons.gate.history import (
     latest_before,
     metric_history,
     recorded_scenes,
-    run_table,
 )
 from simparity.comparisons.execute.execution import default_jobs
-from simparity.comparisons.execute.isolation import GIB, CaseLimits
+from simparity.comparisons.execute.isolation import GIB, MIN_CASE_MEMORY_BYTES, CaseLimits
 from simparity.comparisons.execute.journal import CASES_FOLDER, Journal, read_request
 from simparity.comparisons.engines.placeholders import BrokenEngine, UnavailableEngine
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS
@@ -89,19 +97,18 @@ def cmd_engines(args, out) -> int:
 
 
 def _out_dir(args) -> Path:
-    """The run's folder: --out (refused when it holds a run, unless --force), else a new one."""
+    """The run's folder, created and probed for writing before the run: --out (refused when it holds a run, unless
+    --force), else a new one."""
     if args.out is None:
-        return default_out_dir()
+        return writable_folder("--out (default)", default_out_dir())
     try:
-        return _checked_out_dir(args.out, args.force)
+        return writable_folder("--out", _checked_out_dir(args.out, args.force))
     except (OSError, ValueError) as err:  # a name the OS rejects: too long, a NUL byte
         raise SimparityError(f"--out {one_line(args.out)}: {getattr(err, 'strerror', None) or err} (allowed: a "
                              "folder path the system accepts)") from None
 
 
 def _checked_out_dir(out_dir: Path, force: bool) -> Path:
-    if out_dir.exists() and not out_dir.is_dir():
-        raise SimparityError(f"--out {one_line(out_dir)}: exists and is not a folder (allowed: a new or empty folder)")
     held = [name for name in (RESULTS_FILE, RUN_INFO_FILE) if (out_dir / name).exists()]
     if held and not force:
         raise SimparityError(f"--out {one_line(out_dir)}: already holds a run ({', '.join(held)}); nothing was "
@@ -149,8 +156,11 @@ def _limits(args, jobs: int) -> CaseLimits:
         raise SimparityError(f"--case-timeout {args.case_timeout}: out of range (allowed: a number of seconds > 0)")
     if args.case_memory is None:  # on Dask, each node's own default
         return CaseLimits(args.case_timeout, CaseLimits.default(jobs).memory_bytes if args.executor == "local" else None)
-    if not (math.isfinite(args.case_memory) and 0 < args.case_memory <= 1e6):
-        raise SimparityError(f"--case-memory {args.case_memory}: out of range (allowed: GiB > 0, up to 1e6)")
+    floor = MIN_CASE_MEMORY_BYTES / GIB
+    if not (math.isfinite(args.case_memory) and floor <= args.case_memory <= 1e6):
+        raise SimparityError(f"--case-memory {args.case_memory:g}: out of range: below {floor:.3g} GiB (an idle worker "
+                             f"with the engines imported) every case would be killed (allowed: GiB from {floor:.3g} "
+                             "up to 1e6)")
     return CaseLimits(args.case_timeout, int(args.case_memory * GIB))
 
 
@@ -174,6 +184,7 @@ def cmd_run(args, out) -> int:
     execution = Execution(args.executor, jobs, _limits(args, jobs), args.scheduler)
     transforms = fixed_transforms(args.transform) if args.transform else ()
     engines = EngineSet(check_engine_names(args.engines))
+    engines.refuse_non_engines()
     run_limits = Limits(max_steps=args.max_steps, max_samples=args.max_samples, max_joints=args.max_joints)
     if args.scenes and args.suite:
         raise SimparityError(f"--suite {args.suite} with scenes named: give one (allowed: scene names or files, "
@@ -181,8 +192,12 @@ def cmd_run(args, out) -> int:
     chosen = (library.load(args.scenes, run_limits, engines) if args.scenes
               else library.suite(args.suite or "default", run_limits, engines))
     gate = load_gate(args.tolerances or DEFAULT_TOLERANCES) if args.check else None
-    if gate is None and (args.check_engines or args.require_engines):
-        raise SimparityError("--check-engines or --require-engines without --check (allowed: add --check)")
+    if gate is None:
+        refuse_check_options(args, CHECK_OPTIONS, "without --check", "add --check, or drop them")
+    else:
+        checked_check_options(args)
+        if args.baseline not in (None, "latest"):  # read now: a baseline that is no run must not cost the run
+            baseline_run(args.baseline)
     held = _engine_names(gate, args)[0] if gate is not None else None
     out_dir = _out_dir(args)
 
@@ -216,7 +231,11 @@ def cmd_run(args, out) -> int:
             return EXIT_INTERRUPTED
         code = EXIT_FAILED_CASES if result.failed_cases else EXIT_OK
         if result.check is not None and gate is not None:
-            code = max(code, _check(out_dir, gate, args, out, result.check))
+            try:
+                code = max(code, _check(out_dir, gate, args, out, result.check))
+            except SimparityError as err:  # after the run (a full device, the history): the run itself is whole
+                raise SimparityError(f"the run's results are kept in {one_line(out_dir)} ('simparity check "
+                                     f"{one_line(out_dir)}' checks them again), its check stopped: {err}") from None
         return code
     finally:  # what the run cost, also when it was interrupted or stopped by an error
         print(resource_line(time.perf_counter() - start), file=out, flush=True)
@@ -237,21 +256,6 @@ def _cost(scenes) -> str:
     return (f"{len(scenes)} scenes: {steps:,} body-steps per integrator, {samples:,} configurations, "
             f"{targets:,} IK targets per solver" + (f", {states:,} joint-dynamics states" if states else "")
             + (f", {joint_steps:,} chain steps per integrator" if joint_steps else ""))
-
-
-def _baseline_table(option: str, run_dir: Path, profile: str, history_option: str | None):
-    """The baseline's rows: a stored run's folder, or ``latest``, the latest earlier run of ``profile`` (this run's)
-    in the history; a baseline of another profile is refused (its rows are of other time steps and horizons)."""
-    if option == "latest":
-        path = history_path(history_option)
-        run_id, _ = latest_before(path, run_dir.resolve(), profile)  # of this profile, or of none recorded
-        return run_table(path, run_id)
-    table, info = read_run(Path(option))
-    if profile and info.profile and info.profile != profile:
-        raise SimparityError(f"--baseline {one_line(option)}: a {info.profile}-profile run, this one is {profile} "
-                             f"(allowed: a baseline of the {profile} profile; its rows have other time steps and "
-                             "horizons)")
-    return table
 
 
 def _engine_names(gate: Gate, args) -> tuple[EngineNames | None, EngineNames | None]:
@@ -281,10 +285,10 @@ def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = No
     table, info = read_run(run_dir)
     result = held_to(check_table(table, gate.bounds) if result is None else result, *_engine_names(gate, args))
     diff = None
-    if args.baseline:
-        if not math.isfinite(args.baseline_rel) or args.baseline_rel < 0:
-            raise SimparityError(f"--baseline-rel {args.baseline_rel}: out of range (allowed: a number >= 0)")
-        diff = compare_with_baseline(table, _baseline_table(args.baseline, run_dir, info.profile, args.history), args.baseline_rel)
+    if args.baseline is not None:
+        relative = BASELINE_RELATIVE if args.baseline_rel is None else args.baseline_rel
+        diff = compare_with_baseline(table, baseline_table(args.baseline, run_dir, info.profile, args.history),
+                                     relative)
     shown = result.violations if args.verbose else grouped(result.violations)
     for violation in shown:
         print(f"violation: {one_line(violation.line(), MESSAGE_LIMIT)}", file=out)
@@ -301,11 +305,6 @@ def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = No
     unbounded = "" if args.allow_unbounded else result.too_unbounded()
     if unbounded:
         print(f"unbounded: {unbounded}", file=out)
-    if args.junit:
-        args.junit.write_text(junit_xml(result, diff, unbounded), encoding="utf-8")
-    if args.summary:
-        with open(args.summary, "a", encoding="utf-8") as handle:
-            handle.write(summary_markdown(result, diff, unbounded))
     passed = result.passed and not (diff and diff.blocking) and not unbounded
     moved = "" if diff is None else (f"; since the baseline {len(diff.moved)} moved, {len(diff.missing)} missing, "
                                      f"{len(diff.new)} new" + (f" ({diff.scope_line()})" if diff.scope_line() else ""))
@@ -313,7 +312,11 @@ def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = No
     print(f"check {'passed' if passed else 'FAILED'}: {held_line(result)}, {len(result.violations)} "
           f"outside their bounds{cases}, {result.unchecked} without a bound, {result.value_bounded} held to a value or "
           f"verdict; {len(result.unbounded_series)} of {len(result.series)} series without a value bound{moved}",
-          file=out)
+          file=out, flush=True)
+    if args.junit:  # after the verdict: a file that cannot be written loses nothing printed
+        write_file("--junit", args.junit, junit_xml(result, diff, unbounded))
+    if args.summary:
+        write_file("--summary", args.summary, summary_markdown(result, diff, unbounded), append=True)
     return EXIT_OK if passed else EXIT_FAILED_CASES
 
 
@@ -330,10 +333,15 @@ def cmd_check(args, out) -> int:
                              "--integrator, --metric)")
     if args.spread is not None and args.bless is None:
         raise SimparityError("--spread without --bless (allowed: --bless FILE --spread RUN_DIR)")
+    if args.explain is not None or args.bless is not None:
+        refuse_check_options(args, tuple(n for n in CHECK_OPTIONS if n != "tolerances"),
+                              f"with --{'explain' if args.explain is not None else 'bless'}",
+                              "drop them, or check the run without --bless and --explain")
+    checked_check_options(args)
     if args.explain is not None:
         return _explain(run_dir, bounds, args.explain, narrowed, out)
     if args.bless is not None:
-        return _bless(run_dir, args.bless, args.spread, args.tolerances, out)
+        return _bless(run_dir, writable_file("--bless", args.bless), args.spread, args.tolerances, out)
     return _check(run_dir, gate, args, out)
 
 
@@ -411,7 +419,7 @@ def cmd_bench(args, out) -> int:
     def say(line: str) -> None:
         print(line, file=out, flush=True)
 
-    path = run_bench(args.out, args.quick, " ".join(["simparity"] + sys.argv[1:]), say)
+    path = run_bench(writable_folder("--out", args.out), args.quick, " ".join(["simparity"] + sys.argv[1:]), say)
     say(f"wrote {path} and {path.with_name('benchmarks.csv')}")
     return EXIT_OK
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from simparity.comparisons.engines.registry import DEFAULT_ENGINES, allowed_engines
 from simparity.comparisons.execute.execution import default_jobs
-from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS
+from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS, GIB, MIN_CASE_MEMORY_BYTES
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS
 from simparity.comparisons.execute.store import DEFAULT_OUT_ROOT
 from simparity.comparisons.gate.check import BASELINE_RELATIVE, UNBOUNDED_SHARE_MAX
@@ -15,7 +15,7 @@ from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES
 from simparity.comparisons.invariance.transforms import TRANSFORM_NAMES
 from simparity.comparisons.scenes.limits import DEFAULT_LIMITS
 from simparity.comparisons.scenes.profiles import QUICK_CONTACT_STEPS, QUICK_LADDER, QUICK_MAX_STEPS, QUICK_TARGETS
-from simparity.core.model.errors import UsageError
+from simparity.core.model.errors import UsageError, echo, one_line
 from simparity.core.model.scene import SUITES
 
 EXPORTABLE = ("mujoco", "pybullet", "pinocchio")
@@ -28,21 +28,57 @@ class _Parser(argparse.ArgumentParser):
     """argparse whose errors are one line and exit 2 like every other bad input (no usage block)."""
 
     def error(self, message: str):
-        raise UsageError(f"{self.prog}: {message} (allowed: see '{self.prog} --help')")
+        allowed = "" if "(allowed: " in message else f" (allowed: see '{self.prog} --help')"
+        raise UsageError(f"{self.prog}: {message}{allowed}")
 
 
-def _engine_list(text: str) -> tuple[str, ...]:
-    return tuple(n.strip() for n in text.split(",") if n.strip())
+def name_list(known: tuple[str, ...] = (), kind: str = "name"):
+    """An argparse type: comma-separated names, each given once, none empty (``''``, ``','`` and ``'a,'`` name
+    nothing or an empty name: refused, never read as fewer names); ``known``: the only names allowed, each a
+    ``kind`` (empty: any name, checked later against what exists)."""
+    allowed = f"allowed: {', '.join(known)}, comma-separated, each once" if known else (
+        "allowed: comma-separated names, each once, none empty")
+
+    def parse(text: str) -> tuple[str, ...]:
+        names = [n.strip() for n in text.split(",")]
+        if not any(names):
+            raise argparse.ArgumentTypeError(f"{echo(text)} names nothing ({allowed})")
+        if "" in names:
+            raise argparse.ArgumentTypeError(f"{echo(text)}: an empty name between or after commas ({allowed})")
+        repeated = [n for n in dict.fromkeys(names) if names.count(n) > 1]
+        if repeated:
+            raise argparse.ArgumentTypeError(f"{echo(text)}: {one_line(repeated[0])} named twice ({allowed})")
+        unknown = [n for n in names if known and n not in known]
+        if unknown:
+            raise argparse.ArgumentTypeError(f"{one_line(unknown[0])}: no such {kind} ({allowed})")
+        return tuple(names)
+
+    return parse
+
+
+def name_argument(text: str) -> str:
+    """An argparse type: a name or pattern, never the empty string (which would read as the option not given)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"{echo(text)} names nothing (allowed: a non-empty name)")
+    return text
+
+
+def path_argument(text: str) -> Path:
+    """An argparse type: a path, never the empty string (which ``Path`` would read as the current folder) nor one
+    holding a NUL byte."""
+    if not text.strip() or "\0" in text:  # no system takes a NUL byte in a path
+        raise argparse.ArgumentTypeError(f"{echo(text)} is no path (allowed: a file or folder path, no NUL byte)")
+    return Path(text)
 
 
 def _add_check_options(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--tolerances", type=Path, default=None, metavar="FILE",
+    parser.add_argument("--tolerances", type=path_argument, default=None, metavar="FILE",
                         help=f"bounds to hold the run to: your file extends the shipped {DEFAULT_TOLERANCES.name} "
                         "(extends = \"none\" in it starts empty) and its bounds win where they match")
-    parser.add_argument("--check-engines", type=_engine_list, default=None, metavar="A,B,...",
+    parser.add_argument("--check-engines", type=name_list(), default=None, metavar="A,B,...",
                         help="the engines the gate holds (default: every engine of the run, or the tolerances file's "
                         "check_engines): the others' violations are printed as findings and never fail the check")
-    parser.add_argument("--require-engines", type=_engine_list, default=None, metavar="A,B,...",
+    parser.add_argument("--require-engines", type=name_list(), default=None, metavar="A,B,...",
                         help="fail the check when one of these engines measured nothing: not in the run, or every "
                         "row n/a or failed (default: the tolerances file's require_engines, else none)")
     parser.add_argument("--allow-unbounded", action="store_true",
@@ -54,17 +90,17 @@ def _add_check_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--baseline", default=None, metavar="DIR|latest",
                         help="also flag every metric that moved since this run, among the scenes x engines both runs "
                         "ran ('latest': the latest earlier run of the same profile, from the history)")
-    parser.add_argument("--baseline-rel", type=float, default=BASELINE_RELATIVE, metavar="X",
+    parser.add_argument("--baseline-rel", type=float, default=None, metavar="X",
                         help=f"relative change that counts as a move (default: {BASELINE_RELATIVE:g}); timing "
                         "changes are listed apart and never fail the check")
-    parser.add_argument("--junit", type=Path, default=None, metavar="FILE",
+    parser.add_argument("--junit", type=path_argument, default=None, metavar="FILE",
                         help="write JUnit XML: one test case per scene x engine x integrator x dt")
-    parser.add_argument("--summary", type=Path, default=None, metavar="FILE",
+    parser.add_argument("--summary", type=path_argument, default=None, metavar="FILE",
                         help="write a Markdown summary (e.g. $GITHUB_STEP_SUMMARY)")
 
 
 def _add_history_option(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--history", default=None, metavar="PATH",
+    parser.add_argument("--history", type=path_argument, default=None, metavar="PATH",
                         help=f"run history database (default: $SIMPARITY_HISTORY or {DEFAULT_OUT_ROOT}/history.sqlite)")
 
 
@@ -99,10 +135,10 @@ def build_parser() -> argparse.ArgumentParser:
                      help="run a built-in suite: default (what 'simparity run' runs), contact (every scene with "
                      "planes), hard (the numerical-stability cases, each with the verdict it must earn) or bench (the "
                      "arms 'simparity bench' times, 10,000 IK targets each)")
-    run.add_argument("--engines", type=_engine_list, default=DEFAULT_ENGINES, metavar="A,B,...",
+    run.add_argument("--engines", type=name_list(), default=DEFAULT_ENGINES, metavar="A,B,...",
                      help=f"comma-separated engines to run (default: {','.join(DEFAULT_ENGINES)}; "
                      f"known: {allowed_engines()}; 'simparity engines' lists them)")
-    run.add_argument("--out", type=Path, default=None, metavar="DIR",
+    run.add_argument("--out", type=path_argument, default=None, metavar="DIR",
                      help=f"output folder; must not hold a run yet (default: a new {DEFAULT_OUT_ROOT}/<UTC date-time>/)")
     run.add_argument("--force", action="store_true", help="overwrite the run already in --out")
     run.add_argument("--repeats", type=int, default=None, metavar="N",
@@ -118,15 +154,16 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--executor", choices=EXECUTORS, default="local",
                      help="where cases run: local worker processes (default), or a Dask distributed cluster (a "
                      "LocalCluster on this machine unless --scheduler is given; needs pip install 'simparity[dask]')")
-    run.add_argument("--scheduler", default=None, metavar="ADDRESS",
+    run.add_argument("--scheduler", type=name_argument, default=None, metavar="ADDRESS",
                      help="with --executor dask: the scheduler of a running cluster, e.g. tcp://10.0.0.5:8786")
     run.add_argument("--case-timeout", type=float, default=DEFAULT_CASE_SECONDS, metavar="SECONDS",
                      help="a case still running after this long is killed and becomes a failed row (default: "
                      f"{DEFAULT_CASE_SECONDS:g})")
     run.add_argument("--case-memory", type=float, default=None, metavar="GIB",
                      help="a case whose worker's resident memory passes this is killed and becomes a failed row "
-                     f"(default: {MEMORY_HELP})")
-    run.add_argument("--resume", type=Path, default=None, metavar="DIR",
+                     f"(default: {MEMORY_HELP}; at least {MIN_CASE_MEMORY_BYTES / GIB:.3g}, what an idle worker with "
+                     "the engines imported holds)")
+    run.add_argument("--resume", type=path_argument, default=None, metavar="DIR",
                      help="finish the interrupted run in DIR: its finished cases are kept, the rest run; give no "
                      "scenes, --suite, --engines, --out, --quick, --repeats or --max-* (the run's own are used)")
     run.add_argument("--max-steps", type=int, default=DEFAULT_LIMITS.max_steps, metavar="N",
@@ -137,7 +174,7 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--max-joints", type=int, default=DEFAULT_LIMITS.max_joints, metavar="N",
                      help=f"refuse a chain or URDF file of more than N movable joints (default: "
                      f"{DEFAULT_LIMITS.max_joints:,})")
-    run.add_argument("--transform", type=_engine_list, default=(), metavar="NAME[,NAME]",
+    run.add_argument("--transform", type=name_list(TRANSFORM_NAMES, "transform"), default=(), metavar="NAME[,NAME]",
                      help="also run every scene transformed (" + ", ".join(TRANSFORM_NAMES) + ": 2 km from the "
                      "origin, turned with its gravity, its bodies reordered, its units rescaled, time in ms) and add "
                      "each engine's invariance rows (invariance_ratio_NAME <= 1, invariance_status_changes_NAME = 0; "
@@ -152,20 +189,20 @@ def build_parser() -> argparse.ArgumentParser:
         description="Hold every metric of a stored run to its bound; print each violation on one line. Exit 0 "
         "when all are inside, 1 when any is not (or, with --baseline, when numerics moved), 2 on bad input.",
     )
-    check.add_argument("run_dir", nargs="?", type=Path, default=None, metavar="RUN_DIR",
+    check.add_argument("run_dir", nargs="?", type=path_argument, default=None, metavar="RUN_DIR",
                        help="a folder written by 'simparity run' (default: the latest run in the history)")
-    check.add_argument("--explain", default=None, metavar="ENGINE",
+    check.add_argument("--explain", type=name_argument, default=None, metavar="ENGINE",
                        help="print, per scene, every bound that holds ENGINE's rows (which rows, to what, and why) "
                        "instead of checking; your engine is held to the bounds of its schemes' kinds. With --scene, "
                        "--integrator or --metric: for each row, every bound that matched, its file, and which decided")
     for key in ("scene", "integrator", "metric"):
-        check.add_argument(f"--{key}", default=None, metavar="PATTERN",
+        check.add_argument(f"--{key}", type=name_argument, default=None, metavar="PATTERN",
                            help=f"with --explain: only rows whose {key} matches (fnmatch, e.g. 'order_*')")
-    check.add_argument("--bless", type=Path, default=None, metavar="FILE",
+    check.add_argument("--bless", type=path_argument, default=None, metavar="FILE",
                        help="write a tolerances file from the run instead of checking: each row held to its measured "
                        "value with a margin (never timing; a failed row refuses the file; a diverged one is marked "
                        "'expected - review'); docs/check.md")
-    check.add_argument("--spread", type=Path, default=None, metavar="RUN_DIR",
+    check.add_argument("--spread", type=path_argument, default=None, metavar="RUN_DIR",
                        help="with --bless: a second run of the same scenes (another machine, a perturbed scene); each "
                        "margin covers 3 x the two runs' difference")
     _add_check_options(check)
@@ -173,9 +210,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     history = sub.add_parser("history", help="how metrics moved across recorded runs",
                              description="Show one metric (or all) across the runs recorded in the history database.")
-    history.add_argument("scene", nargs="?", default=None, metavar="SCENE")
-    history.add_argument("--engine", default=None)
-    history.add_argument("--metric", default=None)
+    history.add_argument("scene", nargs="?", type=name_argument, default=None, metavar="SCENE")
+    history.add_argument("--engine", type=name_argument, default=None)
+    history.add_argument("--metric", type=name_argument, default=None)
     _add_history_option(history)
 
     export = sub.add_parser(
@@ -184,7 +221,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     export.add_argument("scene", metavar="SCENE|FILE")
     export.add_argument("--engine", required=True, choices=EXPORTABLE)
-    export.add_argument("--integrator", default=None, help="dynamics only (default: the engine's first)")
+    export.add_argument("--integrator", type=name_argument, default=None, help="dynamics only (default: the engine's first)")
     export.add_argument("--dt", type=float, default=None, help="dynamics only, [s] (default: the scene's first)")
 
     show = sub.add_parser(
@@ -200,7 +237,7 @@ def build_parser() -> argparse.ArgumentParser:
         "falling arms) for core and every engine in one run, each time with the error it reaches; "
         "write BENCHMARKS.md and benchmarks.csv with the ratios and the targets met or missed. About 5 minutes "
         "(--quick: about 1).")
-    bench.add_argument("--out", type=Path, default=Path("."), metavar="DIR",
+    bench.add_argument("--out", type=path_argument, default=Path("."), metavar="DIR",
                        help="folder for BENCHMARKS.md and benchmarks.csv (default: the current folder)")
     bench.add_argument("--quick", action="store_true", help="B = 1 and 100 only, 300 IK targets per arm")
 
@@ -208,8 +245,8 @@ def build_parser() -> argparse.ArgumentParser:
         "report", help="re-render report.md, report.html and figures/ of a stored run",
         description="Re-render report.md, report.html and the figures (SVG, PNG) from a stored run's results.csv, "
         "series.csv.gz and run.json; runs no engine. Flagged findings hold the run to --tolerances.")
-    report.add_argument("run_dir", type=Path, metavar="DIR")
-    report.add_argument("--tolerances", type=Path, default=None, metavar="FILE",
+    report.add_argument("run_dir", type=path_argument, metavar="DIR")
+    report.add_argument("--tolerances", type=path_argument, default=None, metavar="FILE",
                         help=f"bounds for the flagged findings (default: the shipped {DEFAULT_TOLERANCES.name}); its "
                         "check_engines, if any, say which of your engines open the report with 'Is ENGINE right?'")
     return parser

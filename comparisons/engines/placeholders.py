@@ -5,7 +5,8 @@ not installed): ``n/a`` rows, as for any scene an engine cannot do.
 :class:`BrokenEngine` stands in for a user's engine that does not import (a typo in its module, a
 missing dependency), whose own code raised while it was loaded or built, or that broke the interface:
 ``failed`` rows, which fail ``simparity run`` (exit 1) and the CI gate like any other failure: an
-engine the user asked for that never ran must not pass.
+engine the user asked for that never ran must not pass. :class:`NotAnEngine`, a BrokenEngine, stands in
+for a ``module:attr`` that names no engine at all, which the command line refuses before running.
 """
 
 from __future__ import annotations
@@ -100,3 +101,20 @@ class BrokenEngine(StandInEngine):
 
     def supports_ik(self, chain, solver: str, position_only: bool) -> Support:
         raise PluginError(self.reason)
+
+
+class NotAnEngine(BrokenEngine):
+    """A spec or plugin whose ``module:attr`` names no engine at all: an attribute the module lacks, a value, a class
+    that is not an Engine subclass, a callable that needs arguments or returns something else. A mistake in the
+    name, not in an engine's code: ``simparity run`` refuses it before any case runs (exit 2); elsewhere (the API,
+    ``simparity engines``) it fails its rows like any broken engine.
+
+    Attributes
+    ----------
+    mistake : str
+        What ``module:attr`` names instead of an engine, and what is allowed (one line).
+    """
+
+    def __init__(self, name: str, mistake: str) -> None:
+        super().__init__(name, mistake)
+        self.mistake = mistake

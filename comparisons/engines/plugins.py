@@ -16,17 +16,19 @@ does not allow, gives failed rows with the error. How to write one: docs/plugins
 from __future__ import annotations
 
 import functools
+import importlib
+import inspect
 import os
 import re
 import sys
 from dataclasses import dataclass
 from importlib import metadata
-from typing import cast
+from typing import Callable, cast
 
-from simparity.comparisons.engines.placeholders import BrokenEngine
+from simparity.comparisons.engines.placeholders import BrokenEngine, NotAnEngine
 from simparity.comparisons.measure.rows import error_text
 from simparity.core.model.engine import Engine
-from simparity.core.model.errors import PluginError, echo, one_line
+from simparity.core.model.errors import echo, one_line
 
 ENTRY_POINT_GROUP = "simparity.engines"
 
@@ -39,6 +41,9 @@ SPEC = re.compile(r"[A-Za-z_]\w*(?:\.[A-Za-z_]\w*)*:[A-Za-z_]\w*(?:\.[A-Za-z_]\w
 
 OFFERED_NAME = re.compile(r"[^\s,]+")
 """An integrator or IK solver name: a CSV cell and a list item, so no white space and no comma."""
+
+MAKER_RULE = "allowed: an Engine subclass or a zero-argument callable returning an Engine"
+"""What ``module:attr`` (a spec's, or a plugin's entry point's) must name."""
 
 RESERVED_OFFERED = ("-",)
 """Not an integrator or solver name: the runner's mark of a case of an engine that offers none."""
@@ -125,17 +130,37 @@ def load_engine(target: str, name: str | None = None, taken: frozenset[str] = fr
     plugin's), then ``target`` itself. A spec's module is looked for on the import path, then in the
     current folder. Returns the engine, or a :class:`BrokenEngine` when it does not import (a typo in its
     module, a missing dependency: the user asked for it, so its rows fail rather than pass the gate as n/a),
-    its code raised or it broke the interface.
+    its code raised or it broke the interface; a :class:`NotAnEngine` (a BrokenEngine the command line refuses
+    before running) when ``attr`` is missing from the module or names what cannot make an engine: a value, a
+    class that is not an Engine subclass, a callable that needs arguments or returned something else.
     """
     label = name or target
     if name is None and os.getcwd() not in sys.path:
         sys.path.append(os.getcwd())  # last: a file here never shadows an installed module
+    entry = metadata.EntryPoint(label, target, ENTRY_POINT_GROUP)
     try:
-        engine = _instantiate(metadata.EntryPoint(label, target, ENTRY_POINT_GROUP).load(), target)
+        module = importlib.import_module(entry.module)
     except ImportError as err:  # where: always the import machinery, so not said
         return BrokenEngine(label, f"{target} does not import here: {one_line(f'{type(err).__name__}: {err}')}")
     except (Exception, SystemExit) as err:  # noqa: BLE001 - a user's code: its cases fail with the error
-        return BrokenEngine(label, f"importing or constructing {target} raised {one_line(error_text(err))}")
+        return BrokenEngine(label, f"importing {target} raised {one_line(error_text(err))}")
+    try:
+        found: object = functools.reduce(getattr, entry.attr.split(".") if entry.attr else (), module)
+    except AttributeError as err:  # the module imported: the name after the colon is the mistake
+        return NotAnEngine(label, f"{target}: {entry.module} has no attribute {entry.attr} (AttributeError: "
+                           f"{one_line(err)}; {MAKER_RULE})")
+    except (Exception, SystemExit) as err:  # noqa: BLE001 - a module's own __getattr__ raised
+        return BrokenEngine(label, f"importing {target} raised {one_line(error_text(err))}")
+    mistake = _not_an_engine_maker(found, target)
+    if mistake:
+        return NotAnEngine(label, mistake)
+    try:
+        engine = cast(Callable[[], object], found)()  # callable: _not_an_engine_maker said so
+    except (Exception, SystemExit) as err:  # noqa: BLE001 - a user's code: its cases fail with the error
+        return BrokenEngine(label, f"constructing {target} raised {one_line(error_text(err))}")
+    if not isinstance(engine, Engine):
+        return NotAnEngine(label, f"{target}() returned a value of type {type(engine).__name__}, not a "
+                           f"simparity.core.engine.Engine ({MAKER_RULE})")
     try:
         own = engine.name
         engine.name = name or (own if isinstance(own, str) and ENGINE_NAME.fullmatch(own) and own not in taken
@@ -146,16 +171,20 @@ def load_engine(target: str, name: str | None = None, taken: frozenset[str] = fr
     return BrokenEngine(label, f"{target}: {problem}") if problem else engine
 
 
-def _instantiate(found: object, target: str) -> Engine:
-    """An engine from what an entry point loaded: an Engine subclass, or a callable returning an Engine."""
+def _not_an_engine_maker(found: object, target: str) -> str:
+    """Why what ``target`` names cannot make an engine, told without calling it ("" when it may): a value, a class
+    that is not an :class:`Engine` subclass, a callable that needs arguments."""
     if not callable(found):
-        raise PluginError(f"{target} is a value of type {type(found).__name__} (allowed: an Engine subclass or a "
-                          "zero-argument callable returning an Engine)")
-    engine = found()
-    if not isinstance(engine, Engine):
-        raise PluginError(f"{target}() returned a value of type {type(engine).__name__}, not a "
-                          "simparity.core.engine.Engine")
-    return engine
+        return f"{target} is a value of type {type(found).__name__} ({MAKER_RULE})"
+    if isinstance(found, type) and not issubclass(found, Engine):
+        return f"{target} is the class {found.__name__}, not a simparity.core.engine.Engine subclass ({MAKER_RULE})"
+    try:
+        inspect.signature(found).bind()
+    except TypeError as err:
+        return f"{target} cannot be called without arguments ({one_line(err)}; {MAKER_RULE})"
+    except ValueError:  # a built-in without a signature: only calling it tells
+        pass
+    return ""
 
 
 def _interface_problem(engine: Engine) -> str:

@@ -12,7 +12,7 @@ import functools
 import importlib
 from dataclasses import dataclass
 
-from simparity.comparisons.engines.placeholders import UnavailableEngine
+from simparity.comparisons.engines.placeholders import NotAnEngine, UnavailableEngine
 from simparity.comparisons.engines.plugins import discover, is_spec, load_engine
 from simparity.core.model.engine import Engine
 from simparity.core.model.errors import UnknownEngineError, one_line
@@ -98,8 +98,21 @@ class EngineSet:
         return tuple(n for n in dict.fromkeys(self.names) if n not in _ENGINES)
 
     @functools.cached_property
+    def _users_described(self) -> list[Engine]:
+        return describe_engines(self.users) if self.users else []
+
+    @functools.cached_property
     def _described(self) -> list[Engine]:
-        return list(_built_ins()) + (describe_engines(self.users) if self.users else [])
+        return list(_built_ins()) + self._users_described
+
+    def refuse_non_engines(self) -> None:
+        """Raise UnknownEngineError, before anything runs, when one of the user's engines names no engine at all
+        (:class:`~comparisons.engines.placeholders.NotAnEngine`: ``os:path``, ``json:dumps``, a class that is not an
+        Engine, an attribute the module lacks); a user's engine whose own code fails still runs, its rows failed.
+        Only the user's engines are described for it (each in a process of its own), once per set."""
+        mistakes = [engine for engine in self._users_described if isinstance(engine, NotAnEngine)]
+        if mistakes:
+            raise UnknownEngineError(f"--engines: {one_line(mistakes[0].mistake)}")
 
     @functools.cached_property
     def _references(self) -> dict[str, Engine]:

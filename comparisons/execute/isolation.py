@@ -37,6 +37,13 @@ MEMORY_SHARE = 0.8
 """Share of the machine's memory the workers may use together by default; the rest is the system's
 and the parent's."""
 
+MIN_CASE_MEMORY_BYTES = 160 * 1024 ** 2
+"""The smallest per-case memory limit ``--case-memory`` takes: an idle worker with every built-in engine imported
+holds ~150 MiB resident (measured: 150 MiB with core, MuJoCo, PyBullet and Pinocchio built; 79 MiB with core
+only), and the case's process forked from it starts there: below it every case would be killed before it
+computed anything. The smallest built-in scene runs within it (lecture-projectile, quick, on core, MuJoCo and
+Pinocchio at 0.16 GiB: no case killed)."""
+
 MIN_MEMORY_BYTES = 1 * GIB
 """The smallest per-case memory limit by default, on small machines: every built-in scene fits in 1 GiB."""
 
