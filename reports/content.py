@@ -950,7 +950,7 @@ def _blocks(builder: _Builder, table: pd.DataFrame, info: RunInfo) -> list[Block
     """Every block of the report, in order."""
     versions = ", ".join(f"{k} {v}" for k, v in info.engine_versions.items())
     m = info.machine
-    counts = case_counts(table.to_dict("records"))
+    counts = case_counts(table[["scene", "engine", "integrator", "dt", "status"]].itertuples(index=False))
     blocks: list[Block] = [
         Heading(1, "simparity report"),
         Paragraph(f"Run {info.created_utc} · commit {info.git_commit} · "

@@ -86,6 +86,10 @@ class Journal:
     def _path(self, key: CaseKey) -> Path:
         return self.folder / f"{key.digest()}.pickle"
 
+    def __contains__(self, key: CaseKey) -> bool:
+        """Whether an outcome is kept under ``key`` (read or not)."""
+        return self._path(key).is_file()
+
     def load(self, key: CaseKey) -> CaseOutcome | None:
         """The outcome stored under ``key``, or None (never stored, or unreadable: computed again)."""
         try:
