@@ -14,7 +14,7 @@ the cases run the progress bar's time left is the measured pace.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Callable
 
 from simparity.comparisons.execute.cases import (
@@ -97,14 +97,18 @@ def group_seconds(group: CaseGroup, scheme_of: SchemeOf = _unknown, skip: frozen
 
 @dataclass(frozen=True)
 class RunEstimate:
-    """What a run's cases will cost: ``cases`` to run, ``seconds`` [s] of wall time on ``workers``, and its costliest
-    case (``costliest``: scene, engine, integrator or method; ``costliest_seconds``)."""
+    """What a run's cases will cost: ``cases`` to run, ``seconds`` [s] of wall time on ``workers`` (``total_seconds``
+    on one), its costliest
+    case (``costliest``: scene, engine, integrator or method; ``costliest_seconds``), and ``case_seconds``: the
+    modelled cost [s] of a case by (scene, engine, integrator) (the mean over a dynamics scene's time steps)."""
 
     cases: int
     seconds: float
     workers: int
+    total_seconds: float = 0.0
     costliest: tuple[str, str, str] = ("", "", "")
     costliest_seconds: float = 0.0
+    case_seconds: dict[tuple[str, str, str], float] = field(default_factory=dict, compare=False)
 
     def line(self, case_limit_seconds: float | None = None) -> str:
         """One line: the estimate and, when a case is modelled to outlast ``case_limit_seconds``, which and how to
@@ -127,18 +131,21 @@ def estimate_run(groups: list[tuple[CaseGroup, frozenset[int]]], workers: int,
     worker)."""
     total, longest, cases = 0.0, 0.0, 0
     costliest, costliest_seconds = ("", "", ""), 0.0
+    by_case: dict[tuple[str, str, str], list[float]] = {}
     for group, skip in groups:
         seconds = 0.0
         for c, spec in enumerate(group.cases):
             if c in skip:
                 continue
-            one = _cost(group, spec, scheme_of)
+            one, key = _cost(group, spec, scheme_of), (group.scene.name, spec.engine, spec.integrator)
             seconds, cases = seconds + one, cases + 1
+            by_case.setdefault(key, []).append(one)
             if one > costliest_seconds:
-                costliest, costliest_seconds = (group.scene.name, spec.engine, spec.integrator), one
+                costliest, costliest_seconds = key, one
         total, longest = total + seconds, max(longest, seconds)
     workers = max(1, workers)
-    return RunEstimate(cases, max(total / workers, longest), workers, costliest, costliest_seconds)
+    return RunEstimate(cases, max(total / workers, longest), workers, total, costliest, costliest_seconds,
+                       {key: sum(costs) / len(costs) for key, costs in by_case.items()})
 
 
 def duration(seconds: float) -> str:

@@ -234,7 +234,7 @@ class Session:
         store = _Store(self.out_dir, self.engines, self.command, self.scenes, self.profile)
         sizes, cost = estimate(self.scenes, self.engines, make_engine, self.execution.workers, journal, self.specs)
         self.say(cost.line(self.execution.case_seconds))
-        bar = ProgressBar(sum(sizes), self.progress) if self.progress is not None else None
+        bar = ProgressBar(sum(sizes), self.progress, estimate=cost) if self.progress is not None else None
         failed = 0
         try:
             # the workers stop as soon as the cases do, before the report; the store then writes its typed copy
