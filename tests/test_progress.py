@@ -37,6 +37,6 @@ def test_time_left_is_the_modelled_cost_still_to_run_at_the_pace_measured():
     clock = iter([0.0, 10.0]).__next__
     stream = _Terminal()
     costs = {("chain", "pinocchio", "recursive"): 1.0, ("chain", "core", "jacobian_sum"): 99.0}
-    bar = ProgressBar(2, stream, clock=clock, estimate=RunEstimate(2, 99.0, 2, 100.0, case_seconds=costs))
+    bar = ProgressBar(2, stream, clock=clock, estimate=RunEstimate(2, 99.0, 2, 100.0, by_case=costs))
     bar.case_done("chain", "pinocchio", "recursive")
     assert "1/2 cases" in stream.getvalue() and "16m30s left" in stream.getvalue()

@@ -4,12 +4,12 @@ asks for, the cases spread over the workers a group at a time.
 A case costs :data:`CASE_OVERHEAD_SECONDS` (its child process forked, its engine's model built, its rows) plus its
 work times the seconds one unit of that work took (:data:`SECONDS_PER_UNIT`): body-steps of a dynamics scene, IK
 targets, configurations, chain steps times joints, and for joint-space dynamics the evaluations per state, each
-costing ``n ** p`` for a chain of n joints, p the power its scheme of computation declares
-(:data:`JOINT_DYNAMICS_COST`: the lecture's sum over link Jacobians is O(n^3) per evaluation, a recursive algorithm O(n)).
-A group's cases run one after the other in one worker, so a run takes at least its costliest group, and at least
-its total over the workers. The model orders the groups (costliest first) and gives the estimate; its constants
-were measured on 2 shared cores (2026-11-28, see each), so a faster machine takes less and a loaded one more; while
-the cases run the progress bar's time left is the measured pace.
+costing ``c n ** p`` for a chain of n joints, p by the kind of scheme its method declares (:data:`JOINT_DYNAMICS_COST`:
+the lecture's sum over link Jacobians is O(n^3) per evaluation, a recursive algorithm O(n)). A group's cases run one
+after the other in one worker, so a run takes at least its costliest group, and at least its total over the workers.
+The model orders the groups (costliest first) and gives the estimate; its constants were measured on 2 shared cores
+(2026-11-28, see each), so a faster machine takes less and a loaded one more. While the cases run, the progress bar's
+time left is the modelled cost still to run at the pace measured so far (:mod:`comparisons.execute.progress`).
 """
 
 from __future__ import annotations
@@ -98,9 +98,8 @@ def group_seconds(group: CaseGroup, scheme_of: SchemeOf = _unknown, skip: frozen
 @dataclass(frozen=True)
 class RunEstimate:
     """What a run's cases will cost: ``cases`` to run, ``seconds`` [s] of wall time on ``workers`` (``total_seconds``
-    on one), its costliest
-    case (``costliest``: scene, engine, integrator or method; ``costliest_seconds``), and ``case_seconds``: the
-    modelled cost [s] of a case by (scene, engine, integrator) (the mean over a dynamics scene's time steps)."""
+    on one), its costliest case (``costliest``: scene, engine, integrator or method; ``costliest_seconds``), and
+    ``by_case``: the modelled cost [s] of a case by (scene, engine, integrator) (the mean over a scene's time steps)."""
 
     cases: int
     seconds: float
@@ -108,7 +107,7 @@ class RunEstimate:
     total_seconds: float = 0.0
     costliest: tuple[str, str, str] = ("", "", "")
     costliest_seconds: float = 0.0
-    case_seconds: dict[tuple[str, str, str], float] = field(default_factory=dict, compare=False)
+    by_case: dict[tuple[str, str, str], float] = field(default_factory=dict, compare=False)
 
     def line(self, case_limit_seconds: float | None = None) -> str:
         """One line: the estimate and, when a case is modelled to outlast ``case_limit_seconds``, which and how to

@@ -27,7 +27,7 @@ class ProgressBar:
 
     def __init__(self, total: int, stream, clock=time.monotonic, estimate: RunEstimate | None = None) -> None:
         self.total, self.done, self.stream, self.clock = max(total, 1), 0, stream, clock
-        self.costs = estimate.case_seconds if estimate is not None else {}
+        self.costs = estimate.by_case if estimate is not None else {}
         self.total_cost = estimate.total_seconds if estimate is not None else 0.0
         self.mean_cost = self.total_cost / max(estimate.cases, 1) if estimate is not None else 0.0
         self.done_cost = 0.0
