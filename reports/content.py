@@ -950,7 +950,7 @@ def _blocks(builder: _Builder, table: pd.DataFrame, info: RunInfo) -> list[Block
     """Every block of the report, in order."""
     versions = ", ".join(f"{k} {v}" for k, v in info.engine_versions.items())
     m = info.machine
-    counts = case_counts(table.to_dict("records"))
+    counts = _case_counts(table)
     blocks: list[Block] = [
         Heading(1, "simparity report"),
         Paragraph(f"Run {info.created_utc} · commit {info.git_commit} · "
@@ -974,6 +974,14 @@ def _blocks(builder: _Builder, table: pd.DataFrame, info: RunInfo) -> list[Block
         chosen = table[(table["scene"].map(kinds) == kind) & ~table["scene"].isin(builder.sweep_of)]
         blocks += section(chosen) if not chosen.empty else []
     return blocks
+
+
+def _case_counts(table: pd.DataFrame) -> dict[str, int]:
+    """:func:`case_counts` of the table's rows, each case's statuses gathered by pandas: a row at a time, a sweep of
+    1,000 IK variants (429,000 rows) took 24 s."""
+    cases = table.groupby(["scene", "engine", "integrator", "dt"], sort=False, dropna=False)["status"].unique()
+    return case_counts({"scene": key, "engine": "", "integrator": "", "dt": 0.0, "status": status}
+                       for key, statuses in cases.items() for status in statuses)
 
 
 _TABULATED_KINDS = ("kinematics", "joint_dynamics")

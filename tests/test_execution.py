@@ -6,7 +6,8 @@ from __future__ import annotations
 import pytest
 
 from simparity.comparisons.engines.registry import make_engine
-from simparity.comparisons.execute.execution import count_cases, estimated_cost, run_scenes
+from simparity.comparisons.execute.estimate import group_seconds
+from simparity.comparisons.execute.execution import count_cases, run_scenes
 from simparity.comparisons.execute.isolation import CaseLimits, IsolatedPool
 from simparity.comparisons.execute.journal import Journal
 from simparity.core.model.results import STATUSES, case_counts
@@ -37,7 +38,7 @@ def test_every_case_is_heard_once_and_the_costliest_group_goes_first():
                               on_case=lambda *event: heard.append(event)))
     assert [s.name for s, _, _ in results] == ["lecture-planar-arm", "lecture-projectile"]
     assert len(heard) == sum(count_cases(scenes, built_engines(("core",)), make_engine))
-    costs = [estimated_cost(job.group) for job in executor.jobs]
+    costs = [group_seconds(job.group) for job in executor.jobs]
     assert costs == sorted(costs, reverse=True) and executor.jobs[0].group.scene.name == "lecture-projectile"
 
 

@@ -4,6 +4,7 @@ an uninterrupted run; finished cases are kept, cases that did not finish are tri
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 import pickle
 import subprocess
@@ -78,6 +79,17 @@ def test_unfinished_and_unreadable_cases_are_computed_again(tmp_path):
     assert journal.load(key) is None and journal.unreadable == 1
     other = CaseKey("hash", "core", "1.1", "rk4", 0.01, "dynamics")
     assert other.digest() != key.digest()
+
+
+def test_a_case_without_a_time_step_is_read_back(tmp_path):
+    """Issue #39: an IK, kinematics or joint-dynamics case is kept under a key whose dt is NaN, and NaN != NaN: it was
+    never read back, so --resume computed every such case again (a sweep of 1,000 IK variants from its start)."""
+    journal = Journal(tmp_path)
+    for kind, method in (("ik", "damped_least_squares"), ("kinematics", ""), ("joint_dynamics", "recursive")):
+        key = CaseKey("hash", "core", "1.0", method, math.nan, kind)
+        journal.save(key, CaseOutcome([]))
+        assert journal.load(key) == CaseOutcome([]), kind
+    assert journal.unreadable == 0
 
 
 def test_a_case_kept_before_its_types_moved_is_read_by_their_names(tmp_path):

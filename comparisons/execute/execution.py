@@ -3,10 +3,11 @@
 Every scene is planned into groups of cases (:mod:`comparisons.cases`); cases already in the run's
 :class:`~comparisons.journal.Journal` (a resumed run) are taken from it, the others go to an
 executor — local worker processes (:class:`~comparisons.isolation.IsolatedPool`) or a Dask cluster
-(:mod:`comparisons.dask_executor`) — costliest group first. Each case is journaled as it finishes;
-a scene's rows come back as soon as it and every scene before it are complete, so the stored run
-keeps the suite's order whatever finished first, and is the same whatever executed it. A scene's outcomes are let
-go once its rows are handed back, so the caller holds the cases of the scenes still incomplete, not the run's.
+(:mod:`comparisons.dask_executor`) — costliest group first (as :mod:`comparisons.execute.estimate` models them).
+Each case is journaled as it finishes; a scene's rows come back as soon as it and every scene before it are
+complete, so the stored run keeps the suite's order whatever finished first, and is the same whatever executed it. A
+scene's outcomes are let go once its rows are handed back, so the caller holds the cases of the scenes still
+incomplete, not the run's.
 """
 
 from __future__ import annotations
@@ -15,23 +16,18 @@ import os
 from dataclasses import dataclass
 from typing import Callable, Iterator, Protocol, cast
 
-from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome, case_key, plan_scene
+from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome, CaseSpec, case_key, plan_scene
+from simparity.comparisons.execute.estimate import RunEstimate, SchemeOf, estimate_run, group_seconds
 from simparity.comparisons.execute.isolation import Job
 from simparity.comparisons.execute.journal import Journal
 from simparity.comparisons.execute.runner import assemble_scene
+from simparity.comparisons.measure.rows import declared_scheme
 from simparity.core.model.engine import Engine
 from simparity.core.model.results import ResultRow, SeriesRecord
-from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, Scene
+from simparity.core.model.scene import Scene
 
 OnCase = Callable[[str, str, str], None]
 """Called with (scene, engine, integrator or solver) after each case, in the calling process."""
-
-SECONDS_PER_UNIT = {"dynamics": 5e-4, "ik": 1.7e-3, "kinematics": 1.2e-4, "joint_dynamics": 1e-3,
-                    "joint_motion": 1e-4}
-"""Seconds per case x (steps x bodies, targets, configurations, or states), measured on the default suite
-(2026-11-23, 2 cores, repeats on; joint dynamics 2026-11-27, ~(n + 12) evaluations per state); only their ratios
-matter: they order the groups; joint motion per step and joint, 2026-11-27)."""
-
 
 def default_jobs() -> int:
     """Worker processes by default: one per CPU."""
@@ -48,20 +44,16 @@ class Executor(Protocol):
         """Stop the workers."""
 
 
-def estimated_cost(group: CaseGroup) -> float:
-    """A group's rough cost [s], to start the costliest first: its cases times the work of one."""
-    scene, cases = group.scene, len(group.cases)
-    if isinstance(scene, DynamicsScene):
-        steps = scene.n_steps(group.dt) if group.dt == group.dt else max(scene.n_steps(dt) for dt in scene.dts)
-        return cases * steps * len(scene.bodies) * SECONDS_PER_UNIT["dynamics"]
-    if isinstance(scene, IKScene):
-        return cases * (scene.n_targets + len(scene.hard_targets)) * SECONDS_PER_UNIT["ik"]
-    if isinstance(scene, JointDynamicsScene):
-        return cases * scene.n_states * SECONDS_PER_UNIT["joint_dynamics"]
-    if isinstance(scene, JointMotionScene):
-        steps = scene.n_steps(group.dt) * scene.copies * (17 if scene.segments else 1)  # segments: dt and dt / 16
-        return cases * steps * scene.chain.n_joints * SECONDS_PER_UNIT["joint_motion"]
-    return cases * scene.n_configurations * SECONDS_PER_UNIT["kinematics"]
+def scheme_lookup(engines: list[Engine]) -> SchemeOf:
+    """The kind of scheme each case's engine (one of ``engines``, by name) declares on the case's scene: what its
+    modelled cost depends on (:mod:`comparisons.execute.estimate`); "" for an engine not among them."""
+    by_name = {e.name: e for e in engines}
+
+    def scheme_of(group: CaseGroup, spec: CaseSpec) -> str:
+        engine = by_name.get(spec.engine)
+        return "" if engine is None else declared_scheme(engine, spec.integrator, group.scene)
+
+    return scheme_of
 
 
 @dataclass
@@ -118,7 +110,8 @@ def run_scenes(scenes: list, engines: list[Engine], make_engine: Callable[[str],
                     on_case(item.scene.name, spec.engine, spec.integrator)
             if len(skip) < len(group.cases):
                 jobs.append(Job((s, g), group, skip))
-    jobs.sort(key=lambda job: -estimated_cost(job.group))
+    scheme_of = scheme_lookup(engines)
+    jobs.sort(key=lambda job: -group_seconds(job.group, scheme_of, frozenset(job.skip)))
     emitted = 0
     try:
         for key, c, outcome in executor.run(jobs):
@@ -154,3 +147,20 @@ def _assembled(item: _Scene) -> tuple[Scene, list[ResultRow], list[SeriesRecord]
 def count_cases(scenes: list, engines: list[Engine], make_engine: Callable[[str], Engine]) -> list[int]:
     """The number of cases of each scene (each reported once to ``on_case``)."""
     return [sum(len(g.cases) for g in item.groups) for item in plan_run(scenes, engines, make_engine, 0)]
+
+
+def estimate(scenes: list, engines: list[Engine], make_engine: Callable[[str], Engine], workers: int,
+             journal: Journal | None = None, specs: dict[str, str] | None = None) -> tuple[list[int], RunEstimate]:
+    """(the number of cases of each scene, the :class:`RunEstimate` of those not in ``journal`` on ``workers``), from
+    one plan of the run, before any case runs."""
+    planned = plan_run(scenes, engines, make_engine, 0, specs)
+    versions = {e.name: e.version() for e in engines}
+
+    def done(group: CaseGroup) -> frozenset[int]:
+        if journal is None:
+            return frozenset()
+        return frozenset(c for c, spec in enumerate(group.cases) if case_key(group, spec, versions) in journal)
+
+    groups = [(group, done(group)) for item in planned for group in item.groups]
+    return ([sum(len(g.cases) for g in item.groups) for item in planned],
+            estimate_run(groups, workers, scheme_lookup(engines)))

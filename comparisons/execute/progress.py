@@ -1,10 +1,14 @@
 """Progress of a run: a one-line bar on a terminal (scene, engine, integrator, cases done / total,
-time left), nothing extra when the output is not a terminal (CI logs keep one line per scene)."""
+time left), nothing extra when the output is not a terminal (CI logs keep one line per scene). Given each case's
+modelled cost (:mod:`comparisons.execute.estimate`), the time left is the modelled cost still to run at the pace
+measured so far: a run whose last case costs more than all the others together is not said to be nearly done."""
 
 from __future__ import annotations
 
 import shutil
 import time
+
+from simparity.comparisons.execute.estimate import RunEstimate, duration
 
 REDRAW_SECONDS = 0.1
 """Least time between two redraws of the bar: a terminal does not need more, a fast run is not slowed."""
@@ -13,19 +17,20 @@ _WIDTH = 24
 """Characters of the bar itself."""
 
 
-def _duration(seconds: float) -> str:
-    seconds = int(round(seconds))
-    return f"{seconds // 3600}h{seconds // 60 % 60:02d}m" if seconds >= 3600 else f"{seconds // 60}m{seconds % 60:02d}s"
-
-
 class ProgressBar:
     """Counts cases as they finish and draws the bar on ``stream`` when it is a terminal.
 
-    ``total`` is the number of cases the run will count (``comparisons.runner.count_cases``).
+    ``total`` is the number of cases the run will count (``comparisons.runner.count_cases``); ``estimate``, what they
+    are modelled to cost (None: every case alike). A case it does not know of (one restored by ``--resume``) counts
+    at the mean cost.
     """
 
-    def __init__(self, total: int, stream, clock=time.monotonic) -> None:
+    def __init__(self, total: int, stream, clock=time.monotonic, estimate: RunEstimate | None = None) -> None:
         self.total, self.done, self.stream, self.clock = max(total, 1), 0, stream, clock
+        self.costs = estimate.by_case if estimate is not None else {}
+        self.total_cost = estimate.total_seconds if estimate is not None else 0.0
+        self.mean_cost = self.total_cost / max(estimate.cases, 1) if estimate is not None else 0.0
+        self.done_cost = 0.0
         self.active = bool(getattr(stream, "isatty", lambda: False)())
         self.start = clock()
         self._drawn_at = -float("inf")
@@ -36,12 +41,16 @@ class ProgressBar:
         fraction = min(self.done / self.total, 1.0)
         filled = int(round(fraction * _WIDTH))
         elapsed = now - self.start
-        left = f"{_duration(elapsed / self.done * (self.total - self.done))} left" if self.done else "estimating"
+        if self.costs and self.done_cost > 0:
+            left = f"{duration(elapsed / self.done_cost * max(self.total_cost - self.done_cost, 0.0))} left"
+        else:
+            left = f"{duration(elapsed / self.done * (self.total - self.done))} left" if self.done else "estimating"
         return (f"[{'#' * filled}{'.' * (_WIDTH - filled)}] {self.done}/{self.total} cases · {scene} · "
                 f"{engine} {integrator}".rstrip() + f" · {left}")
 
     def case_done(self, scene: str, engine: str, integrator: str) -> None:
         self.done += 1
+        self.done_cost += self.costs.get((scene, engine, integrator), self.mean_cost)
         now = self.clock()
         if self.active and now - self._drawn_at >= REDRAW_SECONDS:
             self._drawn_at = now

@@ -26,7 +26,7 @@ import pandas as pd
 
 from simparity.comparisons.engines.registry import EngineSet, check_engine_names, describe_engines, make_engine
 from simparity.comparisons.execute.cases import CaseOutcome
-from simparity.comparisons.execute.execution import Executor, count_cases, default_jobs, run_scenes
+from simparity.comparisons.execute.execution import Executor, default_jobs, estimate, run_scenes
 from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS, CaseLimits, IsolatedPool, Job
 from simparity.comparisons.execute.journal import Journal, run_lock, write_request
 from simparity.comparisons.execute.progress import ProgressBar
@@ -63,6 +63,16 @@ class Execution:
     jobs: int = field(default_factory=default_jobs)
     limits: CaseLimits | None = None
     scheduler: str | None = None
+
+    @property
+    def workers(self) -> int:
+        """Cases that run at once: ``jobs``, one in this process (``inline``)."""
+        return 1 if self.where == IN_PROCESS else self.jobs
+
+    @property
+    def case_seconds(self) -> float | None:
+        """The wall time [s] a case may take before it is killed; None in this process (nothing kills it)."""
+        return None if self.where == IN_PROCESS else (self.limits.seconds if self.limits else DEFAULT_CASE_SECONDS)
 
     def executor(self, engine_for: Callable[[str], Engine]) -> Executor:
         """A new executor of this kind; ``engine_for`` builds an engine in this process (``inline`` only)."""
@@ -164,7 +174,8 @@ class Session:
     ``report``), recorded in ``history`` (a database path; None: not recorded) and, with ``request``,
     resumable (``resume.json``). ``resume``: keep the folder's finished cases. ``bounds``: tolerances the
     finished run is held to; ``held``: the engines that gate holds (None: every one), whose report opens with "is
-    my engine right?" for each of the user's. ``say`` hears one line per scene and what the run wrote, ``warn`` what went wrong
+    my engine right?" for each of the user's. ``say`` hears, before the cases start, how long they are modelled to
+    take (:mod:`comparisons.execute.estimate`), then one line per scene and what the run wrote, ``warn`` what went wrong
     beside the run (default: ``say``); ``progress`` is a stream for the progress bar (None: no bar)."""
 
     def __init__(self, scenes: list, engines: EngineSet, *, profile: str = "full", repeats: int = DEFAULT_REPEATS,
@@ -221,8 +232,9 @@ class Session:
     def _run(self, executor: Executor) -> SessionResult:
         journal = Journal(self.out_dir) if self.out_dir is not None else None
         store = _Store(self.out_dir, self.engines, self.command, self.scenes, self.profile)
-        sizes = count_cases(self.scenes, self.engines, make_engine)
-        bar = ProgressBar(sum(sizes), self.progress) if self.progress is not None else None
+        sizes, cost = estimate(self.scenes, self.engines, make_engine, self.execution.workers, journal, self.specs)
+        self.say(cost.line(self.execution.case_seconds))
+        bar = ProgressBar(sum(sizes), self.progress, estimate=cost) if self.progress is not None else None
         failed = 0
         try:
             # the workers stop as soon as the cases do, before the report; the store then writes its typed copy
