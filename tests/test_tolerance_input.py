@@ -8,6 +8,7 @@ rows written as ``simparity run`` writes them (no engine runs), but for the one 
 
 import dataclasses
 import math
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import pandas as pd
@@ -48,8 +49,8 @@ def _bound(**keys) -> str:
     return f"[[bound]]\n{lines}reason = \"test\"\n"
 
 
-def _check(capsys, run: Path, tolerances_file: Path) -> tuple[int, str, str]:
-    code = main(["check", str(run), "--tolerances", str(tolerances_file)])
+def _check(capsys, run: Path, tolerances_file: Path, *options: str) -> tuple[int, str, str]:
+    code = main(["check", str(run), "--tolerances", str(tolerances_file), *options])
     captured = capsys.readouterr()
     return code, captured.out, captured.err
 
@@ -90,12 +91,14 @@ def test_a_glob_that_exists_but_matches_nothing_in_the_run_is_a_loud_line_and_a_
     path = _file(tmp_path, _bound(engine="m*", metric="position_error_max", max=1.0)
                  + _bound(engine="pybullet", max=1.0) + _bound(scene="ur5-*", max=1.0)
                  + _bound(scheme=["penalty+*", "soft+*"], max=1.0) + _bound(integrator="clik*", max=1.0))
-    code, out, _ = _check(capsys, run, path)
+    code, out, _ = _check(capsys, run, path, "--junit", str(tmp_path / "junit.xml"))
     lines = [line for line in out.splitlines() if line.startswith("tolerances: ")]
     assert code == EXIT_OK
     assert [line.split(": ", 2)[2].split(" matched")[0] for line in lines] == [f"bound[{i}]" for i in (1, 2, 3, 4)]
     assert "its engine 'pybullet' matches none of the run's 1 engines" in lines[0]
     assert "its scheme ['penalty+*', 'soft+*'] matches none" in lines[2]
+    skipped = ET.parse(tmp_path / "junit.xml").getroot().find(".//testcase[@classname='tolerances']/skipped")
+    assert skipped is not None and skipped.text.splitlines() == [line.removeprefix("tolerances: ") for line in lines]
 
 
 def test_a_bound_that_can_match_nothing_is_refused_before_a_run_starts(tmp_path, capsys):

@@ -38,7 +38,11 @@ the file wins. ``simparity check --explain ENGINE --metric M`` lists, for each r
 and which one decided.
 
 Every bound's ``metric`` is checked against the metric catalogue (:mod:`comparisons.gate.metric_names`): a name
-no run can write is refused with the closest names. Top-level ``check_engines = [...]`` names the engines the gate
+no run can write is refused with the closest names; its other keys are checked against what exists when it is held to
+a run (:mod:`comparisons.gate.bound_names`). ``reference = "self"`` holds only rows measured against themselves. A
+bound that holds no value is refused: an empty interval, every value below 0 on a metric that is never negative, a
+``dt_power`` beyond :data:`DT_POWER_MAX`; so is a chain of files with more than :data:`MAX_BOUNDS` bounds. Rows find
+their bounds through :class:`comparisons.gate.bound_index.BoundIndex`, never by scanning them all. Top-level ``check_engines = [...]`` names the engines the gate
 holds (the others' violations are findings, never blocking) and ``require_engines = [...]`` those that must have
 measured something (:func:`load_gate`; the nearest file of an ``extends`` chain that names them wins).
 """
