@@ -129,6 +129,7 @@ def test_every_shipped_bound_matches_something_that_exists():
     (dict(metric="time_per_step", max=-1.0, dt_power=1, expected=-0.5, band=0.1), "expected", "never negative"),
     (dict(metric="order_position", expected=4.0, band=0.3, min=4.5), "expected", "holds no value"),
     (dict(metric="order_position", min=3.5, dt=1e308), "dt", "is not a time step"),
+    (dict(metric="order_position", expected=4.0, rel=1e308), "rel", "is more than the expected value itself"),
     (dict(metric="order_position", min=3.5, reference="others"), "reference", "is not allowed"),
 ])
 def test_a_bound_that_holds_no_value_is_refused_naming_its_key(tmp_path, keys, key, says):

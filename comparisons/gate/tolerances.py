@@ -81,6 +81,9 @@ DT_POWER_MAX = 16.0
 """Largest magnitude of ``dt_power``: a scheme's error is C dt^p with p its order (8 at most for a scheme simparity
 knows, DOP853), a rounding floor's grows as dt^-1; twice the highest order, and dt^p stays finite over every time step
 a scene may have (1e-9 to 1e3 s), where 1e308 overflows to a bound of 0 or infinity that holds nothing."""
+REL_MAX = 1.0
+"""Largest ``rel``: a share of ``|expected|``; beyond 1 the band takes in values of the other sign, no longer a
+tolerance relative to the expected value (``band``, ``min`` or ``max`` say what is meant)."""
 MAX_BOUNDS = 100_000
 """Bounds a tolerances file and the files it extends may hold together: a blessed run of every built-in suite in the
 full profile is ~40,000; parsing TOML costs ~0.2 ms a bound, so more is a mistake or an attack, refused in one line."""
@@ -302,6 +305,9 @@ def _empty(bound: Bound) -> tuple[str, str, str] | None:
         return "dt_power", f"{bound.dt_power!r} is no scheme's order", (
             f"-{DT_POWER_MAX:g} to {DT_POWER_MAX:g}: a scheme's error C dt^p has p its order (8 at most), a rounding "
             "floor's -1")
+    if bound.rel is not None and bound.rel > REL_MAX:
+        return "rel", f"{bound.rel:g} is more than the expected value itself", (
+            f"0 to {REL_MAX:g}, a share of |expected| (beyond it the band takes in the other sign: use band, min or max)")
     if bound.min is not None and bound.max is not None and bound.min > bound.max:
         return "min", f"min {bound.min:g} > max {bound.max:g}: the bound in [{bound.min:g}, {bound.max:g}] holds no value", \
             "min <= max"
