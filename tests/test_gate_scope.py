@@ -85,13 +85,13 @@ def test_every_metric_of_the_shipped_tolerances_is_in_the_catalogue():
 def test_a_bound_of_the_user_s_that_matches_no_row_is_a_loud_line_not_a_failure(tmp_path, capsys):
     run = _stored(tmp_path / "run", _rows("mine"))
     tolerances = _file(tmp_path, BOUND + BOUND.replace('"my-scene"', '"my-scen*"').replace(
-        '"position_error_max"', '"order_*"') + BOUND.replace('"my-scene"', '"my-sceen"'))
+        '"position_error_max"', '"order_*"') + BOUND.replace('"my-scene"', '"wind"'))
     code, out, _ = _check(capsys, run, "--tolerances", str(tolerances))
     lines = [line for line in out.splitlines() if line.startswith("tolerances: ")]
     assert code == EXIT_OK
     assert lines == [f"tolerances: {tolerances}: bound[1] matched no row of this run: its metric 'order_*' matches none "
                      "of the run's 1 metrics; it held nothing",
-                     f"tolerances: {tolerances}: bound[2] matched no row of this run: its scene 'my-sceen' matches none "
+                     f"tolerances: {tolerances}: bound[2] matched no row of this run: its scene 'wind' matches none "
                      "of the run's 1 scenes; it held nothing"]
 
 

@@ -32,6 +32,7 @@ from simparity.comparisons.execute.journal import Journal, run_lock, write_reque
 from simparity.comparisons.execute.progress import ProgressBar
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS, run_group
 from simparity.comparisons.execute.store import RunWriter
+from simparity.comparisons.gate.bound_names import offered, refuse_impossible
 from simparity.comparisons.gate.check import CheckResult, check_table
 from simparity.comparisons.gate.history import record_run
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, Bound, load_tolerances
@@ -199,6 +200,9 @@ class Session:
             self.engines = describe_engines(self.names, self.scenes)
         check_distinct(self.engines, self.names, self.scenes)
         self.specs = dict(zip((e.name for e in self.engines), self.names))
+        if bounds is not None:  # before any case runs: a bound that can match nothing is bad input
+            refuse_impossible(bounds, {"scene": [s.name for s in self.scenes], "engine": [e.name for e in self.engines],
+                                       "integrator": offered(self.engines)})
 
     def run(self, start: Callable[[], str] | None = None) -> SessionResult:
         """Run every case, store and check the run; a SimparityError raised midway keeps what was computed

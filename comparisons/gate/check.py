@@ -25,10 +25,13 @@ import pandas as pd
 from simparity.comparisons.gate.cross_check import CROSS_CHECK_FACTOR, SOLVE_RATE_FRACTION, cross_check, held_series
 from simparity.comparisons.gate.violation import Violation, row_label
 from simparity.comparisons.engines.registry import ENGINE_NAMES
+from simparity.comparisons.gate.bound_index import unmatched_patterns
+from simparity.comparisons.gate.bound_names import patterns_of, refuse_impossible
 from simparity.comparisons.gate.tolerances import Bound, BoundIndex, EngineNames
 from simparity.core.model.errors import SimparityError, one_line
 from simparity.core.model.metric_catalogue import is_cost, is_timing
-from simparity.core.model.results import ALARM_FLAGS, DIMENSIONLESS, FAILED, NOT_AVAILABLE, OK, ROUNDING_FLOOR
+from simparity.core.model.results import (ALARM_FLAGS, DIMENSIONLESS, FAILED, NOT_AVAILABLE, OK, ROUNDING_FLOOR,
+                                          reference_label)
 
 CASE_KEYS = ("scene", "engine", "integrator", "dt")
 ROW_KEYS = CASE_KEYS + ("metric",)
@@ -143,7 +146,6 @@ def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = 
     row to the built-in schemes of its kind (:mod:`comparisons.gate.cross_check`)."""
     result, index = CheckResult(engines=tuple(dict.fromkeys(table["engine"]))), BoundIndex(bounds)
     measured: dict[tuple, str | None] = {}  # case -> the reason nothing was measured (None: something was)
-    matched: set[str] = set()  # the bounds (by where) that matched some row
     for row in table.to_dict("records"):
         key = _case_key(row["scene"], row["engine"], row["integrator"], float(row["dt"]))
         result.cases.setdefault(key, [])
@@ -152,9 +154,7 @@ def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = 
         elif key not in measured:
             measured[key] = str(row["detail"] or NOT_AVAILABLE)
         _note_engine(result, row)
-        matching = index.matching(*_row_key(row))
-        matched.update(b.where for b in matching)
-        bound = matching[0] if matching else None
+        bound = index.decider(*_row_key(row))
         _count_series(result, row, bound)
         if bound is None:
             result.unchecked += 1
@@ -179,7 +179,7 @@ def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = 
         if series in result.series:
             result.series[series] = True
     result.unmeasured = {key: reason for key, reason in measured.items() if reason is not None and not result.cases[key]}
-    result.unmatched = unmatched_bounds(table, [b for b in bounds if not b.shipped and b.where not in matched])
+    result.unmatched = unmatched_bounds(table, [b for b in index.unmatched() if not b.shipped])
     return result
 
 
@@ -227,21 +227,26 @@ def _note_engine(result: CheckResult, row: dict) -> None:
         result.refusals[engine] = f"{row['status']}: {detail or 'no detail'}"
 
 
-UNMATCHED_KEYS = ("scene", "engine", "integrator", "metric")
+UNMATCHED_KEYS = ("scene", "engine", "integrator", "scheme", "metric")
 """A bound's patterns a run's rows are searched for, in this order, to say why the bound matched no row."""
 
 
 def unmatched_bounds(table: pd.DataFrame, bounds: list[Bound]) -> list[str]:
-    """One line per bound (of a user's file) that matched no row: the first of its patterns that matches none of the
-    run's values of that column, else that no row matches them together (a time step, a kind of scheme)."""
-    values = {key: sorted(set(table[key].fillna("").astype(str))) for key in UNMATCHED_KEYS}
+    """One line per bound (of a user's file) that matched no row: the first of its keys none of whose patterns matches
+    any of the run's values of that column, else that no row matches them together (a time step, a reference). A
+    pattern that matches nothing that exists either is refused (:func:`refuse_impossible`, exit 2)."""
+    values = {key: sorted(set(table[key].fillna("").astype(str))) if key in table else [""] for key in UNMATCHED_KEYS}
+    refuse_impossible(bounds, values)
+    missing = {key: unmatched_patterns({p for bound in bounds for p in patterns_of(bound, key)}, values[key])
+               for key in UNMATCHED_KEYS}
     lines = []
     for bound in bounds:
-        why = "no row matches its keys together (scene, engine, integrator, metric, dt, scheme)"
+        why = "no row matches its keys together (scene, engine, integrator, scheme, metric, dt, reference)"
         for key in UNMATCHED_KEYS:
-            pattern = getattr(bound, key)
-            if not any(fnmatch.fnmatchcase(value, pattern) for value in values[key]):
-                why = f"its {key} {pattern!r:.80} matches none of the run's {len(values[key])} {key}s"
+            patterns = patterns_of(bound, key)
+            if all(p in missing[key] for p in patterns):
+                shown = patterns[0] if len(patterns) == 1 else list(patterns)
+                why = f"its {key} {shown!r:.80} matches none of the run's {len(values[key])} {key}s"
                 break
         lines.append(f"{bound.where} matched no row of this run: {why}; it held nothing")
     return lines
@@ -264,11 +269,13 @@ def _case_key(scene: str, engine: str, integrator: str, dt: float) -> tuple:
     return (scene, engine, integrator, "nan" if math.isnan(dt) else dt)
 
 
-def _row_key(row: dict) -> tuple[str, str, str, str, float, str]:
-    """What a bound matches of a results table's record (a table without a scheme column: scheme "")."""
-    scheme = row.get("scheme", "")
-    return (row["scene"], row["engine"], row["integrator"], row["metric"], float(row["dt"]),
-            scheme if isinstance(scheme, str) else "")
+def _row_key(row: dict) -> tuple[str, str, str, str, float, str, bool]:
+    """What a bound matches of a results table's record (a table without a scheme column: scheme ""), and whether
+    the row is measured against itself (its engine and integrator are its reference)."""
+    scheme, integrator = row.get("scheme", ""), row["integrator"] if isinstance(row["integrator"], str) else ""
+    own_reference = row.get("reference") == reference_label(row["engine"], integrator)
+    return (row["scene"], row["engine"], integrator, row["metric"], float(row["dt"]),
+            scheme if isinstance(scheme, str) else "", own_reference)
 
 
 def _row_bound(index: BoundIndex, row: dict) -> Bound | None:

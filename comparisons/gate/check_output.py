@@ -64,7 +64,7 @@ def junit_xml(result: CheckResult, diff: BaselineDiff | None = None, unbounded: 
     """JUnit XML: one test case per scene x engine x integrator x dt; a case with violations fails with
     them as its message and text, a case that measured nothing (every row n/a) is skipped with the reason;
     a baseline comparison is one more test case, and so is the share of series held to a value (``unbounded``:
-    the reason it fails, "" when it does not)."""
+    the reason it fails, "" when it does not); the user's bounds that matched no row are one skipped test case."""
     suites = ET.Element("testsuites", name="simparity check")
     suite = ET.SubElement(suites, "testsuite", name="simparity")
     failures = skipped = 0
@@ -105,6 +105,14 @@ def junit_xml(result: CheckResult, diff: BaselineDiff | None = None, unbounded: 
     if unbounded:
         failures += 1
         ET.SubElement(case, "failure", message=unbounded[:MESSAGE_CHARS], type="unbounded").text = unbounded
+    if result.unmatched:  # loud, never blocking: skipped, as a finding is
+        tests += 1
+        skipped += 1
+        case = ET.SubElement(suite, "testcase", classname="tolerances", name="every bound of the user's held a row",
+                             time="0")
+        ET.SubElement(case, "skipped", message=(f"{len(result.unmatched)} bound(s) matched no row, never blocking: "
+                                                + "; ".join(result.unmatched))[:MESSAGE_CHARS]).text = "\n".join(
+            result.unmatched)
     for element in (suites, suite):
         element.set("tests", str(tests))
         element.set("failures", str(failures))

@@ -12,7 +12,7 @@ import difflib
 import fnmatch
 import re
 
-from simparity.core.model.metric_catalogue import CATALOGUE, FAMILIES, family_of
+from simparity.core.model.metric_catalogue import CATALOGUE, FAMILIES, family_of, is_non_negative
 
 WILDCARDS = re.compile(r"[*?\[]")
 """What makes an fnmatch pattern a pattern rather than a name written out."""
@@ -62,3 +62,11 @@ def allowed_text(pattern: str) -> str:
     near = closest(pattern)
     return ("closest: " + ", ".join(near) + "; or " if near else "") + (
         "a metric of docs/metrics.md (a name, or a family's such as hard_<target>_solved), or a pattern matching one")
+
+
+def non_negative(pattern: str) -> bool:
+    """Whether every metric ``pattern`` can match is >= 0 (errors, drifts, residuals, times, rates: not an order), so
+    that a bound whose every value is below 0 holds no value of it. A family member is non-negative."""
+    if not WILDCARDS.search(pattern):
+        return is_non_negative(pattern)
+    return all(is_non_negative(name) for name in CATALOGUE if fnmatch.fnmatchcase(name, pattern))

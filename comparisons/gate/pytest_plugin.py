@@ -18,6 +18,7 @@ a test asks for a run.
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import pytest
@@ -99,6 +100,8 @@ class SimparityChecker:
         required = EngineNames(tuple(require_engines), "require_engines=") if require_engines else gate.require_engines
         check = held_to(result.check, held, required) if result.check is not None else None
         problems = [g.line() for g in grouped(check.violations)] + check.absent if check is not None else []
+        for line in check.unmatched if check is not None else []:  # loud, never failing: as `simparity check` says it
+            warnings.warn(f"simparity: tolerances: {line}", UserWarning, stacklevel=3)
         unbounded = "" if allow_unbounded or check is None else check.too_unbounded()
         problems += [f"unbounded: {unbounded} (here: allow_unbounded=True)"] if unbounded else []
         if self._baseline:

@@ -38,7 +38,11 @@ the file wins. ``simparity check --explain ENGINE --metric M`` lists, for each r
 and which one decided.
 
 Every bound's ``metric`` is checked against the metric catalogue (:mod:`comparisons.gate.metric_names`): a name
-no run can write is refused with the closest names. Top-level ``check_engines = [...]`` names the engines the gate
+no run can write is refused with the closest names; its other keys are checked against what exists when it is held to
+a run (:mod:`comparisons.gate.bound_names`). ``reference = "self"`` holds only rows measured against themselves. A
+bound that holds no value is refused: an empty interval, every value below 0 on a metric that is never negative, a
+``dt_power`` beyond :data:`DT_POWER_MAX`; so is a chain of files with more than :data:`MAX_BOUNDS` bounds. Rows find
+their bounds through :class:`comparisons.gate.bound_index.BoundIndex`, never by scanning them all. Top-level ``check_engines = [...]`` names the engines the gate
 holds (the others' violations are findings, never blocking) and ``require_engines = [...]`` those that must have
 measured something (:func:`load_gate`; the nearest file of an ``extends`` chain that names them wins).
 """
@@ -51,9 +55,11 @@ from typing import Any
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from simparity.comparisons.gate.metric_names import allowed_text, unknown_metric
+from simparity.comparisons.gate.bound_index import DT_MATCH, BoundIndex
+from simparity.comparisons.gate.metric_names import allowed_text, non_negative, unknown_metric
 from simparity.core.model.errors import SceneError, ToleranceError, one_line
 from simparity.core.model.files import read_toml
+from simparity.core.model.ranges import RANGES
 from simparity.core.model.results import FLAGS, OK, STATUSES
 
 
@@ -62,13 +68,25 @@ DEFAULT_TOLERANCES = Path(__file__).resolve().parents[1] / "tolerances" / "defau
 
 MATCH_KEYS = ("scene", "engine", "integrator", "metric")
 NUMBER_KEYS = ("max", "min", "expected", "band", "rel", "dt_power")
-ALLOWED_KEYS = MATCH_KEYS + ("scheme", "dt") + NUMBER_KEYS + ("status", "na_when", "reason")
+REFERENCE_KEY, ANY_REFERENCE, SELF_REFERENCE = "reference", "*", "self"
+"""``reference = "self"``: the bound holds only rows measured against themselves (their own engine and integrator are
+the case's reference, :func:`core.model.results.reference_label`): a truth's zero error against itself, which the same
+truth measured against another engine's reference does not have."""
+ALLOWED_KEYS = MATCH_KEYS + ("scheme", "dt", REFERENCE_KEY) + NUMBER_KEYS + ("status", "na_when", "reason")
 EXTENDS_DEFAULT, EXTENDS_NONE = "default", "none"
 """``extends`` values: the shipped tolerances (the default of every file but the shipped one), or nothing."""
 MAX_EXTENDS_DEPTH = 16
 """Files at most in one chain of ``extends``: deeper is a loop or a mistake, refused in one line."""
-DT_MATCH = 1e-9
-"""Relative difference under which a bound's ``dt`` [s] names a row's time step."""
+DT_POWER_MAX = 16.0
+"""Largest magnitude of ``dt_power``: a scheme's error is C dt^p with p its order (8 at most for a scheme simparity
+knows, DOP853), a rounding floor's grows as dt^-1; twice the highest order, and dt^p stays finite over every time step
+a scene may have (1e-9 to 1e3 s), where 1e308 overflows to a bound of 0 or infinity that holds nothing."""
+REL_MAX = 1.0
+"""Largest ``rel``: a share of ``|expected|``; beyond 1 the band takes in values of the other sign, no longer a
+tolerance relative to the expected value (``band``, ``min`` or ``max`` say what is meant)."""
+MAX_BOUNDS = 100_000
+"""Bounds a tolerances file and the files it extends may hold together: a blessed run of every built-in suite in the
+full profile is ~40,000; parsing TOML costs ~0.2 ms a bound, so more is a mistake or an attack, refused in one line."""
 
 
 @dataclass(frozen=True)
@@ -100,6 +118,10 @@ class Bound:
     layer : int
         The file's place in its ``extends`` chain: 0 for the first file extended (the shipped one), one more
         for each file that extends it; a higher layer wins whatever the specificity.
+    source : str
+        The file the bound is in.
+    against_self : bool
+        ``reference = "self"``: the bound holds only rows measured against themselves (:data:`SELF_REFERENCE`).
     shipped : bool
         Whether the bound is the shipped file's (:data:`DEFAULT_TOLERANCES`): a bound of a user's file that
         matches no row of a run is said so (:func:`comparisons.gate.check.unmatched_bounds`), a shipped one not
@@ -125,6 +147,8 @@ class Bound:
     na_when: tuple[str, ...] = ()
     layer: int = 0
     shipped: bool = False
+    against_self: bool = False
+    source: str = ""
 
     @property
     def specificity(self) -> int:
@@ -135,7 +159,10 @@ class Bound:
         return dt_weight + scheme_weight + sum(_weight(p) for p in patterns)
 
     def matches(self, scene: str, engine: str, integrator: str, metric: str, dt: float = math.nan,
-                scheme: str = "") -> bool:
+                scheme: str = "", own_reference: bool = False) -> bool:
+        """Whether the bound holds a row (``own_reference``: the row is measured against itself)."""
+        if self.against_self and not own_reference:
+            return False
         if self.dt == "*" and math.isnan(dt):
             return False
         if isinstance(self.dt, float) and not abs(dt - self.dt) <= DT_MATCH * self.dt:
@@ -228,8 +255,14 @@ def _bound(source: str, index: int, table) -> Bound:
     dt = table.get("dt")
     if dt is not None and dt != "*":
         dt = _number(source, f"{where}.dt", table["dt"])
-        if dt <= 0:
-            raise ToleranceError(source, f"{where}.dt", f"{dt!r} is not a time step", "a time step > 0 [s]")
+        if not (dt > 0 and RANGES["dt"].allows(dt)):
+            raise ToleranceError(source, f"{where}.dt", f"{dt!r} is not a time step", f"a time step > 0 [s], "
+                                 f"{RANGES['dt'].text()}")
+    reference = table.get(REFERENCE_KEY, ANY_REFERENCE)
+    if reference not in (ANY_REFERENCE, SELF_REFERENCE):
+        raise ToleranceError(source, f"{where}.{REFERENCE_KEY}", f"{reference!r:.60} is not allowed",
+                             f'"{SELF_REFERENCE}" (only rows measured against themselves: their own engine and '
+                             f'integrator are the reference) or "{ANY_REFERENCE}" (every row, the default)')
     numbers: dict[str, Any] = {key: None for key in NUMBER_KEYS}
     for key in NUMBER_KEYS:
         if key in table:
@@ -254,10 +287,41 @@ def _bound(source: str, index: int, table) -> Bound:
         raise ToleranceError(source, f"{where}.na_when", f"{na_when!r:.60} is not a flag or a list of them",
                              ", ".join(FLAGS))
     bound = Bound(**patterns, dt=dt, **numbers, statuses=statuses, reason=reason.strip(), where=f"{source}: {where}",
-                  order=index, na_when=tuple(na_when))
+                  order=index, na_when=tuple(na_when), against_self=reference == SELF_REFERENCE, source=source)
     if not bound.bounds_a_number and status is None:
         raise ToleranceError(source, where, "bounds nothing", "max, min, expected or status")
+    empty = _empty(bound)
+    if empty:
+        key, problem, allowed = empty
+        raise ToleranceError(source, f"{where}.{key}", problem, allowed)
     return bound
+
+
+def _empty(bound: Bound) -> tuple[str, str, str] | None:
+    """(key, problem, allowed) when ``bound`` holds no value its rows could have (an empty interval, every value
+    below 0 for a metric that is never negative) or scales by a meaningless power of dt; None when it means
+    something. With ``dt_power`` and a ``band`` the interval depends on dt: only ``min > max`` is then decided."""
+    if bound.dt_power is not None and not abs(bound.dt_power) <= DT_POWER_MAX:
+        return "dt_power", f"{bound.dt_power!r} is no scheme's order", (
+            f"-{DT_POWER_MAX:g} to {DT_POWER_MAX:g}: a scheme's error C dt^p has p its order (8 at most), a rounding "
+            "floor's -1")
+    if bound.rel is not None and bound.rel > REL_MAX:
+        return "rel", f"{bound.rel:g} is more than the expected value itself", (
+            f"0 to {REL_MAX:g}, a share of |expected| (beyond it the band takes in the other sign: use band, min or max)")
+    if bound.min is not None and bound.max is not None and bound.min > bound.max:
+        return "min", f"min {bound.min:g} > max {bound.max:g}: the bound in [{bound.min:g}, {bound.max:g}] holds no value", \
+            "min <= max"
+    scale_free = bound.dt_power is None or not bound.band  # every limit then scales alike (or not at all)
+    low, high = bound.limits(math.nan)
+    key = "expected" if bound.expected is not None else "max" if bound.max is not None else "min"
+    if scale_free and low > high:
+        return key, f"the bound in [{low:.3g}, {high:.3g}] holds no value", (
+            "limits that leave a value: expected +- band or rel inside [min, max]")
+    if non_negative(bound.metric) and bound.bounds_a_number and (high < 0 if scale_free else
+                                                                  bound.max is not None and bound.max < 0):
+        return key, (f"{bound.describe(math.nan)} holds no value of {bound.metric!r:.60}, which is never "
+                     "negative"), "limits that admit a value >= 0 (an error, drift, residual, time or rate is >= 0)"
+    return None
 
 
 CHECK_ENGINES, REQUIRE_ENGINES = "check_engines", "require_engines"
@@ -308,6 +372,10 @@ def _load(path: Path, chain: tuple[Path, ...]) -> Gate:
                              "[[bound]] tables, extends = ..., " + " = [...], ".join(ENGINE_KEYS) + " = [...]")
     base = _extended(path, data.get("extends", _default_extends(path)), chain + (_resolved(path),))
     tables = data.get("bound", [])
+    if isinstance(tables, list) and len(base.bounds) + len(tables) > MAX_BOUNDS:
+        raise ToleranceError(source, "bound", f"{len(tables):,} bounds" + (
+            f" and {len(base.bounds):,} in the files it extends" if base.bounds else ""), f"at most {MAX_BOUNDS:,} "
+            "bounds in a file and the files it extends together (a blessed run of every built-in suite has ~40,000)")
     inherits = "extends" in data or any(key in data for key in ENGINE_KEYS)
     if not isinstance(tables, list) or not (tables or (inherits and base.bounds)):
         raise ToleranceError(source, "bound", "no bounds", "one or more [[bound]] tables, or extends = a file that has some")
@@ -356,49 +424,13 @@ def _extended(path: Path, extends, chain: tuple[Path, ...]) -> Gate:
     return _load(target, chain)
 
 
-class BoundIndex:
-    """Bounds looked up by row without scanning them all: a bound whose scene, engine, integrator and metric are all
-    written out (a blessed file's thousands) is found by that key, only the others are matched one by one."""
-
-    def __init__(self, bounds: list[Bound]) -> None:
-        self.exact: dict[tuple[str, str, str, str], list[Bound]] = {}
-        self.patterned: list[Bound] = []
-        self._by_metric: dict[str, list[Bound]] = {}
-        """The patterned bounds that may match a metric, in their order: those naming it or a pattern (a run of
-        20,000 rows, a sweep of 1,000 variants, matched every row against every bound: a minute)."""
-        for bound in bounds:
-            key = (bound.scene, bound.engine, bound.integrator, bound.metric)
-            if all(_weight(p) == 2 for p in key):
-                self.exact.setdefault(key, []).append(bound)
-            else:
-                self.patterned.append(bound)
-
-    def _patterned(self, metric: str) -> list[Bound]:
-        if metric not in self._by_metric:
-            self._by_metric[metric] = [b for b in self.patterned if _weight(b.metric) < 2 or b.metric == metric]
-        return self._by_metric[metric]
-
-    def matching(self, scene: str, engine: str, integrator: str, metric: str, dt: float = math.nan,
-                 scheme: str = "") -> list[Bound]:
-        """Every bound that matches a row, the deciding one first (highest :attr:`Bound.precedence`)."""
-        candidates = self.exact.get((scene, engine, integrator, metric), []) + self._patterned(metric)
-        matching = [b for b in candidates if b.matches(scene, engine, integrator, metric, dt, scheme)]
-        return sorted(matching, key=lambda b: b.precedence, reverse=True)
-
-    def decider(self, scene: str, engine: str, integrator: str, metric: str, dt: float = math.nan,
-                scheme: str = "") -> Bound | None:
-        """The bound that decides a row (the first of :meth:`matching`), or None."""
-        matching = self.matching(scene, engine, integrator, metric, dt, scheme)
-        return matching[0] if matching else None
-
-
 def matching_bounds(bounds: list[Bound], scene: str, engine: str, integrator: str, metric: str,
-                    dt: float = math.nan, scheme: str = "") -> list[Bound]:
+                    dt: float = math.nan, scheme: str = "", own_reference: bool = False) -> list[Bound]:
     """Every bound that matches a row, the deciding one first (highest :attr:`Bound.precedence`)."""
-    return BoundIndex(bounds).matching(scene, engine, integrator, metric, dt, scheme)
+    return BoundIndex(bounds).matching(scene, engine, integrator, metric, dt, scheme, own_reference)
 
 
 def bound_for(bounds: list[Bound], scene: str, engine: str, integrator: str, metric: str,
-              dt: float = math.nan, scheme: str = "") -> Bound | None:
+              dt: float = math.nan, scheme: str = "", own_reference: bool = False) -> Bound | None:
     """The bound that decides a row (highest :attr:`Bound.precedence` among those that match), or None."""
-    return BoundIndex(bounds).decider(scene, engine, integrator, metric, dt, scheme)
+    return BoundIndex(bounds).decider(scene, engine, integrator, metric, dt, scheme, own_reference)

@@ -34,7 +34,8 @@ class Metric:
 
     ``scale``: the quantity whose own scale saturates it (``position``, ``velocity``, ``orientation``,
     ``angular_velocity``, ``energy``; "" when none); ``theory``: the rule it is held to in theory ("" when
-    none), e.g. an order's scheme order; ``source``: for an order, the error it is the slope of."""
+    none), e.g. an order's scheme order; ``source``: for an order, the error it is the slope of; ``signed``: a value
+    below 0 is a measurement (not an error's magnitude: M's smallest scaled eigenvalue)."""
 
     name: str
     unit: str
@@ -43,10 +44,17 @@ class Metric:
     scale: str = ""
     theory: str = ""
     source: str = ""
+    signed: bool = False
 
     @property
     def is_timing(self) -> bool:
         return self.kind == TIMING
+
+    @property
+    def non_negative(self) -> bool:
+        """Whether no value of it is below 0: errors, drifts, residuals, times, rates and counts are magnitudes; an
+        observed order (an error growing as dt falls has a negative slope) and a ``signed`` quantity are not."""
+        return not self.signed and self.kind != ORDER
 
 
 @dataclass(frozen=True)
@@ -187,7 +195,8 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(ROUND_TRIP_RESIDUAL, DIMENSIONLESS, VALIDITY,
            theory="ABA(q, qdot, RNEA(q, qdot, qddot)) = qddot (in torque space): 0 up to rounding"),
     Metric(MASS_MATRIX_ASYMMETRY, DIMENSIONLESS, VALIDITY, theory="M = M^T: 0 up to rounding"),
-    Metric(MASS_MATRIX_DEFINITENESS_MIN, DIMENSIONLESS, VALIDITY, theory="> 0: M (scaled by its diagonal) is positive definite"),
+    Metric(MASS_MATRIX_DEFINITENESS_MIN, DIMENSIONLESS, VALIDITY, signed=True,
+           theory="> 0: M (scaled by its diagonal) is positive definite"),
     Metric(KINETIC_ENERGY_RESIDUAL, DIMENSIONLESS, VALIDITY,
            theory="1/2 qdot^T M qdot = the links' kinetic energy: 0 up to rounding"),
     Metric(CORIOLIS_SKEW_RESIDUAL, DIMENSIONLESS, VALIDITY,
@@ -263,6 +272,14 @@ FAMILIES = (HARD_TARGET_SOLVED, HARD_TARGET_UNREACHABLE, HARD_TARGET_LIMIT_VIOLA
 def family_of(name: str) -> MetricFamily | None:
     """The family a metric not in :data:`CATALOGUE` belongs to, or None."""
     return next((f for f in FAMILIES if f.matches(name)), None)
+
+
+def is_non_negative(name: str) -> bool:
+    """Whether every value of the metric ``name`` is >= 0 (:attr:`Metric.non_negative`; a family's members are
+    residuals, flags, counts and ratios: all are); False for a name the catalogue does not know."""
+    if name in CATALOGUE:
+        return CATALOGUE[name].non_negative
+    return family_of(name) is not None
 
 
 def unit_of(name: str) -> str:

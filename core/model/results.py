@@ -114,6 +114,12 @@ class ResultRow:
         return asdict(self)
 
 
+def reference_label(engine: str, integrator: str) -> str:
+    """The ``reference`` column of the cases measured against ``engine`` running ``integrator``
+    (``engine:integrator``): a row whose own engine and integrator give its reference is measured against itself."""
+    return f"{engine}:{integrator}"
+
+
 GROUND_TRUTH_ENGINES = ("analytic", "tight")
 """Engines that compute a scene's truth (closed form, or a tight adaptive solve), not schemes a user
 would pick: reports rank the other engines and never offer these as the cheapest scheme."""
