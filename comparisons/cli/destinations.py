@@ -16,18 +16,27 @@ def _reason(err: Exception) -> str:
 
 
 def writable_folder(option: str, folder: Path) -> Path:
-    """``folder``, created if missing, once a file could be made in it (and removed): a path through a file, a
-    read-only file system, a name the system rejects are refused here in one line, before any work."""
+    """``folder`` once a file could be made in it (and removed), the folders the probe had to create removed again:
+    a path through a file, a read-only file system, a name the system rejects are refused here in one line, before
+    any work, and a refused or failed run leaves no folder behind."""
+    created: list[Path] = []
     try:
         if folder.exists() and not folder.is_dir():
             raise SimparityError(f"{option} {one_line(folder)}: exists and is not a folder (allowed: a folder you "
                                  "can write)")
+        created = [p for p in (folder, *folder.parents) if not p.exists()]
         folder.mkdir(parents=True, exist_ok=True)
         with tempfile.TemporaryFile(dir=folder):
             pass
     except (OSError, ValueError) as err:  # ValueError: a NUL byte in the name
         raise SimparityError(f"{option} {one_line(folder)}: cannot write in that folder: {_reason(err)} (allowed: "
                              "a folder you can write)") from None
+    finally:
+        for path in created:  # deepest first
+            try:
+                path.rmdir()
+            except OSError:
+                pass
     return folder
 
 
