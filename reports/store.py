@@ -4,6 +4,7 @@ and writing that typed copy of the CSV (:func:`write_parquet`)."""
 from __future__ import annotations
 
 import csv
+import functools
 import math
 import os
 import re
@@ -110,32 +111,52 @@ def _read_table(path: Path, text: list[str], numbers: tuple[str, ...], **options
     return table
 
 
+def _ends_with_newline(path: Path) -> bool:
+    """Whether the file ``path`` is empty or its last byte is a newline (only that byte is read)."""
+    with open(path, "rb") as handle:
+        if handle.seek(0, os.SEEK_END) == 0:
+            return True
+        handle.seek(-1, os.SEEK_END)
+        return handle.read(1) == b"\n"
+
+
 def _read_csv(results: Path, fixed: tuple[str, ...], empty: bool = False) -> pd.DataFrame:
     """``results.csv`` typed as :func:`read_run` describes, refused (ResultsError) where it breaks the schema of a
     run of the ``fixed`` columns (schema 1's missing ``flag`` and ``scheme`` then added empty): a header not
-    simparity's, a row of another number of fields than the header (cut short, split, blank), a last row cut mid-line,
-    a cell breaking :func:`reports.run_schema.conformed`."""
+    simparity's, a row of another number of fields than the header (cut short, or two rows run together), a last row
+    cut mid-line, a cell breaking :func:`reports.run_schema.conformed`. Blank lines are skipped, as pandas does."""
     header = _header(results)
     problem = header_problem(header, fixed)
     if problem:
         raise ResultsError(f"{one_line(results)}: header: {problem}")
-    scan = records(results.read_bytes())
-    if not scan.ended and len(scan.fields) > 1:
-        raise ResultsError(f"{one_line(results)}: row {len(scan.fields) - 1} (line {scan.lines[-1]}): cut mid-line, "
-                           f"the file does not end with a newline (allowed: {_ALLOWED_CSV}, every row ended)")
-    uneven = np.flatnonzero(scan.fields != len(header))
-    if len(uneven):
-        row = int(uneven[0])
-        raise ResultsError(f"{one_line(results)}: row {row} (line {scan.lines[row]}): {scan.fields[row]} fields where "
-                           f"the header has {len(header)} (allowed: {_ALLOWED_CSV}, a value in every column of every "
-                           "row)")
+    # Where each row is (its line, its fields) is read from the file's bytes only when a row is in doubt.
+    content = functools.cache(results.read_bytes)
+    scan = functools.cache(lambda: records(content()))
+    refused = f"{one_line(results)}: row {{}} (line {{}}): {{}} (allowed: {_ALLOWED_CSV}{{}})"
+    if not _ends_with_newline(results) and len(scan().lines) > 1:
+        raise ResultsError(refused.format(len(scan().lines) - 1, scan().lines[-1], "cut mid-line, the file does not "
+                                          "end with a newline", ", every row ended"))
+
+    def refuse_uneven(doubted: np.ndarray) -> None:  # doubted: records, by index
+        counts = scan().fields(content(), doubted)
+        uneven = np.flatnonzero(counts != len(header))
+        if len(uneven):
+            record = int(doubted[uneven[0]])
+            raise ResultsError(refused.format(record, scan().lines[record], f"{counts[uneven[0]]} fields where the "
+                                              f"header has {len(header)}", ", a value in every column of every row"))
+
     try:
+        # keep_default_na=False: pandas would read the status "n/a" as missing.
         swept = header[len(fixed):]
-        table = _read_table(results, [c for c in fixed if c not in NUMERIC_COLUMNS], NUMERIC_COLUMNS, **_EXACT_FLOATS,
-                            dtype={c: str for c in swept})
+        table = _read_table(results, [c for c in fixed if c not in NUMERIC_COLUMNS], NUMERIC_COLUMNS,
+                            **_EXACT_FLOATS, dtype={c: str for c in swept})
     except (pd.errors.ParserError, UnicodeDecodeError, ValueError) as err:
+        refuse_uneven(scan().rows())  # a row of too many fields, named by its row and line
         raise ResultsError(f"{one_line(results)}: not a table of the header's {len(header)} columns: {one_line(err)} "
                            f"(allowed: {_ALLOWED_CSV})") from None
+    padded = np.flatnonzero(table[header[-1]].to_numpy() == "") if len(table) else np.zeros(0, np.int64)
+    if len(padded):  # pandas pads a row cut short with empty cells: only a row whose last cell is empty may be one
+        refuse_uneven(scan().rows()[padded])
     if table.empty and empty:
         return _schema_1_filled(table)
     try:
@@ -143,7 +164,7 @@ def _read_csv(results: Path, fixed: tuple[str, ...], empty: bool = False) -> pd.
         for column in header[len(fixed) + 1:]:
             table[column] = _swept_values(table[column])
     except RowProblem as err:
-        raise refuse(err, one_line(results), lambda row: f"row {row + 1} (line {scan.lines[row + 1]})",
+        raise refuse(err, one_line(results), lambda row: f"row {row + 1} (line {scan().lines[scan().rows()[row]]})",
                      ResultsError) from None
     return _schema_1_filled(table)
 

@@ -176,7 +176,6 @@ ROW_DAMAGE = {
                               "row 1 (line 2): 10 fields where the header has 12"),
     "a row with a field too many": (lambda lines: lines[:2] + [lines[2].rstrip("\n") + ",x\n"] + lines[3:],
                                     "row 2 (line 3): 13 fields where the header has 12"),
-    "a blank line": (lambda lines: lines[:2] + ["\n"] + lines[2:], "row 2 (line 3): 1 fields where the header has"),
     "a quoted detail never closed": (lambda lines: lines[:-1] + [lines[-1].replace("a difference", '"a difference')],
                                      f"row {len(ROWS)} (line {len(ROWS) + 1}): "),
     "the empty file": (lambda lines: [], "empty, not even a header"),
@@ -192,10 +191,15 @@ def test_damaged_rows_are_refused_naming_the_row(run, capsys, name):
     assert message.startswith(str(run / RESULTS_FILE) + ": ") and expected in message, message
 
 
-def test_line_numbers_count_the_newlines_inside_quoted_details(tmp_path, capsys):
+def test_line_numbers_count_the_newlines_inside_quoted_details_and_blank_lines(tmp_path, capsys):
     run = _run(tmp_path / "run", [dataclasses.replace(ROWS[0], detail="two\nlines")] + ROWS[1:])
     _replace_cell(run, 4, "status", "bogus")  # row 3 of the file's lines: the detail took two
     assert "row 3 (line 5): status 'bogus'" in _refusal(run, capsys)
+    lines = _lines(run)
+    _write(run, lines[:2] + ["\n"] + lines[2:])  # a blank line is skipped (as pandas does), and counted
+    assert "row 3 (line 6): status 'bogus'" in _refusal(run, capsys)
+    _write(run, lines[:2] + ["\n"] + lines[2:4] + [lines[4].replace("bogus", "n/a")] + lines[5:])
+    assert len(read_run(run)[0]) == len(ROWS)
 
 
 def test_a_schema_1_run_reads_without_flag_and_scheme_but_a_schema_2_run_needs_them(run, capsys):
