@@ -319,6 +319,8 @@ HISTORIES = {
     "a blob where a time belongs": ("UPDATE runs SET created_utc = X'01'", "run #1: created"),
     "a run without rows": ("DELETE FROM results", "run #1 has no rows"),
     "no runs table columns": ("ALTER TABLE runs DROP COLUMN command", "unreadable run history"),
+    "no value column": ("ALTER TABLE results DROP COLUMN value", "run #1, row 1: status ok with value nan"),
+    "no runs table": ("DROP TABLE runs", "no earlier run"),
 }
 
 

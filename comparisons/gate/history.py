@@ -135,7 +135,7 @@ def _conformed(path: Path, table: pd.DataFrame, row_name, text: tuple[str, ...] 
 def runs(path: Path) -> pd.DataFrame:
     """The recorded runs, oldest first: id, run_dir, created_utc, git_commit, command, profile ("": unknown)."""
     recorded = _query(path, "SELECT id, run_dir, created_utc, git_commit, command, profile FROM runs ORDER BY id")
-    if not pd.api.types.is_integer_dtype(recorded["id"].dtype):  # an id is SQLite's rowid: nothing else reads so
+    if len(recorded) and not pd.api.types.is_integer_dtype(recorded["id"].dtype):  # an id is SQLite's rowid: nothing else reads so
         raise HistoryError(f"{path}: run history: runs.id holds {recorded['id'].dtype} (allowed: whole numbers)")
     return _conformed(path, recorded, lambda row: f"run #{recorded['id'].iloc[row]}",
                       ("run_dir", "created_utc", "git_commit", "command", "profile"))
