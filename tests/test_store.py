@@ -96,7 +96,7 @@ def test_a_damaged_sweep_column_is_a_results_error(tmp_path):
     writer.append([_row("drop_mass-1.0")])
     path = tmp_path / RESULTS_FILE
     path.write_text(path.read_text(encoding="utf-8").replace(",drop,1.0", ",drop,heavy"), encoding="utf-8")
-    with pytest.raises(ResultsError, match="unreadable stored run"):
+    with pytest.raises(ResultsError, match=r"results.csv: row 1 \(line 2\): sweep:body\[ball\].mass .heavy. is not a number"):
         read_run(tmp_path)
 
 
@@ -106,7 +106,7 @@ def _finished_sweep(tmp_path):
     writer = RunWriter(tmp_path, [], "simparity run", scenes)
     writer.append([_row(s.name) for s in scenes])
     writer.append([ResultRow(scenes[0].name, "mujoco", "", math.nan, "position_error_max", math.nan, "m",
-                             "analytic:exact", "n/a", "no such integrator, \"quoted\"", "saturated", "rk")])
+                             "analytic:exact", "n/a", "no such integrator, \"quoted\"", "saturated", "rk4")])
     writer.finish()
     return scenes
 

@@ -302,6 +302,8 @@ def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = No
                              ("timing (not blocking)", diff.timing)):
             for item in items:
                 print(f"{label}: {one_line(item, MESSAGE_LIMIT)}", file=out)
+    for line in filter(None, (result.nothing_checked, diff.nothing_compared if diff is not None else "")):
+        print(f"nothing checked: {line}", file=out)
     unbounded = "" if args.allow_unbounded else result.too_unbounded()
     if unbounded:
         print(f"unbounded: {unbounded}", file=out)

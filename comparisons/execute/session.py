@@ -298,6 +298,10 @@ class Session:
         bounds (default: the shipped tolerances) for the report's flagged findings. Returns that verdict."""
         if self.out_dir is None or not self.report:
             return None
+        from simparity.reports.store import read_run
+
+        if read_run(self.out_dir, empty=True)[0].empty:  # interrupted before its first row: nothing to report
+            return None
         return write_run_report(self.out_dir, self.say, self.bounds, self.held)
 
     def _record(self, table: pd.DataFrame) -> None:
@@ -306,7 +310,7 @@ class Session:
             return
         from simparity.reports.store import read_run
 
-        _, info = read_run(self.out_dir)
+        _, info = read_run(self.out_dir, empty=True)
         try:
             record_run(self.history, self.out_dir.resolve(), info, table)
         except HistoryError as err:
@@ -335,7 +339,7 @@ class _Store:
         if self.writer is not None:
             from simparity.reports.store import read_run
 
-            return read_run(self.writer.out_dir)[0]
+            return read_run(self.writer.out_dir, empty=True)[0]
         return pd.DataFrame([r.as_dict() for r in self.rows], columns=list(COLUMNS))
 
 

@@ -80,7 +80,18 @@ class CheckResult:
 
     @property
     def passed(self) -> bool:
-        return not self.violations and not self.absent
+        return not self.violations and not self.absent and not self.nothing_checked
+
+    @property
+    def nothing_checked(self) -> str:
+        """A one-line reason when the gate held no row of the engines it holds to a bound, else "": a check that
+        checked 0 metrics checked nothing, and fails (exit 1; a run of no rows is refused before, exit 2)."""
+        if self.held_checked if self.held is not None else self.checked:
+            return ""
+        held = ", ".join(self.held_engines) or "none"
+        return (f"0 metrics checked: no bound applies to any of the run's {self.checked + self.unchecked} rows of the "
+                f"engines held ({held}); a check that checks nothing does not pass (allowed: bounds whose scene, "
+                "engine, integrator, scheme and metric match the run's rows; 'simparity check RUN --explain ENGINE')")
 
     @property
     def held_engines(self) -> tuple[str, ...]:
@@ -383,10 +394,22 @@ class BaselineDiff:
     timing: list[str] = field(default_factory=list)
     out_of_scope: int = 0
     not_in_baseline: int = 0
+    compared: int = 0
+    """Rows both runs have (same scene, engine, integrator, dt and metric): what the comparison compared."""
 
     @property
     def blocking(self) -> bool:
-        return bool(self.moved or self.missing)
+        return bool(self.moved or self.missing or self.nothing_compared)
+
+    @property
+    def nothing_compared(self) -> str:
+        """A one-line reason when no row of this run has its counterpart in the baseline, else "": a comparison
+        that compared nothing does not pass."""
+        if self.compared:
+            return ""
+        return (f"0 rows compared: none of this run's {self.not_in_baseline + len(self.new)} rows has its scene, "
+                f"engine, integrator, dt and metric in the baseline's {self.out_of_scope + len(self.missing)} "
+                "(allowed: a baseline of the same scenes and engines)")
 
     def scope_line(self) -> str:
         """What the comparison left out, in one line ("" when both runs ran the same scenes x engines)."""
@@ -432,13 +455,14 @@ def compare_with_baseline(table: pd.DataFrame, baseline: pd.DataFrame,
                         new=[_key_label(k) for k in now.index.difference(before.index)],
                         out_of_scope=len(all_before) - len(before), not_in_baseline=len(all_now) - len(now))
     common = now.index.intersection(before.index)
+    diff.compared = len(common)
     a, b = now.loc[common], before.loc[common]
     x, y = a["value"].to_numpy(dtype=float), b["value"].to_numpy(dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
         change = np.where(y != 0, np.abs(x - y) / np.abs(y), np.where(x == 0, 0.0, np.inf))
     status_now, status_before = a["status"].to_numpy(), b["status"].to_numpy()
     retagged = status_now != status_before
-    moved = ~retagged & ~(np.isnan(x) & np.isnan(y)) & ~(change <= relative)
+    moved = ~retagged & ~(x == y) & ~(np.isnan(x) & np.isnan(y)) & ~(change <= relative)  # inf -> inf: unchanged
     timing: dict[str, list[float]] = {}
     for i in np.flatnonzero(retagged | moved):
         key = common[i]

@@ -92,8 +92,14 @@ def junit_xml(result: CheckResult, diff: BaselineDiff | None = None, unbounded: 
         case = ET.SubElement(suite, "testcase", classname="baseline", name="unchanged since the baseline", time="0")
         if diff.blocking:
             failures += 1
-            failure = ET.SubElement(case, "failure", message="numerics moved since the baseline", type="baseline")
+            failure = ET.SubElement(case, "failure", message=diff.nothing_compared[:MESSAGE_CHARS] or "numerics moved "
+                                    "since the baseline", type="baseline")
             failure.text = "\n".join(diff.moved + [f"missing: {m}" for m in diff.missing])
+    if result.nothing_checked:
+        tests += 1
+        failures += 1
+        case = ET.SubElement(suite, "testcase", classname="tolerances", name="metrics checked", time="0")
+        ET.SubElement(case, "failure", message=result.nothing_checked[:MESSAGE_CHARS], type="nothing-checked")
     if result.absent:
         tests += 1
         failures += 1
@@ -136,6 +142,8 @@ def summary_markdown(result: CheckResult, diff: BaselineDiff | None = None, unbo
              f"result (n/a); {len(result.unbounded_series)} of {len(result.series)} series without a value bound.", ""]
     if unbounded:
         lines += [f"**Too few value bounds:** {_cell(unbounded)}", ""]
+    lines += [f"**Nothing checked:** {_cell(line)}" for line in (result.nothing_checked, diff and diff.nothing_compared)
+              if line]
     lines += [f"**Required engine without a measured row:** {_cell(line)}" for line in result.absent]
     lines += [f"- tolerances: {_cell(line)}" for line in result.unmatched]
     lines += _violation_table(result.violations)

@@ -25,6 +25,7 @@ from simparity.comparisons.execute.store import DEFAULT_OUT_ROOT
 from simparity.core.model.errors import HistoryError
 from simparity.core.model.results import COLUMNS
 from simparity.core.model.run_info import RunInfo
+from simparity.reports.run_schema import RowProblem, conformed, refuse, require_text
 
 HISTORY_ENV = "SIMPARITY_HISTORY"
 DEFAULT_HISTORY = DEFAULT_OUT_ROOT / "history.sqlite"
@@ -115,18 +116,39 @@ def _query(path: Path, sql: str, params=()) -> pd.DataFrame:
         connection.close()
 
 
+_OPTIONAL_TEXT = ("integrator", "detail", "flag", "scheme", "git_commit", "command", "profile")
+"""Text columns a database may leave NULL (read as ""): a kinematics scene's integrator, the runs' columns added
+later."""
+
+
+def _conformed(path: Path, table: pd.DataFrame, row_name, text: tuple[str, ...] = ()) -> pd.DataFrame:
+    """``table`` read from the history held to the stored run's schema (:mod:`reports.run_schema`): the results'
+    columns it has, and ``text`` columns holding text; HistoryError naming the database and ``row_name(row)``."""
+    table = table.fillna({c: "" for c in _OPTIONAL_TEXT if c in table.columns})
+    try:
+        require_text(table, text)
+        return conformed(table) if "status" in table.columns and not table.empty else table
+    except RowProblem as err:
+        raise refuse(err, f"{path}: run history", row_name, HistoryError) from None
+
+
 def runs(path: Path) -> pd.DataFrame:
     """The recorded runs, oldest first: id, run_dir, created_utc, git_commit, command, profile ("": unknown)."""
-    return _query(path, "SELECT id, run_dir, created_utc, git_commit, command, profile FROM runs ORDER BY id")
+    recorded = _query(path, "SELECT id, run_dir, created_utc, git_commit, command, profile FROM runs ORDER BY id")
+    if len(recorded) and not pd.api.types.is_integer_dtype(recorded["id"].dtype):  # an id is SQLite's rowid: nothing else reads so
+        raise HistoryError(f"{path}: run history: runs.id holds {recorded['id'].dtype} (allowed: whole numbers)")
+    return _conformed(path, recorded, lambda row: f"run #{recorded['id'].iloc[row]}",
+                      ("run_dir", "created_utc", "git_commit", "command", "profile"))
 
 
 def run_table(path: Path, run_id: int) -> pd.DataFrame:
-    """The rows of one recorded run, in the columns of ``results.csv``."""
+    """The rows of one recorded run, in the columns of ``results.csv`` (``dt`` and ``value`` float64); HistoryError
+    for a run of no rows or one that breaks the stored run's schema."""
     table = _query(path, f"SELECT {', '.join(COLUMNS)} FROM results WHERE run_id = ?", (run_id,))
-    table["integrator"] = table["integrator"].fillna("")
-    table["detail"] = table["detail"].fillna("")
-    table[["flag", "scheme"]] = table[["flag", "scheme"]].fillna("")
-    return table.astype({"dt": float, "value": float})
+    if table.empty:
+        raise HistoryError(f"{path}: run #{run_id} has no rows (allowed: a run recorded with its rows, as 'simparity "
+                           "run' records it)")
+    return _conformed(path, table, lambda row: f"run #{run_id}, row {row + 1}")
 
 
 def latest_before(path: Path, run_dir: Path | None = None, profile: str = "") -> tuple[int, str]:
@@ -159,8 +181,8 @@ def metric_history(path: Path, scene: str | None = None, engine: str | None = No
     long = _query(path, query, params)
     if long.empty:
         return long
+    long = _conformed(path, long, lambda row: f"run #{long['run'].iloc[row]}", ("created",))
     long["run"] = "#" + long["run"].astype(str) + " " + long["created"]
-    long["integrator"] = long["integrator"].fillna("")
     long["dt"] = long["dt"].map(lambda d: "" if pd.isna(d) else f"{d:g}")
     long["shown"] = [f"{v:.6g}" if s == "ok" else s for v, s in zip(long["value"], long["status"])]
     return long.pivot_table(index=["scene", "engine", "integrator", "dt", "metric"], columns="run", values="shown",

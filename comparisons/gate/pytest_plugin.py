@@ -99,7 +99,8 @@ class SimparityChecker:
         held = EngineNames(tuple(check_engines), "check_engines=") if check_engines else gate.check_engines
         required = EngineNames(tuple(require_engines), "require_engines=") if require_engines else gate.require_engines
         check = held_to(result.check, held, required) if result.check is not None else None
-        problems = [g.line() for g in grouped(check.violations)] + check.absent if check is not None else []
+        problems = ([g.line() for g in grouped(check.violations)] + check.absent + [check.nothing_checked]
+                    if check is not None else [])
         for line in check.unmatched if check is not None else []:  # loud, never failing: as `simparity check` says it
             warnings.warn(f"simparity: tolerances: {line}", UserWarning, stacklevel=3)
         unbounded = "" if allow_unbounded or check is None else check.too_unbounded()
@@ -112,7 +113,8 @@ class SimparityChecker:
             diff = compare_with_baseline(table, before[before["scene"] == loaded.name],
                                          BASELINE_RELATIVE if self._relative is None else self._relative)
             problems += [f"moved since {self._baseline}: {m}" for m in diff.moved]
-            problems += [f"missing since {self._baseline}: {m}" for m in diff.missing]
+            problems += [f"missing since {self._baseline}: {m}" for m in diff.missing] + [diff.nothing_compared]
+        problems = [problem for problem in problems if problem]  # a check or comparison of nothing is a problem
         if problems:
             pytest.fail(f"simparity: {len(problems)} problem(s) in {loaded.name}:\n" + "\n".join(problems),
                         pytrace=False)

@@ -9,9 +9,40 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from simparity.core.model.errors import ResultsError, one_line
+from simparity.core.model.json_input import (
+    COUNT,
+    FINITE,
+    NUMBER,
+    SCALAR,
+    TEXT,
+    WHOLE,
+    JSONInputError,
+    list_of,
+    read_json,
+    record,
+    table_of,
+)
 from simparity.core.model.results import READ_SCHEMA_VERSIONS, SCHEMA_VERSION
 
-_MAPPINGS = ("machine", "engine_versions", "theoretical_orders", "integrator_variants", "scenes", "peak_memory")
+MAX_RUN_INFO_BYTES = 64_000_000
+"""Largest ``run.json`` read [bytes]: a scene's entry is under 1 kB, and a run of 1,000 swept variants (the most one
+file expands into) with the built-in scenes writes about 1 MB."""
+
+_ALLOWED = "the run.json 'simparity run' wrote"
+_SCENE = record(
+    "a table of what the run recorded of a scene",
+    kind=TEXT, description=TEXT, reference=TEXT, source=TEXT, suites=list_of(TEXT), bodies=COUNT,
+    headline_metric=TEXT, segments=COUNT, position_tolerance=NUMBER,
+    contact=record("a table of the scene's contact", planes=list_of(TEXT), restitution=list_of(list_of(NUMBER)),
+                   methods=list_of(TEXT), rest_speed=NUMBER),
+    sweep=record("a table of the variant's sweep", base=TEXT, index=COUNT, count=COUNT, values=table_of(NUMBER)))
+RUN_INFO_SHAPE = record(
+    f"a table (JSON object): {_ALLOWED}",
+    schema_version=WHOLE, created_utc=TEXT, command=TEXT, git_commit=TEXT, profile=TEXT,
+    machine=table_of(SCALAR), engine_versions=table_of(TEXT), theoretical_orders=table_of(table_of(FINITE)),
+    integrator_variants=table_of(table_of(list_of(TEXT, 2))), scenes=table_of(_SCENE), peak_memory=table_of(COUNT))
+"""What each key of ``run.json`` holds (the keys a report, the gate and the history read); keys a newer writer
+added are left out."""
 
 
 @dataclass(frozen=True)
@@ -50,24 +81,20 @@ class RunInfo:
 
     @classmethod
     def read(cls, path: Path) -> "RunInfo":
-        """The information in ``path``; raises ResultsError for a file that is not a run.json this simparity reads
-        (unreadable, another schema version, a field of the wrong type). Fields a newer writer added are left out."""
+        """The information in ``path``; raises ResultsError in one line naming the file and the key for a file that is
+        not a run.json this simparity reads: not a regular file, larger than :data:`MAX_RUN_INFO_BYTES`, not JSON,
+        nested too deeply or holding too long an integer (:func:`core.model.json_input.read_json`), another schema
+        version, a key holding what :data:`RUN_INFO_SHAPE` does not allow. Fields a newer writer added are left out."""
         try:
-            data = json.loads(Path(path).read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
-            raise ResultsError(f"{one_line(path)}: unreadable: {one_line(err)} (allowed: the run.json 'simparity run' "
-                               "wrote)") from None
-        if not isinstance(data, dict):
-            raise ResultsError(f"{one_line(path)}: not a run's information (allowed: the run.json 'simparity run' wrote)")
+            data = read_json(Path(path), MAX_RUN_INFO_BYTES, _ALLOWED)
+        except JSONInputError as err:
+            raise ResultsError(f"{one_line(path)}: {err}") from None
+        problem = RUN_INFO_SHAPE.problem(data)
+        if problem:
+            raise ResultsError(f"{one_line(path)}: {problem}")
+        assert isinstance(data, dict)  # the shape's first test
         if data.get("schema_version") not in READ_SCHEMA_VERSIONS:
-            raise ResultsError(f"{path}: schema_version {data.get('schema_version')!r:.20} (allowed: "
+            raise ResultsError(f"{one_line(path)}: schema_version {data.get('schema_version')!r:.20} (allowed: "
                                f"{', '.join(map(str, READ_SCHEMA_VERSIONS))}, the versions this simparity reads)")
         known = {f.name for f in dataclasses.fields(cls)}
-        values = {key: value for key, value in data.items() if key in known}
-        for key in _MAPPINGS:
-            if not isinstance(values.get(key, {}), dict):
-                raise ResultsError(f"{path}: {key} is not a table (allowed: the run.json 'simparity run' wrote)")
-        for key in ("created_utc", "command", "git_commit", "profile"):
-            if not isinstance(values.get(key, ""), str):
-                raise ResultsError(f"{path}: {key} is not text (allowed: the run.json 'simparity run' wrote)")
-        return cls(**values)
+        return cls(**{key: value for key, value in data.items() if key in known})
