@@ -74,7 +74,8 @@ DAMAGES = {
                                   ROWS),
     "unknown status": (_update("UPDATE results SET status = ? WHERE rowid = ?", ("passed",)), ROWS),
     "blob scene": (_update("UPDATE results SET scene = ? WHERE rowid = ?", (b"\x00scene",)), ROWS),
-    "blob run_dir": (_update("UPDATE runs SET run_dir = ? WHERE rowid = ?", (b"\x00\xfe",)), (EITHER, REFUSED, REFUSED)),
+    "blob run_dir": (_update("UPDATE runs SET run_dir = ? WHERE rowid = ?", (b"\x00\xfe",)),
+                     (EITHER, REFUSED, REFUSED)),
     "integer created_utc": (_update("UPDATE runs SET created_utc = ? WHERE rowid = ?", (12345,)), (EITHER,) * 3),
     "blob profile": (_update("UPDATE runs SET profile = ? WHERE rowid = ?", (b"quick",)), (EITHER, REFUSED, EITHER)),
     "results of another column set": (_script("DROP TABLE results; CREATE TABLE results (a TEXT, b BLOB);"

@@ -200,8 +200,8 @@ def _scene(text: str, names: tuple[str, ...], folder: Path, base: Base, run: boo
     path = folder / SCENE_FILE
     path.write_text(text, encoding="utf-8")
     if run:  # a subprocess: what a diverging case prints on stderr is seen
-        return Call(argv=("run", str(path), "--engines", "core", "--jobs", "1", "--quick", "--out", str(folder / "out")),
-                    names=names, subprocess=True)
+        argv = ("run", str(path), "--engines", "core", "--jobs", "1", "--quick", "--out", str(folder / "out"))
+        return Call(argv=argv, names=names, subprocess=True)
     return Call(argv=("show", str(path)), names=names)
 
 

@@ -146,7 +146,8 @@ def run_cases(rng: np.random.Generator) -> list[Case]:
             found.append(Case(RUN_FAMILY, f"run --check {option} {kind}", partial(_run_output, option, kind)))
     found.append(Case(RUN_FAMILY, "run --check --junit a folder (subprocess)",
                       partial(_run_output, "--junit", "a folder", subprocess=True)))
-    found += [Case(RUN_FAMILY, f"export --dt {value}", partial(_export_dt, value)) for value in NUMBERS[:-1] + ("5e-324",)]
+    found += [Case(RUN_FAMILY, f"export --dt {value}", partial(_export_dt, value))
+              for value in NUMBERS[:-1] + ("5e-324",)]
     found += [Case(RUN_FAMILY, f"run --resume {kind}", partial(_resume, kind)) for kind in IN_PATHS]
     return found
 

@@ -206,5 +206,7 @@ def _last_line(outcome: Outcome) -> str:
 
 
 def failure_class(verdict: str) -> str:
-    """The class of a verdict of :func:`judge`, without the input's own text (to group failures)."""
-    return verdict.split(":")[0]
+    """The class of a verdict of :func:`judge`, without the input's own text (to group failures): what escaped or
+    warned is named by its type."""
+    parts = verdict.split(":")
+    return ":".join(parts[:2]) if parts[0] in ("traceback", "warning") else parts[0]

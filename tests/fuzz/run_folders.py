@@ -198,8 +198,8 @@ def _digits(data, rng):
     big = "1" + "0" * 5000
     if key == "schema_version":
         return json.dumps(data).replace('"schema_version": 2', f'"schema_version": {big}')
-    return json.dumps(dict(data, peak_memory={}))[:-1].replace('"peak_memory": {}', '"peak_memory": {"this_process_bytes": '
-                                                                + big + "}") + "}"
+    text = json.dumps(dict(data, peak_memory={}))
+    return text.replace('"peak_memory": {}', '"peak_memory": {"this_process_bytes": ' + big + "}")
 
 
 def _scenes_entry_text(data, rng):
@@ -319,7 +319,8 @@ def _cases(family: str, damages: dict[str, tuple[Damage, frozenset[int], str]], 
         routes = ("check", "read_run") + (("baseline",) if name in baseline else ()) + (("report",) if name in reported
                                                                                         else ())
         for route in routes:
-            found.append(Case(family, f"{name} via {route}", partial(_build, damage, seed_of(rng), route, file), accept))
+            build = partial(_build, damage, seed_of(rng), route, file)
+            found.append(Case(family, f"{name} via {route}", build, accept))
     return found
 
 
