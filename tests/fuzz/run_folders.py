@@ -21,6 +21,9 @@ ROUTES = ("check", "read_run", "baseline")
 ``report`` (seconds per input when it renders) takes :data:`REPORTED` drawn damages."""
 REPORTED = 4
 """Damages of each file also tried through ``simparity report``, drawn by the generator's seed."""
+RUN_BASELINE = ("header only", "nan value with status ok", "binary results.csv")
+"""results.csv damages also given as ``simparity run --check --baseline DIR`` (a run of the tiny scene, seconds, where
+the baseline is read only when the run is done)."""
 
 Damage = Callable[[Path, np.random.Generator], None]
 """Breaks the run copied into the given folder, with its own seeded generator."""
@@ -296,6 +299,9 @@ def _build(damage: Damage, seed: int, route: str, file: str, folder: Path, base:
         return Call(function=partial(read_run, run), names=names)
     if route == "baseline":
         return Call(argv=("check", str(base.run_dir), "--baseline", str(run)), names=names)
+    if route == "run --baseline":
+        return Call(argv=("run", str(base.scene), "--engines", "core", "--jobs", "1", "--quick", "--out",
+                          str(folder / "out"), "--check", "--allow-unbounded", "--baseline", str(run)), names=names)
     return Call(argv=(route, str(run)), names=names)
 
 
@@ -328,6 +334,10 @@ def results_cases(rng: np.random.Generator) -> list[Case]:
     """results.csv damages, and the controls: the valid run, and one stored without series."""
     found = _cases("run_results", {name: (damage, accept, "results.csv")
                                    for name, (damage, accept) in RESULTS_DAMAGES.items()}, rng)
+    for name in RUN_BASELINE:
+        damage, accept = RESULTS_DAMAGES[name]
+        found.append(Case("run_results", f"{name} via run --baseline",
+                          partial(_build, damage, seed_of(rng), "run --baseline", "results.csv"), accept))
     for route in ROUTES:
         found.append(Case("run_results", f"control: the valid run via {route}", partial(_control, route), VALID))
         found.append(Case("run_results", f"control: no series.csv.gz via {route}", partial(_no_series, route), VALID,
