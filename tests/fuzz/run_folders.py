@@ -214,7 +214,7 @@ def _orders_text(data, rng):
     orders[pick(rng, sorted(orders))] = pick(rng, ("four", "1", "", "nan"))
 
 
-def _orders_nonfinite(data, rng):
+def _orders_out_of_range(data, rng):
     orders = data["theoretical_orders"]["core"]
     orders[pick(rng, sorted(orders))] = pick(rng, (float("nan"), float("inf"), -1, 10**30))
 
@@ -246,7 +246,7 @@ RUN_INFO_DAMAGES: dict[str, tuple[Damage, frozenset[int]]] = {
     "run.json 5001-digit integer": (_json(_digits), REFUSED),
     "run.json scenes entry a string": (_json(_scenes_entry_text), REFUSED),
     "run.json theoretical order a string": (_json(_orders_text), REFUSED),
-    "run.json theoretical order not finite": (_json(_orders_nonfinite), REFUSED),
+    "run.json theoretical order not a positive number": (_json(_orders_out_of_range), REFUSED),
     "run.json integrator variant not a pair": (_json(_variants_text), REFUSED),
     "run.json engine version not text": (_json(_versions_not_text), REFUSED),
     **{f"run.json {key} of a wrong type": (_json(_wrong_type(key)), REFUSED) for key in RUN_INFO_KEYS},
