@@ -138,7 +138,10 @@ def run_cases(rng: np.random.Generator) -> list[Case]:
             found.append(Case(RUN_FAMILY, f"run {option} {value!r}", partial(_run_option, option, value)))
     found += [Case(RUN_FAMILY, f"run --transform {value!r}", partial(_run_option, "--transform", value))
               for value in ("nosuch", "translate,nosuch")]
-    found += [Case(RUN_FAMILY, f"run --engines {value}", partial(_run_engines, value)) for value in NOT_ENGINES]
+    # a module that does not import is an engine unavailable here (n/a rows with the reason, like a missing library):
+    # exit 1 or a refusal; an attribute that is no engine class is refused
+    found += [Case(RUN_FAMILY, f"run --engines {value}", partial(_run_engines, value),
+                   FAILS if value.startswith("nosuchmodule:") else REFUSED) for value in NOT_ENGINES]
     # never --out /: a simparity that does not refuse it writes a run into the root folder
     found += [Case(RUN_FAMILY, f"run --out {kind}", partial(_run_out, kind)) for kind in ("/dev/full", "/proc", "''")]
     drawn = [str(k) for k in rng.choice([k for k in OUT_PATHS if k != "missing parents"], 2, replace=False)]
