@@ -32,8 +32,9 @@ def test_nothing_is_drawn_when_not_on_a_terminal():
     assert stream.getvalue() == "" and not bar.active and bar.done == 3
 
 
-def test_time_left_is_the_modelled_cost_still_to_run_at_the_pace_measured():
+def test_time_left_is_the_modelled_cost_still_to_run_at_the_pace_measured(monkeypatch):
     """Issue #39: a cheap case done in 10 s, a case modelled 99 x costlier to go: 990 s left, not 10 s."""
+    monkeypatch.setenv("COLUMNS", "200")  # the bar is cut to the terminal's width: a wide one shows the whole line
     clock = iter([0.0, 10.0]).__next__
     stream = _Terminal()
     costs = {("chain", "pinocchio", "recursive"): 1.0, ("chain", "core", "jacobian_sum"): 99.0}
