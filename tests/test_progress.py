@@ -3,8 +3,16 @@ process ran it: tests/test_execution.py)."""
 
 import io
 
+import pytest
+
 from simparity.comparisons.execute.estimate import RunEstimate
 from simparity.comparisons.execute.progress import ProgressBar
+
+
+@pytest.fixture(autouse=True)
+def _wide_terminal(monkeypatch):
+    """The bar is cut to the terminal's width (COLUMNS first): a wide one shows the whole line."""
+    monkeypatch.setenv("COLUMNS", "200")
 
 
 class _Terminal(io.StringIO):
@@ -32,9 +40,8 @@ def test_nothing_is_drawn_when_not_on_a_terminal():
     assert stream.getvalue() == "" and not bar.active and bar.done == 3
 
 
-def test_time_left_is_the_modelled_cost_still_to_run_at_the_pace_measured(monkeypatch):
+def test_time_left_is_the_modelled_cost_still_to_run_at_the_pace_measured():
     """Issue #39: a cheap case done in 10 s, a case modelled 99 x costlier to go: 990 s left, not 10 s."""
-    monkeypatch.setenv("COLUMNS", "200")  # the bar is cut to the terminal's width: a wide one shows the whole line
     clock = iter([0.0, 10.0]).__next__
     stream = _Terminal()
     costs = {("chain", "pinocchio", "recursive"): 1.0, ("chain", "core", "jacobian_sum"): 99.0}
