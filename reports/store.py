@@ -247,8 +247,11 @@ def read_series(run_dir: str | Path) -> pd.DataFrame:
     float64); empty for a run stored without them. Raises ResultsError, in one line naming the file and the row or
     column, for a file that is not gzip, not CSV, has other columns, text where a number belongs or a row cut short."""
     path = Path(run_dir) / SERIES_FILE
-    if not path.is_file():
+    if not path.exists():
         return pd.DataFrame(columns=list(SERIES_COLUMNS))
+    if not path.is_file():
+        raise ResultsError(f"{one_line(path)}: not a regular file (allowed: {_ALLOWED_SERIES}, or no such file: a run "
+                           "stored without series)")
     try:
         series = _read_table(path, [c for c in SERIES_COLUMNS if c not in SERIES_NUMBERS], SERIES_NUMBERS,
                              compression="gzip")

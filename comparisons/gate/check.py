@@ -190,7 +190,9 @@ def check_table(table: pd.DataFrame, bounds: list[Bound], cross_checked: bool = 
         if series in result.series:
             result.series[series] = True
     result.unmeasured = {key: reason for key, reason in measured.items() if reason is not None and not result.cases[key]}
-    result.unmatched = unmatched_bounds(table, [b for b in index.unmatched() if not b.shipped])
+    values = _run_values(table)
+    refuse_impossible([b for b in bounds if not b.shipped], values)  # each pattern of a list, matched or not
+    result.unmatched = unmatched_bounds(table, [b for b in index.unmatched() if not b.shipped], values)
     return result
 
 
@@ -242,11 +244,17 @@ UNMATCHED_KEYS = ("scene", "engine", "integrator", "scheme", "metric")
 """A bound's patterns a run's rows are searched for, in this order, to say why the bound matched no row."""
 
 
-def unmatched_bounds(table: pd.DataFrame, bounds: list[Bound]) -> list[str]:
+def _run_values(table: pd.DataFrame) -> dict[str, list[str]]:
+    """The run's distinct values of each of :data:`UNMATCHED_KEYS`."""
+    return {key: sorted(set(table[key].fillna("").astype(str))) if key in table else [""] for key in UNMATCHED_KEYS}
+
+
+def unmatched_bounds(table: pd.DataFrame, bounds: list[Bound], values: dict[str, list[str]] | None = None) -> list[str]:
     """One line per bound (of a user's file) that matched no row: the first of its keys none of whose patterns matches
-    any of the run's values of that column, else that no row matches them together (a time step, a reference). A
-    pattern that matches nothing that exists either is refused (:func:`refuse_impossible`, exit 2)."""
-    values = {key: sorted(set(table[key].fillna("").astype(str))) if key in table else [""] for key in UNMATCHED_KEYS}
+    any of the run's values of that column (``values``, default: read from ``table``), else that no row matches them
+    together (a time step, a reference). A pattern that matches nothing that exists either is refused
+    (:func:`refuse_impossible`, exit 2)."""
+    values = _run_values(table) if values is None else values
     refuse_impossible(bounds, values)
     missing = {key: unmatched_patterns({p for bound in bounds for p in patterns_of(bound, key)}, values[key])
                for key in UNMATCHED_KEYS}

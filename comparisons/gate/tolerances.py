@@ -421,7 +421,11 @@ def _extended(path: Path, extends, chain: tuple[Path, ...]) -> Gate:
     if len(chain) >= MAX_EXTENDS_DEPTH:
         raise ToleranceError(str(path), "extends", f"more than {MAX_EXTENDS_DEPTH} files in a chain of extends",
                              allowed)
-    return _load(target, chain)
+    try:
+        return _load(target, chain)
+    except ToleranceError as err:  # the message names the file the user gave, and the file its extends reached
+        raise ToleranceError(str(path), "extends", f"{extends!r:.80}: {one_line(err.source)}: {err.key}: "
+                             f"{err.problem}", err.allowed) from None
 
 
 def matching_bounds(bounds: list[Bound], scene: str, engine: str, integrator: str, metric: str,

@@ -116,6 +116,7 @@ WHOLE = Shape("a whole number", lambda v: isinstance(v, int) and not isinstance(
 COUNT = Shape("a whole number >= 0", lambda v: WHOLE.accepts(v) and v >= 0)  # type: ignore[operator]
 NUMBER = Shape("a number", _is_number)
 FINITE = Shape("a finite number", lambda v: _is_number(v) and math.isfinite(v))  # type: ignore[arg-type]
+POSITIVE = Shape("a finite number > 0", lambda v: FINITE.accepts(v) and v > 0)  # type: ignore[operator]
 SCALAR = Shape("text, a number, a boolean or null", lambda v: v is None or isinstance(v, (str, int, float, bool)))
 
 

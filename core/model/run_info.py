@@ -11,8 +11,8 @@ from pathlib import Path
 from simparity.core.model.errors import ResultsError, one_line
 from simparity.core.model.json_input import (
     COUNT,
-    FINITE,
     NUMBER,
+    POSITIVE,
     SCALAR,
     TEXT,
     WHOLE,
@@ -39,7 +39,7 @@ _SCENE = record(
 RUN_INFO_SHAPE = record(
     f"a table (JSON object): {_ALLOWED}",
     schema_version=WHOLE, created_utc=TEXT, command=TEXT, git_commit=TEXT, profile=TEXT,
-    machine=table_of(SCALAR), engine_versions=table_of(TEXT), theoretical_orders=table_of(table_of(FINITE)),
+    machine=table_of(SCALAR), engine_versions=table_of(TEXT), theoretical_orders=table_of(table_of(POSITIVE)),
     integrator_variants=table_of(table_of(list_of(TEXT, 2))), scenes=table_of(_SCENE), peak_memory=table_of(COUNT))
 """What each key of ``run.json`` holds (the keys a report, the gate and the history read); keys a newer writer
 added are left out."""
