@@ -77,6 +77,23 @@ def test_a_pattern_that_matches_nothing_that_exists_is_refused_with_the_closest_
     assert (f"closest: {closest}" in err) if closest else "closest" not in err
 
 
+def test_each_pattern_of_a_list_is_held_even_when_the_bound_matched_rows(tmp_path, capsys):
+    """A scheme list whose first pattern matches the run's rows and whose second matches nothing that exists."""
+    run = _stored(tmp_path / "run", _rows())
+    code, out, err = _check(capsys, run, _file(tmp_path, _bound(scheme=["rk4", "nosuch"], max=1.0)))
+    assert code == EXIT_USAGE and out == "" and "bound[0].scheme: 'nosuch' matches no scheme that exists" in err
+
+
+def test_a_file_reached_through_extends_is_named_with_the_file_given(tmp_path, capsys):
+    """The user gave mine.toml; its extends names base.toml, whose bound is refused: the line names both."""
+    run = _stored(tmp_path / "run", _rows())
+    _file(tmp_path, _bound(min=2.0, max=1.0), "base.toml")
+    path = _file(tmp_path, 'extends = "base.toml"\n' + _bound(max=1.0))
+    code, _, err = _check(capsys, run, path)
+    assert code == EXIT_USAGE and len(err.strip().splitlines()) == 1
+    assert err.startswith(f"simparity: error: {path}: extends: 'base.toml': ") and "base.toml: bound[0]" in err
+
+
 @pytest.mark.parametrize("key, pattern", [("scene", "ur.*"), ("engine", "(core|mujoco)"), ("scene", "^wind$"),
                                           ("integrator", "rk4.+"), ("scene", r"ur\d-ik")])
 def test_a_regular_expression_where_a_glob_is_meant_is_refused_saying_so(tmp_path, capsys, key, pattern):
