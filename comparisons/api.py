@@ -13,6 +13,7 @@ from simparity.comparisons.execute.session import IN_PROCESS, ISOLATED, Executio
 from simparity.comparisons.scenes import library
 from simparity.comparisons.scenes.loader import load_scene as load_scene_file
 from simparity.core.model.scene import Scene
+from simparity.core.model.scene_ranges import check_scene_ranges
 
 
 def load_scene(name_or_path: str | Path) -> Scene:
@@ -66,6 +67,8 @@ def run_scene(scene: Scene | str | Path, engines=DEFAULT_ENGINES, repeats: int =
     """
     if isinstance(scene, (str, Path)):
         scene = load_scene(scene)
+    else:  # built in code: held to the ranges a scene file is held to as it is read
+        check_scene_ranges(scene)
     engine_set = EngineSet(check_engine_names(engine_specs(engines)))
     execution = Execution(ISOLATED if isolate else IN_PROCESS, default_jobs() if jobs is None else jobs)
     return Session([scene], engine_set, profile=profile, repeats=repeats, execution=execution).run().table

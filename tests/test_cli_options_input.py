@@ -334,7 +334,7 @@ FUZZ_SEED = 39
 LIST_TOKENS = ("core", "mujoco", "", " ", "core", "translate", "rotate", "\t", "é", "x" * 80, "a:b", "-", "*")
 NUMBERS = {  # value: meaningless for the option (refused naming it) or not
     "--case-timeout": {"nan": True, "inf": True, "-inf": True, "0": True, "-1": True, "1e309": True, "0x10": True,
-                       "": True, "1e-320": False, "5": False},
+                       "": True, "1e-320": True, "0.5": True, "1e8": True, "1": False, "5": False},
     "--case-memory": {"nan": True, "inf": True, "0": True, "-0": True, "0.1": True, "1e6": False, "1e7": True,
                       "1": False, "١": False},  # an Arabic-Indic one is a number to Python: taken, as 1
     "--repeats": {"-1": True, "101": True, "1.0": True, "nan": True, "0": False, "3": False, "1_0": False},

@@ -53,7 +53,13 @@ from simparity.comparisons.gate.history import (
     recorded_scenes,
 )
 from simparity.comparisons.execute.execution import default_jobs
-from simparity.comparisons.execute.isolation import GIB, MIN_CASE_MEMORY_BYTES, CaseLimits
+from simparity.comparisons.execute.isolation import (
+    GIB,
+    MAX_CASE_SECONDS,
+    MIN_CASE_MEMORY_BYTES,
+    MIN_CASE_SECONDS,
+    CaseLimits,
+)
 from simparity.comparisons.execute.journal import CASES_FOLDER, Journal, read_request
 from simparity.comparisons.engines.placeholders import BrokenEngine, UnavailableEngine
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS
@@ -152,8 +158,9 @@ def _request(args, names: tuple[str, ...], repeats: int) -> dict:
 
 def _limits(args, jobs: int) -> CaseLimits:
     """The per-case limits from --case-timeout and --case-memory (default: a share of the machine a case runs on)."""
-    if not (math.isfinite(args.case_timeout) and args.case_timeout > 0):
-        raise SimparityError(f"--case-timeout {args.case_timeout}: out of range (allowed: a number of seconds > 0)")
+    if not MIN_CASE_SECONDS <= args.case_timeout <= MAX_CASE_SECONDS:  # False for nan
+        raise SimparityError(f"--case-timeout {args.case_timeout:g}: out of range (allowed: seconds from "
+                             f"{MIN_CASE_SECONDS:g}, a case's fixed cost with room, to {MAX_CASE_SECONDS:g})")
     if args.case_memory is None:  # on Dask, each node's own default
         return CaseLimits(args.case_timeout, CaseLimits.default(jobs).memory_bytes if args.executor == "local" else None)
     floor = MIN_CASE_MEMORY_BYTES / GIB

@@ -7,7 +7,13 @@ from pathlib import Path
 
 from simparity.comparisons.engines.registry import DEFAULT_ENGINES, allowed_engines
 from simparity.comparisons.execute.execution import default_jobs
-from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS, GIB, MIN_CASE_MEMORY_BYTES
+from simparity.comparisons.execute.isolation import (
+    DEFAULT_CASE_SECONDS,
+    GIB,
+    MAX_CASE_SECONDS,
+    MIN_CASE_MEMORY_BYTES,
+    MIN_CASE_SECONDS,
+)
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS
 from simparity.comparisons.execute.store import DEFAULT_OUT_ROOT
 from simparity.comparisons.gate.check import BASELINE_RELATIVE, UNBOUNDED_SHARE_MAX
@@ -157,8 +163,8 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--scheduler", type=name_argument, default=None, metavar="ADDRESS",
                      help="with --executor dask: the scheduler of a running cluster, e.g. tcp://10.0.0.5:8786")
     run.add_argument("--case-timeout", type=float, default=DEFAULT_CASE_SECONDS, metavar="SECONDS",
-                     help="a case still running after this long is killed and becomes a failed row (default: "
-                     f"{DEFAULT_CASE_SECONDS:g})")
+                     help="a case still running after this long is killed and becomes a failed row (from "
+                     f"{MIN_CASE_SECONDS:g} to {MAX_CASE_SECONDS:g}; default: {DEFAULT_CASE_SECONDS:g})")
     run.add_argument("--case-memory", type=float, default=None, metavar="GIB",
                      help="a case whose worker's resident memory passes this is killed and becomes a failed row "
                      f"(default: {MEMORY_HELP}; at least {MIN_CASE_MEMORY_BYTES / GIB:.3g}, what an idle worker with "

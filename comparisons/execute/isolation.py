@@ -33,6 +33,14 @@ DEFAULT_CASE_SECONDS = 900.0
 """Per-case time limit [s] by default: 15 minutes, ~5x the longest case of the built-in suites (the
 bench suite's 10,000 IK targets on PyBullet, ~3 min); a case that needs more is given --case-timeout."""
 
+MIN_CASE_SECONDS = 1.0
+"""The shortest per-case time limit --case-timeout takes [s]: a case's fixed cost alone (a child forked, the engine's
+model built, its rows sent back) is modelled at 0.5 s (``execute/estimate.py`` CASE_OVERHEAD_SECONDS); below a second
+cases are killed before they measure anything."""
+
+MAX_CASE_SECONDS = 1e7
+"""The longest per-case time limit [s]: four months, the longest scene duration a scene file may give."""
+
 MEMORY_SHARE = 0.8
 """Share of the machine's memory the workers may use together by default; the rest is the system's
 and the parent's."""

@@ -38,6 +38,12 @@ class SimparityChecker:
     def __init__(self, baseline: str | None, relative: float | None, test_folder: Path | None = None) -> None:
         if relative is not None and not (relative >= 0 and relative < float("inf")):
             raise pytest.UsageError(f"--simparity-baseline-rel {relative}: out of range (allowed: a number >= 0)")
+        if baseline is not None and not baseline.strip():  # never read as "no baseline"
+            raise pytest.UsageError("--simparity-baseline '': an empty path (allowed: a stored run's folder, or leave "
+                                    "the option out for no baseline)")
+        if relative is not None and baseline is None:
+            raise pytest.UsageError("--simparity-baseline-rel without --simparity-baseline: it compares with nothing "
+                                    "(allowed: both, or neither)")
         self._baseline, self._relative, self._folder = baseline, relative, test_folder
 
     def _path(self, name: str | Path) -> str | Path:
@@ -83,6 +89,7 @@ class SimparityChecker:
 
         from simparity.comparisons.scenes.profiles import PROFILES
         from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
+        from simparity.core.model.scene_ranges import check_scene_ranges
 
         if profile not in PROFILES or not isinstance(repeats, int) or not 0 <= repeats <= 100:
             raise SimparityError(f"profile {profile!r:.40}, repeats {repeats!r:.20}: out of range (allowed: profile "
@@ -91,6 +98,7 @@ class SimparityChecker:
             raise SimparityError(f"scene {scene!r:.60}: not a scene (allowed: a built-in name, a scene file's path, "
                                  "or a loaded scene)")
         loaded = load_scene(self._path(scene)) if isinstance(scene, (str, Path)) else scene
+        check_scene_ranges(loaded)  # a scene built in code, held as a file's is as it is read
         gate = load_gate(self._path(tolerances) if tolerances else DEFAULT_TOLERANCES)
         session = Session([loaded], EngineSet(check_engine_names(engine_specs(engines))), profile=profile,
                           repeats=repeats, execution=Execution(ISOLATED if isolate else IN_PROCESS), bounds=gate.bounds)
