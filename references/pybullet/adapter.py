@@ -108,6 +108,7 @@ from simparity.references.common.conventions import (
 )
 from simparity.references.pybullet.quiet import pybullet
 from simparity.references.common.quiet import captured_output
+from simparity.references.common.dynamics_urdf import dynamics_urdf
 from simparity.references.common.urdf_export import (
     UrdfChains,
     body_urdf,
@@ -462,6 +463,28 @@ class PybulletChain(KinematicsModel):
         return self.base.jacobian(out)
 
 
+MAX_LINKS = 127
+"""The most links of a body whose joint states PyBullet reads back: its shared-memory API sizes them by
+MAX_DEGREE_OF_FREEDOM = MAX_NUM_LINKS = 128 (``SharedMemoryPublic.h``), and measured (pybullet 3.2, fresh clients,
+with or without a fixed last joint) a body of 127 links reads, one of 128 fails every getJointState ('getJointState
+failed', joint 0 too). A URDF's links past its root are its joints."""
+
+
+def _links_support(urdf_text: str) -> Support:
+    """No when the URDF PyBullet is given has more links (joints) than :data:`MAX_LINKS`."""
+    links = urdf_text.count("<joint ")  # the adapter's own serialisation: one '<joint ' per joint element
+    if links > MAX_LINKS:
+        return Support.no(f"PyBullet reads back the joint states of at most {MAX_LINKS} links per body (its "
+                          f"shared-memory MAX_DEGREE_OF_FREEDOM); this chain's URDF has {links}")
+    return Support.yes()
+
+
+def _dynamics_support(chain: Chain) -> Support:
+    """Whether PyBullet can hold the chain's dynamics: no armature, at most :data:`MAX_LINKS` links."""
+    armature = _armature_support(chain)
+    return _links_support(dynamics_urdf(chain)) if armature.ok else armature
+
+
 def _armature_support(chain: Chain) -> Support:
     """PyBullet has no joint armature: no when a joint of ``chain`` declares one."""
     armature = [j for j in chain.joints if j.armature > 0]
@@ -524,12 +547,16 @@ class PybulletEngine(UrdfChains, Engine):
         from its simulator's articulated-body algorithm (:mod:`references.pybullet.joint_dynamics`)."""
         return ("recursive",)
 
+    def supports_kinematics(self, chain: Chain) -> Support:
+        named = super().supports_kinematics(chain)
+        return _links_support(chain_urdf(chain)) if named.ok else named
+
     def supports_joint_dynamics(self, chain: Chain, method: str) -> Support:
         named = super().supports_joint_dynamics(chain, method)
         problem = chain.dynamics_problem() if named.ok else ""
         if problem:
             return Support.no(problem)
-        return _armature_support(chain) if named.ok else named
+        return _dynamics_support(chain) if named.ok else named
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
         # imported here: joint_dynamics reuses this module's client and loader
@@ -543,7 +570,7 @@ class PybulletEngine(UrdfChains, Engine):
 
     def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
         named = super().supports_joint_motion(scene, integrator)
-        return _armature_support(scene.chain) if named.ok else named
+        return _dynamics_support(scene.chain) if named.ok else named
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         # imported here: joint_motion reuses this module's client, loader and chain kinematics
