@@ -337,6 +337,7 @@ class _Builder:
     def figure(self, fig, name: str, caption: str) -> list[Block]:
         if fig is None:
             return []
+        name = figures.figure_stem(name)  # a stored run's scene name never leads out of figures/
         self.svgs[name] = self.writer.submit(fig, self.figure_dir, name)
         return [Figure(name, caption)]
 

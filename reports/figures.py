@@ -13,6 +13,7 @@ import math
 import multiprocessing
 import os
 import pickle
+import re
 import signal
 from collections.abc import Mapping
 from pathlib import Path
@@ -409,6 +410,15 @@ def sweep_parameter_figure(base: str, panels: list[tuple[str, pd.DataFrame]], ke
     axes[-1, 0].set(xlabel=name, xscale="log" if log_x else "linear")
     legend(axes[0, 0])
     return finish(fig, row_gap=_PANEL_GAP)
+
+
+_UNSAFE = re.compile(r"[^A-Za-z0-9_.-]")
+
+
+def figure_stem(name: str) -> str:
+    """A figure's file name (without suffix) from a name built of a scene's: every character but letters, digits and
+    ``_ . -`` made ``_`` and no leading dot, so no name (``../x``, ``/abs``, ``a/b``) leads out of the folder."""
+    return _UNSAFE.sub("_", name).lstrip(".") or "figure"
 
 
 def save(fig, folder: Path, name: str) -> str:

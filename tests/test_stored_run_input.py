@@ -246,6 +246,13 @@ RUN_INFOS = {
     "a list": ("[]", "a list [] (allowed: a table (JSON object)"),
     "not JSON": ("{'single': 'quotes'}", "not JSON: "),
     "not UTF-8": (b"{\"command\": \"\xff\"}", "unreadable: 'utf-8' codec can't decode"),
+    "a NaN literal": ('{"schema_version": 2, "machine": {"cpus": NaN}}', "NaN, which is not JSON"),
+    "a key given twice": ('{"schema_version": 99, "schema_version": 2}', "the key 'schema_version' given twice"),
+    "a lone surrogate escape": ('{"schema_version": 2, "engine_versions": {"core": "\\udcff 1.0"}}',
+                                "a lone surrogate escape"),
+    "a headline no report ranks by": (
+        lambda info: info | {"scenes": {SCENE: info["scenes"][SCENE] | {"headline_metric": "nope"}}},
+        f"scenes.{SCENE}.headline_metric: text 'nope' (allowed: one of position_error_max"),
 }
 
 

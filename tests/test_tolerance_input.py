@@ -232,3 +232,13 @@ def test_a_truth_is_held_to_zero_against_itself_only():
     assert sorted(v.metric for v in own.violations) == ["impact_time_error", "position_error_max"]
     assert other.passed and other.checked == 2
     assert math.isclose(own.checked, other.checked)
+
+
+@pytest.mark.parametrize("digits", [400, 5001])
+def test_an_integer_beyond_any_float_is_refused_in_one_line(tmp_path, capsys, digits):
+    """Held-out review of #39: 1 followed by 400 zeros overflowed a float (OverflowError); 5,001 digits pass Python's
+    integer-string limit (ValueError inside the TOML parser)."""
+    run = _stored(tmp_path / "run", _rows())
+    path = _file(tmp_path, f'[[bound]]\nmetric = "position_error_max"\nmax = 1{"0" * digits}\nreason = "r"\n')
+    code, out, err = _check(capsys, run, path)
+    assert code == EXIT_USAGE and out == "" and len(err.strip().splitlines()) == 1 and str(path) in err

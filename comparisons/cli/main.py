@@ -47,6 +47,7 @@ from simparity.comparisons.engines.registry import (
     make_engine,
 )
 from simparity.comparisons.gate.history import (
+    check_usable,
     history_path,
     latest_before,
     metric_history,
@@ -207,6 +208,7 @@ def cmd_run(args, out) -> int:
             baseline_run(args.baseline)
     held = _engine_names(gate, args)[0] if gate is not None else None
     out_dir = _out_dir(args)
+    check_usable(history_path(args.history))  # the run is recorded there: a database it cannot record in, said now
 
     def say(line: str) -> None:
         print(line, file=out, flush=True)

@@ -57,6 +57,15 @@ def history_path(option: str | None = None) -> Path:
     return Path(option or os.environ.get(HISTORY_ENV) or DEFAULT_HISTORY)
 
 
+def check_usable(path: Path) -> None:
+    """Raise :class:`HistoryError` (one line) when ``path`` exists and is no history database this simparity can
+    record in (a folder, a text file, a damaged database): said before a run, never after it."""
+    if path.exists() or path.is_symlink():
+        if not path.is_file():
+            raise HistoryError(f"{path}: not a regular file (allowed: an SQLite file simparity wrote, or a new path)")
+        _connect(path, create=False).close()
+
+
 def _connect(path: Path, create: bool) -> sqlite3.Connection:
     if not create and not path.is_file():
         raise HistoryError(f"{path}: no run history here (allowed: a database 'simparity run' wrote; --history PATH or $SIMPARITY_HISTORY points at it)")

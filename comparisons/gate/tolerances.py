@@ -216,12 +216,19 @@ class Bound:
         return f"<= {high:.3g}" if self.max is not None else f">= {low:.3g}"
 
 
+FLOAT_BITS = 1024
+"""The bits of the largest integer a float64 holds (~1.8e308): a larger one cannot be compared, nor printed in full."""
+
+
 def _weight(pattern: str) -> int:
     """How specific one pattern is: 0 for ``*``, 1 for another pattern, 2 for a name written out."""
     return 0 if pattern == "*" else 1 if any(c in pattern for c in "*?[") else 2
 
 
 def _number(source: str, key: str, value, non_negative: bool = False) -> float:
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > FLOAT_BITS:
+        raise ToleranceError(source, key, f"an integer of {value.bit_length():,} bits, beyond any float",
+                             "finite numbers")
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise ToleranceError(source, key, f"expected a finite number, got {value!r:.60}", "finite numbers")
     if non_negative and value < 0:

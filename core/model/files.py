@@ -104,6 +104,9 @@ def read_toml(path: str | os.PathLike, max_bytes: int = MAX_FILE_BYTES, what: st
         raise SceneError(source, key, f"not valid TOML: {problem}", "TOML (https://toml.io)") from None
     except RecursionError:
         raise SceneError(source, "-", "arrays or tables nested too deeply", MAX_NESTING_HINT) from None
+    except ValueError as err:  # an integer beyond Python's 4,300 digits (tomllib raises no TOMLDecodeError for it)
+        raise SceneError(source, "-", f"a number too long to read: {str(err).split(';')[0]}", "numbers a float64 "
+                         "holds (at most ~1.8e308)") from None
 
 
 MAX_XML_DEPTH = 100

@@ -67,9 +67,56 @@ def read_json(path: Path, max_bytes: int, allowed: str) -> object:
     if depth > MAX_JSON_DEPTH:
         raise JSONInputError(f"nested {depth:,} levels deep (allowed: at most {MAX_JSON_DEPTH}; {allowed})")
     try:
-        return json.loads(text, parse_int=_integer)
+        value = json.loads(text, parse_int=_integer, parse_constant=_constant, object_pairs_hook=_table)
     except json.JSONDecodeError as err:
         raise JSONInputError(f"not JSON: {one_line(err)} (allowed: {allowed})") from None
+    except _NotJSON as err:
+        raise JSONInputError(f"{err} (allowed: {allowed})") from None
+    lone = _lone_surrogate(value)
+    if lone is not None:
+        raise JSONInputError(f"text holding a lone surrogate escape {lone!r:.40} (allowed: {allowed}, UTF-8 text)")
+    return value
+
+
+class _NotJSON(JSONInputError):
+    """A value JSON does not have, or a table JSON leaves ambiguous (the file's ``allowed`` is added to it)."""
+
+
+def _constant(name: str) -> float:
+    """``NaN``, ``Infinity``, ``-Infinity``: not JSON (Python's writer alone emits them), never a run's value."""
+    raise _NotJSON(f"{name}, which is not JSON")
+
+
+def _table(pairs: list[tuple[str, object]]) -> dict:
+    """A JSON object whose keys are distinct (a repeated key would be read as its last value, silently)."""
+    table = dict(pairs)
+    if len(table) != len(pairs):
+        seen: set[str] = set()
+        twice = next(key for key, _ in pairs if key in seen or seen.add(key))  # type: ignore[func-returns-value]
+        raise _NotJSON(f"the key {twice!r:.40} given twice")
+    return table
+
+
+def _lone_surrogate(value: object) -> str | None:
+    """The first text (key or value) in ``value`` holding a lone UTF-16 surrogate (``"\\ud800"``), else None: it
+    cannot be written back as UTF-8."""
+    stack = [value]
+    while stack:
+        item = stack.pop()
+        texts: list[object] = []
+        if isinstance(item, dict):
+            texts, stack = list(item), stack + list(item.values())
+        elif isinstance(item, list):
+            stack += item
+        else:
+            texts = [item]
+        for text in texts:
+            if isinstance(text, str):
+                try:
+                    text.encode("utf-8")
+                except UnicodeEncodeError:
+                    return text
+    return None
 
 
 @dataclass(frozen=True)

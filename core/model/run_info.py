@@ -17,11 +17,13 @@ from simparity.core.model.json_input import (
     TEXT,
     WHOLE,
     JSONInputError,
+    Shape,
     list_of,
     read_json,
     record,
     table_of,
 )
+from simparity.core.model.metric_catalogue import JOINT_ANGLE_ERROR_MAX, ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX
 from simparity.core.model.results import READ_SCHEMA_VERSIONS, SCHEMA_VERSION
 
 MAX_RUN_INFO_BYTES = 64_000_000
@@ -29,10 +31,14 @@ MAX_RUN_INFO_BYTES = 64_000_000
 file expands into) with the built-in scenes writes about 1 MB."""
 
 _ALLOWED = "the run.json 'simparity run' wrote"
+SCENE_HEADLINES = (POSITION_ERROR_MAX, ORIENTATION_ERROR_MAX, JOINT_ANGLE_ERROR_MAX)
+"""The errors a report ranks a scene's schemes by (a dynamics scene's position or orientation error, a chain in
+motion's joint angle error): the only ``headline_metric`` a run records."""
+_HEADLINE = Shape(f"one of {', '.join(SCENE_HEADLINES)}", lambda v: v in SCENE_HEADLINES)
 _SCENE = record(
     "a table of what the run recorded of a scene",
     kind=TEXT, description=TEXT, reference=TEXT, source=TEXT, suites=list_of(TEXT), bodies=COUNT,
-    headline_metric=TEXT, segments=COUNT, position_tolerance=NUMBER,
+    headline_metric=_HEADLINE, segments=COUNT, position_tolerance=NUMBER,
     contact=record("a table of the scene's contact", planes=list_of(TEXT), restitution=list_of(list_of(NUMBER)),
                    methods=list_of(TEXT), rest_speed=NUMBER),
     sweep=record("a table of the variant's sweep", base=TEXT, index=COUNT, count=COUNT, values=table_of(NUMBER)))
