@@ -65,7 +65,7 @@ def test_resume_refuses_a_folder_without_a_run_and_options_that_change_it(tmp_pa
     assert err.count("\n") == 1 and "SCENE" in err and "allowed with --resume" in err
     (tmp_path / "resume.json").write_text("{not json", encoding="utf-8")
     assert main(["run", "--resume", str(tmp_path)]) == 2
-    assert "unreadable" in capsys.readouterr().err
+    assert "resume.json: not JSON" in capsys.readouterr().err
 
 
 def test_unfinished_and_unreadable_cases_are_computed_again(tmp_path):
@@ -186,3 +186,22 @@ def test_a_finished_run_is_not_resumed(tmp_path, capsys):
     assert main(["run", "--resume", str(out)]) == 2
     err = capsys.readouterr().err
     assert "that run finished" in err and err.count("\n") == 1
+
+
+@pytest.mark.parametrize("text, says", [
+    ("[" * 100_000 + "]" * 100_000, "nested 100,000 levels deep"),
+    ('{"scenes": ["a"], "max_steps": ' + "9" * 5001 + "}", "an integer of 5,001 digits"),
+    ('{"scenes": [5]}', "scenes[0]: a number 5 (allowed: text)"),
+    ('{"scenes": ["a"], "max_joints": "many"}', "max_joints: text 'many'"),
+    ('{"scenes": ["a"], "max_steps": NaN}', "NaN, which is not JSON"),
+    ('{"scenes": ["a"], "max_steps": 0}', "max_steps: a number 0 (allowed: a whole number > 0)"),
+])
+def test_a_damaged_request_is_refused_in_one_line(tmp_path, text, says):
+    """Held-out review of #39: resume.json was read by json.loads alone (RecursionError, ValueError, TypeError)."""
+    from simparity.comparisons.execute.journal import RESUME_FILE, read_request
+    from simparity.core.model.errors import SimparityError
+
+    (tmp_path / RESUME_FILE).write_text(text, encoding="utf-8")
+    with pytest.raises(SimparityError) as refused:
+        read_request(tmp_path)
+    assert says in str(refused.value) and "\n" not in str(refused.value)

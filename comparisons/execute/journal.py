@@ -23,6 +23,7 @@ from pathlib import Path
 
 from simparity.comparisons.execute.cases import CaseKey, CaseOutcome
 from simparity.core.model.errors import SimparityError, one_line
+from simparity.core.model.json_input import COUNT, TEXT, JSONInputError, Shape, list_of, read_json, record
 
 CASES_FOLDER = "cases"
 RESUME_FILE = "resume.json"
@@ -136,19 +137,31 @@ def write_request(run_dir: Path, request: dict) -> None:
     (Path(run_dir) / RESUME_FILE).write_text(json.dumps(request, indent=2) + "\n", encoding="utf-8")
 
 
+MAX_REQUEST_BYTES = 10_000_000
+"""Largest ``resume.json`` read [bytes]: a request lists its scenes by path or name (1,000 scene files: ~200 kB)."""
+
+_COUNT_ABOVE_0 = Shape("a whole number > 0", lambda v: COUNT.accepts(v) and v > 0)  # type: ignore[operator]
+REQUEST_SHAPE = record(
+    "a table (JSON object): the request a run wrote",
+    scenes=list_of(TEXT), suite=Shape("text or null", lambda v: v is None or isinstance(v, str)),
+    engines=list_of(TEXT), repeats=COUNT, quick=Shape("a boolean", lambda v: isinstance(v, bool)),
+    max_steps=_COUNT_ABOVE_0, max_samples=_COUNT_ABOVE_0, max_joints=_COUNT_ABOVE_0, transform=list_of(TEXT))
+"""What each key of ``resume.json`` holds (:func:`comparisons.cli.main._request` writes it)."""
+
+
 def read_request(run_dir: Path) -> dict:
     """What the run in ``run_dir`` was asked to do; a folder without it is a one-line error."""
     path = Path(run_dir) / RESUME_FILE
-    try:
-        request = json.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
+    if not path.exists():
         raise SimparityError(f"--resume {one_line(run_dir)}: no {RESUME_FILE} there (allowed: the folder of a run "
-                             "started by 'simparity run')") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise SimparityError(f"--resume {one_line(path)}: unreadable: {one_line(err)} (allowed: the file a run "
-                             "wrote)") from None
-    if not isinstance(request, dict):
-        raise SimparityError(f"--resume {one_line(path)}: not a run request (allowed: the file a run wrote)")
+                             "started by 'simparity run')")
+    try:  # bounded in size, depth and integer length, no NaN, no key twice: json_input.read_json
+        request = read_json(path, MAX_REQUEST_BYTES, "the file a run wrote")
+    except JSONInputError as err:
+        raise SimparityError(f"--resume {one_line(path)}: {err}") from None
+    problem = REQUEST_SHAPE.problem(request)
+    if problem:
+        raise SimparityError(f"--resume {one_line(path)}: {problem}")
     return request
 
 
