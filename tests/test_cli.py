@@ -259,11 +259,17 @@ def test_run_check_junit_summary_and_history(tmp_path, capsys, projectile_run):
 
 @pytest.mark.slow
 def test_a_broken_history_database_never_loses_a_run(tmp_path, capsys, monkeypatch):
-    """A corrupt database: one line on stderr, the run's CSV and report are written, exit 0."""
-    corrupt = tmp_path / "history.sqlite"
-    corrupt.write_bytes(b"not a database" * 100)
+    """A database that fails when the run is recorded: one line on stderr, the run's CSV and report are written,
+    exit 0. (One that is no database at all is refused before the run: tests/test_output_confinement.py.)"""
+    from simparity.comparisons.execute import session
+    from simparity.core.model.errors import HistoryError
+
+    def broken(*args, **kwargs):
+        raise HistoryError(f"{tmp_path / 'history.sqlite'}: run history unusable: disk I/O error")
+
+    monkeypatch.setattr(session, "record_run", broken)
     code = main(["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0", "--out", str(tmp_path / "r"),
-                 "--history", str(corrupt)])
+                 "--history", str(tmp_path / "history.sqlite")])
     err = capsys.readouterr().err
     assert code == EXIT_OK and err.startswith("simparity: history not updated") and err.count("\n") == 1
     assert (tmp_path / "r" / "results.csv").is_file() and (tmp_path / "r" / "report.md").is_file()
