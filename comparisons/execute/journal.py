@@ -20,6 +20,7 @@ import os
 import pickle
 import sys
 from pathlib import Path
+from typing import cast
 
 from simparity.comparisons.execute.cases import CaseKey, CaseOutcome
 from simparity.core.model.errors import SimparityError, one_line
@@ -162,7 +163,7 @@ def read_request(run_dir: Path) -> dict:
     problem = REQUEST_SHAPE.problem(request)
     if problem:
         raise SimparityError(f"--resume {one_line(path)}: {problem}")
-    return request
+    return cast(dict, request)  # REQUEST_SHAPE accepts a table (JSON object) only
 
 
 @contextlib.contextmanager
