@@ -1,4 +1,4 @@
-"""Engines that misbehave the ways a user's engine can take a process down, for tests/test_isolation.py.
+"""Engines that misbehave the ways a user's engine can take a process down, for tests/comparisons/execute/test_isolation.py.
 
 Each is core's in-house engine with a ``run`` that, instead of simulating, segfaults, hangs in C
 code (the GIL held: no Python-level timeout could stop it) or allocates without bound. They are

@@ -12,7 +12,7 @@ has collided when E(p(t_i)) <= 0. The lecture lists three ways to handle it, all
 Arrays are float64 in the world frame and SI units, batched over B particles. The rigid-body
 methods the engine runs on scenes with contact (:mod:`core.contact` and the modules it names) build
 on :func:`penalty_force` and :func:`entry_time`; the particle steppers here are the lecture's
-recipes as written, checked against closed forms in ``tests/test_collision.py``.
+recipes as written, checked against closed forms in ``tests/core/contact/test_particle.py``.
 """
 
 from __future__ import annotations

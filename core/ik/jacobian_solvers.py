@@ -108,7 +108,7 @@ class IKOptions(IKTolerances):
         Gain of Liegeois' joint-limit term of H, 0 for none [1].
     """
 
-    # Defaults tuned on the seeded KUKA iiwa pose targets of tests/test_ik_solvers.py.
+    # Defaults tuned on the seeded KUKA iiwa pose targets of tests/core/ik/test_jacobian_solvers.py.
     # Damping is light: max_step already bounds the steps near singularities, and
     # damping_max = 1e-2 lowered the solve rate from 99.7 % to 99.1 % because damping
     # slows the approach to near-singular solutions (linear rate lambda^2 / (sigma^2 +

@@ -33,7 +33,7 @@ lasts pi / (omega_n sqrt(1 - zeta^2)) >= 2 pi dt, about 6-7 steps. The standard 
 (timeconst, dampratio) cannot express this: its stiffness is 1/(timeconst dampratio)^2, which
 grows without bound as zeta -> 0 (k -> 1). The mapping is that of a continuous oscillator;
 the time-stepped contact differs by a few percent, which the comparisons MEASURE (0.48-0.57 for
-k = 0.5 and 0.78-0.85 for k = 0.8 over dt = 0.001-0.01, tests/test_contact_engines.py). MuJoCo's
+k = 0.5 and 0.78-0.85 for k = 0.8 over dt = 0.001-0.01, tests/references/test_contact_engines.py). MuJoCo's
 documentation ("Restitution" and "Solver parameters" in doc/modeling.rst) recommends exactly
 the direct form for restitution.
 The penetration MuJoCo's soft contact allows: at most about v_impact / omega_n = 2 v dt during

@@ -1,6 +1,6 @@
 """MuJoCo behind the shared engine interface.
 
-Conversions (each pinned by a test in ``tests/test_mujoco_adapter.py``)
+Conversions (each pinned by a test in ``tests/references/mujoco/test_adapter.py``)
 ----------------------------------------------------------------------
 - ``qpos[3:7]`` and MJCF ``quat`` are (w, x, y, z): no reordering.
 - Free-joint ``qvel[0:3]`` is the world-frame velocity of the body ORIGIN; the body origin

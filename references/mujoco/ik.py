@@ -16,7 +16,7 @@ scene's (position residual <= ``options.position_tolerance`` and angle <=
 ``options.orientation_tolerance``, checked also after the last update) instead of
 ``err_norm < tol``, and ``max_steps`` = ``options.max_iterations``.
 
-Conventions and what the adapter does (pinned in ``tests/test_mujoco_ik.py``)
+Conventions and what the adapter does (pinned in ``tests/references/mujoco/test_ik.py``)
 ---------------------------------------------------------------------------
 - The model is the chain's (:class:`references.mujoco_adapter.MujocoChain`: its URDF file
   without geometry, or the MJCF export); the end effector is its site. Targets are given

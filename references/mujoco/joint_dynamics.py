@@ -1,6 +1,6 @@
 """A chain's joint-space dynamics in MuJoCo: mass matrix, bias forces, inverse and forward dynamics (issue #27).
 
-What MuJoCo is given, and each default switched off (each pinned by ``tests/test_joint_dynamics_engines.py``)
+What MuJoCo is given, and each default switched off (each pinned by ``tests/references/test_joint_dynamics_engines.py``)
 ------------------------------------------------------------------------------------------------------------
 - The model: the URDF text of :func:`references.common.dynamics_urdf.dynamics_urdf` (the chain's file, base
   subtree only, without geometry and ``<dynamics>``, held joints fixed, links without ``<inertial>`` given an

@@ -1,6 +1,6 @@
 """A chain stepped through time by MuJoCo's own integrators (issue #28).
 
-What MuJoCo is given (each pinned by ``tests/test_mujoco_joint_motion.py``)
+What MuJoCo is given (each pinned by ``tests/references/mujoco/test_joint_motion.py``)
 ---------------------------------------------------------------------------
 - The joint-dynamics model (the builder both share, :class:`references.mujoco.joint_dynamics.ChainModel`):
   MuJoCo's URDF importer on :func:`references.common.dynamics_urdf.dynamics_urdf`, gravity exactly the scene's

@@ -3,7 +3,7 @@
 Pinocchio computes dynamics but has no time stepper: the harness steps the accelerations
 of ``pin.aba`` itself, and the results say so ("harness-stepped").
 
-Conversions (each pinned by a test in ``tests/test_pinocchio_adapter.py``)
+Conversions (each pinned by a test in ``tests/references/pinocchio/test_adapter.py``)
 ------------------------------------------------------------------------
 - Free-flyer ``q[3:7]`` is (x, y, z, w): reordered here.
 - Free-flyer ``v[0:3]`` and ``v[3:6]`` are in the LOCAL (body) frame: v_world = R v[0:3],

@@ -13,7 +13,7 @@ Position-only targets use the same damped update on the 3 translational rows of 
 LOCAL_WORLD_ALIGNED frame Jacobian with err = p_des - p [m] and v = J^T (J J^T + damp
 I)^-1 err.
 
-Conventions and what the adapter does (pinned in ``tests/test_pinocchio_ik.py``)
+Conventions and what the adapter does (pinned in ``tests/references/pinocchio/test_ik.py``)
 -------------------------------------------------------------------------------
 - The model is the chain's (:class:`references.pinocchio_adapter.PinocchioChain`: its
   URDF file without geometry, or the export, read by ``buildModelFromXML``; fixed base);

@@ -3,7 +3,7 @@
 Pinocchio computes dynamics but steps nothing: the harness steps the accelerations of ``pin.aba``, and the rows'
 ``detail`` says so ("harness-stepped").
 
-What Pinocchio is given, and each default handled (each pinned by ``tests/test_pinocchio_joint_motion.py``)
+What Pinocchio is given, and each default handled (each pinned by ``tests/references/pinocchio/test_joint_motion.py``)
 ------------------------------------------------------------------------------------------------------
 - The model of joint-space dynamics, :func:`references.pinocchio.joint_dynamics.chain_model`: the chain's dynamics
   URDF read by Pinocchio's own parser, ``model.gravity`` exactly the scene's (zero for None, where Pinocchio's

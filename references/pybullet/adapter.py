@@ -1,6 +1,6 @@
 """PyBullet behind the shared engine interface.
 
-Conversions and overridden defaults (each pinned by a test in ``tests/test_pybullet_adapter.py``)
+Conversions and overridden defaults (each pinned by a test in ``tests/references/pybullet/test_adapter.py``)
 -----------------------------------------------------------------------------------------------
 - Quaternions are (x, y, z, w) in PyBullet: reordered here.
 - ``getBasePositionAndOrientation`` / ``resetBasePositionAndOrientation`` speak of the

@@ -18,7 +18,7 @@ rest pose at the target's own configuration and with 2000 iterations (iiwa, UR5,
 measured), so they are Bullet's damped projector (``Jacobian::CalcDeltaThetasDLSwithNullspace``),
 reported upstream as bullet3 #2210 (:data:`NULLSPACE_LIMITATION`, in the rows' detail).
 
-Conventions and what the adapter does (pinned in ``tests/test_pybullet_ik.py``)
+Conventions and what the adapter does (pinned in ``tests/references/pybullet/test_ik.py``)
 -----------------------------------------------------------------------------
 - The chain is the URDF of :func:`references.urdf_export.chain_urdf`, loaded with a fixed
   base (:class:`references.pybullet_adapter.PybulletChain`). Targets are given in the

@@ -7,7 +7,7 @@ the declared mass properties of a chain without a file) with its own URDF parser
 (``useFixedBase``; the adapter's ``_load_urdf``, its console output kept off). Joints are found by name
 (``getJointInfo``): PyBullet counts every URDF joint, fixed ones too, and its calls take the positions of ALL movable
 joints in its own order. Each default below is switched off or set, and pinned by
-``tests/test_pybullet_joint_dynamics.py``:
+``tests/references/pybullet/test_joint_dynamics.py``:
 
 - Gravity defaults to 0: set to exactly the scene's ``gravity_world`` (None: zero).
 - Inertia: ``URDF_USE_INERTIA_FROM_FILE`` (else PyBullet recomputes it from collision shapes: a body without any

@@ -6,7 +6,7 @@ gives every default and why): the chain's dynamics URDF with its axes normalised
 gravity exactly the scene's (None: zero), link damping 0, braking motors off (VELOCITY_CONTROL, force 0), joint limits
 without force, the velocity cap raised to 1e300, jointDamping the chain's. The world holds nothing else: no ground
 plane, and the bodies have no collision shapes (the dynamics URDF has none), so nothing collides. Each setting is
-pinned by ``tests/test_pybullet_joint_motion.py``:
+pinned by ``tests/references/pybullet/test_joint_motion.py``:
 
 - Time step exactly dt (``setTimeStep``), ``numSubSteps`` 0: one ``stepSimulation`` is one step of dt (read back by
   ``getPhysicsEngineParameters``).

@@ -1,5 +1,5 @@
 """Fuzzed inputs for the surfaces of issue #39: stored runs, history databases, tolerance files, command-line options
-and joint inputs (tests/test_fuzz_inputs.py runs them under the sweep marker; ``python -m tests.fuzz`` prints every
+and joint inputs (tests/system/test_fuzz_inputs.py runs them under the sweep marker; ``python -m tests.fuzz`` prints every
 failing input grouped by class, or materialises one input to reproduce it).
 
 Each family module has ``cases(rng) -> list[Case]``: built from a seeded ``numpy.random.Generator`` passed in, so the

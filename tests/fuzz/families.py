@@ -1,4 +1,4 @@
-"""Every family of fuzzed inputs, generated from one seed: what tests/test_fuzz_inputs.py and ``python -m
+"""Every family of fuzzed inputs, generated from one seed: what tests/system/test_fuzz_inputs.py and ``python -m
 tests.fuzz`` try."""
 
 from __future__ import annotations

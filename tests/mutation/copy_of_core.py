@@ -34,7 +34,7 @@ SHARED_PACKAGES = ("model", "runtime")
 SHARED_ALIASES = frozenset({"arrays", "engine", "errors", "results", "scene", "trajectory", "ik.problem", "ik.result"})
 """The data model's public aliases at its old paths (re-exports of ``model``)."""
 """Modules of core (dotted, relative to it) the copy imports from the real ``simparity.core``: the data model
-(what the harness and the references share with core, ``tests/test_architecture.py``'s DATA_MODEL, plus the
+(what the harness and the references share with core, ``tests/system/test_architecture.py``'s DATA_MODEL, plus the
 file, name and range checks the scene model uses) and the process and memory plumbing (no numerics)."""
 
 PLUGIN_MODULE = "mutant_plugin"

@@ -1,0 +1,158 @@
+"""A user's engine is built and described in a process of its own: one that crashes, exits or hangs as it is
+constructed or asked about itself becomes a broken engine naming the cause, and simparity goes on."""
+
+from __future__ import annotations
+
+import time
+
+import pandas as pd
+import pytest
+
+from simparity.comparisons.engines import probe as engine_probe
+from simparity.comparisons.cli.main import main
+from simparity.comparisons.engines.probe import PROBE_CHAIN, DescribedEngine, probe_engines
+from simparity.comparisons.engines.placeholders import BrokenEngine
+from simparity.core.model.engine import Engine, Support
+from simparity.core.inhouse import InHouseEngine
+from tests.helpers import THROWN_BALL, builtin
+
+CORE_SPEC = "simparity.core.inhouse:InHouseEngine"
+"""Core named by its spec: a plugin whose integrators differ by scene (contact or not)."""
+
+SHORT_PROBE_SECONDS = 5.0
+"""The hanging engine's limit in these tests: a probe's start and imports take ~1-2 s under load."""
+
+RUN_SECONDS = 90.0
+"""A run of the tiny scene on core takes ~5 s, ~30 s on a loaded machine; far under the 900 s a hung case would
+take."""
+
+
+@pytest.mark.slow
+def test_a_probe_describes_an_engine_as_it_describes_itself():
+    scenes = [builtin("lecture-projectile"), builtin("ball-bounce-k05")]
+    described = probe_engines([CORE_SPEC], scenes)[CORE_SPEC]
+    real = InHouseEngine()
+    assert isinstance(described, DescribedEngine)
+    assert described.name == CORE_SPEC and described.version() == real.version()  # "core" is the built-in's
+    assert described.integrators() == real.integrators() and described.ik_solvers() == real.ik_solvers()
+    for integrator in real.integrators():
+        assert described.theoretical_order(integrator) == real.theoretical_order(integrator)
+        assert described.stages(integrator) == real.stages(integrator)
+        assert described.integrator_variant(integrator) == real.integrator_variant(integrator)
+    for scene in scenes:  # contact methods on the bouncing ball, free-body integrators on the projectile
+        assert described.scene_integrators(scene) == real.scene_integrators(scene)
+    assert described.scene_integrators(scenes[0]) != described.scene_integrators(scenes[1])
+    assert described.supports_kinematics(PROBE_CHAIN).ok
+    # found by the mutation suite: a described engine offered no joint-motion integrator, so a plugin's chains in
+    # motion were n/a in every run (and a planted bug in them passed the gate)
+    assert described.joint_motion_integrators() == real.joint_motion_integrators() != ()
+    assert described.joint_dynamics_methods() == real.joint_dynamics_methods()
+    for integrator in real.joint_motion_integrators():
+        assert described.theoretical_order(integrator) == real.theoretical_order(integrator)
+        assert described.stages(integrator) == real.stages(integrator)
+
+
+@pytest.mark.slow
+def test_a_crash_or_an_exit_while_building_or_describing_is_a_broken_engine():
+    found = probe_engines(["tests.hostile_engines:SegfaultOnConstruction", "tests.hostile_engines:ExitInVersion",
+                           "no_such_module_here:Engine"])
+    segfault = found["tests.hostile_engines:SegfaultOnConstruction"]
+    assert isinstance(segfault, BrokenEngine) and "killed by signal 11 (SIGSEGV)" in segfault.reason
+    assert "in File" in segfault.reason  # where, from the faulthandler's stack
+    exits = found["tests.hostile_engines:ExitInVersion"]
+    assert isinstance(exits, BrokenEngine) and "exited with code 3" in exits.reason
+    missing = found["no_such_module_here:Engine"]
+    assert isinstance(missing, BrokenEngine) and "does not import here: ModuleNotFoundError" in missing.reason
+
+
+@pytest.mark.slow
+def test_a_hang_while_describing_is_a_broken_engine_within_the_limit(monkeypatch):
+    monkeypatch.setattr(engine_probe, "PROBE_SECONDS", SHORT_PROBE_SECONDS)
+    hung = probe_engines(["tests.hostile_engines:HangInIntegrators"])["tests.hostile_engines:HangInIntegrators"]
+    assert isinstance(hung, BrokenEngine) and f"took more than {SHORT_PROBE_SECONDS:g} s" in hung.reason
+
+
+@pytest.mark.slow
+def test_a_run_goes_on_when_an_engine_crashes_as_it_is_built(tmp_path, monkeypatch):
+    """Before, the segfault in the constructor killed `simparity run` itself; now its cases fail, core's complete."""
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    engines = "core,tests.hostile_engines:SegfaultOnConstruction,tests.hostile_engines:ExitInVersion"
+    assert main(["run", str(scene), "--engines", engines, "--repeats", "0", "--jobs", "1",
+                 "--out", str(tmp_path / "run")]) == 1
+    table = pd.read_csv(tmp_path / "run" / "results.csv")
+    for spec, cause in (("tests.hostile_engines:SegfaultOnConstruction", "SIGSEGV"),
+                        ("tests.hostile_engines:ExitInVersion", "exited with code 3")):
+        rows = table[table.engine == spec]
+        assert len(rows) and set(rows.status) == {"failed"} and rows.detail.str.contains(cause).all(), spec
+    core = table[(table.engine == "core") & (table.metric == "position_error_max")]
+    assert len(core) >= 2 and set(core.status) == {"ok"}
+
+
+@pytest.mark.slow
+def test_an_engine_that_hung_while_described_is_not_built_again_by_the_cases(tmp_path, monkeypatch):
+    """Its cases fail at once with the probe's cause, instead of each hanging to the 900 s case limit."""
+    monkeypatch.setattr(engine_probe, "PROBE_SECONDS", SHORT_PROBE_SECONDS)
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    start = time.monotonic()
+    assert main(["run", str(scene), "--engines", "core,tests.hostile_engines:HangInIntegrators", "--repeats", "0",
+                 "--jobs", "1", "--out", str(tmp_path / "run")]) == 1
+    assert time.monotonic() - start < RUN_SECONDS
+    table = pd.read_csv(tmp_path / "run" / "results.csv")
+    rows = table[table.engine == "tests.hostile_engines:HangInIntegrators"]
+    assert len(rows) and set(rows.status) == {"failed"}
+    assert rows.detail.str.contains(f"took more than {SHORT_PROBE_SECONDS:g} s", regex=False).all()
+
+
+class OwnIntegrators(Engine):
+    """A user's engine with an integrator name no built-in has: core's RK4, called ``own_rk4``."""
+
+    name = "own"
+
+    def __init__(self) -> None:
+        self._core = InHouseEngine()
+
+    def version(self) -> str:
+        return self._core.version()
+
+    def integrators(self):
+        return ("own_rk4",)
+
+    def supports_dynamics(self, scene, integrator):
+        return self._core.supports_dynamics(scene, "rk4")
+
+    def build_dynamics(self, scene, integrator, dt):
+        return self._core.build_dynamics(scene, "rk4", dt)
+
+    def supports_kinematics(self, chain):
+        return Support.no("dynamics only")
+
+    def build_kinematics(self, chain):
+        raise NotImplementedError("dynamics only")
+
+    def theoretical_order(self, integrator):
+        return 4
+
+
+@pytest.mark.slow
+def test_a_scene_file_and_the_quick_profile_may_name_a_spec_engines_own_integrators(tmp_path):
+    """Before, `own_rk4` was refused as no engine's integrator: only built-ins' and installed plugins' names were
+    known when the scene file was checked."""
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL.replace('integrators = ["rk4"]', 'integrators = ["own_rk4"]'), encoding="utf-8")
+    for quick in ([], ["--quick"]):
+        out = tmp_path / f"run{len(quick)}"
+        assert main(["run", str(scene), "--engines", "core,tests.comparisons.engines.test_probe:OwnIntegrators", "--repeats", "0",
+                     "--jobs", "1", "--out", str(out), *quick]) == 0
+        table = pd.read_csv(out / "results.csv", keep_default_na=False)
+        own = table[(table.engine == "own") & (table.metric == "position_error_max")]
+        assert list(own.integrator) == ["own_rk4", "own_rk4"] and set(own.status) == {"ok"}
+        assert (table[table.engine == "core"].status == "n/a").all()  # core offers no own_rk4
+
+
+def test_a_described_engine_runs_nothing():
+    described = probe_engines([CORE_SPEC])[CORE_SPEC]
+    assert described.stages("rk4") == 4 and described.stages("explicit_euler") == 1  # what it declared, as data
+    with pytest.raises(Exception, match="described, not built"):
+        described.build_dynamics(builtin("lecture-projectile"), "rk4", 0.01)

@@ -1,0 +1,137 @@
+"""The import contract: layers import downward only, and no reference borrows the code it checks.
+
+Read from the source with :mod:`ast` (every ``import`` and ``from ... import``, at any
+depth, also inside functions), so a violation fails the suite whether or not the import
+ever runs.
+"""
+
+import ast
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+LAYERS = ("core", "references", "comparisons", "reports")
+
+MODEL = "simparity.core.model"
+"""The data model (scenes, trajectories, results, the engine interface, errors, IK types), all of it one folder:
+what references/ and the judges may import from core, never an in-house method (integrators, forces, rigid-body
+state, rotations, kinematics, inertia, IK solvers, collision, ...)."""
+
+PUBLIC_ALIASES = {
+    "simparity.core.scene", "simparity.core.trajectory", "simparity.core.results", "simparity.core.engine",
+    "simparity.core.errors", "simparity.core.arrays", "simparity.core.ik.problem", "simparity.core.ik.result",
+}
+"""The data model's modules at the paths plugins import (docs/plugins.md): re-exports of :data:`MODEL`."""
+
+
+def _data_model(name: str) -> bool:
+    return name == MODEL or name.startswith(MODEL + ".") or name in PUBLIC_ALIASES
+
+
+ENGINES = ("mujoco", "pybullet", "pinocchio")
+
+
+def _imports(path: Path) -> set[str]:
+    """Absolute module names a file imports (``from a.b import c`` gives a.b and a.b.c)."""
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.add(node.module)
+            names.update(f"{node.module}.{alias.name}" for alias in node.names)
+    return names
+
+
+def _modules(layer: str) -> list[Path]:
+    return sorted((ROOT / layer).rglob("*.py"))
+
+
+def _project_modules(names: set[str]) -> set[str]:
+    """The imported names that are project modules (a ``from m import function`` gives m only)."""
+    return {n for n in names if n.startswith("simparity.") and (
+        (ROOT / Path(*n.split(".")[1:])).with_suffix(".py").is_file() or (ROOT / Path(*n.split(".")[1:])).is_dir())}
+
+
+@pytest.mark.parametrize("path", _modules("references"), ids=lambda p: p.name)
+def test_references_import_only_the_data_model_of_core(path):
+    """A reference that imported core's methods would agree with a bug in them."""
+    borrowed = {n for n in _project_modules(_imports(path)) if n.startswith("simparity.core") and not _data_model(n)}
+    borrowed.discard("simparity.core")
+    assert not borrowed, f"{path.name} imports in-house code {sorted(borrowed)}; allowed: {MODEL}"
+
+
+JUDGES = ("measure/metrics.py", "measure/contact_metrics.py", "measure/divergence.py", "measure/invariants.py",
+          "measure/joint_motion_metrics.py", "execute/ik_runner.py") + tuple(f"invariance/{p.name}" for p in sorted((ROOT / "comparisons" /
+                                                                                  "invariance").glob("*.py")))
+"""The comparisons that measure and judge (the metamorphic ones included: a transform computed with core's
+rotations would agree with a bug in them): like a reference, they must not use the code they judge."""
+
+
+@pytest.mark.parametrize("name", JUDGES)
+def test_metrics_use_no_in_house_method(name):
+    """A metric computed with core's rotations would agree with a bug in them."""
+    path = ROOT / "comparisons" / name
+    borrowed = {n for n in _project_modules(_imports(path)) if n.startswith("simparity.core") and not _data_model(n)}
+    borrowed.discard("simparity.core")
+    assert not borrowed, f"{name} imports in-house code {sorted(borrowed)}; allowed: {MODEL}"
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "core" / "model").rglob("*.py")), ids=lambda p: p.name)
+def test_the_data_model_imports_no_in_house_method(path):
+    """The data model references may use stays free of core's methods, so the contract above is not bypassed."""
+    used = {n for n in _project_modules(_imports(path)) if n != "simparity.core"}
+    assert all(_data_model(n) for n in used), f"{path.name} imports {sorted(used)}"
+
+
+@pytest.mark.parametrize("alias", sorted(PUBLIC_ALIASES))
+def test_the_public_aliases_re_export_the_data_model_alone(alias):
+    """``simparity.core.engine`` and the other paths plugins import are the data model under another name."""
+    path = (ROOT / Path(*alias.split(".")[1:])).with_suffix(".py")
+    used = _project_modules(_imports(path)) - {"simparity.core"}
+    assert used and all(n.startswith(MODEL + ".") for n in used), f"{alias} imports {sorted(used)}"
+
+
+@pytest.mark.parametrize("layer", LAYERS)
+def test_the_project_imports_the_data_model_by_its_own_path(layer):
+    """The aliases are for users' code: inside simparity one path per module, so a search finds every use."""
+    for path in _modules(layer):
+        if path.with_suffix("").relative_to(ROOT).as_posix().replace("/", ".") in {
+                a.removeprefix("simparity.") for a in PUBLIC_ALIASES}:
+            continue
+        aliases = sorted(_imports(path) & PUBLIC_ALIASES)
+        assert not aliases, f"{path.relative_to(ROOT)} imports {aliases}; inside simparity: {MODEL}"
+
+
+@pytest.mark.parametrize("layer, forbidden", [
+    ("core", ("simparity.references", "simparity.comparisons", "simparity.reports") + ENGINES),
+    ("references", ("simparity.comparisons", "simparity.reports")),
+    ("comparisons", ()),
+    ("reports", ("simparity.references", "simparity.comparisons") + ENGINES),
+])
+def test_layers_import_downward_only(layer, forbidden):
+    """core imports no engine and nothing above it; reports never run an engine."""
+    for path in _modules(layer):
+        bad = [n for n in _imports(path) if n.split(".")[0] in ENGINES and n.split(".")[0] in forbidden
+               or any(n == f or n.startswith(f + ".") for f in forbidden if f.startswith("simparity"))]
+        assert not bad, f"{path.relative_to(ROOT)} imports {bad}"
+
+
+@pytest.mark.parametrize("layer", LAYERS)
+def test_project_modules_are_imported_through_the_namespace(layer):
+    """A bare ``import core`` works only from a checkout; installed, the code lives in simparity.core."""
+    for path in _modules(layer):
+        bare = [n for n in _imports(path) if n.split(".")[0] in LAYERS]
+        assert not bare, f"{path.relative_to(ROOT)} imports {bare} outside the simparity namespace"
+
+
+EXAMPLE_PLUGIN = ROOT / "examples" / "plugin-engine" / "src"
+"""The plugin engine users copy (docs/plugins.md)."""
+
+
+@pytest.mark.parametrize("path", sorted(EXAMPLE_PLUGIN.rglob("*.py")), ids=lambda p: p.name)
+def test_the_example_plugin_imports_only_the_data_model_of_core(path):
+    """Like a reference: a user's engine built on core's methods would agree with their bugs."""
+    borrowed = {n for n in _project_modules(_imports(path)) - {"simparity.core"} if not _data_model(n)}
+    assert not borrowed, f"{path.name} imports {sorted(borrowed)}; allowed: {MODEL} and its public aliases"
