@@ -23,7 +23,8 @@ from tests.helpers import builtin
 @pytest.mark.slow
 def test_the_same_scene_hashes_the_same_in_another_process():
     here = scene_hash(builtin("ball-bounce-k05"))
-    code = ("from simparity.comparisons.execute.cases import scene_hash; from simparity.comparisons.scenes.loading import "
+    code = ("from simparity.comparisons.execute.cases import scene_hash; "
+            "from simparity.comparisons.scenes.loading.scene_file import "
             f"load_scene; print(scene_hash(load_scene({str(builtin_paths()['ball-bounce-k05'])!r})))")
     there = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
                            env={"PYTHONHASHSEED": "123", "PATH": ""}).stdout.strip()

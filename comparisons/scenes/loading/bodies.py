@@ -7,7 +7,12 @@ import numpy as np
 
 from simparity.comparisons.scenes.loading.contact import CONTACT_BODY_KEYS
 from simparity.comparisons.scenes.loading.reader import TableReader
-from simparity.core.dynamics.inertia import INERTIA_RTOL, inertia_from_point_masses, inertia_problem, mass_and_center_of_mass
+from simparity.core.dynamics.inertia import (
+    INERTIA_RTOL,
+    inertia_from_point_masses,
+    inertia_problem,
+    mass_and_center_of_mass,
+)
 from simparity.core.model.ranges import RANGES
 from simparity.core.model.scenes.bodies import AppliedForce, PointMasses, RigidBody
 from simparity.references.common.conventions import quat_wxyz_to_matrix

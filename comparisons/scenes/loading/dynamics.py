@@ -15,6 +15,8 @@ from simparity.core.model.scenes.dynamics import DynamicsScene
 
 
 def read_dynamics(top: TableReader, head: dict, engines: EngineSet) -> DynamicsScene:
+    """The free-body scene of the file's tables ``top``; ``head``: its ``[scene]`` keys; ``engines`` offer the
+    integrators it may name."""
     world = top.optional_subtable("world", ("gravity_world", "air_velocity_world"))
     gravity = world.vector("gravity_world", 3, length=1) if world and world.has("gravity_world") else None
     air = world.vector("air_velocity_world", 3, length=1) if world and world.has("air_velocity_world") else None

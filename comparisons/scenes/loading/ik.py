@@ -47,6 +47,7 @@ def _position_tolerance(t: TableReader, chain: Chain) -> float:
 
 
 def read_ik(top: TableReader, head: dict) -> IKScene:
+    """The inverse-kinematics scene of the file's tables ``top``; ``head``: its ``[scene]`` keys."""
     chain = read_chain(top, head["name"])
     t = top.subtable("targets", _TARGETS)
     count = t.integer("count", 100, minimum=1, maximum=t.limits.max_samples, why=SAMPLES_WHY)

@@ -8,7 +8,12 @@ from dataclasses import replace
 import numpy as np
 
 from simparity.comparisons.engines.registry import EngineSet
-from simparity.comparisons.scenes.loading.chain import joint_powers, joint_values, read_dynamics_chain, within_limits
+from simparity.comparisons.scenes.loading.chain import (
+    joint_powers,
+    joint_values,
+    read_dynamics_chain,
+    within_limits,
+)
 from simparity.comparisons.scenes.loading.reader import MAX_SEED, TableReader
 from simparity.comparisons.scenes.loading.time_steps import STEP_COUNT_RTOL, time_step_ladder
 from simparity.core.model.errors import echo
@@ -50,6 +55,8 @@ def _with_damping(drive: TableReader, chain: Chain) -> Chain:
 
 
 def read_joint_motion(top: TableReader, head: dict, engines: EngineSet) -> JointMotionScene:
+    """The joint-motion scene of the file's tables ``top``; ``head``: its ``[scene]`` keys; ``engines`` offer the
+    integrators it may name."""
     chain = read_dynamics_chain(top, head)
     world = top.optional_subtable("world", ("gravity_world",))
     gravity = world.vector("gravity_world", 3, length=1) if world and world.has("gravity_world") else None

@@ -8,6 +8,7 @@ from simparity.core.model.scenes.kinematics import KinematicsScene
 
 
 def read_kinematics(top: TableReader, head: dict) -> KinematicsScene:
+    """The forward-kinematics scene of the file's tables ``top``; ``head``: its ``[scene]`` keys."""
     chain = read_chain(top, head["name"])
     sampling = top.optional_subtable("sampling", ("configurations", "seed"))
     limit = top.limits.max_samples

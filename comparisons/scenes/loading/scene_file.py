@@ -38,8 +38,8 @@ def parse_scene(data: dict, source: str = "<scene>", limits: Limits = DEFAULT_LI
     is several scenes: :func:`parse_scenes`."""
     if SWEEP_TABLE in data:
         raise SceneError(source, SWEEP_TABLE, "the file sweeps keys: it is several scenes, not one",
-                         "load_scenes or parse_scenes (comparisons.scenes.loading.scene_file), library.load, simparity.load_scenes "
-                         "or simparity run FILE, which expand it into its variants")
+                         "load_scenes or parse_scenes (comparisons.scenes.loading.scene_file), library.load, "
+                         "simparity.load_scenes or simparity run FILE, which expand it into its variants")
     try:
         return _parse(data, source, limits, engines or EngineSet())
     except SceneError as err:
