@@ -12,9 +12,12 @@ from simparity.core.model.names import NAME_RULE, TEXT_RULE, name_problem, text_
 from simparity.core.model.ranges import NORM_RANGES, RANGES, SUBNORMAL_RULE, safe_norm, subnormal
 
 MAX_SEED = 2**63 - 1
+"""The largest seed a scene may give (a seeded sampler takes any int64 >= 0)."""
 SAMPLES_WHY = "; simparity run --max-samples N raises it"
+"""Ends the refusal of a count of samples, configurations, states or targets above the limit."""
 
 _REQUIRED = object()  # marks a key without a default
+
 
 class TableReader:
     """Typed access to one table of a scene file, with key paths for error messages."""

@@ -26,6 +26,7 @@ LENGTH_UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "ft": 0.3048, "in": 0.0254}
 """Units a scene may declare for lengths, and their size in metres."""
 
 KINDS = ("dynamics", "kinematics", "ik", "joint_dynamics", "joint_motion")
+"""The kinds of scene a file may declare: each read by ``read_<kind>`` in this folder's module of its name."""
 _TOP = ("scene", "world", "body", "simulation", "plane", "contact", "chain", "sampling", "targets", "initial", "drive")
 _PARTS = {"dynamics": ("world", "body", "simulation", "plane", "contact"), "kinematics": ("chain", "sampling"),
           "ik": ("chain", "targets"), "joint_dynamics": ("chain", "world", "sampling"),
