@@ -11,8 +11,8 @@ from simparity.comparisons.execute.execution import default_jobs
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS
 from simparity.comparisons.execute.session import IN_PROCESS, ISOLATED, Execution, Session, engine_specs
 from simparity.comparisons.scenes import library
-from simparity.comparisons.scenes.loader import load_scene as load_scene_file
-from simparity.core.model.scene import Scene
+from simparity.comparisons.scenes.loading.scene_file import load_scene as load_scene_file
+from simparity.core.model.scenes.kinds import Scene
 from simparity.core.model.scene_ranges import check_scene_ranges
 
 

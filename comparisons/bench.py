@@ -47,13 +47,16 @@ from simparity.comparisons import bench_joint_dynamics, bench_joint_motion, benc
 from simparity.comparisons.scenes import library
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.ik_targets import random_targets
-from simparity.comparisons.scenes.loader import EXAMPLE_ROBOT_DATA_ROBOTS
+from simparity.comparisons.scenes.loading.chain import EXAMPLE_ROBOT_DATA_ROBOTS
 from simparity.comparisons.execute.timing import PeakMemory
 from simparity.comparisons.measure.metrics import kinematics_errors, trajectory_errors
 from simparity.core.model.errors import ResultsError, SimparityError, one_line
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix
-from simparity.core.model.scene import DynamicsScene, Forces, IKScene, RigidBody, sample_configurations
+from simparity.core.model.scenes.bodies import Forces, RigidBody
+from simparity.core.model.scenes.chain import sample_configurations
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
 from simparity.core.urdf import chain_from_urdf
 from simparity.references.differential_ik import MinkIK, PinkIK, available
 from simparity.references.mujoco.adapter import BatchRollout, MujocoChain

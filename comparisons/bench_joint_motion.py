@@ -33,7 +33,7 @@ import numpy as np
 
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes import library
-from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 
 ARMS = ("iiwa-falling", "ur5-falling", "panda-falling")
 """The built-in falling arms the bench times."""

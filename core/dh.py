@@ -28,7 +28,7 @@ from types import MappingProxyType
 import numpy as np
 
 from simparity.core.model.errors import SceneError
-from simparity.core.model.scene import Chain, Joint
+from simparity.core.model.scenes.chain import Chain, Joint
 
 CONVENTIONS = ("standard", "modified")
 JOINT_TYPES = ("revolute", "prismatic")

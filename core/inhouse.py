@@ -36,7 +36,11 @@ from simparity.core.dynamics.quaternion_integrators import PackedBodies, make_pa
 from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.dynamics.rigid_body import MassProperties, State, initial_state, velocities
 from simparity.core.rotations import matrix_to_quat_wxyz, quat_wxyz_to_matrix
-from simparity.core.model.scene import PENALTY_PREFIX, Chain, DynamicsScene, IKScene, JointMotionScene
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.contact import PENALTY_PREFIX
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
 
 _DEFAULT_ORIENTATION = "quaternion"

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from simparity.core.rotations import skew, so3_log
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.trajectory import FramePoses
 
 

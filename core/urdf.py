@@ -12,7 +12,7 @@ a missing ``<axis>`` is (1, 0, 0), a missing ``lower`` / ``upper`` attribute of 
 missing ``damping`` is 0, a link without ``<inertial>`` is massless (mass and inertia 0), ``rpy`` is
 roll-pitch-yaw Rz(yaw) Ry(pitch) Rx(roll) (:func:`core.rotations.rpy_to_matrix`).
 
-Each chain joint's ``link`` (:class:`~core.model.scene.LinkInertia`) is everything rigidly attached
+Each chain joint's ``link`` (:class:`~core.model.scenes.chain.LinkInertia`) is everything rigidly attached
 to the joint's child link, in that link's frame: its own inertial, the links hanging from it by
 fixed joints (those on the path up to the next chain joint, and any beyond the tip link: a payload),
 and every branch off the chain below it, its movable joints held at 0 (their transform is their
@@ -20,7 +20,7 @@ origin). The inertials are combined exactly: total mass, mass-weighted centre of
 inertia about that centre by the parallel-axis theorem (``R I R^T`` for a rotated inertial frame).
 The held joints (the file's movable joints below the base link that are not on the chain, in file
 order) are ``Chain.held_joints``. A chain whose links are all massless loads (kinematics needs no
-mass); :meth:`core.model.scene.Chain.dynamics_problem` refuses it for dynamics.
+mass); :meth:`core.model.scenes.chain.Chain.dynamics_problem` refuses it for dynamics.
 
 The rules, stricter on the chain because every engine loads the whole file but only the chain is compared:
 
@@ -80,7 +80,7 @@ from simparity.core.model.errors import SceneError, one_line
 from simparity.core.model.files import MAX_FILE_BYTES, parse_xml, read_input
 from simparity.core.model.names import NAME_RULE, name_problem
 from simparity.core.model.ranges import NORM_RANGES, RANGES, SUBNORMAL_RULE, Range, safe_norm, subnormal
-from simparity.core.model.scene import Chain, Joint, LinkInertia
+from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
 from simparity.core.rotations import rpy_to_matrix
 
 URDF_JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")

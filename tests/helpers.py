@@ -19,12 +19,16 @@ from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes.library import builtin_paths
 from simparity.comparisons.scenes.profiles import apply_profile
 from simparity.comparisons.execute.runner import run_group
-from simparity.comparisons.scenes.loader import load_scene
+from simparity.comparisons.scenes.loading.scene_file import load_scene
 from simparity.core.ik.jacobian_solvers import IKOptions
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.kinematics import forward_kinematics
 from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix, rpy_to_matrix, so3_exp
-from simparity.core.model.scene import Chain, DynamicsScene, Forces, IKScene, Joint, KinematicsScene, RigidBody
+from simparity.core.model.scenes.bodies import Forces, RigidBody
+from simparity.core.model.scenes.chain import Chain, Joint
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.core.urdf import chain_from_urdf
 
 
@@ -129,7 +133,7 @@ HAND_WRENCH = dict(
 
 def hand_wrench_forces() -> Forces:
     """The forces of :data:`HAND_WRENCH` as a scene declares them (one body, index 0)."""
-    from simparity.core.model.scene import AppliedForce
+    from simparity.core.model.scenes.bodies import AppliedForce
 
     h = HAND_WRENCH
     return Forces(np.array(h["gravity"]), np.array(h["wind"]), np.array([h["linear_drag"]]),

@@ -74,7 +74,11 @@ from simparity.comparisons.invariance.transforms import fixed_transforms
 from simparity.core.model.errors import SimparityError, one_line
 from simparity.core.model.ranges import RANGES
 from simparity.core.model.results import RESULTS_FILE, RUN_INFO_FILE
-from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.reports.store import read_run
 
 EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE = 0, 1, 2

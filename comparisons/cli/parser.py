@@ -22,7 +22,7 @@ from simparity.comparisons.invariance.transforms import TRANSFORM_NAMES
 from simparity.comparisons.scenes.limits import DEFAULT_LIMITS
 from simparity.comparisons.scenes.profiles import QUICK_CONTACT_STEPS, QUICK_LADDER, QUICK_MAX_STEPS, QUICK_TARGETS
 from simparity.core.model.errors import UsageError, echo, one_line
-from simparity.core.model.scene import SUITES
+from simparity.core.model.scenes.suites import SUITES
 
 EXPORTABLE = ("mujoco", "pybullet", "pinocchio")
 EXECUTORS = ("local", "dask")

@@ -35,7 +35,7 @@ from simparity.comparisons.execute.timing import status_bytes
 from simparity.core.model.engine import Engine, KinematicsModel, Simulation, Support
 from simparity.core.model.errors import PluginError, one_line
 from simparity.core.runtime.processes import die_with_parent, kill_group
-from simparity.core.model.scene import Chain, Joint
+from simparity.core.model.scenes.chain import Chain, Joint
 
 PROBE_SECONDS = 60.0
 """Time limit [s] to import, build and describe one engine: MuJoCo takes ~0.3 s, a plugin that loads a large

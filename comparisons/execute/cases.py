@@ -26,15 +26,13 @@ import numpy as np
 from simparity.comparisons.engines.placeholders import StandInEngine
 from simparity.core.model.engine import TRUTH_SCHEMES, Engine
 from simparity.core.model.results import ResultRow, SeriesRecord
-from simparity.core.model.scene import (
-    PENALTY_PREFIX,
-    DynamicsScene,
-    IKScene,
-    JointDynamicsScene,
-    JointMotionScene,
-    KinematicsScene,
-    Scene,
-)
+from simparity.core.model.scenes.contact import PENALTY_PREFIX
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinds import Scene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 
 DYNAMICS, STABILITY, KINEMATICS, IK, JOINT_DYNAMICS, JOINT_MOTION = (
     "dynamics", "stability", "kinematics", "ik", "joint_dynamics", "joint_motion")

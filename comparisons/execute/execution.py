@@ -24,7 +24,7 @@ from simparity.comparisons.execute.runner import assemble_scene
 from simparity.comparisons.measure.rows import declared_scheme
 from simparity.core.model.engine import Engine
 from simparity.core.model.results import ResultRow, SeriesRecord
-from simparity.core.model.scene import Scene
+from simparity.core.model.scenes.kinds import Scene
 
 OnCase = Callable[[str, str, str], None]
 """Called with (scene, engine, integrator or solver) after each case, in the calling process."""

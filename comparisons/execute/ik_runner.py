@@ -46,7 +46,7 @@ from simparity.core.model.results import (
     ResultRow,
     SeriesRecord,
 )
-from simparity.core.model.scene import IKScene
+from simparity.core.model.scenes.ik import IKScene
 from simparity.references.common.conventions import rotation_angle
 from simparity.core.model.metric_catalogue import (
     units,

@@ -29,7 +29,7 @@ import numpy as np
 from simparity.core.model.engine import KinematicsModel
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.rotations import so3_exp
-from simparity.core.model.scene import IKScene
+from simparity.core.model.scenes.ik import IKScene
 
 ORIENTATION_ONLY = ("orientation_in_place", "wrist_flip")
 """Hard targets that only make sense for pose targets."""

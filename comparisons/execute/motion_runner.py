@@ -34,7 +34,7 @@ from simparity.core.model.metric_catalogue import (
     SELF_PARTING_TIME, TIME_PER_STEP,
 )
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, SATURATED, ResultRow
-from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 
 EngineFor = Callable[[str], Engine]

@@ -79,7 +79,11 @@ from simparity.core.model.engine import (
 )
 from simparity.core.model.errors import DivergedError, SimparityError
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
-from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.references.common.scene_inputs import as_given
 from simparity.core.model.trajectory import Trajectory, joined, trajectory_pieces
 from simparity.core.model.metric_catalogue import (

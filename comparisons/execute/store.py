@@ -29,7 +29,9 @@ from simparity.core.model.results import (
 )
 from simparity.core.model.run_info import RunInfo
 from simparity.core.model.metric_catalogue import JOINT_ANGLE_ERROR_MAX
-from simparity.core.model.scene import DynamicsScene, IKScene, JointMotionScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 
 DEFAULT_OUT_ROOT = Path("simparity-results")
 """Default parent folder of runs: each run goes to ``simparity-results/<UTC time>/``."""

@@ -88,7 +88,9 @@ class SimparityChecker:
         from simparity.reports.store import read_run
 
         from simparity.comparisons.scenes.profiles import PROFILES
-        from simparity.core.model.scene import DynamicsScene, IKScene, KinematicsScene
+        from simparity.core.model.scenes.dynamics import DynamicsScene
+        from simparity.core.model.scenes.ik import IKScene
+        from simparity.core.model.scenes.kinematics import KinematicsScene
         from simparity.core.model.scene_ranges import check_scene_ranges
 
         if profile not in PROFILES or not isinstance(repeats, int) or not 0 <= repeats <= 100:

@@ -55,7 +55,10 @@ from simparity.core.model.metric_catalogue import is_timing
 from simparity.core.model.errors import TransformError, UnitError, one_line
 from simparity.core.model.results import DIMENSIONLESS, FAILED, NOT_AVAILABLE, OK, ROUNDING_FLOOR, ResultRow
 from simparity.comparisons.execute.cases import motion_reference_integrator
-from simparity.core.model.scene import DynamicsScene, JointDynamicsScene, JointMotionScene, Scene
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinds import Scene
 
 RunScenes = Callable[[list], list[list[ResultRow]]]
 """Runs scenes on the engines being checked: the rows of each scene, in order (:func:`in_process`, or a run's

@@ -31,7 +31,11 @@ from dataclasses import replace
 import numpy as np
 
 from simparity.comparisons.invariance.transforms import Transform, transform_scene
-from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 
 ULP_FACTORS = (np.nextafter(1.0, 2.0), np.nextafter(1.0, 0.0))
 """The two nearest floats to 1: a unit one ulp longer or shorter."""

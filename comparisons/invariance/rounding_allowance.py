@@ -40,9 +40,12 @@ import numpy as np
 
 from simparity.comparisons.invariance.units import Dimension
 from simparity.comparisons.measure.body_scales import contact_of
-from simparity.core.model.scene import (
-    Chain, DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene,
-)
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 
 ALLOWANCE_FACTOR = 16.0
 """The metrics' rounding floor is 2 eps (N + kappa) x the scale (measured rounding of exact schemes stays below

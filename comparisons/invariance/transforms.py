@@ -38,24 +38,14 @@ from scipy.spatial.transform import Rotation
 from simparity.comparisons.invariance.units import unit_factor
 from simparity.core.model.arrays import readonly
 from simparity.core.model.errors import TransformError, one_line
-from simparity.core.model.scene import (
-    AppliedForce,
-    Chain,
-    Contact,
-    DHTable,
-    DynamicsScene,
-    Forces,
-    IKScene,
-    Joint,
-    JointDynamicsScene,
-    JointMotionScene,
-    KinematicsScene,
-    LinkInertia,
-    Plane,
-    PointMasses,
-    RigidBody,
-    Shape,
-)
+from simparity.core.model.scenes.bodies import AppliedForce, Forces, PointMasses, RigidBody
+from simparity.core.model.scenes.chain import Chain, DHTable, Joint, LinkInertia
+from simparity.core.model.scenes.contact import Contact, Plane, Shape
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.references.common.conventions import (
     matrix_to_quat_wxyz,
     matrix_to_rpy,

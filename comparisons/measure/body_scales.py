@@ -14,7 +14,8 @@ from typing import cast
 
 import numpy as np
 
-from simparity.core.model.scene import Contact, DynamicsScene
+from simparity.core.model.scenes.contact import Contact
+from simparity.core.model.scenes.dynamics import DynamicsScene
 
 TOUCH_RTOL = 1e-9
 """A sample whose support distance is within this fraction of the body's size touches the plane: a body

@@ -36,7 +36,7 @@ from simparity.comparisons.measure.body_scales import (
 from simparity.comparisons.measure.invariants import kinetic_energy, potential_energy
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.results import NOTHING_TO_MEASURE
-from simparity.core.model.scene import DynamicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory
 from simparity.references.common.conventions import quat_wxyz_to_matrix
 from simparity.core.model.metric_catalogue import (

@@ -27,7 +27,7 @@ from simparity.comparisons.measure.contact_metrics import ContactReading, contac
 from simparity.comparisons.measure.extents import RunExtents
 from simparity.comparisons.measure.invariants import angular_momentum_world
 from simparity.comparisons.measure.metrics import energy_scale
-from simparity.core.model.scene import DynamicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory
 from simparity.references.common.conventions import quat_wxyz_to_matrix
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from simparity.comparisons.measure.invariants import angular_momentum_world, kinetic_energy, potential_energy
-from simparity.core.model.scene import DynamicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory
 from simparity.references.common.conventions import quat_wxyz_angle, quat_wxyz_to_matrix
 from simparity.core.model.metric_catalogue import (

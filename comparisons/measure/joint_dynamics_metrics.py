@@ -52,7 +52,7 @@ from simparity.core.model.metric_catalogue import (
     TIME_PER_MASS_MATRIX,
     units,
 )
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 
 JOINT_DYNAMICS_METRICS = units(
     MASS_MATRIX_ERROR_MAX,

@@ -32,7 +32,8 @@ from simparity.core.model.metric_catalogue import (
     TIME_PER_STEP, TIME_PER_STEP_BATCHED, order_source, units,
 )
 from simparity.core.model.results import NOTHING_TO_MEASURE, ROUNDING_FLOOR, SATURATED
-from simparity.core.model.scene import Chain, JointMotionScene
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 
 JOINT_MOTION_METRICS = units(

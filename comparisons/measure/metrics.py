@@ -30,7 +30,7 @@ from simparity.core.model.results import (
     SATURATED,
     SUPERCONVERGENT,
 )
-from simparity.core.model.scene import DynamicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import FramePoses, Trajectory
 from simparity.references.common.conventions import rotation_angle
 from simparity.core.model.metric_catalogue import (

@@ -12,7 +12,7 @@ from simparity.comparisons.measure.metrics import dynamics_metrics, energy_scale
 from simparity.comparisons.measure.rows import Case
 from simparity.core.model.metric_catalogue import ANGULAR_MOMENTUM_DRIFT_MAX, ENERGY_DRIFT_MAX
 from simparity.core.model.results import SERIES_POINTS, SeriesRecord
-from simparity.core.model.scene import DynamicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory
 from simparity.references.common.conventions import quat_wxyz_angle
 

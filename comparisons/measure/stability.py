@@ -32,7 +32,7 @@ from simparity.comparisons.measure.divergence import blow_up
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import Engine
 from simparity.core.model.errors import SimparityError
-from simparity.core.model.scene import DynamicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.metric_catalogue import STABLE_DT_MAX
 
 STABILITY_METRICS = {STABLE_DT_MAX: "s"}

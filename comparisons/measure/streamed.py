@@ -14,7 +14,7 @@ import numpy as np
 
 from simparity.comparisons.measure.extents import ErrorExtents, ReferenceExtents, RunExtents
 from simparity.comparisons.measure.series import DynamicsSeries
-from simparity.core.model.scene import DynamicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory, joined
 
 SAMPLE_BYTES = 13 * 8

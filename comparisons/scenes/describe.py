@@ -10,7 +10,12 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.comparisons.scenes.sweep import value_text
-from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.references.common.dynamics_urdf import model_changes
 
 

@@ -9,11 +9,11 @@ from pathlib import Path
 
 from simparity.comparisons.engines.registry import EngineSet
 from simparity.comparisons.scenes.limits import DEFAULT_LIMITS, Limits
-from simparity.comparisons.scenes.loader import load_scenes
+from simparity.comparisons.scenes.loading.scene_file import load_scenes
 from simparity.comparisons.scenes.sweep import SWEEP_TABLE
 from simparity.core.model.errors import UnknownSceneError, one_line
 from simparity.core.model.files import file_problem, read_toml
-from simparity.core.model.scene import SUITES
+from simparity.core.model.scenes.suites import SUITES
 
 SCENES_DIR = Path(__file__).parent
 

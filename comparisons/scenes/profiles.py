@@ -28,7 +28,11 @@ from dataclasses import replace
 import numpy as np
 
 from simparity.comparisons.engines.registry import EngineSet
-from simparity.core.model.scene import DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 
 QUICK_MAX_STEPS = 2000
 QUICK_MOTION_LADDER = 3

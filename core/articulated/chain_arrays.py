@@ -17,7 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 from simparity.core.rotations import skew
 
 SYMMETRIC_PAIRS = ((0, 2), (0, 5), (2, 3), (3, 5),  # x parts of the 2-vectors a rotation about z turns

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 from simparity.core.kinematics import joint_frames
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 
 
 class JacobianSum:

@@ -8,7 +8,7 @@ from simparity.core.articulated.chain_arrays import chain_arrays
 from simparity.core.articulated.jacobian_sum import JacobianSum
 from simparity.core.articulated.recursive import Recursive
 from simparity.core.model.engine import JointDynamicsModel
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 
 RECURSIVE, JACOBIAN_SUM = "recursive", "jacobian_sum"
 METHODS = (RECURSIVE, JACOBIAN_SUM)

@@ -10,7 +10,7 @@ from simparity.core.articulated.chain_arrays import chain_arrays
 from simparity.core.articulated.recursive import Recursive
 from simparity.core.kinematics import forward_kinematics
 from simparity.core.model.engine import BatchedRun, JointSimulation
-from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 
 

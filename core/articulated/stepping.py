@@ -26,7 +26,8 @@ import numpy as np
 
 from simparity.core.articulated.chain_arrays import chain_arrays
 from simparity.core.articulated.recursive import Recursive
-from simparity.core.model.scene import Chain, JointMotionScene
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 
 EXPLICIT_EULER, SEMI_IMPLICIT_EULER, MIDPOINT, RK4, IMPLICIT_DAMPING = (
     "explicit_euler", "semi_implicit_euler", "midpoint", "rk4", "implicit_damping")

@@ -28,7 +28,8 @@ from simparity.core.contact.particle import penalty_force
 from simparity.core.dynamics.forces import make_wrench
 from simparity.core.dynamics.rigid_body import MassProperties, State, Wrench
 from simparity.core.rotations import cross
-from simparity.core.model.scene import AppliedForce, Contact, Forces, Plane
+from simparity.core.model.scenes.bodies import AppliedForce, Forces
+from simparity.core.model.scenes.contact import Contact, Plane
 
 CONTACT_TOLERANCE = 1e-9
 """[m] Points within this distance of a plane (and of the deepest point) touch it together: an edge or

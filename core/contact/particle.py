@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.core.dynamics.point_mass import average_velocity_step
-from simparity.core.model.scene import Plane
+from simparity.core.model.scenes.contact import Plane
 
 METHODS = ("backup", "detect_and_reflect")
 """Collision handling offered by :func:`step_particles`."""

@@ -14,7 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from simparity.core.dynamics.rigid_body import MassProperties, Wrench
-from simparity.core.model.scene import Forces
+from simparity.core.model.scenes.bodies import Forces
 
 
 def make_wrench(forces: Forces, props: MassProperties) -> Wrench:

@@ -12,7 +12,7 @@ from typing import Callable
 import numpy as np
 
 from simparity.core.rotations import quat_wxyz_to_matrix
-from simparity.core.model.scene import RigidBody
+from simparity.core.model.scenes.bodies import RigidBody
 
 Wrench = Callable[[float | np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
 """f(t, x, R, v, omega) -> (force_world (B, 3) [N], torque_world about the COM (B, 3) [N m]); t [s] is a float,

@@ -58,7 +58,7 @@ from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.model.ik_result import IKResult
 from simparity.core.kinematics import jacobian_of_frames, jacobian_world, packed_frames
 from simparity.core.rotations import so3_log
-from simparity.core.model.scene import Chain, sample_configurations
+from simparity.core.model.scenes.chain import Chain, sample_configurations
 
 METHODS = ("jacobian_inverse", "pseudo_inverse", "transpose", "damped_least_squares")
 

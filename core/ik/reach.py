@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 
 
 def reach_upper_bound(chain: Chain) -> tuple[np.ndarray, float]:

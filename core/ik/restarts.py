@@ -37,7 +37,7 @@ from simparity.core.ik.jacobian_solvers import IKOptions, failure_causes, solve_
 from simparity.core.model.ik_problem import check_inputs
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.model.ik_result import IKResult
-from simparity.core.model.scene import Chain, sample_configurations
+from simparity.core.model.scenes.chain import Chain, sample_configurations
 
 RESTART_STREAM = 0x5E57A27
 """Spawn key of the restart draws' stream of the seed."""

@@ -17,7 +17,11 @@ import numpy as np
 from simparity.core.model.errors import NotBatchedError, SimparityError
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.ik_result import IKResult
-from simparity.core.model.scene import Chain, DynamicsScene, JointMotionScene, KinematicsScene, Scene
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinds import Scene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.core.model.trajectory import FramePoses, JointTrajectory, Trajectory, joined, trajectory_pieces
 
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 
 MAX_TARGET_DISTANCE = 1e9
 """[m] Largest distance of a target from the origin: a million kilometres is beyond any robot, and its

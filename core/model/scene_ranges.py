@@ -1,6 +1,6 @@
 """The physical ranges (:mod:`core.model.ranges`) held on a scene built in code.
 
-A scene file is held to the ranges as it is read (``comparisons/scenes/loader.py``, :mod:`core.urdf`); a scene object
+A scene file is held to the ranges as it is read (``comparisons/scenes/loading/``, :mod:`core.urdf`); a scene object
 a user builds and hands to ``simparity.run_scene`` or the pytest fixture is held here, field by field: every number
 of a field named like a range key (``mass``, ``damping``, ``com_xyz``, ...) must lie in that range, and no number may
 be subnormal. An infinite joint limit is the data model's "no limit" and is passed over.

@@ -43,7 +43,8 @@ from scipy.spatial import ConvexHull
 
 from simparity.core.model.engine import Simulation, Support
 from simparity.core.model.errors import SimparityError
-from simparity.core.model.scene import DynamicsScene, Plane, Shape
+from simparity.core.model.scenes.contact import Plane, Shape
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory
 from simparity.references.common.conventions import quat_wxyz_to_matrix
 

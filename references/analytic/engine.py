@@ -48,7 +48,9 @@ from simparity.core.model.engine import (
 )
 from simparity.core.model.ik_problem import IKTolerances, check_inputs
 from simparity.core.model.ik_result import IKResult
-from simparity.core.model.scene import Chain, DynamicsScene, JointMotionScene
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
 from simparity.references.analytic import contact as analytic_contact
 from simparity.references.analytic import joint_dynamics as planar_dynamics

@@ -52,7 +52,7 @@ import numpy as np
 
 from simparity.core.model.engine import JointDynamicsModel, Support
 from simparity.core.model.errors import SceneError
-from simparity.core.model.scene import Chain, LinkInertia
+from simparity.core.model.scenes.chain import Chain, LinkInertia
 
 _PLANAR_RTOL = 1e-12
 """Relative tolerance of "parallel", "in the plane" and "a principal axis": a chain built planar in code or a URDF

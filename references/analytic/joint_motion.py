@@ -43,7 +43,7 @@ import numpy as np
 from scipy.special import ellipj, ellipk, ellipkinc
 
 from simparity.core.model.engine import JointSimulation, Support
-from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.analytic.solutions import linear_drag
 

@@ -25,7 +25,8 @@ import scipy
 from scipy.integrate import solve_ivp
 
 from simparity.core.model.engine import Engine, KinematicsModel, PieceSimulation, Simulation, Support
-from simparity.core.model.scene import Chain, DynamicsScene
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory, piece_bounds
 from simparity.references.common import external_forces
 from simparity.references.common.scene_inputs import derives_own_inputs

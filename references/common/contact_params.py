@@ -50,7 +50,7 @@ import math
 
 import numpy as np
 
-from simparity.core.model.scene import Contact, Plane, Shape
+from simparity.core.model.scenes.contact import Contact, Plane, Shape
 
 POINT_RADIUS = 1e-5  # [m]
 """Radius of the sphere standing for a point (a "point" body, each of "points", each box corner

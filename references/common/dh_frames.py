@@ -1,7 +1,7 @@
 """Joint frames of a Denavit-Hartenberg table, with the references' own code (not ``core.dh``).
 
 A chain a scene file gives as ``[chain.dh]`` reaches core as joint frames ``core.dh`` computed; the references
-build the same frames here from the table itself (:class:`~core.model.scene.DHTable`), so that a bug in either
+build the same frames here from the table itself (:class:`~core.model.scenes.chain.DHTable`), so that a bug in either
 shows as a disagreement. This module writes each row's transform as the textbook's closed-form 4 x 4 matrix
 (Spong's A_i for the standard convention, Craig's for the modified one) instead of core's product of elementary
 rotations and translations.
@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simparity.core.model.scene import DHTable
+from simparity.core.model.scenes.chain import DHTable
 
 Frame = tuple[np.ndarray, np.ndarray]
 """(origin (3,) [m], rotation (3, 3)) of a frame in its parent's."""

@@ -37,7 +37,7 @@ import numpy as np
 
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.files import parse_xml
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.urdf_export import exported_chain_urdf, zero_inertial
 
 REMOVED_FROM_LINKS = ("visual", "collision")

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simparity.core.model.scene import Forces
+from simparity.core.model.scenes.bodies import Forces
 
 DETAIL = "drag and wind computed by the references (independently of core) from the state at each step's start"
 """What the rows' detail says of the forces computed here."""

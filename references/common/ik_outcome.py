@@ -22,7 +22,7 @@ import numpy as np
 
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.ik_result import LIMIT_TOLERANCE, IKResult
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 
 
 def reach_bound(chain: Chain) -> tuple[np.ndarray, float]:

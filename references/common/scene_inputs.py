@@ -26,18 +26,14 @@ import functools
 from dataclasses import replace
 from typing import Any, TypeVar
 
-from simparity.core.model.scene import (
-    Chain,
-    Contact,
-    DynamicsScene,
-    IKScene,
-    JointDynamicsScene,
-    JointMotionScene,
-    KinematicsScene,
-    PointMasses,
-    RigidBody,
-    Shape,
-)
+from simparity.core.model.scenes.bodies import PointMasses, RigidBody
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.contact import Contact, Shape
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.references.common.conventions import quat_wxyz_to_matrix, rpy_to_matrix
 from simparity.references.common.dh_frames import dh_frames
 from simparity.references.common.point_masses import point_mass_properties

@@ -32,7 +32,8 @@ from typing import TYPE_CHECKING, cast
 
 from simparity.core.model.engine import Support
 from simparity.core.model.files import parse_xml
-from simparity.core.model.scene import Chain, LinkInertia, RigidBody
+from simparity.core.model.scenes.bodies import RigidBody
+from simparity.core.model.scenes.chain import Chain, LinkInertia
 from simparity.references.common.conventions import (
     PLACEHOLDER_INERTIA,
     PLACEHOLDER_MASS,

@@ -64,7 +64,12 @@ from simparity.core.model.engine import (
 )
 from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.scene import Chain, DynamicsScene, Forces, IKScene, JointDynamicsScene, JointMotionScene
+from simparity.core.model.scenes.bodies import Forces
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
 from simparity.references.common import contact_params, external_forces
 from simparity.references.mujoco import ik as mujoco_ik

@@ -37,7 +37,7 @@ from mujoco import rollout
 
 from simparity.core.model.engine import BatchedRun, JointSimulation
 from simparity.core.model.errors import DivergedError
-from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common.conventions import fmt
 from simparity.references.mujoco.joint_dynamics import ChainModel

@@ -40,7 +40,9 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from simparity.core.model.scene import Chain, Contact, DynamicsScene
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.contact import Contact
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.references.common import contact_params
 from simparity.references.common.conventions import PLACEHOLDER_INERTIA, PLACEHOLDER_MASS, fmt, matrix_to_quat_wxyz
 

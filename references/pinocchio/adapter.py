@@ -54,7 +54,11 @@ from simparity.core.model.engine import (
 )
 from simparity.core.model.errors import NotBatchedError
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.scene import Chain, DynamicsScene, IKScene, JointDynamicsScene, JointMotionScene
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
 from simparity.references.common import external_forces
 from simparity.references.pinocchio import ik as pinocchio_ik

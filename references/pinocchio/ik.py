@@ -45,7 +45,7 @@ import pinocchio as pin
 from simparity.core.model.engine import IKModel, StoppingRule
 from simparity.core.model.ik_problem import IKTolerances, check_inputs
 from simparity.core.model.ik_result import IKResult
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.ik_outcome import ik_outcome
 
 SOLVERS = ("clik", "clik-documented")

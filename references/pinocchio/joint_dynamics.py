@@ -33,7 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from simparity.core.model.engine import JointDynamicsModel
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt
 from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output

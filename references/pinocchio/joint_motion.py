@@ -39,7 +39,7 @@ from scipy.integrate import solve_ivp
 
 from simparity.core.model.engine import BatchedRun, JointSimulation
 from simparity.core.model.errors import DivergedError, NotBatchedError
-from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.pinocchio.joint_dynamics import ChainModel, chain_model
 

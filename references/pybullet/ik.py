@@ -53,7 +53,7 @@ from simparity.references.pybullet.quiet import pybullet
 from simparity.core.model.engine import IKModel, StoppingRule
 from simparity.core.model.ik_problem import IKTolerances, check_inputs
 from simparity.core.model.ik_result import IKResult
-from simparity.core.model.scene import Chain
+from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import matrix_to_quat_wxyz, rotation_angle, xyzw_from_wxyz
 from simparity.references.common.ik_outcome import ik_outcome
 

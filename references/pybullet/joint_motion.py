@@ -46,7 +46,7 @@ import numpy as np
 
 from simparity.core.model.engine import BatchedRun, JointSimulation
 from simparity.core.model.errors import DivergedError
-from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common.dynamics_urdf import dynamics_source
 from simparity.references.pybullet.adapter import PybulletChain

@@ -12,7 +12,7 @@ from dataclasses import replace
 
 from simparity import load_scene, run_scene
 from simparity.comparisons.scenes.profiles import apply_profile
-from simparity.core.model.scene import DynamicsScene
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from tests.mutation.copy_of_core import CoreCopy
 
 TIMING_PREFIX = "time_"

@@ -15,7 +15,9 @@ import pybullet
 import pytest
 from scipy.integrate import solve_ivp
 
-from simparity.core.model.scene import Contact, DynamicsScene, Forces, Material, Plane, PointMasses, RigidBody, Shape
+from simparity.core.model.scenes.bodies import Forces, PointMasses, RigidBody
+from simparity.core.model.scenes.contact import Contact, Material, Plane, Shape
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.references.common import contact_params
 from simparity.references.common.conventions import quat_wxyz_to_matrix, wxyz_from_xyzw
 from simparity.references.mujoco.mjcf import dynamics_mjcf

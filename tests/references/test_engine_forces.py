@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.engines.registry import make_engine
-from simparity.core.model.scene import AppliedForce, DynamicsScene, Forces, RigidBody
+from simparity.core.model.scenes.bodies import AppliedForce, Forces, RigidBody
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from tests.helpers import HAND_WRENCH, hand_wrench_forces
 
 ENGINES = [("mujoco", "euler"), ("pybullet", "euler"), ("pinocchio", "euler"), ("core", "engine_euler")]

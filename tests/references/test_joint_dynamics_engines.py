@@ -17,7 +17,7 @@ import pinocchio as pin
 import pybullet_data
 import pytest
 
-from simparity.core.model.scene import Chain, Joint, LinkInertia, sample_configurations
+from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia, sample_configurations
 from simparity.core.urdf import chain_from_urdf
 from simparity.references.common.dynamics_urdf import dynamics_urdf
 from simparity.references.common.urdf_export import original_without_geometry

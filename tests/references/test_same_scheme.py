@@ -12,7 +12,7 @@ import pytest
 
 from simparity.comparisons.engines.registry import make_engine
 from simparity.core.rotations import geodesic_angle_quat_wxyz, so3_exp
-from simparity.core.model.scene import AppliedForce, Forces
+from simparity.core.model.scenes.bodies import AppliedForce, Forces
 from tests.helpers import tumbling_box
 
 # Each step rounds differently on each side (~1e-16) and the tumbling amplifies it:

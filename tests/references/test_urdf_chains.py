@@ -12,7 +12,8 @@ import pytest
 from simparity.comparisons.engines.registry import make_engine
 from simparity.core.kinematics import forward_kinematics, jacobian_world
 from simparity.core.rotations import geodesic_angle_matrix
-from simparity.core.model.scene import DynamicsScene, Forces, RigidBody
+from simparity.core.model.scenes.bodies import Forces, RigidBody
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.urdf import chain_from_urdf
 from simparity.references.mujoco.mjcf import dynamics_mjcf
 from simparity.references.common.urdf_export import chain_urdf, movable_joints_above_base

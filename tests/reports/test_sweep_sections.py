@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from simparity.comparisons.cli.main import main
-from simparity.comparisons.scenes.loader import parse_scenes
+from simparity.comparisons.scenes.loading.scene_file import parse_scenes
 from simparity.comparisons.execute.store import RunWriter
 from simparity.core.model.files import tomllib
 from simparity.core.model.results import REPORT_FILE, SERIES_COLUMNS, ResultRow

@@ -229,7 +229,7 @@ FUZZ_VALUES = [[], [1.0], [0.5, 2.0], [1.0, 1.0], ["a"], [True], [[1.0]], [{}], 
 def test_fuzzed_sweep_tables_load_or_are_refused_on_one_line():
     """Seeded random [sweep] tables over valid and broken keys and values: each loads, or raises SceneError with
     one line that says what is allowed; nothing else escapes (no traceback in the CLI)."""
-    from simparity.comparisons.scenes.loader import parse_scenes
+    from simparity.comparisons.scenes.loading.scene_file import parse_scenes
     from simparity.core.model.errors import SceneError
     from simparity.core.model.files import tomllib
 

@@ -21,13 +21,16 @@ from simparity.comparisons.gate.tolerances import load_tolerances
 from simparity.comparisons.invariance.perturb import ulp_perturbed
 from simparity.comparisons.invariance.transforms import FIXED_TRANSFORMS, transform_scene
 from simparity.comparisons.engines.registry import make_engine
-from simparity.comparisons.scenes import loader
-from simparity.comparisons.scenes.loader import parse_scene
+from simparity.comparisons.scenes.loading import bodies as loading_bodies
+from simparity.comparisons.scenes.loading import chain as loading_chain
+from simparity.comparisons.scenes.loading.scene_file import parse_scene
 from simparity.core import dh as core_dh
 from simparity.core import rotations as core_rotations
 from simparity.core.dynamics import forces as core_forces
 from simparity.core.dynamics import inertia as core_inertia
-from simparity.core.model.scene import DynamicsScene, Forces, sample_configurations
+from simparity.core.model.scenes.bodies import Forces
+from simparity.core.model.scenes.chain import sample_configurations
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.references.common.scene_inputs import as_given
 from tests.helpers import builtin
 
@@ -225,12 +228,12 @@ def _unweighted_center(original):
 
 # (what is planted, [(module, attribute, bug)]): each bug is set on core's module and wherever the loader bound it.
 SCENE_INPUT_BUGS = {
-    "rpy": [(core_rotations, "rpy_to_matrix", _transposed_rpy), (loader, "rpy_to_matrix", _transposed_rpy)],
+    "rpy": [(core_rotations, "rpy_to_matrix", _transposed_rpy), (loading_chain, "rpy_to_matrix", _transposed_rpy)],
     "dh": [(core_dh, "_rot_x", _flipped_rot_x)],
     "point-mass inertia": [(core_inertia, "inertia_from_point_masses", _slide_sign_inertia),
-                           (loader, "inertia_from_point_masses", _slide_sign_inertia)],
+                           (loading_bodies, "inertia_from_point_masses", _slide_sign_inertia)],
     "point-mass centre": [(core_inertia, "mass_and_center_of_mass", _unweighted_center),
-                          (loader, "mass_and_center_of_mass", _unweighted_center)],
+                          (loading_bodies, "mass_and_center_of_mass", _unweighted_center)],
 }
 
 

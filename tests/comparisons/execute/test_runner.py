@@ -273,7 +273,9 @@ def test_warnings_raised_in_a_case_go_into_its_rows_not_the_console(recwarn):
 
 def _drop_scene(**contact):
     """A particle dropped 0.2 m onto z = 0 with restitution 0.5 (a contact scene built in code)."""
-    from simparity.core.model.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
+    from simparity.core.model.scenes.bodies import Forces, RigidBody
+    from simparity.core.model.scenes.contact import Contact, Material, Plane, Shape
+    from simparity.core.model.scenes.dynamics import DynamicsScene
 
     body = RigidBody("particle", 1.0, np.eye(3) * 1e-3, np.array([0.0, 0.0, 0.2]), np.array([1.0, 0, 0, 0]),
                      np.zeros(3), np.zeros(3))

@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from simparity.comparisons.engines.registry import make_engine
-from simparity.comparisons.scenes.loader import parse_scenes
+from simparity.comparisons.scenes.loading.scene_file import parse_scenes
 from simparity.comparisons.execute.store import RunWriter
 from simparity.core.model.errors import ResultsError
 from simparity.core.model.files import tomllib

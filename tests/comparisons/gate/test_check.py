@@ -10,7 +10,7 @@ from simparity.comparisons.gate.check import BASELINE_RELATIVE, check_table, com
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes.profiles import quick
 from simparity.comparisons.execute.session import run_in_process as run_scene
-from simparity.comparisons.scenes.loader import parse_scenes
+from simparity.comparisons.scenes.loading.scene_file import parse_scenes
 from simparity.comparisons.execute.store import RunWriter
 from simparity.comparisons.gate.tolerances import load_tolerances
 from simparity.core.dynamics import quaternion_integrators

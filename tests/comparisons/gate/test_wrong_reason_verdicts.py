@@ -85,7 +85,7 @@ def test_a_contact_that_gains_energy_at_most_impacts_is_diverged_with_the_count_
 def _hanging_rod(q0: float, dts: list[float]):
     """A 1 m, 1 kg rod hinged at one end about z and hanging at q = 0 (gravity along its rest direction, +x),
     released at rest ``q0`` rad from hanging, stepped 3 s by explicit Euler against Jacobi's closed form."""
-    from simparity.comparisons.scenes.loader import parse_scenes
+    from simparity.comparisons.scenes.loading.scene_file import parse_scenes
 
     text = f"""
 [scene]

@@ -46,7 +46,11 @@ from simparity.comparisons.invariance.transforms import FIXED_TRANSFORMS, fixed_
 from simparity.core.model.errors import TransformError
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.results import DIVERGED, FAILED, OK, ResultRow
-from simparity.core.model.scene import IKScene, JointDynamicsScene, JointMotionScene, KinematicsScene, Plane
+from simparity.core.model.scenes.contact import Plane
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.kinematics import KinematicsScene
 from tests.helpers import THROWN_INTO_WIND
 
 ENGINES = ("core", "analytic", "mujoco", "pybullet", "pinocchio")

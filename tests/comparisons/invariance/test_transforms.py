@@ -29,7 +29,7 @@ from simparity.comparisons.invariance.transforms import (
 )
 from simparity.comparisons.invariance.units import Dimension, unit_dimensions, unit_factor
 from simparity.core.model.errors import TransformError, UnitError
-from simparity.core.model.scene import AppliedForce
+from simparity.core.model.scenes.bodies import AppliedForce
 
 CLOSED_FORM_RTOL = 1e-9
 """The closed forms evaluated in two frames agree to rounding of their operands (sines, elliptic functions of

@@ -7,7 +7,9 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.measure.contact_metrics import contact_metrics, impacts
-from simparity.core.model.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
+from simparity.core.model.scenes.bodies import Forces, RigidBody
+from simparity.core.model.scenes.contact import Contact, Material, Plane, Shape
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory
 
 G = 9.81

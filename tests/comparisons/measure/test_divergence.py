@@ -8,7 +8,8 @@ from simparity.comparisons.measure.divergence import AT_REST, DIVERGENCE_MARGIN,
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.session import run_in_process as run_scene
 from simparity.core.model.results import DIVERGED, OK
-from simparity.core.model.scene import AppliedForce, DynamicsScene, Forces, RigidBody
+from simparity.core.model.scenes.bodies import AppliedForce, Forces, RigidBody
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory
 
 

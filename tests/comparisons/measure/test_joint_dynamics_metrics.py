@@ -26,7 +26,8 @@ from simparity.core.model.metric_catalogue import (
     MASS_MATRIX_ERROR_MAX,
     ROUND_TRIP_RESIDUAL,
 )
-from simparity.core.model.scene import Chain, Joint, JointDynamicsScene, LinkInertia
+from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 
 MASS, DISTANCE, INERTIA_ZZ, GRAVITY = 2.0, 0.4, 0.05, 9.81  # [kg], [m], [kg m^2], [m/s^2]
 ROUNDING = 1e-14

@@ -15,7 +15,8 @@ from simparity.comparisons.measure.joint_dynamics_metrics import reference_error
 from simparity.comparisons.measure.joint_force_scale import ForceScale
 from simparity.comparisons.scenes import library
 from simparity.core.model.metric_catalogue import BIAS_FORCE_ERROR_MAX, INVERSE_DYNAMICS_ERROR_MAX
-from simparity.core.model.scene import Chain, Joint, JointDynamicsScene, LinkInertia
+from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 from tests.mutation.catalogue import by_id
 from tests.system.test_mutation import imported  # noqa: F401 - the fixture that materialises copies of core
 

@@ -17,7 +17,8 @@ from simparity.core.model.metric_catalogue import (
     POWER_BALANCE_RESIDUAL_MAX,
 )
 from simparity.core.model.results import NOTHING_TO_MEASURE, SATURATED
-from simparity.core.model.scene import Chain, Joint, JointMotionScene, LinkInertia
+from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 
 INERTIA = 1.0  # kg m^2 about the axis: a point mass of 1 kg at 1 m

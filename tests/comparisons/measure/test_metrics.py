@@ -16,7 +16,8 @@ from simparity.comparisons.measure.metrics import (
 )
 from simparity.comparisons.execute.session import run_in_process as run_scene
 from simparity.comparisons.engines.registry import make_engine
-from simparity.core.model.scene import DynamicsScene, Forces, RigidBody
+from simparity.core.model.scenes.bodies import Forces, RigidBody
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory
 from tests.helpers import builtin
 

@@ -11,7 +11,8 @@ from simparity.comparisons.execute.session import run_in_process as run_scene
 from simparity.comparisons.measure.series import dynamics_series, envelope
 from simparity.comparisons.execute.store import RunWriter
 from simparity.core.model.results import SERIES_POINTS
-from simparity.core.model.scene import DynamicsScene, Forces, RigidBody
+from simparity.core.model.scenes.bodies import Forces, RigidBody
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory
 from simparity.reports.store import read_series
 from tests.helpers import builtin, smoke

@@ -5,7 +5,9 @@ import pytest
 
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.measure.stability import stable_dt_max
-from simparity.core.model.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
+from simparity.core.model.scenes.bodies import Forces, RigidBody
+from simparity.core.model.scenes.contact import Contact, Material, Plane, Shape
+from simparity.core.model.scenes.dynamics import DynamicsScene
 
 STIFFNESS, MASS = 1.0e4, 1.0  # omega = 100 rad/s
 LINEAR_FACTOR = 2.0

@@ -14,7 +14,8 @@ from simparity.comparisons.measure.rows import Case
 from simparity.comparisons.measure.series import StreamedEnvelope, envelope
 from simparity.comparisons.measure.streamed import AlignedPieces, CaseReading
 from simparity.core.model.engine import Engine, PieceSimulation, Simulation, Support, streams_in_pieces
-from simparity.core.model.scene import DynamicsScene, Forces, RigidBody
+from simparity.core.model.scenes.bodies import Forces, RigidBody
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory, joined, piece_bounds, trajectory_pieces
 from tests.helpers import built_engines, builtin, comparable, smoke
 

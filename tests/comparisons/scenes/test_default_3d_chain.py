@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.scenes import library
-from simparity.core.model.scene import Chain, JointDynamicsScene, JointMotionScene
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from tests.mutation.catalogue import by_id
 from tests.mutation.copy_of_core import materialise
 

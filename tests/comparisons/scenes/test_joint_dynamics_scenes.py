@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.scenes import library
-from simparity.comparisons.scenes.loader import parse_scene
+from simparity.comparisons.scenes.loading.scene_file import parse_scene
 from simparity.core.model.errors import SceneError
 from tests.helpers import with_key
 from simparity.core.articulated import model as joint_dynamics
 from simparity.core.inhouse import InHouseEngine
-from simparity.core.model.scene import JointDynamicsScene
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 
 PENDULUM = {
     "scene": {"name": "p", "kind": "joint_dynamics", "reference": "analytic"},
@@ -127,7 +127,7 @@ UNTUNED_ARMS = [
 def _robots() -> str:
     from importlib import metadata
 
-    from simparity.comparisons.scenes.loader import EXAMPLE_ROBOT_DATA_ROBOTS
+    from simparity.comparisons.scenes.loading.chain import EXAMPLE_ROBOT_DATA_ROBOTS
 
     return str(metadata.distribution("example-robot-data").locate_file(EXAMPLE_ROBOT_DATA_ROBOTS))
 

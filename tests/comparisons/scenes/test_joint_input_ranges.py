@@ -14,9 +14,10 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.cli.main import EXIT_USAGE, main
-from simparity.comparisons.scenes.loader import load_scene, load_scenes
+from simparity.comparisons.scenes.loading.scene_file import load_scene, load_scenes
 from simparity.core.model.errors import SceneError
-from simparity.core.model.scene import LinkInertia, RigidBody
+from simparity.core.model.scenes.bodies import RigidBody
+from simparity.core.model.scenes.chain import LinkInertia
 from simparity.core.urdf import SINGLE_CHILDREN, chain_from_urdf
 
 JOINTS = """

@@ -8,13 +8,13 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from simparity.comparisons.scenes.loader import parse_scene
+from simparity.comparisons.scenes.loading.scene_file import parse_scene
 from simparity.core.articulated import stepping
 from simparity.core.articulated.motion import CoreJointMotion
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.errors import SceneError
 from tests.helpers import with_key
-from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 
 ROD = {"name": "hinge", "type": "revolute", "axis": [0.0, 0.0, 1.0], "mass": 1.0, "com_xyz": [0.5, 0.0, 0.0],
        "inertia": [[1e-5, 0.0, 0.0], [0.0, 0.0834, 0.0], [0.0, 0.0, 0.0834]]}
@@ -182,7 +182,7 @@ def test_arms_nobody_tuned_fall_alike_in_every_engine(urdf, base, tip):
     """An arm from a pip wheel falls from a seeded random pose with light damping in every engine: every case runs
     (no default of an engine stops or changes the motion: then it would fail, diverge or disagree), and each scheme's
     error against Pinocchio's DOP853 solve is the same in every engine that runs it."""
-    from simparity.core.model.scene import sample_configurations
+    from simparity.core.model.scenes.chain import sample_configurations
     from simparity.core.urdf import chain_from_urdf
     from tests.comparisons.scenes.test_joint_dynamics_scenes import _robots
 

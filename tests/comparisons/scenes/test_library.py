@@ -16,13 +16,15 @@ from simparity.comparisons.gate.check import check_table
 from simparity.comparisons.scenes.describe import describe
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes.profiles import quick
-from simparity.comparisons.scenes.loader import EXAMPLE_ROBOT_DATA_PREFIX
+from simparity.comparisons.scenes.loading.chain import EXAMPLE_ROBOT_DATA_PREFIX
 from simparity.comparisons.execute.session import run_in_process as run_scene
 from simparity.comparisons.gate.tolerances import load_tolerances
 from simparity.core.model.errors import SceneError, SimparityError, UnknownSceneError
 from simparity.core.model.files import tomllib
 from simparity.core.model.results import COLUMNS, DIVERGED, OK, ResultRow
-from simparity.core.model.scene import DynamicsScene, IKScene, SweepPoint
+from simparity.core.model.scenes.dynamics import DynamicsScene
+from simparity.core.model.scenes.ik import IKScene
+from simparity.core.model.scenes.suites import SweepPoint
 from tests.helpers import builtin
 
 MIN_HARD_CASES = 20

@@ -9,7 +9,9 @@ import pytest
 
 from simparity.comparisons.scenes.library import builtin_paths
 from simparity.comparisons.scenes.describe import describe
-from simparity.comparisons.scenes.loader import LENGTH_UNITS, load_scene, load_scenes, parse_scene, parse_scenes
+from simparity.comparisons.scenes.loading.scene_file import (
+    LENGTH_UNITS, load_scene, load_scenes, parse_scene, parse_scenes,
+)
 from simparity.core.model.files import tomllib
 from simparity.core.model.errors import SceneError
 

@@ -41,7 +41,7 @@ def test_the_quick_default_suite_exercises_every_integrator_variant():
     of the quick default suite (the short rotating scenes keep their variants)."""
     from simparity.comparisons.engines.registry import make_engine
     from simparity.comparisons.scenes.library import suite
-    from simparity.core.model.scene import DynamicsScene
+    from simparity.core.model.scenes.dynamics import DynamicsScene
 
     core = make_engine("core")
     scenes = [quick(s) for s in suite("default") if isinstance(s, DynamicsScene) and s.contact is None]

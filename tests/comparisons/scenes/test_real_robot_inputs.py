@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from simparity.comparisons.scenes.loader import parse_scene
+from simparity.comparisons.scenes.loading.scene_file import parse_scene
 from simparity.core.model.errors import SceneError
-from simparity.core.model.scene import sample_configurations
+from simparity.core.model.scenes.chain import sample_configurations
 from simparity.core.urdf import chain_from_urdf
 
 HEAD_COM = (0.0185, -0.1108, 0.0)
@@ -176,7 +176,7 @@ def test_what_every_engine_is_given_is_named_link_by_link_in_show_and_the_rows_d
     """Before: 'links without <inertial> massless' and 'held at 0', whatever the file. Now each change names its
     links or joints, in ``simparity show`` and in the detail every adapter's rows carry (dynamics_source)."""
     from simparity.comparisons.scenes.describe import describe
-    from simparity.comparisons.scenes.loader import load_scene
+    from simparity.comparisons.scenes.loading.scene_file import load_scene
     from simparity.references.common.dynamics_urdf import dynamics_source
 
     (tmp_path / "arm.urdf").write_text(DYNAMICS_FILE, encoding="utf-8")

@@ -12,7 +12,7 @@ import pytest
 
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.session import run_in_process as run_scene
-from simparity.comparisons.scenes.loader import load_scene
+from simparity.comparisons.scenes.loading.scene_file import load_scene
 from simparity.core.model.results import NOT_AVAILABLE, OK
 
 try:

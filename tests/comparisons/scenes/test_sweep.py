@@ -6,7 +6,7 @@ import pytest
 from simparity.comparisons.scenes.sweep import MAX_KEYS, MAX_VARIANTS, read_sweep
 from simparity.core.model.errors import SceneError
 from simparity.core.model.names import NAME_MAX, name_problem
-from simparity.core.model.scene import SweepPoint
+from simparity.core.model.scenes.suites import SweepPoint
 
 DATA = {
     "scene": {"name": "bounce", "kind": "dynamics", "reference": "analytic"},

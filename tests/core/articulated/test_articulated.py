@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.kinematics import joint_frames
-from simparity.core.model.scene import Chain, Joint, LinkInertia
+from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
 from simparity.core.rotations import rpy_to_matrix
 
 METHODS = ("recursive", "jacobian_sum")

@@ -9,7 +9,8 @@ from scipy.integrate import solve_ivp
 
 from simparity.core.articulated import stepping
 from simparity.core.articulated.motion import CoreJointMotion
-from simparity.core.model.scene import Chain, Joint, JointMotionScene, LinkInertia
+from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 
 MASS, LENGTH, G = 1.0, 1.0, 9.81
 ROD = LinkInertia(MASS, np.array([LENGTH / 2, 0.0, 0.0]), np.diag([0.0, MASS * LENGTH**2 / 12, MASS * LENGTH**2 / 12]))

@@ -12,7 +12,9 @@ import pytest
 from simparity.core.contact.bodies import ContactModel, impulse_response, penalty_stability_limit
 from simparity.core.inhouse import CONTACT_INTEGRATORS, InHouseEngine, integrator_names
 from simparity.core.rotations import quat_wxyz_from_rotvec, quat_wxyz_to_matrix
-from simparity.core.model.scene import Contact, DynamicsScene, Forces, Material, Plane, RigidBody, Shape
+from simparity.core.model.scenes.bodies import Forces, RigidBody
+from simparity.core.model.scenes.contact import Contact, Material, Plane, Shape
+from simparity.core.model.scenes.dynamics import DynamicsScene
 
 G = 9.81  # [m/s^2]
 SEED = 20261123

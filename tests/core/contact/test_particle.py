@@ -15,7 +15,7 @@ from simparity.core.contact.particle import (
     step_particles,
     time_of_impact,
 )
-from simparity.core.model.scene import ZERO_NORMAL
+from simparity.core.model.scenes.contact import ZERO_NORMAL
 
 G = 9.81  # [m/s^2]
 SEED = 20240617

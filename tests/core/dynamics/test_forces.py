@@ -5,7 +5,7 @@ import numpy as np
 from simparity.core.dynamics.forces import make_wrench, without_gravity
 from simparity.core.dynamics.rigid_body import MassProperties
 from simparity.core.rotations import quat_wxyz_to_matrix
-from simparity.core.model.scene import AppliedForce, Forces, RigidBody
+from simparity.core.model.scenes.bodies import AppliedForce, Forces, RigidBody
 from tests.helpers import HAND_WRENCH, hand_wrench_forces
 
 HAND_TOL = 1e-14  # the hand values are written to 15 digits

@@ -10,7 +10,7 @@ from simparity.core.inhouse import InHouseEngine
 from simparity.core.dynamics.integrators import ORDER, ORIENTATION_UPDATES, SCHEMES
 from simparity.comparisons.measure.invariants import angular_momentum_world, kinetic_energy
 from simparity.core.rotations import geodesic_angle_quat_wxyz, quat_wxyz_to_matrix
-from simparity.core.model.scene import Forces
+from simparity.core.model.scenes.bodies import Forces
 from simparity.references.analytic.engine import AnalyticEngine
 from tests.helpers import builtin, tumbling_box
 

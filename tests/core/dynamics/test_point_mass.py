@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.scenes.library import builtin_paths
-from simparity.comparisons.scenes.loader import LENGTH_UNITS, load_scene
+from simparity.comparisons.scenes.loading.scene_file import LENGTH_UNITS, load_scene
 from simparity.core.dynamics import point_mass
 from simparity.core.inhouse import InHouseEngine
 

@@ -14,7 +14,7 @@ from simparity.core.dynamics.quaternion_integrators import (
 )
 from simparity.core.dynamics.rigid_body import MassProperties, initial_state
 from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix
-from simparity.core.model.scene import Forces, RigidBody
+from simparity.core.model.scenes.bodies import Forces, RigidBody
 
 ROUNDING = 1e-14
 """Agreement of two evaluation orders of the same float64 arithmetic on O(1) values."""

@@ -16,7 +16,7 @@ from simparity.core.ik import steps
 from simparity.core.ik.limits import cross_gap, crossable_gap, wrap_into_limits
 from simparity.core.kinematics import joint_frames
 from simparity.core.rotations import so3_exp
-from simparity.core.model.scene import Chain, Joint
+from simparity.core.model.scenes.chain import Chain, Joint
 from simparity.core.urdf import chain_from_urdf
 
 IIWA = chain_from_urdf(os.path.join(pybullet_data.getDataPath(), "kuka_iiwa/model.urdf"))

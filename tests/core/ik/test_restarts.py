@@ -13,7 +13,7 @@ from simparity.core.ik.jacobian_solvers import IKOptions, solve_ik
 from simparity.core.ik.reach import reach_upper_bound
 from simparity.core.ik.restarts import RESTART_STREAM, Restarts, solve_ik_with_restarts
 from simparity.core.inhouse import InHouseEngine
-from simparity.core.model.scene import sample_configurations
+from simparity.core.model.scenes.chain import sample_configurations
 from tests.helpers import builtin
 
 N_TARGETS = 300

@@ -11,8 +11,9 @@ import time
 import numpy as np
 import pytest
 
-from simparity.core.model.scene import (AppliedForce, Contact, DynamicsScene, Forces, Material, Plane, RigidBody,
-                                  Shape)
+from simparity.core.model.scenes.bodies import AppliedForce, Forces, RigidBody
+from simparity.core.model.scenes.contact import Contact, Material, Plane, Shape
+from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.references.analytic.engine import AnalyticEngine
 from simparity.references.analytic.contact import contact_events
 

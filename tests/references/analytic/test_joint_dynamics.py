@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 from scipy.spatial.transform import Rotation
 
-from simparity.core.model.scene import Chain, Joint, LinkInertia
+from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
 from simparity.references.analytic.engine import AnalyticEngine
 
 # Closed forms of a few terms in float64 against numbers written by hand: rounding only (cos(pi/2) ~ 6e-17).

@@ -10,7 +10,8 @@ from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 from scipy.special import ellipk
 
-from simparity.core.model.scene import Chain, Joint, JointMotionScene, LinkInertia
+from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.references.analytic.engine import AnalyticEngine
 
 ENGINE = AnalyticEngine()

@@ -4,7 +4,7 @@ import numpy as np
 
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.ik_result import LIMIT_TOLERANCE
-from simparity.core.model.scene import Chain, Joint
+from simparity.core.model.scenes.chain import Chain, Joint
 from simparity.references.common.ik_outcome import ik_outcome
 
 # A planar 2-link arm, links 1.0 m and 0.8 m: reach 1.8 m from the first joint.

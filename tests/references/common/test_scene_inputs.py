@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from simparity.core.dh import UR5_DH, dh_forward
-from simparity.core.model.scene import DHTable
+from simparity.core.model.scenes.chain import DHTable
 from simparity.references.common.dh_frames import dh_frames
 from simparity.references.common.point_masses import point_mass_properties
 from simparity.references.common.scene_inputs import as_given

@@ -110,7 +110,7 @@ def test_euler_damping_is_implicit_unless_eulerdamp_is_disabled():
     """With drag as dof_damping, default Euler damps implicitly (v / (1 + dt b / m)); the adapter's is explicit."""
     from dataclasses import replace
 
-    from simparity.core.model.scene import Forces
+    from simparity.core.model.scenes.bodies import Forces
 
     scene = replace(tumbling_box(inertia_body=0.2 * np.eye(3), gravity=None), forces=Forces(linear_drag=np.array([4.0])))
     dt, b, m = 0.01, 4.0, scene.bodies[0].mass

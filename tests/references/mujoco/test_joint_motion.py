@@ -17,7 +17,7 @@ from scipy.integrate import cumulative_simpson, solve_ivp
 
 import simparity
 from simparity.core.model.errors import DivergedError
-from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.references.analytic import joint_dynamics as closed_form
 from simparity.references.mujoco.adapter import MujocoEngine
 from simparity.references.mujoco.joint_dynamics import MujocoJointDynamics

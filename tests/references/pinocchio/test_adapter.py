@@ -63,7 +63,7 @@ def test_harness_rk4_on_aba_is_fourth_order():
 
     from simparity.comparisons.measure.metrics import observed_order
     from simparity.core.rotations import geodesic_angle_quat_wxyz
-    from simparity.core.model.scene import Forces
+    from simparity.core.model.scenes.bodies import Forces
     from simparity.references.analytic.engine import AnalyticEngine
 
     scene = replace(tumbling_box(duration=1.0), forces=Forces(np.array([0.0, 0.0, -9.81]), linear_drag=np.array([1.5])))

@@ -18,7 +18,8 @@ import simparity
 from simparity.core.kinematics import forward_kinematics
 from simparity.core.model.engine import SCHEME_KINDS
 from simparity.core.model.errors import NotBatchedError
-from simparity.core.model.scene import Chain, Joint, JointMotionScene, LinkInertia
+from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.references.pinocchio.adapter import PinocchioEngine
 from simparity.references.pinocchio.joint_dynamics import chain_model
 

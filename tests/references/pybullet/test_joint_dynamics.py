@@ -19,7 +19,8 @@ import pinocchio as pin
 import pybullet_data
 import pytest
 
-from simparity.core.model.scene import Chain, JointDynamicsScene, sample_configurations
+from simparity.core.model.scenes.chain import Chain, sample_configurations
+from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 from simparity.core.urdf import chain_from_urdf
 from simparity.references.common.dynamics_urdf import dynamics_urdf
 from simparity.references.common.quiet import captured_output

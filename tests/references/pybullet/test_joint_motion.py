@@ -16,7 +16,7 @@ from scipy.integrate import solve_ivp
 
 import simparity
 from simparity.core.model.errors import SimparityError
-from simparity.core.model.scene import JointMotionScene
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.references.common.dynamics_urdf import dynamics_urdf
 from simparity.references.pybullet.adapter import PybulletEngine
 from simparity.references.pybullet.joint_dynamics import ChainBodies

@@ -1,0 +1,111 @@
+"""The joint-motion scene: :class:`JointMotionScene`, a chain stepped through time."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from simparity.core.model.arrays import readonly
+from simparity.core.model.errors import SceneError
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.suites import SweepPoint
+
+
+@dataclass(frozen=True)
+class JointMotionScene:
+    """A chain's motion through time: its joints stepped from an initial state under gravity, its joints' damping
+    and constant joint forces, for ``duration`` at each time step of ``dts``.
+
+    The chain's base link is fixed in the world and its frame is the world frame. Every engine is given the same
+    model; the applied joint forces are constant in time, so an engine that holds them over a step (MuJoCo holds
+    ``qfrc_applied`` over an RK4 step) and one that evaluates them at every stage see the same forces.
+
+    Attributes
+    ----------
+    name, description, reference : str
+        ``reference`` is ``engine`` or ``engine:integrator`` (the integrator defaults to the engine's first).
+    chain : Chain
+        With mass properties on every link (:meth:`Chain.dynamics_problem` is ""); its joints' ``damping`` and
+        ``armature`` are part of the motion.
+    gravity_world : (3,) ndarray or None
+        [m/s^2] in the base frame; None: no gravity.
+    q0, qdot0 : (B, n) ndarray
+        Initial joint values and velocities of B copies [rad or m, rad/s or m/s] (one copy: B = 1).
+    torque : (n,) ndarray
+        Constant applied joint forces [N m or N].
+    duration : float
+        [s].
+    dts : tuple of float
+        The time-step ladder [s], largest first or in any order.
+    integrators : tuple of str
+        The integrators to run (empty: every one each engine offers for joint motion).
+    perturbation : float
+        > 0: every case also runs from q0 + perturbation on every joint [rad or m] and reports when its two runs part,
+        beside when it parts from the reference (predictability, Chung and Pollard 2016); 0: not run.
+    segments : int
+        0: every engine against the reference. k > 0: accuracy as self-consistency (Erez, Tassa and Todorov
+        2015): the motion is cut into k segments starting on the reference's trajectory, and each engine's
+        state at a segment's end is compared with the same engine and integrator at a much smaller step from
+        the same start, averaged over segments, so that a chaotic chain's divergence is not counted as error.
+    source : str
+    suites : tuple of str
+    sweep : SweepPoint or None
+    """
+
+    name: str
+    description: str
+    reference: str
+    chain: Chain
+    gravity_world: np.ndarray | None
+    q0: np.ndarray
+    qdot0: np.ndarray
+    torque: np.ndarray
+    duration: float
+    dts: tuple[float, ...]
+    integrators: tuple[str, ...] = ()
+    segments: int = 0
+    perturbation: float = 0.0
+    source: str = field(default="<code>", compare=False)
+    suites: tuple[str, ...] = ("default",)
+    sweep: SweepPoint | None = None
+    kind: str = field(default="joint_motion", init=False)
+
+    def __post_init__(self) -> None:
+        problem = self.chain.dynamics_problem()
+        if problem:
+            raise SceneError(self.source, "chain", problem, "a chain with mass properties on every link")
+        n = self.chain.n_joints
+        if self.gravity_world is not None:
+            object.__setattr__(self, "gravity_world", readonly(self.gravity_world, shape=(3,)))
+        for key in ("q0", "qdot0"):
+            value = np.asarray(getattr(self, key), dtype=float)
+            value = value.reshape(1, n) if value.ndim == 1 else value
+            if value.ndim != 2 or value.shape[1] != n or not np.all(np.isfinite(value)):
+                raise SceneError(self.source, key, f"shape {value.shape}", f"finite numbers, (B, {n}) or ({n},)")
+            object.__setattr__(self, key, readonly(value))
+        if self.q0.shape != self.qdot0.shape:
+            raise SceneError(self.source, "qdot0", f"{self.qdot0.shape[0]} copies, q0 has {self.q0.shape[0]}",
+                             "as many initial velocities as initial joint values")
+        object.__setattr__(self, "torque", readonly(np.asarray(self.torque, dtype=float), shape=(n,)))
+        if not (np.isfinite(self.duration) and self.duration > 0):
+            raise SceneError(self.source, "duration", f"{self.duration}", "a finite number of seconds > 0")
+        if not self.dts or not all(np.isfinite(dt) and 0 < dt <= self.duration for dt in self.dts):
+            raise SceneError(self.source, "dt", f"{list(self.dts)}", "time steps > 0 and at most the duration")
+        if self.segments < 0:
+            raise SceneError(self.source, "segments", f"{self.segments}", "0 (against the reference) or more")
+        if not (np.isfinite(self.perturbation) and self.perturbation >= 0):
+            raise SceneError(self.source, "perturbation", f"{self.perturbation}", "a finite number >= 0 (0: none)")
+
+    @property
+    def copies(self) -> int:
+        """B, the copies stepped together."""
+        return self.q0.shape[0]
+
+    def n_steps(self, dt: float) -> int:
+        """Number of steps of size ``dt`` that cover ``duration`` (at least one)."""
+        return max(1, int(round(self.duration / dt)))
+
+    def starting_from(self, q0: np.ndarray, qdot0: np.ndarray, duration: float) -> "JointMotionScene":
+        """The same chain and forces from other initial states ((B, n) each) for ``duration`` [s]."""
+        return replace(self, q0=q0, qdot0=qdot0, duration=duration, dts=tuple(min(dt, duration) for dt in self.dts))
