@@ -34,9 +34,10 @@ class Bullets:
 
 @dataclass(frozen=True)
 class Table:
-    """``trim_order``: for a long list (cases without a result, findings) that report.md may shorten to keep within its
-    line budget (:data:`reports.markdown.MAX_LINES`), saying how many rows the HTML has beyond it: 1 is shortened
-    first, 2 next; 0 (the default) never."""
+    """``trim_order``: for a table that report.md may shorten to keep within its line budget
+    (:data:`reports.markdown.MAX_LINES`), saying how many rows the HTML has beyond it: the lowest is shortened first
+    (1 the cases without a result, 2 the flagged findings, 3 a user's engine's table, 4 the summary's row per scene);
+    0 (the default) never."""
 
     head: tuple[str, ...]
     rows: tuple[tuple[str, ...], ...]

@@ -117,7 +117,7 @@ def tally(per_scene: list[dict[str, dict[str, Choice]]], variants: dict | None =
 
 
 def pick(case: Choice, by: str, show_error: bool) -> str:
-    """One engine's choice in a cell: ``rk4 @ 0.01 (400/s)`` (its cost by ``by``) or ``rk4 @ 0.04: 3.1e-07`` (its
+    """One engine's choice in a cell: ``rk4 @ 0.01 (400/s, 2.1 ms)`` (its cost by ``by``, :func:`cost_text`) or ``rk4 @ 0.04: 3.1e-07`` (its
     error); "none", or the reason it has none."""
     if case is None or isinstance(case, str):
         return case or "none"
@@ -149,8 +149,8 @@ def cheapest_head(by: str, budget: float) -> str:
 
 
 def overall(cases: pd.DataFrame, budget: float, by: str) -> str:
-    """The cheapest case of every engine within an error ``budget``, by ``by``: ``mujoco rk4 @ 0.01 (400/s; +2 as
-    cheap)``, naming how many others do the same work within it; "none"."""
+    """The cheapest case of every engine within an error ``budget``, by ``by``: ``mujoco rk4 @ 0.01 (400/s, 2.1 ms;
+    +2 as cheap)``, naming how many others do the same work within it; "none"."""
     least = summary.equally_cheap(cases, budget, by)
     if least.empty:
         uncounted = summary.measured(cases, None)

@@ -445,9 +445,9 @@ def _figure_worker(parent: int) -> None:
 
 class FigureWriter:
     """Writes figures on one process per CPU while the report goes on (saving, which draws each figure twice, as
-    SVG and PNG, is most of a report's time: 12 s of 17 s for the default suite's 51 figures on one CPU). Use as a
-    context manager; :meth:`submit` returns a future of :func:`save`'s SVG text. One CPU: written at once, in this
-    process."""
+    SVG and PNG, is most of a report's time: 12 s of 17 s for the default suite's figures on one CPU, when it drew
+    51). Use as a context manager; :meth:`submit` returns a future of :func:`save`'s SVG text. One CPU: written at
+    once, in this process."""
 
     def __init__(self, workers: int | None = None) -> None:
         self._workers = max(1, os.cpu_count() or 1) if workers is None else workers

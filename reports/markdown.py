@@ -17,9 +17,10 @@ a table row a reviewer can read on one screen; what is longer is said compactly,
 
 MAX_LINES = 400
 """Lines report.md stays within where it can (issue #26): a pull request's reviewer reads it on a few screens. Over it,
-the tables that may be trimmed (:attr:`reports.blocks.Table.trim_order`: cases without a result, then flagged
-findings) give up their last rows, in that order, down to :data:`MIN_TRIMMED_ROWS` each, with a row saying how many
-more report.html has; every other block stays whole."""
+the tables that may be trimmed (:attr:`reports.blocks.Table.trim_order`: cases without a result, then the flagged
+findings, a user's engine's table, the summary's row per scene) give up their last rows, in that order, down to
+:data:`MIN_TRIMMED_ROWS` each (the summary's row per scene down to none), with a row saying how many more report.html
+has; every other block stays whole."""
 
 MIN_TRIMMED_ROWS = 5
 """Rows a trimmed table keeps at least: its first rows are its most important (each table is sorted so)."""

@@ -1,15 +1,17 @@
 """Writing a stored run's report: ``report.md``, ``report.html`` and ``figures/`` (SVG and PNG),
-from ``results.csv``, ``series.csv.gz`` and ``run.json`` alone."""
+from its results (``results.parquet`` or ``results.csv``, :func:`reports.store.read_run`), ``series.csv.gz`` and
+``run.json`` alone."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
 from simparity.core.model.results import REPORT_FILE, REPORT_HTML_FILE
-from simparity.reports.content import FIGURES_DIR, ToleranceVerdict, build
+from simparity.reports.content import FIGURES_DIR, build
 from simparity.reports.html import to_html
 from simparity.reports.markdown import to_markdown
 from simparity.reports.store import read_run, read_series
+from simparity.reports.tolerance_verdict import ToleranceVerdict
 
 
 FIGURE_SUFFIXES = (".svg", ".png")

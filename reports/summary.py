@@ -1,5 +1,5 @@
 """What a report leads with, computed from a stored run's rows and series (never by running anything):
-the cheapest scheme per error budget, the most accurate per time budget, each scheme's best time
+the cheapest scheme per error budget, the most accurate per cost budget (wall time or force evaluations), each scheme's best time
 step, the best IK solvers, the cases without a result grouped by reason, and flagged findings.
 """
 
@@ -212,7 +212,8 @@ def own_rule_differs(solver: pd.Series, position_tolerance: float | None) -> boo
 
 
 def best_ik(solvers: pd.DataFrame) -> tuple[pd.Series | None, pd.Series | None]:
-    """(the solver of best solve rate, the fastest quicker one on a tie; the fastest at >= 99 %)."""
+    """(the solver of best solve rate, the quicker one on a tie; the fastest at >= :data:`SOLVED_ENOUGH`), None where
+    no solver has both a solve rate and a time per solve."""
     rated = solvers.dropna(subset=[SOLVE_RATE, TIME_PER_SOLVE])
     if rated.empty:
         return None, None

@@ -1,6 +1,6 @@
 """The report's full tables: a row per key (scene, engine, integrator, dt, a sweep's values), a column per metric,
 and the status of the row's cases, as :class:`reports.blocks.Table`. The per-metric columns of each kind of scene
-are here, the compact tables with what they show next to them (:mod:`reports.content`, :mod:`reports.sweep_sections`).
+are here, the compact tables with what they show next to them (:mod:`reports.sections`, :mod:`reports.sweep_sections`).
 """
 
 from __future__ import annotations

@@ -9,7 +9,8 @@ import pytest
 from simparity.core.model.run_info import RunInfo
 from simparity.core.model.results import SERIES_COLUMNS, ResultRow
 from simparity.reports import own_engine
-from simparity.reports.content import ToleranceVerdict, build
+from simparity.reports.content import build
+from simparity.reports.tolerance_verdict import ToleranceVerdict
 from simparity.reports.markdown import LINE_CHARS, to_markdown
 
 STEPS = (0.02, 0.01)

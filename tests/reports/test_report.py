@@ -13,7 +13,8 @@ import pytest
 from simparity.comparisons.cli.main import main
 from simparity.core.model.run_info import RunInfo
 from simparity.core.model.results import REPORT_FILE, REPORT_HTML_FILE, SERIES_COLUMNS, ResultRow
-from simparity.reports.content import ToleranceVerdict, build
+from simparity.reports.content import build
+from simparity.reports.tolerance_verdict import ToleranceVerdict
 from simparity.reports.markdown import LINE_CHARS, to_markdown
 from simparity.reports.store import read_run
 

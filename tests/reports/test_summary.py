@@ -7,7 +7,8 @@ import pandas as pd
 
 from simparity.core.model.results import ResultRow
 from simparity.reports import summary
-from simparity.reports.content import _rates, _scheme_row
+from simparity.reports.sections.dynamics import scheme_row
+from simparity.reports.sections.ik import rates
 
 
 def _case(engine, integrator, dt, error, seconds_per_step, status="ok", detail=""):
@@ -92,10 +93,10 @@ def test_energy_gain_flagged_only_above_threshold_and_not_for_truths():
 def test_variants_of_a_scheme_share_a_row_listing_what_differs():
     """Core's orientation updates of one scheme: one row; a cell lists each variant's value in the order the
     integrator cell names them, or one value where they all agree."""
-    row = _scheme_row("core", "rk4", [("quaternion", ("0.01", "2e-10", "ok 4")), ("matrix", ("0.01", "4e-09", "ok 4")),
+    row = scheme_row("core", "rk4", [("quaternion", ("0.01", "2e-10", "ok 4")), ("matrix", ("0.01", "4e-09", "ok 4")),
                                       ("expmap", ("0.01", "2e-12", "ok 4"))])
     assert row == ("core", "rk4 (quaternion / matrix / expmap)", "0.01", "2e-10 / 4e-09 / 2e-12", "ok 4")
-    assert _scheme_row("mujoco", "rk4", [("", ("0.01", "1e-10", "ok 4"))]) == ("mujoco", "rk4", "0.01", "1e-10", "ok 4")
+    assert scheme_row("mujoco", "rk4", [("", ("0.01", "1e-10", "ok 4"))]) == ("mujoco", "rk4", "0.01", "1e-10", "ok 4")
 
 
 def test_ik_rates_at_both_criteria_with_unsolved_as_zero():
@@ -114,5 +115,5 @@ def test_ik_rates_at_both_criteria_with_unsolved_as_zero():
     assert solvers.loc["default", "solve_rate"] == 0.0
     assert summary.own_rule_differs(solvers.loc["default"], 1e-6)
     assert not summary.own_rule_differs(solvers.loc["tuned"], 1e-6)
-    assert _rates(solvers.loc["default"], 1e-6) == "0.0% at 1e-06 m, 97.0% at its own 0.0001 m"
-    assert _rates(solvers.loc["tuned"], 1e-6) == "90.0% at 1e-06 m"
+    assert rates(solvers.loc["default"], 1e-6) == "0.0% at 1e-06 m, 97.0% at its own 0.0001 m"
+    assert rates(solvers.loc["tuned"], 1e-6) == "90.0% at 1e-06 m"
