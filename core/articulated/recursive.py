@@ -102,6 +102,13 @@ def cross_force(v: np.ndarray, f: np.ndarray) -> np.ndarray:
     return out
 
 
+def _span(bodies: list[int]) -> slice | list[int]:
+    """The bodies as a slice when they are consecutive (a chain's, a depth-first tree's subtrees), else as they
+    are: a slice copies rows faster than an index list."""
+    first = bodies[0]
+    return slice(first, first + len(bodies)) if bodies == list(range(first, first + len(bodies))) else bodies
+
+
 class Recursive:
     """RNEA, CRBA and ABA of one kinematic tree (a chain today) under one gravity.
 
@@ -118,6 +125,10 @@ class Recursive:
         self.parents = [int(p) for p in arrays.parents]
         if any(not -1 <= p < i for i, p in enumerate(self.parents)):
             raise ValueError(f"parents {self.parents} do not number each parent (or -1, the base) before its child")
+        self._is_chain = self.parents == list(range(-1, arrays.n - 1))
+        # The last child of each body: after it, the forward passes let the body's acceleration go (a chain keeps
+        # one live (6, B) array, as large batches need: memory that stays in cache).
+        self._last_child = {parent: i for i, parent in enumerate(self.parents) if parent >= 0}
         self._base_acceleration = np.concatenate([np.zeros(3), -np.asarray(gravity_world, dtype=float)])
         self._inertia_packed = [np.ascontiguousarray(row[:, None]) for row in arrays.inertia_packed]
         self._columns = [PACKED[:, k] for k in arrays.subspace]
@@ -174,11 +185,24 @@ class Recursive:
             return [(0, qd * v[1]), (1, -qd * v[0]), (3, qd * v[4]), (4, -qd * v[3])]
         return [(3, qd * v[1]), (4, -qd * v[0])]
 
-    def _from_parent(self, i: int, accelerations: list[np.ndarray], base: np.ndarray, cos: np.ndarray,
+    def _from_parent(self, i: int, accelerations: list[np.ndarray | None], base: np.ndarray, cos: np.ndarray,
                      sin: np.ndarray, q: np.ndarray) -> np.ndarray:
-        """X_i a_lambda(i): the parent's acceleration (the base's for a root) in body i's coordinates, a new array."""
+        """X_i a_lambda(i): the parent's acceleration (the base's for a root) in body i's coordinates, a new array;
+        the parent's is let go after its last child."""
         parent = self.parents[i]
-        return self._to_child(i, base if parent < 0 else accelerations[parent], cos, sin, q)
+        if parent < 0:
+            return self._to_child(i, base, cos, sin, q)
+        held = accelerations[parent]
+        assert held is not None, "a parent is numbered before its children"
+        if self._last_child[parent] == i:
+            accelerations[parent] = None
+        return self._to_child(i, held, cos, sin, q)
+
+    @staticmethod
+    def _take(carried: list[np.ndarray | None], i: int) -> np.ndarray | None:
+        """carried[i], let go in the list (the backward passes use it once)."""
+        held, carried[i] = carried[i], None
+        return held
 
     @staticmethod
     def _add_to(carried: list[np.ndarray | None], parent: int, value: np.ndarray) -> None:
@@ -198,7 +222,7 @@ class Recursive:
         cos, sin = self._trig(q)
         velocities = self._velocities(q, qdot, cos, sin)
         forces: list[np.ndarray] = []
-        accelerations: list[np.ndarray] = []
+        accelerations: list[np.ndarray | None] = []
         base = np.broadcast_to(self._base_acceleration[:, None], (6, q.shape[1]))
         for i, (k, v) in enumerate(zip(arrays.subspace, velocities)):
             acceleration = self._from_parent(i, accelerations, base, cos, sin, q)
@@ -222,20 +246,22 @@ class Recursive:
         """CRBA: M (n, n, B), armature included. Entries of two bodies on different branches are 0."""
         arrays, n, batch = self.arrays, self.arrays.n, q.shape[1]
         cos, sin = self._trig(q)
-        out = np.zeros((n, n, batch))
+        out = np.empty((n, n, batch)) if self._is_chain else np.zeros((n, n, batch))  # a chain fills every entry
         carried: list[np.ndarray | None] = [None] * n  # the children's composite inertias, in body i's coordinates
         # I^c_j S_j of every body j of the subtrees of body i's children, in body i's coordinates, and those j
         beyond: list[list[np.ndarray]] = [[] for _ in range(n)]
         beyond_bodies: list[list[int]] = [[] for _ in range(n)]
         for i in reversed(range(n)):
-            held = carried[i]
+            held = self._take(carried, i)
             composite = (self._inertia_packed[i] + held if held is not None
                          else np.repeat(self._inertia_packed[i], batch, axis=1))
             column = composite[self._columns[i]][:, None]
             columns = np.concatenate([column] + beyond[i], axis=1) if beyond[i] else column  # (6, subtree, B)
+            beyond[i] = []
             subtree = [i] + beyond_bodies[i]
-            out[i, subtree] = columns[arrays.subspace[i]]
-            out[subtree[1:], i] = out[i, subtree[1:]]
+            bodies = _span(subtree)
+            out[i, bodies] = columns[arrays.subspace[i]]
+            out[bodies, i] = out[i, bodies]  # rewrites (i, i) with itself
             out[i, i] += arrays.armature[i]
             parent = self.parents[i]
             if parent >= 0:
@@ -257,7 +283,7 @@ class Recursive:
         carried: list[np.ndarray | None] = [None] * n  # the children's I^a, in body i's coordinates
         for i in reversed(range(n)):
             k = arrays.subspace[i]
-            held = carried[i]
+            held = self._take(carried, i)
             articulated = self._inertia_packed[i] + (0.0 if held is None else held)  # I^A_i
             U_i = articulated[self._columns[i]]
             if U_i.shape[1] != batch:
@@ -286,7 +312,7 @@ class Recursive:
             self._add_to(carried, parent, self._inertia_to_parent(i, reduced, cos, sin, q))
             bias_forces[parent] += self._to_parent(i, force, cos, sin, q)
         qddot = np.empty_like(q)
-        accelerations: list[np.ndarray] = []
+        accelerations: list[np.ndarray | None] = []
         base = np.broadcast_to(self._base_acceleration[:, None], (6, batch))
         for i, k in enumerate(arrays.subspace):
             acceleration = self._from_parent(i, accelerations, base, cos, sin, q)  # a'_i before S_i qddot_i
