@@ -9,6 +9,7 @@ from scipy.integrate import solve_ivp
 
 from simparity.core.articulated import stepping
 from simparity.core.articulated.motion import CoreJointMotion
+from simparity.core.dynamics.tableau import TABLEAUX
 from simparity.core.model.scene import Chain, Joint, JointMotionScene, LinkInertia
 
 MASS, LENGTH, G = 1.0, 1.0, 9.81
@@ -124,11 +125,11 @@ def test_the_tableau_steps_sum_as_the_written_out_schemes_to_the_bit():
     def qddot(q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         return -np.sin(q) - 0.3 * qdot * np.abs(qdot)
 
-    rk4 = stepping.runge_kutta(stepping.TABLEAUX[stepping.RK4], qddot, dt)(q, qdot)
+    rk4 = stepping.runge_kutta(TABLEAUX[stepping.RK4], qddot, dt)(q, qdot)
     assert all(np.array_equal(x, y) for x, y in zip(rk4, _rk4_by_hand(qddot, q, qdot, dt)))
     half = qdot + 0.5 * dt * qddot(q, qdot)
     midpoint = (q + dt * half, qdot + dt * qddot(q + 0.5 * dt * qdot, half))
-    got = stepping.runge_kutta(stepping.TABLEAUX[stepping.MIDPOINT], qddot, dt)(q, qdot)
+    got = stepping.runge_kutta(TABLEAUX[stepping.MIDPOINT], qddot, dt)(q, qdot)
     assert all(np.array_equal(x, y) for x, y in zip(got, midpoint))
-    got = stepping.runge_kutta(stepping.TABLEAUX[stepping.EXPLICIT_EULER], qddot, dt)(q, qdot)
+    got = stepping.runge_kutta(TABLEAUX[stepping.EXPLICIT_EULER], qddot, dt)(q, qdot)
     assert all(np.array_equal(x, y) for x, y in zip(got, (q + dt * qdot, qdot + dt * qddot(q, qdot))))
