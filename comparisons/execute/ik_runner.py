@@ -36,7 +36,7 @@ from simparity.comparisons.measure.series import disagreement_matrix, quantiles
 from simparity.comparisons.execute.timing import best_of
 from simparity.core.model.engine import Engine, IKModel, KinematicsModel, StoppingRule
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.ik_result import LIMIT_TOLERANCE, IKResult
+from simparity.core.model.ik_result import LIMIT_TOLERANCE, IKReason, IKResult
 from simparity.core.model.results import (
     FAILED,
     HARD_VERDICT_SUFFIXES,
@@ -226,7 +226,7 @@ def _hard_rows(case: Case, hard: list[Targets], results: Sequence[IKResult | Non
         detail = (f"{verdict}; orientation residual {result.orientation_residual[0]:.3g} rad; "
                   f"limit violation {result.limit_violation[0]:.3g}; {targets.note}")
         values = [float(result.position_residual[0]), float(result.success[0]),
-                  float(result.reason[0] == "unreachable"), float(result.limit_violation[0])]
+                  float(result.reason[0] == IKReason.UNREACHABLE), float(result.limit_violation[0])]
         rows += case.rows(metrics, OK, detail, {m: Measured(v, u) for (m, u), v in zip(metrics.items(), values)})
     return rows
 

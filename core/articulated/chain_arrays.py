@@ -94,6 +94,10 @@ class ChainArrays:
 
     Attributes
     ----------
+    parents : (n,) int ndarray
+        Each body's parent, lambda(i) (Featherstone), -1 for the base; every parent numbered before its children.
+        A chain's body i hangs from body i - 1 (the first from the base); a tree's bodies may share a parent, and
+        ``tree_transform`` is then from each body's own parent.
     revolute : (n,) bool ndarray
         True for a revolute joint, False for a prismatic one.
     subspace : (n,) int ndarray
@@ -101,7 +105,7 @@ class ChainArrays:
     alignment : (n, 3, 3) ndarray
         A_i: body axes in link axes.
     tree_transform : (n, 6, 6) ndarray
-        X_T,i: parent body frame (the world for the first) to joint frame, motion vectors.
+        X_T,i: parent body frame (the world for a root) to joint frame, motion vectors.
     tree_force_transform : (n, 6, 6) ndarray
         X_T,i^T: joint-frame forces to the parent body frame.
     tree_congruence : (n, 21, 21) ndarray
@@ -120,6 +124,7 @@ class ChainArrays:
         [kg m^2 or kg], [N m s/rad or N s/m].
     """
 
+    parents: np.ndarray
     revolute: np.ndarray
     subspace: np.ndarray
     alignment: np.ndarray
@@ -159,6 +164,7 @@ def chain_arrays(chain: Chain) -> ChainArrays:
     tree_transform = np.array(tree).reshape(n, 6, 6)
     inertia = np.array([spatial_inertia(m, c, i) for m, c, i in zip(mass, com, inertia_com)]).reshape(n, 6, 6)
     return ChainArrays(
+        parents=np.arange(n) - 1,
         revolute=revolute,
         subspace=np.where(revolute, ANGULAR_Z, LINEAR_Z),
         alignment=alignment,

@@ -10,6 +10,24 @@ operations on the rows it turns. Joint positions, velocities, accelerations and 
 
 The equation of motion is M qddot + h + D qdot = tau with the armature on M's diagonal, D the joints' damping,
 and gravity entered as the base's acceleration -g (Featherstone, section 5.3).
+
+The tree is Featherstone's: body i's parent is ``parents[i]`` (:attr:`ChainArrays.parents`, -1 for the base,
+every parent numbered before its children; a chain's is i - 1), and every recursion indexes it, so a branched
+tree runs as a chain does. The key to the names (Featherstone's symbols, chapters 5-7):
+
+- ``parents[i]``: lambda(i), the parent body (-1: the fixed base);
+- ``_to_child(i, m)``: X_i m = X_J(q_i) X_T,i m, a motion vector of the parent in body i's axes
+  (:meth:`Recursive._from_parent`: the parent's acceleration, the base's for a root);
+- ``_to_parent(i, f)``: X_i^T f, a force of body i in the parent's axes; ``_inertia_to_parent``: X_i^T I X_i;
+- ``subspace[i]`` = k: S_i = e_k, the joint's motion subspace (:data:`core.articulated.chain_arrays.ANGULAR_Z`,
+  :data:`~core.articulated.chain_arrays.LINEAR_Z`); ``_columns[i]``: the packed rows of I e_k;
+- ``velocities[i]``: v_i; ``_bias_acceleration``: c_i = v_i x S_i qdot_i; ``inertia[i]``: I_i;
+- CRBA: ``composite``: I^c_i, the composite inertia of i's subtree; ``columns``: I^c_j S_j of the bodies j of
+  that subtree, in body i's axes (M_ij = S_i^T X I^c_j S_j);
+- ABA: ``articulated``: I^A_i; ``bias_forces[i]``: p^A_i (v_i x* I_i v_i, then the children's share);
+  ``U[i]``: U_i = I^A_i S_i; ``inverse_D[i]``: D_i^-1 = (S_i^T U_i + armature_i)^-1; ``u[i]``: u_i = tau_i -
+  damping_i qdot_i - S_i^T p^A_i; ``reduced``: I^a_i = I^A_i - U_i D_i^-1 U_i^T; ``force``: p^a_i = p^A_i +
+  I^a_i c_i + U_i D_i^-1 u_i; ``carried[i]``: the sum over i's children j of X_j^T I^a_j X_j, in i's axes.
 """
 
 from __future__ import annotations
@@ -84,18 +102,33 @@ def cross_force(v: np.ndarray, f: np.ndarray) -> np.ndarray:
     return out
 
 
+def _span(bodies: list[int]) -> slice | list[int]:
+    """The bodies as a slice when they are consecutive (a chain's, a depth-first tree's subtrees), else as they
+    are: a slice copies rows faster than an index list."""
+    first = bodies[0]
+    return slice(first, first + len(bodies)) if bodies == list(range(first, first + len(bodies))) else bodies
+
+
 class Recursive:
-    """RNEA, CRBA and ABA of one chain under one gravity.
+    """RNEA, CRBA and ABA of one kinematic tree (a chain today) under one gravity.
 
     Parameters
     ----------
     arrays : ChainArrays
+        Its :attr:`~ChainArrays.parents` number every parent before its children.
     gravity_world : (3,) ndarray
         [m/s^2] in the base frame (zeros for none).
     """
 
     def __init__(self, arrays: ChainArrays, gravity_world: np.ndarray) -> None:
         self.arrays = arrays
+        self.parents = [int(p) for p in arrays.parents]
+        if any(not -1 <= p < i for i, p in enumerate(self.parents)):
+            raise ValueError(f"parents {self.parents} do not number each parent (or -1, the base) before its child")
+        self._is_chain = self.parents == list(range(-1, arrays.n - 1))
+        # The last child of each body: after it, the forward passes let the body's acceleration go (a chain keeps
+        # one live (6, B) array, as large batches need: memory that stays in cache).
+        self._last_child = {parent: i for i, parent in enumerate(self.parents) if parent >= 0}
         self._base_acceleration = np.concatenate([np.zeros(3), -np.asarray(gravity_world, dtype=float)])
         self._inertia_packed = [np.ascontiguousarray(row[:, None]) for row in arrays.inertia_packed]
         self._columns = [PACKED[:, k] for k in arrays.subspace]
@@ -103,7 +136,7 @@ class Recursive:
     # -- the joint transforms --------------------------------------------------------------------------------
 
     def _to_child(self, i: int, parent: np.ndarray, cos: np.ndarray, sin: np.ndarray, q: np.ndarray) -> np.ndarray:
-        """X_i m: a motion vector (6, B) of the parent body (the base for i = 0) in body i's coordinates."""
+        """X_i m: a motion vector (6, B) of the parent body (the base for a root) in body i's coordinates."""
         out = self.arrays.tree_transform[i] @ parent
         if self.arrays.revolute[i]:
             turn(out[0::3], out[1::3], cos[i], -sin[i])
@@ -132,14 +165,14 @@ class Recursive:
         return self.arrays.tree_congruence[i] @ packed
 
     def _velocities(self, q: np.ndarray, qdot: np.ndarray, cos: np.ndarray, sin: np.ndarray) -> list[np.ndarray]:
-        """Each body's spatial velocity (6, B) in body coordinates."""
+        """Each body's spatial velocity v_i (6, B) in body coordinates: v_i = X_i v_lambda(i) + S_i qdot_i."""
         out: list[np.ndarray] = []
-        for i, k in enumerate(self.arrays.subspace):
-            if i == 0:
+        for i, (k, parent) in enumerate(zip(self.arrays.subspace, self.parents)):
+            if parent < 0:  # the base does not move
                 v = np.zeros((6, q.shape[1]))
-                v[k] = qdot[0]
+                v[k] = qdot[i]
             else:
-                v = self._to_child(i, out[-1], cos, sin, q)
+                v = self._to_child(i, out[parent], cos, sin, q)
                 v[k] += qdot[i]
             out.append(v)
         return out
@@ -152,6 +185,31 @@ class Recursive:
             return [(0, qd * v[1]), (1, -qd * v[0]), (3, qd * v[4]), (4, -qd * v[3])]
         return [(3, qd * v[1]), (4, -qd * v[0])]
 
+    def _from_parent(self, i: int, accelerations: list[np.ndarray | None], base: np.ndarray, cos: np.ndarray,
+                     sin: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """X_i a_lambda(i): the parent's acceleration (the base's for a root) in body i's coordinates, a new array;
+        the parent's is let go after its last child."""
+        parent = self.parents[i]
+        if parent < 0:
+            return self._to_child(i, base, cos, sin, q)
+        held = accelerations[parent]
+        assert held is not None, "a parent is numbered before its children"
+        if self._last_child[parent] == i:
+            accelerations[parent] = None
+        return self._to_child(i, held, cos, sin, q)
+
+    @staticmethod
+    def _take(carried: list[np.ndarray | None], i: int) -> np.ndarray | None:
+        """carried[i], let go in the list (the backward passes use it once)."""
+        held, carried[i] = carried[i], None
+        return held
+
+    @staticmethod
+    def _add_to(carried: list[np.ndarray | None], parent: int, value: np.ndarray) -> None:
+        """carried[parent] += value, the first child's value itself (a chain's parent has one child: no sum)."""
+        held = carried[parent]
+        carried[parent] = value if held is None else held + value
+
     @staticmethod
     def _trig(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return np.cos(q), np.sin(q)
@@ -163,14 +221,15 @@ class Recursive:
         arrays = self.arrays
         cos, sin = self._trig(q)
         velocities = self._velocities(q, qdot, cos, sin)
-        forces = []
+        forces: list[np.ndarray] = []
+        accelerations: list[np.ndarray | None] = []
         base = np.broadcast_to(self._base_acceleration[:, None], (6, q.shape[1]))
-        acceleration = base
         for i, (k, v) in enumerate(zip(arrays.subspace, velocities)):
-            acceleration = self._to_child(i, acceleration, cos, sin, q)
+            acceleration = self._from_parent(i, accelerations, base, cos, sin, q)
             acceleration[k] += qddot[i]
             for row, value in self._bias_acceleration(i, v, qdot):
                 acceleration[row] += value
+            accelerations.append(acceleration)
             inertia = arrays.inertia[i]
             forces.append(inertia @ acceleration + cross_force(v, inertia @ v))
         tau = np.empty_like(q)
@@ -178,28 +237,37 @@ class Recursive:
             tau[i] = forces[i][arrays.subspace[i]] + arrays.armature[i] * qddot[i]
             if damped:
                 tau[i] += arrays.damping[i] * qdot[i]
-            if i:
-                forces[i - 1] += self._to_parent(i, forces[i], cos, sin, q)
+            parent = self.parents[i]
+            if parent >= 0:
+                forces[parent] += self._to_parent(i, forces[i], cos, sin, q)
         return tau
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
-        """CRBA: M (n, n, B), armature included."""
-        arrays, n = self.arrays, self.arrays.n
+        """CRBA: M (n, n, B), armature included. Entries of two bodies on different branches are 0."""
+        arrays, n, batch = self.arrays, self.arrays.n, q.shape[1]
         cos, sin = self._trig(q)
-        out = np.empty((n, n, q.shape[1]))
-        carried: np.ndarray | None = None  # the composite inertia of the bodies beyond, in the current parent's
-        columns: np.ndarray | None = None  # (6, n - i, B): I^c_j S_j of bodies j >= i, in body i's coordinates
+        out = np.empty((n, n, batch)) if self._is_chain else np.zeros((n, n, batch))  # a chain fills every entry
+        carried: list[np.ndarray | None] = [None] * n  # the children's composite inertias, in body i's coordinates
+        # I^c_j S_j of every body j of the subtrees of body i's children, in body i's coordinates, and those j
+        beyond: list[list[np.ndarray]] = [[] for _ in range(n)]
+        beyond_bodies: list[list[int]] = [[] for _ in range(n)]
         for i in reversed(range(n)):
-            composite = (self._inertia_packed[i] + carried if carried is not None
-                         else np.repeat(self._inertia_packed[i], q.shape[1], axis=1))
+            held = self._take(carried, i)
+            composite = (self._inertia_packed[i] + held if held is not None
+                         else np.repeat(self._inertia_packed[i], batch, axis=1))
             column = composite[self._columns[i]][:, None]
-            columns = column if columns is None else np.concatenate([column, columns], axis=1)
-            out[i, i:] = columns[arrays.subspace[i]]
-            out[i + 1:, i] = out[i, i + 1:]
+            columns = np.concatenate([column] + beyond[i], axis=1) if beyond[i] else column  # (6, subtree, B)
+            beyond[i] = []
+            subtree = [i] + beyond_bodies[i]
+            bodies = _span(subtree)
+            out[i, bodies] = columns[arrays.subspace[i]]
+            out[bodies, i] = out[i, bodies]  # rewrites (i, i) with itself
             out[i, i] += arrays.armature[i]
-            if i:
-                carried = self._inertia_to_parent(i, composite, cos, sin, q)
-                columns = self._to_parent(i, columns, cos, sin, q)
+            parent = self.parents[i]
+            if parent >= 0:
+                self._add_to(carried, parent, self._inertia_to_parent(i, composite, cos, sin, q))
+                beyond[parent].append(self._to_parent(i, columns, cos, sin, q))
+                beyond_bodies[parent] += subtree
         return out
 
     def forward_dynamics(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> np.ndarray:
@@ -208,56 +276,57 @@ class Recursive:
         cos, sin = self._trig(q)
         velocities = self._velocities(q, qdot, cos, sin)
         biases = [self._bias_acceleration(i, v, qdot) for i, v in enumerate(velocities)]
-        forces = [cross_force(v, arrays.inertia[i] @ v) for i, v in enumerate(velocities)]
+        bias_forces = [cross_force(v, arrays.inertia[i] @ v) for i, v in enumerate(velocities)]  # p^A_i
         u = tau - arrays.damping[:, None] * qdot
-        columns, inverse_d = [], []
-        carried: np.ndarray | None = None
+        U: list[np.ndarray] = [np.empty(0)] * n
+        inverse_D: list[np.ndarray] = [np.empty(0)] * n
+        carried: list[np.ndarray | None] = [None] * n  # the children's I^a, in body i's coordinates
         for i in reversed(range(n)):
             k = arrays.subspace[i]
-            articulated = self._inertia_packed[i] + (0.0 if carried is None else carried)
-            column = articulated[self._columns[i]]
-            if column.shape[1] != batch:
-                column = np.array(np.broadcast_to(column, (6, batch)))
-            inv_d = 1.0 / (column[k] + arrays.armature[i])
-            u[i] -= forces[i][k]
-            columns.append(column)
-            inverse_d.append(inv_d)
-            if not i:
-                break
-            scaled = column * inv_d
-            force = forces[i]
+            held = self._take(carried, i)
+            articulated = self._inertia_packed[i] + (0.0 if held is None else held)  # I^A_i
+            U_i = articulated[self._columns[i]]
+            if U_i.shape[1] != batch:
+                U_i = np.array(np.broadcast_to(U_i, (6, batch)))
+            inverse_D[i] = 1.0 / (U_i[k] + arrays.armature[i])
+            u[i] -= bias_forces[i][k]
+            U[i] = U_i
+            parent = self.parents[i]
+            if parent < 0:
+                continue
+            scaled = U_i * inverse_D[i]
+            force = bias_forces[i]
             force += scaled * u[i]
             if batch < WIDE_BATCH:
-                reduced = articulated - column[_PAIR_ROWS] * scaled[_PAIR_COLUMNS]
+                reduced = articulated - U_i[_PAIR_ROWS] * scaled[_PAIR_COLUMNS]
                 for m, value in biases[i]:
                     force += reduced[PACKED[:, m]] * value
             else:
                 reduced = np.empty((21, batch))
                 for row, (r, c) in enumerate(SYMMETRIC_PAIRS):
-                    np.multiply(column[r], scaled[c], out=reduced[row])
+                    np.multiply(U_i[r], scaled[c], out=reduced[row])
                     np.subtract(articulated[row], reduced[row], out=reduced[row])
                 for r in range(6):
                     for m, value in biases[i]:
                         force[r] += reduced[PACKED[r, m]] * value
-            carried = self._inertia_to_parent(i, reduced, cos, sin, q)
-            forces[i - 1] += self._to_parent(i, force, cos, sin, q)
-        columns.reverse()
-        inverse_d.reverse()
+            self._add_to(carried, parent, self._inertia_to_parent(i, reduced, cos, sin, q))
+            bias_forces[parent] += self._to_parent(i, force, cos, sin, q)
         qddot = np.empty_like(q)
-        acceleration = np.broadcast_to(self._base_acceleration[:, None], (6, batch))
+        accelerations: list[np.ndarray | None] = []
+        base = np.broadcast_to(self._base_acceleration[:, None], (6, batch))
         for i, k in enumerate(arrays.subspace):
-            acceleration = self._to_child(i, acceleration, cos, sin, q)
+            acceleration = self._from_parent(i, accelerations, base, cos, sin, q)  # a'_i before S_i qddot_i
             for row, value in biases[i]:
                 acceleration[row] += value
-            column = columns[i]
             if batch < WIDE_BATCH:
-                dot = np.einsum("rb,rb->b", column, acceleration)
+                dot = np.einsum("rb,rb->b", U[i], acceleration)
             else:
-                dot = column[0] * acceleration[0]
+                dot = U[i][0] * acceleration[0]
                 for r in range(1, 6):
-                    dot += column[r] * acceleration[r]
-            np.multiply(u[i] - dot, inverse_d[i], out=qddot[i])
+                    dot += U[i][r] * acceleration[r]
+            np.multiply(u[i] - dot, inverse_D[i], out=qddot[i])
             acceleration[k] += qddot[i]
+            accelerations.append(acceleration)
         return qddot
 
     def kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:

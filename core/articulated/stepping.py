@@ -4,10 +4,10 @@ The state is (q, qdot), each (n, B) (component-major, the recursive algorithms' 
 Featherstone's ABA, qddot = M^-1 (tau - h - D qdot) (:mod:`core.articulated.recursive`). The schemes are the
 free-body family's, on the joints:
 
-- ``explicit_euler``: q' = q + dt qdot, qdot' = qdot + dt qddot(q, qdot). First order.
+- ``explicit_euler``, ``midpoint`` (RK2), ``rk4``: the explicit Runge-Kutta schemes of
+  :data:`core.dynamics.tableau.TABLEAUX` on y = (q, qdot), dy/dt = (qdot, qddot(q, qdot)); their order and stages
+  are the tableau's. Explicit Euler is q' = q + dt qdot, qdot' = qdot + dt qddot(q, qdot).
 - ``semi_implicit_euler``: qdot' = qdot + dt qddot(q, qdot), q' = q + dt qdot'. First order.
-- ``midpoint``: the explicit midpoint rule (RK2). Second order.
-- ``rk4``: classical Runge-Kutta. Fourth order.
 - ``implicit_damping``: semi-implicit Euler with the joint damping taken implicitly,
   (M + dt D) (qdot' - qdot) = dt (tau - h - D qdot), q' = q + dt qdot'. First order; unconditionally stable for
   damping alone (MuJoCo's ``euler`` with ``eulerdamp``, and ``implicitfast`` on a chain without Coriolis
@@ -26,6 +26,7 @@ import numpy as np
 
 from simparity.core.articulated.chain_arrays import chain_arrays
 from simparity.core.articulated.recursive import Recursive
+from simparity.core.dynamics.tableau import TABLEAUX, Tableau
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 
@@ -33,9 +34,14 @@ EXPLICIT_EULER, SEMI_IMPLICIT_EULER, MIDPOINT, RK4, IMPLICIT_DAMPING = (
     "explicit_euler", "semi_implicit_euler", "midpoint", "rk4", "implicit_damping")
 SCHEMES = (EXPLICIT_EULER, SEMI_IMPLICIT_EULER, MIDPOINT, RK4, IMPLICIT_DAMPING)
 """Core's joint-motion integrators, each named as its kind of scheme (:data:`core.model.engine.SCHEME_KINDS`)."""
-ORDER = {EXPLICIT_EULER: 1, SEMI_IMPLICIT_EULER: 1, MIDPOINT: 2, RK4: 4, IMPLICIT_DAMPING: 1}
-STAGES = {EXPLICIT_EULER: 1, SEMI_IMPLICIT_EULER: 1, MIDPOINT: 2, RK4: 4, IMPLICIT_DAMPING: 1}
-"""Evaluations of the forward dynamics (ABA) per step, counted in the code below."""
+RUNGE_KUTTA = (EXPLICIT_EULER, MIDPOINT, RK4)
+"""The schemes stepped by their tableau (:data:`core.dynamics.tableau.TABLEAUX`)."""
+EULER_STEPS = (SEMI_IMPLICIT_EULER, IMPLICIT_DAMPING)
+"""The schemes that are no tableau: first order, one forward dynamics per step."""
+ORDER = {scheme: TABLEAUX[scheme].order for scheme in RUNGE_KUTTA} | {scheme: 1 for scheme in EULER_STEPS}
+"""Each scheme's order of global accuracy."""
+STAGES = {scheme: TABLEAUX[scheme].stages for scheme in RUNGE_KUTTA} | {scheme: 1 for scheme in EULER_STEPS}
+"""Evaluations of the forward dynamics (ABA) per step: a tableau's stages, one for the Euler steps."""
 
 Acceleration = Callable[[np.ndarray, np.ndarray], np.ndarray]
 Step = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
@@ -44,6 +50,45 @@ Step = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
 def _damped_armature(chain: Chain, dt: float) -> Chain:
     """``chain`` with each joint's armature increased by dt times its damping (the implicit damping's M + dt D)."""
     return replace(chain, joints=tuple(replace(j, armature=j.armature + dt * j.damping) for j in chain.joints))
+
+
+def _stage(y: np.ndarray, row: tuple[float, ...], ks: list[np.ndarray], dt: float) -> np.ndarray:
+    """y + sum_j (dt a_ij) k_j, added term by term in stage order, zero coefficients skipped (y itself when all
+    are zero)."""
+    for aij, k in zip(row, ks):
+        if aij:
+            y = y + (dt * aij) * k
+    return y
+
+
+def _weighted(tableau: Tableau, ks: list[np.ndarray]) -> np.ndarray:
+    """sum_i n_i k_i over the stages of nonzero weight, n_i = b_i d (:attr:`Tableau.weight_numerators`), left to
+    right, k_i itself for n_i = 1: the step's increment is dt / d times it, as dt / 6 (k1 + 2 k2 + 2 k3 + k4)."""
+    total: np.ndarray | None = None
+    for numerator, k in zip(tableau.weight_numerators, ks):
+        if numerator:
+            term = k if numerator == 1.0 else numerator * k
+            total = term if total is None else total + term
+    assert total is not None, "a tableau has a stage of nonzero weight"
+    return total
+
+
+def runge_kutta(tableau: Tableau, qddot: Acceleration, dt: float) -> Step:
+    """One step of the explicit Runge-Kutta scheme ``tableau`` on y = (q, qdot), dy/dt = (qdot, qddot(q, qdot)):
+    stage i at (q_i, qdot_i) = y + dt sum_j a_ij k_j with k_j = (qdot_j, qddot(q_j, qdot_j)), then
+    y' = y + dt / d sum_i n_i k_i (the weights over their common denominator d, summed by :func:`_weighted`).
+    The joints' forces do not depend on time, so c enters only through a (c_i = sum_j a_ij)."""
+    scale = dt / tableau.weight_denominator
+
+    def step(q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        velocities: list[np.ndarray] = []
+        accelerations: list[np.ndarray] = []
+        for row in tableau.a:
+            q_i, qdot_i = _stage(q, row, velocities, dt), _stage(qdot, row, accelerations, dt)
+            velocities.append(qdot_i)
+            accelerations.append(qddot(q_i, qdot_i))
+        return q + scale * _weighted(tableau, velocities), qdot + scale * _weighted(tableau, accelerations)
+    return step
 
 
 def stepper(scene: JointMotionScene, scheme: str, dt: float) -> Step:
@@ -56,30 +101,13 @@ def stepper(scene: JointMotionScene, scheme: str, dt: float) -> Step:
     def qddot(q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         return dynamics.forward_dynamics(q, qdot, np.broadcast_to(torque, q.shape))
 
-    if scheme == EXPLICIT_EULER:
-        return lambda q, qdot: (q + dt * qdot, qdot + dt * qddot(q, qdot))
+    if scheme in RUNGE_KUTTA:
+        return runge_kutta(TABLEAUX[scheme], qddot, dt)
     if scheme == SEMI_IMPLICIT_EULER:
         def semi_implicit(q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             qdot = qdot + dt * qddot(q, qdot)
             return q + dt * qdot, qdot
         return semi_implicit
-    if scheme == MIDPOINT:
-        def midpoint(q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            half = qdot + 0.5 * dt * qddot(q, qdot)
-            return q + dt * half, qdot + dt * qddot(q + 0.5 * dt * qdot, half)
-        return midpoint
-    if scheme == RK4:
-        def rk4(q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            a1 = qddot(q, qdot)
-            v2 = qdot + 0.5 * dt * a1
-            a2 = qddot(q + 0.5 * dt * qdot, v2)
-            v3 = qdot + 0.5 * dt * a2
-            a3 = qddot(q + 0.5 * dt * v2, v3)
-            v4 = qdot + dt * a3
-            a4 = qddot(q + dt * v3, v4)
-            return (q + dt / 6.0 * (qdot + 2.0 * v2 + 2.0 * v3 + v4),
-                    qdot + dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4))
-        return rk4
     if scheme == IMPLICIT_DAMPING:
         implicit = Recursive(chain_arrays(_damped_armature(scene.chain, dt)), gravity)
 

@@ -34,8 +34,9 @@ from typing import Callable, cast
 
 import numpy as np
 
-from simparity.core.dynamics.quaternion_integrators import TABLEAUX, state_step
+from simparity.core.dynamics.quaternion_integrators import state_step
 from simparity.core.dynamics.rigid_body import MassProperties, State, Wrench, velocities
+from simparity.core.dynamics.tableau import TABLEAUX
 from simparity.core.rotations import (
     cross,
     orthonormalize,
@@ -45,22 +46,15 @@ from simparity.core.rotations import (
 
 ORIENTATION_UPDATES = ("quaternion", "matrix", "expmap")
 
-SCHEMES = tuple(TABLEAUX) + ("semi_implicit_euler", "engine_euler")
+EULER_STEPS = ("semi_implicit_euler", "engine_euler")
+"""The schemes that are no Runge-Kutta tableau: first order, one evaluation of the forces at the step's start."""
 
-ORDER = {
-    "explicit_euler": 1,
-    "semi_implicit_euler": 1,
-    "engine_euler": 1,
-    "average_velocity": 2,
-    "midpoint": 2,
-    "rk4": 4,
-}
-"""Theoretical order of global accuracy of each scheme."""
+SCHEMES = tuple(TABLEAUX) + EULER_STEPS
 
-STAGES = {scheme: len(weights) for scheme, (_, weights, _) in TABLEAUX.items()} | {
-    "semi_implicit_euler": 1,
-    "engine_euler": 1,
-}
+ORDER = {scheme: tableau.order for scheme, tableau in TABLEAUX.items()} | {scheme: 1 for scheme in EULER_STEPS}
+"""Theoretical order of global accuracy of each scheme (a tableau's :attr:`~core.dynamics.tableau.Tableau.order`)."""
+
+STAGES = {scheme: tableau.stages for scheme, tableau in TABLEAUX.items()} | {scheme: 1 for scheme in EULER_STEPS}
 """Evaluations of the scene's wrench per step of each scheme, whatever its orientation update: one per stage of a
 Runge-Kutta tableau (explicit Euler 1, midpoint and average velocity 2, RK4 4), one for the Euler steps that take
 the forces at the step's start."""
@@ -122,8 +116,11 @@ def _derivative(t: float, state: State, props: MassProperties, wrench: Wrench) -
 def runge_kutta_step(
     scheme: str, orientation_update: str, props: MassProperties, wrench: Wrench
 ) -> Step:
-    """One step of an explicit Runge-Kutta scheme. Returns ``step(t, state, dt) -> state``."""
-    a, b, c = TABLEAUX[scheme]
+    """One step of an explicit Runge-Kutta scheme (:data:`core.dynamics.tableau.TABLEAUX`). Returns
+    ``step(t, state, dt) -> state``. Each stage's and the step's increments are summed from 0 over every
+    coefficient, sum_j (dt a_ij) k_j, then added to the state."""
+    tableau = TABLEAUX[scheme]
+    a, b, c = tableau.a, tableau.b, tableau.c
     lie = orientation_update == "expmap"
 
     def step(t: float, s: State, dt: float) -> State:

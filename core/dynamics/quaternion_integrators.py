@@ -24,20 +24,13 @@ from typing import Callable
 import numpy as np
 
 from simparity.core.dynamics.rigid_body import MassProperties, State, Wrench
+from simparity.core.dynamics.tableau import TABLEAUX
 from simparity.core.rotations import quat_wxyz_from_rotvec, quat_wxyz_multiply, quat_wxyz_normalize
 
 X, Q, P, L = slice(0, 3), slice(3, 7), slice(7, 10), slice(10, 13)
 """Rows of the packed state."""
 
 ROWS = 13
-
-# Butcher tableaux (a, b, c) of the explicit Runge-Kutta schemes.
-TABLEAUX: dict[str, tuple[list[list[float]], list[float], list[float]]] = {
-    "explicit_euler": ([[]], [1.0], [0.0]),
-    "average_velocity": ([[], [1.0]], [0.5, 0.5], [0.0, 1.0]),
-    "midpoint": ([[], [0.5]], [0.0, 1.0], [0.0, 0.5]),
-    "rk4": ([[], [0.5], [0.0, 0.5], [0.0, 0.0, 1.0]], [1 / 6, 1 / 3, 1 / 3, 1 / 6], [0.0, 0.5, 0.5, 1.0]),
-}
 
 CHUNK_ELEMENTS = 1 << 15
 """Samples x bodies per chunk of :meth:`PackedBodies.samples`: 256 KiB per row, in L2 cache."""
@@ -166,8 +159,11 @@ def _normalised(packed: np.ndarray) -> np.ndarray:
 
 
 def runge_kutta(scheme: str, bodies: PackedBodies, wrench: Wrench) -> PackedStep:
-    """One step of an explicit Runge-Kutta scheme on the packed state (quaternion normalised after)."""
-    a, b, c = TABLEAUX[scheme]
+    """One step of an explicit Runge-Kutta scheme (:data:`core.dynamics.tableau.TABLEAUX`) on the packed state
+    (quaternion normalised after). Stages and step accumulate onto the state term by term, y + (dt a_ij) k_j and
+    y + (dt b_i) k_i in stage order, skipping zero coefficients."""
+    tableau = TABLEAUX[scheme]
+    a, b, c = tableau.a, tableau.b, tableau.c
 
     def step(t: float, s: np.ndarray, dt: float | np.ndarray) -> np.ndarray:
         ks: list[np.ndarray] = []
@@ -231,7 +227,8 @@ def engine_euler(bodies: PackedBodies, wrench: Wrench) -> PackedStep:
 
 
 def make_packed_step(scheme: str, props: MassProperties, wrench: Wrench) -> PackedStep:
-    """The packed step of ``scheme`` (a key of :data:`TABLEAUX`, ``semi_implicit_euler`` or ``engine_euler``)."""
+    """The packed step of ``scheme`` (a key of :data:`core.dynamics.tableau.TABLEAUX`, ``semi_implicit_euler``
+    or ``engine_euler``)."""
     bodies = PackedBodies(props)
     if scheme in TABLEAUX:
         return runge_kutta(scheme, bodies, wrench)

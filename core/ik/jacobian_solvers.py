@@ -51,11 +51,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from simparity.core.ik import steps
+from simparity.core.ik.batch_progress import BatchProgress
 from simparity.core.ik.limits import cross_gap, crossable_gap, inside, wrap_into_limits
 from simparity.core.model.ik_problem import IKTolerances, check_inputs
 from simparity.core.ik.nullspace import limit_penalty_gradient, nullspace_term, penalty_gradient
 from simparity.core.ik.reach import reach_upper_bound
-from simparity.core.model.ik_result import IKResult
+from simparity.core.model.ik_result import IKReason, IKResult
 from simparity.core.kinematics import jacobian_of_frames, jacobian_world, packed_frames
 from simparity.core.rotations import so3_log
 from simparity.core.model.scenes.chain import Chain, sample_configurations
@@ -200,32 +201,18 @@ def solve_ik(
     center, radius = reach_upper_bound(chain)
     beyond_reach = np.linalg.norm(target_position - center, axis=1) > radius + options.position_tolerance
 
-    batch = q.shape[0]
-    q = np.clip(q, lower, upper)
-    best_q, best_merit = q.copy(), np.full(batch, np.inf)
-    since_best = np.zeros(batch, int)
-    iterations = np.zeros(batch, int)
-    crossings_left = np.full(batch, options.gap_crossings)
-    reason = np.full(batch, "iteration_cap", dtype=object)
-    active = np.ones(batch, bool)
+    progress = BatchProgress.start(np.clip(q, lower, upper), options.gap_crossings)
     for it in range(options.max_iterations + 1):
-        idx = np.flatnonzero(active)
+        idx = progress.unsolved()
         if idx.size == 0:
             break
-        qa = q[idx]
+        qa = progress.q[idx]
         frames = packed_frames(chain, qa)  # one FK pass gives the error and the Jacobian
         end_world = frames.positions[-1].T
         err, pos_res, rot_res = _error(end_world, frames.end_rotation.transpose(2, 0, 1), target_position[idx],
                                        None if target_rotation is None else target_rotation[idx])
-        merit = np.linalg.norm(err, axis=1)
-        better = merit < best_merit[idx]
-        since_best[idx] = np.where(merit < best_merit[idx] * (1 - options.stall_ratio), 0, since_best[idx] + 1)
         solved = (pos_res <= options.position_tolerance) & (rot_res <= options.orientation_tolerance)
-        keep = better | solved
-        best_q[idx[keep]] = qa[keep]
-        best_merit[idx[better]] = merit[better]
-        reason[idx[solved]] = ""
-        active[idx[solved]] = False
+        progress.observe(idx, qa, np.linalg.norm(err, axis=1), solved, options.stall_ratio)
         go = ~solved  # only the unsolved targets are updated
         idx, qa, err, end_world = idx[go], qa[go], err[go], end_world[go]
         if idx.size == 0:
@@ -238,46 +225,45 @@ def solve_ik(
             dq, locked = _update(method, basis.T @ jac, err @ basis, qa, lower, upper, revolute, options)
         # Only a target that has not progressed for stall_window iterations can stop unsolved: only those are
         # classified (the singular values cost more than the rest of the iteration), and none when abandoned.
-        due = np.flatnonzero(since_best[idx] >= options.stall_window)
-        cause = np.full(due.size, "iteration_cap", dtype=object)
+        due = progress.stalled(idx, options.stall_window)
+        cause = np.full(due.size, IKReason.ITERATION_CAP, dtype=object)
         if due.size and not options.abandon_stalled:
             cause[:] = _classify(jac[due], locked[due], end_world[due], target_position[idx[due]], center,
                                  beyond_reach[idx[due]], options)
             # A stalled iterate that oscillates about a singular best configuration (the
             # pseudo-inverse at a stretched arm) is judged at that configuration, which it returns.
-            waiting = np.flatnonzero(cause == "iteration_cap")
+            waiting = np.flatnonzero(cause == IKReason.ITERATION_CAP)
             if waiting.size:
                 w = idx[due[waiting]]
-                best = packed_frames(chain, best_q[w])
+                best = packed_frames(chain, progress.best_q[w])
                 cause[waiting] = _classify(jacobian_of_frames(chain, best)[:, :rows],
                                            locked[due[waiting]], best.positions[-1].T, target_position[w], center,
                                            beyond_reach[w], options)
-        crossable_due = np.any(locked[due] & crossable, axis=1) & (crossings_left[idx[due]] > 0)
-        escapes = crossable_due & ((cause == "limit_blocked") | options.abandon_stalled)
-        stops = ~escapes & ((cause != "iteration_cap") | options.abandon_stalled)
+        crossable_due = np.any(locked[due] & crossable, axis=1) & progress.may_cross(idx[due])
+        escapes = crossable_due & ((cause == IKReason.LIMIT_BLOCKED) | options.abandon_stalled)
+        stops = ~escapes & ((cause != IKReason.ITERATION_CAP) | options.abandon_stalled)
         stalled, escape = np.zeros(idx.size, bool), np.zeros(idx.size, bool)
         stalled[due[stops]], escape[due[escapes]] = True, True
         last = it == options.max_iterations
         if last:
             capped = ~stalled
-            reason[idx[capped]] = np.where(beyond_reach[idx[capped]], "unreachable", "iteration_cap")
-        reason[idx[due[stops]]] = cause[stops]
+            progress.stop(idx[capped], np.where(beyond_reach[idx[capped]], IKReason.UNREACHABLE,
+                                                IKReason.ITERATION_CAP))
+        progress.stop(idx[due[stops]], cause[stops])
 
         step = ~(stalled | escape) & (not last)
-        q[idx[step]] = np.clip(wrap_into_limits(qa[step] + dq[step], revolute, lower, upper), lower, upper)
         escape &= not last
-        q[idx[escape]] = cross_gap(qa[escape], locked[escape] & crossable, lower, upper)
-        crossings_left[idx[escape]] -= 1
-        since_best[idx[escape]] = 0
-        iterations[idx[step | escape]] += 1
-        active[idx[~(step | escape)]] = False
+        stepped = np.clip(wrap_into_limits(qa[step] + dq[step], revolute, lower, upper), lower, upper)
+        progress.advance(idx, step, stepped, escape, cross_gap(qa[escape], locked[escape] & crossable, lower, upper))
 
+    best_q = progress.best_q
     frames = packed_frames(chain, best_q)
     _, pos_res, rot_res = _error(frames.positions[-1].T, frames.end_rotation.transpose(2, 0, 1), target_position,
                                  target_rotation)
     violation = np.max(np.maximum(np.maximum(lower - best_q, best_q - upper), 0.0), axis=1, initial=0.0)
-    return IKResult(q=best_q, success=reason == "", iterations=iterations, position_residual=pos_res,
-                    orientation_residual=rot_res, limit_violation=violation, reason=reason.astype(str))
+    return IKResult(q=best_q, success=progress.reason == IKReason.SOLVED, iterations=progress.iterations,
+                    position_residual=pos_res, orientation_residual=rot_res, limit_violation=violation,
+                    reason=progress.reason.astype(str))
 
 
 TASK_SAMPLES = 32
@@ -385,9 +371,9 @@ def _classify(jac, locked, end_world, target_position, center, beyond_reach, opt
     sigma_task = np.linalg.svd(jac, compute_uv=False)[:, -1]
     sigma_position = np.linalg.svd(jac[:, :3], compute_uv=False)[:, -1]
     farther = np.linalg.norm(target_position - center, axis=1) > np.linalg.norm(end_world - center, axis=1)
-    cause = np.full(len(jac), "iteration_cap", dtype=object)
-    cause[sigma_task < options.singular_threshold] = "singular"
-    cause[(sigma_position < options.singular_threshold) & farther] = "unreachable"
-    cause[np.any(locked, axis=1)] = "limit_blocked"
-    cause[beyond_reach] = "unreachable"
+    cause = np.full(len(jac), IKReason.ITERATION_CAP, dtype=object)
+    cause[sigma_task < options.singular_threshold] = IKReason.SINGULAR
+    cause[(sigma_position < options.singular_threshold) & farther] = IKReason.UNREACHABLE
+    cause[np.any(locked, axis=1)] = IKReason.LIMIT_BLOCKED
+    cause[beyond_reach] = IKReason.UNREACHABLE
     return cause

@@ -36,7 +36,7 @@ import numpy as np
 from simparity.core.ik.jacobian_solvers import IKOptions, failure_causes, solve_ik
 from simparity.core.model.ik_problem import check_inputs
 from simparity.core.ik.reach import reach_upper_bound
-from simparity.core.model.ik_result import IKResult
+from simparity.core.model.ik_result import IKReason, IKResult
 from simparity.core.model.scenes.chain import Chain, sample_configurations
 
 RESTART_STREAM = 0x5E57A27
@@ -162,7 +162,7 @@ def solve_ik_with_restarts(
         for name in _FIELDS:
             if name != "iterations":
                 best[name][todo[take]] = getattr(again, name)[pick[take]]
-    capped = np.flatnonzero(best["reason"] == "iteration_cap")
+    capped = np.flatnonzero(best["reason"] == IKReason.ITERATION_CAP)
     if capped.size:
         best["reason"][capped] = failure_causes(chain, best["q"][capped], target_position[capped],
                                                 3 if target_rotation is None else 6, options)

@@ -3,15 +3,40 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import Enum
 
 import numpy as np
 
 from simparity.core.model.arrays import readonly
 
-REASONS = ("", "unreachable", "singular", "limit_blocked", "iteration_cap", "outside_limits")
-"""Failure vocabulary: ``""`` for a success, otherwise why the target was not reached.
-``"outside_limits"``: the residuals are within their tolerances but the joint values are not
-within their limits (an engine's solver that ignores limits): not a solution for the robot."""
+class IKReason(str, Enum):
+    """Why a target was not reached, or :attr:`SOLVED` (``""``) when it was. A member is its text (the str value
+    written to ``IKResult.reason`` and the results), so it compares, hashes and formats as that text.
+
+    - ``UNREACHABLE``: the target is beyond the chain's reach (a bound, or the arm stretched toward it);
+    - ``SINGULAR``: the task Jacobian lost rank where the iteration stopped;
+    - ``LIMIT_BLOCKED``: a joint limit stopped the progress;
+    - ``ITERATION_CAP``: stopped by the iteration cap, or by a solver that names no cause;
+    - ``OUTSIDE_LIMITS``: the residuals are within their tolerances but the joint values are not within their
+      limits (an engine's solver that ignores limits): not a solution for the robot.
+    """
+
+    SOLVED = ""
+    UNREACHABLE = "unreachable"
+    SINGULAR = "singular"
+    LIMIT_BLOCKED = "limit_blocked"
+    ITERATION_CAP = "iteration_cap"
+    OUTSIDE_LIMITS = "outside_limits"
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __format__(self, spec: str) -> str:
+        return format(self.value, spec)
+
+
+REASONS = tuple(reason.value for reason in IKReason)
+"""The failure vocabulary as text: :class:`IKReason`'s values, ``""`` for a success."""
 
 LIMIT_TOLERANCE = 1e-6
 """[rad or m] A joint value this close outside its limit still counts as inside: PyBullet returns

@@ -47,7 +47,7 @@ from simparity.core.model.engine import (
     Support,
 )
 from simparity.core.model.ik_problem import IKTolerances, check_inputs
-from simparity.core.model.ik_result import IKResult
+from simparity.core.model.ik_result import IKReason, IKResult
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
@@ -295,8 +295,9 @@ class _TwoLinkIK(IKModel):
         reached = self._fk.forward_kinematics(q).position_world[:, -1]
         residual = np.linalg.norm(reached - p, axis=1)
         success = reachable & ~blocked & (residual <= self._options.position_tolerance)
-        reason = np.where(success, "", np.where(~reachable, "unreachable",
-                                                np.where(blocked, "limit_blocked", "singular")))
+        reason = np.where(success, IKReason.SOLVED,
+                          np.where(~reachable, IKReason.UNREACHABLE,
+                                   np.where(blocked, IKReason.LIMIT_BLOCKED, IKReason.SINGULAR)))
         violation = np.max(np.maximum(np.maximum(lower - q, q - upper), 0.0), axis=1)
         return IKResult(q, success, np.zeros(len(p), int), residual, np.zeros(len(p)), violation, reason)
 

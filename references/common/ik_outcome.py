@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.ik_result import LIMIT_TOLERANCE, IKResult
+from simparity.core.model.ik_result import LIMIT_TOLERANCE, IKReason, IKResult
 from simparity.core.model.scenes.chain import Chain
 
 
@@ -69,7 +69,8 @@ def ik_outcome(chain: Chain, q: np.ndarray, iterations: np.ndarray, position_res
     success = reached & inside
     center, radius = reach_bound(chain)
     beyond = np.linalg.norm(target_position_world - center, axis=1) > radius + options.position_tolerance
-    reason = np.where(success, "", np.where(reached, "outside_limits",
-                                            np.where(beyond, "unreachable", "iteration_cap")))
+    reason = np.where(success, IKReason.SOLVED,
+                      np.where(reached, IKReason.OUTSIDE_LIMITS,
+                               np.where(beyond, IKReason.UNREACHABLE, IKReason.ITERATION_CAP)))
     return IKResult(q=q, success=success, iterations=iterations, position_residual=position_residual,
                     orientation_residual=orientation_residual, limit_violation=violation, reason=reason)

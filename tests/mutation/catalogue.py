@@ -44,21 +44,21 @@ damping and the articulated suite's chains and falling arms."""
 MUTANTS: tuple[Mutation, ...] = (
     # --- Dynamics: integrators ------------------------------------------------------------------------------
     Mutation(
-        "rk4_weights", "integrator weights", "dynamics/quaternion_integrators.py",
-        "[1 / 6, 1 / 3, 1 / 3, 1 / 6], [0.0, 0.5, 0.5, 1.0]),",
-        "[1 / 4, 1 / 4, 1 / 4, 1 / 4], [0.0, 0.5, 0.5, 1.0]),",
+        "rk4_weights", "integrator weights", "dynamics/tableau.py",
+        "b=(1 / 6, 1 / 3, 1 / 3, 1 / 6), c=(0.0, 0.5, 0.5, 1.0), order=4)",
+        "b=(1 / 4, 1 / 4, 1 / 4, 1 / 4), c=(0.0, 0.5, 0.5, 1.0), order=4)",
         "RK4's four slopes averaged with equal weights 1/4 instead of 1/6, 1/3, 1/3, 1/6 (second order)",
         FLIGHT, "wind"),
     Mutation(
-        "rk4_last_stage", "integrator stages", "dynamics/quaternion_integrators.py",
-        "[[], [0.5], [0.0, 0.5], [0.0, 0.0, 1.0]]",
-        "[[], [0.5], [0.0, 0.5], [0.0, 0.0, 0.5]]",
+        "rk4_last_stage", "integrator stages", "dynamics/tableau.py",
+        "(0.0, 0.5, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0)),",
+        "(0.0, 0.5, 0.0, 0.0), (0.0, 0.0, 0.5, 0.0)),",
         "RK4's fourth stage taken half a step along k3 instead of a whole step (first order)",
         FLIGHT, "wind"),
     Mutation(
-        "midpoint_full_step", "integrator stages", "dynamics/quaternion_integrators.py",
-        '"midpoint": ([[], [0.5]], [0.0, 1.0], [0.0, 0.5]),',
-        '"midpoint": ([[], [1.0]], [0.0, 1.0], [0.0, 0.5]),',
+        "midpoint_full_step", "integrator stages", "dynamics/tableau.py",
+        "MIDPOINT = Tableau(a=((0.0, 0.0), (0.5, 0.0)),",
+        "MIDPOINT = Tableau(a=((0.0, 0.0), (1.0, 0.0)),",
         "the midpoint rule's second stage evaluated a whole step ahead instead of half a step (first order)",
         FLIGHT, "wind"),
     Mutation(
@@ -267,8 +267,8 @@ MUTANTS: tuple[Mutation, ...] = (
     # --- Joint-space time stepping --------------------------------------------------------------------------
     Mutation(
         "joint_rk4_stage_typo", "integrator weights", "articulated/stepping.py",
-        "qdot + dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)",
-        "qdot + dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a2 + a4)",
+        "qdot + scale * _weighted(tableau, accelerations)",
+        "qdot + scale * _weighted(tableau, accelerations[:2] + accelerations[1:2] + accelerations[3:])",
         "the joints' RK4 velocity update sums k2 twice instead of k2 and k3 (a copy-and-paste slip: third order)",
         JOINT_MOTION, "pendulum-large-amplitude"),
     Mutation(

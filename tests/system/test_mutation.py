@@ -73,8 +73,8 @@ def imported(tmp_path, monkeypatch):
 
 
 def _mutation(**changes) -> Mutation:
-    fields = dict(id="demo", kind="integrator weights", file="dynamics/quaternion_integrators.py",
-                  old="[1 / 6, 1 / 3, 1 / 3, 1 / 6]", new="[1 / 4, 1 / 4, 1 / 4, 1 / 4]",
+    fields = dict(id="demo", kind="integrator weights", file="dynamics/tableau.py",
+                  old="(1 / 6, 1 / 3, 1 / 3, 1 / 6)", new="(1 / 4, 1 / 4, 1 / 4, 1 / 4)",
                   description="equal weights", suites=("default",), witness="wind")
     return Mutation(**(fields | changes))
 
@@ -84,14 +84,14 @@ def _mutation(**changes) -> Mutation:
 
 def test_a_mutation_changes_only_its_text_in_the_copy(tmp_path):
     copy = materialise(_mutation(), tmp_path)
-    changed = (tmp_path / copy.package / "dynamics" / "quaternion_integrators.py").read_text(encoding="utf-8")
-    original = (Path(sys.modules[CORE_PACKAGE].__file__).parent / "dynamics" / "quaternion_integrators.py").read_text("utf-8")
-    assert "[1 / 4, 1 / 4, 1 / 4, 1 / 4]" in changed and "[1 / 6, 1 / 3, 1 / 3, 1 / 6]" not in changed
-    assert changed.replace(copy.package, CORE_PACKAGE).replace("[1 / 4, 1 / 4, 1 / 4, 1 / 4]",
-                                                              "[1 / 6, 1 / 3, 1 / 3, 1 / 6]") == original
+    changed = (tmp_path / copy.package / "dynamics" / "tableau.py").read_text(encoding="utf-8")
+    original = (Path(sys.modules[CORE_PACKAGE].__file__).parent / "dynamics" / "tableau.py").read_text("utf-8")
+    assert "(1 / 4, 1 / 4, 1 / 4, 1 / 4)" in changed and "(1 / 6, 1 / 3, 1 / 3, 1 / 6)" not in changed
+    assert changed.replace(copy.package, CORE_PACKAGE).replace("(1 / 4, 1 / 4, 1 / 4, 1 / 4)",
+                                                              "(1 / 6, 1 / 3, 1 / 3, 1 / 6)") == original
 
 
-@pytest.mark.parametrize("old, problem", [("[1 / 7, 1 / 3]", "does not occur"), ("new = np.empty_like(s)", "occurs 2 times")])
+@pytest.mark.parametrize("old, problem", [("(1 / 7, 1 / 3)", "does not occur"), ("1 / 3, ", "occurs 2 times")])
 def test_a_mutation_whose_text_is_not_found_exactly_once_raises(tmp_path, old, problem):
     """A mutant that silently does not apply (or applies somewhere unintended) would be a bug of the suite."""
     with pytest.raises(MutationError, match=problem):
@@ -108,7 +108,7 @@ def test_a_bad_mutation_record_raises():
     with pytest.raises(MutationError, match="suites"):
         _mutation(suites=("bench",))
     with pytest.raises(MutationError, match="same"):
-        _mutation(new="[1 / 6, 1 / 3, 1 / 3, 1 / 6]")
+        _mutation(new="(1 / 6, 1 / 3, 1 / 3, 1 / 6)")
 
 
 def test_the_copy_imports_and_reports_its_own_name(imported):

@@ -9,6 +9,7 @@ from scipy.integrate import solve_ivp
 
 from simparity.core.articulated import stepping
 from simparity.core.articulated.motion import CoreJointMotion
+from simparity.core.dynamics.tableau import TABLEAUX
 from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 
@@ -101,3 +102,35 @@ def test_energy_and_end_effector_by_hand():
 def test_unknown_scheme_is_refused():
     with pytest.raises(ValueError, match="allowed: explicit_euler"):
         stepping.stepper(_scene(0.0, 0.0), "leapfrog", 0.01)
+
+
+def _rk4_by_hand(qddot, q: np.ndarray, qdot: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """The classical RK4 step on (q, qdot) written out, summed as dt / 6 (k1 + 2 k2 + 2 k3 + k4)."""
+    a1 = qddot(q, qdot)
+    v2 = qdot + 0.5 * dt * a1
+    a2 = qddot(q + 0.5 * dt * qdot, v2)
+    v3 = qdot + 0.5 * dt * a2
+    a3 = qddot(q + 0.5 * dt * v2, v3)
+    v4 = qdot + dt * a3
+    a4 = qddot(q + dt * v3, v4)
+    return (q + dt / 6.0 * (qdot + 2.0 * v2 + 2.0 * v3 + v4), qdot + dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4))
+
+
+def test_the_tableau_steps_sum_as_the_written_out_schemes_to_the_bit():
+    """The joints' Runge-Kutta steps read the shared tableau and keep the floating-point order of the formulas they
+    replaced (issue #40: results bit for bit), on a nonlinear acceleration of a random batch."""
+    rng = np.random.default_rng(40)
+    q, qdot = rng.normal(size=(3, 5)), rng.normal(size=(3, 5))
+    dt = 0.013
+
+    def qddot(q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        return -np.sin(q) - 0.3 * qdot * np.abs(qdot)
+
+    rk4 = stepping.runge_kutta(TABLEAUX[stepping.RK4], qddot, dt)(q, qdot)
+    assert all(np.array_equal(x, y) for x, y in zip(rk4, _rk4_by_hand(qddot, q, qdot, dt)))
+    half = qdot + 0.5 * dt * qddot(q, qdot)
+    midpoint = (q + dt * half, qdot + dt * qddot(q + 0.5 * dt * qdot, half))
+    got = stepping.runge_kutta(TABLEAUX[stepping.MIDPOINT], qddot, dt)(q, qdot)
+    assert all(np.array_equal(x, y) for x, y in zip(got, midpoint))
+    got = stepping.runge_kutta(TABLEAUX[stepping.EXPLICIT_EULER], qddot, dt)(q, qdot)
+    assert all(np.array_equal(x, y) for x, y in zip(got, (q + dt * qdot, qdot + dt * qddot(q, qdot))))

@@ -5,7 +5,6 @@ import pytest
 
 from simparity.core.dynamics.forces import make_wrench
 from simparity.core.dynamics.quaternion_integrators import (
-    TABLEAUX,
     PackedBodies,
     make_packed_step,
     pack,
@@ -13,6 +12,7 @@ from simparity.core.dynamics.quaternion_integrators import (
     unpack,
 )
 from simparity.core.dynamics.rigid_body import MassProperties, initial_state
+from simparity.core.dynamics.tableau import TABLEAUX
 from simparity.core.rotations import quat_wxyz_normalize, quat_wxyz_to_matrix
 from simparity.core.model.scenes.bodies import Forces, RigidBody
 
