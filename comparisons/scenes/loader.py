@@ -2,7 +2,7 @@
 
 Every value is checked; a bad one raises :class:`core.errors.SceneError` naming the file,
 the key path, what was wrong and what is allowed. A file with a ``[sweep]`` is several scenes, one per
-variant (:mod:`comparisons.sweep`; :func:`load_scenes`). The format is documented in ``docs/scenes.md``.
+variant (:mod:`comparisons.scenes.sweep`; :func:`load_scenes`). The format is documented in ``docs/scenes.md``.
 """
 
 from __future__ import annotations
@@ -109,7 +109,7 @@ class _Reader:
         return value
 
     def text(self, key: str, default: str) -> str:
-        """Free text for people (a description): one line of printable characters (:mod:`core.names`); ``default``
+        """Free text for people (a description): one line of printable characters (:mod:`core.model.names`); ``default``
         when the key is absent."""
         if not self.has(key):
             return default
@@ -120,7 +120,7 @@ class _Reader:
         return value
 
     def name(self, key: str, default=None) -> str:
-        """A string that names something (see :mod:`core.names`)."""
+        """A string that names something (see :mod:`core.model.names`)."""
         value = self.string(key, default)
         problem = name_problem(value)
         if problem:
@@ -931,7 +931,7 @@ def parse_scenes(data: dict, source: str = "<scene>", limits: Limits = DEFAULT_L
     """The scenes of parsed TOML ``data``: the one it describes, or the variants of its ``[sweep]`` in the
     sweep's order. The file without its ``[sweep]`` must be a valid scene; each variant is checked like a file
     written by hand with its values, and an error in one names the sweep key and value
-    (:meth:`comparisons.sweep.Sweep.refusal`)."""
+    (:meth:`comparisons.scenes.sweep.Sweep.refusal`)."""
     if SWEEP_TABLE not in data:
         return [parse_scene(data, source, limits, engines)]
     engines = engines or EngineSet()  # one for every variant: a plugin or a reference is asked once

@@ -3,7 +3,7 @@
 Each entry names a key of the file by its path (``"body[ball].restitution"``) and gives its values: a list, or
 a range ``{start, stop, num}`` (linear; ``spacing = "log"`` for geometric steps). Several entries combine as
 their Cartesian product, the first key varying slowest; ``combine = "zip"`` pairs their k-th values instead.
-A variant is the file with its values written in, so :mod:`comparisons.scene_loader` checks it exactly like a
+A variant is the file with its values written in, so :mod:`comparisons.scenes.loader` checks it exactly like a
 file written by hand; this module only reads the ``[sweep]`` table, finds the keys and writes the values.
 Format and path syntax: ``docs/scenes.md`` ("Sweeps").
 """

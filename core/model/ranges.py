@@ -3,7 +3,7 @@
 Ranges are generous (they admit a microgram bead and a freight train) but physical: a value
 outside them is a typo or an attack, and letting it through would give meaningless numbers (a
 mass of 5e-324 kg, a velocity of 1e308 m/s) or overflow inside an engine. They are held by the
-scene loader (``comparisons.scene_loader``) and the URDF reader (:mod:`core.urdf`), and listed in
+scene loader (``comparisons.scenes.loader``) and the URDF reader (:mod:`core.urdf`), and listed in
 ``docs/scenes.md``.
 """
 

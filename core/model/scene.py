@@ -5,7 +5,7 @@ frame has its origin at the centre of mass; its inertia tensor is about the cent
 mass, in body axes. A scene carries only what it needs: ``gravity_world`` is ``None``
 when the scene has no gravity, and adapters then give the engines none.
 
-Scenes are built by the loader in ``comparisons.scene_loader`` (which checks every value
+Scenes are built by the loader in ``comparisons.scenes.loader`` (which checks every value
 and reports the file and key of a bad one) or directly in code (tests, benchmarks).
 """
 
@@ -205,7 +205,7 @@ CONTACT_METHODS = ("backup", "act_after", "penalty")
 
 PENALTY_PREFIX = "penalty_"
 """Integrator names of the penalty method: this prefix and the time integrator (``penalty_rk4``).
-Each has its stability limit measured on the scene (``comparisons.stability``)."""
+Each has its stability limit measured on the scene (``comparisons.measure.stability``)."""
 
 
 @dataclass(frozen=True)
@@ -400,7 +400,7 @@ class PointMasses:
     frame_position_world : (3,) ndarray or None
         Where the file's ``position_world`` put the frame the points were given in [m] (the body's
         ``position_world`` is this plus its rotation times the COM); None with ``positions_given``. Code that moves
-        such a body moves this too (``comparisons.transforms``, ``comparisons.perturb``).
+        such a body moves this too (``comparisons.invariance.transforms``, ``comparisons.invariance.perturb``).
     """
 
     masses: np.ndarray
@@ -580,7 +580,7 @@ class DHTable:
         [m, rad, m, rad], the table at q = 0.
     base_xyz : (3,) ndarray
         [m] The table's base frame in the chain's base frame: zero as a file writes it; a transformed scene
-        (``comparisons.transforms``) places the table there.
+        (``comparisons.invariance.transforms``) places the table there.
     base_rotation : (3, 3) ndarray
         Table base frame to chain base frame: the identity as a file writes it.
     """
@@ -637,7 +637,7 @@ class Joint:
         Rx(roll)): the raw numbers core turned into the matrix, kept so that every reference turns them with its
         own code (``references.common.scene_inputs``). None when the rotation was given as a matrix (in code,
         from a URDF file or a DH table). Code that changes ``origin_rotation`` changes this with it
-        (``comparisons.transforms``), or sets it to None.
+        (``comparisons.invariance.transforms``), or sets it to None.
     """
 
     name: str
@@ -808,7 +808,7 @@ the crafted arm. A scene may be in several."""
 
 HARD_TARGETS = ("stretched", "beyond_reach", "at_base", "near_limits", "beyond_limits", "orientation_in_place",
                 "wrist_flip")
-"""Hard IK targets a scene may ask for (see ``comparisons.ik_targets``)."""
+"""Hard IK targets a scene may ask for (see ``comparisons.execute.ik_targets``)."""
 
 
 @dataclass(frozen=True)
