@@ -107,14 +107,7 @@ def _attribute(scope: object, name: str, module: str) -> tuple[bool, object]:
                 names.update(dict.fromkeys(_self_attributes(node)))
         if name in names:
             return True, names[name]
-        # an inherited name: look it up in base classes this module can name
-        for base in scope.bases:
-            base_name = base.id if isinstance(base, ast.Name) else None
-            if base_name and isinstance(_module_names(module).get(base_name), ast.ClassDef):
-                found, value = _attribute(_module_names(module)[base_name], name, module)
-                if found:
-                    return True, value
-        return _documented_base(scope), None
+        return _inherited(scope, name, module), None
     names = _module_names(module)
     if name in names:
         return True, names[name]
@@ -124,9 +117,23 @@ def _attribute(scope: object, name: str, module: str) -> tuple[bool, object]:
     return _module_file(f"{module}.{name}") is not None, ("module", f"{module}.{name}")
 
 
-def _documented_base(klass: ast.ClassDef) -> bool:
-    """A class built on one from outside (an Enum, a NamedTuple, an exception) may have names we cannot see."""
-    return any(not isinstance(base, ast.Name) or base.id not in {"object"} for base in klass.bases)
+def _inherited(klass: ast.ClassDef, name: str, module: str) -> bool:
+    """Whether a base of ``klass`` has ``name``: a base of the package is looked up, one from outside (an Enum, a
+    NamedTuple, an exception) may hold names this reading cannot see, so it is taken to."""
+    for base in klass.bases:
+        if not isinstance(base, ast.Name):
+            return True
+        known = _module_names(module).get(base.id)
+        if isinstance(known, ast.ClassDef):
+            if _attribute(known, name, module)[0]:
+                return True
+        elif isinstance(known, tuple) and known[0] == "import":
+            if not known[1].startswith(f"{PACKAGE}.") or _resolves_in(known[1].removeprefix(f"{PACKAGE}."),
+                                                                       [known[2], name]):
+                return True
+        elif base.id != "object":
+            return True  # a builtin base (Exception, tuple, ...)
+    return False
 
 
 def _resolves_in(module: str, rest: list[str]) -> bool:
@@ -200,6 +207,8 @@ def test_resolver_tells_a_path_from_a_stale_one():
     assert resolves("simparity.core.engine.Engine")  # through the alias module's * import
     assert not resolves("simparity.core.integrators")
     assert not resolves("core.model.scene.NoSuchName")
+    assert resolves("core.model.scene.DynamicsScene.n_steps")  # a method of a class
+    assert not resolves("core.model.scene.DynamicsScene.no_such_attribute")
 
 
 def test_every_dotted_module_path_resolves():
