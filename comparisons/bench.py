@@ -1,6 +1,6 @@
 """``simparity bench``: speed with its accuracy, core against the engines, measured in one run.
 
-Three workloads, every time the median of repeats after a warm-up call, every ratio core / engine
+Five workloads, every time the median of repeats after a warm-up call, every ratio core / engine
 computed from the same run:
 
 1. rigid-body stepping of B identical boxes (torque-free tumbling; falling with drag), time per

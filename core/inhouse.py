@@ -178,7 +178,7 @@ class _ParticleSimulation(_InHouseSimulation):
 class _ContactSimulation(_InHouseSimulation):
     """Bodies against the scene's planes by one of core's contact methods.
 
-    After :meth:`run`, ``events`` holds the backup method's contact events (:class:`core.contact.EventLog`;
+    After :meth:`run`, ``events`` holds the backup method's contact events (:class:`core.contact.bodies.EventLog`;
     empty for the other methods).
     """
 
@@ -319,7 +319,7 @@ class InHouseEngine(Engine):
         return scheme, orientation
 
     def theoretical_order(self, integrator: str) -> int | None:
-        """The scheme's order (:data:`core.integrators.ORDER`); None for the particle rules (it depends on the
+        """The scheme's order (:data:`core.dynamics.integrators.ORDER`); None for the particle rules (it depends on the
         scene) and the contact methods (a contact's first-order or exact treatment dominates the scheme's)."""
         if integrator in CONTACT_INTEGRATORS:
             return None
@@ -328,7 +328,7 @@ class InHouseEngine(Engine):
         return ORDER.get(parse_integrator(integrator)[0])
 
     def stages(self, integrator: str) -> int | None:
-        """Wrench evaluations per step, counted in the code (:data:`core.integrators.STAGES`): a scheme's stages
+        """Wrench evaluations per step, counted in the code (:data:`core.dynamics.integrators.STAGES`): a scheme's stages
         whatever its orientation update; a particle rule 1 (:data:`PARTICLE_STAGES`); ``penalty_<scheme>`` its
         scheme's (the penalty force is part of the wrench); backup and act_after their free flight's, RK4's 4.
         That is all act_after evaluates (its push-out and impulses evaluate no force). Backup's event handling is

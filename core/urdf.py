@@ -41,7 +41,7 @@ The rules, stricter on the chain because every engine loads the whole file but o
   lower = upper = 0; real files have such knees and wheels) loads: no limit acts in joint dynamics
   or motion, and where limits act (sampled configurations, IK) it is held at that value. Names
   on the path (and the robot's) follow
-  :data:`core.names.NAME_RULE`, numbers on the path the physical ranges of :mod:`core.ranges`
+  :data:`core.model.names.NAME_RULE`, numbers on the path the physical ranges of :mod:`core.model.ranges`
   (origins, angles, joint limits, axis norms). Joints off the path may be of any URDF type,
   mimic ones included, and their names and magnitudes are not held to those rules.
 - The inertials of links in the base link's subtree must be a complete ``<inertial>`` (``<mass
@@ -143,8 +143,8 @@ def chain_from_urdf(
         nested deeper than :data:`core.model.files.MAX_XML_DEPTH`, missing links, a link with two parents, several
         roots, an unknown or missing base/tip link, several leaves without ``tip_link``,
         a mimic, floating or planar joint on the path, a joint with lower > upper, a name on the
-        path outside :data:`core.names.NAME_RULE`, a number on the
-        path outside its physical range (:mod:`core.ranges`), an incomplete or malformed
+        path outside :data:`core.model.names.NAME_RULE`, a number on the
+        path outside its physical range (:mod:`core.model.ranges`), an incomplete or malformed
         ``<inertial>`` below the base link, a negative mass or damping, a mass, inertia entry or
         inertial origin outside its physical range, a non-physical inertia tensor on a link riding
         on a chain link, or a file that is too large, has too many joints or is not a regular
@@ -497,7 +497,7 @@ _MAGNITUDES = (("xyz", "origin_xyz", "origin/@xyz"), ("rpy", "origin_rpy", "orig
 
 def _check_magnitudes(joint: dict, where: str, source: str) -> None:
     """Hold a joint on the chain (``where``: its name and branch, for messages) to the physical ranges of
-    :mod:`core.ranges`."""
+    :mod:`core.model.ranges`."""
     key = joint["key"]
     for field, range_key, element in _MAGNITUDES:
         allowed = RANGES[range_key]

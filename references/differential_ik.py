@@ -13,11 +13,11 @@ joint velocity that drives task errors to zero under limits; their documented us
 With the task gain 1, a step moves by the whole linearised error, so ``dt`` only scales the
 velocity (:data:`DT`). Both keep the joints inside their limits (the ConfigurationLimit
 constraint). Targets are given in the chain's base frame and moved into the library's world
-(:mod:`references.base_frame`); residuals come from the library's own forward kinematics at the
+(:mod:`references.common.base_frame`); residuals come from the library's own forward kinematics at the
 returned configuration: |p_target - p| [m] and the angle of R^T R_target [rad]. pink stops with
 ``NotWithinConfigurationLimits`` (its default safety break) when an iterate leaves the limits
 by rounding; that target ends there. Judged by
-:func:`references.ik_outcome.ik_outcome` like every library adapter. Position-only targets use
+:func:`references.common.ik_outcome.ik_outcome` like every library adapter. Position-only targets use
 orientation_cost 0.
 
 Optional: ``pip install 'simparity[bench]'`` installs both (and the ``daqp`` QP solver);
@@ -61,7 +61,7 @@ def _converged(options: IKTolerances, position: float, angle: float) -> bool:
 
 
 class MinkIK(IKModel):
-    """mink's documented loop on the chain's MuJoCo model (:class:`references.mujoco_adapter.MujocoChain`)."""
+    """mink's documented loop on the chain's MuJoCo model (:class:`references.mujoco.adapter.MujocoChain`)."""
 
     def __init__(self, kinematics, chain: Chain, options: IKTolerances) -> None:
         import mink
@@ -103,7 +103,7 @@ class MinkIK(IKModel):
         return ik_outcome(self._chain, q, iterations, position, angle, p, self._options)
 
 class PinkIK(IKModel):
-    """pink's documented loop on the chain's Pinocchio model (:class:`references.pinocchio_adapter.PinocchioChain`)."""
+    """pink's documented loop on the chain's Pinocchio model (:class:`references.pinocchio.adapter.PinocchioChain`)."""
 
     def __init__(self, kinematics, chain: Chain, options: IKTolerances) -> None:
         import pink

@@ -6,7 +6,7 @@ packaged is named by its spec directly (``--engines my_module:MyEngine``). ``att
 :class:`~simparity.core.model.engine.Engine` subclass or a zero-argument callable returning an Engine.
 
 Whatever goes wrong comes back as an engine standing in for the one asked for
-(:mod:`comparisons.placeholder_engines`), never as an exception: a module that will not import (a
+(:mod:`comparisons.engines.placeholders`), never as an exception: a module that will not import (a
 missing dependency) gives n/a rows, like a built-in engine's missing library; a module or constructor
 that raises, or an engine whose ``version()``, ``integrators()``, ``ik_solvers()``, ``joint_dynamics_methods()``, ``joint_motion_integrators()``,
 ``theoretical_order()``, ``stages()`` or ``integrator_variant()`` raises or returns what the interface

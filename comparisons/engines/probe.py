@@ -4,10 +4,10 @@ A plugin's or spec's import, constructor, ``version()``, ``integrators()`` and t
 engine says of itself run in a child process (``python -m simparity.comparisons.engines.probe``) with a
 time limit (:data:`PROBE_SECONDS`) and a memory limit (:data:`PROBE_MEMORY_BYTES`). An engine that
 segfaults, exits, hangs or grows without bound there becomes a
-:class:`~comparisons.placeholder_engines.BrokenEngine` naming the cause, and simparity goes on. What it
+:class:`~comparisons.engines.placeholders.BrokenEngine` naming the cause, and simparity goes on. What it
 answered comes back as a :class:`DescribedEngine`: its answers as data, all that ``simparity run``
 needs to plan its cases and ``simparity engines`` to list it. The cases themselves build the real
-engine in their worker (:mod:`comparisons.case_worker`).
+engine in their worker (:mod:`comparisons.execute.case_worker`).
 """
 
 from __future__ import annotations
@@ -70,7 +70,7 @@ class EngineDescription:
     kinematics : str
         ``yes`` or ``no`` (its support of :data:`PROBE_CHAIN`), or ``unknown (<error>)``.
     scene_integrators : dict of str to tuple of str or str
-        ``scene_integrators`` of each scene asked about, by :func:`~comparisons.cases.scene_hash`; the error
+        ``scene_integrators`` of each scene asked about, by :func:`~comparisons.execute.cases.scene_hash`; the error
         text where it raised.
     joint_dynamics_methods, joint_motion_integrators : tuple of str
         (``orders``, ``stages`` and ``variants`` cover the joint-motion integrators too.)
@@ -148,7 +148,7 @@ class DescribedEngine(Engine):
 
 def describe(engine: Engine, scenes: list) -> EngineDescription:
     """The description of a built engine, asked about ``scenes`` (an engine that loaded passed the interface
-    checks of :func:`~comparisons.plugins.load_engine`, so only ``scene_integrators`` and kinematics support
+    checks of :func:`~comparisons.engines.plugins.load_engine`, so only ``scene_integrators`` and kinematics support
     may still raise)."""
     integrators = engine.integrators()
     every = tuple(dict.fromkeys(integrators + tuple(engine.joint_motion_integrators())))

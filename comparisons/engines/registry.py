@@ -1,9 +1,9 @@
 """The engines simparity knows, by name, imported only when asked for: the built-ins, the installed plugins
-(:mod:`comparisons.plugins`), and any engine named by its spec ``module:attr``.
+(:mod:`comparisons.engines.plugins`), and any engine named by its spec ``module:attr``.
 
 A built-in name wins over a plugin of the same name. Asking for a built-in never looks for plugins, and
 nothing here raises for an engine that cannot run: it comes back as an engine standing in for it
-(:mod:`comparisons.placeholder_engines`), whose rows say why.
+(:mod:`comparisons.engines.placeholders`), whose rows say why.
 """
 
 from __future__ import annotations
@@ -58,7 +58,7 @@ def check_engine_names(names) -> tuple[str, ...]:
 
 def make_engine(name: str) -> Engine:
     """The engine called ``name`` (a built-in, a plugin, or a spec ``module:attr``), or one standing in for it
-    when it cannot run (:mod:`comparisons.placeholder_engines`)."""
+    when it cannot run (:mod:`comparisons.engines.placeholders`)."""
     check_engine_names([name])
     if name in _ENGINES:
         module, cls = _ENGINES[name]
@@ -74,7 +74,7 @@ def make_engine(name: str) -> Engine:
 
 def describe_engines(names, scenes=()) -> list[Engine]:
     """The engines called ``names`` as simparity itself may hold them: a built-in built here, a plugin or spec
-    described by a process of its own, asked about ``scenes`` (:mod:`comparisons.engine_probe`): a user's code
+    described by a process of its own, asked about ``scenes`` (:mod:`comparisons.engines.probe`): a user's code
     never runs in this process, so one that crashes or hangs there cannot take simparity down."""
     from simparity.comparisons.engines.probe import probe_engines  # it starts processes: only when asked
 

@@ -1,6 +1,6 @@
 """A worker process: runs the case groups it is sent, one case at a time, and reports each as it goes.
 
-Started by :mod:`comparisons.isolation` as ``python -m simparity.comparisons.execute.case_worker IN_FD OUT_FD``:
+Started by :mod:`comparisons.execute.isolation` as ``python -m simparity.comparisons.execute.case_worker IN_FD OUT_FD``:
 it reads ``(group, skip, reference_failure)`` messages from IN_FD and writes ``("start", index, pid)``
 (index None: the group's shared part; pid: the process running it), ``("done", index, outcome)``,
 ``("crashed", code, first index)`` (the child running an engine's cases died: its exit code, negative

@@ -69,13 +69,13 @@ class CaseGroup:
     cases : tuple of CaseSpec
     engines : tuple of (str, str)
         (name, spec) of every engine of the run, in order (an IK group's judges); a worker builds an
-        engine from its spec (``comparisons.engines.make_engine``), a reference from its name.
+        engine from its spec (``comparisons.engines.registry.make_engine``), a reference from its name.
     repeats : int
         Timed repeats per case.
     reference_label : str
         The reference named in the rows (``engine:integrator``).
     stand_ins : tuple of StandInEngine
-        The run's engines that cannot run (:mod:`comparisons.placeholder_engines`): a worker uses them as they
+        The run's engines that cannot run (:mod:`comparisons.engines.placeholders`): a worker uses them as they
         are instead of building the engine again.
     """
 

@@ -1,7 +1,7 @@
 """Running case groups on a Dask distributed cluster (``simparity run --executor dask``).
 
 Each group is one Dask task. On the Dask worker the task runs its group in an
-:class:`~comparisons.isolation.IsolatedPool` of one worker process, kept for the worker's next
+:class:`~comparisons.execute.isolation.IsolatedPool` of one worker process, kept for the worker's next
 tasks, so a case that crashes, hangs or exhausts memory fails alone there exactly as it does
 locally, and the Dask worker lives on. Without a scheduler address a ``LocalCluster`` is started on
 the loopback interface with one single-threaded worker process per job. Without --case-memory, each case's

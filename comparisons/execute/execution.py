@@ -1,9 +1,9 @@
 """Running a run's scenes: planned into case groups, executed anywhere, handed back scene by scene in order.
 
-Every scene is planned into groups of cases (:mod:`comparisons.cases`); cases already in the run's
-:class:`~comparisons.journal.Journal` (a resumed run) are taken from it, the others go to an
-executor — local worker processes (:class:`~comparisons.isolation.IsolatedPool`) or a Dask cluster
-(:mod:`comparisons.dask_executor`) — costliest group first (as :mod:`comparisons.execute.estimate` models them).
+Every scene is planned into groups of cases (:mod:`comparisons.execute.cases`); cases already in the run's
+:class:`~comparisons.execute.journal.Journal` (a resumed run) are taken from it, the others go to an
+executor — local worker processes (:class:`~comparisons.execute.isolation.IsolatedPool`) or a Dask cluster
+(:mod:`comparisons.execute.dask_executor`) — costliest group first (as :mod:`comparisons.execute.estimate` models them).
 Each case is journaled as it finishes; a scene's rows come back as soon as it and every scene before it are
 complete, so the stored run keeps the suite's order whatever finished first, and is the same whatever executed it. A
 scene's outcomes are let go once its rows are handed back, so the caller holds the cases of the scenes still

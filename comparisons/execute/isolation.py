@@ -1,6 +1,6 @@
 """Worker processes that run case groups with a time and a memory limit per case.
 
-Each worker is a fresh Python process (:mod:`comparisons.case_worker`) speaking over two pipes. The
+Each worker is a fresh Python process (:mod:`comparisons.execute.case_worker`) speaking over two pipes. The
 pool hands a worker one group at a time and watches it: a worker that dies (a segfault in an engine,
 ``os._exit``), goes past the per-case time limit or past the per-case memory limit (resident memory,
 read from /proc) is killed and replaced; the case it was running becomes ``failed`` rows naming the
@@ -79,7 +79,7 @@ def physical_memory_bytes() -> int:
 @dataclass(frozen=True)
 class CaseLimits:
     """What one case may take: wall time [s] and resident memory of its worker [bytes]; None: the default of the
-    machine that runs it, resolved there (a Dask node's, :func:`comparisons.dask_executor.node_memory_bytes`)."""
+    machine that runs it, resolved there (a Dask node's, :func:`comparisons.execute.dask_executor.node_memory_bytes`)."""
 
     seconds: float
     memory_bytes: int | None

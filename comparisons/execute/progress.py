@@ -20,7 +20,7 @@ _WIDTH = 24
 class ProgressBar:
     """Counts cases as they finish and draws the bar on ``stream`` when it is a terminal.
 
-    ``total`` is the number of cases the run will count (``comparisons.runner.count_cases``); ``estimate``, what they
+    ``total`` is the number of cases the run will count (``comparisons.execute.execution.count_cases``); ``estimate``, what they
     are modelled to cost (None: every case alike). A case it does not know of (one restored by ``--resume``) counts
     at the mean cost.
     """

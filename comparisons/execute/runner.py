@@ -4,7 +4,7 @@ Every scene x engine x integrator x dt gets one row per metric: ``ok`` with a va
 ``n/a`` / ``failed`` / ``diverged`` with the reason in ``detail``. An engine that raises
 becomes ``failed`` rows; the run goes on.
 
-A scene is planned into groups of cases (:mod:`comparisons.cases`); :func:`run_group` runs one
+A scene is planned into groups of cases (:mod:`comparisons.execute.cases`); :func:`run_group` runs one
 group wherever it is sent (this process, a worker process, a Dask worker), yielding each case's
 outcome as it finishes; :func:`assemble_scene` puts a scene's outcomes together in its stored
 order, with the observed orders of convergence and the IK agreement matrix
@@ -273,7 +273,7 @@ def _prepare_nothing(group: CaseGroup, engine_for: EngineFor, reference_failure:
 
 
 def _stability_case_at(group: CaseGroup, shared: None, index: int, engine_for: EngineFor) -> CaseOutcome:
-    """The measured stability limit of one penalty-method integrator (:mod:`comparisons.stability`)."""
+    """The measured stability limit of one penalty-method integrator (:mod:`comparisons.measure.stability`)."""
     scene, spec = group.dynamics_scene, group.cases[index]
     engine = engine_for(spec.engine)
     case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label,

@@ -34,7 +34,6 @@ from simparity.core.model.results import (ALARM_FLAGS, DIMENSIONLESS, FAILED, NO
                                           reference_label)
 
 CASE_KEYS = ("scene", "engine", "integrator", "dt")
-ROW_KEYS = CASE_KEYS + ("metric",)
 
 UNBOUNDED_SHARE_MAX = 0.10
 """Share of a run's measured series (scene x engine x integrator or solver) that may have no bound on any

@@ -2,7 +2,7 @@
 
 An engine that compares a dimensioned quantity with a fixed number (a solver tolerance, a contact threshold, a
 float32 representation) cannot give the same results in every frame and system of units. Those found by
-``comparisons.metamorphic`` on the built-in engines are listed here, each with the part of a transform that
+``comparisons.invariance.metamorphic`` on the built-in engines are listed here, each with the part of a transform that
 exposes it and where it lives, so an invariance row that breaks names the cause instead of leaving a user to
 find it. Measured on the built-in scenes; docs/invariance.md has the numbers.
 """

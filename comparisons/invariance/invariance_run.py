@@ -1,9 +1,9 @@
 """``simparity run --transform NAME[,NAME]``: a run's invariance rows, computed on the run's own executor.
 
 After a run's scenes are done, each is run again under the named fixed transforms
-(:data:`comparisons.transforms.FIXED_TRANSFORMS`), and, where the comparison needs them, under one-ulp
+(:data:`comparisons.invariance.transforms.FIXED_TRANSFORMS`), and, where the comparison needs them, under one-ulp
 perturbations, on the same engines, workers, limits and journal (so ``--resume`` keeps what finished); the
-comparison (:mod:`comparisons.metamorphic`) gives each scene x engine x integrator x dt its invariance rows,
+comparison (:mod:`comparisons.invariance.metamorphic`) gives each scene x engine x integrator x dt its invariance rows,
 which join the run's results, report and ``--check``. Transformed runs are timed once: their times are not
 compared.
 """

@@ -1,14 +1,14 @@
 """Metamorphic invariance: a scene and its transformed version must give the same results.
 
 Physics does not change when a scene is translated, rotated with its gravity, its bodies listed in another
-order or its units rescaled (:mod:`comparisons.transforms`); neither may any result or verdict of an engine,
+order or its units rescaled (:mod:`comparisons.invariance.transforms`); neither may any result or verdict of an engine,
 nor of simparity's own metrics. :func:`check_invariance` runs each scene and its transformed versions on the
 same engines, carries every value of the transformed run back into the scene's own units (from its unit
 string: m -> / L, m/s -> / (L/T), ...) and its time steps back (dt' / T), and compares row by row (timing rows
 ``time_per_*`` left out):
 
 - the statuses must be equal. A status change is accepted only where rounding explains it: a one-ulp
-  perturbation (:mod:`comparisons.perturb`: the initial state or the chain's geometry, and the units, each one
+  perturbation (:mod:`comparisons.invariance.perturb`: the initial state or the chain's geometry, and the units, each one
   ulp off) of the scene turns that row to the transformed run's status, or one of the transformed scene turns
   it back (the value sits within its spread of the threshold); or one side is ``n/a`` at the rounding floor
   (flag ``rounding-floor``: the value is rounding in that frame); or it is an observed order fitted over an
@@ -17,7 +17,7 @@ string: m -> / L, m/s -> / (L/T), ...) and its time steps back (dt' / T), and co
 - ok values must agree within the largest of :data:`SPREAD_FACTOR` x the row's ulp spread (how far the value
   moves over :data:`ULP_SEEDS` one-ulp perturbations of the untransformed scene: what chaos, a settling
   contact or a singular pose make of rounding), :data:`ROUNDING_RTOL` x the value, and the rounding allowance
-  of the row's unit in either frame (:mod:`comparisons.rounding_allowance`: rounding alone, 2 km from the
+  of the row's unit in either frame (:mod:`comparisons.invariance.rounding_allowance`: rounding alone, 2 km from the
   origin 2000 x what it is at 1 m; for chains also the coarsest forward kinematics of the engines run,
   PyBullet's float32 link states). An observed order is a fit of log errors over the time steps: its
   allowance is what its errors' allowances allow the fit's slope. The perturbed runs are made only for scenes
@@ -31,7 +31,7 @@ that reason: there is nothing to measure the transformed engines against.
 transform: ``invariance_ratio_<transform>``, the largest |difference| / allowed over the case's metrics (<= 1:
 invariant), and ``invariance_status_changes_<transform>``, the status changes rounding does not explain; each
 detail names the transform, the worst metric with both values, the changes, and an engine's known absolute
-constant (:mod:`comparisons.engine_constants`) when the transform scales its dimension. An engine that
+constant (:mod:`comparisons.invariance.engine_constants`) when the transform scales its dimension. An engine that
 hard-codes z-up gravity or the world origin is caught by them without any reference.
 """
 

@@ -2,7 +2,7 @@
 
 A result that moves when a scene moves by one unit in the last place (ulp) carries that much rounding noise:
 a chaotic motion (the Dzhanibekov flip), a contact that settles in a soft or penalty contact, an IK solve near
-a singular pose amplify it, a closed form does not. ``comparisons.metamorphic`` takes this spread as the bound
+a singular pose amplify it, a closed form does not. ``comparisons.invariance.metamorphic`` takes this spread as the bound
 within which a transformed scene's result may differ, and a verdict that flips under it as sitting on its
 threshold.
 

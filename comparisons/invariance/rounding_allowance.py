@@ -5,7 +5,7 @@ noise: another frame or another system of units rounds every operation different
 sample of that noise, while the initial state perturbed by one ulp does not (adding the same increments to
 a shifted value rounds the same way: a projectile's velocity error is bit-identical under a one-ulp change
 of its initial state, and six times larger in a rotated frame, both far below its rounding floor). Such
-values are compared within the floor the metrics define (``comparisons.metrics.rounding_floors``: 2 eps x
+values are compared within the floor the metrics define (``comparisons.measure.metrics.rounding_floors``: 2 eps x
 (N + kappa) x the state's scale, N rounded steps, kappa the inertia's condition number), taken here from
 the scene's data alone, as upper bounds of its state's scale:
 
@@ -19,7 +19,7 @@ the scene's data alone, as upper bounds of its state's scale:
   effector (its reach bound), N its joints (kinematics) or the solver's iterations (IK); its joint-space dynamics
   (every metric a ratio): N its joints, times X over the chain's own extent (X less its first joint's distance).
 
-A metric of dimension L^a M^b T^c (``comparisons.units``) then has the allowance FACTOR x eps x (N + kappa) x
+A metric of dimension L^a M^b T^c (``comparisons.invariance.units``) then has the allowance FACTOR x eps x (N + kappa) x
 its scale: m -> X, m/s -> V, rad/s -> Omega, rad and 1 (both dimensionless) -> 1 + T Omega, s -> T, others
 X^a M^b T^c (M the heaviest body). Counts (impacts missed, iterations, solve rates) are integers or fractions
 of integers: rounding moves them only across a threshold, which the ulp spread and the status rules judge.

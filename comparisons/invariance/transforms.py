@@ -8,7 +8,7 @@ an angular velocity R omega / T, a body's inertia tensor M L^2 I (body axes do n
 the body's orientation does, q' = q_R q), a drag coefficient of N s/m becomes (M / T) b, a contact
 stiffness (M / T^2) k, the rest speed (L / T) v_rest, a time step T dt. Physics says the transformed scene
 moves exactly as the transformed original, so every result, carried back into the scene's own units
-(:meth:`Transform.to_scene_units`), must be the same up to rounding: ``comparisons.metamorphic`` checks it.
+(:meth:`Transform.to_scene_units`), must be the same up to rounding: ``comparisons.invariance.metamorphic`` checks it.
 
 What a kind of scene can express:
 
@@ -20,7 +20,7 @@ What a kind of scene can express:
   as it is. A chain read from a URDF file is loaded from that file by every engine, so neither its base
   nor its lengths can be changed in the scene: :class:`~simparity.core.model.errors.TransformError`.
 
-Rotations are SciPy's (:mod:`references.conventions`), never core's. The numbers a file gave, which the references
+Rotations are SciPy's (:mod:`references.common.conventions`), never core's. The numbers a file gave, which the references
 derive their quantities from (:mod:`references.common.scene_inputs`), are transformed with the rest: a point-mass
 body's points are scaled and the frame they were given in placed; the first joint's roll-pitch-yaw becomes that of
 R times its rotation (as a file in the transformed frame would write it); a DH table's lengths are scaled and its

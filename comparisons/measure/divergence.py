@@ -15,7 +15,7 @@ A run is diverged when, for some body,
   is; contact only takes energy away, so this holds with contact too) or |L| (not with contact).
 
 Speeds are compared with :data:`DIVERGENCE_MARGIN` times their bound. Energies come from
-:mod:`comparisons.metrics`, rotations from SciPy; nothing here is in-house code.
+:mod:`comparisons.measure.metrics`, rotations from SciPy; nothing here is in-house code.
 """
 
 from __future__ import annotations
@@ -121,7 +121,7 @@ def divergence_of(scene: DynamicsScene, run: RunExtents) -> str:
 def blow_up(scene: DynamicsScene, traj: Trajectory) -> tuple[str, ContactReading | None]:
     """(why ``traj`` counts as diverged, "" if it does not; its contact reading, None without contact or when
     it blew up before one was taken). Non-finite, :func:`divergence`, or with contact energy gained across
-    one beyond :data:`comparisons.contact_metrics.UNSTABLE_ENERGY_GAIN`."""
+    one beyond :data:`comparisons.measure.contact_metrics.UNSTABLE_ENERGY_GAIN`."""
     blown = blow_up_of(scene, RunExtents.of(scene, traj))
     if blown or scene.contact is None:
         return blown, None

@@ -4,7 +4,7 @@ observed orders of convergence. Definitions with their reasons: ``docs/metrics.m
 Each function returns ``{metric: Measured}``. Errors are maxima over every body, sample and
 frame; "final" is at the last sample. A value that cannot mean anything (saturated, at the
 rounding floor, nothing to compare against) is returned unmeasurable with the reason, and
-becomes an ``n/a`` row. Rotations are SciPy's (:mod:`references.conventions`), never the
+becomes an ``n/a`` row. Rotations are SciPy's (:mod:`references.common.conventions`), never the
 in-house code these metrics judge.
 """
 
@@ -107,7 +107,7 @@ the gate to judge): half the gap between neighbouring integer orders."""
 
 SATURATED_DRIFT = 1.0
 """A relative drift above 100 % of its scale says the quantity has nothing left in common with its start,
-not how far it is off: n/a. (Growth that large is divergence: see comparisons.divergence.)"""
+not how far it is off: n/a. (Growth that large is divergence: see comparisons.measure.divergence.)"""
 
 ROUNDING_FLOOR_FACTOR = 2.0
 """The rounding floor of an error after N steps is this x eps x (N + kappa) x the state's scale:
@@ -315,7 +315,7 @@ def _relative_drift(change_max: np.ndarray, scale: np.ndarray, quantity: str) ->
 
 
 def energy_scale(scene: DynamicsScene, energy: EnergyExtents) -> np.ndarray:
-    """(B,) [J] what a body's energy drift is relative to (:func:`comparisons.body_scales.energy_scales`)."""
+    """(B,) [J] what a body's energy drift is relative to (:func:`comparisons.measure.body_scales.energy_scales`)."""
     return energy_scales(scene, energy.kinetic0, energy.potential0, energy.potential_min)
 
 
@@ -328,7 +328,7 @@ def drifts_of(scene: DynamicsScene, run: RunExtents) -> dict[str, Measured]:
     """Relative drifts of what the scene conserves (:func:`dynamics_metrics`), the worst body's:
 
     - ``energy_drift_max`` = max_t |E(t) - E(0)| / the body's energy scale
-      (:func:`comparisons.body_scales.energy_scales`: |E(0)| without gravity; with gravity not |E(0)|, which
+      (:func:`comparisons.measure.body_scales.energy_scales`: |E(0)| without gravity; with gravity not |E(0)|, which
       depends on where the origin is, but the kinetic energy the body has to trade);
     - ``angular_momentum_drift_max`` = max_t |L(t) - L(0)| / |L(0)|, L about the COM.
     """

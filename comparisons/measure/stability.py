@@ -5,9 +5,9 @@ step of order 1 / omega, omega = sqrt(k_s / m), by a factor that depends on the 
 Euler 2, RK4 about 2.8 for an undamped spring; explicit Euler never without damping). The limit is
 measured, not quoted: the scene is run at trial steps and a run counts as **unstable** when it
 
-- blows up (non-finite state, or :func:`comparisons.divergence.divergence`),
+- blows up (non-finite state, or :func:`comparisons.measure.divergence.divergence`),
 - gains energy: kinetic plus potential rises across a contact by more than
-  :data:`comparisons.contact_metrics.UNSTABLE_ENERGY_GAIN` of its largest kinetic energy (contact only
+  :data:`comparisons.measure.contact_metrics.UNSTABLE_ENERGY_GAIN` of its largest kinetic energy (contact only
   takes energy away; the runner marks such a case diverged too).
 
 (A plane is a half-space: a spring that is integrated stably always pushes a body back out, so a

@@ -1,6 +1,6 @@
 """What a scene may ask for: the resource limits a run is refused beyond, checked on loading
 (before anything runs) with the cost in the message. The physical range of every number is in
-:mod:`core.ranges`, the names a scene may give in :mod:`core.names`; all are listed in
+:mod:`core.model.ranges`, the names a scene may give in :mod:`core.model.names`; all are listed in
 ``docs/scenes.md``.
 """
 

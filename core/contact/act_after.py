@@ -2,8 +2,8 @@
 
 Every body flies the whole step (RK4, quaternion orientation). Then, where a contact point has
 E <= 0, the body is translated back along N by the penetration depth and the impulse of
-:func:`core.contact.impulse_response` is applied at the deepest touching point moving into the plane
-(at the centre of the patch of points touching with it, :func:`core.contact.patch_lever`): for a
+:func:`core.contact.bodies.impulse_response` is applied at the deepest touching point moving into the plane
+(at the centre of the patch of points touching with it, :func:`core.contact.bodies.patch_lever`): for a
 particle exactly v - (1 + k)(v . N) N, the tangential part by Coulomb friction. A few Gauss-Seidel
 passes repeat this for the points still moving in, so that a box landing flat does not tip and a body
 in a corner leaves both planes.

@@ -2,20 +2,20 @@
 
 Each step of each body is cut at its contact events. From the start of a sub-step the body flies
 freely (RK4, quaternion orientation: exact for translation under constant gravity) and the first
-instant a contact point reaches a plane is found (:mod:`core.contact_roots`): exactly for a body whose
+instant a contact point reaches a plane is found (:mod:`core.contact.roots`): exactly for a body whose
 contact points move on parabolas (a point or a sphere, or a body that does not turn, under gravity
 alone), else by a bracketed root finder along the free flight, vectorised over bodies with per-body
 sub-steps, which also catches a corner dipping in and out within one step.
 
-The body is advanced to that instant and responds (:func:`core.contact.impulse_response` at the patch
-of touching points, :func:`core.contact.patch_lever`), then flies the rest of the step; several events
+The body is advanced to that instant and responds (:func:`core.contact.bodies.impulse_response` at the patch
+of touching points, :func:`core.contact.bodies.patch_lever`), then flies the rest of the step; several events
 within one step are handled in time order, at most :data:`MAX_EVENTS_PER_STEP` per body (one exceeding
 it is put at rest). Each round works only on the bodies that still have time left.
 
 Slow contacts: where the rebound normal speed would be below ``rest_speed`` the impulse is plastic
 (friction included), and then
 
-- if the points touching the plane support the COM (:func:`core.contact.supported`: always for a point
+- if the points touching the plane support the COM (:func:`core.contact.bodies.supported`: always for a point
   or a sphere, a box lying on a face) the body rests on the plane: normal velocity and spin removed,
   lowest point on the plane. A resting body does not turn; the plane supports it (normal force -F.N)
   and Coulomb friction acts on it: sliding with slip direction s, a = (F_t - mu_k |F.N| s) / m, constant
@@ -23,7 +23,7 @@ Slow contacts: where the rebound normal speed would be below ``rest_speed`` the 
   sticks while |F_t| <= mu_s |F.N| (else slides along F_t). Exact for a block sliding on a level plane
   or along the line of steepest slope. It leaves the plane when F.N >= 0 or at an impact elsewhere;
 - otherwise (a box on an edge or a corner) the body pivots: it flies to the end of the step and its
-  contacts are resolved after the fact (:func:`core.contact_act_after.resolve_after`, plastic on that
+  contacts are resolved after the fact (:func:`core.contact.act_after.resolve_after`, plastic on that
   plane), a first-order treatment under which it topples.
 
 Known limits: the friction direction is frozen over a sub-step, so a slip not along F_t is stopped in
@@ -142,7 +142,7 @@ def _hold(model, state: State, resting: np.ndarray, stopped: np.ndarray) -> Stat
 
 def _settling_gap(bodies: Bodies, state: State, normal: np.ndarray, dt: float) -> np.ndarray:
     """RESTING_GAP + |a.N| dt^2 [m] (n,): how far from flat a slow body may settle
-    (:data:`core.contact.RESTING_GAP`)."""
+    (:data:`core.contact.bodies.RESTING_GAP`)."""
     rotation = state.rotation_world
     v, omega = velocities(state, bodies.props, rotation)
     force, _ = bodies.external(0.0, state.position_world, rotation, v, omega)
@@ -155,7 +155,7 @@ def _respond(bodies: Bodies, state: State, resting: np.ndarray, dt: float, clock
 
     A bounce (impulse with restitution k), or where the rebound would be slower than ``rest_speed`` a
     plastic impulse; then the body rests on the plane if that supports its COM, else it pivots about the
-    contact for the rest of the step (resolved after the fact, :func:`core.contact_act_after.resolve_after`).
+    contact for the rest of the step (resolved after the fact, :func:`core.contact.act_after.resolve_after`).
     """
     model, mass = bodies.model, bodies.props.mass
     lever, distance, speed = distances(bodies, state, resting)
@@ -196,7 +196,7 @@ class BackupStepper:
     """One step of the backup method: ``step(t, state, resting, dt, log) -> (state, resting)``.
 
     ``resting`` (B,) int is the plane each body rests on, :data:`FREE` if none; the step's events are
-    appended to ``log`` (:class:`core.contact.EventLog`).
+    appended to ``log`` (:class:`core.contact.bodies.EventLog`).
     """
 
     def __init__(self, bodies: Bodies) -> None:

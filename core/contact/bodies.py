@@ -2,7 +2,7 @@
 
 The lecture's "Bodies in Contact" for the full rigid-body state S = (x, R, P, L), batched over
 B bodies and P planes (bodies never touch each other). The three methods that use these pieces
-are :mod:`core.contact_backup` (back up time), :mod:`core.contact_act_after` (respond after the
+are :mod:`core.contact.backup` (back up time), :mod:`core.contact.act_after` (respond after the
 fact) and the penalty force of :func:`penalty_wrench` integrated by any of core's schemes.
 
 Contact points: a body's shape vertices (:meth:`Shape.vertices_body`) rotated and translated;
@@ -187,7 +187,7 @@ class Bodies:
 
     @cached_property
     def external(self) -> Wrench:
-        """The scene's forces on these bodies (:func:`core.forces.make_wrench`), built once per batch."""
+        """The scene's forces on these bodies (:func:`core.dynamics.forces.make_wrench`), built once per batch."""
         return make_wrench(self.forces, self.props)
 
     def take(self, idx: np.ndarray) -> "Bodies":
@@ -361,7 +361,7 @@ def impulse_response(
 def penalty_wrench(model: ContactModel, props: MassProperties, external: Wrench) -> Wrench:
     """The external wrench plus the penalty contact force of every penetrating point.
 
-    At each point with E < 0: F_n = (-k_s E - k_d u.N)^+ N (:func:`core.collision.penalty_force`)
+    At each point with E < 0: F_n = (-k_s E - k_d u.N)^+ N (:func:`core.contact.particle.penalty_force`)
     and regularised Coulomb friction -mu_k |F_n| u_t / max(|u_t|, v_reg)
     (:data:`FRICTION_REGULARISATION_SPEED`); torque r x F about the COM. Returns
     f(t, x, R, v, omega) -> (force (B, 3) [N], torque (B, 3) [N m]).

@@ -117,7 +117,7 @@ def time_of_impact(start_world: np.ndarray, end_world: np.ndarray, plane: Plane)
 def entry_time(e0: np.ndarray, normal_speed: np.ndarray, half_normal_gravity, dt):
     """First root s in [0, dt] where E(s) = e0 + u s + a s^2 crosses zero going in (E' <= 0).
 
-    Shared with the rigid-body backup method (:mod:`core.contact_backup`), whose bodies that do not
+    Shared with the rigid-body backup method (:mod:`core.contact.backup`), whose bodies that do not
     turn move their contact points on such parabolas. Arguments broadcast against each other.
 
     Of the two roots (-u -+ sqrt(u^2 - 4 a e0)) / (2 a), the entering one is always the

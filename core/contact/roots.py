@@ -1,10 +1,10 @@
 """When a body first reaches a plane within a step: the contact search of the backup method.
 
 Two searches over n bodies with per-body horizons, each on a free flight ``flight(t, state, duration)``
-(with ``.bodies``, ``.wrench`` and ``.take(idx)``, :class:`core.contact_backup._Flight`):
+(with ``.bodies``, ``.wrench`` and ``.take(idx)``, :class:`core.contact.backup._Flight`):
 
 - :func:`exact_contact`: the entering root of E(s) = E0 + (u.N) s + (a.N) s^2 / 2
-  (:func:`core.collision.entry_time`), exact for a body whose contact points move with its COM under a
+  (:func:`core.contact.particle.entry_time`), exact for a body whose contact points move with its COM under a
   constant force (a point, a sphere, a body that does not turn);
 - :func:`root_contact`: a bracketed root finder on f(s) = min over points of E + delta
   (:data:`ROOT_OFFSET_RTOL` of the body's size) along the flight. The bracket ends at the end of the horizon

@@ -24,7 +24,7 @@ expmap
     scheme's order.
 
 The quaternion updates and engine_euler are implemented on a component-major packed state in
-:mod:`core.quaternion_integrators` (the speed path); the matrix and expmap updates here.
+:mod:`core.dynamics.quaternion_integrators` (the speed path); the matrix and expmap updates here.
 """
 
 from __future__ import annotations
@@ -187,7 +187,7 @@ def make_step(scheme: str, orientation_update: str, props: MassProperties, wrenc
     """The step function of ``scheme`` with ``orientation_update`` (see module docstring).
 
     Quaternion updates and ``engine_euler`` run on the packed layout of
-    :mod:`core.quaternion_integrators`; matrix and exponential-map updates here.
+    :mod:`core.dynamics.quaternion_integrators`; matrix and exponential-map updates here.
     """
     if scheme not in SCHEMES:
         raise ValueError(f"unknown scheme '{scheme}' (known: {', '.join(SCHEMES)})")

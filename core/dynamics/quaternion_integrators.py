@@ -1,10 +1,10 @@
-"""The quaternion-orientation integrators of :mod:`core.integrators`, component-major for speed.
+"""The quaternion-orientation integrators of :mod:`core.dynamics.integrators`, component-major for speed.
 
 The state of B bodies is one (13, B) array, rows ``x (3) | q_wxyz (4) | P (3) | L (3)``: every
 row is a contiguous run of B floats, so each term of the lecture's dS/dt = (v, 1/2 (0, omega) q,
 F, tau) is a handful of element-wise operations over the batch instead of stacked 3 x 3 matrix
 products (4-10x faster at B >= 100; see BENCHMARKS.md). The mathematics is that of
-:mod:`core.integrators`:
+:mod:`core.dynamics.integrators`:
 
 - explicit Runge-Kutta (``explicit_euler``, ``average_velocity``, ``midpoint``, ``rk4``): additive
   quaternion stages, normalised after the step;
@@ -13,7 +13,7 @@ products (4-10x faster at B >= 100; see BENCHMARKS.md). The mathematics is that 
 - ``engine_euler``: linear and body-frame angular velocity first with the explicit gyroscopic term,
   then x += dt v and q <- q exp(dt omega_body) (the exponential map), sign fixed to w >= 0.
 
-The scene's wrench (:data:`core.rigid_body.Wrench`) is called with transposed views, so forces keep
+The scene's wrench (:data:`core.dynamics.rigid_body.Wrench`) is called with transposed views, so forces keep
 their (B, 3) interface.
 """
 
@@ -206,7 +206,7 @@ def _quat_exp_body(q: np.ndarray, rotvec_body: np.ndarray) -> np.ndarray:
 
 
 def engine_euler(bodies: PackedBodies, wrench: Wrench) -> PackedStep:
-    """The engines' first-order scheme (``engine_euler`` in :mod:`core.integrators`' docstring) on the packed
+    """The engines' first-order scheme (``engine_euler`` in :mod:`core.dynamics.integrators`' docstring) on the packed
     state."""
 
     def step(t: float, s: np.ndarray, dt: float | np.ndarray) -> np.ndarray:
@@ -240,7 +240,7 @@ def make_packed_step(scheme: str, props: MassProperties, wrench: Wrench) -> Pack
 
 
 def state_step(scheme: str, props: MassProperties, wrench: Wrench) -> Callable[[float, State, float], State]:
-    """The packed step behind the State interface of :data:`core.integrators.Step` (quaternion states)."""
+    """The packed step behind the State interface of :data:`core.dynamics.integrators.Step` (quaternion states)."""
     packed_step = make_packed_step(scheme, props, wrench)
 
     def step(t: float, s: State, dt: float) -> State:

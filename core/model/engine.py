@@ -71,9 +71,6 @@ TRUTH_SCHEMES = ("closed_form", "adaptive")
 """The kinds of scheme a truth is: a reference runs one where it has one, and no report ranks one beside the schemes
 it judges."""
 
-CONTACT_TREATMENTS = ("backup", "act_after", "penalty", "soft", "impulse")
-
-
 def is_scheme_label(label: str) -> bool:
     """Whether ``label`` is "" or kinds of :data:`SCHEME_KINDS` joined by ``+``."""
     return label == "" or all(part in SCHEME_KINDS for part in label.split("+"))

@@ -105,7 +105,7 @@ class HistoryError(SimparityError):
 
 
 class TransformError(SceneError):
-    """A metamorphic transform (``comparisons.transforms``) is invalid, or cannot be applied to a scene: the
+    """A metamorphic transform (``comparisons.invariance.transforms``) is invalid, or cannot be applied to a scene: the
     scene's data cannot express the transformed physics (file or ``<code>``, the transform's key, why)."""
 
 

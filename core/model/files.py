@@ -66,11 +66,6 @@ def read_input(path: str | os.PathLike, max_bytes: int = MAX_FILE_BYTES, what: s
     return data
 
 
-def is_regular_file(path: str | os.PathLike) -> bool:
-    """True for an existing regular file; False for anything else, including a path the OS rejects."""
-    return file_problem(path) is None
-
-
 _TOML_POSITION = re.compile(r"\(at line (\d+), column (\d+)\)")
 MAX_NESTING_HINT = "TOML nested at most a few hundred levels deep"
 _BOMS = {b"\xef\xbb\xbf": "UTF-8", b"\xff\xfe": "UTF-16", b"\xfe\xff": "UTF-16"}

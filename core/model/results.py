@@ -1,6 +1,6 @@
 """The results data model: one tidy row per scene x engine x integrator x dt x metric.
 
-The writer (``comparisons.store``) and the reader (``reports.store``) share these names,
+The writer (``comparisons.execute.store``) and the reader (``reports.store``) share these names,
 so a stored run means the same thing to both.
 """
 

@@ -1,6 +1,6 @@
 """Analytic ground truth behind the shared engine interface.
 
-Dynamics: closed forms from :mod:`references.analytic_solutions`, evaluated at the sample
+Dynamics: closed forms from :mod:`references.analytic.solutions`, evaluated at the sample
 times of the step being compared (the "integrator" is ``exact``). Translation and rotation
 decouple (no force here couples them), and each is solved per body:
 
@@ -11,7 +11,7 @@ decouple (no force here couples them), and each is solved per body:
   angular drag on an isotropic body.
 
 Anything else (applied forces, both drags at once, quadratic angular drag, ...) gets
-``n/a`` with the reason. Scenes with contact go to :mod:`references.analytic_contact`
+``n/a`` with the reason. Scenes with contact go to :mod:`references.analytic.contact`
 (translating bodies bouncing, resting and sliding on a plane, event by event).
 
 Kinematics: planar chains (revolute joints about z, origins in the xy plane): the end

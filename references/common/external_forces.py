@@ -1,6 +1,6 @@
 """Forces that no engine models natively, computed by the references themselves.
 
-Written independently of ``core.forces`` (a reference must not borrow the code it checks):
+Written independently of ``core.dynamics.forces`` (a reference must not borrow the code it checks):
 a sign error in core's drag or torque then shows up as a disagreement with every engine.
 
 - Drag acts on the velocity relative to the air, u = v - w (w: wind, zero in still air):

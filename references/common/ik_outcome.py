@@ -1,7 +1,7 @@
 """The IK adapters' shared verdict: success, reason and limit violation from residuals.
 
-Every library IK adapter (:mod:`references.pybullet_ik`, :mod:`references.pinocchio_ik`,
-:mod:`references.mujoco_ik`) judges its solutions the same way, whatever the library's
+Every library IK adapter (:mod:`references.pybullet.ik`, :mod:`references.pinocchio.ik`,
+:mod:`references.mujoco.ik`) judges its solutions the same way, whatever the library's
 own stopping rule was:
 
 - success: position residual <= ``options.position_tolerance`` [m] AND orientation

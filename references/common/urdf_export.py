@@ -8,7 +8,7 @@ What the engines are given, and why
 - A free body is one link whose ``<inertial>`` carries the scene's mass and inertia in
   PRINCIPAL axes (``origin rpy`` = the principal frame, off-diagonal terms zero): PyBullet
   keeps only a diagonal inertia and reports the base pose in this inertial frame, so the
-  adapters convert with the same rotation (:func:`references.conventions.principal_axes`).
+  adapters convert with the same rotation (:func:`references.common.conventions.principal_axes`).
   No ``<collision>`` or ``<visual>``: nothing collides. In a scene with contact, PyBullet's
   body gets its contact spheres as ``<collision>`` elements (``spheres``, centres in the body
   frame, which is the link frame); loaded with ``URDF_USE_INERTIA_FROM_FILE`` they add no mass.

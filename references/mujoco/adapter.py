@@ -16,7 +16,7 @@ Conversions (each pinned by a test in ``tests/references/mujoco/test_adapter.py`
   implicit, by design). Wind adds the constant force b w, passed to rollout as
   ``xfrc_applied``. A force at a body point is applied at the point's WORLD position with
   ``mj_applyFT`` (MuJoCo computes its torque). Quadratic drags, which MuJoCo does not
-  model, come from :mod:`references.external_forces` (independent of core) as
+  model, come from :mod:`references.common.external_forces` (independent of core) as
   ``xfrc_applied``. Both are set from the state at the start of each step (positions
   updated by ``mj_kinematics`` and ``mj_comPos`` first) and held over the step by an
   ``mj_step`` loop; its RK4 then sees them as constant within a step.
@@ -26,14 +26,14 @@ Conversions (each pinned by a test in ``tests/references/mujoco/test_adapter.py`
   run and raises ``DivergedError`` with MuJoCo's message instead (captured, not printed).
 - Kinematics: ``mj_kinematics`` then ``mj_comPos`` before ``mj_jacSite`` (the Jacobian is
   silently zero without ``mj_comPos``). A chain read from a URDF file is that file without
-  its visual and collision geometry (:func:`references.urdf_export.chain_urdf`), compiled by
+  its visual and collision geometry (:func:`references.common.urdf_export.chain_urdf`), compiled by
   MuJoCo's own URDF importer with ``fusestatic`` off (by default MuJoCo merges fixed-joint
   links away, and the end effector may be one), ``boundmass`` / ``boundinertia`` so that a
   kinematics-only file without ``<inertial>`` compiles (masses play no part in
   kinematics), and a site added at the tip link; poses are re-expressed in the chain's base
-  link (:mod:`references.base_frame`). Other chains come from the adapter's MJCF.
-- Contact (a scene with ``contact``; model in :mod:`references.mjcf`, parameters and their
-  reasons in :mod:`references.contact_params`): planes and shapes as geoms, one explicit
+  link (:mod:`references.common.base_frame`). Other chains come from the adapter's MJCF.
+- Contact (a scene with ``contact``; model in :mod:`references.mujoco.mjcf`, parameters and their
+  reasons in :mod:`references.common.contact_params`): planes and shapes as geoms, one explicit
   contact pair per body geom and plane with that pair's material, elliptic cone. What MuJoCo
   cannot give the scene: a restitution coefficient (a damped contact spring whose damping
   ratio is derived from k; the restitution it produces is measured, not assumed), static
@@ -344,7 +344,7 @@ class MujocoChain(KinematicsModel):
 
 @derives_own_inputs
 class MujocoEngine(Engine):
-    """MuJoCo, built from MJCF the adapter writes (see :mod:`references.mjcf`) or from a chain's URDF file."""
+    """MuJoCo, built from MJCF the adapter writes (see :mod:`references.mujoco.mjcf`) or from a chain's URDF file."""
 
     name = "mujoco"
 

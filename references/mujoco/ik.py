@@ -18,9 +18,9 @@ scene's (position residual <= ``options.position_tolerance`` and angle <=
 
 Conventions and what the adapter does (pinned in ``tests/references/mujoco/test_ik.py``)
 ---------------------------------------------------------------------------
-- The model is the chain's (:class:`references.mujoco_adapter.MujocoChain`: its URDF file
+- The model is the chain's (:class:`references.mujoco.adapter.MujocoChain`: its URDF file
   without geometry, or the MJCF export); the end effector is its site. Targets are given
-  in the chain's base frame and moved into MuJoCo's world (:mod:`references.base_frame`);
+  in the chain's base frame and moved into MuJoCo's world (:mod:`references.common.base_frame`);
   residuals are distances, the same in either frame.
 - ``mj_kinematics`` then ``mj_comPos`` before ``mj_jacSite`` (the Jacobian is silently
   zero without ``mj_comPos``); dm_control calls ``mj_fwdPosition``, which does both.
@@ -30,7 +30,7 @@ Conventions and what the adapter does (pinned in ``tests/references/mujoco/test_
 - No joint limits (dm_control ignores them): ``limit_violation`` says how far outside
   the returned joint values are.
 - Residuals are MuJoCo's own (double): |err_pos| [m] and |err_rot| [rad] at the returned
-  qpos. A progress halt is reported as ``"iteration_cap"`` (see :mod:`references.ik_outcome`).
+  qpos. A progress halt is reported as ``"iteration_cap"`` (see :mod:`references.common.ik_outcome`).
 """
 
 from __future__ import annotations
@@ -65,7 +65,7 @@ class MujocoIK(IKModel):
     Parameters
     ----------
     kinematics : MujocoChain
-        The chain's MuJoCo model (``references.mujoco_adapter``).
+        The chain's MuJoCo model (``references.mujoco.adapter``).
     chain : Chain
     solver : str
         ``"dls"``.

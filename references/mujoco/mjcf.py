@@ -9,7 +9,7 @@ What MuJoCo is given, and why
 - Every free body gets an explicit ``<inertial>`` with ``fullinertia`` from the scene (no
   inertia from geoms). A scene without contact has no geom at all and contact disabled.
 - A scene with contact (:func:`contact_elements`, parameters from
-  :mod:`references.contact_params`): ``inertiafromgeom="false"`` (geoms carry no mass: the
+  :mod:`references.common.contact_params`): ``inertiafromgeom="false"`` (geoms carry no mass: the
   scene's inertia stays exactly the ``<inertial>``), a ``plane`` geom per plane (its frame's z
   axis along N, origin -d N), the body's shape as geoms (sphere; box of the half extents at
   its centre; a sphere of ``POINT_RADIUS`` per point), every geom with ``contype`` =

@@ -19,13 +19,13 @@ Conversions (each pinned by a test in ``tests/references/pinocchio/test_adapter.
 - Forces other than gravity (``model.gravity``) enter ``aba`` as ``fext``, as Pinocchio
   users give them: per joint a spatial force about the joint origin (the COM) in the LOCAL
   frame. A force f at a body point p is ``SE3(I, p).act(Force(R^T f, 0))`` (Pinocchio
-  computes its moment); drag and wind (:mod:`references.external_forces`, independent of
+  computes its moment); drag and wind (:mod:`references.common.external_forces`, independent of
   core) are (R^T F, R^T tau) at the COM.
-- Chains: the chain's URDF text (:func:`references.urdf_export.chain_urdf`: a URDF file
+- Chains: the chain's URDF text (:func:`references.common.urdf_export.chain_urdf`: a URDF file
   without its visual and collision geometry, or the adapter's export) read by
   ``buildModelFromXML``; fixed base. A ``continuous`` joint has nq = 2 (cos, sin). Joint
   frames are the child links' frames; Jacobians are LOCAL_WORLD_ALIGNED; poses are
-  re-expressed in the chain's base link (:mod:`references.base_frame`).
+  re-expressed in the chain's base link (:mod:`references.common.base_frame`).
 - Contact: a scene with contact is n/a (:data:`NO_CONTACT`). Pinocchio 4.1 has the pieces of ONE
   contact problem (``PointContactConstraintModel`` with a ``CoulombFrictionCone``, Delassus
   operators, ``PGSConstraintSolver`` / ``ADMMConstraintSolver`` for a single conic problem,

@@ -15,10 +15,10 @@ I)^-1 err.
 
 Conventions and what the adapter does (pinned in ``tests/references/pinocchio/test_ik.py``)
 -------------------------------------------------------------------------------
-- The model is the chain's (:class:`references.pinocchio_adapter.PinocchioChain`: its
+- The model is the chain's (:class:`references.pinocchio.adapter.PinocchioChain`: its
   URDF file without geometry, or the export, read by ``buildModelFromXML``; fixed base);
   the end effector is the BODY frame named after it. Targets are given in the chain's
-  base frame and moved into Pinocchio's world (:mod:`references.base_frame`).
+  base frame and moved into Pinocchio's world (:mod:`references.common.base_frame`).
 - A ``continuous`` (unlimited revolute) joint has nq = 2, (cos, sin): the start angle is
   converted in, the result converted back with atan2 (in (-pi, pi]). ``integrate``
   keeps (cos, sin) on the unit circle; nothing else is normalised.
@@ -72,7 +72,7 @@ class PinocchioIK(IKModel):
     Parameters
     ----------
     kinematics : PinocchioChain
-        The chain's Pinocchio model (``references.pinocchio_adapter``).
+        The chain's Pinocchio model (``references.pinocchio.adapter``).
     chain : Chain
     solver : str
         One of :data:`SOLVERS`.

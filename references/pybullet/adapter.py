@@ -15,11 +15,11 @@ Conversions and overridden defaults (each pinned by a test in ``tests/references
 - ``maxJointVelocity`` (Bullet clamps velocities at 100 rad/s by default) is raised to 1e9,
   far above any scene's; a run that still reaches it has blown up and raises DivergedError.
 - A chain read from a URDF file is loaded from that file without its visual and collision
-  geometry (:func:`references.urdf_export.chain_urdf`; ``useFixedBase``), so PyBullet opens
-  no mesh; poses are re-expressed in the chain's base link (:mod:`references.base_frame`;
+  geometry (:func:`references.common.urdf_export.chain_urdf`; ``useFixedBase``), so PyBullet opens
+  no mesh; poses are re-expressed in the chain's base link (:mod:`references.common.base_frame`;
   the base link's pose comes from ``getLinkState``, float32, when it is not the root).
   Other chains from the adapter's URDF. What PyBullet prints while loading is kept off the
-  console (:mod:`references.quiet`).
+  console (:mod:`references.common.quiet`).
 - ``getLinkState`` positions and orientations are FLOAT32 (errors ~1e-7); the Jacobian
   from ``calculateJacobian`` is double.
 - PyBullet has one integrator (semi-implicit Euler, velocity then position); time step = dt,
@@ -28,11 +28,11 @@ Conversions and overridden defaults (each pinned by a test in ``tests/references
   users apply them: a force at a body point with ``applyExternalForce`` at the point's
   WORLD position (the base pose's ``getMatrixFromQuaternion``, double; PyBullet's
   ``multiplyTransforms`` would round it to float32; PyBullet computes the torque);
-  drag and wind (:mod:`references.external_forces`, independent of core) as a world-frame
+  drag and wind (:mod:`references.common.external_forces`, independent of core) as a world-frame
   force at the COM and a world-frame torque (``applyExternalTorque``). All with
   WORLD_FRAME (in 3.2.7 both honour the flag, which bullet3 #1949 once had swapped for the
   base); PyBullet clears them after every step.
-- Contact (a scene with ``contact``; shared parameters in :mod:`references.contact_params`):
+- Contact (a scene with ``contact``; shared parameters in :mod:`references.common.contact_params`):
   every plane is a static multibody with a ``GEOM_PLANE`` shape of normal N placed at -d N;
   every body keeps its URDF inertia (``URDF_USE_INERTIA_FROM_FILE``) and gets collision
   spheres: a sphere of radius r + POINT_RADIUS, a point (each of "points", each box corner)

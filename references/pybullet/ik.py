@@ -20,9 +20,9 @@ reported upstream as bullet3 #2210 (:data:`NULLSPACE_LIMITATION`, in the rows' d
 
 Conventions and what the adapter does (pinned in ``tests/references/pybullet/test_ik.py``)
 -----------------------------------------------------------------------------
-- The chain is the URDF of :func:`references.urdf_export.chain_urdf`, loaded with a fixed
-  base (:class:`references.pybullet_adapter.PybulletChain`). Targets are given in the
-  chain's base frame and moved into PyBullet's world (:mod:`references.base_frame`).
+- The chain is the URDF of :func:`references.common.urdf_export.chain_urdf`, loaded with a fixed
+  base (:class:`references.pybullet.adapter.PybulletChain`). Targets are given in the
+  chain's base frame and moved into PyBullet's world (:mod:`references.common.base_frame`).
 - PyBullet's target POSITION is the URDF link frame's origin of the end-effector link, but
   its target ORIENTATION is that of the link's INERTIAL frame, which PyBullet rotates to
   principal axes when the URDF inertia has products of inertia (measured on the Panda's
@@ -38,7 +38,7 @@ Conventions and what the adapter does (pinned in ``tests/references/pybullet/tes
   so residuals below ~1e-7 m or ~3e-7 rad are rounding, and a 1e-6 tolerance is judged
   at float32 resolution.
 - PyBullet reports neither iterations (``iterations`` is -1) nor why it stopped (see
-  :mod:`references.ik_outcome` for the failure reasons); it does not clamp to the limits,
+  :mod:`references.common.ik_outcome` for the failure reasons); it does not clamp to the limits,
   and neither does the adapter (``limit_violation`` says how far outside they are).
 - Its own stopping rule (:class:`StoppingRule`, the ``solve_rate_own_stop`` row): the position
   residual within ``residualThreshold`` (:data:`DEFAULT_RESIDUAL_THRESHOLD` by default, the
@@ -101,7 +101,7 @@ class PybulletIK(IKModel):
     Parameters
     ----------
     kinematics : PybulletChain
-        The chain loaded in PyBullet (``references.pybullet_adapter``).
+        The chain loaded in PyBullet (``references.pybullet.adapter``).
     chain : Chain
     solver : str
         One of :data:`SOLVERS`.

@@ -2,7 +2,7 @@
 
 The C extension prints the banner through C's stdio (seen on stdout and on stderr depending
 on how the streams are attached), so it would land in ``simparity export ... > model.urdf``
-and in every log; :func:`references.quiet.captured_output` keeps it off. A failing import
+and in every log; :func:`references.common.quiet.captured_output` keeps it off. A failing import
 still raises as usual.
 """
 

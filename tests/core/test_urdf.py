@@ -213,8 +213,8 @@ def test_closed_loop_through_the_tip_is_rejected():
         chain_from_urdf(text, tip_link="c")
 
 
-# Numbers and names on the chain are held to the physical ranges (core.ranges) and the name rule
-# (core.names); off the chain only what the engines' importers need is checked.
+# Numbers and names on the chain are held to the physical ranges (core.model.ranges) and the name rule
+# (core.model.names); off the chain only what the engines' importers need is checked.
 ON_PATH_REJECTED = [
     ("huge limit", _joint("j1", "a", "b").replace('lower="-1"', 'lower="-1e308"'), "j1']/limit/@lower", "physical range"),
     ("huge origin", _joint("j1", "a", "b").replace('xyz="0 0 0.1"', 'xyz="1e308 0 0"'), "j1']/origin/@xyz",

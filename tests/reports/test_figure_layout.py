@@ -62,6 +62,7 @@ def test_fixed_margins_and_room_for_the_legend():
     plt.close(fig)
 
 
+@pytest.mark.slow  # ~1.5 s of CPU: figures drawn
 def test_a_legend_wider_than_the_figure_widens_it_instead_of_crushing_the_axes():
     """Found by a run of core beside three copies of it: dozens of schemes gave a three-column legend wider than the
     figure, and laying it out raised (left >= right) and lost the report."""

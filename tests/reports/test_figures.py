@@ -208,6 +208,7 @@ def _every_figure() -> dict:
     }
 
 
+@pytest.mark.slow  # ~6 s of CPU: every figure drawn
 def test_no_text_of_any_figure_overlaps_another():
     """Tick labels, axis labels, titles, texts in the axes and legend entries of every figure, drawn with Agg on
     a quick run's schemes, each readable: no two boxes meet by more than OVERLAP_PIXELS, none leaves the figure."""

@@ -281,6 +281,7 @@ def test_past_the_compact_limit_a_sweep_shows_its_distribution_not_a_row_per_var
     assert all(fig is not None for fig, _ in drawn)
 
 
+@pytest.mark.slow  # ~7 s of CPU: a sweep run and rendered
 def test_a_compact_sweep_keeps_the_report_within_its_lines(tmp_path):
     _, table, info = _many(tmp_path)
     report = _report(tmp_path, table, info)

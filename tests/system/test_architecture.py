@@ -87,10 +87,17 @@ def test_the_data_model_imports_no_in_house_method(path):
 
 @pytest.mark.parametrize("alias", sorted(PUBLIC_ALIASES))
 def test_the_public_aliases_re_export_the_data_model_alone(alias):
-    """``simparity.core.engine`` and the other paths plugins import are the data model under another name."""
+    """``simparity.core.engine`` and the other paths plugins import are the data model under another name: each a
+    one-line re-export (one per module for ``core.scene``, whose types are a folder), named in docs/plugins.md."""
     path = (ROOT / Path(*alias.split(".")[1:])).with_suffix(".py")
     used = _project_modules(_imports(path)) - {"simparity.core"}
     assert used and all(n.startswith(MODEL + ".") for n in used), f"{alias} imports {sorted(used)}"
+    body = ast.parse(path.read_text(encoding="utf-8")).body
+    code = [node for node in body if not (isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant))]
+    assert code and all(isinstance(node, ast.ImportFrom) and [a.name for a in node.names] == ["*"] for node in code), (
+        f"{alias} is more than re-exports `from {MODEL}.… import *`")
+    assert f"`{alias}`" in (ROOT / "docs" / "plugins.md").read_text(encoding="utf-8"), (
+        f"docs/plugins.md does not name {alias}, a path plugins import")
 
 
 @pytest.mark.parametrize("layer", LAYERS)

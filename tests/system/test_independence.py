@@ -288,7 +288,9 @@ def _load(text: str):
     return builtin(text) if "\n" not in text else parse_scene(tomllib.loads(text), "<test>")
 
 
-@pytest.mark.parametrize(("bug", "text", "compute", "references"), CASES,
+@pytest.mark.parametrize(("bug", "text", "compute", "references"),
+                         # a contact run on two engines: ~3 s of CPU, slow
+                         [pytest.param(*c, marks=pytest.mark.slow) if c[2] is _contact_motion else c for c in CASES],
                          ids=[f"{c[0]}-{i}" for i, c in enumerate(CASES)])
 def test_a_bug_in_how_core_derives_a_scene_moves_core_only(bug, text, compute, references, monkeypatch):
     """With core's derivation of the scene file's numbers broken, every reference computes bit for bit what it did,

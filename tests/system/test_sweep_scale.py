@@ -55,6 +55,7 @@ class _Watched(InProcess):
             yield key, index, outcome
 
 
+@pytest.mark.slow  # ~2.5 s of CPU: a sweep run
 def test_the_cases_of_a_scene_handed_back_are_let_go(tmp_path):
     """Once a scene's rows are handed back, nothing of the run holds its cases' outcomes: when each variant's rows
     arrive, every earlier variant's outcome is gone (the run held every one until it ended)."""

@@ -418,6 +418,7 @@ def test_run_of_an_unknown_scene_name_suggests_the_closest(capsys):
     assert "wind" not in err   # not the whole list
 
 
+@pytest.mark.slow  # ~2 s of CPU: a subprocess
 def test_export_of_a_urdf_nested_5000_deep_is_one_line_in_a_process_of_its_own(tmp_path):
     """Issue #25, as a user runs it: no RecursionError traceback, exit 2, one line naming the file and the limit."""
     from simparity.core.model.files import MAX_XML_DEPTH

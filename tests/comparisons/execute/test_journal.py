@@ -94,7 +94,7 @@ def test_a_case_without_a_time_step_is_read_back(tmp_path):
 
 def test_a_case_kept_before_its_types_moved_is_read_by_their_names(tmp_path):
     """A journal names its types by module path; kept by a simparity whose modules were elsewhere (before the
-    folders per job: simparity.comparisons.cases, simparity.core.results), it is still read, not computed again."""
+    folders per job: simparity.comparisons.execute.cases, simparity.core.results), it is still read, not computed again."""
     journal = Journal(tmp_path)
     key = CaseKey("hash", "core", "1.0", "rk4", 0.01, "dynamics")
     row = ResultRow("s", "core", "rk4", 0.01, "position_error_max", 1e-6, "m", "analytic:exact", "ok")

@@ -33,6 +33,7 @@ def _small():
     return quick(load([SCENE])[0])
 
 
+@pytest.mark.slow  # ~10 s of CPU: worker processes, one of them crashing
 def test_run_scene_isolates_an_engine_that_segfaults():
     """The segfault kills the engine's case process, not this interpreter: its rows are failed, core's are ok."""
     table = run_scene(_small(), engines=["core", SEGFAULTING], repeats=0)
@@ -42,6 +43,7 @@ def test_run_scene_isolates_an_engine_that_segfaults():
     assert OK in set(table[table["engine"] == "core"]["status"])
 
 
+@pytest.mark.slow  # ~11 s of CPU: a run in worker processes and one in process
 def test_run_scene_in_process_gives_the_rows_of_the_isolated_run():
     """isolate=False is the same pipeline in this process: the same rows, timing aside."""
     isolated = run_scene(_small(), engines=["core"], repeats=0)
@@ -62,6 +64,7 @@ def test_an_engine_defined_in_main_is_refused_in_one_line_when_isolated():
         refuse_unreachable(("core", "__main__:MyEngine"))
 
 
+@pytest.mark.slow  # ~7 s of CPU: a script run in a subprocess
 def test_a_script_s_own_engine_is_refused_isolated_and_runs_in_process(tmp_path):
     """A script run directly (its engine in __main__): isolated, one line and no hang; in process, it runs."""
     script = tmp_path / "mine.py"
@@ -93,6 +96,7 @@ def test_a_script_s_own_engine_is_refused_isolated_and_runs_in_process(tmp_path)
     assert lines[1].startswith("in process: ['mine']") and int(lines[1].split()[-1]) > 0
 
 
+@pytest.mark.slow  # ~17 s of CPU: a pytest session in a subprocess
 def test_the_fixture_fails_a_test_whose_engine_segfaults_and_the_session_goes_on(pytester, monkeypatch):
     monkeypatch.setenv("PYTHONPATH", str(ROOT))  # the hostile engines' module, for the test run and its workers
     pytester.makepyfile(test_crash=f'''

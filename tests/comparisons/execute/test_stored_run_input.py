@@ -50,7 +50,6 @@ ROWS = [
 ]
 """A run of each status, a NaN dt, non-finite values where a status allows them (diverged; +inf on an ok invariance
 ratio) and a quoted detail."""
-FIELDS = len(COLUMNS)
 
 
 def _run(folder, rows=ROWS, series=()):

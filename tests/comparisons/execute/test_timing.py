@@ -24,6 +24,7 @@ HIGH_WATER_DRIFT = 0.01
 run.json allocates a few KiB; the test process holds tens of MiB)."""
 
 
+@pytest.mark.slow  # ~1.5 s of CPU: subprocesses
 @pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="needs Linux's /proc (VmHWM)")
 def test_a_process_started_by_a_large_one_reports_its_own_peak():
     """Held-out finding (issue #11): ru_maxrss survives exec, so `simparity run` started by a 3.8 GiB benchmark

@@ -208,6 +208,7 @@ def test_a_run_held_only_to_its_statuses_is_too_unbounded_to_pass(tmp_path):
     assert held.unbounded_share == 0.0 and held.too_unbounded() == "" and held.value_bounded == 10
 
 
+@pytest.mark.slow  # ~9 s of CPU: the built-in suites run
 def test_the_shipped_tolerances_hold_the_built_in_suites_to_values(tmp_path):
     """The shipped file leaves at most the documented share of the built-in suites' series without a value bound
     (the quick default suite, stored beside the tests as a results table is too large: measured here on a run of

@@ -9,6 +9,7 @@ pytest_plugins = ["pytester"]
 EXAMPLE = Path(__file__).resolve().parents[3] / "docs" / "examples" / "test_my_numerics.py"
 
 
+@pytest.mark.slow  # ~10 s of CPU: a pytest session in a subprocess
 def test_the_documented_example_passes(pytester):
     pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
     result = pytester.runpytest_subprocess()

@@ -2,7 +2,7 @@
 
 A scene translated 2 km, turned with its gravity, its bodies listed in another order, its units rescaled or
 its time counted in milliseconds is the same physics: every status and value must come back the same, within
-the bounds of :mod:`comparisons.metamorphic` (the scene's one-ulp spread, rounding). What does not is listed
+the bounds of :mod:`comparisons.invariance.metamorphic` (the scene's one-ulp spread, rounding). What does not is listed
 below with its cause, in two lists:
 
 - :data:`KNOWN_METRIC_FINDINGS`: absolute thresholds in simparity's own judging code (metrics, contact

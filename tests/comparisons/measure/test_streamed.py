@@ -46,6 +46,7 @@ def _read(scene: DynamicsScene, traj: Trajectory, ref: Trajectory, engine_cut: i
     return reading
 
 
+@pytest.mark.slow  # ~1.5 s of CPU a scene: each run twice
 @pytest.mark.parametrize("name", SCENES)
 def test_a_run_read_in_pieces_measures_what_the_whole_run_measures(name):
     """Every extent, error and sampled series of a run read in pieces of 7 samples (its reference cut at 11) is
@@ -178,6 +179,7 @@ def _peak_bytes(engine: Engine, n_steps: int) -> tuple[int, list]:
         tracemalloc.stop()
 
 
+@pytest.mark.slow  # ~6 s of CPU: long runs, their memory measured
 def test_memory_is_flat_in_the_number_of_steps(monkeypatch):
     """A case of 10^5 steps holds no more than one of 10^4 (its reference, the closed form, streamed beside it),
     and its numbers are right (exact against exact); an engine that returns whole trajectories still runs, its

@@ -154,6 +154,7 @@ def test_arms_nobody_tuned_to_pass_the_shipped_gate_on_every_engine(urdf, base, 
     assert errors.loc[("core", "recursive")] <= 1e-12 and errors.loc[("core", "jacobian_sum")] <= 1e-12
 
 
+@pytest.mark.slow  # ~3 s of CPU: a checked and reported run
 def test_a_run_checks_and_reports_joint_dynamics(tmp_path):
     """simparity run --check on the lecture's arm and the crafted arm: green, every engine in the report's section
     and the summary, each row of report.md within 300 characters."""

@@ -83,6 +83,7 @@ def _run(scene, engines=("core", "analytic", "pinocchio"), profile: str = "full"
     return simparity.run_scene(scene, engines, repeats=0, isolate=isolate, profile=profile)
 
 
+@pytest.mark.slow  # ~1.5 s of CPU: a run on every engine
 def test_rows_orders_and_pairing_against_the_closed_form():
     """The pendulum on core and the closed form: RK4 of order 4 with its error, the rows unitless, the closed form
     the reference; core's semi-implicit Euler and implicit damping equal without damping."""
@@ -98,6 +99,7 @@ def test_rows_orders_and_pairing_against_the_closed_form():
     assert truth["status"].iloc[0] == "n/a" and "no order" in truth["detail"].iloc[0]
 
 
+@pytest.mark.slow  # ~7 s of CPU: a run of a chaotic chain on every engine
 def test_a_chaotic_chain_is_measured_over_the_references_horizon():
     two = _with("scene.reference", "pinocchio",
                 _with("chain.joint", [ROD, dict(ROD, name="elbow", origin_xyz=[1.0, 0.0, 0.0])],
@@ -108,6 +110,7 @@ def test_a_chaotic_chain_is_measured_over_the_references_horizon():
     assert "reference's horizon" in rk4["detail"].iloc[0]
 
 
+@pytest.mark.slow  # ~6 s of CPU: runs of the falling arms
 def test_self_consistency_segments_compare_each_engine_with_itself():
     chain = _with("scene.reference", "pinocchio", _with("simulation.segments", 4))
     table = _run(parse_scene(chain), ("core", "pinocchio"))
@@ -144,6 +147,7 @@ class MidpointAsRk4(_Planted):
     name, bug = "midpoint-as-rk4", "rk4-as-midpoint"
 
 
+@pytest.mark.slow  # ~16 s of CPU a case: a checked run of the falling arms
 @pytest.mark.parametrize("planted", [GravityOff, MidpointAsRk4])
 def test_a_users_engine_with_a_planted_bug_turns_the_gate_red(planted):
     """Gravity off by 0.1 % or an RK4 that is the midpoint rule: the shipped tolerances (keyed by scheme) and the
@@ -177,6 +181,7 @@ PYBULLET_SCHEME_RTOL = 1e-3
 dynamics' PyBullet bound: ~1e-8 relative in the tensors); its errors agree with the others' to 1e-3 or better."""
 
 
+@pytest.mark.slow  # ~3 s of CPU an arm: a run on every engine
 @pytest.mark.parametrize(("urdf", "base", "tip"), UNTUNED_ARMS, ids=[a[0].split("/")[-1] for a in UNTUNED_ARMS])
 def test_arms_nobody_tuned_fall_alike_in_every_engine(urdf, base, tip):
     """An arm from a pip wheel falls from a seeded random pose with light damping in every engine: every case runs

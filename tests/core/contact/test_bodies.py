@@ -657,7 +657,7 @@ def test_a_tall_box_landing_while_sliding_fast_tips_over(method):
     trajectory, _ = _run(scene, method)
     tilt = np.degrees(2 * np.arccos(np.clip(np.abs(trajectory.quat_wxyz[-1, 0, 0]), 0.0, 1.0)))
     assert abs(tilt - 90.0) <= TIPPED_TOL
-    # backup puts a settling body at rest within its resting gap (core.contact.RESTING_GAP, 1e-6 m) of the plane;
+    # backup puts a settling body at rest within its resting gap (core.contact.bodies.RESTING_GAP, 1e-6 m) of the plane;
     # act_after pushes out after each step and keeps a hop of order g dt^2
     settled = 2e-6 if method == "backup" else 2 * G * scene.dts[0] ** 2
     assert trajectory.position_world[-1, 0, 2] == pytest.approx(0.05, abs=settled)

@@ -1,4 +1,4 @@
-"""Mass properties (core.inertia) against hand-checkable cases, Pinocchio and MuJoCo."""
+"""Mass properties (core.dynamics.inertia) against hand-checkable cases, Pinocchio and MuJoCo."""
 
 from __future__ import annotations
 

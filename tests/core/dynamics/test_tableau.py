@@ -2,7 +2,7 @@
 
 The conditions are the elementary weights of the rooted trees (Hairer, Norsett & Wanner, Solving Ordinary
 Differential Equations I, section II.2, table 2.2): sum_i b_i Phi_i(t) = 1 / gamma(t) for every tree t of at most
-p nodes. The measured orders (tests/test_integrators.py, tests/test_joint_stepping.py) are the other half.
+p nodes. The measured orders (tests/core/dynamics/test_integrators.py, tests/core/articulated/test_stepping.py) are the other half.
 """
 
 import numpy as np

@@ -243,6 +243,7 @@ def test_every_copy_starts_from_its_initial_state():
     np.testing.assert_allclose(trajectory.qdot[0, :, 0], scene.qdot0[:, 0], rtol=0, atol=HAND_TOL)
 
 
+@pytest.mark.slow  # ~2 s of CPU: DOP853 at a tight tolerance
 def test_the_tilted_pendulum_matches_dop853_at_large_amplitude_and_turning():
     down = _tilted_down()
     q0, qdot0 = down + TILTED_THETA0, TILTED_THETADOT0

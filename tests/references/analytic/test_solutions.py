@@ -1,4 +1,4 @@
-"""Closed-form ground truths (references.analytic_solutions) against tight numerical solves."""
+"""Closed-form ground truths (references.analytic.solutions) against tight numerical solves."""
 
 from __future__ import annotations
 

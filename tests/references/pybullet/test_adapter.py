@@ -11,12 +11,6 @@ from simparity.references.pybullet.adapter import PybulletEngine
 from simparity.references.common.urdf_export import body_urdf
 from tests.helpers import builtin, exact_projectile, tumbling_box
 
-# getLinkState returns float32: relative error ~6e-8 of coordinates up to ~3 m, and
-# ~3e-7 rad in orientation; these bounds leave a factor ~3-8 of margin.
-LINK_STATE_POSITION_TOL = 1e-6  # [m]
-LINK_STATE_ORIENTATION_TOL = 2e-6  # [rad]
-# calculateJacobian is computed in double from the joint values we pass.
-JACOBIAN_TOL = 1e-12
 ACCUMULATED_ROUNDING_TOL = 1e-9
 
 
