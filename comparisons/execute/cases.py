@@ -19,7 +19,7 @@ import math
 import struct
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import cast
+from typing import Callable, cast
 
 import numpy as np
 
@@ -40,6 +40,9 @@ DYNAMICS, STABILITY, KINEMATICS, IK, JOINT_DYNAMICS, JOINT_MOTION = (
     "dynamics", "stability", "kinematics", "ik", "joint_dynamics", "joint_motion")
 """What a group computes: stepping at one dt, the penalty integrators' stability limits, FK and
 Jacobians, IK solves, joint-space dynamics at states."""
+
+EngineFor = Callable[[str], Engine]
+"""The engine of a name (the run's engines, the scene's reference), as a group's cases are run with it."""
 
 NO_INTEGRATOR = "-"
 """The integrator of the one n/a case of an engine that offers none of the integrators a scene runs

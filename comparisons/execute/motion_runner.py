@@ -15,12 +15,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
 from simparity.comparisons.execute.case_cost import case_cost, theory
-from simparity.comparisons.execute.cases import NO_INTEGRATOR, CaseGroup, CaseOutcome
+from simparity.comparisons.execute.cases import NO_INTEGRATOR, CaseGroup, CaseOutcome, EngineFor
 from simparity.comparisons.execute.timing import best_of
 from simparity.comparisons.measure.joint_motion_metrics import (
     REFERENCE_ERRORS, Horizon, OwnReading, divergence, energy_metrics, joint_scales, motion_metrics, parting_times,
@@ -36,8 +35,6 @@ from simparity.core.model.metric_catalogue import (
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, SATURATED, ResultRow
 from simparity.core.model.scene import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
-
-EngineFor = Callable[[str], Engine]
 
 COARSE_SUFFIX = "_coarse"
 """A reference integrator ``x`` whose engine also offers ``x_coarse`` (the same solve at a looser tolerance) has a
