@@ -13,7 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simparity.comparisons.execute.cases import DYNAMICS, IK, KINEMATICS, NO_INTEGRATOR, STABILITY, plan_scene, scene_hash
+from simparity.comparisons.execute.cases import DYNAMICS, IK, KINEMATICS, STABILITY, plan_scene
+from simparity.comparisons.common.integrators import NO_INTEGRATOR
+from simparity.comparisons.common.scene_hash import scene_hash
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes.library import builtin_paths
 from simparity.comparisons.scenes.loader import load_scene

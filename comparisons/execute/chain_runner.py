@@ -23,7 +23,8 @@ from simparity.comparisons.measure.joint_dynamics_metrics import (
     timed_values,
 )
 from simparity.comparisons.measure.joint_force_scale import ForceScale, force_scale
-from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, error_text, warnings_into_rows
+from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
+from simparity.comparisons.common.error_text import error_text
 from simparity.comparisons.execute.timing import best_of
 from simparity.core.model.engine import Engine, JointDynamicsModel, Support
 from simparity.core.model.errors import SimparityError

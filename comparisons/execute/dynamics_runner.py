@@ -16,7 +16,8 @@ from typing import Iterator
 
 import numpy as np
 
-from simparity.comparisons.execute.cases import NO_INTEGRATOR, CaseGroup, CaseOutcome, EngineFor
+from simparity.comparisons.common.integrators import NO_INTEGRATOR
+from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome, EngineFor
 from simparity.comparisons.measure.contact_metrics import contact_blow_up, contact_metrics, read_contact
 from simparity.comparisons.measure.divergence import blow_up_of
 from simparity.comparisons.measure.metrics import (
@@ -29,7 +30,8 @@ from simparity.comparisons.measure.metrics import (
     saturation_scales_of,
     state_validity,
 )
-from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, error_text, warnings_into_rows
+from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
+from simparity.comparisons.common.error_text import error_text
 from simparity.comparisons.measure.stability import STABILITY_METRICS, stable_dt_max
 from simparity.comparisons.measure.streamed import (
     AlignedPieces, CaseReading, piece_problem, samples_per_piece,

@@ -19,13 +19,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from simparity.comparisons.execute.case_cost import case_cost, theory
-from simparity.comparisons.execute.cases import NO_INTEGRATOR, CaseGroup, CaseOutcome, EngineFor
+from simparity.comparisons.common.integrators import NO_INTEGRATOR
+from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome, EngineFor
 from simparity.comparisons.execute.timing import best_of
 from simparity.comparisons.measure.joint_motion_metrics import (
     REFERENCE_ERRORS, Horizon, OwnReading, divergence, energy_metrics, joint_scales, motion_metrics, parting_times,
     read_own, reach, reference_errors, reference_horizon,
 )
-from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, error_text, warnings_into_rows
+from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
+from simparity.comparisons.common.error_text import error_text
 from simparity.core.model.engine import Engine, JointSimulation, Support
 from simparity.core.model.errors import DivergedError
 from simparity.core.model.metric_catalogue import (

@@ -10,7 +10,7 @@ outcome as it finishes, each kind of group by its runner (:mod:`comparisons.exec
 :mod:`comparisons.execute.chain_runner`, :mod:`comparisons.execute.ik_runner`,
 :mod:`comparisons.execute.motion_runner`); :func:`assemble_scene` puts a scene's outcomes together in its stored
 order, with the observed orders of convergence and the IK agreement matrix
-(:mod:`comparisons.execute.session` runs scenes through them, wherever their cases execute).
+(:mod:`comparisons.pipeline.session` runs scenes through them, wherever their cases execute).
 """
 
 from __future__ import annotations
@@ -25,13 +25,13 @@ from simparity.comparisons.execute.cases import (
     JOINT_DYNAMICS,
     JOINT_MOTION,
     KINEMATICS,
-    NO_INTEGRATOR,
     STABILITY,
     CaseGroup,
     CaseOutcome,
     CaseSpec,
     EngineFor,
 )
+from simparity.comparisons.common.integrators import NO_INTEGRATOR
 from simparity.comparisons.execute.ik_runner import failed_ik_outcome, ik_case, ik_scene_series, prepare_ik
 from simparity.comparisons.measure.metrics import (
     KINEMATICS_METRICS,

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from simparity.comparisons.engines.registry import ENGINE_NAMES, EngineSet
-from simparity.comparisons.execute.cases import NO_INTEGRATOR, motion_reference_integrator
+from simparity.comparisons.common.integrators import NO_INTEGRATOR, motion_reference_integrator
 from simparity.core.model.engine import Support
 from simparity.comparisons.scenes.limits import DEFAULT_LIMITS, POSITION_TOLERANCE_OF_REACH, Limits, allowed_at_most
 from simparity.comparisons.scenes.sweep import SWEEP_TABLE, read_sweep
