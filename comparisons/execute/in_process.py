@@ -12,6 +12,7 @@ from simparity.comparisons.execute.runner import DEFAULT_REPEATS, run_group
 from simparity.core.model.engine import Engine
 from simparity.core.model.results import ResultRow, SeriesRecord
 
+
 class InProcessExecutor:
     """Every job in this process, one after the other (``isolate=False``): no worker to start, and nothing between
     an engine and the caller, so an engine that crashes ends the caller's interpreter."""
