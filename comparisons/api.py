@@ -9,7 +9,7 @@ import pandas as pd
 from simparity.comparisons.engines.registry import DEFAULT_ENGINES, EngineSet, check_engine_names
 from simparity.comparisons.execute.execution import default_jobs
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS
-from simparity.comparisons.execute.session import IN_PROCESS, ISOLATED, Execution, Session, engine_specs
+from simparity.comparisons.pipeline.session import IN_PROCESS, ISOLATED, Execution, Session, engine_specs
 from simparity.comparisons.scenes import library
 from simparity.comparisons.scenes.loading.scene_file import load_scene as load_scene_file
 from simparity.core.model.scenes.kinds import Scene

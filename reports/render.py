@@ -6,11 +6,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pandas as pd
+
 from simparity.core.model.results import REPORT_FILE, REPORT_HTML_FILE
 from simparity.reports.content import FIGURES_DIR, build
 from simparity.reports.html import to_html
 from simparity.reports.markdown import to_markdown
-from simparity.reports.store import read_run, read_series
+from simparity.reports.store import read_info, read_run, read_series
 from simparity.reports.tolerance_verdict import ToleranceVerdict
 
 
@@ -26,12 +28,14 @@ def _remove_stale_figures(folder: Path, drawn: set[str]) -> None:
                 path.unlink()
 
 
-def write_report(run_dir: str | Path, verdict: ToleranceVerdict | None = None) -> tuple[Path, Path]:
+def write_report(run_dir: str | Path, verdict: ToleranceVerdict | None = None,
+                 table: pd.DataFrame | None = None) -> tuple[Path, Path]:
     """Render the run in ``run_dir``; return the paths of (report.md, report.html).
 
-    ``verdict``: the run held to tolerances (None: it was not)."""
+    ``verdict``: the run held to tolerances (None: it was not); ``table``: its rows when the caller has them (the
+    writer handed them back), else read from the folder."""
     run_dir = Path(run_dir)
-    table, info = read_run(run_dir)
+    table, info = read_run(run_dir) if table is None else (table, read_info(run_dir))
     blocks, svgs = build(table, info, read_series(run_dir), verdict, run_dir)
     _remove_stale_figures(run_dir / FIGURES_DIR, set(svgs))
     markdown, page = run_dir / REPORT_FILE, run_dir / REPORT_HTML_FILE

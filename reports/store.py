@@ -1,5 +1,7 @@
-"""Reading a stored run, from ``results.parquet`` when it is there and pyarrow is installed, else from ``results.csv``;
-and writing that typed copy of the CSV (:func:`write_parquet`)."""
+"""The stored run's format, its one owner: writing a run as it goes (:class:`RunWriter`: ``results.csv`` and
+``series.csv.gz`` appended scene by scene, ``run.json`` through :class:`RunInfo`, ``results.parquet`` when it ends,
+the table it wrote handed back) and reading one (:func:`read_run`, from ``results.parquet`` when it is there and
+pyarrow is installed, else from ``results.csv``; :func:`read_series`)."""
 
 from __future__ import annotations
 
@@ -8,6 +10,7 @@ import functools
 import math
 import os
 import re
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +27,9 @@ from simparity.core.model.results import (
     SERIES_FILE,
     SWEEP_COLUMN,
     SWEEP_PREFIX,
+    ResultRow,
+    SeriesRecord,
+    sweep_column,
 )
 from simparity.reports.csv_records import records
 from simparity.reports.run_schema import (
@@ -81,6 +87,11 @@ def read_run(run_dir: str | Path, empty: bool = False) -> tuple[pd.DataFrame, Ru
     if table is None:
         table = _read_csv(results, fixed_columns(meta.schema_version), empty)
     return table, meta
+
+
+def read_info(run_dir: str | Path) -> RunInfo:
+    """``run.json`` of a stored run (its rows at hand: the writer handed them back); ResultsError as :func:`read_run`."""
+    return RunInfo.read(Path(run_dir) / RUN_INFO_FILE)
 
 
 _ALLOWED_CSV = f"the {RESULTS_FILE} 'simparity run' wrote"
@@ -212,13 +223,79 @@ def write_parquet(run_dir: str | Path) -> Path | None:
         return None
     run_dir = Path(run_dir)
     schema = RunInfo.read(run_dir / RUN_INFO_FILE).schema_version
-    table = _read_csv(run_dir / RESULTS_FILE, fixed_columns(schema), empty=True)
+    return _write_parquet(_read_csv(run_dir / RESULTS_FILE, fixed_columns(schema), empty=True), run_dir)
+
+
+def _write_parquet(table: pd.DataFrame, run_dir: Path) -> Path:
+    """``table`` (as :func:`_read_csv` read the run's CSV) as the run's ``results.parquet``; returns its path."""
     typed = table.astype({c: "category" for c in CATEGORICAL_COLUMNS if c in table.columns})
     path = run_dir / RESULTS_PARQUET_FILE
     partial = path.with_name(path.name + ".partial")
     typed.to_parquet(partial, engine="pyarrow", index=False)
     os.replace(partial, path)
     return path
+
+
+def sweep_cells(info: RunInfo) -> tuple[list[str], dict[str, dict[str, object]]]:
+    """(the columns a run's sweeps add to :data:`core.model.results.COLUMNS`, {scene name: {column: value}} of each
+    swept scene of ``info.scenes``). No columns when no scene was swept; else :data:`core.model.results.SWEEP_COLUMN`
+    (the base scene's name), then one column per swept key in the order the scenes first sweep it."""
+    columns: list[str] = []
+    cells = {}
+    for name, scene in info.scenes.items():
+        if "sweep" not in scene:
+            continue
+        sweep = scene["sweep"]
+        cells[name] = {SWEEP_COLUMN: sweep["base"]} | {sweep_column(k): v for k, v in sweep["values"].items()}
+        columns += [column for column in cells[name] if column not in columns]
+    return columns, cells
+
+
+def _series_frame(series: Sequence[SeriesRecord]) -> pd.DataFrame:
+    """The points of ``series`` as rows of :data:`SERIES_COLUMNS`: each record's keys repeated along its points."""
+    lengths = [len(record.x) for record in series]
+    keys = {column: np.repeat([getattr(record, column) for record in series], lengths)
+            for column in SERIES_COLUMNS if column not in ("x", "value")}
+    return pd.DataFrame(keys | {"x": np.concatenate([r.x for r in series]),
+                                "value": np.concatenate([r.value for r in series])}, columns=list(SERIES_COLUMNS))
+
+
+class RunWriter:
+    """Appends rows to ``results.csv`` and series to ``series.csv.gz`` as they are produced, so nothing
+    computed is lost; :meth:`finish` reads the CSV back once, adds ``results.parquet`` (pyarrow installed) and hands
+    the table back. ``info`` is written as ``run.json``; a run of swept scenes (``info.scenes`` with a ``sweep``) has
+    the sweep columns of :func:`sweep_cells` after the fixed ones, filled from each row's scene."""
+
+    def __init__(self, out_dir: Path, info: RunInfo) -> None:
+        self.out_dir, self.info = Path(out_dir), info
+        self.out_dir.mkdir(parents=True, exist_ok=True)
+        self.results_path = self.out_dir / RESULTS_FILE
+        self.series_path = self.out_dir / SERIES_FILE
+        (self.out_dir / RESULTS_PARQUET_FILE).unlink(missing_ok=True)  # a new (or resumed) run's CSV starts afresh
+        self._sweep_columns, self._sweep_cells = sweep_cells(info)
+        pd.DataFrame(columns=list(COLUMNS) + self._sweep_columns).to_csv(self.results_path, index=False)
+        pd.DataFrame(columns=list(SERIES_COLUMNS)).to_csv(self.series_path, index=False)
+        info.write(self.out_dir / RUN_INFO_FILE)
+
+    def append(self, rows: list[ResultRow], series: Sequence[SeriesRecord] = ()) -> None:
+        frame = pd.DataFrame([r.as_dict() for r in rows], columns=list(COLUMNS))
+        for column in self._sweep_columns:
+            # object cells: an int stays an int, a float is written as its shortest exact text, "" is no value
+            frame[column] = pd.Series([self._sweep_cells.get(r.scene, {}).get(column, "") for r in rows], dtype=object)
+        frame.to_csv(self.results_path, mode="a", header=False, index=False, float_format="%.17g")
+        if series:
+            # Each append is one more gzip member; readers (gzip, pandas) read the members as one file.
+            points = _series_frame(series)
+            points.to_csv(self.series_path, mode="a", header=False, index=False, float_format="%.9g")
+
+    def finish(self) -> pd.DataFrame:
+        """The run's rows are all appended (it ended, or was interrupted): ``results.csv`` read back, the one read of
+        it a run makes (typed as :func:`read_run` gives it, empty when no row was appended), written as
+        ``results.parquet`` when pyarrow is installed, and handed back."""
+        table = _read_csv(self.results_path, fixed_columns(self.info.schema_version), empty=True)
+        if parquet_available():
+            _write_parquet(table, self.out_dir)
+        return table
 
 
 _WHOLE = re.compile(r"-?[0-9]+")

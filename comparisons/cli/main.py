@@ -15,6 +15,8 @@ import sys
 import time
 from pathlib import Path
 
+import pandas as pd
+
 from simparity.comparisons.scenes import library
 from simparity.comparisons.gate.check import (
     BASELINE_RELATIVE,
@@ -64,10 +66,10 @@ from simparity.comparisons.execute.isolation import (
 from simparity.comparisons.execute.journal import CASES_FOLDER, Journal, read_request
 from simparity.comparisons.engines.placeholders import BrokenEngine, UnavailableEngine
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS
-from simparity.comparisons.execute.session import Execution, Session, write_run_report
+from simparity.comparisons.pipeline.session import Execution, Session, write_run_report
 from simparity.comparisons.cli.parser import build_parser
 from simparity.comparisons.scenes.limits import Limits
-from simparity.comparisons.execute.store import default_out_dir
+from simparity.comparisons.common.out_folder import default_out_dir
 from simparity.comparisons.execute.timing import record_peak_memory, resource_line
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, EngineNames, Gate, load_gate, load_tolerances
 from simparity.comparisons.invariance.transforms import fixed_transforms
@@ -79,7 +81,7 @@ from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.scenes.kinematics import KinematicsScene
-from simparity.reports.store import read_run
+from simparity.reports.store import read_info, read_run
 
 EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE = 0, 1, 2
 MAX_JOBS = 256
@@ -245,7 +247,7 @@ def cmd_run(args, out) -> int:
         code = EXIT_FAILED_CASES if result.failed_cases else EXIT_OK
         if result.check is not None and gate is not None:
             try:
-                code = max(code, _check(out_dir, gate, args, out, result.check))
+                code = max(code, _check(out_dir, gate, args, out, result.check, result.table))
             except SimparityError as err:  # after the run (a full device, the history): the run itself is whole
                 raise SimparityError(f"the run's results are kept in {one_line(out_dir)} ('simparity check "
                                      f"{one_line(out_dir)}' checks them again), its check stopped: {err}") from None
@@ -292,10 +294,12 @@ def _say_some(label: str, lines: list[str], verbose: bool, out) -> None:
         print(f"{label}: ... and {len(lines) - LINES_SHOWN} more (--verbose for each)", file=out)
 
 
-def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = None) -> int:
+def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = None,
+           table: pd.DataFrame | None = None) -> int:
     """Print the verdict on a stored run (and the moves since the baseline); 0 passed, 1 not.
-    ``result``: the run already held to ``gate``'s bounds."""
-    table, info = read_run(run_dir)
+    ``result``: the run already held to ``gate``'s bounds; ``table``: its rows, as the run's writer handed them back
+    (None: read from ``run_dir``)."""
+    table, info = read_run(run_dir) if table is None else (table, read_info(run_dir))
     result = held_to(check_table(table, gate.bounds) if result is None else result, *_engine_names(gate, args))
     diff = None
     if args.baseline is not None:

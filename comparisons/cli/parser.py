@@ -15,7 +15,7 @@ from simparity.comparisons.execute.isolation import (
     MIN_CASE_SECONDS,
 )
 from simparity.comparisons.execute.runner import DEFAULT_REPEATS
-from simparity.comparisons.execute.store import DEFAULT_OUT_ROOT
+from simparity.comparisons.common.out_folder import DEFAULT_OUT_ROOT
 from simparity.comparisons.gate.check import BASELINE_RELATIVE, UNBOUNDED_SHARE_MAX
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES
 from simparity.comparisons.invariance.transforms import TRANSFORM_NAMES

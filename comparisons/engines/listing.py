@@ -13,7 +13,7 @@ from simparity.comparisons.engines.probe import PROBE_CHAIN
 from simparity.comparisons.engines.registry import ENGINE_NAMES, describe_engines
 from simparity.comparisons.engines.placeholders import BrokenEngine, UnavailableEngine
 from simparity.comparisons.engines.plugins import discover
-from simparity.comparisons.measure.rows import error_text
+from simparity.comparisons.common.error_text import error_text
 from simparity.core.model.engine import Engine
 from simparity.core.model.errors import one_line
 

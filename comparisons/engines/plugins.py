@@ -26,7 +26,7 @@ from importlib import metadata
 from typing import Callable, cast
 
 from simparity.comparisons.engines.placeholders import BrokenEngine, NotAnEngine
-from simparity.comparisons.measure.rows import error_text
+from simparity.comparisons.common.error_text import error_text
 from simparity.core.model.engine import Engine
 from simparity.core.model.errors import echo, one_line
 

@@ -26,12 +26,11 @@ from typing import cast
 
 import numpy as np
 
-from simparity.comparisons.execute.cases import scene_hash
+from simparity.comparisons.common.scene_hash import scene_hash
 from simparity.comparisons.engines.registry import make_engine
-from simparity.comparisons.execute.isolation import death_cause, worker_environment
+from simparity.comparisons.common.processes import death_cause, status_bytes, worker_environment
 from simparity.comparisons.engines.placeholders import BrokenEngine, StandInEngine
-from simparity.comparisons.measure.rows import error_text
-from simparity.comparisons.execute.timing import status_bytes
+from simparity.comparisons.common.error_text import error_text
 from simparity.core.model.engine import Engine, KinematicsModel, Simulation, Support
 from simparity.core.model.errors import PluginError, one_line
 from simparity.core.runtime.processes import die_with_parent, kill_group
@@ -70,7 +69,7 @@ class EngineDescription:
     kinematics : str
         ``yes`` or ``no`` (its support of :data:`PROBE_CHAIN`), or ``unknown (<error>)``.
     scene_integrators : dict of str to tuple of str or str
-        ``scene_integrators`` of each scene asked about, by :func:`~comparisons.execute.cases.scene_hash`; the error
+        ``scene_integrators`` of each scene asked about, by :func:`~comparisons.common.scene_hash.scene_hash`; the error
         text where it raised.
     joint_dynamics_methods, joint_motion_integrators : tuple of str
         (``orders``, ``stages`` and ``variants`` cover the joint-motion integrators too.)

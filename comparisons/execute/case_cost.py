@@ -6,7 +6,8 @@ from __future__ import annotations
 import math
 
 from simparity.comparisons.execute.timing import best_of
-from simparity.comparisons.measure.rows import Case, Measured, error_text
+from simparity.comparisons.measure.rows import Case, Measured
+from simparity.comparisons.common.error_text import error_text
 from simparity.core.model.engine import Engine, JointSimulation, Simulation
 from simparity.core.model.errors import NotBatchedError
 from simparity.core.model.metric_catalogue import EVALUATIONS_PER_SECOND, TIME_PER_STEP_BATCHED, unit_of

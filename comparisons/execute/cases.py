@@ -12,19 +12,17 @@ interrupted run resumes where it stopped.
 
 from __future__ import annotations
 
-import dataclasses
-import enum
 import hashlib
 import math
-import struct
-from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import cast
+from typing import Callable, cast
 
 import numpy as np
 
+from simparity.comparisons.common.scene_hash import scene_hash
+from simparity.comparisons.common.integrators import NO_INTEGRATOR, motion_reference_integrator
 from simparity.comparisons.engines.placeholders import StandInEngine
-from simparity.core.model.engine import TRUTH_SCHEMES, Engine
+from simparity.core.model.engine import Engine
 from simparity.core.model.results import ResultRow, SeriesRecord
 from simparity.core.model.scenes.contact import PENALTY_PREFIX
 from simparity.core.model.scenes.dynamics import DynamicsScene
@@ -39,9 +37,8 @@ DYNAMICS, STABILITY, KINEMATICS, IK, JOINT_DYNAMICS, JOINT_MOTION = (
 """What a group computes: stepping at one dt, the penalty integrators' stability limits, FK and
 Jacobians, IK solves, joint-space dynamics at states."""
 
-NO_INTEGRATOR = "-"
-"""The integrator of the one n/a case of an engine that offers none of the integrators a scene runs
-(or no IK solver)."""
+EngineFor = Callable[[str], Engine]
+"""The engine of a name (the run's engines, the scene's reference), as a group's cases are run with it."""
 
 
 @dataclass(frozen=True)
@@ -183,52 +180,6 @@ def case_key(group: CaseGroup, spec: CaseSpec, versions: dict[str, str]) -> Case
     return CaseKey(group.scene_hash, spec.engine, versions[spec.engine], spec.integrator, group.dt, group.kind)
 
 
-def scene_hash(scene) -> str:
-    """SHA-256 of a scene's content: every field of its dataclasses that takes part in their equality (not
-    ``compare=False`` ones, such as the file a scene was read from: the same file by a relative or an absolute
-    path, or moved, is the same scene), arrays by dtype, shape and bytes, floats exactly. The same scene
-    loaded twice, in any process, hashes the same."""
-    digest = hashlib.sha256()
-    _feed(digest, scene)
-    return digest.hexdigest()
-
-
-def _feed(digest, value) -> None:
-    """Feed ``value`` to ``digest`` with its type, so different structures never give the same bytes."""
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        digest.update(f"<{type(value).__qualname__}".encode())
-        for f in (f for f in dataclasses.fields(value) if f.compare):
-            digest.update(f.name.encode() + b"=")
-            _feed(digest, getattr(value, f.name))
-        digest.update(b">")
-    elif isinstance(value, np.ndarray):
-        digest.update(f"<array {value.dtype.str} {value.shape}>".encode())
-        digest.update(np.ascontiguousarray(value).tobytes())
-    elif isinstance(value, (list, tuple)):
-        digest.update(f"<{type(value).__name__} {len(value)}".encode())
-        for item in value:
-            _feed(digest, item)
-        digest.update(b">")
-    elif isinstance(value, Mapping):
-        digest.update(f"<dict {len(value)}".encode())
-        for k in sorted(value, key=repr):
-            _feed(digest, k)
-            _feed(digest, value[k])
-        digest.update(b">")
-    elif isinstance(value, enum.Enum):
-        digest.update(f"<enum {type(value).__qualname__}.{value.name}>".encode())
-    elif isinstance(value, bool) or value is None:
-        digest.update(f"<{value!r}>".encode())
-    elif isinstance(value, (int, np.integer)):
-        digest.update(f"<int {int(value)}>".encode())
-    elif isinstance(value, (float, np.floating)):
-        digest.update(b"<float" + struct.pack("<d", float(value)) + b">")
-    elif isinstance(value, str):
-        digest.update(f"<str {len(value)}>".encode() + value.encode("utf-8", "surrogatepass"))
-    else:
-        raise TypeError(f"scene_hash: cannot hash a {type(value).__name__}")
-
-
 def _integrators(scene: DynamicsScene, engine: Engine) -> list[str]:
     """The engine's integrators the scene runs (all it offers unless the scene names some); none when the
     engine fails to say (its one case then fails in a worker, with the error)."""
@@ -263,17 +214,6 @@ def _motion_integrators(scene: JointMotionScene, engine: Engine) -> list[str]:
     except Exception:  # noqa: BLE001 - a user's engine: its case reports the error
         return []
     return [i for i in offered if not scene.integrators or i in scene.integrators]
-
-
-def motion_reference_integrator(scene: JointMotionScene, reference: Engine) -> str:
-    """The integrator a joint-motion scene's reference runs: its first of a truth's kind (:data:`TRUTH_SCHEMES`),
-    else its first; NO_INTEGRATOR when it offers none."""
-    try:
-        offered = tuple(reference.joint_motion_integrators())
-        truths = [i for i in offered if reference.scheme(i, scene) in TRUTH_SCHEMES]
-    except Exception:  # noqa: BLE001 - a user's engine as a reference: its rows say what fails
-        return NO_INTEGRATOR
-    return (truths or list(offered) or [NO_INTEGRATOR])[0]
 
 
 def plan_scene(scene, engines: list[Engine], reference: Engine, repeats: int,

@@ -31,7 +31,8 @@ import numpy as np
 
 from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome, CaseSpec
 from simparity.comparisons.execute.ik_targets import ORIENTATION_ONLY, Targets, hard_target, random_targets
-from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, error_text, warnings_into_rows
+from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
+from simparity.comparisons.common.error_text import error_text
 from simparity.comparisons.measure.series import disagreement_matrix, quantiles
 from simparity.comparisons.execute.timing import best_of
 from simparity.core.model.engine import Engine, IKModel, KinematicsModel, StoppingRule

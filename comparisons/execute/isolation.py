@@ -12,19 +12,18 @@ from __future__ import annotations
 
 import collections
 import os
-import signal
 import subprocess
 import sys
-import sysconfig
 import tempfile
 import time
 from dataclasses import dataclass, field
 from multiprocessing.connection import Connection, wait
 from typing import Iterator, cast
 
+from simparity.comparisons.common.processes import death_cause, status_bytes, worker_environment
 from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome
 from simparity.comparisons.execute.runner import failed_outcome
-from simparity.comparisons.execute.timing import status_bytes
+from simparity.comparisons.common.processes import status_bytes
 from simparity.core.runtime.processes import kill_group
 
 GIB = 1024 ** 3
@@ -59,9 +58,6 @@ POLL_SECONDS = 0.05
 """How often a worker's time and memory are looked at: an allocation of ~1 GB/s overshoots the limit
 by ~50 MB before it is caught."""
 
-BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
-"""Set to 1 in every worker: each worker is one CPU, many small matrix products gain nothing from BLAS
-threads, and results do not depend on how many threads summed them."""
 
 EXIT_GRACE_SECONDS = 1.0
 """How long a worker whose pipe closed is given to exit by itself before it is killed (a Python exception or
@@ -89,15 +85,6 @@ class CaseLimits:
         """:data:`DEFAULT_CASE_SECONDS`, and :data:`MEMORY_SHARE` of the machine split between ``workers``."""
         share = int(MEMORY_SHARE * physical_memory_bytes() / max(1, workers))
         return cls(DEFAULT_CASE_SECONDS, max(MIN_MEMORY_BYTES, share))
-
-
-def worker_environment() -> dict[str, str]:
-    """The environment of a worker: this one, with one BLAS thread and this process's import path."""
-    env = dict(os.environ)
-    for variable in BLAS_THREAD_VARIABLES:
-        env[variable] = "1"
-    env["PYTHONPATH"] = os.pathsep.join(p for p in sys.path if p)
-    return env
 
 
 @dataclass
@@ -159,35 +146,6 @@ class _Worker:
     def close(self) -> None:
         self.kill()
         self.stderr.close()
-
-
-def death_cause(code: int, stderr: str, process: str = "the worker") -> str:
-    """Why ``process`` died, from its exit code and the end of its standard error (faulthandler's stack)."""
-    if code < 0:
-        name = signal.Signals(-code).name if -code in signal.valid_signals() else f"signal {-code}"
-        cause = f"crashed: {process} was killed by signal {-code} ({name})"
-        if -code == signal.SIGKILL:
-            cause += " (the system's out-of-memory killer, or another process)"
-    else:
-        cause = f"crashed: {process} exited with code {code}" + (" before its cases finished" if code == 0 else "")
-    lines = [line.strip() for line in stderr.splitlines() if line.strip()]
-    frames = [line for line in lines if line.startswith("File ")]
-    faulthandler_stack = any(line.startswith(("Current thread", "Thread 0x")) for line in lines)
-    if faulthandler_stack and frames:  # most recent call first
-        cause += f", in {frames[0]}"
-        own = next((f for f in frames if not _in_stdlib(f)), frames[0])
-        if own != frames[0]:  # the crash is in the standard library (ctypes): say whose code called it
-            cause += f", called from {own}"
-    elif lines:  # a Python traceback: its last line is the error
-        cause += f": {lines[-1][:300]}" + (f" ({frames[-1][:200]})" if frames else "")
-    return cause
-
-
-def _in_stdlib(frame: str) -> bool:
-    """True when a faulthandler frame line (``File "path", line N in name``) is in Python's standard library."""
-    path = frame.split('"')[1] if frame.count('"') >= 2 else ""
-    stdlib = sysconfig.get_paths()["stdlib"]
-    return path.startswith(stdlib + os.sep) and "site-packages" not in path
 
 
 class IsolatedPool:

@@ -15,18 +15,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 
 from simparity.comparisons.execute.case_cost import case_cost, theory
-from simparity.comparisons.execute.cases import NO_INTEGRATOR, CaseGroup, CaseOutcome
+from simparity.comparisons.common.integrators import NO_INTEGRATOR
+from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome, EngineFor
 from simparity.comparisons.execute.timing import best_of
 from simparity.comparisons.measure.joint_motion_metrics import (
     REFERENCE_ERRORS, Horizon, OwnReading, divergence, energy_metrics, joint_scales, motion_metrics, parting_times,
     read_own, reach, reference_errors, reference_horizon,
 )
-from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, error_text, warnings_into_rows
+from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
+from simparity.comparisons.common.error_text import error_text
 from simparity.core.model.engine import Engine, JointSimulation, Support
 from simparity.core.model.errors import DivergedError
 from simparity.core.model.metric_catalogue import (
@@ -36,8 +37,6 @@ from simparity.core.model.metric_catalogue import (
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, SATURATED, ResultRow
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
-
-EngineFor = Callable[[str], Engine]
 
 COARSE_SUFFIX = "_coarse"
 """A reference integrator ``x`` whose engine also offers ``x_coarse`` (the same solve at a looser tolerance) has a

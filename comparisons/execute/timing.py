@@ -10,6 +10,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 from typing import TypeVar
 
+from simparity.comparisons.common.processes import status_bytes
 from simparity.core.model.results import RUN_INFO_FILE
 from simparity.core.model.run_info import RunInfo
 
@@ -57,19 +58,6 @@ def best_after(first: float, fn: Callable[[], object], repeats: int) -> float:
         if spent >= REPEAT_BUDGET_SECONDS:
             break
     return best
-
-
-def status_bytes(field: str, pid: int | str = "self") -> int | None:
-    """A memory field of a process from Linux's /proc (``VmHWM``, ``VmRSS``, ...) [bytes]; None when it cannot be
-    read (not Linux, the process is gone)."""
-    try:
-        with open(f"/proc/{pid}/status", encoding="ascii") as status:
-            for line in status:
-                if line.startswith(f"{field}:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError):
-        return None
-    return None
 
 
 def _high_water_mark_bytes() -> int | None:

@@ -21,7 +21,7 @@ from typing import cast
 
 import pandas as pd
 
-from simparity.comparisons.execute.store import DEFAULT_OUT_ROOT
+from simparity.comparisons.common.out_folder import DEFAULT_OUT_ROOT
 from simparity.core.model.errors import HistoryError
 from simparity.core.model.results import COLUMNS
 from simparity.core.model.run_info import RunInfo

@@ -63,7 +63,7 @@ class SimparityChecker:
         As ``simparity check``, the test also fails when more than a small share of the scene's series have no
         bound on any value (only on their status), unless ``allow_unbounded``.
 
-        The scene runs through the same session as ``simparity run`` (:mod:`comparisons.execute.session`): with
+        The scene runs through the same session as ``simparity run`` (:mod:`comparisons.pipeline.session`): with
         ``isolate`` (default) its cases run in worker processes, so an engine that crashes or hangs fails the test
         with its rows, never the pytest session; ``isolate=False`` runs them in the test's process."""
         from simparity.core.model.errors import SimparityError, one_line
@@ -79,8 +79,7 @@ class SimparityChecker:
                check_engines, require_engines):
         from simparity.comparisons.api import load_scene
         from simparity.comparisons.engines.registry import EngineSet, check_engine_names
-        from simparity.comparisons.execute.session import (IN_PROCESS, ISOLATED, Execution, Session,
-                                                             engine_specs)
+        from simparity.comparisons.pipeline.session import IN_PROCESS, ISOLATED, Execution, Session, engine_specs
         from simparity.comparisons.gate.check import BASELINE_RELATIVE, compare_with_baseline, held_to
         from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, EngineNames, load_gate
         from simparity.comparisons.gate.violation import grouped

@@ -43,6 +43,7 @@ from typing import Callable, Iterable, NamedTuple, cast
 
 import numpy as np
 
+from simparity.comparisons.execute.in_process import run_in_process
 from simparity.comparisons.invariance.engine_constants import constants_exposed
 from simparity.comparisons.measure.joint_motion_metrics import JOINT_ORDER_SOURCES
 from simparity.comparisons.measure.metrics import ORDER_SOURCES as BODY_ORDER_SOURCES
@@ -54,7 +55,7 @@ from simparity.core.model.engine import Engine
 from simparity.core.model.metric_catalogue import is_timing
 from simparity.core.model.errors import TransformError, UnitError, one_line
 from simparity.core.model.results import DIMENSIONLESS, FAILED, NOT_AVAILABLE, OK, ROUNDING_FLOOR, ResultRow
-from simparity.comparisons.execute.cases import motion_reference_integrator
+from simparity.comparisons.common.integrators import motion_reference_integrator
 from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
@@ -205,9 +206,8 @@ class SceneInvariance:
 
 
 def in_process(engines: list[Engine], make_reference: Callable[[str], Engine], repeats: int = 0) -> RunScenes:
-    """Runs scenes with ``comparisons.execute.session.run_in_process`` in this process (tests, notebooks);
+    """Runs scenes with :func:`comparisons.execute.in_process.run_in_process` in this process (tests, notebooks);
     ``repeats`` 0 times one cold call (timing is not compared)."""
-    from simparity.comparisons.execute.session import run_in_process  # imports every engine adapter: only when asked
 
     def run(scenes: list) -> list[list[ResultRow]]:
         return [run_in_process(scene, engines, make_reference, repeats=repeats) for scene in scenes]

@@ -4,12 +4,10 @@ from __future__ import annotations
 
 import contextlib
 import math
-import traceback
 import warnings
 from dataclasses import dataclass, replace
 
 from simparity.core.model.engine import is_scheme_label
-from simparity.core.model.errors import PluginError
 from simparity.core.model.results import NOT_AVAILABLE, OK, ResultRow
 
 
@@ -98,16 +96,6 @@ def declared_scheme(engine, name: str, scene) -> str:
     except Exception:  # noqa: BLE001 - a user's engine; its rows report what else fails
         return ""
     return label if isinstance(label, str) and is_scheme_label(label) else ""
-
-
-def error_text(err: BaseException) -> str:
-    """``Type: message at file:line`` of an exception, on one line; an engine standing in for a broken one raises
-    a :class:`PluginError` whose message says all (where it was raised is simparity's, not the engine's)."""
-    if isinstance(err, PluginError):
-        return str(err).replace("\n", " ")
-    where = traceback.extract_tb(err.__traceback__)[-1] if err.__traceback__ else None
-    at = f" at {where.filename.rsplit('/', 1)[-1]}:{where.lineno}" if where else ""
-    return f"{type(err).__name__}: {err}{at}".replace("\n", " ")
 
 
 @contextlib.contextmanager

@@ -1,7 +1,7 @@
 """The results data model: one tidy row per scene x engine x integrator x dt x metric.
 
-The writer (``comparisons.execute.store``) and the reader (``reports.store``) share these names,
-so a stored run means the same thing to both.
+The stored run's one owner (``reports.store``: its writer and its readers) and everything that makes or reads
+rows share these names, so a stored run means the same thing to all of them.
 """
 
 from __future__ import annotations

@@ -142,3 +142,73 @@ def test_the_example_plugin_imports_only_the_data_model_of_core(path):
     """Like a reference: a user's engine built on core's methods would agree with their bugs."""
     borrowed = {n for n in _project_modules(_imports(path)) - {"simparity.core"} if not _data_model(n)}
     assert not borrowed, f"{path.name} imports {sorted(borrowed)}; allowed: {MODEL} and its public aliases"
+
+
+COMPARISONS = "simparity.comparisons"
+
+FOLDER_IMPORTS = {
+    "common": set(),
+    "measure": {"common"},
+    "engines": {"common"},
+    "scenes": {"common", "engines"},
+    "execute": {"common", "engines", "measure"},
+    "invariance": {"common", "engines", "execute", "measure"},
+    "gate": {"common", "engines", "scenes"},
+    "pipeline": {"common", "engines", "execute", "gate", "invariance", "measure", "scenes"},
+    "cli": {"common", "engines", "execute", "gate", "invariance", "measure", "pipeline", "scenes"},
+}
+"""Which folder of comparisons/ may import which, bottom up: ``common/`` (the names every folder shares) under
+everything; the measuring, the engines and the scenes under the execution; the pipeline (``Session``) above the folders
+it orchestrates; the CLI on top. A folder may import itself; the modules at comparisons/'s top (the public API, the
+bench) may import every folder. One way only: no folder is in the set of a folder it may import."""
+
+FRONT_ENDS = {"gate/pytest_plugin.py": "the pytest plugin runs scenes through a Session, as the CLI does; it stays "
+              "at the path its installed entry point (pyproject's pytest11) names"}
+"""Modules inside a folder that stand above every folder, with the reason they live there."""
+
+
+def _folder_of(name: str) -> str | None:
+    """The comparisons folder a dotted module name is in (None: not in a folder of comparisons)."""
+    parts = name.split(".")
+    if parts[:2] != COMPARISONS.split(".") or len(parts) < 3:
+        return None
+    return parts[2] if (ROOT / "comparisons" / parts[2]).is_dir() else None
+
+
+def _folder_violations(path: Path) -> list[str]:
+    """The comparisons folders ``path`` (a module of a folder of comparisons/) imports against :data:`FOLDER_IMPORTS`."""
+    relative = path.relative_to(ROOT / "comparisons")
+    if relative.as_posix() in FRONT_ENDS or len(relative.parts) < 2:
+        return []
+    own = relative.parts[0]
+    used = {_folder_of(n) for n in _imports(path)} - {None, own}
+    return sorted(f for f in used if f not in FOLDER_IMPORTS[own])
+
+
+def test_the_folder_table_names_every_folder_and_is_one_way():
+    """A new folder takes its place in the table before it imports anything; the table itself has no cycle."""
+    folders = {p.name for p in (ROOT / "comparisons").iterdir() if p.is_dir() and (p / "__init__.py").is_file()}
+    assert folders == set(FOLDER_IMPORTS), f"folders {sorted(folders ^ set(FOLDER_IMPORTS))} in one of the folders " \
+                                           "and the table only"
+    for folder, allowed in FOLDER_IMPORTS.items():
+        assert folder not in allowed
+        assert not [other for other in allowed if folder in FOLDER_IMPORTS[other]], f"{folder} both ways"
+    assert all((ROOT / "comparisons" / module).is_file() for module in FRONT_ENDS)
+
+
+@pytest.mark.parametrize("path", [p for p in _modules("comparisons") if len(p.relative_to(ROOT / "comparisons").parts) > 1],
+                         ids=lambda p: p.relative_to(ROOT / "comparisons").as_posix())
+def test_comparisons_folders_import_one_way(path):
+    """Each folder imports only the folders below it (:data:`FOLDER_IMPORTS`), inside functions too."""
+    bad = _folder_violations(path)
+    assert not bad, f"{path.relative_to(ROOT)} imports comparisons/{bad}; allowed: {sorted(FOLDER_IMPORTS[path.relative_to(ROOT / 'comparisons').parts[0]])}"
+
+
+def test_a_function_level_import_against_the_table_fails(tmp_path, monkeypatch):
+    """The check sees an import inside a function (the way a cycle used to be dodged), not only a module's head."""
+    planted = ROOT / "comparisons" / "measure" / "_planted_for_the_test.py"
+    source = "def f():\n    from simparity.comparisons.execute.runner import DEFAULT_REPEATS\n    return DEFAULT_REPEATS\n"
+    monkeypatch.setattr(Path, "read_text", lambda self, encoding=None: source if self == planted else
+                        Path.read_bytes(self).decode(encoding or "utf-8"))
+    assert _folder_violations(planted) == ["execute"]
+    assert _folder_violations(ROOT / "comparisons" / "execute" / "runner.py") == []

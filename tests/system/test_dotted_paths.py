@@ -204,7 +204,7 @@ def _unresolved() -> list[str]:
 def test_resolver_tells_a_path_from_a_stale_one():
     assert resolves("simparity.core.model.scenes.kinds.Scene")
     assert resolves("core.model.scenes")
-    assert not resolves("core.model.scene")
+    assert not resolves("core.model." + "scene")  # the module before #40 split it (written in two: the rewrite of moved paths skips it)
     assert resolves("simparity.core.engine.Engine")  # through the alias module's * import
     assert not resolves("simparity.core.integrators")
     assert not resolves("core.model.scenes.kinds.NoSuchName")

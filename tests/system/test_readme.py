@@ -4,7 +4,9 @@ import math
 import re
 from pathlib import Path
 
-from simparity.comparisons.execute.store import RunWriter
+from simparity.comparisons.pipeline.run_info import run_info
+
+from simparity.reports.store import RunWriter
 from simparity.core.model.results import ResultRow
 
 README = Path(__file__).resolve().parents[2] / "README.md"
@@ -16,7 +18,7 @@ def _python_blocks() -> list[str]:
 
 def test_loading_recipes_give_numeric_columns_and_keep_n_a(tmp_path):
     """Both loading recipes read dt and value as numbers and the status n/a as text."""
-    writer = RunWriter(tmp_path, [], "test", [])
+    writer = RunWriter(tmp_path, run_info([], "test", []))
     writer.append([ResultRow("s", "core", "rk4", 0.01, "m", 1.5, "m", "r", "ok"),
                    ResultRow("s", "core", "", math.nan, "m", math.nan, "m", "r", "n/a", "why")])
     pandas_recipe = next(b for b in _python_blocks() if "pd.read_csv(path" in b)

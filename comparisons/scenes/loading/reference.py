@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from simparity.comparisons.engines.registry import EngineSet
-from simparity.comparisons.execute.cases import NO_INTEGRATOR, motion_reference_integrator
+from simparity.comparisons.common.integrators import NO_INTEGRATOR, motion_reference_integrator
 from simparity.comparisons.scenes.loading.reader import TableReader
 from simparity.core.model.engine import Support
 from simparity.core.model.scenes.dynamics import DynamicsScene

@@ -50,7 +50,7 @@ def test_run_without_scenes_runs_a_whole_builtin_suite(tmp_path, monkeypatch, su
             seen.append((scene.name, tuple(e.name for e in engines)))
             yield scene, [], []
 
-    monkeypatch.setattr("simparity.comparisons.execute.session.run_scenes", run_scenes)
+    monkeypatch.setattr("simparity.comparisons.pipeline.session.run_scenes", run_scenes)
     code, _ = _run(["run", "--out", str(tmp_path), "--jobs", "1"] + (["--suite", suite] if suite else []))
     assert code == EXIT_OK
     wanted = suite or "default"
@@ -261,7 +261,7 @@ def test_run_check_junit_summary_and_history(tmp_path, capsys, projectile_run):
 def test_a_broken_history_database_never_loses_a_run(tmp_path, capsys, monkeypatch):
     """A database that fails when the run is recorded: one line on stderr, the run's CSV and report are written,
     exit 0. (One that is no database at all is refused before the run: tests/system/test_output_confinement.py.)"""
-    from simparity.comparisons.execute import session
+    from simparity.comparisons.pipeline import session
     from simparity.core.model.errors import HistoryError
 
     def broken(*args, **kwargs):
@@ -338,9 +338,10 @@ def test_check_explain_says_what_holds_an_engine(capsys, projectile_run):
 
 def _stored(path, rows, profile="quick"):
     """A stored run of ``rows`` (ResultRow) with ``profile`` in its run.json, written as 'simparity run' writes."""
-    from simparity.comparisons.execute.store import RunWriter
+    from simparity.comparisons.pipeline.run_info import run_info
+    from simparity.reports.store import RunWriter
 
-    RunWriter(path, [], "test", [], profile).append(rows)
+    RunWriter(path, run_info([], "test", [], profile)).append(rows)
     return path
 
 

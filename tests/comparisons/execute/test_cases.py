@@ -13,7 +13,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simparity.comparisons.execute.cases import DYNAMICS, IK, KINEMATICS, NO_INTEGRATOR, STABILITY, plan_scene, scene_hash
+from simparity.comparisons.execute.cases import DYNAMICS, IK, KINEMATICS, STABILITY, plan_scene
+from simparity.comparisons.common.integrators import NO_INTEGRATOR
+from simparity.comparisons.common.scene_hash import scene_hash
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes.library import builtin_paths
 from simparity.comparisons.scenes.loading.scene_file import load_scene
@@ -23,7 +25,7 @@ from tests.helpers import builtin
 @pytest.mark.slow
 def test_the_same_scene_hashes_the_same_in_another_process():
     here = scene_hash(builtin("ball-bounce-k05"))
-    code = ("from simparity.comparisons.execute.cases import scene_hash; "
+    code = ("from simparity.comparisons.common.scene_hash import scene_hash; "
             "from simparity.comparisons.scenes.loading.scene_file import "
             f"load_scene; print(scene_hash(load_scene({str(builtin_paths()['ball-bounce-k05'])!r})))")
     there = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,

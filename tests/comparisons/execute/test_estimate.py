@@ -7,11 +7,11 @@ from __future__ import annotations
 import pytest
 
 from simparity.comparisons.engines.registry import EngineSet, make_engine
-from simparity.comparisons.execute import session as session_module
+from simparity.comparisons.pipeline import session as session_module
 from simparity.comparisons.execute.estimate import RunEstimate, duration
 from simparity.comparisons.execute.execution import estimate
 from simparity.comparisons.execute.isolation import CaseLimits
-from simparity.comparisons.execute.session import ISOLATED, Execution, Session
+from simparity.comparisons.pipeline.session import ISOLATED, Execution, Session
 from simparity.comparisons.scenes.library import load
 from simparity.comparisons.scenes.profiles import quick
 

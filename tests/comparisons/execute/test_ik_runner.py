@@ -8,7 +8,7 @@ import pytest
 
 from simparity.comparisons.engines.registry import DEFAULT_ENGINES, make_engine
 from simparity.comparisons.execute.ik_runner import IK_METRICS, own_stop_rate, stopping_rule
-from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.execute.in_process import run_in_process as run_scene
 from simparity.comparisons.execute.ik_targets import random_targets
 from simparity.comparisons.scenes.profiles import quick
 from simparity.core.inhouse import InHouseEngine

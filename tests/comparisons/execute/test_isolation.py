@@ -12,8 +12,8 @@ from simparity.comparisons.cli.main import main
 from simparity.comparisons.scenes import library
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.execution import run_scenes
-from simparity.comparisons.execute.isolation import (BLAS_THREAD_VARIABLES, CaseLimits, IsolatedPool, death_cause,
-                                            worker_environment)
+from simparity.comparisons.common.processes import BLAS_THREAD_VARIABLES, death_cause, worker_environment
+from simparity.comparisons.execute.isolation import CaseLimits, IsolatedPool
 from simparity.comparisons.scenes.library import builtin_paths
 from tests.helpers import THROWN_BALL, no_leftovers_within
 

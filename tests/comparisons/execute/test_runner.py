@@ -9,7 +9,7 @@ import pytest
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.measure.metrics import DYNAMICS_METRICS, KINEMATICS_METRICS, ORDER_METRICS, dynamics_metrics
 from simparity.comparisons.execute.case_cost import BATCH_STEPS
-from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.execute.in_process import run_in_process as run_scene
 from simparity.comparisons.scenes.profiles import quick
 from simparity.core.model.engine import Simulation, Support
 from simparity.core.inhouse import InHouseEngine

@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 
 from simparity import run_scene
-from simparity.comparisons.execute.session import engine_specs, refuse_unreachable
+from simparity.comparisons.pipeline.session import engine_specs, refuse_unreachable
 from simparity.comparisons.scenes.library import load
 from simparity.comparisons.scenes.profiles import quick
 from simparity.core.model.errors import SimparityError

@@ -14,7 +14,8 @@ import pandas as pd
 import pytest
 
 from simparity.comparisons.cli.main import EXIT_FAILED_CASES, EXIT_USAGE, main
-from simparity.comparisons.execute.store import RunWriter
+from simparity.comparisons.pipeline.run_info import run_info
+from simparity.reports.store import RunWriter
 from simparity.comparisons.gate.check import check_table, compare_with_baseline
 from simparity.comparisons.gate.history import record_run
 from simparity.core.model import run_info
@@ -53,7 +54,7 @@ ratio) and a quoted detail."""
 
 
 def _run(folder, rows=ROWS, series=()):
-    writer = RunWriter(folder, [], "simparity run", [builtin(SCENE)])
+    writer = RunWriter(folder, run_info([], "simparity run", [builtin(SCENE)]))
     writer.append(rows, series)
     return folder
 

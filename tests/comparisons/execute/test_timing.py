@@ -7,13 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from simparity.comparisons.execute.timing import (
-    PeakMemory,
-    peak_memory,
-    record_peak_memory,
-    resource_line,
-    status_bytes,
-)
+from simparity.comparisons.execute.timing import PeakMemory, peak_memory, record_peak_memory, resource_line
+from simparity.comparisons.common.processes import status_bytes
 from simparity.core.model.results import RUN_INFO_FILE
 from simparity.core.model.run_info import RunInfo
 

@@ -35,9 +35,10 @@ reason = "ten times what a right engine errs by on my scene"
 
 
 def _stored(path: Path, rows: list[ResultRow]) -> Path:
-    from simparity.comparisons.execute.store import RunWriter
+    from simparity.comparisons.pipeline.run_info import run_info
+    from simparity.reports.store import RunWriter
 
-    RunWriter(path, [], "test", [], "quick").append(rows)
+    RunWriter(path, run_info([], "test", [], "quick")).append(rows)
     return path
 
 

@@ -32,9 +32,10 @@ def _rows(scene: str = "my-scene", engine: str = "mine", reference: str = "analy
 
 
 def _stored(path: Path, rows: list[ResultRow]) -> Path:
-    from simparity.comparisons.execute.store import RunWriter
+    from simparity.comparisons.pipeline.run_info import run_info
+    from simparity.reports.store import RunWriter
 
-    RunWriter(path, [], "test", [], "quick").append(rows)
+    RunWriter(path, run_info([], "test", [], "quick")).append(rows)
     return path
 
 

@@ -10,7 +10,7 @@ import pytest
 import pandas as pd
 
 from simparity.comparisons.engines.registry import make_engine
-from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.execute.in_process import run_in_process as run_scene
 from simparity.comparisons.gate.check import check_table
 from simparity.comparisons.gate.tolerances import load_tolerances
 from simparity.comparisons.measure.joint_motion_metrics import JOINT_MOTION_ORDERS

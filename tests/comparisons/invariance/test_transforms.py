@@ -16,7 +16,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from simparity.comparisons.scenes import library
-from simparity.comparisons.execute.cases import scene_hash
+from simparity.comparisons.common.scene_hash import scene_hash
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.invariance.perturb import ulp_perturbed
 from simparity.comparisons.invariance.rounding_allowance import rounding_floors

@@ -6,7 +6,7 @@ import numpy as np
 
 from simparity.comparisons.measure.divergence import AT_REST, DIVERGENCE_MARGIN, divergence
 from simparity.comparisons.engines.registry import make_engine
-from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.execute.in_process import run_in_process as run_scene
 from simparity.core.model.results import DIVERGED, OK
 from simparity.core.model.scenes.bodies import AppliedForce, Forces, RigidBody
 from simparity.core.model.scenes.dynamics import DynamicsScene

@@ -14,7 +14,7 @@ from simparity.comparisons.measure.metrics import (
     rounding_floors,
     trajectory_errors,
 )
-from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.execute.in_process import run_in_process as run_scene
 from simparity.comparisons.engines.registry import make_engine
 from simparity.core.model.scenes.bodies import Forces, RigidBody
 from simparity.core.model.scenes.dynamics import DynamicsScene

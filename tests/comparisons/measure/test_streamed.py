@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.engines.registry import make_engine
-from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.execute.in_process import run_in_process as run_scene
 from simparity.comparisons.measure import streamed
 from simparity.comparisons.measure.rows import Case
 from simparity.comparisons.measure.series import StreamedEnvelope, envelope

@@ -17,7 +17,7 @@ from simparity.comparisons.scenes.describe import describe
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes.profiles import quick
 from simparity.comparisons.scenes.loading.chain import EXAMPLE_ROBOT_DATA_PREFIX
-from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.execute.in_process import run_in_process as run_scene
 from simparity.comparisons.gate.tolerances import load_tolerances
 from simparity.core.model.errors import SceneError, SimparityError, UnknownSceneError
 from simparity.core.model.files import tomllib

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.engines.registry import make_engine
-from simparity.comparisons.execute.session import run_in_process as run_scene
+from simparity.comparisons.execute.in_process import run_in_process as run_scene
 from simparity.comparisons.scenes.loading.scene_file import load_scene
 from simparity.core.model.results import NOT_AVAILABLE, OK
 

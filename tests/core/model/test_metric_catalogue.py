@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 from simparity.comparisons.execute.ik_runner import IK_METRICS
-from simparity.comparisons.execute.session import run_in_process
+from simparity.comparisons.execute.in_process import run_in_process
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.measure.contact_metrics import CONTACT_METRICS
 from simparity.comparisons.measure.metrics import DRIFT_METRICS, DYNAMICS_METRICS, KINEMATICS_METRICS, ORDER_METRICS

@@ -20,27 +20,29 @@ from __future__ import annotations
 import contextlib
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Iterator, Sequence
+from typing import Callable, Sequence
 
 import pandas as pd
 
 from simparity.comparisons.engines.registry import EngineSet, check_engine_names, describe_engines, make_engine
-from simparity.comparisons.execute.cases import CaseOutcome
 from simparity.comparisons.execute.execution import Executor, default_jobs, estimate, run_scenes
-from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS, CaseLimits, IsolatedPool, Job
+from simparity.comparisons.execute.in_process import InProcessExecutor
+from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS, CaseLimits, IsolatedPool
 from simparity.comparisons.execute.journal import Journal, run_lock, write_request
 from simparity.comparisons.execute.progress import ProgressBar
-from simparity.comparisons.execute.runner import DEFAULT_REPEATS, run_group
-from simparity.comparisons.execute.store import RunWriter
+from simparity.comparisons.execute.runner import DEFAULT_REPEATS
 from simparity.comparisons.gate.bound_names import offered, refuse_impossible
 from simparity.comparisons.gate.check import CheckResult, check_table
 from simparity.comparisons.gate.history import record_run
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, Bound, load_tolerances
+from simparity.comparisons.gate.check_output import report_verdict
 from simparity.comparisons.invariance.invariance_run import invariance_rows
+from simparity.comparisons.pipeline.run_info import run_info
 from simparity.comparisons.scenes.profiles import apply_profile
 from simparity.core.model.engine import Engine
 from simparity.core.model.errors import HistoryError, SimparityError, one_line
 from simparity.core.model.results import COLUMNS, FAILED, RESULTS_FILE, ResultRow, SeriesRecord, case_counts
+from simparity.reports.store import RunWriter, read_info, read_run
 
 ISOLATED, DASK, IN_PROCESS = "local", "dask", "inline"
 """Where a session's cases run: worker processes here (each case's engine in a child of its own), a Dask
@@ -84,41 +86,6 @@ class Execution:
 
             return DaskExecutor(self.scheduler, self.jobs, self.limits or CaseLimits(DEFAULT_CASE_SECONDS, None))
         return IsolatedPool(self.jobs, self.limits or CaseLimits.default(self.jobs))
-
-
-class InProcessExecutor:
-    """Every job in this process, one after the other (``isolate=False``): no worker to start, and nothing between
-    an engine and the caller, so an engine that crashes ends the caller's interpreter."""
-
-    def __init__(self, engine_for: Callable[[str], Engine]) -> None:
-        self._engine_for = engine_for
-
-    def run(self, jobs: list[Job]) -> Iterator[tuple[object, int, CaseOutcome]]:
-        for job in jobs:
-            for index, outcome in run_group(job.group, self._engine_for, skip=frozenset(job.skip),
-                                            reference_failure=job.reference_failure):
-                yield job.key, index, outcome
-
-    def close(self) -> None:
-        return None
-
-
-def run_in_process(scene, engines: list[Engine], make_reference: Callable[[str], Engine],
-                   repeats: int = DEFAULT_REPEATS, series: list[SeriesRecord] | None = None) -> list[ResultRow]:
-    """All rows of one scene on ``engines`` (objects, used as given) against ``make_reference(scene.reference)``,
-    through the same pipeline as every run, its cases in this process. ``series``, when a list, gets the scene's
-    sampled series (:mod:`comparisons.measure.series`)."""
-    by_name = {e.name: e for e in engines}
-
-    def engine_for(name: str) -> Engine:
-        if name not in by_name:
-            by_name[name] = make_reference(name)
-        return by_name[name]
-
-    [(_, rows, records)] = run_scenes([scene], engines, engine_for, repeats, InProcessExecutor(engine_for))
-    if series is not None:
-        series += records
-    return rows
 
 
 @dataclass(frozen=True)
@@ -269,10 +236,11 @@ class Session:
             if self.out_dir is not None:
                 self.say(f"interrupted; results so far are in {self.out_dir / RESULTS_FILE}; finish the run with: "
                          f"simparity run --resume {self.out_dir}")
-            self._write_report()
+            self._write_report(store.table())
             return SessionResult(self.out_dir, store.table(), failed, interrupted=True)
         except SimparityError:
-            self._write_report()  # keep what was computed, then report the error
+            if store.closed:
+                self._write_report(store.table())  # keep what was computed, then report the error
             raise
         unfinished = unreadable = 0
         if journal is not None:
@@ -287,32 +255,26 @@ class Session:
                 journal.remove()
         table = store.table()
         self._record(table)  # before the report: a report that cannot be drawn never costs the run its history
-        checked = self._write_report()
+        checked = self._write_report(table)
         check = None
         if self.bounds is not None:
             check = checked if checked is not None else check_table(table, self.bounds)
         return SessionResult(self.out_dir, table, failed, unfinished, unreadable, check)
 
-    def _write_report(self) -> CheckResult | None:
-        """report.md, report.html and figures/ of a stored run (when asked for); its metrics held to the session's
-        bounds (default: the shipped tolerances) for the report's flagged findings. Returns that verdict."""
-        if self.out_dir is None or not self.report:
+    def _write_report(self, table: pd.DataFrame) -> CheckResult | None:
+        """report.md, report.html and figures/ of a stored run (when asked for), ``table`` its rows; its metrics held to
+        the session's bounds (default: the shipped tolerances) for the report's flagged findings. Returns that verdict."""
+        if self.out_dir is None or not self.report or table.empty:  # empty: interrupted before its first row
             return None
-        from simparity.reports.store import read_run
-
-        if read_run(self.out_dir, empty=True)[0].empty:  # interrupted before its first row: nothing to report
-            return None
-        return write_run_report(self.out_dir, self.say, self.bounds, self.held)
+        return write_run_report(self.out_dir, self.say, self.bounds, self.held, table)
 
     def _record(self, table: pd.DataFrame) -> None:
-        """Copy a stored run into the history database; a database problem is one line, never a lost run."""
+        """Copy a stored run (``table``: its rows) into the history database; a database problem is one line, never a
+        lost run."""
         if self.out_dir is None or self.history is None:
             return
-        from simparity.reports.store import read_run
-
-        _, info = read_run(self.out_dir, empty=True)
         try:
-            record_run(self.history, self.out_dir.resolve(), info, table)
+            record_run(self.history, self.out_dir.resolve(), read_info(self.out_dir), table)
         except HistoryError as err:
             self.warn(f"simparity: history not updated: {one_line(err, 1000)}; the run is in {self.out_dir}")
 
@@ -321,8 +283,10 @@ class _Store:
     """Where a session's rows go: the run folder (``RunWriter``), or memory when it has none."""
 
     def __init__(self, out_dir: Path | None, engines: list[Engine], command: str, scenes: list, profile: str) -> None:
-        self.writer = RunWriter(out_dir, engines, command, scenes, profile) if out_dir is not None else None
+        self.writer = RunWriter(out_dir, run_info(engines, command, scenes, profile)) if out_dir is not None else None
         self.rows: list[ResultRow] = []
+        self.written: pd.DataFrame | None = None
+        self.closed = False
 
     def append(self, rows: list[ResultRow], series: Sequence[SeriesRecord] = ()) -> None:
         if self.writer is not None:
@@ -331,31 +295,31 @@ class _Store:
             self.rows += rows
 
     def close(self) -> None:
-        """Every row is in: the stored run's typed copy (``results.parquet``), when it has a folder."""
+        """Every row is in: the stored run read back once and its typed copy (``results.parquet``) written, when it
+        has a folder."""
         if self.writer is not None:
-            self.writer.finish()
+            self.written = self.writer.finish()
+        self.closed = True
 
     def table(self) -> pd.DataFrame:
-        if self.writer is not None:
-            from simparity.reports.store import read_run
-
-            return read_run(self.writer.out_dir, empty=True)[0]
+        """Every row of the run (after :meth:`close`): as the writer read ``results.csv`` back, or from memory."""
+        if self.written is not None:
+            return self.written
         return pd.DataFrame([r.as_dict() for r in self.rows], columns=list(COLUMNS))
 
 
 def write_run_report(out_dir: Path, say: Say, bounds: list[Bound] | None = None,
-                     held: tuple[str, ...] | None = None) -> CheckResult:
-    """report.md, report.html and figures/ of the run in ``out_dir``; its metrics are held to ``bounds`` (default:
-    the shipped tolerances) for the report's flagged findings, which never changes an exit code. Returns that
-    verdict."""
-    from simparity.comparisons.gate.check_output import report_verdict
-    from simparity.reports.render import write_report
-    from simparity.reports.store import read_run
+                     held: tuple[str, ...] | None = None, table: pd.DataFrame | None = None) -> CheckResult:
+    """report.md, report.html and figures/ of the run in ``out_dir`` (``table``: its rows, as the writer handed them
+    back; None: read from the folder); its metrics are held to ``bounds`` (default: the shipped tolerances) for the
+    report's flagged findings, which never changes an exit code. Returns that verdict."""
+    from simparity.reports.render import write_report  # imports matplotlib: only when a report is drawn
 
-    table, _ = read_run(out_dir)
+    if table is None:
+        table, _ = read_run(out_dir)
     result = check_table(table, bounds if bounds is not None else load_tolerances(DEFAULT_TOLERANCES))
     verdict = report_verdict(result, held)
-    markdown, page = write_report(out_dir, verdict)
+    markdown, page = write_report(out_dir, verdict, table)
     say(f"results: {Path(out_dir) / RESULTS_FILE}\nreport:  {markdown}\n         {page}")
     return result
 
