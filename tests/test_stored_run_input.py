@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 from simparity.comparisons.cli.main import EXIT_FAILED_CASES, EXIT_USAGE, main
-from simparity.comparisons.pipeline.run_info import run_info
+from simparity.comparisons.pipeline.run_info import describe_run
 from simparity.reports.store import RunWriter
 from simparity.comparisons.gate.check import check_table, compare_with_baseline
 from simparity.comparisons.gate.history import record_run
@@ -55,7 +55,7 @@ FIELDS = len(COLUMNS)
 
 
 def _run(folder, rows=ROWS, series=()):
-    writer = RunWriter(folder, run_info([], "simparity run", [builtin(SCENE)]))
+    writer = RunWriter(folder, describe_run([], "simparity run", [builtin(SCENE)]))
     writer.append(rows, series)
     return folder
 
