@@ -402,4 +402,5 @@ def test_a_session_reads_back_a_run_interrupted_before_its_first_row(tmp_path):
     assert read_run(run, empty=True)[0].empty
     with pytest.raises(ResultsError, match="no rows"):
         read_run(run)
-    assert store.write_parquet(run) is not None
+    writer = RunWriter(run, describe_run([], "simparity run", [builtin(SCENE)]))
+    assert writer.finish().empty and (run / store.RESULTS_PARQUET_FILE).is_file()  # the typed copy of no rows
