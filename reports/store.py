@@ -215,19 +215,10 @@ def _read_parquet(path: Path, results: Path, empty: bool = False) -> pd.DataFram
         raise refuse(err, one_line(path), lambda row: f"row {row + 1}", ResultsError) from None
 
 
-def write_parquet(run_dir: str | Path) -> Path | None:
-    """``results.parquet`` beside the run's ``results.csv``: the same table as :func:`read_run` reads from the CSV,
-    the :data:`CATEGORICAL_COLUMNS` dictionary-encoded, numbers typed. Written to a temporary name and renamed. Returns
-    its path; None (and nothing written) without pyarrow."""
-    if not parquet_available():
-        return None
-    run_dir = Path(run_dir)
-    schema = RunInfo.read(run_dir / RUN_INFO_FILE).schema_version
-    return _write_parquet(_read_csv(run_dir / RESULTS_FILE, fixed_columns(schema), empty=True), run_dir)
-
-
 def _write_parquet(table: pd.DataFrame, run_dir: Path) -> Path:
-    """``table`` (as :func:`_read_csv` read the run's CSV) as the run's ``results.parquet``; returns its path."""
+    """``results.parquet`` beside the run's ``results.csv``: ``table`` (as :func:`_read_csv` read the CSV, the same
+    table :func:`read_run` reads from it), the :data:`CATEGORICAL_COLUMNS` dictionary-encoded, numbers typed. Written
+    to a temporary name and renamed. Returns its path."""
     typed = table.astype({c: "category" for c in CATEGORICAL_COLUMNS if c in table.columns})
     path = run_dir / RESULTS_PARQUET_FILE
     partial = path.with_name(path.name + ".partial")

@@ -75,7 +75,7 @@ def _scene_info(scene) -> dict:
     return info
 
 
-def run_info(engines: list[Engine], command: str, scenes: list, profile: str = "") -> RunInfo:
+def describe_run(engines: list[Engine], command: str, scenes: list, profile: str = "") -> RunInfo:
     """``run.json`` of a run of ``scenes`` on ``engines`` by ``command`` under ``profile``, created now."""
     return RunInfo(
         schema_version=SCHEMA_VERSION,

@@ -37,7 +37,7 @@ from simparity.comparisons.gate.history import record_run
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, Bound, load_tolerances
 from simparity.comparisons.gate.check_output import report_verdict
 from simparity.comparisons.invariance.invariance_run import invariance_rows
-from simparity.comparisons.pipeline.run_info import run_info
+from simparity.comparisons.pipeline.run_info import describe_run
 from simparity.comparisons.scenes.profiles import apply_profile
 from simparity.core.model.engine import Engine
 from simparity.core.model.errors import HistoryError, SimparityError, one_line
@@ -283,7 +283,7 @@ class _Store:
     """Where a session's rows go: the run folder (``RunWriter``), or memory when it has none."""
 
     def __init__(self, out_dir: Path | None, engines: list[Engine], command: str, scenes: list, profile: str) -> None:
-        self.writer = RunWriter(out_dir, run_info(engines, command, scenes, profile)) if out_dir is not None else None
+        self.writer = RunWriter(out_dir, describe_run(engines, command, scenes, profile)) if out_dir is not None else None
         self.rows: list[ResultRow] = []
         self.written: pd.DataFrame | None = None
         self.closed = False

@@ -10,7 +10,7 @@ import pytest
 
 from simparity.comparisons.cli.main import main
 from simparity.comparisons.scenes.loading.scene_file import parse_scenes
-from simparity.comparisons.pipeline.run_info import run_info
+from simparity.comparisons.pipeline.run_info import describe_run
 from simparity.reports.store import RunWriter
 from simparity.core.model.files import tomllib
 from simparity.core.model.results import REPORT_FILE, SERIES_COLUMNS, ResultRow
@@ -47,7 +47,7 @@ def _case(scene, engine, integrator, error, seconds_per_step, status="ok", dt=0.
 
 
 def _stored(tmp_path, scenes, rows):
-    writer = RunWriter(tmp_path, run_info([], "simparity run", scenes))
+    writer = RunWriter(tmp_path, describe_run([], "simparity run", scenes))
     writer.append(rows)
     return read_run(tmp_path)
 

@@ -4,7 +4,7 @@ import math
 import re
 from pathlib import Path
 
-from simparity.comparisons.pipeline.run_info import run_info
+from simparity.comparisons.pipeline.run_info import describe_run
 
 from simparity.reports.store import RunWriter
 from simparity.core.model.results import ResultRow
@@ -18,7 +18,7 @@ def _python_blocks() -> list[str]:
 
 def test_loading_recipes_give_numeric_columns_and_keep_n_a(tmp_path):
     """Both loading recipes read dt and value as numbers and the status n/a as text."""
-    writer = RunWriter(tmp_path, run_info([], "test", []))
+    writer = RunWriter(tmp_path, describe_run([], "test", []))
     writer.append([ResultRow("s", "core", "rk4", 0.01, "m", 1.5, "m", "r", "ok"),
                    ResultRow("s", "core", "", math.nan, "m", math.nan, "m", "r", "n/a", "why")])
     pandas_recipe = next(b for b in _python_blocks() if "pd.read_csv(path" in b)

@@ -338,10 +338,10 @@ def test_check_explain_says_what_holds_an_engine(capsys, projectile_run):
 
 def _stored(path, rows, profile="quick"):
     """A stored run of ``rows`` (ResultRow) with ``profile`` in its run.json, written as 'simparity run' writes."""
-    from simparity.comparisons.pipeline.run_info import run_info
+    from simparity.comparisons.pipeline.run_info import describe_run
     from simparity.reports.store import RunWriter
 
-    RunWriter(path, run_info([], "test", [], profile)).append(rows)
+    RunWriter(path, describe_run([], "test", [], profile)).append(rows)
     return path
 
 

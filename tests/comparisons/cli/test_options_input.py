@@ -17,7 +17,7 @@ from simparity.comparisons.cli.main import EXIT_USAGE, main
 from simparity.comparisons.engines.placeholders import BrokenEngine, NotAnEngine
 from simparity.comparisons.engines.plugins import load_engine
 from simparity.comparisons.execute.isolation import GIB, MIN_CASE_MEMORY_BYTES
-from simparity.comparisons.pipeline.run_info import run_info
+from simparity.comparisons.pipeline.run_info import describe_run
 from simparity.reports.store import RunWriter
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.invariance.transforms import TRANSFORM_NAMES
@@ -40,7 +40,7 @@ def _refused(capsys, argv: list[str]) -> str:
 def stored_run(tmp_path):
     """A run folder as 'simparity run' writes it, of a few rows of core on the projectile (no engine runs)."""
     folder = tmp_path / "stored"
-    writer = RunWriter(folder, run_info([make_engine("core")], "simparity run", [builtin(SCENE)], profile="quick"))
+    writer = RunWriter(folder, describe_run([make_engine("core")], "simparity run", [builtin(SCENE)], profile="quick"))
     writer.append([ResultRow(SCENE, "core", "rk4", dt, "position_error_max", 1e-12, "m", "analytic:exact", OK,
                              scheme="rk4") for dt in (0.1, 0.05)])
     writer.finish()

@@ -9,7 +9,7 @@ import pytest
 
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes.loading.scene_file import parse_scenes
-from simparity.comparisons.pipeline.run_info import run_info
+from simparity.comparisons.pipeline.run_info import describe_run
 from simparity.core.model.errors import ResultsError
 from simparity.core.model.files import tomllib
 from simparity.core.model.results import COLUMNS, RESULTS_FILE, ResultRow
@@ -22,7 +22,7 @@ from tests.comparisons.scenes.test_loader import VALID_DYNAMICS, VALID_KINEMATIC
 def test_rows_round_trip_with_full_precision(tmp_path):
     """Appended rows read back with the same values (17 digits), NaN kept as NaN, metadata present."""
     core = make_engine("core")
-    writer = RunWriter(tmp_path, run_info([core], "simparity run", [builtin("lecture-projectile")]))
+    writer = RunWriter(tmp_path, describe_run([core], "simparity run", [builtin("lecture-projectile")]))
     value = 0.1 + 0.2
     writer.append([ResultRow("s", "core", "rk4", 1 / 30, "m", value, "m", "analytic:exact", "ok", "a, b")])
     writer.append([ResultRow("s", "core", "", math.nan, "m", math.nan, "m", "analytic:exact", "n/a", "why")])
@@ -42,7 +42,7 @@ def test_bad_run_folders_raise_results_error(tmp_path):
     """A folder without results, or with a future schema, is a ResultsError saying what is wrong."""
     with pytest.raises(ResultsError, match="missing"):
         read_run(tmp_path)
-    RunWriter(tmp_path, run_info([], "x", []))
+    RunWriter(tmp_path, describe_run([], "x", []))
     info = json.loads((tmp_path / "run.json").read_text())
     info["schema_version"] = 99
     (tmp_path / "run.json").write_text(json.dumps(info))
@@ -66,7 +66,7 @@ def test_a_run_of_swept_scenes_has_a_column_per_swept_key(tmp_path):
     """Issue #12: `sweep` (the base scene) and `sweep:KEY` per swept key after the fixed columns, read back exactly
     and typed (a seed stays a whole number), empty where a scene does not sweep the key; run.json has the sweep."""
     scenes = _swept_scenes()
-    writer = RunWriter(tmp_path, run_info([], "simparity run", scenes))
+    writer = RunWriter(tmp_path, describe_run([], "simparity run", scenes))
     writer.append([_row(s.name) for s in scenes[3:]])          # rows arrive in any order
     writer.append([_row(s.name) for s in scenes[:3]] + [_row("not-in-the-run")])
     table, info = read_run(tmp_path)
@@ -84,7 +84,7 @@ def test_a_run_of_swept_scenes_has_a_column_per_swept_key(tmp_path):
 
 
 def test_a_run_without_sweeps_keeps_exactly_the_fixed_columns(tmp_path):
-    writer = RunWriter(tmp_path, run_info([], "simparity run", [builtin("lecture-projectile")]))
+    writer = RunWriter(tmp_path, describe_run([], "simparity run", [builtin("lecture-projectile")]))
     writer.append([_row("lecture-projectile")])
     assert (tmp_path / RESULTS_FILE).read_text(encoding="utf-8").splitlines()[0] == ",".join(COLUMNS)
     table, _ = read_run(tmp_path)
@@ -92,7 +92,7 @@ def test_a_run_without_sweeps_keeps_exactly_the_fixed_columns(tmp_path):
 
 
 def test_a_damaged_sweep_column_is_a_results_error(tmp_path):
-    writer = RunWriter(tmp_path, run_info([], "simparity run", _swept_scenes()[:2]))
+    writer = RunWriter(tmp_path, describe_run([], "simparity run", _swept_scenes()[:2]))
     writer.append([_row("drop_mass-1.0")])
     path = tmp_path / RESULTS_FILE
     path.write_text(path.read_text(encoding="utf-8").replace(",drop,1.0", ",drop,heavy"), encoding="utf-8")
@@ -104,7 +104,7 @@ def _finished_sweep(tmp_path) -> tuple[list, pd.DataFrame]:
     """A finished run of swept scenes (floats, whole numbers, NaN, n/a and empty cells) with its results.parquet: (its
     scenes, the table its writer handed back)."""
     scenes = _swept_scenes()
-    writer = RunWriter(tmp_path, run_info([], "simparity run", scenes))
+    writer = RunWriter(tmp_path, describe_run([], "simparity run", scenes))
     writer.append([_row(s.name) for s in scenes])
     writer.append([ResultRow(scenes[0].name, "mujoco", "", math.nan, "position_error_max", math.nan, "m",
                              "analytic:exact", "n/a", "no such integrator, \"quoted\"", "saturated", "rk4")])
@@ -169,6 +169,6 @@ def test_a_run_that_starts_writing_again_drops_its_parquet(tmp_path):
     """A new run or a resumed one in the folder rewrites results.csv from its first row: the parquet of the run before
     is removed at once, so read_run never reads rows the CSV no longer has."""
     scenes, _ = _finished_sweep(tmp_path)
-    RunWriter(tmp_path, run_info([], "simparity run --resume", scenes)).append([_row(scenes[0].name)])
+    RunWriter(tmp_path, describe_run([], "simparity run --resume", scenes)).append([_row(scenes[0].name)])
     assert not (tmp_path / store.RESULTS_PARQUET_FILE).exists()
     assert len(read_run(tmp_path)[0]) == 1

@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 from simparity.comparisons.cli.main import EXIT_FAILED_CASES, EXIT_USAGE, main
-from simparity.comparisons.pipeline.run_info import run_info
+from simparity.comparisons.pipeline.run_info import describe_run
 from simparity.reports.store import RunWriter
 from simparity.comparisons.gate.check import check_table, compare_with_baseline
 from simparity.comparisons.gate.history import record_run
@@ -54,7 +54,7 @@ ratio) and a quoted detail."""
 
 
 def _run(folder, rows=ROWS, series=()):
-    writer = RunWriter(folder, run_info([], "simparity run", [builtin(SCENE)]))
+    writer = RunWriter(folder, describe_run([], "simparity run", [builtin(SCENE)]))
     writer.append(rows, series)
     return folder
 
@@ -401,4 +401,5 @@ def test_a_session_reads_back_a_run_interrupted_before_its_first_row(tmp_path):
     assert read_run(run, empty=True)[0].empty
     with pytest.raises(ResultsError, match="no rows"):
         read_run(run)
-    assert store.write_parquet(run) is not None
+    writer = RunWriter(run, describe_run([], "simparity run", [builtin(SCENE)]))
+    assert writer.finish().empty and (run / store.RESULTS_PARQUET_FILE).is_file()  # the typed copy of no rows

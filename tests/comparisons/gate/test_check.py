@@ -11,7 +11,7 @@ from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes.profiles import quick
 from simparity.comparisons.execute.in_process import run_in_process as run_scene
 from simparity.comparisons.scenes.loading.scene_file import parse_scenes
-from simparity.comparisons.pipeline.run_info import run_info
+from simparity.comparisons.pipeline.run_info import describe_run
 from simparity.reports.store import RunWriter
 from simparity.comparisons.gate.tolerances import load_tolerances
 from simparity.core.dynamics import tableau
@@ -107,8 +107,8 @@ def test_a_run_with_sweep_columns_is_checked_and_compared_like_any_other(bounds,
     sweeps (fixed columns only) is its baseline without a move."""
     variants = parse_scenes(tomllib.loads(VALID_DYNAMICS + '[sweep]\n"body[ball].mass" = [1.0, 2.0]\n'))
     rows = [dataclasses.replace(_row(value=value), scene=scene.name) for scene in variants for value in (4.02, 2.9)]
-    RunWriter(tmp_path / "new", run_info([], "simparity run", variants)).append(rows)
-    RunWriter(tmp_path / "old", run_info([], "simparity run", [])).append(rows)
+    RunWriter(tmp_path / "new", describe_run([], "simparity run", variants)).append(rows)
+    RunWriter(tmp_path / "old", describe_run([], "simparity run", [])).append(rows)
     new, old = read_run(tmp_path / "new")[0], read_run(tmp_path / "old")[0]
     assert "sweep:body[ball].mass" in new.columns and tuple(old.columns) == COLUMNS
     verdict = check_table(new, bounds)

@@ -69,14 +69,14 @@ def example_run():
 @pytest.mark.slow
 def test_a_baseline_that_differs_fails(pytester, tmp_path, example_run):
     """--simparity-baseline with a stored run whose value differs: the move is reported."""
-    from simparity.comparisons.pipeline.run_info import run_info
+    from simparity.comparisons.pipeline.run_info import describe_run
     from simparity.reports.store import RunWriter
     from simparity.core.model.results import ResultRow
 
     scene, table = example_run
     table = table.copy()
     table.loc[table["metric"] == "position_error_final", "value"] *= 1.01
-    writer = RunWriter(tmp_path / "base", run_info([], "test", [scene]))
+    writer = RunWriter(tmp_path / "base", describe_run([], "test", [scene]))
     writer.append([ResultRow(**row) for row in table.to_dict("records")])
     pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
     result = pytester.runpytest_subprocess("--simparity-baseline", str(tmp_path / "base"))
@@ -115,7 +115,7 @@ def test_the_documented_example_passes_against_a_baseline_that_ran_more_engines(
     plus another scene: the example, which runs core alone, has nothing moved and nothing missing."""
     import dataclasses
 
-    from simparity.comparisons.pipeline.run_info import run_info
+    from simparity.comparisons.pipeline.run_info import describe_run
 
     from simparity.reports.store import RunWriter
     from simparity.core.model.results import ResultRow
@@ -124,7 +124,7 @@ def test_the_documented_example_passes_against_a_baseline_that_ran_more_engines(
     rows = [ResultRow(**row) for row in table.to_dict("records")]
     more = rows + [dataclasses.replace(r, engine="mujoco") for r in rows] + [
         dataclasses.replace(r, scene="wind") for r in rows]
-    RunWriter(tmp_path / "base", run_info([], "test", [scene], "quick")).append(more)
+    RunWriter(tmp_path / "base", describe_run([], "test", [scene], "quick")).append(more)
     pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
     result = pytester.runpytest_subprocess("--simparity-baseline", str(tmp_path / "base"))
     result.assert_outcomes(passed=1)

@@ -35,10 +35,10 @@ reason = "ten times what a right engine errs by on my scene"
 
 
 def _stored(path: Path, rows: list[ResultRow]) -> Path:
-    from simparity.comparisons.pipeline.run_info import run_info
+    from simparity.comparisons.pipeline.run_info import describe_run
     from simparity.reports.store import RunWriter
 
-    RunWriter(path, run_info([], "test", [], "quick")).append(rows)
+    RunWriter(path, describe_run([], "test", [], "quick")).append(rows)
     return path
 
 

@@ -32,10 +32,10 @@ def _rows(scene: str = "my-scene", engine: str = "mine", reference: str = "analy
 
 
 def _stored(path: Path, rows: list[ResultRow]) -> Path:
-    from simparity.comparisons.pipeline.run_info import run_info
+    from simparity.comparisons.pipeline.run_info import describe_run
     from simparity.reports.store import RunWriter
 
-    RunWriter(path, run_info([], "test", [], "quick")).append(rows)
+    RunWriter(path, describe_run([], "test", [], "quick")).append(rows)
     return path
 
 

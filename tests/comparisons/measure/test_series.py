@@ -9,7 +9,7 @@ from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.measure.rows import Case
 from simparity.comparisons.execute.in_process import run_in_process as run_scene
 from simparity.comparisons.measure.series import dynamics_series, envelope
-from simparity.comparisons.pipeline.run_info import run_info
+from simparity.comparisons.pipeline.run_info import describe_run
 from simparity.reports.store import RunWriter
 from simparity.core.model.results import SERIES_POINTS
 from simparity.core.model.scenes.bodies import Forces, RigidBody
@@ -72,7 +72,7 @@ def test_runner_series_round_trip_through_the_store(tmp_path):
     engines = [make_engine("core"), make_engine("mujoco")]
     series = []
     rows = run_scene(scene, engines, make_engine, repeats=0, series=series)
-    writer = RunWriter(tmp_path, run_info(engines, "test", [scene]))
+    writer = RunWriter(tmp_path, describe_run(engines, "test", [scene]))
     writer.append(rows, series[: len(series) // 2])
     writer.append([], series[len(series) // 2:])   # a second gzip member reads as the same file
     table = read_series(tmp_path)
