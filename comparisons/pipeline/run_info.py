@@ -17,6 +17,7 @@ from simparity.core.model.results import SCHEMA_VERSION
 from simparity.core.model.run_info import RunInfo
 from simparity.core.model.scene import DynamicsScene, IKScene, JointMotionScene
 
+
 def git_commit() -> str:
     """``git describe``-style commit of the project source (``unknown`` outside a checkout)."""
     here = Path(__file__).resolve().parent
