@@ -6,6 +6,7 @@ import traceback
 
 from simparity.core.model.errors import PluginError
 
+
 def error_text(err: BaseException) -> str:
     """``Type: message at file:line`` of an exception, on one line; an engine standing in for a broken one raises
     a :class:`PluginError` whose message says all (where it was raised is simparity's, not the engine's)."""

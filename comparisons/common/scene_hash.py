@@ -10,6 +10,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+
 def scene_hash(scene) -> str:
     """SHA-256 of a scene's content: every field of its dataclasses that takes part in their equality (not
     ``compare=False`` ones, such as the file a scene was read from: the same file by a relative or an absolute

@@ -19,6 +19,7 @@ from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 
+
 def git_commit() -> str:
     """``git describe``-style commit of the project source (``unknown`` outside a checkout)."""
     here = Path(__file__).resolve().parent
