@@ -5,13 +5,10 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from typing import TYPE_CHECKING
 
 from simparity.comparisons.gate.check import BaselineDiff, CheckResult
 from simparity.comparisons.gate.violation import GROUP_METRICS_SHOWN, Violation, grouped
-
-if TYPE_CHECKING:  # the report's modules draw figures: imported when a report is written, not by every check
-    from simparity.reports.tolerance_verdict import ToleranceVerdict
+from simparity.reports.tolerance_verdict import ToleranceVerdict  # a dataclass alone: no figure module comes with it
 
 
 MESSAGE_CHARS = 500
@@ -45,8 +42,6 @@ def held_line(result: CheckResult) -> str:
 def report_verdict(result: CheckResult, held: tuple[str, ...] | None = None) -> ToleranceVerdict:
     """The verdict as the report shows it: counts, one line per case and reason with the engine it is about, and the
     engines the gate holds (``held``, else the result's; None: every one)."""
-    from simparity.reports.tolerance_verdict import ToleranceVerdict
-
     groups = grouped(result.violations + result.findings)
     return ToleranceVerdict(result.checked, result.unchecked, tuple(g.line() for g in groups),
                             len(result.violations) + len(result.findings),
