@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
 import shutil
 import subprocess
 import sys
@@ -29,7 +30,8 @@ def test_the_same_scene_hashes_the_same_in_another_process():
             "from simparity.comparisons.scenes.loading.scene_file import "
             f"load_scene; print(scene_hash(load_scene({str(builtin_paths()['ball-bounce-k05'])!r})))")
     there = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True,
-                           env={"PYTHONHASHSEED": "123", "PATH": ""}).stdout.strip()
+                           env={"PYTHONHASHSEED": "123", "PATH": "",  # the simparity under test, not the installed one
+                                **{k: v for k, v in os.environ.items() if k == "PYTHONPATH"}}).stdout.strip()
     assert here == there == scene_hash(builtin("ball-bounce-k05"))
 
 
