@@ -64,6 +64,9 @@ Every refusal about a link or a joint names it and its branch from the tree's ro
 Anything else is rejected with a :class:`~core.errors.SceneError` naming the element; nothing is
 guessed. A file with a ``<!DOCTYPE>`` (hence any entity declaration) or elements nested deeper than
 :data:`core.model.files.MAX_XML_DEPTH` is refused before anything is read from it.
+
+Over 600 lines: one format's reader. Every check (each naming the element and its branch) and the chain
+assembled from the file work on the same parsed joints and links.
 """
 
 from __future__ import annotations

@@ -7,10 +7,11 @@ import pytest
 
 from simparity.comparisons.gate.history import HISTORY_ENV
 
-UNMARKED_CPU_SECONDS_MAX = 2.0
+UNMARKED_CPU_SECONDS_MAX = 3.0
 """CPU seconds (this process's and the child processes it waited for: worker pools, `simparity` subprocesses) a test
 not marked ``slow`` may spend in its set-up and call. The marker's own definition (pyproject's markers) is "a second or
-more"; twice that, so a test near a second does not flip from one machine to the next. CPU time, not the clock: a
+more"; the tests measured over ~1.2 s here are marked, and three seconds leaves them room on a machine up to ~2.5 times
+slower (a fresh CI machine), so a test near a second does not flip from one machine to the next. CPU time, not the clock: a
 machine loaded by other work does not make a test slow. A child still running when the test ends is not counted."""
 UNMARKED_WALL_SECONDS_MAX = 60.0
 """Seconds by the clock an unmarked test may take (a test that waits spends no CPU): the inner loop's whole budget

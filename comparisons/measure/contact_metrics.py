@@ -16,6 +16,9 @@ truth (sampled at the same times) and each engine are measured by one protocol:
   body that does not turn, the contact point's).
 
 Definitions with their reasons are in docs/metrics.md ("Contact").
+
+Over 600 lines: one protocol. The impact episodes (:func:`read_contact`) and every contact metric
+read the same :class:`ContactReading`; apart, each metric module would re-derive the episodes' conventions.
 """
 
 from __future__ import annotations

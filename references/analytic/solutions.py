@@ -8,6 +8,10 @@ Translation: :func:`projectile`, :func:`linear_drag`, :func:`quadratic_drag_alon
 Rotation: :func:`linear_angular_drag_isotropic`, :func:`torque_free_axisymmetric`,
 :func:`torque_free_asymmetric` (Jacobi elliptic functions + quadrature) and
 :func:`intermediate_axis_flip_period`. Rotations are SciPy's (:mod:`simparity.references.common.conventions`), not core's.
+
+Over 600 lines: the asymmetric torque-free solution alone (Jacobi elliptic functions by the Landen ladder,
+the precession quadrature, the Euler-angle assembly) is half the module, and the other closed forms share its
+helpers.
 """
 
 from __future__ import annotations

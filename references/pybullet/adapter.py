@@ -69,6 +69,9 @@ Conversions and overridden defaults (each pinned by a test in ``tests/references
   step unless rest_speed / k exceeds |g| dt (measured 3.3e-6 m at k = 0.5, dt = 1e-3), and
   bounces settle at a rebound speed k |g| dt / (1 - k) instead of dying out (hard-zeno, k = 0.9,
   dt = 0.01: still bouncing ~7 cm high at the end).
+
+Over 600 lines: one engine's adapter. Every conversion to and from PyBullet is here by the architecture's
+rule (conversions live in the engine's adapter), with the defaults it overrides listed above.
 """
 
 from __future__ import annotations
