@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from simparity.comparisons.engines.placeholders import UnavailableEngine
 from simparity.comparisons.engines.registry import EngineSet
 from simparity.comparisons.common.integrators import NO_INTEGRATOR, motion_reference_integrator
 from simparity.comparisons.scenes.loading.reader import TableReader
@@ -20,8 +21,6 @@ def check_reference(top: TableReader, scene, engines: EngineSet) -> None:
             raise top.fail("scene.reference", "core is the reference, but the scene's contact methods leave out "
                            "backup, its exact one", 'contact.methods with "backup", or another reference')
         return
-    from simparity.comparisons.engines.placeholders import UnavailableEngine
-
     engine = engines.reference(scene.reference)
     if isinstance(engine, UnavailableEngine):  # its library is missing here: the run's rows say so
         return
