@@ -4,7 +4,8 @@ The proof that a change which must not move a number did not (a redesign, a move
 suites before and after it (``simparity run --suite S --quick --out DIR`` at each commit) and compare. Every
 column of ``results.csv`` must be equal, row for row and in the same order, except the value and detail of the
 timing metrics (``time_per_*``: wall time), and where a detail names a file an engine read from an installed package
-(``.../site-packages/pybullet_data/...``): two environments install it in two places. The sampled series
+(``.../site-packages/pybullet_data/...``) or a built-in scene's file in simparity's checkout: two environments install
+them in two places. The sampled series
 (``series.csv.gz``) must be equal too, every value as written. Prints one line per difference (at most :data:`SHOWN`) and a count;
 exit 0 when the runs are the same, 1 when not.
 """
@@ -26,6 +27,9 @@ TIMING_PREFIX = "time_per_"
 INSTALLED = re.compile(r"\S*/site-packages/")
 """Where an environment installed a package (a detail names the robot file an engine read)."""
 
+CHECKOUT = re.compile(r"\S*?/(?=comparisons/scenes/)")
+"""Where simparity itself lives (a detail names a built-in scene's URDF file): two checkouts, two places."""
+
 SHOWN = 20
 """Differences printed at most (the count covers all)."""
 
@@ -33,7 +37,8 @@ SHOWN = 20
 def _read(run_dir: Path) -> pd.DataFrame:
     # Every column as text: numbers are compared as written (repr round-trips float64 exactly).
     table = pd.read_csv(Path(run_dir) / RESULTS_FILE, dtype=str, keep_default_na=False)
-    table["detail"] = table["detail"].str.replace(INSTALLED, "<site-packages>/", regex=True)
+    table["detail"] = (table["detail"].str.replace(INSTALLED, "<site-packages>/", regex=True)
+                       .str.replace(CHECKOUT, "<simparity>/", regex=True))
     return table
 
 

@@ -33,6 +33,22 @@ def test_where_an_environment_installed_a_package_is_not_a_difference(tmp_path):
     assert differences(before, after) == []
 
 
+def test_where_a_checkout_of_simparity_lives_is_not_a_difference_but_another_file_is(tmp_path):
+    """Two checkouts (a worktree beside main) read a built-in scene's URDF from two places; another file is a change."""
+    def with_detail(name, path):
+        folder = _run(tmp_path / name, ["1e-3", "2e-6"])
+        table = pd.read_csv(folder / RESULTS_FILE, dtype=str, keep_default_na=False)
+        table.loc[0, "detail"] = f"read {path}, 7 joints"
+        table.to_csv(folder / RESULTS_FILE, index=False)
+        return folder
+
+    main = with_detail("a", "/work/main/comparisons/scenes/urdf/arm.urdf")
+    worktree = with_detail("b", "/w/tree/.typecheck/simparity/comparisons/scenes/urdf/arm.urdf")
+    other = with_detail("c", "/w/tree/.typecheck/simparity/comparisons/scenes/urdf/other.urdf")
+    assert differences(main, worktree) == []
+    assert len(differences(main, other)) == 1
+
+
 def test_a_sampled_series_that_moved_is_found(tmp_path):
     """The series are compared too (a redesign of how runs are read must keep the envelopes the report draws)."""
     before, after = _run(tmp_path / "a", ["1e-3", "2e-6"]), _run(tmp_path / "b", ["1e-3", "2e-6"])
