@@ -162,11 +162,6 @@ everything; the measuring, the engines and the scenes under the execution; the p
 it orchestrates; the CLI on top. A folder may import itself; the modules at comparisons/'s top (the public API, the
 bench) may import every folder. One way only: no folder is in the set of a folder it may import."""
 
-FRONT_ENDS = {"gate/pytest_plugin.py": "the pytest plugin runs scenes through a Session, as the CLI does; it stays "
-              "at the path its installed entry point (pyproject's pytest11) names"}
-"""Modules inside a folder that stand above every folder, with the reason they live there."""
-
-
 def _folder_of(name: str) -> str | None:
     """The comparisons folder a dotted module name is in (None: not in a folder of comparisons)."""
     parts = name.split(".")
@@ -179,7 +174,7 @@ def _folder_violations(relative: str, imported: set[str]) -> list[str]:
     """The comparisons folders a module at ``relative`` (its path inside comparisons/) importing ``imported`` imports
     against :data:`FOLDER_IMPORTS`."""
     parts = relative.split("/")
-    if relative in FRONT_ENDS or len(parts) < 2:
+    if len(parts) < 2:
         return []
     used = {_folder_of(n) for n in imported} - {None, parts[0]}
     return sorted(f for f in used if f not in FOLDER_IMPORTS[parts[0]])
@@ -193,7 +188,6 @@ def test_the_folder_table_names_every_folder_and_is_one_way():
     for folder, allowed in FOLDER_IMPORTS.items():
         assert folder not in allowed
         assert not [other for other in allowed if folder in FOLDER_IMPORTS[other]], f"{folder} both ways"
-    assert all((ROOT / "comparisons" / module).is_file() for module in FRONT_ENDS)
 
 
 @pytest.mark.parametrize("path", [p for p in _modules("comparisons") if len(p.relative_to(ROOT / "comparisons").parts) > 1],

@@ -133,7 +133,7 @@ def test_the_documented_example_passes_against_a_baseline_that_ran_more_engines(
 @pytest.mark.parametrize("baseline, relative", [("", None), ("  ", 0.1), (None, 0.1)])
 def test_an_empty_baseline_or_a_relative_change_without_one_is_refused(baseline, relative):
     """Issue #39: '' is never read as "no baseline", and a threshold without a baseline compares with nothing."""
-    from simparity.comparisons.gate.pytest_plugin import SimparityChecker
+    from simparity.comparisons.pytest_plugin import SimparityChecker
 
     with pytest.raises(pytest.UsageError, match="simparity-baseline"):
         SimparityChecker(baseline, relative)
