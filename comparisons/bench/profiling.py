@@ -13,6 +13,7 @@ from simparity.comparisons.execute.ik_targets import random_targets
 from simparity.comparisons.scenes import library
 from simparity.core.model.ik_problem import IKTolerances
 
+
 def profile_summary(batch: int, say: Callable[[str], None]) -> str:
     """cProfile of core's rk4 on ``batch`` tumbling boxes, of its restarted IK on the iiwa, of its ABA on ``batch``
     iiwa states and of its rk4 joint motion on ``batch`` falling iiwas, top functions."""

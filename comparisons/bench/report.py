@@ -18,6 +18,7 @@ from simparity.comparisons.bench.rows import BenchRow
 from simparity.comparisons.bench.stepping import DT, ERROR_METRIC, ERROR_STEPS, ERROR_UNIT
 from simparity.comparisons.bench.targets import targets
 
+
 def machine() -> dict[str, str]:
     """What the numbers were measured on."""
     import mujoco

@@ -19,6 +19,7 @@ from simparity.comparisons.bench.targets import targets
 from simparity.comparisons.bench.verdict import TARGET_BATCH
 from simparity.core.model.errors import SimparityError, one_line
 
+
 def run_bench(out_dir: Path, quick: bool, command: str, say: Callable[[str], None]) -> Path:
     """Measure everything, write ``benchmarks.csv`` and ``BENCHMARKS.md`` into ``out_dir``; returns the latter."""
     start = time.perf_counter()
