@@ -433,7 +433,7 @@ def cmd_show(args, out) -> int:
 
 
 def cmd_bench(args, out) -> int:
-    from simparity.comparisons.bench import run_bench  # imports every engine: only when asked
+    from simparity.comparisons.bench.run import run_bench  # imports every engine: only when asked
 
     def say(line: str) -> None:
         print(line, file=out, flush=True)

@@ -72,7 +72,7 @@ class Restarts:
     """
 
     # Measured on the bench suite (10,000 TRAC-IK targets per arm: iiwa, Panda, UR5) and on the 5-DOF SO-100
-    # (comparisons/bench.py five_dof_scene), each setting against its neighbours in one run:
+    # (comparisons/bench/ik.py five_dof_scene), each setting against its neighbours in one run:
     # - error damping c = 0.01 (Sugihara's LM): an attempt solves 97-99 % of what it solves in 60 iterations by its
     #   25th (90 % on the UR5 under the lecture's sigma_min damping), in 1.3-2x fewer iterations; c = 0.003 and
     #   0.03 needed within 8 % of its iterations per target, c = 1 needed 1.3-1.7x as many;

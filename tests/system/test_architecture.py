@@ -155,12 +155,13 @@ FOLDER_IMPORTS = {
     "invariance": {"common", "engines", "execute", "measure"},
     "gate": {"common", "engines", "scenes"},
     "pipeline": {"common", "engines", "execute", "gate", "invariance", "measure", "scenes"},
-    "cli": {"common", "engines", "execute", "gate", "invariance", "measure", "pipeline", "scenes"},
+    "bench": {"common", "engines", "execute", "gate", "invariance", "measure", "pipeline", "scenes"},
+    "cli": {"bench", "common", "engines", "execute", "gate", "invariance", "measure", "pipeline", "scenes"},
 }
 """Which folder of comparisons/ may import which, bottom up: ``common/`` (the names every folder shares) under
 everything; the measuring, the engines and the scenes under the execution; the pipeline (``Session``) above the folders
-it orchestrates; the CLI on top. A folder may import itself; the modules at comparisons/'s top (the public API, the
-bench) may import every folder. One way only: no folder is in the set of a folder it may import."""
+it orchestrates; the bench (``simparity bench``, which times every folder's work) above them; the CLI on top. A folder may
+import itself; the modules at comparisons/'s top (the public API) may import every folder. One way only: no folder is in the set of a folder it may import."""
 
 def _folder_of(name: str) -> str | None:
     """The comparisons folder a dotted module name is in (None: not in a folder of comparisons)."""

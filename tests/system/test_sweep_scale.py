@@ -12,7 +12,7 @@ import weakref
 
 import pytest
 
-from simparity.comparisons.bench_sweep import SPEEDS, sweep_scene
+from simparity.comparisons.bench.sweep import SPEEDS, sweep_scene
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.execution import run_scenes
 from simparity.comparisons.execute.timing import PeakMemory

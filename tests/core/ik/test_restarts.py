@@ -7,7 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from simparity.comparisons.bench import FIVE_DOF_ARM, five_dof_scene
+from simparity.comparisons.bench.ik import FIVE_DOF_ARM, five_dof_scene
 from simparity.comparisons.execute.ik_targets import random_targets
 from simparity.core.ik.jacobian_solvers import IKOptions, solve_ik
 from simparity.core.ik.reach import reach_upper_bound

@@ -127,7 +127,7 @@ def test_euler_damping_is_implicit_unless_eulerdamp_is_disabled():
 def test_a_scene_without_contact_gets_an_arena_sized_by_its_bodies():
     """Issue #11: MuJoCo's default arena grows as nv^2 (1.7 GiB at 1,000 bodies; 10,000 failed to allocate);
     a scene without contact has no constraints and gets 1 MiB + 2 KiB per body, in the detail too."""
-    from simparity.comparisons.bench import boxes
+    from simparity.comparisons.bench.stepping import boxes
     from simparity.references.mujoco.mjcf import arena_kib
 
     scene = boxes(3000, drag=False)
@@ -139,7 +139,7 @@ def test_a_scene_without_contact_gets_an_arena_sized_by_its_bodies():
 
 def test_the_batch_rollout_steps_each_body_as_the_scene_adapter_does():
     """BatchRollout (B single-body rollouts, the bench's MuJoCo batch) is bit-identical to the B-body model."""
-    from simparity.comparisons.bench import boxes
+    from simparity.comparisons.bench.stepping import boxes
     from simparity.references.mujoco.adapter import BatchRollout
 
     for drag in (False, True):

@@ -95,7 +95,7 @@ def test_a_point_mass_body_keeps_its_hand_computed_tensor_in_pinocchio():
 def test_each_body_gets_a_single_free_flyer_model_shared_by_identical_bodies():
     """Issue #11: B free flyers in one Pinocchio model made createData allocate O(nv^2) and more (13 GiB at
     B = 100, the machine's OOM killer); every body now has a 6-dof model, identical bodies share one."""
-    from simparity.comparisons.bench import boxes
+    from simparity.comparisons.bench.stepping import boxes
 
     sim = PinocchioEngine().build_dynamics(boxes(50, drag=True), "euler", 1e-3)
     assert {model.nv for model, _ in sim._models} == {6}

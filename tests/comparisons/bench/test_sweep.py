@@ -1,4 +1,4 @@
-"""Issue #29: ``simparity bench``'s sweep rows (comparisons/bench_sweep.py): the wall time and the client's peak memory
+"""Issue #29: ``simparity bench``'s sweep rows (comparisons/bench/sweep.py): the wall time and the client's peak memory
 of ``simparity run`` on sweeps of 10, 100 and 1,000 variants on a local Dask cluster."""
 
 from __future__ import annotations
@@ -7,7 +7,9 @@ import math
 
 import pytest
 
-from simparity.comparisons import bench, bench_sweep
+from simparity.comparisons.bench import sweep as bench_sweep
+from simparity.comparisons.bench.memory import run_peak_memory
+from simparity.comparisons.bench.rows import BenchRow
 from simparity.comparisons.execute.timing import PeakMemory
 from simparity.comparisons.scenes import library
 
@@ -36,7 +38,7 @@ def test_a_row_per_count_of_variants_and_its_table(monkeypatch):
         asked.append((arguments, out))
         return (PeakMemory(300 * 2**20, 500 * 2**20), 12.5, "") if len(asked) == 1 else (None, 3.0, "killed")
 
-    rows = bench_sweep.sweep_rows(True, run, bench.BenchRow, lambda line: None)
+    rows = bench_sweep.sweep_rows(True, run, BenchRow, lambda line: None)
     assert [r.batch for r in rows] == list(bench_sweep.QUICK_VARIANTS)
     assert rows[0].value == 300 and rows[0].accuracy == 12.5 and rows[0].unit == "MiB"
     assert math.isnan(rows[1].value) and rows[1].note == "n/a: the run recorded no peak memory: killed"
@@ -50,5 +52,5 @@ def test_a_row_per_count_of_variants_and_its_table(monkeypatch):
 @pytest.mark.slow
 def test_a_real_sweep_run_records_its_clients_peak(monkeypatch):
     monkeypatch.setattr(bench_sweep, "QUICK_VARIANTS", (10,))
-    [row] = bench_sweep.sweep_rows(True, bench.run_peak_memory, bench.BenchRow, lambda line: None)
+    [row] = bench_sweep.sweep_rows(True, run_peak_memory, BenchRow, lambda line: None)
     assert 50 < row.value < 2048 and row.accuracy > 0 and not row.note.startswith("n/a")

@@ -78,7 +78,7 @@ integrators = ["rk4", "semi_implicit_euler"]
 
 RunMemory = Callable[[list[str], Path], tuple[PeakMemory | None, float, str]]
 """``simparity run ARGUMENTS --out RUN`` in a process of its own: (its recorded peak memory or None, its wall time
-[s], the end of its standard error) (:func:`comparisons.bench.run_peak_memory`)."""
+[s], the end of its standard error) (:func:`comparisons.bench.memory.run_peak_memory`)."""
 
 
 def run_arguments(scene: Path, history: Path) -> list[str]:
@@ -91,7 +91,7 @@ def run_arguments(scene: Path, history: Path) -> list[str]:
 def sweep_rows(quick: bool, run: RunMemory, row: type, say: Callable[[str], None]) -> list:
     """A :data:`CLIENT` row [MiB] (accuracy: the run's wall time [s]) per number of variants of
     :data:`VARIANTS` (:data:`QUICK_VARIANTS` quick), each measured by ``run`` in a fresh folder; ``row`` is
-    :class:`comparisons.bench.BenchRow`."""
+    :class:`comparisons.bench.rows.BenchRow`."""
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         for variants in QUICK_VARIANTS if quick else VARIANTS:

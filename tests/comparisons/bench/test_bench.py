@@ -8,18 +8,12 @@ from pathlib import Path
 
 import pytest
 
-from simparity.comparisons import bench, bench_joint_dynamics
-from simparity.comparisons.bench import (
-    MEMORY_CHILD,
-    MEMORY_PROCESS,
-    TARGET_BATCH,
-    TARGET_IK_TARGETS,
-    BenchRow,
-    equal_error_factor,
-    markdown,
-    run_peak_memory,
-    targets,
-)
+from simparity.comparisons.bench import ik, joint_dynamics, kinematics, stepping
+from simparity.comparisons.bench.memory import MEMORY_CHILD, MEMORY_PROCESS, run_peak_memory
+from simparity.comparisons.bench.report import markdown, write_csv
+from simparity.comparisons.bench.rows import BenchRow, median_time
+from simparity.comparisons.bench.targets import equal_error_factor, targets
+from simparity.comparisons.bench.verdict import TARGET_BATCH, TARGET_IK_TARGETS
 
 
 def _row(section, workload, engine, method, batch, value, accuracy, unit="rad", note=""):
@@ -103,19 +97,18 @@ def test_markdown_shows_tables_ratios_and_misses():
 @pytest.mark.slow
 def test_a_small_real_run_measures_every_section(monkeypatch, tmp_path):
     """Every section runs end to end on tiny sizes and gives finite times with errors (or n/a saying why)."""
-    monkeypatch.setattr(bench, "DYNAMICS", (("core", "rk4"), ("mujoco", "rk4"), ("mujoco-rollout", "euler")))
-    monkeypatch.setattr(bench, "ERROR_STEPS", 20)
-    monkeypatch.setattr(bench, "KINEMATICS", ("core", "pinocchio"))
-    monkeypatch.setattr(bench, "IK", (("core", "damped_least_squares+restarts"), ("mujoco", "dls")))
-    monkeypatch.setattr(bench, "LIBRARY_TARGETS", 3)
+    monkeypatch.setattr(stepping, "DYNAMICS", (("core", "rk4"), ("mujoco", "rk4"), ("mujoco-rollout", "euler")))
+    monkeypatch.setattr(stepping, "ERROR_STEPS", 20)
+    monkeypatch.setattr(kinematics, "KINEMATICS", ("core", "pinocchio"))
+    monkeypatch.setattr(ik, "IK", (("core", "damped_least_squares+restarts"), ("mujoco", "dls")))
+    monkeypatch.setattr(ik, "LIBRARY_TARGETS", 3)
     lines = []
-    rows = bench.dynamics_rows([1, 3], quick=True, say=lines.append)
-    rows += bench.kinematics_rows([2], say=lines.append)
-    rows += bench.ik_rows(5, say=lines.append)
-    monkeypatch.setattr(bench_joint_dynamics, "ARMS", ("ur5-dynamics",))
-    monkeypatch.setattr(bench_joint_dynamics, "ENGINES", (("core", "recursive"), ("mujoco", "recursive")))
-    rows += bench_joint_dynamics.joint_dynamics_rows([2], lambda fn: bench.median_time(fn, 1), bench.BenchRow,
-                                                     lines.append)
+    rows = stepping.dynamics_rows([1, 3], quick=True, say=lines.append)
+    rows += kinematics.kinematics_rows([2], say=lines.append)
+    rows += ik.ik_rows(5, say=lines.append)
+    monkeypatch.setattr(joint_dynamics, "ARMS", ("ur5-dynamics",))
+    monkeypatch.setattr(joint_dynamics, "ENGINES", (("core", "recursive"), ("mujoco", "recursive")))
+    rows += joint_dynamics.joint_dynamics_rows([2], lambda fn: median_time(fn, 1), BenchRow, lines.append)
     measured = [r for r in rows if math.isfinite(r.value)]
     assert {r.section for r in measured} == {"dynamics", "kinematics", "ik", "joint_dynamics"}
     # core and MuJoCo against Pinocchio at the same states: double-precision agreement (the shipped 1e-12 bound)
@@ -125,17 +118,17 @@ def test_a_small_real_run_measures_every_section(monkeypatch, tmp_path):
     assert all(r.note.startswith("n/a: ") for r in rows if not math.isfinite(r.value))
     core_rk4 = [r for r in rows if (r.engine, r.method) == ("core", "rk4")]
     assert core_rk4 and all(r.accuracy < 1e-9 for r in core_rk4)  # rk4 at dt 1e-3 over 20 steps
-    bench.write_csv(rows, tmp_path / "benchmarks.csv")
+    write_csv(rows, tmp_path / "benchmarks.csv")
     assert (tmp_path / "benchmarks.csv").read_text().count("\n") == len(rows) + 1
 
 
 def test_a_measurement_over_budget_is_skipped_with_its_probed_estimate(monkeypatch):
     """The skip rule probes the batch size itself (a smaller batch's cost per body-step overestimated core's
     batched cost a hundredfold and skipped rows that take a quarter second)."""
-    monkeypatch.setattr(bench, "DYNAMICS", (("core", "rk4"),))
-    monkeypatch.setattr(bench, "ERROR_STEPS", 5)
-    monkeypatch.setattr(bench, "BUDGET_SECONDS", 0.0)
-    rows = bench.dynamics_rows([2], quick=True, say=lambda line: None)
+    monkeypatch.setattr(stepping, "DYNAMICS", (("core", "rk4"),))
+    monkeypatch.setattr(stepping, "ERROR_STEPS", 5)
+    monkeypatch.setattr(stepping, "BUDGET_SECONDS", 0.0)
+    rows = stepping.dynamics_rows([2], quick=True, say=lambda line: None)
     assert rows and all(not math.isfinite(r.value) and "steps predict" in r.note for r in rows)
     assert all(math.isfinite(r.accuracy) for r in rows)  # the error is still measured
 

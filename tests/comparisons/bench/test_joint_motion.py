@@ -1,4 +1,4 @@
-"""The joint-motion bench (:mod:`comparisons.bench_joint_motion`) at tiny sizes: its rows, its equal-accuracy check
+"""The joint-motion bench (:mod:`comparisons.bench.joint_motion`) at tiny sizes: its rows, its equal-accuracy check
 and its BENCHMARKS.md section. No timing thresholds: speed targets live in the bench as ratios of one run."""
 
 import math
@@ -6,8 +6,8 @@ import math
 import numpy as np
 import pytest
 
-from simparity.comparisons import bench, bench_joint_motion as jm
-from simparity.comparisons.bench import BenchRow
+from simparity.comparisons.bench import joint_motion as jm
+from simparity.comparisons.bench.rows import BenchRow, median_time
 from simparity.comparisons.scenes import library
 
 RK4_AGREEMENT = 1e-9
@@ -31,7 +31,7 @@ def rows():
                         ("REPEATS", 1)):
         patch.setattr(jm, name, value)
     try:
-        return jm.joint_motion_rows(BATCHES, bench.median_time, BenchRow, lambda line: None)
+        return jm.joint_motion_rows(BATCHES, median_time, BenchRow, lambda line: None)
     finally:
         patch.undo()
 

@@ -1,0 +1,28 @@
+"""``simparity bench``: speed with its accuracy, core against the engines, measured in one run.
+
+Five workloads, one module each, every time the median of repeats after a warm-up call
+(:func:`comparisons.bench.rows.median_time`), every ratio core / engine computed from the same run:
+
+1. rigid-body stepping of B identical boxes (torque-free tumbling; falling with drag), time per body-step of each
+   engine's ``run`` next to the error each reaches at that dt against the tight reference
+   (:mod:`comparisons.bench.stepping`);
+2. forward kinematics + end-effector Jacobian of the iiwa and the UR5, time per configuration, with the largest
+   difference to Pinocchio (:mod:`comparisons.bench.kinematics`);
+3. IK on the ``bench`` suite's arms (TRAC-IK protocol), solve rate and time per solve, failures inside the time,
+   limit violations (:mod:`comparisons.bench.ik`);
+4. joint-space dynamics (M + h, RNEA, ABA) of the ``articulated`` suite's real arms, time per state with the largest
+   relative difference to Pinocchio (:mod:`comparisons.bench.joint_dynamics`);
+5. joint motion of the falling arms, time per copy-step of each engine's RK4 at equal accuracy (the error against
+   DOP853 and the difference to Pinocchio's RK4) (:mod:`comparisons.bench.joint_motion`).
+
+Beside them, the peak memory of ``simparity run`` against the steps (:mod:`comparisons.bench.memory`) and its wall
+time and client memory against a sweep's variants (:mod:`comparisons.bench.sweep`), and a profile of core
+(:mod:`comparisons.bench.profiling`). :func:`comparisons.bench.run.run_bench` measures them all.
+
+Results go to ``benchmarks.csv`` (one tidy row per measurement) and ``BENCHMARKS.md``
+(:mod:`comparisons.bench.report`), with a verdict on each of the issue's targets that says what it compared
+(:mod:`comparisons.bench.targets`). The targets are set for the full sizes (:mod:`comparisons.bench.verdict`); measured
+at other sizes (``--quick``), a target is "not comparable", never met or missed. IK speed is compared only among
+solvers that solve at least :data:`comparisons.bench.targets.COMPARABLE_SOLVE_RATE` times as often as core at the
+harness's tolerance.
+"""
