@@ -6,7 +6,7 @@ import pytest
 
 pytest_plugins = ["pytester"]
 
-EXAMPLE = Path(__file__).resolve().parents[3] / "docs" / "examples" / "test_my_numerics.py"
+EXAMPLE = Path(__file__).resolve().parents[2] / "docs" / "examples" / "test_my_numerics.py"
 
 
 @pytest.mark.slow  # ~10 s of CPU: a pytest session in a subprocess

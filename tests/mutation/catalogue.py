@@ -214,8 +214,8 @@ MUTANTS: tuple[Mutation, ...] = (
         IK, "iiwa-ik"),
     Mutation(
         "ik_limits_not_clamped", "joint limits", "ik/jacobian_solvers.py",
-        "q[idx[step]] = np.clip(wrap_into_limits(qa[step] + dq[step], revolute, lower, upper), lower, upper)",
-        "q[idx[step]] = wrap_into_limits(qa[step] + dq[step], revolute, lower, upper)",
+        "stepped = np.clip(wrap_into_limits(qa[step] + dq[step], revolute, lower, upper), lower, upper)",
+        "stepped = wrap_into_limits(qa[step] + dq[step], revolute, lower, upper)",
         "each iterate is wrapped into the limits by 2 pi but never clipped: joints leave their limits",
         IK, "iiwa-ik"),
     Mutation(
