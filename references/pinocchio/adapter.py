@@ -102,7 +102,6 @@ INTEGRATORS = ("euler", "rk4")
 # Classical RK4 tableau.
 _RK4_A = ((), (0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
 _RK4_B = (1 / 6, 1 / 3, 1 / 3, 1 / 6)
-_RK4_C = (0.0, 0.5, 0.5, 1.0)
 
 
 class _Simulation(PieceSimulation):
@@ -112,6 +111,12 @@ class _Simulation(PieceSimulation):
     in the LOCAL frame (Pinocchio's). ``euler``: the engines' scheme (velocities first, then
     p += dt v, R = R exp(dt w)). ``rk4``: classical RK4 on (p, v, w) with the rotation by
     Runge-Kutta-Munthe-Kaas in the body frame, R = R0 exp(u), du/dt = dexp^-1_{-u}(w).
+
+    The step is a Python loop around Pinocchio's calls (``aba``, ``exp3``, ``Jlog3`` take one body each; its one
+    batched dynamics call, ``abaInParallel``, takes one model and no ``fext``): the vectors (p, v, w) travel
+    stacked as one (3, B, 3) array, the RK4 stage derivatives as one (4, B, 3) array (dp, dv, dw, du), so that each
+    stage costs a few NumPy calls whatever the body count, each the same float operation on the same operands as
+    one vector at a time.
     """
 
     def __init__(self, scene: DynamicsScene, integrator: str, dt: float) -> None:
@@ -123,16 +128,17 @@ class _Simulation(PieceSimulation):
                 model = free_body_model(body, scene.forces.gravity_world)
                 models[key] = (model, model.createData())
             self._models.append(models[key])
-        self._position0 = np.stack([b.position_world for b in scene.bodies])
-        self._rotation0 = quat_wxyz_to_matrix(np.stack([b.quat_wxyz for b in scene.bodies]))
-        self._velocity0 = np.stack([b.velocity_world for b in scene.bodies])
-        self._omega_local0 = np.einsum(
-            "bji,bj->bi", self._rotation0, np.stack([b.angular_velocity_world for b in scene.bodies])
-        )
+        rotation0 = quat_wxyz_to_matrix(np.stack([b.quat_wxyz for b in scene.bodies]))
+        omega_local0 = np.einsum("bji,bj->bi", rotation0, np.stack([b.angular_velocity_world for b in scene.bodies]))
+        self._state0 = (np.stack([np.stack([b.position_world for b in scene.bodies]),
+                                  np.stack([b.velocity_world for b in scene.bodies]), omega_local0]), rotation0)
         self._tau = np.zeros(6)
         self._forces = scene.forces
         self._drag = external_forces.has_drag(scene.forces) or external_forces.has_angular_drag(scene.forces)
         self._external = self._drag or bool(scene.forces.applied)
+        # aba's fext per body (universe, then its joint): the joint's entry is rewritten at every call.
+        self._fext = [pin.StdVec_Force([pin.Force.Zero(), pin.Force.Zero()]) for _ in scene.bodies]
+        self._at_points = [pin.SE3(np.eye(3), applied.point_body) for applied in scene.forces.applied]
         self._step = self._rk4 if integrator == "rk4" else self._euler
         self._dt = dt
         self.detail = ("harness-stepped: pin.aba accelerations, "
@@ -146,68 +152,84 @@ class _Simulation(PieceSimulation):
                               "stepping")
 
     def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
-        dt, b = self._dt, len(self._position0)
-        state = (self._position0, self._rotation0, self._velocity0, self._omega_local0)
+        dt, b = self._dt, len(self._models)
+        state = self._state0
         for start, stop in piece_bounds(n_steps, samples_per_piece):
             pos, rot, vel, omg = (np.empty((stop - start, b) + s) for s in ((3,), (3, 3), (3,), (3,)))
             for j, i in enumerate(range(start, stop)):
                 if i:
-                    state = self._step((i - 1) * dt, state, dt)
-                p, r, v, w = state
+                    state = self._step(state, dt)
+                (p, v, w), r = state
                 pos[j], rot[j], vel[j], omg[j] = p, r, v, np.einsum("bij,bj->bi", r, w)
             yield Trajectory(np.arange(start, stop) * dt, pos, matrix_to_quat_wxyz(rot), vel, omg)
 
-    def _fext(self, r: np.ndarray, v: np.ndarray, w_local: np.ndarray) -> list[pin.StdVec_Force]:
-        """aba's external forces of each body's model (universe, then its joint), LOCAL frame, about the COM."""
+    def _set_fext(self, r: np.ndarray, v: np.ndarray, w_local: np.ndarray) -> None:
+        """aba's external force on each body's joint: LOCAL frame, about the COM."""
         b = len(r)
         force, torque = np.zeros((b, 3)), np.zeros((b, 3))
         if self._drag:
             force = external_forces.drag_force_world(self._forces, v)
             torque = external_forces.drag_torque_world(self._forces, np.einsum("bij,bj->bi", r, w_local))
         per_body = [pin.Force(r[k].T @ force[k], r[k].T @ torque[k]) for k in range(b)]
-        for applied in self._forces.applied:
+        for applied, at_point in zip(self._forces.applied, self._at_points):
             k = applied.body
-            at_point = pin.SE3(np.eye(3), applied.point_body)
-            per_body[k] = per_body[k] + at_point.act(pin.Force(r[k].T @ applied.force_world, np.zeros(3)))
-        out = []
-        for spatial in per_body:
-            fext = pin.StdVec_Force()
-            fext.append(pin.Force.Zero())
-            fext.append(spatial)
-            out.append(fext)
-        return out
+            per_body[k] = per_body[k] + at_point.act(pin.Force(r[k].T @ applied.force_world, _NO_TORQUE))
+        for fext, spatial in zip(self._fext, per_body):
+            fext[1] = spatial
 
-    def _accelerations(self, t, p, r, v, w_local) -> tuple[np.ndarray, np.ndarray]:
-        """(dv/dt world (B, 3), dw/dt local (B, 3)) from aba, the scene's non-gravity forces as fext."""
-        b = len(p)
+    def _accelerations(self, s: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """(dv/dt world, dw/dt local), (2, B, 3), from aba at the state ``s`` = (p, v, w_local) (3, B, 3) and
+        rotations ``r`` (B, 3, 3); the scene's non-gravity forces as fext."""
+        p, v, w_local = s
         v_local = np.einsum("bji,bj->bi", r, v)
         qd = np.concatenate([v_local, w_local], axis=1)
-        fext = self._fext(r, v, w_local) if self._external else None
-        a = np.empty((b, 6))
+        if self._external:
+            self._set_fext(r, v, w_local)
+        a = np.empty((len(p), 6))
         for k, (model, data) in enumerate(self._models):
             q = pin.SE3ToXYZQUAT(pin.SE3(r[k], p[k]))
-            a[k] = (pin.aba(model, data, q, qd[k], self._tau, fext[k]) if fext is not None
+            a[k] = (pin.aba(model, data, q, qd[k], self._tau, self._fext[k]) if self._external
                     else pin.aba(model, data, q, qd[k], self._tau))
+        out = np.empty((2,) + v.shape)
         # aba's linear part is the spatial acceleration; the COM's classical one adds w x v.
-        return np.einsum("bij,bj->bi", r, a[:, :3] + np.cross(w_local, v_local)), a[:, 3:]
+        out[0] = np.einsum("bij,bj->bi", r, a[:, :3] + _cross(w_local, v_local))
+        out[1] = a[:, 3:]
+        return out
 
-    def _euler(self, t, state, dt):
-        p, r, v, w = state
-        dv, dw = self._accelerations(t, p, r, v, w)
-        v, w = v + dt * dv, w + dt * dw
-        return p + dt * v, r @ _exp3(dt * w), v, w
+    def _euler(self, state, dt):
+        s, r = state
+        stepped = np.empty_like(s)
+        stepped[1:] = s[1:] + dt * self._accelerations(s, r)
+        stepped[0] = s[0] + dt * stepped[1]
+        return stepped, r @ _exp3(dt * stepped[2])
 
-    def _rk4(self, t, state, dt):
-        p, r, v, w = state
-        ks = []  # (dp, du, dv, dw) per stage
-        for a_row, c in zip(_RK4_A, _RK4_C):
-            inc = [sum((dt * a * k[j] for a, k in zip(a_row, ks)), start=np.zeros_like(p)) for j in range(4)]
-            u = inc[1]
-            stage_v, stage_w = v + inc[2], w + inc[3]
-            dv, dw = self._accelerations(t + c * dt, p + inc[0], r @ _exp3(u), stage_v, stage_w)
-            ks.append((stage_v, _dexp_inverse(u, stage_w), dv, dw))
-        total = [sum(dt * bi * k[j] for bi, k in zip(_RK4_B, ks)) for j in range(4)]
-        return p + total[0], r @ _exp3(total[1]), v + total[2], w + total[3]
+    def _rk4(self, state, dt):
+        s, r = state
+        ks = []  # (dp, dv, dw, du) per stage, (4, B, 3)
+        for a_row in _RK4_A:
+            inc = sum(((dt * a) * k for a, k in zip(a_row, ks)), start=np.zeros((4,) + s.shape[1:]))
+            stage, u = s + inc[:3], inc[3]
+            rotation = _exp3(u)
+            k = np.empty_like(inc)
+            k[0] = stage[1]
+            k[1:3] = self._accelerations(stage, r @ rotation)
+            k[3] = _dexp_inverse(rotation, stage[2])
+            ks.append(k)
+        total = sum((dt * b) * k for b, k in zip(_RK4_B, ks))
+        return s + total[:3], r @ _exp3(total[3])
+
+
+_NO_TORQUE = np.zeros(3)
+"""The moment about its own point of a force applied at a point (``SE3.act`` moves it to the COM)."""
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise a x b, (B, 3) x (B, 3) -> (B, 3): ``np.cross``'s products and differences, without its axis handling."""
+    return a.take(_NEXT, axis=1) * b.take(_AFTER, axis=1) - a.take(_AFTER, axis=1) * b.take(_NEXT, axis=1)
+
+
+_NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])
+"""Component i of a cross product is a[i+1] b[i+2] - a[i+2] b[i+1] (indices mod 3)."""
 
 
 def _exp3(rotvec: np.ndarray) -> np.ndarray:
@@ -215,9 +237,10 @@ def _exp3(rotvec: np.ndarray) -> np.ndarray:
     return np.array([pin.exp3(u) for u in rotvec])
 
 
-def _dexp_inverse(u: np.ndarray, w_local: np.ndarray) -> np.ndarray:
-    """du/dt of R = R0 exp3(u) with body angular velocity w: Jlog3(exp3(u)) w. (B, 3) x (B, 3) -> (B, 3)."""
-    return np.array([pin.Jlog3(pin.exp3(uk)) @ wk for uk, wk in zip(u, w_local)])
+def _dexp_inverse(rotation: np.ndarray, w_local: np.ndarray) -> np.ndarray:
+    """du/dt of R = R0 exp3(u) with body angular velocity w: Jlog3(exp3(u)) w, given exp3(u) (B, 3, 3) and w
+    (B, 3) -> (B, 3)."""
+    return np.array([pin.Jlog3(e) @ wk for e, wk in zip(rotation, w_local)])
 
 
 class PinocchioChain(KinematicsModel):
