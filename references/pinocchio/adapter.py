@@ -177,9 +177,9 @@ class _Simulation(PieceSimulation):
         for fext, spatial in zip(self._fext, per_body):
             fext[1] = spatial
 
-    def _accelerations(self, s: np.ndarray, r: np.ndarray) -> np.ndarray:
-        """(dv/dt world, dw/dt local), (2, B, 3), from aba at the state ``s`` = (p, v, w_local) (3, B, 3) and
-        rotations ``r`` (B, 3, 3); the scene's non-gravity forces as fext."""
+    def _accelerations(self, s: np.ndarray, r: np.ndarray, out: np.ndarray) -> None:
+        """(dv/dt world, dw/dt local) into ``out`` (2, B, 3), from aba at the state ``s`` = (p, v, w_local) (3, B, 3)
+        and rotations ``r`` (B, 3, 3); the scene's non-gravity forces as fext."""
         p, v, w_local = s
         v_local = np.einsum("bji,bj->bi", r, v)
         qd = np.concatenate([v_local, w_local], axis=1)
@@ -190,16 +190,15 @@ class _Simulation(PieceSimulation):
             q = pin.SE3ToXYZQUAT(pin.SE3(r[k], p[k]))
             a[k] = (pin.aba(model, data, q, qd[k], self._tau, self._fext[k]) if self._external
                     else pin.aba(model, data, q, qd[k], self._tau))
-        out = np.empty((2,) + v.shape)
         # aba's linear part is the spatial acceleration; the COM's classical one adds w x v.
-        out[0] = np.einsum("bij,bj->bi", r, a[:, :3] + _cross(w_local, v_local))
+        out[0] = np.einsum("bij,bj->bi", r, a[:, :3] + _spin_cross(qd))
         out[1] = a[:, 3:]
-        return out
 
     def _euler(self, state, dt):
         s, r = state
         stepped = np.empty_like(s)
-        stepped[1:] = s[1:] + dt * self._accelerations(s, r)
+        self._accelerations(s, r, stepped[1:])
+        stepped[1:] = s[1:] + dt * stepped[1:]
         stepped[0] = s[0] + dt * stepped[1]
         return stepped, r @ _exp3(dt * stepped[2])
 
@@ -207,12 +206,14 @@ class _Simulation(PieceSimulation):
         s, r = state
         ks = []  # (dp, dv, dw, du) per stage, (4, B, 3)
         for a_row in _RK4_A:
-            inc = sum(((dt * a) * k for a, k in zip(a_row, ks)), start=np.zeros((4,) + s.shape[1:]))
+            inc = np.zeros((4,) + s.shape[1:])
+            for a, k in zip(a_row, ks):
+                inc = inc + (dt * a) * k
             stage, u = s + inc[:3], inc[3]
             rotation = _exp3(u)
             k = np.empty_like(inc)
             k[0] = stage[1]
-            k[1:3] = self._accelerations(stage, r @ rotation)
+            self._accelerations(stage, r @ rotation, k[1:3])
             k[3] = _dexp_inverse(rotation, stage[2])
             ks.append(k)
         total = sum((dt * b) * k for b, k in zip(_RK4_B, ks))
@@ -223,13 +224,15 @@ _NO_TORQUE = np.zeros(3)
 """The moment about its own point of a force applied at a point (``SE3.act`` moves it to the COM)."""
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise a x b, (B, 3) x (B, 3) -> (B, 3): ``np.cross``'s products and differences, without its axis handling."""
-    return a.take(_NEXT, axis=1) * b.take(_AFTER, axis=1) - a.take(_AFTER, axis=1) * b.take(_NEXT, axis=1)
+def _spin_cross(twist: np.ndarray) -> np.ndarray:
+    """w x v of twists (v, w), (B, 6) -> (B, 3): ``np.cross(w, v)``'s products and differences, in two gathers."""
+    products = twist.take(_W_FIRST, axis=1) * twist.take(_V_SECOND, axis=1)
+    return products[:, :3] - products[:, 3:]
 
 
-_NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])
-"""Component i of a cross product is a[i+1] b[i+2] - a[i+2] b[i+1] (indices mod 3)."""
+_W_FIRST, _V_SECOND = np.array([4, 5, 3, 5, 3, 4]), np.array([2, 0, 1, 1, 2, 0])
+"""Component i of w x v is w[i+1] v[i+2] - w[i+2] v[i+1] (indices mod 3), w at columns 3-5 of a twist, v at 0-2:
+the first factors of the six products, then the second."""
 
 
 def _exp3(rotvec: np.ndarray) -> np.ndarray:

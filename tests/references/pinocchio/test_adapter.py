@@ -104,16 +104,17 @@ def test_each_body_gets_a_single_free_flyer_model_shared_by_identical_bodies():
 
 
 def test_cross_product_is_numpys_bit_for_bit():
-    """The stepper's row-wise cross product (w x v of aba's classical acceleration) repeats np.cross's products and
-    differences: equal bit for bit, signed zeros and cancellations included, so results stay those of np.cross."""
-    from simparity.references.pinocchio.adapter import _cross
+    """The stepper's w x v of aba's classical acceleration repeats np.cross's products and differences: equal bit for
+    bit, signed zeros and cancellations included, so results stay those of np.cross."""
+    from simparity.references.pinocchio.adapter import _spin_cross
 
     rng = np.random.default_rng(41)
-    a, b = rng.normal(size=(2, 1000, 3)) * 10.0 ** rng.integers(-8, 8, size=(2, 1000, 3))
-    a[::7], b[::5, 1] = -0.0, 0.0
-    b[::3] = a[::3] * (1 + 1e-15)  # near-parallel rows: the difference of two close products
-    np.testing.assert_array_equal(np.signbit(_cross(a, b)), np.signbit(np.cross(a, b)))
-    np.testing.assert_array_equal(_cross(a, b), np.cross(a, b))
+    twist = rng.normal(size=(1000, 6)) * 10.0 ** rng.integers(-8, 8, size=(1000, 6))
+    twist[::7, 3:], twist[::5, 1] = -0.0, 0.0
+    twist[::3, :3] = twist[::3, 3:] * (1 + 1e-15)  # near-parallel v and w: the difference of two close products
+    w, v = twist[:, 3:], twist[:, :3]
+    np.testing.assert_array_equal(np.signbit(_spin_cross(twist)), np.signbit(np.cross(w, v)))
+    np.testing.assert_array_equal(_spin_cross(twist), np.cross(w, v))
 
 
 @pytest.mark.parametrize("integrator", ["euler", "rk4"])
