@@ -27,7 +27,7 @@ import numpy as np
 from simparity.core.contact.particle import penalty_force
 from simparity.core.dynamics.forces import make_wrench
 from simparity.core.dynamics.rigid_body import MassProperties, State, Wrench
-from simparity.core.rotations import cross
+from simparity.core.rotations import cross, vector_lengths
 from simparity.core.model.scenes.bodies import AppliedForce, Forces
 from simparity.core.model.scenes.contact import Contact, Plane
 
@@ -376,8 +376,8 @@ def penalty_wrench(model: ContactModel, props: MassProperties, external: Wrench)
             u = v[:, None, :] + cross(omega[:, None, :], r)
             f_n = penalty_force(x[:, None, :] + r, u, plane, model.stiffness, model.damping[:, p, None])
             u_t = u - (u @ plane.normal_world)[..., None] * plane.normal_world
-            slip = np.maximum(np.linalg.norm(u_t, axis=-1, keepdims=True), FRICTION_REGULARISATION_SPEED)
-            magnitude = np.linalg.norm(f_n, axis=-1, keepdims=True)
+            slip = np.maximum(vector_lengths(u_t), FRICTION_REGULARISATION_SPEED)
+            magnitude = vector_lengths(f_n)
             f = (f_n - model.friction_kinetic[:, p, None, None] * magnitude * u_t / slip) * model.weights[..., None]
             force = force + f.sum(axis=1)
             torque = torque + cross(r, f).sum(axis=1)
