@@ -27,7 +27,7 @@ import numpy as np
 from simparity.core.contact.particle import penalty_force
 from simparity.core.dynamics.forces import make_wrench
 from simparity.core.dynamics.rigid_body import MassProperties, State, Wrench
-from simparity.core.rotations import cross
+from simparity.core.rotations import cross, vector_lengths
 from simparity.core.model.scenes.bodies import AppliedForce, Forces
 from simparity.core.model.scenes.contact import Contact, Plane
 
@@ -155,10 +155,14 @@ class ContactModel:
         """(B,) True where the contact points do not depend on the orientation (point, sphere)."""
         return np.all(self.vertices_body == 0.0, axis=(1, 2))
 
-    def points(self, position_world: np.ndarray, rotation_world: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Levers r (B, P, V, 3) [m] (contact point minus COM, world axes) and distances E (B, P, V) [m]."""
+    def levers(self, rotation_world: np.ndarray) -> np.ndarray:
+        """Levers r (B, P, V, 3) [m]: contact point minus COM, world axes."""
         lever = np.einsum("bij,bvj->bvi", rotation_world, self.vertices_body)[:, None]
-        lever = lever - self.radius[:, None, None, None] * self.normals[None, :, None, :]
+        return lever - self.radius[:, None, None, None] * self.normals[None, :, None, :]
+
+    def points(self, position_world: np.ndarray, rotation_world: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Levers r (B, P, V, 3) [m] (:meth:`levers`) and distances E (B, P, V) [m]."""
+        lever = self.levers(rotation_world)
         distance = np.einsum("bpvi,pi->bpv", position_world[:, None, None, :] + lever, self.normals)
         return lever, distance + self.offsets[None, :, None]
 
@@ -366,19 +370,22 @@ def penalty_wrench(model: ContactModel, props: MassProperties, external: Wrench)
     (:data:`FRICTION_REGULARISATION_SPEED`); torque r x F about the COM. Returns
     f(t, x, R, v, omega) -> (force (B, 3) [N], torque (B, 3) [N m]).
     """
-    planes = [Plane(n, d) for n, d in zip(model.normals, model.offsets)]
+    # per plane, what its terms read (sliced once, not at every call): the plane, k_d (B, 1), mu_k (B, 1, 1)
+    planes = [(p, Plane(n, d), model.damping[:, p, None], model.friction_kinetic[:, p, None, None])
+              for p, (n, d) in enumerate(zip(model.normals, model.offsets))]
+    weights = model.weights[..., None]
 
     def wrench(t, x, rotation, v, omega):
         force, torque = external(t, x, rotation, v, omega)
-        lever, _ = model.points(x, rotation)
-        for p, plane in enumerate(planes):
+        lever = model.levers(rotation)
+        for p, plane, damping, friction in planes:
             r = lever[:, p]
             u = v[:, None, :] + cross(omega[:, None, :], r)
-            f_n = penalty_force(x[:, None, :] + r, u, plane, model.stiffness, model.damping[:, p, None])
+            f_n = penalty_force(x[:, None, :] + r, u, plane, model.stiffness, damping)
             u_t = u - (u @ plane.normal_world)[..., None] * plane.normal_world
-            slip = np.maximum(np.linalg.norm(u_t, axis=-1, keepdims=True), FRICTION_REGULARISATION_SPEED)
-            magnitude = np.linalg.norm(f_n, axis=-1, keepdims=True)
-            f = (f_n - model.friction_kinetic[:, p, None, None] * magnitude * u_t / slip) * model.weights[..., None]
+            slip = np.maximum(vector_lengths(u_t), FRICTION_REGULARISATION_SPEED)
+            magnitude = vector_lengths(f_n)
+            f = (f_n - friction * magnitude * u_t / slip) * weights
             force = force + f.sum(axis=1)
             torque = torque + cross(r, f).sum(axis=1)
         return force, torque

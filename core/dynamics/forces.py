@@ -15,6 +15,7 @@ import numpy as np
 
 from simparity.core.dynamics.rigid_body import MassProperties, Wrench
 from simparity.core.model.scenes.bodies import Forces
+from simparity.core.rotations import vector_lengths
 
 
 def make_wrench(forces: Forces, props: MassProperties) -> Wrench:
@@ -39,11 +40,11 @@ def make_wrench(forces: Forces, props: MassProperties) -> Wrench:
             if b is not None:
                 force -= b[:, None] * relative
             if c is not None:
-                force -= c[:, None] * np.linalg.norm(relative, axis=1, keepdims=True) * relative
+                force -= c[:, None] * vector_lengths(relative) * relative
         if k is not None:
             torque -= k[:, None] * omega
         if kq is not None:
-            torque -= kq[:, None] * np.linalg.norm(omega, axis=1, keepdims=True) * omega
+            torque -= kq[:, None] * vector_lengths(omega) * omega
         if len(applied_body):
             lever = np.einsum("aij,aj->ai", rotation[applied_body], applied_point)
             np.add.at(torque, applied_body, np.cross(lever, applied_force))

@@ -96,19 +96,23 @@ class PackedBodies:
     inertia_body_inv : (3, 3, B) ndarray, or (3, B) diagonal when every body's tensor is diagonal
     """
 
-    def __init__(self, props: MassProperties) -> None:
-        self.props = props
+    def __init__(self, props: MassProperties, one_body: bool = False) -> None:
+        self.props, self.one_body = props, one_body
         self.inverse_mass = 1.0 / props.mass
         self.inertia_body = np.ascontiguousarray(props.inertia_body.transpose(1, 2, 0))
         inv = props.inertia_body_inv
         diagonal = not np.any(inv - inv * np.eye(3))
         self.inertia_body_inv = (np.ascontiguousarray(np.diagonal(inv, axis1=1, axis2=2).T) if diagonal
                                  else np.ascontiguousarray(inv.transpose(1, 2, 0)))
+        if one_body:  # no batch axis: (3, 3), (3,) and scalars
+            self.inverse_mass, self.inertia_body, self.inertia_body_inv = (
+                self.inverse_mass[0], self.inertia_body[..., 0], self.inertia_body_inv[..., 0])
 
     def apply_inverse_inertia_body(self, a: np.ndarray) -> np.ndarray:
-        """I_body^-1 a. (3, ..., B) -> (3, ..., B)."""
+        """I_body^-1 a. (3, ..., B) -> (3, ..., B); (3,) -> (3,) for one body."""
         inv = self.inertia_body_inv
-        inv = inv.reshape(inv.shape[:-1] + (1,) * (a.ndim - 2) + inv.shape[-1:])  # broadcast over middle axes
+        if not self.one_body:
+            inv = inv.reshape(inv.shape[:-1] + (1,) * (a.ndim - 2) + inv.shape[-1:])  # broadcast over middle axes
         return inv * a if inv.ndim == a.ndim else _matvec(inv, a)
 
     def omega_world(self, rotation: np.ndarray, angular_momentum: np.ndarray) -> np.ndarray:
@@ -138,7 +142,11 @@ class PackedBodies:
 
 def _wrench(wrench: Wrench, t: float | np.ndarray, packed: np.ndarray, rotation: np.ndarray, v: np.ndarray,
             omega: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The scene's wrench, called body-major on transposed views; returns (F, tau) as (3, B)."""
+    """The scene's wrench, called body-major on transposed views; returns (F, tau) as (3, B), or (3,) for a packed
+    state of one body without a batch axis (13,)."""
+    if packed.ndim == 1:
+        force, torque = wrench(t, packed[X][None], rotation[None], v[None], omega[None])
+        return force[0], torque[0]
     force, torque = wrench(t, packed[X].T, rotation.transpose(2, 0, 1), v.T, omega.T)
     return force.T, torque.T
 
@@ -154,7 +162,8 @@ def _derivative(bodies: PackedBodies, wrench: Wrench, t: float | np.ndarray, pac
 
 def _normalised(packed: np.ndarray) -> np.ndarray:
     q = packed[Q]
-    packed[Q] = q / np.sqrt(np.einsum("ib,ib->b", q, q))
+    columns = q.reshape(4, -1)  # one body without a batch axis summed as a batch of one: the same rounding
+    packed[Q] = q / np.sqrt(np.einsum("ib,ib->b", columns, columns)).reshape(q.shape[1:])
     return packed
 
 
@@ -202,7 +211,7 @@ def semi_implicit_euler(bodies: PackedBodies, wrench: Wrench) -> PackedStep:
 def _quat_exp_body(q: np.ndarray, rotvec_body: np.ndarray) -> np.ndarray:
     """q exp(rotvec) (a body-frame increment), sign fixed to w >= 0. (4, B) x (3, B) -> (4, B)."""
     out = quat_wxyz_normalize(quat_wxyz_multiply(q.T, quat_wxyz_from_rotvec(rotvec_body.T)))
-    return (out * np.where(out[:, :1] < 0, -1.0, 1.0)).T
+    return (out * np.where(out[..., :1] < 0, -1.0, 1.0)).T
 
 
 def engine_euler(bodies: PackedBodies, wrench: Wrench) -> PackedStep:
@@ -228,15 +237,31 @@ def engine_euler(bodies: PackedBodies, wrench: Wrench) -> PackedStep:
 
 def make_packed_step(scheme: str, props: MassProperties, wrench: Wrench) -> PackedStep:
     """The packed step of ``scheme`` (a key of :data:`core.dynamics.tableau.TABLEAUX`, ``semi_implicit_euler``
-    or ``engine_euler``)."""
-    bodies = PackedBodies(props)
+    or ``engine_euler``).
+
+    One body steps without its batch axis: (13,) instead of (13, 1), so that the many scalar products of the
+    rotation and the quaternion rate are NumPy scalars (~0.1 us each) instead of one-element arrays (~1 us each),
+    several times faster per step with the same operations in the same order (the same numbers, bit for bit)."""
+    one_body = len(props.mass) == 1
+    bodies = PackedBodies(props, one_body)
     if scheme in TABLEAUX:
-        return runge_kutta(scheme, bodies, wrench)
-    if scheme == "semi_implicit_euler":
-        return semi_implicit_euler(bodies, wrench)
-    if scheme == "engine_euler":
-        return engine_euler(bodies, wrench)
-    raise ValueError(f"unknown scheme '{scheme}'")
+        step = runge_kutta(scheme, bodies, wrench)
+    elif scheme == "semi_implicit_euler":
+        step = semi_implicit_euler(bodies, wrench)
+    elif scheme == "engine_euler":
+        step = engine_euler(bodies, wrench)
+    else:
+        raise ValueError(f"unknown scheme '{scheme}'")
+    return _with_batch_axis(step) if one_body else step
+
+
+def _with_batch_axis(step: PackedStep) -> PackedStep:
+    """A step of one body's (13,) state as the (13, 1) PackedStep interface."""
+
+    def batched(t: float, s: np.ndarray, dt: float | np.ndarray) -> np.ndarray:
+        return step(t, s[:, 0], dt)[:, None]
+
+    return batched
 
 
 def state_step(scheme: str, props: MassProperties, wrench: Wrench) -> Callable[[float, State, float], State]:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from fractions import Fraction
+from functools import cached_property
 from math import lcm
 
 MAX_WEIGHT_DENOMINATOR = 1000
@@ -57,12 +58,12 @@ class Tableau:
         """Evaluations of the right-hand side per step."""
         return len(self.b)
 
-    @property
+    @cached_property  # read at every step of a stepper that sums over it: computed once per tableau
     def weight_denominator(self) -> float:
         """The least common denominator of the weights b (6.0 for RK4, 1.0 for midpoint)."""
         return float(lcm(*(_fraction(w).denominator for w in self.b)))
 
-    @property
+    @cached_property
     def weight_numerators(self) -> tuple[float, ...]:
         """The weights b times :attr:`weight_denominator` (1, 2, 2, 1 for RK4)."""
         denominator = lcm(*(_fraction(w).denominator for w in self.b))
