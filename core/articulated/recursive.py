@@ -60,17 +60,21 @@ def turn_inertia(packed: np.ndarray, c: np.ndarray, s: np.ndarray) -> None:
     turn(packed[0:4], packed[4:8], c, s)
     a, d, b, e = packed[8:11], packed[11:14], packed[14:17], packed[17]
     half_cos2, half_sin2 = 0.5 * (c - s) * (c + s), c * s
-    mean = (a + d) * 0.5
+    mean = a + d
+    mean *= 0.5
     m2, n2 = a - d, b + b
     np.add(b[2], e, out=n2[2])
-    anti = (b[2] - e) * 0.5
-    m_new = m2 * half_cos2 - n2 * half_sin2
-    n_new = m2 * half_sin2 + n2 * half_cos2
+    anti = b[2] - e
+    anti *= 0.5
+    m_new, scratch = m2 * half_cos2, n2 * half_sin2
+    m_new -= scratch
+    np.multiply(m2, half_sin2, out=b)  # b <- n_new = m2 sin2 + n2 cos2 (m2, n2 are copies)
+    np.multiply(n2, half_cos2, out=scratch)
+    b += scratch
     np.add(mean, m_new, out=a)
     np.subtract(mean, m_new, out=d)
-    b[:] = n_new
+    np.subtract(b[2], anti, out=e)
     b[2] += anti
-    np.subtract(n_new[2], anti, out=e)
 
 
 def slide_inertia(packed: np.ndarray, q: np.ndarray) -> np.ndarray:
