@@ -275,7 +275,9 @@ class _InHouseIK(IKModel):
                        + ("; null-space term H = sum a (q - q_start)^2 toward the start pose" if self._nullspace else "")
                        + (f"; failed targets restarted from up to {restarts.attempts} seeded random configurations "
                           f"({restarts.starts_per_round} per round, more when fewer than {restarts.min_round_rows} "
-                          f"would make the round, seed {restarts.seed}), each attempt at most "
+                          f"would make the round, seed {restarts.seed}"
+                          f"{'; the first round the pool poses nearest each target' if restarts.nearest_first else ''}"
+                          f"; a target's other starts stopped at its first solution), each attempt at most "
                           f"{restarts.max_iterations} iterations with Levenberg-Marquardt damping lambda^2 = "
                           f"{restarts.error_damping:g} |e|^2 + {restarts.damping_floor:g}^2, abandoned after "
                           f"{restarts.stall_window} iterations without a {restarts.stall_ratio:.0%} fall of |e|"

@@ -60,17 +60,21 @@ def turn_inertia(packed: np.ndarray, c: np.ndarray, s: np.ndarray) -> None:
     turn(packed[0:4], packed[4:8], c, s)
     a, d, b, e = packed[8:11], packed[11:14], packed[14:17], packed[17]
     half_cos2, half_sin2 = 0.5 * (c - s) * (c + s), c * s
-    mean = (a + d) * 0.5
+    mean = a + d
+    mean *= 0.5
     m2, n2 = a - d, b + b
     np.add(b[2], e, out=n2[2])
-    anti = (b[2] - e) * 0.5
-    m_new = m2 * half_cos2 - n2 * half_sin2
-    n_new = m2 * half_sin2 + n2 * half_cos2
+    anti = b[2] - e
+    anti *= 0.5
+    m_new, scratch = m2 * half_cos2, n2 * half_sin2
+    m_new -= scratch
+    np.multiply(m2, half_sin2, out=b)  # b <- n_new = m2 sin2 + n2 cos2 (m2, n2 are copies)
+    np.multiply(n2, half_cos2, out=scratch)
+    b += scratch
     np.add(mean, m_new, out=a)
     np.subtract(mean, m_new, out=d)
-    b[:] = n_new
+    np.subtract(b[2], anti, out=e)
     b[2] += anti
-    np.subtract(n_new[2], anti, out=e)
 
 
 def slide_inertia(packed: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -93,12 +97,18 @@ def cross_force(v: np.ndarray, f: np.ndarray) -> np.ndarray:
     w0, w1, w2, v0, v1, v2 = v
     n0, n1, n2, f0, f1, f2 = f
     out = np.empty_like(f)
-    out[0] = w1 * n2 - w2 * n1 + v1 * f2 - v2 * f1
-    out[1] = w2 * n0 - w0 * n2 + v2 * f0 - v0 * f2
-    out[2] = w0 * n1 - w1 * n0 + v0 * f1 - v1 * f0
-    out[3] = w1 * f2 - w2 * f1
-    out[4] = w2 * f0 - w0 * f2
-    out[5] = w0 * f1 - w1 * f0
+    scratch = np.empty_like(f[0])
+    # each row's products summed left to right, as written: out[0] = w1 n2 - w2 n1 + v1 f2 - v2 f1, ...
+    for row, terms in ((0, ((w1, n2), (w2, n1), (v1, f2), (v2, f1))), (1, ((w2, n0), (w0, n2), (v2, f0), (v0, f2))),
+                       (2, ((w0, n1), (w1, n0), (v0, f1), (v1, f0))), (3, ((w1, f2), (w2, f1))),
+                       (4, ((w2, f0), (w0, f2))), (5, ((w0, f1), (w1, f0)))):
+        np.multiply(*terms[0], out=out[row])
+        for sign, (a, b) in zip((-1, 1, -1), terms[1:]):
+            np.multiply(a, b, out=scratch)
+            if sign < 0:
+                out[row] -= scratch
+            else:
+                out[row] += scratch
     return out
 
 
@@ -210,6 +220,11 @@ class Recursive:
         held = carried[parent]
         carried[parent] = value if held is None else held + value
 
+    def _base(self, batch: int) -> np.ndarray:
+        """The base's acceleration for each of ``batch`` states (6, B), contiguous: a BLAS product takes it as it is
+        (a broadcast view of one column would be copied, or multiplied ~8x slower)."""
+        return np.repeat(self._base_acceleration[:, None], batch, axis=1)
+
     @staticmethod
     def _trig(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return np.cos(q), np.sin(q)
@@ -223,7 +238,7 @@ class Recursive:
         velocities = self._velocities(q, qdot, cos, sin)
         forces: list[np.ndarray] = []
         accelerations: list[np.ndarray | None] = []
-        base = np.broadcast_to(self._base_acceleration[:, None], (6, q.shape[1]))
+        base = self._base(q.shape[1])
         for i, (k, v) in enumerate(zip(arrays.subspace, velocities)):
             acceleration = self._from_parent(i, accelerations, base, cos, sin, q)
             acceleration[k] += qddot[i]
@@ -284,7 +299,11 @@ class Recursive:
         for i in reversed(range(n)):
             k = arrays.subspace[i]
             held = self._take(carried, i)
-            articulated = self._inertia_packed[i] + (0.0 if held is None else held)  # I^A_i
+            if held is None:
+                articulated = self._inertia_packed[i] + 0.0  # I^A_i, (21, 1) until it meets the batch
+            else:
+                articulated = held
+                articulated += self._inertia_packed[i]  # I^A_i in place: the children's sum is this body's own
             U_i = articulated[self._columns[i]]
             if U_i.shape[1] != batch:
                 U_i = np.array(np.broadcast_to(U_i, (6, batch)))
@@ -302,18 +321,21 @@ class Recursive:
                 for m, value in biases[i]:
                     force += reduced[PACKED[:, m]] * value
             else:
-                reduced = np.empty((21, batch))
+                # I^a_i in place of I^A_i (U_i is a copy), through one (B,) scratch row: no (21, B) temporary
+                reduced = articulated if articulated.shape[1] == batch else np.repeat(articulated, batch, axis=1)
+                scratch = np.empty(batch)
                 for row, (r, c) in enumerate(SYMMETRIC_PAIRS):
-                    np.multiply(U_i[r], scaled[c], out=reduced[row])
-                    np.subtract(articulated[row], reduced[row], out=reduced[row])
+                    np.multiply(U_i[r], scaled[c], out=scratch)
+                    reduced[row] -= scratch
                 for r in range(6):
                     for m, value in biases[i]:
-                        force[r] += reduced[PACKED[r, m]] * value
+                        np.multiply(reduced[PACKED[r, m]], value, out=scratch)
+                        force[r] += scratch
             self._add_to(carried, parent, self._inertia_to_parent(i, reduced, cos, sin, q))
             bias_forces[parent] += self._to_parent(i, force, cos, sin, q)
         qddot = np.empty_like(q)
         accelerations: list[np.ndarray | None] = []
-        base = np.broadcast_to(self._base_acceleration[:, None], (6, batch))
+        base = self._base(batch)
         for i, k in enumerate(arrays.subspace):
             acceleration = self._from_parent(i, accelerations, base, cos, sin, q)  # a'_i before S_i qddot_i
             for row, value in biases[i]:

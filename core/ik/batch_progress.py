@@ -72,6 +72,13 @@ class BatchProgress:
         self.reason[idx[solved]] = IKReason.SOLVED
         self.active[idx[solved]] = False
 
+    def retire_runs(self, solved: np.ndarray, run: int) -> None:
+        """End the iteration of every target in a run of ``run`` consecutive targets (one target from ``run``
+        starts) that holds one of the just ``solved`` (k,) batch indices; the others keep their reason, best
+        configuration and count."""
+        first = np.unique(solved // run) * run
+        self.active[(first[:, None] + np.arange(run)).ravel()] = False
+
     def stalled(self, idx: np.ndarray, window: int) -> np.ndarray:
         """(m,) positions within ``idx`` of the targets without progress for ``window`` iterations."""
         return np.flatnonzero(self.since_best[idx] >= window)

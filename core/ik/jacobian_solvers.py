@@ -153,6 +153,7 @@ def solve_ik(
     q_start: np.ndarray | None = None,
     method: str = "damped_least_squares",
     options: IKOptions = IKOptions(),
+    starts_per_target: int = 1,
 ) -> IKResult:
     """Solve a batch of position or pose targets with one of the Jacobian methods.
 
@@ -171,6 +172,10 @@ def solve_ik(
         arm of 3 joints with pose targets moves in x, y and the turn about the plane's normal: its inverse is
         taken on those, :func:`task_basis`).
     options : IKOptions
+    starts_per_target : int
+        Rows that are one target from several starts, in runs of this many consecutive rows (B a multiple of it):
+        once one row of a run is solved, the others stop where they are (with ``"iteration_cap"``), since the
+        target needs no second solution (:mod:`core.ik.restarts`). 1: every row its own target.
 
     Returns
     -------
@@ -187,6 +192,9 @@ def solve_ik(
     target_position, target_rotation, q = check_inputs(chain, target_position, target_rotation, q_start)
     if method not in METHODS:
         raise ValueError(f"unknown IK method {method!r}, expected one of {METHODS}")
+    if not (starts_per_target >= 1 and len(target_position) % starts_per_target == 0):
+        raise ValueError(f"starts_per_target is {starts_per_target!r}: a whole number >= 1 that divides the "
+                         f"{len(target_position)} targets")
     rows = 3 if target_rotation is None else 6
     basis = None
     if method == "jacobian_inverse" and rows != chain.n_joints:
@@ -213,7 +221,9 @@ def solve_ik(
                                        None if target_rotation is None else target_rotation[idx])
         solved = (pos_res <= options.position_tolerance) & (rot_res <= options.orientation_tolerance)
         progress.observe(idx, qa, np.linalg.norm(err, axis=1), solved, options.stall_ratio)
-        go = ~solved  # only the unsolved targets are updated
+        if starts_per_target > 1 and solved.any():
+            progress.retire_runs(idx[solved], starts_per_target)
+        go = progress.active[idx]  # only the unsolved targets still iterated are updated
         idx, qa, err, end_world = idx[go], qa[go], err[go], end_world[go]
         if idx.size == 0:
             break
@@ -308,12 +318,16 @@ def _update(method, jac, err, q, lower, upper, revolute, options):
     for _ in range(q.shape[1] if method != "jacobian_inverse" else 0):
         qr, dr = q[redo], dq[redo]
         pushing = ~locked[redo] & (((qr <= lower) & (dr < 0)) | ((qr >= upper) & (dr > 0)))
-        pushing &= ~inside(wrap_into_limits(qr + dr, revolute, lower, upper), lower, upper)
+        some = np.flatnonzero(np.any(pushing, axis=1))  # only these can push outward: wrapped only where needed
+        if not some.size:
+            break
+        pushing = pushing[some] & ~inside(wrap_into_limits(qr[some] + dr[some], revolute, lower, upper), lower,
+                                          upper)
         again = np.any(pushing, axis=1)
         if not np.any(again):
             break
-        redo = redo[again]
-        locked[redo] |= pushing[again]
+        pushing, redo = pushing[again], redo[some[again]]
+        locked[redo] |= pushing
         dq[redo] = _direction(method, jac[redo], err[redo], None if z is None else z[redo], locked[redo], options)
     largest = np.max(np.abs(dq), axis=1, initial=0.0)
     scale = np.minimum(1.0, options.max_step / np.where(largest > 0, largest, 1.0))
