@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import functools
 import math
-import time
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
@@ -13,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from simparity.comparisons.bench.rows import BenchRow
+from simparity.comparisons.bench.rows import BenchRow, Meter
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.ik_targets import random_targets
 from simparity.comparisons.scenes import library
@@ -89,14 +88,15 @@ def ik_rows(n_targets: int | None, say: Callable[[str], None]) -> list[BenchRow]
                 say(f"  {scene.chain.name:<13} {engine:<10} n/a: {missing}")
                 continue
             model = build()
-            start = time.perf_counter()
             rotation = None if targets.rotation_world is None else targets.rotation_world[:count]
-            result = model.solve(targets.position_world[:count], rotation, scene.q_start)
-            seconds = time.perf_counter() - start
+            with Meter() as meter:
+                result = model.solve(targets.position_world[:count], rotation, scene.q_start)
+            seconds = meter.wall_seconds
             violations = int(np.sum(result.limit_violation > 0))
             sample = f"; the first {count:,} targets" if count < scene.n_targets else ""
-            rows.append(BenchRow("ik", scene.chain.name, engine, solver, count, seconds / count * 1e3, "ms/solve",
-                                 result.solve_rate, "solve rate", f"{violations} solutions outside the limits{sample}"))
+            rows.append(meter.stamp(BenchRow("ik", scene.chain.name, engine, solver, count, seconds / count * 1e3,
+                                             "ms/solve", result.solve_rate, "solve rate",
+                                             f"{violations} solutions outside the limits{sample}")))
             say(f"  {scene.chain.name:<13} {engine:<10} {solver:<34} {result.solve_rate:8.4f} solved "
                 f"{seconds / count * 1e3:8.3f} ms/solve ({count / seconds:,.0f}/s)")
     return rows

@@ -10,7 +10,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from simparity.comparisons.bench.rows import BenchRow
+from simparity.comparisons.bench.rows import BenchRow, Meter
 from simparity.comparisons.bench.verdict import TARGET_MEMORY_STEPS, Verdict, sized
 from simparity.comparisons.execute.timing import PeakMemory
 from simparity.comparisons.scenes import library
@@ -79,13 +79,15 @@ def memory_rows(quick: bool, folder: Path, say: Callable[[str], None]) -> list[B
             scene_text = scene_text.replace('integrators = ["taylor2", "semi_implicit_euler+matrix", "euler", "exact"]',
                                             f"integrators = {integrators}")
         scene.write_text(scene_text, encoding="utf-8")
-        peak, seconds, stderr = run_peak_memory([str(scene), "--repeats", "0", "--jobs", "1", "--max-steps",
-                                                 str(steps), *engines], folder / f"run-{index}")
+        with Meter(children=True) as meter:
+            peak, seconds, stderr = run_peak_memory([str(scene), "--repeats", "0", "--jobs", "1", "--max-steps",
+                                                     str(steps), *engines], folder / f"run-{index}")
         note = "" if peak else f"n/a: the run recorded no peak memory: {stderr}"
         method_of = "simparity run --jobs 1" + (f" {' '.join(engines)}" if engines else "")
         for method, mib in ((MEMORY_PROCESS, peak.this_process_bytes / 2**20 if peak else math.nan),
                             (MEMORY_CHILD, peak.largest_child_bytes / 2**20 if peak else math.nan)):
-            rows.append(BenchRow("memory", workload, method_of, method, steps, mib, "MiB", seconds, "s", note))
+            rows.append(meter.stamp(BenchRow("memory", workload, method_of, method, steps, mib, "MiB", seconds, "s",
+                                             note)))
         say(f"  {workload} cut to {steps:,} steps: peak {rows[-2].value:,.0f} MiB in this process, "
             f"{rows[-1].value:,.0f} MiB in its largest child, in {seconds:.0f} s")
     return rows

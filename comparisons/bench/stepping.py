@@ -11,7 +11,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from simparity.comparisons.bench.rows import REPEATS, BenchRow, median_time
+from simparity.comparisons.bench.rows import REPEATS, BenchRow, Meter, median_time
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.measure.metrics import trajectory_errors
 from simparity.core.model.metric_catalogue import ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX
@@ -94,14 +94,15 @@ def dynamics_rows(batches: list[int], quick: bool, say: Callable[[str], None]) -
                                              f"n/a: skipped, {PROBE_STEPS} steps predict {probe:.0f} s per call of "
                                              f"{steps} steps (budget {BUDGET_SECONDS:g} s)"))
                         continue
-                    seconds = median_time(lambda: sim.run(steps), 1 if probe > 1.0 else REPEATS)
+                    with Meter() as meter:
+                        seconds = median_time(lambda: sim.run(steps), 1 if probe > 1.0 else REPEATS)
                 except Exception as err:  # noqa: BLE001
                     rows.append(BenchRow("dynamics", workload, engine, integrator, batch, math.nan, "us/body-step",
                                          error, ERROR_UNIT[workload], f"n/a: {err}"))
                     continue
                 per_body_step = seconds / (batch * steps)
-                rows.append(BenchRow("dynamics", workload, engine, integrator, batch, per_body_step * 1e6,
-                                     "us/body-step", error, ERROR_UNIT[workload], note))
+                rows.append(meter.stamp(BenchRow("dynamics", workload, engine, integrator, batch, per_body_step * 1e6,
+                                                 "us/body-step", error, ERROR_UNIT[workload], note)))
                 say(f"  {workload:<13} {engine:<15} {integrator:<20} B={batch:<6} {per_body_step * 1e6:9.3f} "
                     f"us/body-step   error {error:.2e} {ERROR_UNIT[workload]}")
     return rows
