@@ -14,7 +14,7 @@ from simparity.comparisons.bench.kinematics import kinematics_rows
 from simparity.comparisons.bench.memory import memory_rows, run_peak_memory
 from simparity.comparisons.bench.profiling import profile_summary
 from simparity.comparisons.bench.report import cpus, machine, markdown, write_csv
-from simparity.comparisons.bench.rows import REPEATS, BenchRow, median_time
+from simparity.comparisons.bench.rows import REPEATS, BenchRow, Meter, median_time
 from simparity.comparisons.bench.stepping import dynamics_rows
 from simparity.comparisons.bench.targets import targets
 from simparity.comparisons.bench.verdict import TARGET_BATCH
@@ -44,24 +44,32 @@ def run_bench(out_dir: Path, quick: bool, command: str, say: Callable[[str], Non
 
 
 def _measure(quick: bool, say: Callable[[str], None]) -> tuple[list[BenchRow], str]:
-    """Every workload's rows, and the profile."""
+    """Every workload's rows, each workload's wall and CPU time and load said after it, and the profile."""
     batches = [1, 100] if quick else [1, 100, TARGET_BATCH]
-    say("stepping (time per body-step, with the error at that dt)")
-    rows = dynamics_rows(batches, quick, say)
-    say("small batches: core against MuJoCo's same scheme at B = 1 and 3 (time per step)")
-    rows += small_batch.small_batch_rows(quick, say)
-    say("forward kinematics + Jacobian")
-    rows += kinematics_rows(batches, say)
-    say("joint-space dynamics (time per state, with the difference to Pinocchio)")
-    rows += joint_dynamics.joint_dynamics_rows(batches, lambda fn: median_time(fn, REPEATS), BenchRow, say)
-    say("joint motion (time per copy-step, with the error against DOP853 and the difference to Pinocchio's RK4)")
-    rows += joint_motion.joint_motion_rows(batches, median_time, BenchRow, say)
-    say("IK")
-    rows += ik_rows(300 if quick else None, say)
-    say("memory of simparity run against the number of steps")
-    with tempfile.TemporaryDirectory() as folder:
-        rows += memory_rows(quick, Path(folder), say)
-    say("sweeps: simparity run's wall time and client memory against the number of variants")
-    rows += sweep.sweep_rows(quick, run_peak_memory, BenchRow, say)
+    workloads: list[tuple[str, Callable[[], list[BenchRow]]]] = [
+        ("stepping (time per body-step, with the error at that dt)", lambda: dynamics_rows(batches, quick, say)),
+        ("small batches: core against MuJoCo's same scheme at B = 1 and 3 (time per step)",
+         lambda: small_batch.small_batch_rows(quick, say)),
+        ("forward kinematics + Jacobian", lambda: kinematics_rows(batches, say)),
+        ("joint-space dynamics (time per state, with the difference to Pinocchio)",
+         lambda: joint_dynamics.joint_dynamics_rows(batches, lambda fn: median_time(fn, REPEATS), BenchRow, say)),
+        ("joint motion (time per copy-step, with the error against DOP853 and the difference to Pinocchio's RK4)",
+         lambda: joint_motion.joint_motion_rows(batches, median_time, BenchRow, say)),
+        ("IK", lambda: ik_rows(300 if quick else None, say)),
+        ("memory of simparity run against the number of steps", lambda: _memory_rows(quick, say)),
+        ("sweeps: simparity run's wall time and client memory against the number of variants",
+         lambda: sweep.sweep_rows(quick, run_peak_memory, BenchRow, say))]
+    rows: list[BenchRow] = []
+    for title, measure in workloads:
+        say(title)
+        with Meter(children=True) as meter:
+            rows += measure()
+        say(f"  ({meter.wall_seconds:.0f} s wall, {meter.cpu_seconds:.0f} s CPU with the processes it started, load "
+            f"{meter.load_before:.2f} -> {meter.load_after:.2f})")
     say("profile")
     return rows, profile_summary(batches[-1], say)
+
+
+def _memory_rows(quick: bool, say: Callable[[str], None]) -> list[BenchRow]:
+    with tempfile.TemporaryDirectory() as folder:
+        return memory_rows(quick, Path(folder), say)

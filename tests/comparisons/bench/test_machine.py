@@ -9,7 +9,7 @@ import os
 import numpy as np
 import pytest
 
-from simparity.comparisons.bench import report
+from simparity.comparisons.bench import report, run
 from simparity.comparisons.bench.blas import describe_threads, loaded_blas, one_blas_thread
 from simparity.comparisons.bench.rows import BenchRow, Meter
 from simparity.comparisons.bench.targets import IK_SOLVES_PER_SECOND, targets
@@ -92,3 +92,22 @@ def test_the_markdown_states_the_blas_threads_and_the_load_of_each_workload():
     assert f"## Machine load ({CPUS} CPUs)" in text
     assert f"| ik | arm | 2 | {QUIET_LOAD:.2f}-{BUSY_LOAD:.2f} | 1.00-1.00 | 1 |" in text
     assert "not judged: machine loaded" in text  # the verdict on the first (loaded) row
+
+
+def test_the_bench_measures_on_one_blas_thread_and_writes_the_load_beside_each_row(monkeypatch, tmp_path):
+    """run_bench's plumbing, its workloads replaced by one loaded IK row (the real ones take minutes)."""
+    seen = []
+
+    def measure(quick, say):
+        seen.append([b.threads for b in loaded_blas()])
+        return [_ik_row(2 * IK_SOLVES_PER_SECOND, BUSY_LOAD)], "profile"
+
+    monkeypatch.setattr(run, "_measure", measure)
+    lines: list[str] = []
+    path = run.run_bench(tmp_path, True, "simparity bench --quick", lines.append)
+    assert seen == [[1] * len(loaded_blas())]
+    text = path.read_text()
+    assert "BLAS threads " + ("1 (" if loaded_blas() else "not read") in text
+    header, row = (tmp_path / "benchmarks.csv").read_text().splitlines()
+    assert header.endswith("load_before,load_after,cpu_seconds,wall_seconds") and f",{BUSY_LOAD},{BUSY_LOAD}," in row
+    assert any(line.startswith("not judged") and "machine loaded" in line for line in lines)
