@@ -98,7 +98,7 @@ def markdown_lines(rows: list[BenchRow]) -> list[str]:
     lines = ["## Small batches: core against MuJoCo's same scheme at B = 1 and B = 3 (us per step of the scene)", "",
              "Every integrator pair the two engines name the same scheme; B boxes tumbling in one scene, or B copies "
              f"of {ARM}. Ratio core / MuJoCo: > 1, core is slower.", "",
-             "| workload | scheme | core | MuJoCo | " + " | ".join(f"B = {b}: core | MuJoCo | ratio" for b in BATCHES)
+             "| workload | scheme | core | MuJoCo | " + " | ".join(f"B = {b} core | B = {b} MuJoCo | B = {b} ratio" for b in BATCHES)
              + " |", "|---|---|---|---|" + "---|---|---|" * len(BATCHES)]
     for workload, method, scheme in dict.fromkeys((r.workload, r.method, r.note) for r in ratios):
         mine, theirs = method.split(" / ")

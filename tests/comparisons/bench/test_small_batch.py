@@ -33,4 +33,4 @@ def test_a_tiny_run_times_both_engines_at_b_1_and_3_and_divides_them(monkeypatch
     for r in ratios:
         assert r.value == timed[r.workload, "core", r.batch].value / timed[r.workload, "mujoco", r.batch].value
     text = "\n".join(small_batch.markdown_lines(rows))
-    assert text.count("| tumbling | rk4 | rk4 | rk4 |") == 1 and "B = 3: core | MuJoCo | ratio" in text
+    assert text.count("| tumbling | rk4 | rk4 | rk4 |") == 1 and "B = 3 core | B = 3 MuJoCo | B = 3 ratio" in text
