@@ -56,10 +56,20 @@ def boxes(n_bodies: int, drag: bool, seed: int = 0) -> DynamicsScene:
                          ERROR_STEPS * DT, (DT,))
 
 
+ROLLOUT_THREADS = os.cpu_count() or 1
+"""Threads of ``mujoco-rollout`` (:class:`BatchRollout`), one per CPU: the one stepping row on more than one thread
+(its note says so)."""
+
+
 def simulation(engine: str, integrator: str, scene: DynamicsScene):
     if engine == "mujoco-rollout":
-        return BatchRollout(scene, integrator, DT, os.cpu_count() or 1)
+        return BatchRollout(scene, integrator, DT, ROLLOUT_THREADS)
     return make_engine(engine).build_dynamics(scene, integrator, DT)
+
+
+def _threads_note(engine: str) -> str:
+    """The note of a row that does not run on one thread."""
+    return f"{ROLLOUT_THREADS} threads (mujoco.rollout, one per CPU)" if engine == "mujoco-rollout" else ""
 
 
 def _steps(batch: int, quick: bool) -> int:
@@ -76,7 +86,7 @@ def dynamics_rows(batches: list[int], quick: bool, say: Callable[[str], None]) -
         for engine, integrator in DYNAMICS:
             try:
                 errors = trajectory_errors(simulation(engine, integrator, small).run(ERROR_STEPS), reference)
-                error, note = errors[ERROR_METRIC[workload]].value, ""
+                error, note = errors[ERROR_METRIC[workload]].value, _threads_note(engine)
             except Exception as err:  # noqa: BLE001 - an engine that cannot do the workload is a row saying why
                 rows += [BenchRow("dynamics", workload, engine, integrator, b, math.nan, "us/body-step", math.nan,
                                   ERROR_UNIT[workload], f"n/a: {err}") for b in batches]
