@@ -35,8 +35,16 @@ FIVE_DOF_IK = (("core", "damped_least_squares"), ("core", "damped_least_squares+
 the bench suite's arms)."""
 LIBRARY_IK = ("mink", "pink")
 """Differential-IK libraries (:mod:`references.differential_ik`): one QP per update, milliseconds per solve, so
-they solve the first :data:`LIBRARY_TARGETS` targets of each arm."""
+they solve the first :func:`library_targets` targets of each arm."""
 LIBRARY_TARGETS = 1000
+LIBRARY_SHARE = 10
+"""The libraries solve one target in this many of an arm's (at most :data:`LIBRARY_TARGETS`): 1,000 of the 10,000,
+30 of ``--quick``'s 300."""
+
+
+def library_targets(n_targets: int) -> int:
+    """Targets a differential-IK library solves on an arm of ``n_targets`` (its first; at least one)."""
+    return max(1, min(n_targets // LIBRARY_SHARE, LIBRARY_TARGETS))
 
 
 def _build_ik(engine: str, chain, solver: str, options: IKTolerances) -> Any:
@@ -80,7 +88,7 @@ def ik_rows(n_targets: int | None, say: Callable[[str], None]) -> list[BenchRow]
         solvers += [(name, "documented loop", functools.partial(_library_ik, name, scene.chain, options))
                     for name in (() if five_dof else LIBRARY_IK)]
         for engine, solver, build in solvers:
-            count = min(scene.n_targets, LIBRARY_TARGETS) if engine in LIBRARY_IK else scene.n_targets
+            count = library_targets(scene.n_targets) if engine in LIBRARY_IK else scene.n_targets
             missing = available(engine) if engine in LIBRARY_IK else ""
             if missing:
                 rows.append(BenchRow("ik", scene.chain.name, engine, solver, count, math.nan, "ms/solve", math.nan,

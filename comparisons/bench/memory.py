@@ -55,17 +55,20 @@ core's particle rule and the closed form (its reference streamed beside each cas
 CHEAP_MEMORY_STEPS = (100_000, 1_000_000, 3_000_000, 10_000_000)
 """Steps of the cheap memory rows: the slope between them says whether memory grows with the steps; the last is
 run by the closed form alone (core's Python loop would take ten minutes)."""
+QUICK_SCALE = 100
+"""``--quick`` runs each memory run at this fraction of its steps (a run's start-up then dominates its memory)."""
 WORKER_LIMIT_MIB = 1024
 """[MiB] What a worker may hold for :data:`CHEAP_MEMORY_STEPS`' largest run."""
 
 
 def memory_rows(quick: bool, folder: Path, say: Callable[[str], None]) -> list[BenchRow]:
     """Peak memory of ``simparity run --jobs 1``, each run in its own process: on :data:`MEMORY_SCENE` with every
-    default engine cut to 10^5 and 10^6 steps, and on :data:`CHEAP_MEMORY` at :data:`CHEAP_MEMORY_STEPS` (a tenth
-    of each quick). A :data:`MEMORY_PROCESS` and a :data:`MEMORY_CHILD` row per run [MiB], read from the run's
-    ``run.json``, with the run's wall time [s] as accuracy."""
+    default engine cut to 10^5 and 10^6 steps, and on :data:`CHEAP_MEMORY` at :data:`CHEAP_MEMORY_STEPS` (a
+    :data:`QUICK_SCALE`-th of each quick: a check that the runs work, not a measurement). A :data:`MEMORY_PROCESS` and
+    a :data:`MEMORY_CHILD` row per run [MiB], read from the run's ``run.json``, with the run's wall time [s] as
+    accuracy."""
     text = library.resolve(MEMORY_SCENE).read_text(encoding="utf-8")
-    scale = 10 if quick else 1
+    scale = QUICK_SCALE if quick else 1
     runs: list[tuple[str, int, str | None, list[str]]] = [
         (MEMORY_SCENE, steps // scale, None, []) for steps in (100_000, TARGET_MEMORY_STEPS)]
     runs += [(CHEAP_MEMORY, steps // scale, '["taylor2", "exact"]', ["--engines", "core,analytic"])
