@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import functools
 import math
-import time
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
@@ -13,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from simparity.comparisons.bench.rows import BenchRow
+from simparity.comparisons.bench.rows import BenchRow, Meter
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.ik_targets import random_targets
 from simparity.comparisons.scenes import library
@@ -36,8 +35,16 @@ FIVE_DOF_IK = (("core", "damped_least_squares"), ("core", "damped_least_squares+
 the bench suite's arms)."""
 LIBRARY_IK = ("mink", "pink")
 """Differential-IK libraries (:mod:`references.differential_ik`): one QP per update, milliseconds per solve, so
-they solve the first :data:`LIBRARY_TARGETS` targets of each arm."""
+they solve the first :func:`library_targets` targets of each arm."""
 LIBRARY_TARGETS = 1000
+LIBRARY_SHARE = 10
+"""The libraries solve one target in this many of an arm's (at most :data:`LIBRARY_TARGETS`): 1,000 of the 10,000,
+30 of ``--quick``'s 300."""
+
+
+def library_targets(n_targets: int) -> int:
+    """Targets a differential-IK library solves on an arm of ``n_targets`` (its first; at least one)."""
+    return max(1, min(n_targets // LIBRARY_SHARE, LIBRARY_TARGETS))
 
 
 def _build_ik(engine: str, chain, solver: str, options: IKTolerances) -> Any:
@@ -81,7 +88,7 @@ def ik_rows(n_targets: int | None, say: Callable[[str], None]) -> list[BenchRow]
         solvers += [(name, "documented loop", functools.partial(_library_ik, name, scene.chain, options))
                     for name in (() if five_dof else LIBRARY_IK)]
         for engine, solver, build in solvers:
-            count = min(scene.n_targets, LIBRARY_TARGETS) if engine in LIBRARY_IK else scene.n_targets
+            count = library_targets(scene.n_targets) if engine in LIBRARY_IK else scene.n_targets
             missing = available(engine) if engine in LIBRARY_IK else ""
             if missing:
                 rows.append(BenchRow("ik", scene.chain.name, engine, solver, count, math.nan, "ms/solve", math.nan,
@@ -89,14 +96,15 @@ def ik_rows(n_targets: int | None, say: Callable[[str], None]) -> list[BenchRow]
                 say(f"  {scene.chain.name:<13} {engine:<10} n/a: {missing}")
                 continue
             model = build()
-            start = time.perf_counter()
             rotation = None if targets.rotation_world is None else targets.rotation_world[:count]
-            result = model.solve(targets.position_world[:count], rotation, scene.q_start)
-            seconds = time.perf_counter() - start
+            with Meter() as meter:
+                result = model.solve(targets.position_world[:count], rotation, scene.q_start)
+            seconds = meter.wall_seconds
             violations = int(np.sum(result.limit_violation > 0))
             sample = f"; the first {count:,} targets" if count < scene.n_targets else ""
-            rows.append(BenchRow("ik", scene.chain.name, engine, solver, count, seconds / count * 1e3, "ms/solve",
-                                 result.solve_rate, "solve rate", f"{violations} solutions outside the limits{sample}"))
+            rows.append(meter.stamp(BenchRow("ik", scene.chain.name, engine, solver, count, seconds / count * 1e3,
+                                             "ms/solve", result.solve_rate, "solve rate",
+                                             f"{violations} solutions outside the limits{sample}")))
             say(f"  {scene.chain.name:<13} {engine:<10} {solver:<34} {result.solve_rate:8.4f} solved "
                 f"{seconds / count * 1e3:8.3f} ms/solve ({count / seconds:,.0f}/s)")
     return rows

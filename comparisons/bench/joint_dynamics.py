@@ -16,6 +16,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from simparity.comparisons.bench.rows import Meter
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes import library
 
@@ -30,6 +31,9 @@ ERROR_STATES = 100
 SEED = 11
 OPERATIONS = ("M+h", "rnea", "aba")
 """What is timed: the mass matrix and the bias forces; inverse dynamics; forward dynamics."""
+ABA_OVER_POOL = 1.5
+"""The issue's (#41) target: core's ABA at the largest B this many times as fast per state as Pinocchio's batched
+API on one thread, on every arm (a ratio of two rows of the same run)."""
 
 
 def _states(scene, count: int) -> tuple[np.ndarray, ...]:
@@ -92,16 +96,20 @@ def joint_dynamics_rows(batches: list[int], median_time, row, say: Callable[[str
             for batch in batches:
                 count = batch if engine == "core" else min(batch, ENGINE_STATES)
                 for name, fn in _operations(model, _states(scene, count)).items():
-                    seconds = median_time(fn) / count
-                    rows.append(row("joint_dynamics", scene.name, engine, f"{method} {name}", batch, seconds * 1e6,
-                                    "us/state", errors[name], "1", "vs pinocchio" if engine != "pinocchio" else ""))
+                    with Meter() as meter:
+                        seconds = median_time(fn) / count
+                    rows.append(meter.stamp(row("joint_dynamics", scene.name, engine, f"{method} {name}", batch,
+                                                seconds * 1e6, "us/state", errors[name], "1",
+                                                "vs pinocchio" if engine != "pinocchio" else "")))
                     say(f"  {scene.name:<15} {engine:<9} {method:<12} {name:<4} B={batch:<6} "
                         f"{seconds * 1e6:9.3f} us/state")
         for batch in batches:
-            batched = _pinocchio_batched(scene, _states(scene, batch), median_time)
+            states = _states(scene, batch)
+            with Meter() as meter:  # both operations' measurements: the load and CPU time of the pair
+                batched = _pinocchio_batched(scene, states, median_time)
             for name, seconds in batched.items():
-                rows.append(row("joint_dynamics", scene.name, "pinocchio-pool", f"recursive {name}", batch,
-                                seconds * 1e6, "us/state", 0.0, "1", "ModelPool, 1 thread"))
+                rows.append(meter.stamp(row("joint_dynamics", scene.name, "pinocchio-pool", f"recursive {name}", batch,
+                                            seconds * 1e6, "us/state", 0.0, "1", "ModelPool, 1 thread")))
                 say(f"  {scene.name:<15} pinocchio-pool {name:<4} B={batch:<6} {seconds * 1e6:9.3f} us/state")
     return rows
 
@@ -128,8 +136,8 @@ def markdown_lines(rows: list) -> list[str]:
 
 
 def target_lines(rows: list) -> list[tuple[str, str, bool]]:
-    """(target, compared, met) of the issue's speed target: core at the largest B at least as fast per forward
-    dynamics as Pinocchio's batched API on one thread, per arm."""
+    """(target, compared, met) of the issue's speed target: core at the largest B at least :data:`ABA_OVER_POOL`
+    times as fast per forward dynamics as Pinocchio's batched API on one thread, per arm."""
     out = []
     mine = [r for r in rows if r.section == "joint_dynamics" and math.isfinite(r.value)]
     for arm in dict.fromkeys(r.workload for r in mine):
@@ -140,7 +148,8 @@ def target_lines(rows: list) -> list[tuple[str, str, bool]]:
         if core is None or not pool:
             continue
         best = min(pool, key=lambda r: r.value)
-        out.append((f"{arm}: core ABA at the largest B at least as fast per state as Pinocchio's ModelPool (1 thread)",
+        out.append((f"{arm}: core ABA at the largest B at least {ABA_OVER_POOL:g}x as fast per state as Pinocchio's "
+                    "ModelPool (1 thread)",
                     f"core at B = {big:,}: {core.value:.3g} us vs Pinocchio pool at B = {best.batch:,}: "
-                    f"{best.value:.3g} us ({best.value / core.value:.2f}x)", best.value / core.value >= 1.0))
+                    f"{best.value:.3g} us ({best.value / core.value:.2f}x)", best.value / core.value >= ABA_OVER_POOL))
     return out

@@ -6,9 +6,8 @@ Copies: copy 0 starts at the scene's pose, copy k > 0 at that pose plus seeded n
 :data:`PERTURBATION` rad per joint (the scene's qdot0, zero). Each engine's ``run`` of the B copies is timed (the
 trajectory it records included):
 
-- core: its ``rk4``, every copy in one NumPy batch. NumPy's matrix products may run on OpenBLAS threads (each row's
-  note gives the CPU time over the wall time of its calls; ``OPENBLAS_NUM_THREADS=1`` in the environment of
-  ``simparity bench`` keeps them to one, as the runner's workers do);
+- core: its ``rk4``, every copy in one NumPy batch, on one BLAS thread (:mod:`comparisons.bench.blas`, as the
+  runner's workers);
 - MuJoCo: its ``rk4`` (``mj_RungeKutta``), the B copies as B rollouts of ONE ``mujoco.rollout`` call on the calling
   thread (one ``MjData``, the adapter's path). ``mujoco.rollout.Rollout(nthread=k)`` with k ``MjData`` would split the
   copies over k threads; it is not used, for a like-for-like comparison with core's one batch;
@@ -26,11 +25,11 @@ the RK4s are the same scheme on the same dynamics, so they differ by rounding on
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 
 import numpy as np
 
+from simparity.comparisons.bench.rows import Meter
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes import library
 from simparity.core.model.scenes.joint_motion import JointMotionScene
@@ -119,22 +118,14 @@ def accuracy(scene: JointMotionScene) -> dict[tuple[str, str], tuple[float, floa
     return out
 
 
-def _timed(engine: str, integrator: str, scene: JointMotionScene, batch: int, median_time) -> tuple[float, str]:
-    """(us per copy-step, note) of the engine's ``run`` of ``batch`` copies; ``median_time(fn, repeats)`` -> s. The
-    note gives the process's CPU time over wall time across the calls: above 1, the engine (or NumPy's BLAS) used
-    more than one thread; below 1, the machine was busy with something else."""
+def _timed(engine: str, integrator: str, scene: JointMotionScene, batch: int, median_time) -> tuple[float, str, Meter]:
+    """(us per copy-step, note, the measurement's load and CPU time) of the engine's ``run`` of ``batch`` copies;
+    ``median_time(fn, repeats)`` -> s."""
     steps = steps_per_call(batch)
     sim = make_engine(engine).build_joint_motion(copies(scene, batch, steps), integrator, DT)
-    spent = np.zeros(2)  # CPU seconds, wall seconds
-
-    def call() -> None:
-        cpu, wall = time.process_time(), time.perf_counter()
-        sim.run(steps)
-        spent[:] += time.process_time() - cpu, time.perf_counter() - wall
-
-    seconds = median_time(call, 1 if batch * steps >= LARGE_CALL else REPEATS)
-    return (seconds / (batch * steps) * 1e6,
-            f"{NOTES.get(engine, '')}; {steps} steps per call; CPU/wall {spent[0] / spent[1]:.2f}")
+    with Meter() as meter:
+        seconds = median_time(lambda: sim.run(steps), 1 if batch * steps >= LARGE_CALL else REPEATS)
+    return seconds / (batch * steps) * 1e6, f"{NOTES.get(engine, '')}; {steps} steps per call", meter
 
 
 def _skipped(engine: str, batch: int, measured: dict[int, float]) -> str:
@@ -168,18 +159,20 @@ def joint_motion_rows(batches: list[int], median_time, row, say: Callable[[str],
             found = errors[engine, integrator]
             measured: dict[int, float] = {}
             for batch in batches:
+                meter = None
                 if isinstance(found, str):
                     value, note = math.nan, found
                 elif engine in NOT_BATCHED and batch > PER_COPY_MAX_BATCH:
                     value, note = math.nan, _skipped(engine, batch, measured)
                 else:
                     try:
-                        value, note = _timed(engine, integrator, scene, batch, median_time)
+                        value, note, meter = _timed(engine, integrator, scene, batch, median_time)
                         measured[batch] = value
                     except Exception as err:  # noqa: BLE001 - a run that fails at this size: its row says why
                         value, note = math.nan, f"n/a: {err}"
                 error = math.nan if isinstance(found, str) else found[0]
-                rows.append(row(SECTION, scene.name, engine, integrator, batch, value, UNIT, error, "rad", note))
+                measured_row = row(SECTION, scene.name, engine, integrator, batch, value, UNIT, error, "rad", note)
+                rows.append(meter.stamp(measured_row) if meter else measured_row)
                 say(f"  {scene.name:<14} {engine:<9} {integrator:<6} B={batch:<6} {value:10.3f} us/copy-step "
                     f"({1e6 / value:,.0f} copy-steps/s) {note}")
     return rows
@@ -198,8 +191,7 @@ def markdown_lines(rows: list) -> list[str]:
     batches = sorted({r.batch for r in timed})
     lines = [f"## Joint motion: falling arms (us per copy-step at dt {DT:g} s, copy-steps per second)", "",
              "Each engine's `run` of B copies (the scene's random pose and B - 1 seeded perturbations of it), the "
-             "recorded trajectory included. core: one NumPy batch, whose matrix products OpenBLAS may spread over "
-             "threads (CPU/wall in the notes; `OPENBLAS_NUM_THREADS=1 simparity bench` keeps it to one). "
+             "recorded trajectory included. core: one NumPy batch on one BLAS thread. "
              "MuJoCo: one `mujoco.rollout` call on ONE thread (one MjData; `mujoco.rollout.Rollout(nthread=k)` could "
              "split the copies over k threads: not used). Pinocchio: the harness's Python loop of `pin.aba` copy by "
              f"copy, flat in B, timed up to B = {PER_COPY_MAX_BATCH}. PyBullet: semi-implicit Euler, its copies in one "

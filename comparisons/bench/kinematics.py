@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import replace
 
-from simparity.comparisons.bench.rows import REPEATS, BenchRow, median_time
+from simparity.comparisons.bench.rows import REPEATS, BenchRow, Meter, median_time
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.measure.metrics import kinematics_errors
 from simparity.comparisons.scenes import library
@@ -41,13 +41,15 @@ def kinematics_rows(batches: list[int], say: Callable[[str], None]) -> list[Benc
                 def both():
                     return model.forward_kinematics(q), model.jacobian_world(q)
 
-                seconds = median_time(both, REPEATS if count * chain.n_joints < 50_000 else 2)
+                with Meter() as meter:
+                    seconds = median_time(both, REPEATS if count * chain.n_joints < 50_000 else 2)
                 poses, jac = both()
                 k = min(count, ERROR_CONFIGURATIONS)
                 errors = kinematics_errors(poses_slice(poses, k), jac[:k], poses_slice(ref_poses, k), ref_jacobian[:k])
                 error = max(errors[POSITION_ERROR_MAX].value, errors[JACOBIAN_ERROR_MAX].value)
-                rows.append(BenchRow("kinematics", chain.name, engine, "fk+jacobian", batch, seconds / count * 1e6,
-                                     "us/configuration", error, "m", "vs pinocchio" if engine != "pinocchio" else ""))
+                rows.append(meter.stamp(BenchRow("kinematics", chain.name, engine, "fk+jacobian", batch,
+                                                 seconds / count * 1e6, "us/configuration", error, "m",
+                                                 "vs pinocchio" if engine != "pinocchio" else "")))
                 say(f"  {chain.name:<13} {engine:<10} B={batch:<6} {seconds / count * 1e6:9.3f} us/configuration")
     return rows
 

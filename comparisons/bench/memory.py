@@ -10,7 +10,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from simparity.comparisons.bench.rows import BenchRow
+from simparity.comparisons.bench.rows import BenchRow, Meter
 from simparity.comparisons.bench.verdict import TARGET_MEMORY_STEPS, Verdict, sized
 from simparity.comparisons.execute.timing import PeakMemory
 from simparity.comparisons.scenes import library
@@ -55,17 +55,20 @@ core's particle rule and the closed form (its reference streamed beside each cas
 CHEAP_MEMORY_STEPS = (100_000, 1_000_000, 3_000_000, 10_000_000)
 """Steps of the cheap memory rows: the slope between them says whether memory grows with the steps; the last is
 run by the closed form alone (core's Python loop would take ten minutes)."""
+QUICK_SCALE = 100
+"""``--quick`` runs each memory run at this fraction of its steps (a run's start-up then dominates its memory)."""
 WORKER_LIMIT_MIB = 1024
 """[MiB] What a worker may hold for :data:`CHEAP_MEMORY_STEPS`' largest run."""
 
 
 def memory_rows(quick: bool, folder: Path, say: Callable[[str], None]) -> list[BenchRow]:
     """Peak memory of ``simparity run --jobs 1``, each run in its own process: on :data:`MEMORY_SCENE` with every
-    default engine cut to 10^5 and 10^6 steps, and on :data:`CHEAP_MEMORY` at :data:`CHEAP_MEMORY_STEPS` (a tenth
-    of each quick). A :data:`MEMORY_PROCESS` and a :data:`MEMORY_CHILD` row per run [MiB], read from the run's
-    ``run.json``, with the run's wall time [s] as accuracy."""
+    default engine cut to 10^5 and 10^6 steps, and on :data:`CHEAP_MEMORY` at :data:`CHEAP_MEMORY_STEPS` (a
+    :data:`QUICK_SCALE`-th of each quick: a check that the runs work, not a measurement). A :data:`MEMORY_PROCESS` and
+    a :data:`MEMORY_CHILD` row per run [MiB], read from the run's ``run.json``, with the run's wall time [s] as
+    accuracy."""
     text = library.resolve(MEMORY_SCENE).read_text(encoding="utf-8")
-    scale = 10 if quick else 1
+    scale = QUICK_SCALE if quick else 1
     runs: list[tuple[str, int, str | None, list[str]]] = [
         (MEMORY_SCENE, steps // scale, None, []) for steps in (100_000, TARGET_MEMORY_STEPS)]
     runs += [(CHEAP_MEMORY, steps // scale, '["taylor2", "exact"]', ["--engines", "core,analytic"])
@@ -79,13 +82,15 @@ def memory_rows(quick: bool, folder: Path, say: Callable[[str], None]) -> list[B
             scene_text = scene_text.replace('integrators = ["taylor2", "semi_implicit_euler+matrix", "euler", "exact"]',
                                             f"integrators = {integrators}")
         scene.write_text(scene_text, encoding="utf-8")
-        peak, seconds, stderr = run_peak_memory([str(scene), "--repeats", "0", "--jobs", "1", "--max-steps",
-                                                 str(steps), *engines], folder / f"run-{index}")
+        with Meter(children=True) as meter:
+            peak, seconds, stderr = run_peak_memory([str(scene), "--repeats", "0", "--jobs", "1", "--max-steps",
+                                                     str(steps), *engines], folder / f"run-{index}")
         note = "" if peak else f"n/a: the run recorded no peak memory: {stderr}"
         method_of = "simparity run --jobs 1" + (f" {' '.join(engines)}" if engines else "")
         for method, mib in ((MEMORY_PROCESS, peak.this_process_bytes / 2**20 if peak else math.nan),
                             (MEMORY_CHILD, peak.largest_child_bytes / 2**20 if peak else math.nan)):
-            rows.append(BenchRow("memory", workload, method_of, method, steps, mib, "MiB", seconds, "s", note))
+            rows.append(meter.stamp(BenchRow("memory", workload, method_of, method, steps, mib, "MiB", seconds, "s",
+                                             note)))
         say(f"  {workload} cut to {steps:,} steps: peak {rows[-2].value:,.0f} MiB in this process, "
             f"{rows[-1].value:,.0f} MiB in its largest child, in {seconds:.0f} s")
     return rows

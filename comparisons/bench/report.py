@@ -12,22 +12,34 @@ from pathlib import Path
 
 import numpy as np
 
-from simparity.comparisons.bench import joint_dynamics, joint_motion, sweep
+from simparity.comparisons.bench import joint_dynamics, joint_motion, small_batch, sweep
+from simparity.comparisons.bench.blas import describe_threads
 from simparity.comparisons.bench.memory import MEMORY_CHILD, MEMORY_PROCESS
 from simparity.comparisons.bench.rows import BenchRow
 from simparity.comparisons.bench.stepping import DT, ERROR_METRIC, ERROR_STEPS, ERROR_UNIT
 from simparity.comparisons.bench.targets import targets
+from simparity.comparisons.bench.verdict import MIN_CPU_PER_WALL, OTHERS_LOAD_PER_CPU, machine_loaded
+
+
+CPUS = "cores"
+"""The key of :func:`machine`'s CPU count."""
 
 
 def machine() -> dict[str, str]:
-    """What the numbers were measured on."""
+    """What the numbers were measured on, with the BLAS threads in effect when called (inside
+    :func:`comparisons.bench.blas.one_blas_thread`: the timed rows')."""
     import mujoco
     import pinocchio
     from importlib import metadata
     return {"python": platform.python_version(), "numpy": np.__version__, "mujoco": mujoco.__version__,
             "pinocchio": pinocchio.__version__, "pybullet": metadata.version("pybullet"),
-            "cpu": platform.processor() or platform.machine(), "cores": str(os.cpu_count()),
-            "system": platform.platform()}
+            "cpu": platform.processor() or platform.machine(), CPUS: str(os.cpu_count()),
+            "BLAS threads": describe_threads(), "system": platform.platform()}
+
+
+def cpus(info: dict[str, str]) -> int:
+    """The machine's CPU count from :func:`machine`'s answer (1 when not known)."""
+    return int(info.get(CPUS) or 1)
 
 
 def write_csv(rows: list[BenchRow], path: Path) -> None:
@@ -44,15 +56,21 @@ def _cell(value: float, digits: str = ".3g") -> str:
 def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: str, seconds: float) -> str:
     lines = ["# BENCHMARKS", "", f"Written by `{command}` in {seconds:.0f} s on "
              + ", ".join(f"{k} {v}" for k, v in info.items()) + ". Every time is the median of repeated calls "
-             "after a warm-up; every ratio is from this run. The raw rows are in `benchmarks.csv`.", "",
+             "after a warm-up, on one BLAS thread (the bench sets it) unless its row says otherwise; every ratio is "
+             "from this run. The raw rows are in `benchmarks.csv`, each with the load average before and after its "
+             "measurement and its CPU and wall time.", "",
              "## Targets", "", ("Each target as set, what this run compared for it, and the verdict; a target set for "
-                                "another size than this run measured (`--quick`) is not comparable."), "",
+                                "another size than this run measured (`--quick`) is not comparable; an absolute target "
+                                "(a rate, not a ratio to a row of this run) measured on a loaded machine is not "
+                                f"judged: the load average around its row, less the bench's own thread, above "
+                                f"{OTHERS_LOAD_PER_CPU:g} per CPU, or its CPU / wall below {MIN_CPU_PER_WALL:g}."), "",
              "| target | compared | verdict |", "|---|---|---|"]
-    for verdict in targets(rows):
+    for verdict in targets(rows, cpus(info)):
         label = "**MISSED**" if verdict.met is False else verdict.label
         lines.append(f"| {verdict.target} | {verdict.compared} | {label} |")
-    lines += ["", "The default suite's wall time (target <= 3 min) is printed on the last line of every `simparity run`, "
-              "with its peak memory.", ""]
+    lines += ["", "The default suite's wall time (target <= 90 s on an idle 2-core machine) is printed on the last "
+              "line of every `simparity run`, with its peak memory.", ""]
+    lines += load_lines(rows, cpus(info))
     for workload in dict.fromkeys(r.workload for r in rows if r.section == "dynamics"):
         mine = [r for r in rows if r.section == "dynamics" and r.workload == workload]
         batches = sorted({r.batch for r in mine})
@@ -89,6 +107,7 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
             lines.append(f"| {chain} | {engine} | " + " | ".join(_cell(cells[b].value) for b in batches)
                          + f" | {_cell(max(c.accuracy for c in cells.values()), '.1e')} |")
         lines.append("")
+    lines += small_batch.markdown_lines(rows)
     lines += joint_dynamics.markdown_lines(rows)
     lines += joint_motion.markdown_lines(rows)
     lines += sweep.markdown_lines(rows)
@@ -96,11 +115,12 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
     if ik:
         lines += [f"## IK, TRAC-IK protocol ({ik[0].batch:,} seeded pose targets per arm from mid-range, success at "
                   "1e-6 m and 1e-6 rad, inside the limits; failures inside the time)", "",
-                  "| arm | engine | solver | targets | solve rate | ms per solve | solves/s | note |",
-                  "|---|---|---|---|---|---|---|---|"]
+                  "| arm | engine | solver | targets | solve rate | ms per solve | solves/s | load | CPU/wall | note |",
+                  "|---|---|---|---|---|---|---|---|---|---|"]
         for r in ik:
             lines.append(f"| {r.workload} | {r.engine} | {r.method} | {r.batch:,} | {_cell(r.accuracy, '.2%')} | "
-                         f"{_cell(r.value)} | {_cell(1e3 / r.value, ',.0f')} | {r.note} |")
+                         f"{_cell(r.value)} | {_cell(1e3 / r.value, ',.0f')} | {_cell(r.load, '.2f')} | "
+                         f"{_cell(r.cpu_per_wall, '.2f')} | {r.note} |")
         lines.append("")
     memory = [r for r in rows if r.section == "memory"]
     if memory:
@@ -121,3 +141,28 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
     lines += ["## Profile", "", "Where core's time goes (cProfile, functions by own time):", "", "```", profile.rstrip(),
               "```", ""]
     return "\n".join(lines)
+
+
+def load_lines(rows: list[BenchRow], cpu_count: int) -> list[str]:
+    """The section of the machine's load: per section and workload, the range of the load averages around its rows
+    and of their CPU / wall, and how many of its rows were measured on a loaded machine
+    (:func:`comparisons.bench.verdict.machine_loaded`)."""
+    metered = [r for r in rows if math.isfinite(r.wall_seconds)]
+    if not metered:
+        return []
+    lines = [f"## Machine load ({cpu_count} CPUs)", "",
+             "Per workload, the 1-minute load average before and after each timed row and the row's CPU time over "
+             "its wall time (below 1: the process waited for a CPU; above 1: more than one thread); every row's in "
+             "`benchmarks.csv`.", "",
+             "| section | workload | rows | load average | CPU/wall | rows on a loaded machine |", "|---|---|---|---|---|---|"]
+    for section, workload in dict.fromkeys((r.section, r.workload) for r in metered):
+        mine = [r for r in metered if (r.section, r.workload) == (section, workload)]
+        loads = [x for r in mine for x in (r.load_before, r.load_after) if math.isfinite(x)]
+        shares = [r.cpu_per_wall for r in mine if math.isfinite(r.cpu_per_wall)]
+        loaded = sum(1 for r in mine if machine_loaded(r, cpu_count))
+        lines.append(f"| {section} | {workload} | {len(mine)} | {_span(loads)} | {_span(shares)} | {loaded} |")
+    return lines + [""]
+
+
+def _span(values: list[float]) -> str:
+    return f"{min(values):.2f}-{max(values):.2f}" if values else "n/a"

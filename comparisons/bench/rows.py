@@ -1,11 +1,14 @@
-"""The bench's measurement row and how a call is timed: the median of repeats after a warm-up call."""
+"""The bench's measurement row, how a call is timed (the median of repeats after a warm-up call), and the machine's
+load and the process's CPU time over the wall time beside each timed row (:class:`Meter`)."""
 
 from __future__ import annotations
 
+import math
+import os
 import statistics
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 REPEATS = 5
 """Timed calls per measurement (median), after one warm-up call."""
@@ -13,7 +16,8 @@ REPEATS = 5
 
 @dataclass(frozen=True)
 class BenchRow:
-    """One measurement: ``value`` per ``unit`` (e.g. microseconds per body-step), with its accuracy."""
+    """One measurement: ``value`` per ``unit`` (e.g. microseconds per body-step), with its accuracy, and the machine
+    it was measured on (:class:`Meter`; NaN for a row that times nothing)."""
 
     section: str
     workload: str
@@ -25,6 +29,70 @@ class BenchRow:
     accuracy: float
     accuracy_unit: str
     note: str = ""
+    load_before: float = math.nan
+    """The 1-minute load average when the row's measurement started (``os.getloadavg()[0]``)."""
+    load_after: float = math.nan
+    """The 1-minute load average when it ended."""
+    cpu_seconds: float = math.nan
+    """CPU time of this process over the measurement (``time.process_time``) [s]."""
+    wall_seconds: float = math.nan
+    """Wall time of the measurement (``time.perf_counter``) [s]; CPU / wall well below 1: the process waited for
+    the CPU (the machine was busy with something else); above 1: it used more than one thread."""
+
+    @property
+    def cpu_per_wall(self) -> float:
+        """CPU time over wall time of the row's measurement (NaN when not metered)."""
+        return self.cpu_seconds / self.wall_seconds if self.wall_seconds > 0 else math.nan
+
+    @property
+    def load(self) -> float:
+        """The larger load average of the two readings around the measurement."""
+        return max(self.load_before, self.load_after)
+
+
+LoadReader = Callable[[], float]
+"""The machine's 1-minute load average (runnable and waiting processes, averaged)."""
+
+
+def load_average() -> float:
+    """``os.getloadavg()[0]``, NaN where the system has none."""
+    try:
+        return os.getloadavg()[0]
+    except OSError:
+        return math.nan
+
+
+def _cpu_with_children() -> float:
+    """CPU time [s] of this process and of its children that have ended (``os.times``)."""
+    spent = os.times()
+    return spent.user + spent.system + spent.children_user + spent.children_system
+
+
+class Meter:
+    """The load average before and after, and the CPU and wall time of, the measurement inside ``with Meter() as m``;
+    :meth:`stamp` writes them into a row. ``children``: the CPU time of the processes the measurement started and
+    waited for counts too (a ``simparity run`` in a process of its own)."""
+
+    def __init__(self, read_load: LoadReader = load_average, children: bool = False) -> None:
+        self._read_load = read_load
+        self._cpu_time = _cpu_with_children if children else time.process_time
+        self.load_before = self.load_after = math.nan
+        self.cpu_seconds = self.wall_seconds = 0.0
+
+    def __enter__(self) -> Meter:
+        self.load_before = self._read_load()
+        self._cpu, self._wall = self._cpu_time(), time.perf_counter()
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.cpu_seconds = self._cpu_time() - self._cpu
+        self.wall_seconds = time.perf_counter() - self._wall
+        self.load_after = self._read_load()
+
+    def stamp(self, row: BenchRow) -> BenchRow:
+        """The row with this measurement's load and CPU and wall time."""
+        return replace(row, load_before=self.load_before, load_after=self.load_after, cpu_seconds=self.cpu_seconds,
+                       wall_seconds=self.wall_seconds)
 
 
 def median_time(fn: Callable[[], object], repeats: int) -> float:

@@ -7,13 +7,14 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from simparity.comparisons.bench import joint_dynamics, joint_motion, sweep
+from simparity.comparisons.bench import joint_dynamics, joint_motion, small_batch, sweep
+from simparity.comparisons.bench.blas import one_blas_thread
 from simparity.comparisons.bench.ik import ik_rows
 from simparity.comparisons.bench.kinematics import kinematics_rows
 from simparity.comparisons.bench.memory import memory_rows, run_peak_memory
 from simparity.comparisons.bench.profiling import profile_summary
-from simparity.comparisons.bench.report import machine, markdown, write_csv
-from simparity.comparisons.bench.rows import REPEATS, BenchRow, median_time
+from simparity.comparisons.bench.report import cpus, machine, markdown, write_csv
+from simparity.comparisons.bench.rows import REPEATS, BenchRow, Meter, median_time
 from simparity.comparisons.bench.stepping import dynamics_rows
 from simparity.comparisons.bench.targets import targets
 from simparity.comparisons.bench.verdict import TARGET_BATCH
@@ -21,35 +22,54 @@ from simparity.core.model.errors import SimparityError, one_line
 
 
 def run_bench(out_dir: Path, quick: bool, command: str, say: Callable[[str], None]) -> Path:
-    """Measure everything, write ``benchmarks.csv`` and ``BENCHMARKS.md`` into ``out_dir``; returns the latter."""
+    """Measure everything on one BLAS thread, write ``benchmarks.csv`` and ``BENCHMARKS.md`` into ``out_dir``;
+    returns the latter."""
     start = time.perf_counter()
     out_dir.mkdir(parents=True, exist_ok=True)
-    batches = [1, 100] if quick else [1, 100, TARGET_BATCH]
-    say("stepping (time per body-step, with the error at that dt)")
-    rows = dynamics_rows(batches, quick, say)
-    say("forward kinematics + Jacobian")
-    rows += kinematics_rows(batches, say)
-    say("joint-space dynamics (time per state, with the difference to Pinocchio)")
-    rows += joint_dynamics.joint_dynamics_rows(batches, lambda fn: median_time(fn, REPEATS), BenchRow, say)
-    say("joint motion (time per copy-step, with the error against DOP853 and the difference to Pinocchio's RK4)")
-    rows += joint_motion.joint_motion_rows(batches, median_time, BenchRow, say)
-    say("IK")
-    rows += ik_rows(300 if quick else None, say)
-    say("memory of simparity run against the number of steps")
-    with tempfile.TemporaryDirectory() as folder:
-        rows += memory_rows(quick, Path(folder), say)
-    say("sweeps: simparity run's wall time and client memory against the number of variants")
-    rows += sweep.sweep_rows(quick, run_peak_memory, BenchRow, say)
-    say("profile")
-    profile = profile_summary(batches[-1], say)
-    for verdict in targets(rows):  # before the files: a write that fails loses no verdict
+    with one_blas_thread():
+        info = machine()
+        say(f"BLAS threads: {info['BLAS threads']}")
+        rows, profile = _measure(quick, say)
+    for verdict in targets(rows, cpus(info)):  # before the files: a write that fails loses no verdict
         reason = verdict.label.removeprefix(verdict.status).strip()
         say(f"{verdict.status:<14} {verdict.target}: {verdict.compared}" + (f" {reason}" if reason else ""))
     path = out_dir / "BENCHMARKS.md"
     try:
         write_csv(rows, out_dir / "benchmarks.csv")
-        path.write_text(markdown(rows, machine(), command, profile, time.perf_counter() - start))
+        path.write_text(markdown(rows, info, command, profile, time.perf_counter() - start))
     except OSError as err:  # a full device, a folder removed meanwhile: the folder was probed before the bench
         raise SimparityError(f"--out {one_line(out_dir)}: cannot write the benchmarks: {err.strerror or err} "
                              "(allowed: a folder you can write); the targets met or missed are printed above") from None
     return path
+
+
+def _measure(quick: bool, say: Callable[[str], None]) -> tuple[list[BenchRow], str]:
+    """Every workload's rows, each workload's wall and CPU time and load said after it, and the profile."""
+    batches = [1, 100] if quick else [1, 100, TARGET_BATCH]
+    workloads: list[tuple[str, Callable[[], list[BenchRow]]]] = [
+        ("stepping (time per body-step, with the error at that dt)", lambda: dynamics_rows(batches, quick, say)),
+        ("small batches: core against MuJoCo's same scheme at B = 1 and 3 (time per step)",
+         lambda: small_batch.small_batch_rows(quick, say)),
+        ("forward kinematics + Jacobian", lambda: kinematics_rows(batches, say)),
+        ("joint-space dynamics (time per state, with the difference to Pinocchio)",
+         lambda: joint_dynamics.joint_dynamics_rows(batches, lambda fn: median_time(fn, REPEATS), BenchRow, say)),
+        ("joint motion (time per copy-step, with the error against DOP853 and the difference to Pinocchio's RK4)",
+         lambda: joint_motion.joint_motion_rows(batches, median_time, BenchRow, say)),
+        ("IK", lambda: ik_rows(300 if quick else None, say)),
+        ("memory of simparity run against the number of steps", lambda: _memory_rows(quick, say)),
+        ("sweeps: simparity run's wall time and client memory against the number of variants",
+         lambda: sweep.sweep_rows(quick, run_peak_memory, BenchRow, say))]
+    rows: list[BenchRow] = []
+    for title, measure in workloads:
+        say(title)
+        with Meter(children=True) as meter:
+            rows += measure()
+        say(f"  ({meter.wall_seconds:.0f} s wall, {meter.cpu_seconds:.0f} s CPU with the processes it started, load "
+            f"{meter.load_before:.2f} -> {meter.load_after:.2f})")
+    say("profile")
+    return rows, profile_summary(batches[-1], say)
+
+
+def _memory_rows(quick: bool, say: Callable[[str], None]) -> list[BenchRow]:
+    with tempfile.TemporaryDirectory() as folder:
+        return memory_rows(quick, Path(folder), say)

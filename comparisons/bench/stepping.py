@@ -11,7 +11,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from simparity.comparisons.bench.rows import REPEATS, BenchRow, median_time
+from simparity.comparisons.bench.rows import REPEATS, BenchRow, Meter, median_time
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.measure.metrics import trajectory_errors
 from simparity.core.model.metric_catalogue import ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX
@@ -56,15 +56,26 @@ def boxes(n_bodies: int, drag: bool, seed: int = 0) -> DynamicsScene:
                          ERROR_STEPS * DT, (DT,))
 
 
+ROLLOUT_THREADS = os.cpu_count() or 1
+"""Threads of ``mujoco-rollout`` (:class:`BatchRollout`), one per CPU: the one stepping row on more than one thread
+(its note says so)."""
+
+
 def simulation(engine: str, integrator: str, scene: DynamicsScene):
     if engine == "mujoco-rollout":
-        return BatchRollout(scene, integrator, DT, os.cpu_count() or 1)
+        return BatchRollout(scene, integrator, DT, ROLLOUT_THREADS)
     return make_engine(engine).build_dynamics(scene, integrator, DT)
 
 
+def _threads_note(engine: str) -> str:
+    """The note of a row that does not run on one thread."""
+    return f"{ROLLOUT_THREADS} threads (mujoco.rollout, one per CPU)" if engine == "mujoco-rollout" else ""
+
+
 def _steps(batch: int, quick: bool) -> int:
-    """Steps timed at a batch size: about 10^6 body-steps (10^5 quick), 10 to 1000 steps."""
-    return int(min(1000, max(10, (100_000 if quick else 1_000_000) // batch)))
+    """Steps timed at a batch size: about 10^6 body-steps (10^4 quick: a check that every row runs), 10 to 1000
+    steps."""
+    return int(min(1000, max(10, (10_000 if quick else 1_000_000) // batch)))
 
 
 def dynamics_rows(batches: list[int], quick: bool, say: Callable[[str], None]) -> list[BenchRow]:
@@ -76,7 +87,7 @@ def dynamics_rows(batches: list[int], quick: bool, say: Callable[[str], None]) -
         for engine, integrator in DYNAMICS:
             try:
                 errors = trajectory_errors(simulation(engine, integrator, small).run(ERROR_STEPS), reference)
-                error, note = errors[ERROR_METRIC[workload]].value, ""
+                error, note = errors[ERROR_METRIC[workload]].value, _threads_note(engine)
             except Exception as err:  # noqa: BLE001 - an engine that cannot do the workload is a row saying why
                 rows += [BenchRow("dynamics", workload, engine, integrator, b, math.nan, "us/body-step", math.nan,
                                   ERROR_UNIT[workload], f"n/a: {err}") for b in batches]
@@ -94,14 +105,15 @@ def dynamics_rows(batches: list[int], quick: bool, say: Callable[[str], None]) -
                                              f"n/a: skipped, {PROBE_STEPS} steps predict {probe:.0f} s per call of "
                                              f"{steps} steps (budget {BUDGET_SECONDS:g} s)"))
                         continue
-                    seconds = median_time(lambda: sim.run(steps), 1 if probe > 1.0 else REPEATS)
+                    with Meter() as meter:
+                        seconds = median_time(lambda: sim.run(steps), 1 if probe > 1.0 else REPEATS)
                 except Exception as err:  # noqa: BLE001
                     rows.append(BenchRow("dynamics", workload, engine, integrator, batch, math.nan, "us/body-step",
                                          error, ERROR_UNIT[workload], f"n/a: {err}"))
                     continue
                 per_body_step = seconds / (batch * steps)
-                rows.append(BenchRow("dynamics", workload, engine, integrator, batch, per_body_step * 1e6,
-                                     "us/body-step", error, ERROR_UNIT[workload], note))
+                rows.append(meter.stamp(BenchRow("dynamics", workload, engine, integrator, batch, per_body_step * 1e6,
+                                                 "us/body-step", error, ERROR_UNIT[workload], note)))
                 say(f"  {workload:<13} {engine:<15} {integrator:<20} B={batch:<6} {per_body_step * 1e6:9.3f} "
                     f"us/body-step   error {error:.2e} {ERROR_UNIT[workload]}")
     return rows

@@ -16,6 +16,7 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
+from simparity.comparisons.bench.rows import Meter
 from simparity.comparisons.execute.timing import PeakMemory
 
 SECTION = "sweep"
@@ -97,13 +98,14 @@ def sweep_rows(quick: bool, run: RunMemory, row: type, say: Callable[[str], None
         for variants in QUICK_VARIANTS if quick else VARIANTS:
             scene = Path(folder) / f"throw-sweep-{variants}.toml"
             scene.write_text(sweep_scene(variants), encoding="utf-8")
-            peak, seconds, stderr = run(run_arguments(scene, Path(folder) / "history.sqlite"),
-                                        Path(folder) / f"run-{variants}")
+            with Meter(children=True) as meter:
+                peak, seconds, stderr = run(run_arguments(scene, Path(folder) / "history.sqlite"),
+                                            Path(folder) / f"run-{variants}")
             note = (f"{WORKERS} Dask workers, engines {ENGINES}, 2 cases per variant" if peak else
                     f"n/a: the run recorded no peak memory: {stderr}")
             mib = peak.this_process_bytes / 2**20 if peak else math.nan
-            rows.append(row(SECTION, WORKLOAD, "simparity run --executor dask", CLIENT, variants, mib, "MiB", seconds,
-                            "s", note))
+            rows.append(meter.stamp(row(SECTION, WORKLOAD, "simparity run --executor dask", CLIENT, variants, mib,
+                                        "MiB", seconds, "s", note)))
             say(f"  {variants:,} variants: client peak {mib:,.0f} MiB, wall time {seconds:.0f} s")
     return rows
 

@@ -1,9 +1,12 @@
 """The bench's verdict on one of the issue's targets, and the sizes the targets are set for: a target measured at
-another size (``--quick``) is "not comparable", never met or missed."""
+another size (``--quick``) is "not comparable", never met or missed; an absolute target (a rate, not a ratio to
+something measured in the same run) measured while the machine was loaded is "not judged"."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+
+from simparity.comparisons.bench.rows import BenchRow
 
 TARGET_BATCH = 10_000
 """Bodies and configurations per batch the speed targets are set for (the largest batch of a full bench)."""
@@ -11,6 +14,13 @@ TARGET_IK_TARGETS = 10_000
 """IK targets per arm the IK targets are set for (the ``bench`` suite's count; core solves them as one batch)."""
 TARGET_MEMORY_STEPS = 1_000_000
 """Steps the memory targets are set for (:data:`comparisons.bench.memory.MEMORY_SCENE` uncut)."""
+OTHERS_LOAD_PER_CPU = 0.25
+"""A row was measured on a loaded machine when the load average around it, less the bench's own thread (1), is
+above this many per CPU (on 2 CPUs: above 1.5, half a CPU taken by others): the bench's thread then shares a CPU
+part of the time, and an absolute speed reads low by up to that share."""
+MIN_CPU_PER_WALL = 0.9
+"""A row was measured on a loaded machine when its process's CPU time was below this fraction of its wall time:
+single-threaded work waited for the CPU more than a tenth of the time."""
 
 
 @dataclass(frozen=True)
@@ -20,23 +30,30 @@ class Verdict:
     target: str
     compared: str
     met: bool | None
-    """None: not judged, because not measured or (``set_for``) measured at another size than the target's."""
+    """None: not judged, because not measured, (``set_for``) measured at another size than the target's, or
+    (``loaded``) an absolute target measured on a loaded machine."""
     measured_at: str = ""
     set_for: str = ""
     """The size the target is set for (``B = 10,000``) where this run measured at another, ``measured_at``."""
+    loaded: str = ""
+    """Why an absolute target was not judged: the machine's load during its row (:func:`machine_loaded`)."""
 
     @property
     def status(self) -> str:
-        """``met``, ``MISSED``, ``not comparable`` (measured at another size) or ``n/a`` (not measured)."""
+        """``met``, ``MISSED``, ``not comparable`` (measured at another size), ``not judged`` (an absolute target on
+        a loaded machine) or ``n/a`` (not measured)."""
         if self.met is not None:
             return "met" if self.met else "MISSED"
-        return "not comparable" if self.set_for else "n/a"
+        if self.set_for:
+            return "not comparable"
+        return "not judged" if self.loaded else "n/a"
 
     @property
     def label(self) -> str:
-        """The status with why a target was not comparable."""
-        return (f"{self.status} (measured at {self.measured_at}, target set for {self.set_for})" if self.set_for
-                else self.status)
+        """The status with why a target was not comparable or not judged."""
+        if self.set_for and self.met is None:
+            return f"{self.status} (measured at {self.measured_at}, target set for {self.set_for})"
+        return f"{self.status}: {self.loaded}" if self.loaded else self.status
 
 
 def sized(target: str, compared: str, met: bool, measured_at: str, set_for: str) -> Verdict:
@@ -45,3 +62,22 @@ def sized(target: str, compared: str, met: bool, measured_at: str, set_for: str)
     if measured_at != set_for:
         return Verdict(target, compared, None, measured_at, set_for)
     return Verdict(target, compared, met)
+
+
+def machine_loaded(row: BenchRow, cpus: int) -> str:
+    """Why ``row`` was measured on a loaded machine (its load average, less the bench's own thread, above
+    :data:`OTHERS_LOAD_PER_CPU` per CPU, or its CPU / wall below :data:`MIN_CPU_PER_WALL`), or "" when it was not
+    (or not metered)."""
+    if row.load - 1 > OTHERS_LOAD_PER_CPU * cpus:
+        return f"machine loaded (load {row.load:.2f} on {cpus} CPUs)"
+    if row.cpu_per_wall < MIN_CPU_PER_WALL:
+        return f"machine loaded (CPU/wall {row.cpu_per_wall:.2f} over the row, load {row.load:.2f} on {cpus} CPUs)"
+    return ""
+
+
+def absolute(verdict: Verdict, row: BenchRow, cpus: int) -> Verdict:
+    """The verdict on an absolute target measured in ``row``: not judged (saying why) when the machine was loaded
+    during that row, as a rate measured then would read low whatever the code does."""
+    why = machine_loaded(row, cpus) if verdict.met is not None else ""
+    return replace(verdict, met=None, loaded=why) if why else verdict
+
