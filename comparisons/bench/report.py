@@ -53,7 +53,11 @@ def _cell(value: float, digits: str = ".3g") -> str:
     return "n/a" if not math.isfinite(value) else format(value, digits)
 
 
-def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: str, seconds: float) -> str:
+def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: str, seconds: float,
+             run_profile: list[str] | None = None) -> str:
+    """BENCHMARKS.md: the targets, every workload's table, the machine's load, ``run_profile`` (the lines of the
+    section on where a run spends its time, :func:`comparisons.bench.run_profile.profile_markdown`) and core's
+    profile."""
     lines = ["# BENCHMARKS", "", f"Written by `{command}` in {seconds:.0f} s on "
              + ", ".join(f"{k} {v}" for k, v in info.items()) + ". Every time is the median of repeated calls "
              "after a warm-up, on one BLAS thread (the bench sets it) unless its row says otherwise; every ratio is "
@@ -138,6 +142,7 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
                                                          for m in (MEMORY_PROCESS, MEMORY_CHILD))
                          + f" | {_cell(first.accuracy, '.0f')} | {first.note} |")
         lines.append("")
+    lines += list(run_profile or ())
     lines += ["## Profile", "", "Where core's time goes (cProfile, functions by own time):", "", "```", profile.rstrip(),
               "```", ""]
     return "\n".join(lines)

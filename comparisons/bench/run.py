@@ -13,12 +13,19 @@ from simparity.comparisons.bench.ik import ik_rows
 from simparity.comparisons.bench.kinematics import kinematics_rows
 from simparity.comparisons.bench.memory import memory_rows, run_peak_memory
 from simparity.comparisons.bench.profiling import profile_summary
+from simparity.comparisons.bench.run_profile import profile_markdown, run_profile
 from simparity.comparisons.bench.report import cpus, machine, markdown, write_csv
 from simparity.comparisons.bench.rows import REPEATS, BenchRow, Meter, median_time
 from simparity.comparisons.bench.stepping import dynamics_rows
 from simparity.comparisons.bench.targets import targets
 from simparity.comparisons.bench.verdict import TARGET_BATCH
+from simparity.comparisons.engines.registry import DEFAULT_ENGINES
+from simparity.comparisons.scenes import library
 from simparity.core.model.errors import SimparityError, one_line
+
+QUICK_PROFILE_SCENES = ("lecture-projectile", "lecture-2link-ik", "damped-joint")
+"""The scenes ``--quick`` profiles a run of (the full bench: the default suite's): a free body, an IK scene and a
+joint motion, one of each kind of case a suite is mostly made of."""
 
 
 def run_bench(out_dir: Path, quick: bool, command: str, say: Callable[[str], None]) -> Path:
@@ -29,22 +36,23 @@ def run_bench(out_dir: Path, quick: bool, command: str, say: Callable[[str], Non
     with one_blas_thread():
         info = machine()
         say(f"BLAS threads: {info['BLAS threads']}")
-        rows, profile = _measure(quick, say)
+        rows, profile, run_lines = _measure(quick, say)
     for verdict in targets(rows, cpus(info)):  # before the files: a write that fails loses no verdict
         reason = verdict.label.removeprefix(verdict.status).strip()
         say(f"{verdict.status:<14} {verdict.target}: {verdict.compared}" + (f" {reason}" if reason else ""))
     path = out_dir / "BENCHMARKS.md"
     try:
         write_csv(rows, out_dir / "benchmarks.csv")
-        path.write_text(markdown(rows, info, command, profile, time.perf_counter() - start))
+        path.write_text(markdown(rows, info, command, profile, time.perf_counter() - start, run_lines))
     except OSError as err:  # a full device, a folder removed meanwhile: the folder was probed before the bench
         raise SimparityError(f"--out {one_line(out_dir)}: cannot write the benchmarks: {err.strerror or err} "
                              "(allowed: a folder you can write); the targets met or missed are printed above") from None
     return path
 
 
-def _measure(quick: bool, say: Callable[[str], None]) -> tuple[list[BenchRow], str]:
-    """Every workload's rows, each workload's wall and CPU time and load said after it, and the profile."""
+def _measure(quick: bool, say: Callable[[str], None]) -> tuple[list[BenchRow], str, list[str]]:
+    """Every workload's rows, each workload's wall and CPU time and load said after it, core's profile and the
+    section on where a run spends its time."""
     batches = [1, 100] if quick else [1, 100, TARGET_BATCH]
     workloads: list[tuple[str, Callable[[], list[BenchRow]]]] = [
         ("stepping (time per body-step, with the error at that dt)", lambda: dynamics_rows(batches, quick, say)),
@@ -67,7 +75,11 @@ def _measure(quick: bool, say: Callable[[str], None]) -> tuple[list[BenchRow], s
         say(f"  ({meter.wall_seconds:.0f} s wall, {meter.cpu_seconds:.0f} s CPU with the processes it started, load "
             f"{meter.load_before:.2f} -> {meter.load_after:.2f})")
     say("profile")
-    return rows, profile_summary(batches[-1], say)
+    profile = profile_summary(batches[-1], say)
+    scenes = QUICK_PROFILE_SCENES if quick else tuple(s.name for s in library.suite("default"))
+    say(f"where a run spends its time: simparity run --quick of {len(scenes)} scenes in this process")
+    return rows, profile, profile_markdown(run_profile(list(scenes), DEFAULT_ENGINES), "simparity run --quick" + (
+        " " + " ".join(scenes) if quick else ""))
 
 
 def _memory_rows(quick: bool, say: Callable[[str], None]) -> list[BenchRow]:

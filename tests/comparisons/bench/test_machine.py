@@ -100,13 +100,14 @@ def test_the_bench_measures_on_one_blas_thread_and_writes_the_load_beside_each_r
 
     def measure(quick, say):
         seen.append([b.threads for b in loaded_blas()])
-        return [_ik_row(2 * IK_SOLVES_PER_SECOND, BUSY_LOAD)], "profile"
+        return [_ik_row(2 * IK_SOLVES_PER_SECOND, BUSY_LOAD)], "profile", ["## Where a run spends its time"]
 
     monkeypatch.setattr(run, "_measure", measure)
     lines: list[str] = []
     path = run.run_bench(tmp_path, True, "simparity bench --quick", lines.append)
     assert seen == [[1] * len(loaded_blas())]
     text = path.read_text()
+    assert "## Where a run spends its time" in text
     assert "BLAS threads " + ("1 (" if loaded_blas() else "not read") in text
     header, row = (tmp_path / "benchmarks.csv").read_text().splitlines()
     assert header.endswith("load_before,load_after,cpu_seconds,wall_seconds") and f",{BUSY_LOAD},{BUSY_LOAD}," in row
