@@ -42,7 +42,8 @@ from simparity.comparisons.pipeline.run_info import describe_run
 from simparity.comparisons.scenes.profiles import apply_profile
 from simparity.core.model.engine import Engine
 from simparity.core.model.errors import HistoryError, SimparityError, one_line
-from simparity.core.model.results import COLUMNS, FAILED, RESULTS_FILE, ResultRow, SeriesRecord, case_counts
+from simparity.core.model.results import (COLUMNS, FAILED, REPORT_FILE, REPORT_HTML_FILE, RESULTS_FILE, ResultRow,
+                                          SeriesRecord, case_counts)
 from simparity.reports.store import RunWriter, read_info, read_run
 
 ISOLATED, DASK, IN_PROCESS = "local", "dask", "inline"
@@ -113,7 +114,7 @@ class SessionResult:
     ``table``: every row (the columns of ``results.csv``); ``failed_cases``: cases whose engine raised or
     crashed; ``unfinished``: cases that did not finish (``--resume`` tries them again); ``unreadable``: kept
     cases of a resumed run that could not be read and were computed again; ``check``: the verdict when the
-    session was given tolerances."""
+    session was given tolerances; ``wall``: where its wall time went."""
 
     out_dir: Path | None
     table: pd.DataFrame
@@ -172,8 +173,10 @@ class Session:
     resumable (``resume.json``). ``resume``: keep the folder's finished cases. ``bounds``: tolerances the
     finished run is held to; ``held``: the engines that gate holds (None: every one), whose report opens with "is
     my engine right?" for each of the user's. ``say`` hears, before the cases start, how long they are modelled to
-    take (:mod:`comparisons.execute.estimate`), then one line per scene and what the run wrote, ``warn`` what went wrong
-    beside the run (default: ``say``); ``progress`` is a stream for the progress bar (None: no bar)."""
+    take (:mod:`comparisons.execute.estimate`), then one line per scene as it finishes and what the run wrote (without
+    ``report``: where the report would be and the command that draws it), ``warn`` what went wrong beside the run
+    (default: ``say``); ``progress`` is a stream for the progress bar, or its heartbeat lines when the stream is no
+    terminal (None: neither). :attr:`SessionResult.wall` says where the run's wall time went."""
 
     def __init__(self, scenes: list, engines: EngineSet, *, profile: str = "full", repeats: int = DEFAULT_REPEATS,
                  execution: Execution = Execution(), out_dir: Path | None = None, history: Path | None = None,
@@ -301,8 +304,8 @@ class Session:
         if self.out_dir is None or table.empty:  # empty: interrupted before its first row
             return None
         if not self.report:
-            self.say(f"results: {self.out_dir / RESULTS_FILE}\nreport:  not drawn (asked for none); draw it with: "
-                     f"simparity report {self.out_dir}")
+            self.say(f"results: {self.out_dir / RESULTS_FILE}\nreport:  not drawn (asked for none); 'simparity report "
+                     f"{self.out_dir}' draws {self.out_dir / REPORT_FILE} and {REPORT_HTML_FILE} beside it")
             return None
         return write_run_report(self.out_dir, self.say, self.bounds, self.held, table)
 

@@ -42,7 +42,7 @@ def test_a_gate_only_run_draws_no_report_and_simparity_report_draws_it_later(tmp
     assert code == EXIT_OK and "check passed" in text
     assert (run / RESULTS_FILE).is_file() and (run / RUN_INFO_FILE).is_file() and junit.is_file() and summary.is_file()
     assert not (run / "report.md").exists() and not (run / "report.html").exists()
-    assert f"draw it with: simparity report {run}" in text
+    assert f"report:  not drawn (asked for none); 'simparity report {run}' draws {run / 'report.md'}" in text
     lines = text.strip().splitlines()
     assert re.fullmatch(r"wall time by part: cases \d+\.\d s, storing \d+\.\d s, report 0\.0 s, the rest \d+\.\d s "
                         r"\(.*\)", lines[-2]) and lines[-1].startswith("wall time ")
