@@ -222,8 +222,9 @@ def cmd_run(args, out) -> int:
     session = Session(chosen, engines, profile="quick" if args.quick else "full", repeats=repeats,
                       execution=execution, out_dir=out_dir, history=history_path(args.history),
                       bounds=gate.bounds if gate is not None else None, held=held.names if held else None,
-                      transforms=transforms, command=" ".join(["simparity"] + sys.argv[1:]), report=not args.no_report,
-                      request=_request(args, engines.names, repeats), resume=args.resume is not None, say=say,
+                      transforms=transforms, command=" ".join(["simparity"] + sys.argv[1:]),
+                      report=not args.no_report, request=_request(args, engines.names, repeats),
+                      resume=args.resume is not None, say=say,
                       warn=lambda line: print(line, file=sys.stderr), progress=sys.stderr)
     if args.resume is not None:
         stand_ins = [n for n, e in zip(session.names, session.engines) if isinstance(e, (UnavailableEngine, BrokenEngine))]

@@ -1,15 +1,16 @@
 """How long a run will take, said before its cases start: every case's cost modelled from the work its scene
 asks for, the cases spread over the workers a group at a time.
 
-A case costs :data:`CASE_OVERHEAD_SECONDS` (its child process forked, its engine's model built, its rows) plus its
-work times the seconds one unit of that work took (:data:`SECONDS_PER_UNIT`): body-steps of a dynamics scene (of a
-penalty stability search, the steps of the trials it runs: :func:`stability_steps`), IK targets, configurations, chain steps times joints, and for joint-space dynamics the evaluations per state, each
-costing ``c n ** p`` for a chain of n joints, p by the kind of scheme its method declares (:data:`JOINT_DYNAMICS_COST`:
-the lecture's sum over link Jacobians is O(n^3) per evaluation, a recursive algorithm O(n)). A group's cases run one
-after the other in one worker, so a run takes at least its costliest group, and at least its total over the workers.
-The model orders the groups (costliest first) and gives the estimate; its constants were measured on 2 shared cores
-(2026-11-28, see each), so a faster machine takes less and a loaded one more. While the cases run, the progress bar's
-time left is the modelled cost still to run at the pace measured so far (:mod:`comparisons.execute.progress`).
+A case costs :data:`CASE_OVERHEAD_SECONDS` (its child process forked, its engine's model built, its rows) plus its work
+times the seconds one unit of that work took (:data:`SECONDS_PER_UNIT`): body-steps of a dynamics scene (of a penalty
+stability search, the steps of the trials it runs: :func:`stability_steps`), IK targets, configurations, chain steps
+times joints, and for joint-space dynamics the evaluations per state, each costing ``c n ** p`` for a chain of n
+joints, p by the kind of scheme its method declares (:data:`JOINT_DYNAMICS_COST`: the lecture's sum over link Jacobians
+is O(n^3) per evaluation, a recursive algorithm O(n)). A group's cases run one after the other in one worker, so a run
+takes at least its costliest group, and at least its total over the workers. The model orders the groups (costliest
+first) and gives the estimate; its constants were measured on 2 shared cores (2026-11-28, see each), so a faster
+machine takes less and a loaded one more. While the cases run, the progress bar's time left is the modelled cost still
+to run at the pace measured so far (:mod:`comparisons.execute.progress`).
 """
 
 from __future__ import annotations

@@ -1,6 +1,7 @@
 """The progress bar: drawn on a terminal, with counts and the time left; elsewhere (a CI log) a plain heartbeat line
 after each silence of HEARTBEAT_SECONDS (every case is counted whichever process ran it:
-tests/comparisons/execute/test_execution.py; a piped run's lines as they come: tests/comparisons/cli/test_progress_lines.py)."""
+tests/comparisons/execute/test_execution.py; a piped run's lines as they come:
+tests/comparisons/cli/test_progress_lines.py)."""
 
 import io
 import threading
