@@ -137,7 +137,7 @@ def _resumed(args) -> None:
         flags = ", ".join("SCENE" if name == "scenes" else "--" + name.replace("_", "-") for name in given)
         raise SimparityError(f"--resume {one_line(args.resume)} with {flags}: a resumed run does what it was asked to "
                              "(allowed with --resume: --jobs, --executor, --scheduler, --case-timeout, --case-memory, "
-                             "--check and its options, --history)")
+                             "--no-report, --check and its options, --history)")
     request = read_request(args.resume)
     if not (args.resume / CASES_FOLDER).is_dir():
         raise SimparityError(f"--resume {one_line(args.resume)}: that run finished (every case is in its "
@@ -223,7 +223,8 @@ def cmd_run(args, out) -> int:
                       execution=execution, out_dir=out_dir, history=history_path(args.history),
                       bounds=gate.bounds if gate is not None else None, held=held.names if held else None,
                       transforms=transforms, command=" ".join(["simparity"] + sys.argv[1:]),
-                      request=_request(args, engines.names, repeats), resume=args.resume is not None, say=say,
+                      report=not args.no_report, request=_request(args, engines.names, repeats),
+                      resume=args.resume is not None, say=say,
                       warn=lambda line: print(line, file=sys.stderr), progress=sys.stderr)
     if args.resume is not None:
         stand_ins = [n for n, e in zip(session.names, session.engines) if isinstance(e, (UnavailableEngine, BrokenEngine))]
@@ -240,6 +241,7 @@ def cmd_run(args, out) -> int:
         return (f"{_cost(session.scenes)}; {len(session.names)} engines; {where}" + (" (quick profile)" if args.quick
                 else "") + (f"; resuming {len(Journal(out_dir))} finished cases" if args.resume else ""))
 
+    result = None
     try:
         result = session.run(start_line)
         if result.interrupted:
@@ -253,7 +255,10 @@ def cmd_run(args, out) -> int:
                                      f"{one_line(out_dir)}' checks them again), its check stopped: {err}") from None
         return code
     finally:  # what the run cost, also when it was interrupted or stopped by an error
-        print(resource_line(time.perf_counter() - start), file=out, flush=True)
+        total = time.perf_counter() - start
+        if result is not None:  # where it went, then what it cost on the last line
+            print(result.wall.line(total), file=out, flush=True)
+        print(resource_line(total), file=out, flush=True)
         if (out_dir / RUN_INFO_FILE).is_file():  # for the bench: the peaks by name, never parsed from the line
             try:
                 record_peak_memory(out_dir)

@@ -169,6 +169,10 @@ def build_parser() -> argparse.ArgumentParser:
                      help="a case whose worker's resident memory passes this is killed and becomes a failed row "
                      f"(default: {MEMORY_HELP}; at least {MIN_CASE_MEMORY_BYTES / GIB:.3g}, what an idle worker with "
                      "the engines imported holds)")
+    run.add_argument("--no-report", action="store_true",
+                     help="a gate-only run: draw no report.md, report.html or figures (results, run.json, the "
+                     "history and --check's verdict, junit and summary as always); 'simparity report DIR' draws them "
+                     "later")
     run.add_argument("--resume", type=path_argument, default=None, metavar="DIR",
                      help="finish the interrupted run in DIR: its finished cases are kept, the rest run; give no "
                      "scenes, --suite, --engines, --out, --quick, --repeats or --max-* (the run's own are used)")

@@ -1,15 +1,16 @@
 """How long a run will take, said before its cases start: every case's cost modelled from the work its scene
 asks for, the cases spread over the workers a group at a time.
 
-A case costs :data:`CASE_OVERHEAD_SECONDS` (its child process forked, its engine's model built, its rows) plus its
-work times the seconds one unit of that work took (:data:`SECONDS_PER_UNIT`): body-steps of a dynamics scene, IK
-targets, configurations, chain steps times joints, and for joint-space dynamics the evaluations per state, each
-costing ``c n ** p`` for a chain of n joints, p by the kind of scheme its method declares (:data:`JOINT_DYNAMICS_COST`:
-the lecture's sum over link Jacobians is O(n^3) per evaluation, a recursive algorithm O(n)). A group's cases run one
-after the other in one worker, so a run takes at least its costliest group, and at least its total over the workers.
-The model orders the groups (costliest first) and gives the estimate; its constants were measured on 2 shared cores
-(2026-11-28, see each), so a faster machine takes less and a loaded one more. While the cases run, the progress bar's
-time left is the modelled cost still to run at the pace measured so far (:mod:`comparisons.execute.progress`).
+A case costs :data:`CASE_OVERHEAD_SECONDS` (its child process forked, its engine's model built, its rows) plus its work
+times the seconds one unit of that work took (:data:`SECONDS_PER_UNIT`): body-steps of a dynamics scene (of a penalty
+stability search, the steps of the trials it runs: :func:`stability_steps`), IK targets, configurations, chain steps
+times joints, and for joint-space dynamics the evaluations per state, each costing ``c n ** p`` for a chain of n
+joints, p by the kind of scheme its method declares (:data:`JOINT_DYNAMICS_COST`: the lecture's sum over link Jacobians
+is O(n^3) per evaluation, a recursive algorithm O(n)). A group's cases run one after the other in one worker, so a run
+takes at least its costliest group, and at least its total over the workers. The model orders the groups (costliest
+first) and gives the estimate; its constants were measured on 2 shared cores (2026-11-28, see each), so a faster
+machine takes less and a loaded one more. While the cases run, the progress bar's time left is the modelled cost still
+to run at the pace measured so far (:mod:`comparisons.execute.progress`).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Callable
 
+from simparity.comparisons.measure.stability import BISECTIONS, SEARCH_FACTOR, TRIAL_STEPS
 from simparity.comparisons.execute.cases import (
     DYNAMICS,
     IK,
@@ -54,6 +56,18 @@ SEGMENT_FACTOR = 17
 """Steps a self-consistency segment costs per step of its time step: one run at dt and one at dt / 16."""
 
 
+def stability_steps(scene) -> int:
+    """The steps a penalty stability search on ``scene`` (a dynamics scene) runs, as
+    :func:`comparisons.measure.stability.stable_dt_max` searches: its first trial at the finest step tried (at most
+    :data:`~comparisons.measure.stability.TRIAL_STEPS`), the octaves above it (together as many steps again), and
+    :data:`~comparisons.measure.stability.BISECTIONS` trials between two octaves, each modelled at the scene's finest
+    step of its own (the limit is not known before it is measured). Its ladder's steps alone are what one dynamics case
+    runs: the quick profile's lecture-bouncing-particle searched 5 penalty schemes for 4 minutes at the end of a
+    10-minute run (2026-11-29, load 12 on 2 cores), modelled at 10 s and therefore run last."""
+    finest = max(min(scene.dts) / SEARCH_FACTOR, scene.duration / TRIAL_STEPS)
+    return 2 * scene.n_steps(finest) + BISECTIONS * scene.n_steps(min(scene.dts))
+
+
 def case_seconds(group: CaseGroup, scheme: str = "") -> float:
     """The modelled cost [s] of one case of ``group`` on one worker; ``scheme``: the kind of scheme the case's engine
     declares its integrator or method to be ("" unknown)."""
@@ -64,8 +78,7 @@ def case_seconds(group: CaseGroup, scheme: str = "") -> float:
         return CASE_OVERHEAD_SECONDS + evaluations * seconds * float(n) ** power
     if group.kind in (DYNAMICS, STABILITY):
         s = group.dynamics_scene
-        steps = s.n_steps(group.dt) if group.kind == DYNAMICS else max(s.n_steps(dt) for dt in s.dts)
-        work = float(steps * len(s.bodies))
+        work = float((s.n_steps(group.dt) if group.kind == DYNAMICS else stability_steps(s)) * len(s.bodies))
     elif group.kind == IK:
         work = float(group.ik_scene.n_targets + len(group.ik_scene.hard_targets))
     elif group.kind == JOINT_MOTION:

@@ -4,10 +4,11 @@ Every scene is planned into groups of cases (:mod:`comparisons.execute.cases`); 
 :class:`~comparisons.execute.journal.Journal` (a resumed run) are taken from it, the others go to an
 executor — local worker processes (:class:`~comparisons.execute.isolation.IsolatedPool`) or a Dask cluster
 (:mod:`comparisons.execute.dask_executor`) — costliest group first (as :mod:`comparisons.execute.estimate` models them).
-Each case is journaled as it finishes; a scene's rows come back as soon as it and every scene before it are
-complete, so the stored run keeps the suite's order whatever finished first, and is the same whatever executed it. A
-scene's outcomes are let go once its rows are handed back, so the caller holds the cases of the scenes still
-incomplete, not the run's.
+Each case is journaled as it finishes; a scene is assembled, and its caller told (``on_scene``), as soon as its last
+case finishes, in whatever order the scenes finish (the costliest groups run first); its rows come back once every
+scene before it is complete too, so the stored run keeps the suite's order whatever finished first, and is the same
+whatever executed it. A scene's outcomes are let go once it is assembled, so the caller holds the cases of the scenes
+still incomplete and the rows of those waiting for their turn, not the run's cases.
 """
 
 from __future__ import annotations
@@ -28,6 +29,10 @@ from simparity.core.model.scenes.kinds import Scene
 
 OnCase = Callable[[str, str, str], None]
 """Called with (scene, engine, integrator or solver) after each case, in the calling process."""
+
+OnScene = Callable[[Scene, list[ResultRow]], None]
+"""Called with a scene and its rows as soon as its last case finishes (before the scenes ahead of it in the run's order
+are complete), in the calling process."""
 
 def default_jobs() -> int:
     """Worker processes by default: one per CPU."""
@@ -89,12 +94,14 @@ def plan_run(scenes: list, engines: list[Engine], make_engine: Callable[[str], E
 
 def run_scenes(scenes: list, engines: list[Engine], make_engine: Callable[[str], Engine], repeats: int,
                executor: Executor, journal: Journal | None = None, on_case: OnCase | None = None,
-               specs: dict[str, str] | None = None) -> Iterator[tuple[Scene, list[ResultRow], list[SeriesRecord]]]:
+               specs: dict[str, str] | None = None,
+               on_scene: OnScene | None = None) -> Iterator[tuple[Scene, list[ResultRow], list[SeriesRecord]]]:
     """(scene, rows, sampled series) for every scene, in order. Cases found in ``journal`` are not run
     again; every case run is journaled as it finishes. Interrupted (KeyboardInterrupt), it first hands back
     the finished cases of every scene not yet complete (without what needs them all: orders, agreement),
-    then raises. ``on_case`` hears of every case, restored ones
-    first. ``specs`` maps engine names to what the workers build them from, when that is not the name."""
+    then raises. ``on_case`` hears of every case, restored ones first; ``on_scene`` of every scene as soon as it
+    is complete (restored ones first), whatever order they finish in. ``specs`` maps engine names to what the
+    workers build them from, when that is not the name."""
     on_case = on_case or (lambda scene, engine, integrator: None)
     versions = {e.name: e.version() for e in engines}
     planned = plan_run(scenes, engines, make_engine, repeats, specs)
@@ -112,8 +119,22 @@ def run_scenes(scenes: list, engines: list[Engine], make_engine: Callable[[str],
                 jobs.append(Job((s, g), group, skip))
     scheme_of = scheme_lookup(engines)
     jobs.sort(key=lambda job: -group_seconds(job.group, scheme_of, frozenset(job.skip)))
+    ready: dict[int, tuple[Scene, list[ResultRow], list[SeriesRecord]]] = {}  # assembled, not yet handed back
+
+    def assemble(s: int) -> None:
+        ready[s] = _assembled(planned[s])
+        planned[s].release()
+        if on_scene is not None:
+            on_scene(ready[s][0], ready[s][1])
+
+    for s, item in enumerate(planned):  # restored whole from the journal
+        if item.complete:
+            assemble(s)
     emitted = 0
     try:
+        while emitted in ready:
+            yield ready.pop(emitted)
+            emitted += 1
         for key, c, outcome in executor.run(jobs):
             s, g = cast(tuple[int, int], key)  # the keys given to the jobs above
             item = planned[s]
@@ -122,21 +143,22 @@ def run_scenes(scenes: list, engines: list[Engine], make_engine: Callable[[str],
             if journal is not None:
                 journal.save(case_key(group, group.cases[c], versions), outcome)
             on_case(item.scene.name, group.cases[c].engine, group.cases[c].integrator)
-            while emitted < len(planned) and planned[emitted].complete:
-                yield _assembled(planned[emitted])
-                planned[emitted].release()
+            if item.complete:
+                assemble(s)
+            while emitted in ready:
+                yield ready.pop(emitted)
                 emitted += 1
-    except KeyboardInterrupt:  # hand back every finished case of the scenes not complete, then stop
-        for item in planned[emitted:]:
-            rows = [r for results in item.outcomes for o in results if o is not None for r in o.rows]
-            if rows:
-                yield item.scene, rows, [r for results in item.outcomes for o in results if o is not None
-                                         for r in o.series]
+    except KeyboardInterrupt:  # hand back every finished case of the scenes not handed back yet, then stop
+        for s in range(emitted, len(planned)):
+            if s in ready:
+                yield ready[s]
+                continue
+            outcomes = [o for results in planned[s].outcomes for o in results if o is not None]
+            if outcomes:
+                yield planned[s].scene, [r for o in outcomes for r in o.rows], [r for o in outcomes for r in o.series]
         raise
-    while emitted < len(planned):  # scenes restored whole from the journal after the last case run
-        yield _assembled(planned[emitted])
-        planned[emitted].release()
-        emitted += 1
+    for s in range(emitted, len(planned)):  # an executor that handed back fewer cases than it was given: fails there
+        yield _assembled(planned[s])
 
 
 def _assembled(item: _Scene) -> tuple[Scene, list[ResultRow], list[SeriesRecord]]:

@@ -18,9 +18,10 @@ caller's interpreter.
 from __future__ import annotations
 
 import contextlib
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable, Sequence
+from typing import Callable, Sequence, TypeVar
 
 import pandas as pd
 
@@ -41,7 +42,8 @@ from simparity.comparisons.pipeline.run_info import describe_run
 from simparity.comparisons.scenes.profiles import apply_profile
 from simparity.core.model.engine import Engine
 from simparity.core.model.errors import HistoryError, SimparityError, one_line
-from simparity.core.model.results import COLUMNS, FAILED, RESULTS_FILE, ResultRow, SeriesRecord, case_counts
+from simparity.core.model.results import (COLUMNS, FAILED, REPORT_FILE, REPORT_HTML_FILE, RESULTS_FILE, ResultRow,
+                                          SeriesRecord, case_counts)
 from simparity.reports.store import RunWriter, read_info, read_run
 
 ISOLATED, DASK, IN_PROCESS = "local", "dask", "inline"
@@ -89,13 +91,30 @@ class Execution:
 
 
 @dataclass(frozen=True)
+class WallSplit:
+    """Where a session's wall time went [s]: ``cases`` (run by the workers, each journaled, the scenes assembled,
+    the workers started and stopped), ``storing`` (results.csv, the series, the typed copy, the history) and
+    ``report`` (report.md, report.html and the figures; 0 when none was drawn)."""
+
+    cases: float = 0.0
+    storing: float = 0.0
+    report: float = 0.0
+
+    def line(self, total: float) -> str:
+        """One line of the split of a command that took ``total`` seconds of wall time, the rest named."""
+        rest = max(total - self.cases - self.storing - self.report, 0.0)
+        return (f"wall time by part: cases {self.cases:.1f} s, storing {self.storing:.1f} s, report "
+                f"{self.report:.1f} s, the rest {rest:.1f} s (start-up, imports, planning, the check)")
+
+
+@dataclass(frozen=True)
 class SessionResult:
     """What a session hands back.
 
     ``table``: every row (the columns of ``results.csv``); ``failed_cases``: cases whose engine raised or
     crashed; ``unfinished``: cases that did not finish (``--resume`` tries them again); ``unreadable``: kept
     cases of a resumed run that could not be read and were computed again; ``check``: the verdict when the
-    session was given tolerances."""
+    session was given tolerances; ``wall``: where its wall time went."""
 
     out_dir: Path | None
     table: pd.DataFrame
@@ -104,6 +123,17 @@ class SessionResult:
     unreadable: int = 0
     check: CheckResult | None = None
     interrupted: bool = False
+    wall: WallSplit = WallSplit()
+
+
+T = TypeVar("T")
+
+
+def _timed(fn: Callable[[], T]) -> tuple[float, T]:
+    """(wall time [s] of ``fn()``, its result)."""
+    start = time.perf_counter()
+    result = fn()
+    return time.perf_counter() - start, result
 
 
 def engine_specs(engines) -> tuple[str, ...]:
@@ -143,8 +173,10 @@ class Session:
     resumable (``resume.json``). ``resume``: keep the folder's finished cases. ``bounds``: tolerances the
     finished run is held to; ``held``: the engines that gate holds (None: every one), whose report opens with "is
     my engine right?" for each of the user's. ``say`` hears, before the cases start, how long they are modelled to
-    take (:mod:`comparisons.execute.estimate`), then one line per scene and what the run wrote, ``warn`` what went wrong
-    beside the run (default: ``say``); ``progress`` is a stream for the progress bar (None: no bar)."""
+    take (:mod:`comparisons.execute.estimate`), then one line per scene as it finishes and what the run wrote (without
+    ``report``: where the report would be and the command that draws it), ``warn`` what went wrong beside the run
+    (default: ``say``); ``progress`` is a stream for the progress bar, or its heartbeat lines when the stream is no
+    terminal (None: neither). :attr:`SessionResult.wall` says where the run's wall time went."""
 
     def __init__(self, scenes: list, engines: EngineSet, *, profile: str = "full", repeats: int = DEFAULT_REPEATS,
                  execution: Execution = Execution(), out_dir: Path | None = None, history: Path | None = None,
@@ -206,21 +238,26 @@ class Session:
         sizes, cost = estimate(self.scenes, self.engines, make_engine, self.execution.workers, journal, self.specs)
         self.say(cost.line(self.execution.case_seconds))
         bar = ProgressBar(sum(sizes), self.progress, estimate=cost) if self.progress is not None else None
-        failed = 0
+        size = {scene.name: n for scene, n in zip(self.scenes, sizes)}
+        failed, started = 0, time.perf_counter()
+
+        def scene_done(scene, rows: list[ResultRow]) -> None:  # as it finishes, whatever order the scenes finish in
+            counts = case_counts(rows)
+            if bar is not None:
+                bar.scene_done(scene.name, size[scene.name])
+            self.say(f"{scene.name}: {sum(counts.values())} cases (" + ", ".join(f"{s} {c}" for s, c in counts.items()
+                                                                                if c) + ")")
+
         try:
             # the workers stop as soon as the cases do, before the report; the store then writes its typed copy
-            with contextlib.closing(executor), contextlib.closing(store):
+            with contextlib.closing(executor), contextlib.closing(store), \
+                    bar if bar is not None else contextlib.nullcontext():
                 base_rows = []
-                for k, (scene, rows, series) in enumerate(run_scenes(
-                        self.scenes, self.engines, make_engine, self.repeats, executor, journal,
-                        bar.case_done if bar is not None and bar.active else None, self.specs)):
+                for scene, rows, series in run_scenes(self.scenes, self.engines, make_engine, self.repeats, executor,
+                                                      journal, bar.case_done if bar is not None else None, self.specs,
+                                                      scene_done):
                     store.append(rows, series)
-                    counts = case_counts(rows)
-                    failed += counts[FAILED]
-                    if bar is not None:
-                        bar.scene_done(sum(sizes[:k + 1]))
-                    self.say(f"{scene.name}: {sum(counts.values())} cases ("
-                             + ", ".join(f"{s} {c}" for s, c in counts.items() if c) + ")")
+                    failed += case_counts(rows)[FAILED]
                     if self.transforms:  # the invariance rows need them; else they are in the store alone
                         base_rows.append(rows)
                 if self.transforms:
@@ -231,13 +268,12 @@ class Session:
                         store.append(rows)
                         failed += sum(1 for r in rows if r.status == FAILED)
         except KeyboardInterrupt:
-            if bar is not None:
-                bar.clear()
             if self.out_dir is not None:
                 self.say(f"interrupted; results so far are in {self.out_dir / RESULTS_FILE}; finish the run with: "
                          f"simparity run --resume {self.out_dir}")
-            self._write_report(store.table())
-            return SessionResult(self.out_dir, store.table(), failed, interrupted=True)
+            cases = time.perf_counter() - started - store.seconds
+            wall = WallSplit(cases, store.seconds, _timed(lambda: self._write_report(store.table()))[0])
+            return SessionResult(self.out_dir, store.table(), failed, interrupted=True, wall=wall)
         except SimparityError:
             if store.closed:
                 self._write_report(store.table())  # keep what was computed, then report the error
@@ -253,18 +289,23 @@ class Session:
                          f"--resume {self.out_dir}' tries them again")
             else:
                 journal.remove()
-        table = store.table()
-        self._record(table)  # before the report: a report that cannot be drawn never costs the run its history
-        checked = self._write_report(table)
+        table, cases = store.table(), time.perf_counter() - started - store.seconds
+        recording, _ = _timed(lambda: self._record(table))  # before the report: a report that cannot be drawn never
+        drawing, checked = _timed(lambda: self._write_report(table))  # costs the run its history
         check = None
         if self.bounds is not None:
             check = checked if checked is not None else check_table(table, self.bounds)
-        return SessionResult(self.out_dir, table, failed, unfinished, unreadable, check)
+        return SessionResult(self.out_dir, table, failed, unfinished, unreadable, check,
+                             wall=WallSplit(cases, store.seconds + recording, drawing))
 
     def _write_report(self, table: pd.DataFrame) -> CheckResult | None:
         """report.md, report.html and figures/ of a stored run (when asked for), ``table`` its rows; its metrics held to
         the session's bounds (default: the shipped tolerances) for the report's flagged findings. Returns that verdict."""
-        if self.out_dir is None or not self.report or table.empty:  # empty: interrupted before its first row
+        if self.out_dir is None or table.empty:  # empty: interrupted before its first row
+            return None
+        if not self.report:
+            self.say(f"results: {self.out_dir / RESULTS_FILE}\nreport:  not drawn (asked for none); 'simparity report "
+                     f"{self.out_dir}' draws {self.out_dir / REPORT_FILE} and {REPORT_HTML_FILE} beside it")
             return None
         return write_run_report(self.out_dir, self.say, self.bounds, self.held, table)
 
@@ -287,19 +328,25 @@ class _Store:
         self.rows: list[ResultRow] = []
         self.written: pd.DataFrame | None = None
         self.closed = False
+        self.seconds = 0.0
+        """Wall time [s] spent storing rows so far."""
 
     def append(self, rows: list[ResultRow], series: Sequence[SeriesRecord] = ()) -> None:
+        start = time.perf_counter()
         if self.writer is not None:
             self.writer.append(rows, series)
         else:
             self.rows += rows
+        self.seconds += time.perf_counter() - start
 
     def close(self) -> None:
         """Every row is in: the stored run read back once and its typed copy (``results.parquet``) written, when it
         has a folder."""
+        start = time.perf_counter()
         if self.writer is not None:
             self.written = self.writer.finish()
         self.closed = True
+        self.seconds += time.perf_counter() - start
 
     def table(self) -> pd.DataFrame:
         """Every row of the run (after :meth:`close`): as the writer read ``results.csv`` back, or from memory."""

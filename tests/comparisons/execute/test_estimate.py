@@ -8,9 +8,10 @@ import pytest
 
 from simparity.comparisons.engines.registry import EngineSet, make_engine
 from simparity.comparisons.pipeline import session as session_module
-from simparity.comparisons.execute.estimate import RunEstimate, duration
+from simparity.comparisons.execute.estimate import RunEstimate, duration, stability_steps
 from simparity.comparisons.execute.execution import estimate
 from simparity.comparisons.execute.isolation import CaseLimits
+from simparity.comparisons.measure.stability import stable_dt_max
 from simparity.comparisons.pipeline.session import ISOLATED, Execution, Session
 from simparity.comparisons.scenes.library import load
 from simparity.comparisons.scenes.profiles import quick
@@ -84,3 +85,32 @@ def test_a_run_takes_at_least_its_costliest_group_whatever_the_workers(tmp_path)
                                            (7 * 3600 + 125, "7h02m")])
 def test_durations_read_as_time(seconds, text):
     assert duration(seconds) == text
+
+
+STABILITY_MODEL_FACTOR = 2.0
+"""How far the modelled steps of a stability search may be from those it ran: the bisection's trials are modelled at
+the scene's finest step, the limit being unknown before it is measured (13,725 counted, 18,000 modelled here)."""
+
+
+@pytest.mark.slow  # one real stability search: ~5 s of CPU
+def test_a_stability_search_is_modelled_at_the_steps_its_trials_run():
+    """Issue #41: the quick profile's bouncing particle searched its penalty schemes' limits for 4 minutes at the end
+    of a 10-minute run: modelled as one run of its ladder (1,000 steps), the group was planned last."""
+    engines = EngineSet(("core",))
+    [scene] = [quick(s, engines) for s in load(["lecture-bouncing-particle"], engines=engines)]
+    counted: list[int] = []
+    core = make_engine("core")
+
+    class Counting:
+        def build_dynamics(self, *args):
+            simulation = core.build_dynamics(*args)
+
+            class Counted:
+                def run(self, steps: int):
+                    counted.append(steps)
+                    return simulation.run(steps)
+
+            return Counted()
+
+    assert stable_dt_max(scene, Counting(), "penalty_semi_implicit_euler").value > 0  # a limit found
+    assert sum(counted) / STABILITY_MODEL_FACTOR <= stability_steps(scene) <= sum(counted) * STABILITY_MODEL_FACTOR

@@ -42,6 +42,20 @@ def test_every_case_is_heard_once_and_the_costliest_group_goes_first():
     assert costs == sorted(costs, reverse=True) and executor.jobs[0].group.scene.name == "lecture-projectile"
 
 
+def test_a_scene_is_said_as_it_finishes_while_the_stored_order_is_the_suites():
+    """Issue #41: the costliest scene runs first; it is said done at once, not after every scene before it in the suite
+    (a CI log used to get every scene's line at the end of the run)."""
+    scenes = smoke_scenes(("lecture-planar-arm", "lecture-projectile"))
+    events = []
+    for scene, rows, _ in run_scenes(scenes, built_engines(("core",)), make_engine, 0, InProcess(),
+                                     on_scene=lambda scene, rows: events.append(("said", scene.name, len(rows)))):
+        events.append(("handed back", scene.name, len(rows)))
+    said = [e for e in events if e[0] == "said"]
+    assert said[0][1] == "lecture-projectile" and events.index(said[0]) == 0
+    assert [e[1] for e in events if e[0] == "handed back"] == ["lecture-planar-arm", "lecture-projectile"]
+    assert sorted(e[1:] for e in said) == sorted(e[1:] for e in events if e[0] == "handed back")
+
+
 @pytest.mark.slow
 def test_an_interrupted_run_resumes_without_recomputing_what_finished(tmp_path, in_process):
     scenes, expected = in_process

@@ -1,7 +1,10 @@
-"""The progress bar: drawn only on a terminal, with counts and the time left (every case is counted whichever
-process ran it: tests/comparisons/execute/test_execution.py)."""
+"""The progress bar: drawn on a terminal, with counts and the time left; elsewhere (a CI log) a plain heartbeat line
+after each silence of HEARTBEAT_SECONDS (every case is counted whichever process ran it:
+tests/comparisons/execute/test_execution.py; a piped run's lines as they come:
+tests/comparisons/cli/test_progress_lines.py)."""
 
 import io
+import threading
 
 import pytest
 
@@ -32,12 +35,54 @@ def test_bar_shows_counts_scene_and_time_left_on_a_terminal():
     assert stream.getvalue().endswith("\r\033[K")
 
 
-def test_nothing_is_drawn_when_not_on_a_terminal():
+def test_no_bar_is_drawn_when_not_on_a_terminal_and_a_scene_counts_its_cases_once():
     stream = io.StringIO()
-    bar = ProgressBar(3, stream)
+    bar = ProgressBar(5, stream)
     bar.case_done("wind", "core", "rk4")
-    bar.scene_done(3)
-    assert stream.getvalue() == "" and not bar.active and bar.done == 3
+    bar.scene_done("wind", 3)   # its other cases were not reported one by one (a failed reference)
+    bar.case_done("drag", "core", "rk4")
+    bar.scene_done("drag", 2)
+    assert stream.getvalue() == "" and not bar.active and bar.done == 5
+
+
+def test_a_silent_run_off_a_terminal_says_how_far_it_is_in_a_plain_line():
+    """Issue #41: in a CI log, a long scene is not a long silence; the line has no carriage return or ANSI code."""
+    times = iter([0.0, 10.0, 29.0, 30.0, 40.0, 59.0, 70.0])
+    stream = io.StringIO()
+    bar = ProgressBar(4, stream, clock=lambda: next(times), heartbeat=30.0)   # starts at 0
+    bar.case_done("wind", "core", "rk4")          # 10 s: one of 4 cases done
+    bar.beat()                                    # 29 s: not yet silent for 30 s
+    assert stream.getvalue() == ""
+    bar.beat()                                    # 30 s
+    assert stream.getvalue() == "progress: 1/4 cases · 30s elapsed · 1m30s left\n"
+    bar.scene_done("wind", 1)                     # 40 s: a scene line is said
+    bar.beat()                                    # 59 s: 19 s after it
+    assert stream.getvalue().count("\n") == 1
+    bar.beat()                                    # 70 s: 30 s after it
+    assert stream.getvalue().splitlines()[-1].startswith("progress: 1/4 cases · 1m10s elapsed")
+    assert "\r" not in stream.getvalue() and "\033" not in stream.getvalue()
+
+
+def test_the_heartbeat_runs_on_its_own_while_the_cases_do():
+    """No case needs to finish for the heartbeat to beat: a thread of its own, stopped when the bar closes."""
+    written = threading.Event()
+
+    class Log(io.StringIO):
+        def flush(self) -> None:
+            written.set()
+
+    stream = Log()
+    with ProgressBar(2, stream, heartbeat=0.01):
+        assert written.wait(timeout=10.0)
+    assert stream.getvalue().startswith("progress: 0/2 cases")
+    assert not [t for t in threading.enumerate() if t.name == "simparity-heartbeat"]
+
+
+def test_no_heartbeat_on_a_terminal_where_the_bar_moves():
+    stream = _Terminal()
+    bar = ProgressBar(2, stream, clock=iter([0.0, 100.0]).__next__, heartbeat=1.0)
+    bar.beat()
+    assert stream.getvalue() == ""
 
 
 def test_time_left_is_the_modelled_cost_still_to_run_at_the_pace_measured():
