@@ -2,6 +2,7 @@
 
 import os
 import time
+from collections import Counter
 
 import pytest
 
@@ -67,3 +68,14 @@ def pytest_runtest_makereport(item, call):
                 " stays the inner loop"
             )
     return report
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(items):
+    """Files holding the most ``slow`` tests first, each file's tests in their own order. With ``--dist loadfile``
+    a file is one worker's serial job, handed out in this order (pyproject's ``--no-loadscope-reorder``): the long
+    files start at once, and the many short ones fill in after them, so the two workers end together instead of one
+    starting a long file when the other is nearly done. Runs after ``-m`` deselected what it deselects."""
+    slow = Counter(item.path for item in items if item.get_closest_marker("slow") is not None)
+    first_seen = {path: index for index, path in enumerate(dict.fromkeys(item.path for item in items))}
+    items.sort(key=lambda item: (-slow[item.path], first_seen[item.path]))

@@ -86,10 +86,16 @@ def _cases(rows):
     return {(r.engine, r.integrator, r.dt): r.status for r in rows}
 
 
+def _coarsest(scene):
+    """``scene`` at its coarsest time step alone (lecture-projectile: 180 steps instead of the ladder's 2,700): for the
+    tests of what a case's rows say, which every time step says alike; the ladder's own tests keep every step."""
+    return dataclasses.replace(scene, dts=scene.dts[:1])
+
+
 @pytest.mark.slow
 def test_each_case_has_every_metric_and_crashes_do_not_stop_the_run():
     """A crashing engine gets failed rows with the error; the engines after it still run."""
-    scene = builtin("lecture-projectile")
+    scene = _coarsest(builtin("lecture-projectile"))
     rows = run_scene(scene, [_Crashing(), _tampered("diverging", "position_world", np.nan), _Refusing(), make_engine("mujoco")], make_engine, repeats=1)
     per_case = {}
     for r in rows:
@@ -112,7 +118,7 @@ def test_each_case_has_every_metric_and_crashes_do_not_stop_the_run():
 @pytest.mark.slow
 def test_missing_reference_keeps_timings_and_says_why():
     """If the reference cannot do the scene, errors are n/a with the reason and timings are still measured."""
-    scene = builtin("lecture-projectile")
+    scene = _coarsest(builtin("lecture-projectile"))
     rows = run_scene(scene, [make_engine("mujoco")], lambda name: _Refusing(), repeats=1)
     timing = [r for r in rows if r.metric == "time_per_step"]
     errors = [r for r in rows if r.metric in DYNAMICS_METRICS and "_error_" in r.metric]
@@ -186,7 +192,7 @@ def test_blown_up_but_finite_run_is_diverged():
 @pytest.mark.slow
 def test_finite_blow_up_is_diverged_by_the_runner_bound():
     """A finite trajectory faster than the scene's forces allow (DIVERGENCE_MARGIN x the bound) is diverged."""
-    scene = builtin("lecture-projectile")
+    scene = _coarsest(builtin("lecture-projectile"))
 
     rows = run_scene(scene, [_tampered("exploding", "velocity_world", 1e12)], make_engine, repeats=1)
     assert {r.status for r in rows if not math.isnan(r.dt)} == {DIVERGED}
@@ -208,7 +214,7 @@ def _retimed(times_of):
 def test_a_trajectory_off_the_time_grid_fails_instead_of_being_measured(rewrite, problem):
     """Samples that are not at k * dt (NaN, twice the step, half a step late, the initial state left out) would be
     compared with the reference's samples at other times: every case fails, naming the first bad sample."""
-    scene = builtin("lecture-projectile")
+    scene = _coarsest(builtin("lecture-projectile"))
     rows = run_scene(scene, [_rewritten(rewrite)], make_engine, repeats=1)
     cases = [r for r in rows if not math.isnan(r.dt)]
     assert cases and {r.status for r in cases} == {FAILED}
@@ -224,7 +230,7 @@ def test_a_trajectory_of_complex_values_fails_instead_of_losing_its_imaginary_pa
         values["position_world"] = values["position_world"] + 1e-3j
         return type(traj)(**values)
 
-    rows = run_scene(builtin("lecture-projectile"), [_rewritten(complex_positions)], make_engine, repeats=1)
+    rows = run_scene(_coarsest(builtin("lecture-projectile")), [_rewritten(complex_positions)], make_engine, repeats=1)
     cases = [r for r in rows if not math.isnan(r.dt)]
     assert cases and {r.status for r in cases} == {FAILED}
     assert all("complex values where real ones (float64) are expected" in r.detail for r in cases)
@@ -235,7 +241,7 @@ def test_energy_drift_without_energy_is_not_available():
     """A body dropped from rest at the potential's zero has E(0) = 0: drift is measured against its kinetic energy."""
     from dataclasses import replace
 
-    scene = builtin("lecture-projectile")
+    scene = _coarsest(builtin("lecture-projectile"))
     body = replace(scene.bodies[0], velocity_world=np.zeros(3))
     rows = run_scene(replace(scene, bodies=(body,)), [make_engine("mujoco")], make_engine, repeats=1)
     drift = [r for r in rows if r.metric == "energy_drift_max"]
@@ -264,7 +270,7 @@ def test_warnings_raised_in_a_case_go_into_its_rows_not_the_console(recwarn):
             return sim
 
     _Warning.name = "warning"
-    scene = dataclasses.replace(builtin("lecture-projectile"), integrators=("explicit_euler", "rk4"))
+    scene = dataclasses.replace(_coarsest(builtin("lecture-projectile")), integrators=("explicit_euler", "rk4"))
     rows = run_scene(scene, [_Warning()], make_engine, repeats=1)
     per_dt = [r for r in rows if not math.isnan(r.dt)]
     assert per_dt and all("warnings: RuntimeWarning: overflow encountered in multiply" in r.detail for r in per_dt)
