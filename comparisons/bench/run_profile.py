@@ -46,14 +46,18 @@ class ProfilePart:
     seconds: float
 
 
+PACKAGE_FOLDERS = ("core", "references", "comparisons", "reports")
+"""The package's folders (a checkout also holds tests/ and examples/ beside them: not the package)."""
+
+
 def folder_of(filename: str) -> str | None:
-    """The simparity folder of a source file (``core/dynamics``, ``reports``), None outside the package."""
+    """The simparity folder of a source file (``core/dynamics``, ``reports``), None outside the package's folders."""
     try:
         relative = Path(filename).resolve().relative_to(PACKAGE_ROOT)
     except ValueError:
         return None
     folders = relative.parts[:-1]
-    return "/".join(folders[:2]) if folders else relative.name
+    return "/".join(folders[:2]) if folders and folders[0] in PACKAGE_FOLDERS else None
 
 
 class StackSampler:

@@ -19,6 +19,7 @@ def test_folder_of_names_the_simparity_folder_of_a_file_and_none_outside():
     assert folder_of(tableau.__file__) == "core/dynamics"
     assert folder_of(rotations.__file__) == "core"
     assert folder_of(np.__file__) is None
+    assert folder_of(__file__) is None  # a checkout's tests sit beside the package's folders, not in them
 
 
 def test_samples_are_charged_to_the_innermost_simparity_frame_not_to_numpy():
