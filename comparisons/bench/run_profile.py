@@ -81,14 +81,18 @@ class StackSampler:
     def _sample(self) -> None:
         while not self._stop.wait(SAMPLE_SECONDS):
             frame = sys._current_frames().get(self._thread_id)
-            part = OUTSIDE
+            part: str | None = OUTSIDE
             while frame is not None:
+                if frame.f_code.co_filename == __file__:  # the sampled thread starting or stopping this sampler
+                    part = None
+                    break
                 folder = folder_of(frame.f_code.co_filename)
                 if folder is not None:
                     part = folder
                     break
                 frame = frame.f_back
-            self.counts[part] += 1
+            if part is not None:
+                self.counts[part] += 1
 
 
 def _phase(name: str, call: Callable[[], object]) -> list[ProfilePart]:
