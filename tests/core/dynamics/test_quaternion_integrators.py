@@ -6,9 +6,12 @@ import pytest
 from simparity.core.dynamics.forces import make_wrench
 from simparity.core.dynamics.quaternion_integrators import (
     PackedBodies,
+    engine_euler,
     make_packed_step,
     pack,
     rotation_rows,
+    runge_kutta,
+    semi_implicit_euler,
     unpack,
 )
 from simparity.core.dynamics.rigid_body import MassProperties, initial_state
@@ -60,6 +63,26 @@ def test_a_per_body_time_step_moves_each_body_as_its_own_scalar_step(scheme):
     for column in (unmoved, original):  # engine_euler returns w >= 0: q and -q are one rotation
         column[3:7] *= np.sign(column[3])
     np.testing.assert_allclose(unmoved, original, rtol=0, atol=ROUNDING)
+
+
+@pytest.mark.parametrize("scheme", list(TABLEAUX) + ["semi_implicit_euler", "engine_euler"])
+@pytest.mark.parametrize("inertia", [None, np.array([[0.2, 0.03, 0.0], [0.03, 0.1, -0.02], [0.0, -0.02, 0.3]])])
+def test_one_body_without_its_batch_axis_steps_bit_for_bit_as_a_batch_of_one(scheme, inertia):
+    """make_packed_step drops a lone body's batch axis for speed: exactly the numbers of the batched step at B = 1
+    (diagonal and full inertia, drag of both kinds, a force at a point), over many steps."""
+    rng = np.random.default_rng(2)
+    bodies = _bodies(rng, 1, inertia)
+    props = MassProperties.of(bodies)
+    forces = Forces(np.array([0.0, 0.0, -9.81]), np.array([0.5, 0.0, 0.1]), np.array([0.3]), np.array([0.2]),
+                    np.array([0.05]), np.array([0.02]))
+    wrench = make_wrench(forces, props)
+    batched = {"semi_implicit_euler": semi_implicit_euler, "engine_euler": engine_euler}.get(
+        scheme, lambda bodies, wrench: runge_kutta(scheme, bodies, wrench))(PackedBodies(props), wrench)
+    one = make_packed_step(scheme, props, wrench)
+    a = b = pack(initial_state(bodies, props, quaternion=True))
+    for i in range(50):
+        a, b = batched(i * 0.01, a, 0.01), one(i * 0.01, b, 0.01)
+    np.testing.assert_array_equal(a, b)
 
 
 def test_the_full_and_the_diagonal_inertia_paths_agree():
