@@ -44,13 +44,13 @@ _DEFINITIONS = (
 def build(table: pd.DataFrame, info: RunInfo, series: pd.DataFrame, verdict: ToleranceVerdict | None,
           run_dir: Path) -> tuple[list[Block], dict[str, str]]:
     """(the report's blocks, the SVG text of each figure by name); figures are written to
-    ``run_dir/figures``, on one process per CPU. ``verdict``: the run held to tolerances, None if it was not."""
+    ``run_dir/figures`` (:class:`reports.figures.FigureWriter`: a few in this process, many on one process per CPU),
+    each in the order drawn. ``verdict``: the run held to tolerances, None if it was not."""
     with figures.FigureWriter() as writer:
         ctx = ReportContext(table, info, series, verdict, Path(run_dir) / FIGURES_DIR, writer,
                             sweep_summary.sweeps(table, info))
         blocks = _blocks(ctx, table, info)
-        svgs = {name: future.result() for name, future in ctx.svgs.items()}
-    return blocks, svgs
+    return blocks, {name: figure.result() for name, figure in ctx.svgs.items()}
 
 
 def _blocks(ctx: ReportContext, table: pd.DataFrame, info: RunInfo) -> list[Block]:

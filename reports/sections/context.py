@@ -5,7 +5,6 @@ the figures submitted so far; and what a scene's rows say it is (:func:`scene_ki
 
 from __future__ import annotations
 
-import concurrent.futures
 from collections import Counter
 from pathlib import Path
 
@@ -57,7 +56,7 @@ class ReportContext:
                  figure_dir: Path, writer: figures.FigureWriter, sweeps: list[Sweep]) -> None:
         self.table, self.info, self.series, self.verdict = table, info, series, verdict
         self.figure_dir, self.writer = figure_dir, writer
-        self.svgs: dict[str, concurrent.futures.Future] = {}
+        self.svgs: dict[str, figures.WrittenFigure] = {}
         self.sweeps = sweeps
         self.sweep_of = {name: sweep for sweep in sweeps for name in sweep.variants}
         self.groups = sweep_summary.groups(sweeps)

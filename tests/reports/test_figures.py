@@ -327,7 +327,7 @@ import os, signal, sys
 from pathlib import Path
 import matplotlib.pyplot as plt
 from simparity.reports.figures import FigureWriter
-with FigureWriter(2) as writer:
+with FigureWriter(2, in_process_max=0) as writer:  # the pool at once
     writer.submit(plt.figure(), Path(sys.argv[1]), "first").result()  # the pool's processes are up
     print(" ".join(str(pid) for pid in writer._pool._processes), flush=True)
     os.kill(os.getpid(), signal.SIGKILL)
@@ -354,3 +354,33 @@ def test_the_figure_processes_of_a_killed_report_do_not_outlive_it(tmp_path):
         time.sleep(0.1)
     assert not any(_alive(p) for p in pids)
     assert os.path.exists(tmp_path / "first.svg")
+
+
+def _line_figure(slope: float):
+    fig, ax = figures.plt.subplots()
+    ax.plot([0.0, 1.0], [0.0, slope])
+    return fig
+
+
+@pytest.mark.slow  # starts a pool of two figure processes (~3 CPU-s)
+def test_a_few_figures_are_written_here_and_more_on_the_pool_the_same_svg_either_way(tmp_path):
+    """Up to ``in_process_max`` figures wait and are written in this process (no pool started: a small report does not
+    pay two interpreters' start-up); the next one starts the pool, which writes the waiting ones too. The SVG text
+    and the files are the same whichever process wrote them."""
+    with figures.FigureWriter(2, in_process_max=2) as small:
+        few = [small.submit(_line_figure(k), tmp_path / "few", f"f{k}") for k in (1, 2)]
+        assert small._pool is None
+    with figures.FigureWriter(2, in_process_max=2) as large:
+        many = [large.submit(_line_figure(k), tmp_path / "many", f"f{k}") for k in (1, 2, 3)]
+        assert large._pool is not None
+    for k, (here, pooled) in enumerate(zip(few, many), start=1):
+        assert here.result() == pooled.result() == (tmp_path / "many" / f"f{k}.svg").read_text(encoding="utf-8")
+        assert (tmp_path / "few" / f"f{k}.png").read_bytes() == (tmp_path / "many" / f"f{k}.png").read_bytes()
+    assert (tmp_path / "many" / "f3.svg").is_file()
+
+
+def test_a_failed_report_writes_none_of_its_waiting_figures(tmp_path):
+    with pytest.raises(RuntimeError), figures.FigureWriter(2) as writer:
+        writer.submit(_line_figure(1.0), tmp_path, "unwritten")
+        raise RuntimeError("the report failed")
+    assert not list(tmp_path.iterdir())
