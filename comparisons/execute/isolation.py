@@ -149,18 +149,23 @@ class _Worker:
 
 
 class IsolatedPool:
-    """``workers`` worker processes running jobs under ``limits``; replaced when one is killed."""
+    """Up to ``workers`` worker processes running jobs under ``limits``; replaced when one is killed. A process is
+    started when a job first needs it: a run of one group starts one, not one per CPU (each costs ~1.2 CPU-s of
+    imports before its first case)."""
 
     def __init__(self, workers: int, limits: CaseLimits) -> None:
         if workers < 1:
             raise ValueError(f"workers {workers}: at least 1")
         self.limits = limits
-        self._workers = [_Worker() for _ in range(workers)]
+        self._size = workers
+        self._workers: list[_Worker] = []
 
     def run(self, jobs: list[Job]) -> Iterator[tuple[object, int, CaseOutcome]]:
         """(job key, case index, outcome) of every case of ``jobs`` not skipped, as each finishes; jobs start
         in the given order."""
         pending = collections.deque(jobs)
+        while len(self._workers) < min(self._size, len(pending)):
+            self._workers.append(_Worker())
         while True:
             for k in range(len(self._workers)):
                 if self._workers[k].job is None and pending:

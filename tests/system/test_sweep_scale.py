@@ -73,7 +73,7 @@ def test_the_cases_of_a_scene_handed_back_are_let_go(tmp_path):
 @pytest.mark.slow
 def test_a_sweep_killed_midway_and_resumed_stores_the_uninterrupted_results(tmp_path):
     scene = _scene(tmp_path, 3 * SPEEDS)
-    _killed_and_resumed(tmp_path, scene, 3 * SPEEDS, ["--jobs", "2"])
+    _killed_and_resumed(tmp_path, scene, 3 * SPEEDS, ["--jobs", "2"], report=False)
 
 
 @pytest.mark.slow
@@ -90,11 +90,14 @@ def _command(scene, out, options: list[str]) -> list[str]:
             *options, "--out", str(out)]
 
 
-def _killed_and_resumed(tmp_path, scene, variants: int, options: list[str]):
+def _killed_and_resumed(tmp_path, scene, variants: int, options: list[str], report: bool = True):
     """Run ``scene`` whole, and again killed once half its cases are kept, then resumed: the two stored runs must be
-    the same, timing aside. Returns the whole run's folder."""
+    the same, timing aside. Returns the whole run's folder. ``report`` False: no report drawn (what is compared is
+    the stored run, not its drawing)."""
     whole, killed = tmp_path / "whole", tmp_path / "killed"
-    subprocess.run(_command(scene, whole, options), check=True, capture_output=True)
-    killed_and_resumed(_command(scene, killed, options), killed, CASES_PER_VARIANT * variants, KILL_WAIT_SECONDS)
+    drawn = () if report else ("--no-report",)
+    subprocess.run(_command(scene, whole, [*options, *drawn]), check=True, capture_output=True)
+    killed_and_resumed(_command(scene, killed, [*options, *drawn]), killed, CASES_PER_VARIANT * variants,
+                       KILL_WAIT_SECONDS, drawn)
     assert differences(whole, killed) == []
     return whole
