@@ -3,7 +3,8 @@
 The checks that need no ``--simparity-baseline`` share one session (:func:`inner`): the example, a tolerance the run
 breaks, ``check_engines`` / ``require_engines`` and paths beside a test file in another folder are each a test file of
 that session, and each test here reads its own inner tests' verdicts and failure texts (from the session's JUnit XML),
-never another's. The two baselines are options of a whole session: each has its own."""
+never another's. The two baselines are options of a whole session: each has its own, in this interpreter (the shared
+session runs the example in a fresh one, the plugin found by its entry point, as a user runs it)."""
 
 from __future__ import annotations
 
@@ -173,7 +174,7 @@ def test_a_baseline_that_differs_fails(pytester, tmp_path, example_run):
     writer = RunWriter(tmp_path / "base", describe_run([], "test", [scene]))
     writer.append([ResultRow(**row) for row in table.to_dict("records")])
     pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
-    result = pytester.runpytest_subprocess("--simparity-baseline", str(tmp_path / "base"))
+    result = pytester.runpytest_inprocess("--simparity-baseline", str(tmp_path / "base"))
     result.assert_outcomes(failed=1)
     result.stdout.fnmatch_lines(["*moved since*position_error_final*"])
 
@@ -195,7 +196,7 @@ def test_the_documented_example_passes_against_a_baseline_that_ran_more_engines(
         dataclasses.replace(r, scene="wind") for r in rows]
     RunWriter(tmp_path / "base", describe_run([], "test", [scene], "quick")).append(more)
     pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
-    result = pytester.runpytest_subprocess("--simparity-baseline", str(tmp_path / "base"))
+    result = pytester.runpytest_inprocess("--simparity-baseline", str(tmp_path / "base"))
     result.assert_outcomes(passed=1)
 
 
