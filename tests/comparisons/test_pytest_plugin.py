@@ -117,7 +117,7 @@ def inner(tmp_path_factory) -> InnerSession:
     return _run_session(folder)
 
 
-@pytest.mark.slow  # the shared session: ~14 s of CPU (six sessions of its own took ~60)
+@pytest.mark.slow  # the shared session: ~14 s of CPU (as four sessions of their own: ~57)
 def test_the_documented_example_passes(inner):
     assert inner.outcomes[EXAMPLE_TEST] == "passed", inner.failures[EXAMPLE_TEST]
 
