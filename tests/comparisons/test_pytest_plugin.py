@@ -1,5 +1,18 @@
-"""The pytest plugin, run under pytester: the documented example passes, a broken variant fails."""
+"""The pytest plugin, run in pytest sessions of their own: the documented example passes, broken variants fail.
 
+The checks that need no ``--simparity-baseline`` share one session (:func:`inner`): the example, a tolerance the run
+breaks, ``check_engines`` / ``require_engines`` and paths beside a test file in another folder are each a test file of
+that session, and each test here reads its own inner tests' verdicts and failure texts (from the session's JUnit XML),
+never another's. The two baselines are options of a whole session: each has its own, in this interpreter (the shared
+session runs the example in a fresh one, the plugin found by its entry point, as a user runs it)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ElementTree
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -7,52 +20,134 @@ import pytest
 pytest_plugins = ["pytester"]
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "docs" / "examples" / "test_my_numerics.py"
+EXAMPLE_TEST = "test_the_lecture_projectile_keeps_its_known_errors"
 
+IMPOSSIBLE_RK4 = ('integrator = "rk4"\nmetric = "order_velocity"\nexpected = 5.0\nband = 0.01\nstatus = ["ok", "n/a"]\n'
+                  'reason = "impossible"\n')
+"""A bound no RK4 run can meet: order exactly 5."""
 
-@pytest.mark.slow  # ~10 s of CPU: a pytest session in a subprocess
-def test_the_documented_example_passes(pytester):
-    pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
-    result = pytester.runpytest_subprocess()
-    result.assert_outcomes(passed=1)
+DRAG = Path(__file__).resolve().parents[2] / "comparisons" / "scenes" / "falling-linear-drag.toml"
+DRAG_RK4 = "drag_rk4.toml"
+"""The shipped falling-linear-drag scene (its name, so the shipped bounds hold it) with RK4 alone: the bounds below
+are on RK4's order, and its other integrators and their orientation variants cost ~8 s of CPU a run."""
+RK4_ALONE = '[simulation]\nintegrators = ["rk4"]\n'
 
-
-@pytest.mark.slow
-def test_a_tolerance_the_run_breaks_fails_with_the_violation(pytester):
-    """A bound no RK4 run can meet (order exactly 5) fails the test and names the metric and the bound."""
-    pytester.makefile(".toml", tight='[[bound]]\nintegrator = "rk4"\nmetric = "order_velocity"\n'
-                                     'expected = 5.0\nband = 0.01\nstatus = ["ok", "n/a"]\nreason = "impossible"\n')
-    pytester.makepyfile(test_broken='''
+BROKEN = f'''
 def test_broken(simparity):
-    simparity.check("falling-linear-drag", engines=["core"], tolerances="tight.toml", profile="quick")
-''')
-    result = pytester.runpytest_subprocess()
-    result.assert_outcomes(failed=1)
-    assert "bound in [4.99, 5.01] (impossible)" in result.stdout.str()
-    result.stdout.fnmatch_lines(["falling-linear-drag core rk4 order_velocity: 4.0*, bound in *"])
+    simparity.check("{DRAG_RK4}", engines=["core"], tolerances="tight.toml", profile="quick", isolate=False)
+'''
+"""A tolerance the run breaks (the cases run in the test's process: what is tested is the verdict, not isolation)."""
 
-
-@pytest.mark.slow
-def test_check_engines_leaves_the_others_findings_out_and_require_engines_fails_without_one(pytester):
-    """Issue #38: a bound MuJoCo's RK4 breaks does not fail a test that holds core alone; a required engine that is
-    not in the run fails it, naming it."""
-    pytester.makefile(".toml", tight='[[bound]]\nengine = "mujoco"\nintegrator = "rk4"\nmetric = "order_velocity"\n'
-                                     'expected = 5.0\nband = 0.01\nstatus = ["ok", "n/a"]\nreason = "impossible"\n')
-    pytester.makepyfile(test_held="""
+HELD = f"""
 def test_core_alone(simparity):
-    simparity.check("falling-linear-drag", engines=["core", "mujoco"], tolerances="tight.toml", profile="quick",
-                    check_engines=["core"])
+    simparity.check("{DRAG_RK4}", engines=["core", "mujoco"], tolerances="tight_mujoco.toml", profile="quick",
+                    check_engines=["core"], isolate=False)
 
 def test_both_held(simparity):
-    simparity.check("falling-linear-drag", engines=["core", "mujoco"], tolerances="tight.toml", profile="quick")
+    simparity.check("{DRAG_RK4}", engines=["core", "mujoco"], tolerances="tight_mujoco.toml", profile="quick",
+                    isolate=False)
 
 def test_a_ghost_required(simparity):
-    simparity.check("falling-linear-drag", engines=["core"], profile="quick", require_engines=["core", "ghost"])
-""")
-    result = pytester.runpytest_subprocess("-v")
-    result.assert_outcomes(passed=1, failed=2)
-    result.stdout.fnmatch_lines(["*test_core_alone PASSED*", "*test_both_held FAILED*"])
-    result.stdout.fnmatch_lines(["*falling-linear-drag mujoco rk4 order_velocity: 4.0*(impossible)*"])
-    result.stdout.fnmatch_lines(["*ghost (require_engines=): no rows in this run*"])
+    simparity.check("{DRAG_RK4}", engines=["core"], profile="quick", require_engines=["core", "ghost"],
+                    isolate=False)
+"""
+"""Issue #38: a bound MuJoCo's RK4 breaks, held on core alone and on both; a required engine not in the run."""
+
+BESIDE = '''
+def test_found_beside(simparity):
+    simparity.check("drop.toml", engines=["core"], tolerances="mine.toml", profile="quick", allow_unbounded=True,
+                    isolate=False)
+
+def test_unknown(simparity):
+    simparity.check("no-such-scene-anywhere", engines=["core"], profile="quick", isolate=False)
+'''
+"""Run from the session's folder, a test in ``suite/`` finds its scene and tolerances beside itself."""
+
+
+@dataclass(frozen=True)
+class InnerSession:
+    """A pytest session's output and, by test name, each test's outcome and failure text."""
+
+    stdout: str
+    outcomes: dict[str, str]
+    failures: dict[str, str]
+
+    def failure(self, test: str) -> pytest.LineMatcher:
+        """The failure text of ``test`` (failed, as asserted first), to match lines in."""
+        assert self.outcomes[test] == "failed", (test, self.outcomes, self.stdout[-2000:])
+        return pytest.LineMatcher(self.failures[test].splitlines())
+
+
+def _run_session(folder: Path) -> InnerSession:
+    """``pytest -v`` in ``folder``, as pytester runs it in a subprocess (no outer options, no user config)."""
+    junit = folder / "junit.xml"
+    env = {key: value for key, value in os.environ.items() if key not in ("PYTEST_ADDOPTS", "TOX_ENV_DIR")}
+    env |= {"HOME": str(folder), "PY_COLORS": "0"}
+    done = subprocess.run([sys.executable, "-m", "pytest", "-v", "-p", "no:cacheprovider", f"--junitxml={junit}",
+                           f"--basetemp={folder / 'basetemp'}"], cwd=folder, env=env, capture_output=True, text=True,
+                          check=False)
+    assert junit.is_file(), done.stdout[-2000:] + done.stderr[-2000:]  # the session ran
+    outcomes, failures = {}, {}
+    for case in ElementTree.parse(junit).getroot().iter("testcase"):
+        found = [child for child in case if child.tag in ("failure", "error", "skipped")]
+        outcomes[case.get("name")] = {"failure": "failed"}.get(found[0].tag, found[0].tag) if found else "passed"
+        failures[case.get("name")] = "\n".join(f"{c.get('message', '')}\n{c.text or ''}" for c in found)
+    return InnerSession(done.stdout, outcomes, failures)
+
+
+@pytest.fixture(scope="module")
+def inner(tmp_path_factory) -> InnerSession:
+    """One pytest session holding every test file below that takes no baseline (the documented example, isolated as
+    it is written; test_broken.py, test_held.py and suite/test_mine.py, their cases in the test's process)."""
+    from tests.comparisons.scenes.test_loader import VALID_DYNAMICS
+
+    folder = tmp_path_factory.mktemp("inner")
+    files = {"test_example.py": EXAMPLE.read_text(encoding="utf-8"), "test_broken.py": BROKEN, "test_held.py": HELD,
+             DRAG_RK4: DRAG.read_text(encoding="utf-8").replace("[simulation]\n", RK4_ALONE),
+             "tight.toml": f"[[bound]]\n{IMPOSSIBLE_RK4}",
+             "tight_mujoco.toml": f'[[bound]]\nengine = "mujoco"\n{IMPOSSIBLE_RK4}',
+             "suite/__init__.py": "", "suite/test_mine.py": BESIDE,
+             "suite/drop.toml": VALID_DYNAMICS.replace("dt = [0.01]", "dt = [0.01, 0.005]"),
+             "suite/mine.toml": '[[bound]]\nscene = "drop"\nmetric = "position_error_max"\nmax = 1e-9\n'
+                                'reason = "free fall is exact for the lecture\'s Taylor rule"\n'
+                                'integrator = "taylor2"\n'}
+    for name, text in files.items():
+        (folder / name).parent.mkdir(exist_ok=True)
+        (folder / name).write_text(text, encoding="utf-8")
+    return _run_session(folder)
+
+
+@pytest.mark.slow  # the shared session: ~14 s of CPU (as four sessions of their own: ~57)
+def test_the_documented_example_passes(inner):
+    assert inner.outcomes[EXAMPLE_TEST] == "passed", inner.failures[EXAMPLE_TEST]
+
+
+@pytest.mark.slow
+def test_a_tolerance_the_run_breaks_fails_with_the_violation(inner):
+    """A bound no RK4 run can meet (order exactly 5) fails the test and names the metric and the bound."""
+    failure = inner.failure("test_broken")
+    assert "bound in [4.99, 5.01] (impossible)" in failure.str()
+    failure.fnmatch_lines(["falling-linear-drag core rk4 order_velocity: 4.0*, bound in *"])
+
+
+@pytest.mark.slow
+def test_check_engines_leaves_the_others_findings_out_and_require_engines_fails_without_one(inner):
+    """Issue #38: a bound MuJoCo's RK4 breaks does not fail a test that holds core alone; a required engine that is
+    not in the run fails it, naming it."""
+    assert inner.outcomes["test_core_alone"] == "passed", inner.failures["test_core_alone"]
+    inner.failure("test_both_held").fnmatch_lines(["*falling-linear-drag mujoco rk4 order_velocity: 4.0*(impossible)*"])
+    inner.failure("test_a_ghost_required").fnmatch_lines(["*ghost (require_engines=): no rows in this run*"])
+
+
+@pytest.mark.slow
+def test_paths_are_found_beside_the_test_file_and_bad_input_is_a_one_line_failure(inner):
+    """Run from another folder, a test finds its scene and tolerances files beside itself; an unknown scene fails
+    its test with simparity's one-line message, not a traceback."""
+    assert inner.outcomes["test_found_beside"] == "passed", inner.failures["test_found_beside"]
+    output = inner.failure("test_unknown").str()
+    assert "simparity: 'no-such-scene-anywhere'" in output or "simparity: no-such-scene-anywhere" in output
+    for text in (output, inner.stdout):
+        assert "Traceback" not in text and "UnknownSceneError" not in text
 
 
 @pytest.fixture(scope="module")
@@ -79,34 +174,9 @@ def test_a_baseline_that_differs_fails(pytester, tmp_path, example_run):
     writer = RunWriter(tmp_path / "base", describe_run([], "test", [scene]))
     writer.append([ResultRow(**row) for row in table.to_dict("records")])
     pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
-    result = pytester.runpytest_subprocess("--simparity-baseline", str(tmp_path / "base"))
+    result = pytester.runpytest_inprocess("--simparity-baseline", str(tmp_path / "base"))
     result.assert_outcomes(failed=1)
     result.stdout.fnmatch_lines(["*moved since*position_error_final*"])
-
-
-@pytest.mark.slow
-def test_paths_are_found_beside_the_test_file_and_bad_input_is_a_one_line_failure(pytester):
-    """Run from another folder, a test finds its scene and tolerances files beside itself; an unknown scene fails
-    its test with simparity's one-line message, not a traceback."""
-    from tests.comparisons.scenes.test_loader import VALID_DYNAMICS
-
-    suite = pytester.mkpydir("suite")
-    (suite / "drop.toml").write_text(VALID_DYNAMICS.replace("dt = [0.01]", "dt = [0.01, 0.005]"), encoding="utf-8")
-    (suite / "mine.toml").write_text('[[bound]]\nscene = "drop"\nmetric = "position_error_max"\nmax = 1e-9\n'
-                                     'reason = "free fall is exact for the lecture\'s Taylor rule"\n'
-                                     'integrator = "taylor2"\n', encoding="utf-8")
-    (suite / "test_mine.py").write_text('''
-def test_found_beside(simparity):
-    simparity.check("drop.toml", engines=["core"], tolerances="mine.toml", profile="quick", allow_unbounded=True)
-
-def test_unknown(simparity):
-    simparity.check("no-such-scene-anywhere", engines=["core"], profile="quick")
-''', encoding="utf-8")
-    result = pytester.runpytest_subprocess("suite")
-    result.assert_outcomes(passed=1, failed=1)
-    output = result.stdout.str()
-    assert "simparity: 'no-such-scene-anywhere'" in output or "simparity: no-such-scene-anywhere" in output
-    assert "Traceback" not in output and "UnknownSceneError" not in output
 
 
 @pytest.mark.slow
@@ -126,7 +196,7 @@ def test_the_documented_example_passes_against_a_baseline_that_ran_more_engines(
         dataclasses.replace(r, scene="wind") for r in rows]
     RunWriter(tmp_path / "base", describe_run([], "test", [scene], "quick")).append(more)
     pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
-    result = pytester.runpytest_subprocess("--simparity-baseline", str(tmp_path / "base"))
+    result = pytester.runpytest_inprocess("--simparity-baseline", str(tmp_path / "base"))
     result.assert_outcomes(passed=1)
 
 

@@ -78,9 +78,10 @@ def test_a_reference_that_cannot_do_the_scene_is_refused_at_load():
 
 
 def _run(scene, engines=("core", "analytic", "pinocchio"), profile: str = "full", isolate: bool = False):
+    """A run of ``scene`` (``isolate``: in one worker process; none of these tests is about a parallel run)."""
     import simparity
 
-    return simparity.run_scene(scene, engines, repeats=0, isolate=isolate, profile=profile)
+    return simparity.run_scene(scene, engines, repeats=0, isolate=isolate, profile=profile, jobs=1)
 
 
 @pytest.mark.slow  # ~1.5 s of CPU: a run on every engine
@@ -99,20 +100,26 @@ def test_rows_orders_and_pairing_against_the_closed_form():
     assert truth["status"].iloc[0] == "n/a" and "no order" in truth["detail"].iloc[0]
 
 
-@pytest.mark.slow  # ~7 s of CPU: a run of a chaotic chain on every engine
+@pytest.mark.slow  # ~4 s of CPU: a run of a chaotic chain on every engine
 def test_a_chaotic_chain_is_measured_over_the_references_horizon():
+    """RK4 alone: the horizon (4.84 s of 6 s) is the reference's, the same for every scheme; the other four schemes
+    saturate on this chain (on another orbit) and cost 40 % of the run."""
     two = _with("scene.reference", "pinocchio",
                 _with("chain.joint", [ROD, dict(ROD, name="elbow", origin_xyz=[1.0, 0.0, 0.0])],
                       _with("initial", {"q": [1.2, 0.3]}, _with("simulation.duration", 6.0,
-                                                           _with("simulation.dt", [0.004])))))
+                                                           _with("simulation.dt", [0.004],
+                                                                 _with("simulation.integrators", ["rk4"]))))))
     table = _run(parse_scene(two), ("core", "pinocchio"))
     rk4 = table[(table["integrator"] == "rk4") & (table["metric"] == "joint_angle_error_max")]
     assert "reference's horizon" in rk4["detail"].iloc[0]
 
 
-@pytest.mark.slow  # ~6 s of CPU: runs of the falling arms
+@pytest.mark.slow  # ~1.5 s of CPU: runs of the pendulum and their dt / 16 runs
 def test_self_consistency_segments_compare_each_engine_with_itself():
-    chain = _with("scene.reference", "pinocchio", _with("simulation.segments", 4))
+    """The two steps the order is read at, over 0.4 s (four segments of 10 and 20 steps): RK4 against itself still
+    measures order 3.96 there (4.02 over 1 s at 10 / 5 / 2.5 ms), its errors 1e-9 and 1e-10, far above rounding."""
+    chain = _with("scene.reference", "pinocchio", _with("simulation.segments", 4, _with(
+        "simulation.dt", [0.01, 0.005], _with("simulation.duration", 0.4))))
     table = _run(parse_scene(chain), ("core", "pinocchio"))
     rows = table[(table["metric"] == "joint_angle_error_max") & (table["status"] == "ok")]
     assert rows["detail"].str.contains("self-consistency: 4 segments").all()
@@ -147,19 +154,32 @@ class MidpointAsRk4(_Planted):
     name, bug = "midpoint-as-rk4", "rk4-as-midpoint"
 
 
-@pytest.mark.slow  # ~16 s of CPU a case: a checked run of the falling arms
-@pytest.mark.parametrize("planted", [GravityOff, MidpointAsRk4])
-def test_a_users_engine_with_a_planted_bug_turns_the_gate_red(planted):
+PLANTED = (GravityOff, MidpointAsRk4)
+
+
+@pytest.fixture(scope="module")
+def planted_run():
+    """The large-amplitude pendulum, quick, on core, the closed form, the faithful copy and every planted engine of
+    :data:`PLANTED` in one run (~16 s of CPU): each engine's rows are its own, so a test that drops the other planted
+    engines' rows holds the table a run of its engine alone gives."""
+    from simparity.comparisons.scenes import library
+
+    scene = library.load(["pendulum-large-amplitude"])[0]
+    return _run(scene, ("core", "analytic", Faithful, *PLANTED), profile="quick", isolate=True)
+
+
+@pytest.mark.slow  # the shared run: ~16 s of CPU
+@pytest.mark.parametrize("planted", PLANTED)
+def test_a_users_engine_with_a_planted_bug_turns_the_gate_red(planted, planted_run):
     """Gravity off by 0.1 % or an RK4 that is the midpoint rule: the shipped tolerances (keyed by scheme) and the
     cross-check against the built-in schemes of its kind name the user's engine; the faithful copy passes. Run as
     `simparity run` runs a plugin (isolated: the plan sees the engine's description only; found by the mutation
     suite, a described engine once offered no joint-motion integrator, and every plugin's row was n/a)."""
     from simparity.comparisons.gate.check import check_table
     from simparity.comparisons.gate.tolerances import load_tolerances
-    from simparity.comparisons.scenes import library
 
-    scene = library.load(["pendulum-large-amplitude"])[0]
-    table = _run(scene, ("core", "analytic", Faithful, planted), profile="quick", isolate=True)
+    others = {p.name for p in PLANTED} - {planted.name}
+    table = planted_run[~planted_run["engine"].isin(others)]
     assert set(table[table["engine"] == planted.name]["integrator"]) >= {"rk4", "semi_implicit_euler"}
     result = check_table(table, load_tolerances())
     named = {v.engine for v in result.violations}
