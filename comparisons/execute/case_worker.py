@@ -1,7 +1,8 @@
 """A worker process: runs the case groups it is sent, one case at a time, and reports each as it goes.
 
 Started by :mod:`comparisons.execute.isolation` as ``python -m simparity.comparisons.execute.case_worker IN_FD OUT_FD``:
-it reads ``(group, skip, reference_failure)`` messages from IN_FD and writes ``("start", index, pid)``
+it writes ``("ready",)`` once its imports are done, reads ``(group, skip, reference_failure)`` messages from IN_FD
+and writes ``("start", index, pid)``
 (index None: the group's shared part; pid: the process running it), ``("done", index, outcome)``,
 ``("crashed", code, first index)`` (the child running an engine's cases died: its exit code, negative
 for a signal) and ``("group done",)`` to OUT_FD. Its parent enforces the limits: a process that crashes,
@@ -123,6 +124,7 @@ def main(argv: list[str]) -> int:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     inbox, outbox = Connection(in_fd, writable=False), Connection(out_fd, readable=False)
     try:
+        outbox.send(("ready",))  # imported: the case clock of a job handed over meanwhile starts again here
         serve(inbox, outbox)
     except BrokenPipeError:  # the parent went away
         return 0

@@ -201,8 +201,10 @@ class IsolatedPool:
             yield from self._replace(worker, f"crashed: the case's process wrote what is not a message to its pipe "
                                      f"({type(err).__name__}); the worker was killed", pending)
             return
-        job = cast(Job, worker.job)  # a worker reports only while it runs a job
-        if message[0] == "start":
+        job = cast(Job, worker.job)  # a worker's messages are read only while it runs a job
+        if message[0] == "ready":  # a new worker's imports are done: its first case's time starts now, not before them
+            worker.since = time.monotonic()
+        elif message[0] == "start":
             worker.phase, worker.phase_pid, worker.since = message[1], message[2], time.monotonic()
         elif message[0] == "crashed":  # the child running the cases of one engine died; the worker lives on
             cause = death_cause(message[1], worker.stderr_tail(), "the case's process")
