@@ -304,8 +304,8 @@ def killed_and_resumed(command: list[str], killed, total: int, wait_seconds: flo
                        resume_options: tuple[str, ...] = ()) -> int:
     """Start ``simparity run`` (``command``, writing the folder ``killed``), kill it with SIGKILL (its process group: a
     lost node, the OOM killer; no chance to clean up) once half of its ``total`` cases are kept, check that half to all
-    but one were kept, and resume it (``simparity run --resume``, with ``resume_options``), which must say how many it
-    kept and succeed. Returns how many were kept."""
+    but one were kept, and resume it (``simparity run --resume``, with ``resume_options``: ``--no-report``), which must
+    say how many it kept and succeed. Returns how many were kept."""
     from simparity.comparisons.execute.journal import CASES_FOLDER, Journal
 
     run = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
@@ -317,7 +317,8 @@ def killed_and_resumed(command: list[str], killed, total: int, wait_seconds: flo
     finished = len(Journal(killed))
     assert total // 2 <= finished < total
     resumed = subprocess.run([sys.executable, "-m", "simparity.comparisons.cli", "run", "--resume", str(killed),
-                              *resume_options], capture_output=True, text=True)
+                              *resume_options],
+                             capture_output=True, text=True)
     assert resumed.returncode == 0, resumed.stderr
     assert f"resuming {finished} finished cases" in resumed.stdout
     return finished

@@ -26,7 +26,14 @@ WORKERS = 2
 
 @pytest.fixture(scope="module")
 def dask():
-    executor = DaskExecutor(None, WORKERS, CaseLimits.default(WORKERS))
+    """A LocalCluster of :data:`WORKERS` workers shared by the module's tests. Its scheduler allows no retry of a task
+    whose worker was lost (the default retries it 3 times): a lost group fails at once, as
+    test_a_group_lost_for_good_fails_only_the_cases_that_never_came_back needs; no other test loses a Dask worker."""
+    import dask.config
+    import distributed  # noqa: F401 - its defaults loaded before the setting below (unset, it would drop them all)
+
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
+        executor = DaskExecutor(None, WORKERS, CaseLimits.default(WORKERS))
     yield executor
     executor.close()
 
@@ -60,7 +67,9 @@ def test_the_cli_runs_on_dask_and_writes_the_local_executor_results(tmp_path):
     scene.write_text(THROWN_BALL, encoding="utf-8")
     # One small dynamics scene: this test is of the command's --executor dask (its cluster, its results.csv);
     # scenes of every kind on Dask against this process are test_a_local_dask_cluster_gives_the_results_of_this_process
-    args = ["run", str(scene), "--quick", "--jobs", str(WORKERS)]
+    # (a cluster of WORKERS workers). No report (the test reads results.csv); one worker process, and the command's own
+    # cluster of one Dask worker: parallelism is not what this test is of.
+    args = ["run", str(scene), "--quick", "--no-report", "--jobs", "1"]
     assert main(args + ["--out", str(tmp_path / "local")]) == 0
     assert main(args + ["--executor", "dask", "--out", str(tmp_path / "dask")]) == 0
     tables = [pd.read_csv(tmp_path / name / RESULTS_FILE, dtype=str, keep_default_na=False) for name in ("local", "dask")]
@@ -188,22 +197,14 @@ def test_cases_stream_back_one_by_one_while_their_group_still_runs(tmp_path, das
 
 
 @pytest.mark.slow
-def test_a_group_lost_for_good_fails_only_the_cases_that_never_came_back(tmp_path):
+def test_a_group_lost_for_good_fails_only_the_cases_that_never_came_back(tmp_path, dask):
     """A lost node (here: a case kills its Dask worker, and the cluster allows no retry) fails the cases of its
     group that were not back yet, with the cause; the cases already back keep their results."""
-    import dask.config
-    import distributed  # noqa: F401 - its defaults loaded before the setting below (unset, it would drop them all)
-
     scene = tmp_path / "throw.toml"
     scene.write_text(THROWN_BALL.replace("dt = [0.01, 0.005]", "dt = [0.01]"), encoding="utf-8")
     engines = built_engines(("core",)) + [make_engine("tests.hostile_engines:HostKillingEngine")]
     specs = {"host-killing": "tests.hostile_engines:HostKillingEngine"}
-    with dask.config.set({"distributed.scheduler.allowed-failures": 0}):
-        executor = DaskExecutor(None, 1, CaseLimits.default(1))
-    try:
-        [(_, rows, _)] = run_scenes(library.load([str(scene)]), engines, make_engine, 0, executor, specs=specs)
-    finally:
-        executor.close()
+    [(_, rows, _)] = run_scenes(library.load([str(scene)]), engines, make_engine, 0, dask, specs=specs)
     assert {r.status for r in rows if r.engine == "core"} == {"ok"}
     lost = [r for r in rows if r.engine == "host-killing"]
     assert lost and all(r.status == "failed" and "the Dask task was lost: KilledWorker" in r.detail for r in lost)

@@ -3,7 +3,10 @@ or allocates without bound becomes failed rows naming the cause, and every other
 
 from __future__ import annotations
 
+import dataclasses
+import io
 import sysconfig
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -17,6 +20,18 @@ from simparity.comparisons.execute.isolation import CaseLimits, IsolatedPool
 from simparity.comparisons.scenes.library import builtin_paths
 from tests.helpers import THROWN_BALL, no_leftovers_within
 
+HANG_SECONDS = 5
+"""The hanging engine's limit: long enough for any honest case of the tiny scene (milliseconds) and a worker's
+start and first imports (~1-2 s under load), short enough for a quick test."""
+
+CRASH_SECONDS = 120
+"""The limit while the hogging engine runs: far more than it needs to pass its memory limit (~0.4 GB/s of
+page faults measured on the 2-core machine under load: ~2 s), so it is caught by memory, not by time (a limit of 10 s,
+to share one run with the hanging engine, caught it by time on a machine loaded ~4 times over: a run each)."""
+
+CASE_GIB = 1.0
+"""The hogging engine's limit: ~4x what a worker running the tiny scene holds (~250 MiB)."""
+
 HANGING = ("tests.hostile_engines:HangingEngine", "hung: no result within the per-case time limit of 5 s")
 CRASHING = {
     "segfaulting": ("tests.hostile_engines:SegfaultingEngine", "killed by signal 11 (SIGSEGV)"),
@@ -24,29 +39,38 @@ CRASHING = {
                 "per-case limit of 1 GiB; the worker was killed"),  # exactly: rows are the same in every run
 }
 
-HANG_SECONDS = 5
-"""The hanging engine's limit: long enough for any honest case of the tiny scene (milliseconds) and a worker's
-start and first imports (~1-2 s under load), short enough for a quick test."""
 
-CRASH_SECONDS = 120
-"""The limit while the hogging engine runs: far more than it needs to pass its memory limit (~0.4 GB/s of
-page faults measured on the 2-core machine under load: ~2 s), so it is caught by memory, not by time."""
+@dataclasses.dataclass(frozen=True)
+class _Run:
+    """What ``simparity run`` gave: its exit code, what it printed and its folder."""
 
-CASE_GIB = 1.0
-"""The hogging engine's limit: ~4x what a worker running the tiny scene holds (~250 MiB)."""
+    code: int
+    printed: str
+    out: Path
+
+    @property
+    def table(self) -> pd.DataFrame:
+        return pd.read_csv(self.out / "results.csv")
 
 
-def _run(tmp_path, hostile: dict, seconds: float) -> pd.DataFrame:
+def _run_throw(folder: Path, engines: str, *options: str) -> _Run:
+    """``simparity run`` of the tiny scene (:data:`tests.helpers.THROWN_BALL`) on ``engines``, without a report (no
+    test here reads one), into ``folder``/run."""
+    scene = folder / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    printed = io.StringIO()
+    code = main(["run", str(scene), "--engines", engines, "--repeats", "0", "--no-report", *options,
+                 "--out", str(folder / "run")], printed)
+    return _Run(code, printed.getvalue(), folder / "run")
+
+
+def _run(tmp_path, hostile: dict, seconds: float) -> _Run:
     """Run the tiny scene on core, MuJoCo and the ``hostile`` engines ({name: (spec, cause)}); check that each hostile
     case failed with its cause, every other case completed, and the run kept its cases for --resume."""
-    scene = tmp_path / "throw.toml"
-    scene.write_text(THROWN_BALL, encoding="utf-8")
-    out = tmp_path / "run"
     engines = ",".join(["core"] + [spec for spec, _ in hostile.values()] + ["mujoco"])
-    code = main(["run", str(scene), "--engines", engines, "--repeats", "0", "--jobs", "2", "--case-timeout",
-                 str(seconds), "--case-memory", str(CASE_GIB), "--out", str(out)])
-    assert code == 1  # failed cases: exit 1, not a crash of the run
-    table = pd.read_csv(out / "results.csv")
+    run = _run_throw(tmp_path, engines, "--jobs", "2", "--case-timeout", str(seconds), "--case-memory", str(CASE_GIB))
+    assert run.code == 1  # failed cases: exit 1, not a crash of the run
+    table = run.table
     assert len(table[table.dt.notna()].groupby(["engine", "dt"])) == (2 + len(hostile)) * 2  # nothing lost
     for name, (_, cause) in hostile.items():
         rows = table[(table.engine == name) & table.dt.notna()]
@@ -54,14 +78,14 @@ def _run(tmp_path, hostile: dict, seconds: float) -> pd.DataFrame:
     for honest in ("core", "mujoco"):
         rows = table[(table.engine == honest) & (table.metric == "position_error_max")]
         assert list(rows.status) == ["ok", "ok"], honest
-    assert (out / "cases").is_dir()  # kept for --resume, which tries the failed cases again
-    return table
+    assert (run.out / "cases").is_dir()  # kept for --resume, which tries the failed cases again
+    return run
 
 
 @pytest.mark.slow
-def test_a_segfault_and_a_memory_blow_up_each_fail_alone(tmp_path, capsys):
-    _run(tmp_path, CRASHING, CRASH_SECONDS)
-    assert "4 cases did not finish (crashed, hung or out of memory)" in capsys.readouterr().out
+def test_a_segfault_and_a_memory_blow_up_each_fail_alone(tmp_path):
+    run = _run(tmp_path, CRASHING, CRASH_SECONDS)
+    assert "4 cases did not finish (crashed, hung or out of memory)" in run.printed
 
 
 @pytest.mark.slow
@@ -69,30 +93,40 @@ def test_a_hang_fails_alone(tmp_path):
     _run(tmp_path, {"hanging": HANGING}, HANG_SECONDS)
 
 
-def _core_values(tmp_path, engines: str, name: str) -> pd.DataFrame:
-    scene = tmp_path / "throw.toml"
-    scene.write_text(THROWN_BALL, encoding="utf-8")
-    main(["run", str(scene), "--engines", engines, "--repeats", "0", "--jobs", "1", "--out", str(tmp_path / name)])
-    table = pd.read_csv(tmp_path / name / "results.csv")
+ONE_WORKER_ENGINES = ("tests.hostile_engines:ExitingEngine", "tests.hostile_engines:MalformedEngine",
+                      "tests.hostile_engines:RoundingEngine", "core")
+"""Engines run in this order by a single worker: core's cases come after each hostile engine's in the same worker."""
+
+
+@pytest.fixture(scope="module")
+def one_worker_run(tmp_path_factory) -> _Run:
+    """One run of the tiny scene on :data:`ONE_WORKER_ENGINES` by one worker, shared by the tests of the exiting,
+    malformed and rounding engines (exit 1: the first two's cases fail)."""
+    run = _run_throw(tmp_path_factory.mktemp("one-worker"), ",".join(ONE_WORKER_ENGINES), "--jobs", "1")
+    assert run.code == 1
+    return run
+
+
+def _core_values(table: pd.DataFrame) -> pd.DataFrame:
     rows = table[(table.engine == "core") & ~table.metric.str.startswith("time_")]
     return rows[["integrator", "dt", "metric", "status", "value"]].reset_index(drop=True)
 
 
 @pytest.mark.slow
-def test_an_engine_that_changes_its_process_cannot_change_another_engines_results(tmp_path):
+def test_an_engine_that_changes_its_process_cannot_change_another_engines_results(tmp_path, one_worker_run):
     """The rounding engine switches the FPU to round upward before its cases; core's cases and the reference,
     run after it by the same single worker, are bit-identical to a run without it: each engine's cases run in
     a process of their own, forked from a worker no engine's code ran in."""
-    alone = _core_values(tmp_path, "core", "alone")
-    beside = _core_values(tmp_path, "tests.hostile_engines:RoundingEngine,core", "beside")
+    alone = _core_values(_run_throw(tmp_path, "core", "--jobs", "1").table)
+    beside = _core_values(one_worker_run.table)
     assert len(alone) > 10 and alone["status"].eq("ok").any()
     pd.testing.assert_frame_equal(alone, beside, check_exact=True)
 
 
 @pytest.mark.slow
-def test_an_engine_that_ends_its_process_quietly_fails_its_case(tmp_path):
+def test_an_engine_that_ends_its_process_quietly_fails_its_case(one_worker_run):
     """os._exit(0) in the middle of a case: failed rows saying so; core, after it in the same worker, completes."""
-    table = _first_then_core(tmp_path, "tests.hostile_engines:ExitingEngine")
+    table = one_worker_run.table
     exiting = table[(table.engine == "exiting") & table.dt.notna()]
     assert set(exiting.status) == {"failed"}
     assert exiting.detail.str.contains("the case's process exited with code 0 before its cases finished").all()
@@ -120,18 +154,9 @@ def test_limits_out_of_range_are_one_line_errors(option, value, capsys, tmp_path
     assert err.count("\n") == 1 and option in err and "allowed" in err
 
 
-def _first_then_core(tmp_path, spec: str) -> pd.DataFrame:
-    """The results of the tiny scene on ``spec`` then core, by one worker (exit 1: the first's cases fail)."""
-    scene = tmp_path / "throw.toml"
-    scene.write_text(THROWN_BALL, encoding="utf-8")
-    assert main(["run", str(scene), "--engines", f"{spec},core", "--repeats", "0", "--jobs", "1",
-                 "--out", str(tmp_path / "run")]) == 1
-    return pd.read_csv(tmp_path / "run" / "results.csv")
-
-
 @pytest.mark.slow
-def test_a_trajectory_that_cannot_be_measured_fails_with_the_error_not_as_a_crash(tmp_path):
-    table = _first_then_core(tmp_path, "tests.hostile_engines:MalformedEngine")
+def test_a_trajectory_that_cannot_be_measured_fails_with_the_error_not_as_a_crash(one_worker_run):
+    table = one_worker_run.table
     rows = table[(table.engine == "malformed") & table.dt.notna()]
     assert set(rows.status) == {"failed"}
     assert rows.detail.str.contains("its trajectory does not sample the scene: run() returned a value of type dict",
@@ -175,7 +200,7 @@ def test_what_an_engine_starts_and_leaves_running_ends_with_its_cases(tmp_path):
     scene = tmp_path / "throw.toml"
     scene.write_text(THROWN_BALL, encoding="utf-8")
     engines = [make_engine("core"), make_engine("tests.hostile_engines:ForkingEngine")]
-    with IsolatedPool(2, CaseLimits.default(2)) as pool:
+    with IsolatedPool(1, CaseLimits.default(1)) as pool:  # one worker: the forking engine's cases after core's
         [(_, rows, _)] = run_scenes(library.load([str(scene)]), engines, make_engine, 0, pool,
                                     specs={"forking": "tests.hostile_engines:ForkingEngine"})
         assert {r.status for r in rows if r.engine == "forking" and r.metric == "position_error_max"} == {"ok"}

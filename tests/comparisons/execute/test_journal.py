@@ -7,7 +7,7 @@ import dataclasses
 import math
 import os
 import pickle
-import subprocess
+import shutil
 import sys
 
 import pandas as pd
@@ -33,9 +33,12 @@ ENGINES = ("core", "analytic", "mujoco")
 computes); PyBullet's and Pinocchio's cases would double the run and test nothing more of resuming."""
 
 
-def _command(out) -> list[str]:
-    return [sys.executable, "-m", "simparity.comparisons.cli", "run", *SCENES, "--quick", "--jobs", "2", "--engines",
-            ",".join(ENGINES), "--out", str(out)]
+NO_REPORT = "--no-report"
+"""Every run here draws no report: the tests read results.csv and the kept cases (a report is ~5 CPU-s a run)."""
+
+
+def _run_args(out, jobs: int) -> list[str]:
+    return ["run", *SCENES, "--quick", "--jobs", str(jobs), "--engines", ",".join(ENGINES), NO_REPORT, "--out", str(out)]
 
 
 def _table(run_dir) -> pd.DataFrame:
@@ -51,8 +54,11 @@ def test_a_run_killed_halfway_and_resumed_writes_the_same_results(tmp_path):
                             [make_engine(n) for n in ENGINES],
                             make_engine))
     whole, killed = tmp_path / "whole", tmp_path / "killed"
-    subprocess.run(_command(whole), check=True, capture_output=True)
-    killed_and_resumed(_command(killed), killed, total, KILL_WAIT_SECONDS)
+    # The uninterrupted run in this process by one worker: a reference only (the results do not depend on the number of
+    # workers); the killed run is a process of its own with two workers, both keeping cases when it is killed.
+    assert main(_run_args(whole, 1)) == 0
+    killed_and_resumed([sys.executable, "-m", "simparity.comparisons.cli", *_run_args(killed, 2)], killed, total,
+                       KILL_WAIT_SECONDS, (NO_REPORT,))
     pd.testing.assert_frame_equal(_table(killed), _table(whole))
 
 
@@ -157,17 +163,31 @@ def _interrupted(run_dir, scene_file: str) -> int:
     return planted
 
 
+def _argv(scene: str, out) -> list[str]:
+    """A quick run of ``scene`` on core by one worker into ``out``."""
+    return ["run", scene, "--quick", "--engines", "core", "--jobs", "1", NO_REPORT, "--out", str(out)]
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory):
+    """The folder of a finished quick run of the thrown ball on core (and its scene file), shared by the tests that
+    resume or overwrite it (each on a copy of its own, or refused before anything is written)."""
+    folder = tmp_path_factory.mktemp("finished")
+    scene, out = _thrown_ball(folder), folder / "run"
+    assert main(_argv(scene, out)) == 0
+    return scene, out
+
+
 @pytest.mark.slow
-def test_a_forced_new_run_reuses_nothing_a_run_left_and_a_finished_run_keeps_no_cases(tmp_path):
-    scene, out = _thrown_ball(tmp_path), tmp_path / "run"
-    argv = ["run", scene, "--quick", "--engines", "core", "--jobs", "1", "--out", str(out)]
-    assert main(argv) == 0
-    assert not (out / CASES_FOLDER).exists()  # finished, every case done: they are in results.csv
+def test_a_forced_new_run_reuses_nothing_a_run_left_and_a_finished_run_keeps_no_cases(tmp_path, finished_run):
+    scene, finished = finished_run
+    assert not (finished / CASES_FOLDER).exists()  # finished, every case done: they are in results.csv
+    out = shutil.copytree(finished, tmp_path / "run")
     assert _interrupted(out, scene) > 0
-    assert main(argv + ["--force"]) == 0
+    assert main(_argv(scene, out) + ["--force"]) == 0
     assert "planted" not in (out / RESULTS_FILE).read_text(encoding="utf-8")
     _interrupted(out, scene)
-    assert main(["run", "--resume", str(out)]) == 0  # a resumed run, by contrast, keeps what it finds
+    assert main(["run", "--resume", str(out), NO_REPORT]) == 0  # a resumed run, by contrast, keeps what it finds
     assert "planted" in (out / RESULTS_FILE).read_text(encoding="utf-8")
 
 
@@ -179,11 +199,8 @@ def test_a_folder_being_written_by_another_run_is_refused(tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_a_finished_run_is_not_resumed(tmp_path, capsys):
-    out = tmp_path / "run"
-    assert main(["run", _thrown_ball(tmp_path), "--quick", "--engines", "core", "--jobs", "1", "--out", str(out)]) == 0
-    capsys.readouterr()
-    assert main(["run", "--resume", str(out)]) == 2
+def test_a_finished_run_is_not_resumed(finished_run, capsys):
+    assert main(["run", "--resume", str(finished_run[1])]) == 2
     err = capsys.readouterr().err
     assert "that run finished" in err and err.count("\n") == 1
 
