@@ -63,6 +63,11 @@ EXIT_GRACE_SECONDS = 1.0
 """How long a worker whose pipe closed is given to exit by itself before it is killed (a Python exception or
 ``sys.exit`` takes milliseconds; killing it at once would report signal 9 instead of its exit code)."""
 
+WORKER_START_SECONDS = 60.0
+"""How long a new worker may take to say it is ready (a fresh interpreter importing simparity, NumPy and SciPy: ~1.2 s of
+CPU, ~10 s by the clock on a machine loaded ten times over), on top of the per-case limit of the job handed to it
+meanwhile: its start does not count against that case, whose clock starts again when it is ready."""
+
 STDERR_TAIL_BYTES = 64 * 1024
 """How much of a dead worker's standard error is read for the cause of its death."""
 
@@ -117,6 +122,7 @@ class _Worker:
         self.phase: int | None = None
         self.phase_pid = self.process.pid
         self.since = time.monotonic()
+        self.ready = False  # its imports done (its first message)
 
     def start(self, job: Job) -> None:
         self.stderr.truncate(0)
@@ -203,7 +209,7 @@ class IsolatedPool:
             return
         job = cast(Job, worker.job)  # a worker's messages are read only while it runs a job
         if message[0] == "ready":  # a new worker's imports are done: its first case's time starts now, not before them
-            worker.since = time.monotonic()
+            worker.ready, worker.since = True, time.monotonic()
         elif message[0] == "start":
             worker.phase, worker.phase_pid, worker.since = message[1], message[2], time.monotonic()
         elif message[0] == "crashed":  # the child running the cases of one engine died; the worker lives on
@@ -223,7 +229,13 @@ class IsolatedPool:
             yield from self._replace(worker, death_cause(code, worker.stderr_tail()), pending)
             return
         elapsed = time.monotonic() - worker.since
-        if elapsed > self.limits.seconds:
+        if not worker.ready and elapsed > self.limits.seconds + WORKER_START_SECONDS:
+            worker.kill()
+            yield from self._replace(worker, f"hung: the worker process did not start (its imports) within "
+                                     f"{WORKER_START_SECONDS:g} s and the per-case time limit of {self.limits.seconds:g}"
+                                     " s; the worker was killed", pending)
+            return
+        if worker.ready and elapsed > self.limits.seconds:
             worker.kill()
             yield from self._replace(worker, f"hung: no result within the per-case time limit of "
                                      f"{self.limits.seconds:g} s; the worker was killed", pending)
