@@ -205,3 +205,21 @@ def test_what_an_engine_starts_and_leaves_running_ends_with_its_cases(tmp_path):
                                     specs={"forking": "tests.hostile_engines:ForkingEngine"})
         assert {r.status for r in rows if r.engine == "forking" and r.metric == "position_error_max"} == {"ok"}
         assert no_leftovers_within()
+
+
+SLOW_IMPORT_SECONDS = 2 * HANG_SECONDS
+"""A worker's start made longer than the case time limit (a machine loaded many times over, a cold disk): its imports
+must not count against the first case handed to it."""
+
+
+@pytest.mark.slow
+def test_a_workers_imports_do_not_count_against_its_first_cases_time_limit(tmp_path, monkeypatch):
+    """The worker (started when its first job is handed over) takes longer to import than the per-case limit; its
+    cases, milliseconds each, complete: the clock starts when it says it is ready (before: every case 'hung')."""
+    slow = tmp_path / "slow-start"
+    slow.mkdir()
+    (slow / "sitecustomize.py").write_text(f"import time\ntime.sleep({SLOW_IMPORT_SECONDS})\n", encoding="utf-8")
+    monkeypatch.syspath_prepend(str(slow))  # a worker's import path is this process's (worker_environment)
+    run = _run_throw(tmp_path, "core", "--jobs", "1", "--case-timeout", str(HANG_SECONDS))
+    assert run.code == 0, run.printed
+    assert set(run.table[run.table.dt.notna()].status) <= {"ok", "n/a"}
