@@ -31,8 +31,8 @@ reports its failures (the case's every path), at a tenth of the 200 that dominat
 
 
 def lean_scenes():
-    """The mixed smoke scenes (every kind of case, each scene several groups), shortened further for the tests that
-    run them whole several times: what they compare is bit-identity and what ran, not a value's accuracy."""
+    """The mixed smoke scenes (every kind of case; 8 groups, several for each of two workers), shortened further for
+    the tests that run them whole several times: what they compare is bit-identity and what ran, not accuracy."""
     def lean(scene):
         if hasattr(scene, "duration"):
             return dataclasses.replace(scene, duration=min(scene.duration, LEAN_STEPS * max(scene.dts)),
