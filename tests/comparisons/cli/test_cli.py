@@ -51,7 +51,8 @@ def test_run_without_scenes_runs_a_whole_builtin_suite(tmp_path, monkeypatch, su
             yield scene, [], []
 
     monkeypatch.setattr("simparity.comparisons.pipeline.session.run_scenes", run_scenes)
-    code, _ = _run(["run", "--out", str(tmp_path), "--jobs", "1"] + (["--suite", suite] if suite else []))
+    code, _ = _run(["run", "--out", str(tmp_path), "--jobs", "1", "--no-report"]
+                   + (["--suite", suite] if suite else []))
     assert code == EXIT_OK
     wanted = suite or "default"
     in_suite = [name for name, path in builtin_paths().items()
@@ -72,8 +73,9 @@ def test_lecture_scenes_end_to_end(tmp_path):
     # --quick keeps the command's whole path (every default engine and time step, timing repeats, results.csv,
     # report.md, run.json); it leaves out only core's orientation variants (+matrix, +expmap: the point never
     # rotates; tests/core/dynamics/test_integrators.py runs them) and half the arm's 200 configurations
+    # --jobs 1: one worker process, not one per CPU (what is tested is the output, not the parallelism)
     code, text = _run(["run", "lecture-projectile", "lecture-planar-arm", "--quick", "--out", str(tmp_path),
-                       "--repeats", "1"])
+                       "--repeats", "1", "--jobs", "1"])
     assert code == EXIT_OK, text
     table, _ = read_run(tmp_path)
     assert tuple(table.columns) == COLUMNS
@@ -141,8 +143,9 @@ def test_export_prints_the_model_for_dynamics(engine, marker):
 @pytest.mark.slow
 def test_report_rerenders_a_stored_run(tmp_path):
     """'simparity report DIR' rebuilds report.md from results.csv alone."""
-    assert _run(["run", "lecture-planar-arm", "--engines", "core,analytic", "--out", str(tmp_path), "--repeats", "1"])[0] == 0
-    (tmp_path / "report.md").unlink()
+    assert _run(["run", "lecture-planar-arm", "--engines", "core,analytic", "--out", str(tmp_path), "--repeats", "1",
+                 "--jobs", "1", "--no-report"])[0] == 0
+    assert not (tmp_path / "report.md").exists()  # the run drew none: what follows is the stored run's alone
     code, _ = _run(["report", str(tmp_path)])
     assert code == EXIT_OK and "lecture-planar-arm" in (tmp_path / "report.md").read_text()
 
@@ -194,11 +197,26 @@ def test_export_output_is_only_the_model():
     assert "build time" not in done.stderr
 
 
+ARM_RUN = ["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0", "--jobs", "1", "--no-report"]
+"""A cheap run (the arm's configurations on core, one worker, no report) for the tests of what any run does."""
+
+
+@pytest.fixture(scope="module")
+def arm_run(tmp_path_factory):
+    """One :data:`ARM_RUN`, shared by the tests that read its exit code and output or copy its folder: (code, text,
+    folder)."""
+    folder = tmp_path_factory.mktemp("arm") / "run"
+    code, text = _run(ARM_RUN + ["--out", str(folder), "--history", str(folder.parent / "history.sqlite")])
+    return code, text, folder
+
+
 @pytest.mark.slow
-def test_out_holding_a_run_is_refused_unless_forced(tmp_path, capsys):
+def test_out_holding_a_run_is_refused_unless_forced(tmp_path, capsys, arm_run):
     """A second run into the same --out exits 2 and leaves the first run untouched; --force overwrites."""
-    argv = ["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0", "--out", str(tmp_path)]
-    assert main(argv) == EXIT_OK
+    code, _, first = arm_run
+    assert code == EXIT_OK
+    shutil.copytree(first, tmp_path, dirs_exist_ok=True)  # this test's own copy of the first run
+    argv = ARM_RUN + ["--out", str(tmp_path)]
     before = (tmp_path / "results.csv").read_bytes()
     capsys.readouterr()
     assert main(argv) == EXIT_USAGE
@@ -213,18 +231,19 @@ def test_default_output_folders_never_collide(tmp_path, monkeypatch):
     """Two runs in the same second get two folders."""
     monkeypatch.chdir(tmp_path)
     for _ in range(2):
-        assert main(["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0"], out=io.StringIO()) == EXIT_OK
+        assert main(ARM_RUN, out=io.StringIO()) == EXIT_OK
     assert len([p for p in (tmp_path / "simparity-results").iterdir() if p.is_dir()]) == 2
 
 
 @pytest.fixture(scope="module")
 def projectile_run(tmp_path_factory):
     """One `run lecture-projectile --quick --engines core --check` (the numerics take ~10 s), shared by the tests that
-    read it and never change it: its exit code, its output, its folder and the history database it recorded into."""
+    read it and never change it: its exit code, its output, its folder and the history database it recorded into.
+    No report: none of them reads one."""
     folder = tmp_path_factory.mktemp("projectile")
     history = folder / "history.sqlite"
     code, text = _run(["run", "lecture-projectile", "--quick", "--engines", "core", "--out", str(folder / "run"),
-                       "--check", "--jobs", "1", "--history", str(history)])
+                       "--check", "--jobs", "1", "--no-report", "--history", str(history)])
     return code, text, folder / "run", history
 
 
@@ -248,7 +267,8 @@ def test_run_check_junit_summary_and_history(tmp_path, capsys, projectile_run):
     assert ET.parse(junit).getroot().get("failures") == str(steps)
     assert "## simparity check: failed" in summary.read_text(encoding="utf-8")
     second = tmp_path / "second"
-    assert main(["run", "lecture-projectile", "--quick", "--engines", "core", "--out", str(second), "--jobs", "1"]) == 0
+    assert main(["run", "lecture-projectile", "--quick", "--engines", "core", "--out", str(second), "--jobs", "1",
+                 "--no-report"]) == 0
     assert main(["check", str(second), "--baseline", "latest"]) == EXIT_OK  # same numerics: nothing moved
     capsys.readouterr()
     assert main(["history", "lecture-projectile", "--engine", "core", "--metric", "position_error_final"]) == EXIT_OK
@@ -268,8 +288,8 @@ def test_a_broken_history_database_never_loses_a_run(tmp_path, capsys, monkeypat
         raise HistoryError(f"{tmp_path / 'history.sqlite'}: run history unusable: disk I/O error")
 
     monkeypatch.setattr(session, "record_run", broken)
-    code = main(["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0", "--out", str(tmp_path / "r"),
-                 "--history", str(tmp_path / "history.sqlite")])
+    code = main(["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0", "--jobs", "1",
+                 "--out", str(tmp_path / "r"), "--history", str(tmp_path / "history.sqlite")])
     err = capsys.readouterr().err
     assert code == EXIT_OK and err.startswith("simparity: history not updated") and err.count("\n") == 1
     assert (tmp_path / "r" / "results.csv").is_file() and (tmp_path / "r" / "report.md").is_file()
@@ -305,10 +325,9 @@ def test_show_reports_a_point_mass_body_and_the_contact_settings():
 
 
 @pytest.mark.slow
-def test_every_run_ends_with_its_wall_time_and_peak_memory(tmp_path):
+def test_every_run_ends_with_its_wall_time_and_peak_memory(tmp_path, arm_run):
     """Issue #11: the last line of `simparity run` is what the run cost; a refused run prints no cost."""
-    code, text = _run(["run", "lecture-planar-arm", "--engines", "core", "--repeats", "0", "--out",
-                       str(tmp_path / "o")])
+    code, text, _ = arm_run
     last = text.strip().splitlines()[-1]
     assert code == EXIT_OK
     assert re.fullmatch(r"wall time \d+\.\d s; peak memory [\d,]+ MiB( \(largest worker process [\d,]+ MiB\))?", last)

@@ -37,8 +37,8 @@ def test_a_piped_run_says_each_scene_as_it_finishes(tmp_path):
 def test_a_gate_only_run_draws_no_report_and_simparity_report_draws_it_later(tmp_path):
     run, junit, summary = tmp_path / "run", tmp_path / "junit.xml", tmp_path / "summary.md"
     code, text = _run(["run", "lecture-planar-arm", "--engines", "core,analytic", "--repeats", "0", "--no-report",
-                       "--out", str(run), "--history", str(tmp_path / "h.sqlite"), "--check", "--junit", str(junit),
-                       "--summary", str(summary)])
+                       "--jobs", "1", "--out", str(run), "--history", str(tmp_path / "h.sqlite"), "--check",
+                       "--junit", str(junit), "--summary", str(summary)])
     assert code == EXIT_OK and "check passed" in text
     assert (run / RESULTS_FILE).is_file() and (run / RUN_INFO_FILE).is_file() and junit.is_file() and summary.is_file()
     assert not (run / "report.md").exists() and not (run / "report.html").exists()

@@ -3,6 +3,8 @@ bit for bit whatever the executor and the number of workers; a resumed run recom
 
 from __future__ import annotations
 
+import dataclasses
+
 import pytest
 
 from simparity.comparisons.engines.registry import make_engine
@@ -13,9 +15,38 @@ from simparity.comparisons.execute.journal import Journal
 from simparity.core.model.results import STATUSES, case_counts
 from tests.helpers import InProcess, built_engines, comparable, smoke_scenes
 
+LEAN_STEPS = 60
+"""Steps at a dynamics scene's coarsest time step in :func:`lean_scenes`: the bouncing ball (dropped from 1 m,
+coarsest dt 0.01 s) still meets the floor, at t = sqrt(2 h / g) = 0.45 s, and leaves it before the end (0.6 s):
+its impact and rebound metrics are measured at both time steps."""
+
+LEAN_INTEGRATORS = ("semi_implicit_euler", "rk4", "backup", "act_after", "exact", "euler")
+"""The integrators of a dynamics scene in :func:`lean_scenes`: every engine still runs a case or two (core its
+contact schemes on the ball), 48 dynamics cases instead of 84: a worker's cost is mostly its cases' own
+processes (each case is forked), not their steps."""
+
+LEAN_ITERATIONS = 20
+"""IK iterations in :func:`lean_scenes`: every solver still iterates, reaches its cap on the hard targets and
+reports its failures (the case's every path), at a tenth of the 200 that dominated the mixed scenes' cost."""
+
+
+def lean_scenes():
+    """The mixed smoke scenes (every kind of case; 8 groups, several for each of two workers), shortened further for
+    the tests that run them whole several times: what they compare is bit-identity and what ran, not accuracy."""
+    def lean(scene):
+        if hasattr(scene, "duration"):
+            return dataclasses.replace(scene, duration=min(scene.duration, LEAN_STEPS * max(scene.dts)),
+                                       integrators=LEAN_INTEGRATORS)
+        if hasattr(scene, "max_iterations"):
+            return dataclasses.replace(scene, max_iterations=LEAN_ITERATIONS)
+        return scene
+    return [lean(scene) for scene in smoke_scenes()]
+
+
 @pytest.fixture(scope="module")
 def in_process():
-    scenes = smoke_scenes()
+    """The lean scenes run once in this process on every engine: the rows the other executors must give."""
+    scenes = lean_scenes()
     return scenes, list(run_scenes(scenes, built_engines(), make_engine, 0, InProcess()))
 
 

@@ -22,11 +22,24 @@ from tests.helpers import builtin
 # Issue #4: core's best solver solves >= 99.5 % of 1000 seeded iiwa pose targets.
 REQUIRED_IIWA_SOLVE_RATE = 0.995
 
+CAPPED_ITERATIONS = 30
+"""max_iterations of the scenes (see :func:`_capped`) whose assertions are about what the harness reports (every
+metric, the judges, n/a and its reason, the hard targets), not about how far a solver gets in 200 iterations: the
+solvers that stall (the transpose method, every solver on the hard targets) were most of these tests' cost. Measured
+at 200 and at 30: the rates asserted below hold alike (2-link DLS 0.917 and J^-1 > 0 at both, 3-link J^-1 0.94 and
+0.92 > 0.8, every judge 1.0 on the analytic solutions, 11 beyond-reach rows, core's rate beside a wrong FK 0.9 and
+0.8 > 0)."""
+
+
+def _capped(scene, **changes):
+    """``scene`` with at most :data:`CAPPED_ITERATIONS` iterations per solve (and ``changes``)."""
+    return dataclasses.replace(scene, max_iterations=CAPPED_ITERATIONS, **changes)
+
 
 @pytest.fixture(scope="module")
 def iiwa_rows():
-    """All engines on the built-in iiwa scene, 40 random targets (the hard targets in full)."""
-    scene = dataclasses.replace(builtin("iiwa-ik"), n_targets=40)
+    """All engines on the built-in iiwa scene, 40 random targets (the hard targets in full), iterations capped."""
+    scene = _capped(builtin("iiwa-ik"), n_targets=40)
     return run_scene(scene, [make_engine(name) for name in DEFAULT_ENGINES], make_engine, repeats=1)
 
 
@@ -80,7 +93,7 @@ def test_core_solves_the_iiwa_criterion():
 def test_analytic_two_link_beside_the_iterative_solvers():
     """On the lecture's 2-link arm the analytic solver solves every reachable target; others are measured. The
     Jacobian inverse works on the arm's plane (its 2 joints move the tip in 2 directions: a square system there)."""
-    scene = dataclasses.replace(builtin("lecture-2link-ik"), n_targets=60)
+    scene = _capped(builtin("lecture-2link-ik"), n_targets=60)
     rows = run_scene(scene, [make_engine("analytic"), make_engine("core")], make_engine, repeats=1)
     rate = {(r.engine, r.integrator): r.value for r in rows if r.metric == "solve_rate" and r.status == OK}
     assert rate[("analytic", "two_link")] == 1.0
@@ -109,7 +122,7 @@ def test_a_failing_solver_still_reports_every_hard_target():
 @pytest.mark.slow
 def test_float32_judge_does_not_fail_double_precision_solutions():
     """A solution within tolerance in double is granted by every judge, PyBullet's float32 FK included."""
-    scene = dataclasses.replace(builtin("lecture-2link-ik"), n_targets=40)
+    scene = _capped(builtin("lecture-2link-ik"), n_targets=40)  # the analytic solutions judged: no iteration
     rows = run_scene(scene, [make_engine("analytic"), make_engine("pybullet"), make_engine("core")], make_engine,
                         repeats=1)
     cross = {r.integrator: r.value for r in rows if r.metric == "cross_eval_solve_rate_min"}
@@ -182,7 +195,7 @@ class _OffsetFK(InHouseEngine):
 
 
 def _quick_rows(name, engines):
-    return run_scene(quick(builtin(name)), engines, make_engine, repeats=1)
+    return run_scene(_capped(quick(builtin(name))), engines, make_engine, repeats=1)
 
 
 @pytest.mark.slow
@@ -203,6 +216,7 @@ def test_a_wrong_fk_is_blamed_on_its_engine_alone():
     assert value[("offset-fk", "damped_least_squares", "fk_departure_max")].value == pytest.approx(1e-3)
     assert value[("core", "damped_least_squares", "fk_departure_max")].value == 0.0
     alone = {(r.integrator, r.metric): r.value for r in _quick_rows("ur5-ik", [make_engine("core")])}
+    assert alone[("damped_least_squares", "cross_eval_solve_rate_min")] > 0  # judged by the offset FK, it would be 0
     assert value[("core", "damped_least_squares", "cross_eval_solve_rate_min")].value == alone[
         ("damped_least_squares", "cross_eval_solve_rate_min")]
 
@@ -212,7 +226,7 @@ def test_the_jacobian_inverse_where_it_applies_and_n_a_where_it_does_not():
     """The lecture's 3-link planar arm moves in 3 of a pose's 6 directions (x, y, the turn about z): J^-1 solves
     its planar pose targets; with 3-D position targets its 3 x 3 Jacobian has a zero row: n/a with the reason,
     never a 0 % ok."""
-    scene = quick(builtin("lecture-3link-ik"))
+    scene = _capped(quick(builtin("lecture-3link-ik")))
     rows = run_scene(scene, [make_engine("core")], make_engine, repeats=1)
     inverse = {r.metric: r for r in rows if r.integrator == "jacobian_inverse"}
     assert inverse["cross_eval_solve_rate_min"].status == OK and inverse["cross_eval_solve_rate_min"].value > 0.8

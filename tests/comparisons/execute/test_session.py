@@ -1,6 +1,7 @@
 """One pipeline: ``simparity.run_scene`` and the pytest fixture run scenes through the session ``simparity run`` uses,
 isolated by default: an engine that segfaults gives failed rows (a failed test), and the interpreter goes on."""
 
+import os
 import subprocess
 import sys
 import textwrap
@@ -13,10 +14,10 @@ import pytest
 from simparity import run_scene
 from simparity.comparisons.pipeline.session import engine_specs, refuse_unreachable
 from simparity.comparisons.scenes.library import load
-from simparity.comparisons.scenes.profiles import quick
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.results import FAILED, OK
 from simparity.core.inhouse import InHouseEngine
+from tests.helpers import smoke
 
 pytest_plugins = ["pytester"]
 
@@ -30,7 +31,14 @@ would take for ever."""
 
 
 def _small():
-    return quick(load([SCENE])[0])
+    """The scene as the execution tests trim it (two time steps, 100 steps of the coarsest): a crash, the isolation
+    and the rows' equality do not depend on how long a case runs."""
+    return smoke(load([SCENE])[0])
+
+
+def _with_root_on_path() -> str:
+    """PYTHONPATH with the repository first (tests.helpers, for a script run in a subprocess), the rest kept."""
+    return os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)
 
 
 @pytest.mark.slow  # ~10 s of CPU: worker processes, one of them crashing
@@ -77,11 +85,11 @@ def test_a_script_s_own_engine_is_refused_isolated_and_runs_in_process(tmp_path)
         class Mine(InHouseEngine):
             name = "mine"
 
-        from simparity.comparisons.scenes.profiles import quick
+        from tests.helpers import smoke
 
-        # quick (the profile's shorter run): the refusal comes before any case runs, and the in-process run
-        # needs only ok rows of the script's engine, not the full 6 s ladder down to 1/240 s
-        scene = quick(simparity.load_scene("{SCENE}"))
+        # smoke (the quick profile, trimmed to 2 time steps of 100 steps): the refusal comes before any case runs,
+        # and the in-process run needs only ok rows of the script's engine, not the full 6 s ladder down to 1/240 s
+        scene = smoke(simparity.load_scene("{SCENE}"))
         try:
             simparity.run_scene(scene, engines=[Mine], repeats=0)
         except SimparityError as err:
@@ -89,7 +97,8 @@ def test_a_script_s_own_engine_is_refused_isolated_and_runs_in_process(tmp_path)
         table = simparity.run_scene(scene, engines=[Mine], repeats=0, isolate=False)
         print("in process:", sorted(set(table["engine"])), (table["status"] == "ok").sum())
     """), encoding="utf-8")
-    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=SCRIPT_SECONDS)
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, timeout=SCRIPT_SECONDS,
+                          env={**os.environ, "PYTHONPATH": _with_root_on_path()})
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     assert lines[0].startswith("refused: engine __main__:Mine: defined in __main__")
@@ -99,17 +108,26 @@ def test_a_script_s_own_engine_is_refused_isolated_and_runs_in_process(tmp_path)
 @pytest.mark.slow  # ~17 s of CPU: a pytest session in a subprocess
 def test_the_fixture_fails_a_test_whose_engine_segfaults_and_the_session_goes_on(pytester, monkeypatch):
     monkeypatch.setenv("PYTHONPATH", str(ROOT))  # the hostile engines' module, for the test run and its workers
+    # the quick profile's two coarsest time steps, not smoke's 100 steps: check() judges core's rows by the shipped
+    # bounds, written for the scene's whole 6 s
     pytester.makepyfile(test_crash=f'''
+import dataclasses
+
 from simparity.comparisons.scenes.library import load
 from simparity.comparisons.scenes.profiles import quick
 
 
+def _coarse():
+    scene = quick(load(["{SCENE}"])[0])
+    return dataclasses.replace(scene, dts=scene.dts[-2:])
+
+
 def test_crash(simparity):
-    simparity.check(quick(load(["{SCENE}"])[0]), engines=["{SEGFAULTING}"])
+    simparity.check(_coarse(), engines=["{SEGFAULTING}"])
 
 
 def test_after(simparity):
-    simparity.check(quick(load(["{SCENE}"])[0]), engines=["core"])
+    simparity.check(_coarse(), engines=["core"])
 ''')
     result = pytester.runpytest_subprocess()
     result.assert_outcomes(passed=1, failed=1)
