@@ -190,7 +190,7 @@ def test_the_run_records_its_largest_workers_peak_measured_independently(tmp_pat
     (tmp_path / "memory_hog.py").write_text(_HOG.format(allocation=ALLOCATION_BYTES))
     monkeypatch.setenv("MEMORY_HOG_OUT", str(tmp_path / "hog.txt"))
     peak, _, stderr = run_peak_memory(["lecture-planar-arm", "--engines", "memory_hog:MemoryHog", "--repeats", "0",
-                                       "--jobs", "1"], tmp_path / "run", cwd=tmp_path)
+                                       "--jobs", "1", "--no-report"], tmp_path / "run", cwd=tmp_path)
     assert peak is not None, stderr
     baseline, high_water, _ = map(int, (tmp_path / "hog.txt").read_text().split())
     assert peak.largest_child_bytes == pytest.approx(baseline + ALLOCATION_BYTES, rel=PEAK_TOLERANCE)
