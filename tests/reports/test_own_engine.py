@@ -4,7 +4,6 @@ counts (force evaluations per simulated second) beside the measured wall time. O
 known without the code under test."""
 
 import pandas as pd
-import pytest
 
 from simparity.core.model.run_info import RunInfo
 from simparity.core.model.results import SERIES_COLUMNS, ResultRow
@@ -12,6 +11,7 @@ from simparity.reports import own_engine
 from simparity.reports.content import build
 from simparity.reports.tolerance_verdict import ToleranceVerdict
 from simparity.reports.markdown import LINE_CHARS, to_markdown
+from tests.reports.undrawn import undrawn_figures
 
 STEPS = (0.02, 0.01)
 """The time steps of every scheme here [s]."""
@@ -49,8 +49,9 @@ def _table(engines=None) -> pd.DataFrame:
 
 
 def _report(tmp_path, verdict: ToleranceVerdict | None) -> str:
-    """The whole report.md (its figures drawn too: some seconds)."""
-    blocks, _ = build(_table(), RunInfo(), pd.DataFrame(columns=list(SERIES_COLUMNS)), verdict, tmp_path)
+    """The whole report.md (its figures made, not saved: no test here reads them)."""
+    with undrawn_figures():
+        blocks, _ = build(_table(), RunInfo(), pd.DataFrame(columns=list(SERIES_COLUMNS)), verdict, tmp_path)
     return to_markdown(blocks)
 
 
@@ -69,7 +70,6 @@ def _verdict(held=None) -> ToleranceVerdict:
     return ToleranceVerdict(40, 0, (MINE_FINDING, CORE_FINDING), 2, ("mine", "core"), held)
 
 
-@pytest.mark.slow
 def test_the_users_engine_comes_first_and_cheapest_says_what_it_counts_beside_the_wall_time(tmp_path):
     """Before: no such section; "cheapest at error ≤ 1e-06" and "core rk4 @ 0.02 (200/s)": a reader could take
     200/s for a speed."""

@@ -23,6 +23,7 @@ from simparity.reports.store import read_run
 from simparity.reports.sweep_sections import SWEEP_PANELS, TABLE_ROWS, _figure_cases, sections, sweep_cases
 from simparity.reports.sweep_summary import sweeps
 from tests.comparisons.scenes.test_loader import VALID_DYNAMICS, VALID_KINEMATICS
+from tests.reports.undrawn import undrawn_figures
 
 GRAVITY_SWEEP = VALID_DYNAMICS + '[sweep]\n"body[ball].mass" = [1.0, 2.0]\n"world.gravity_world[2]" = [-9.81, -1.62]\n'
 """Four variants, mass x gravity, each at one time step (0.01 s)."""
@@ -60,7 +61,9 @@ def _recorded(drawn):
 
 
 def _report(tmp_path, table, info) -> str:
-    blocks, _ = build(table, info, NO_SERIES, None, tmp_path)
+    """The report.md of a stored run, its figures made but not saved (no test here reads a figure's file)."""
+    with undrawn_figures():
+        blocks, _ = build(table, info, NO_SERIES, None, tmp_path)
     return to_markdown(blocks)
 
 
@@ -189,7 +192,6 @@ def test_a_large_table_is_folded_into_the_html(tmp_path):
     assert "scheme0 | 1e-06" not in to_markdown(blocks)
 
 
-@pytest.mark.slow
 def test_variants_share_a_line_in_findings_and_cases_without_a_result(tmp_path):
     hard = GRAVITY_SWEEP.replace('kind = "dynamics"', 'kind = "dynamics"\nsuites = ["hard"]')
     scenes = parse_scenes(tomllib.loads(hard))
@@ -282,7 +284,7 @@ def test_past_the_compact_limit_a_sweep_shows_its_distribution_not_a_row_per_var
     assert all(fig is not None for fig, _ in drawn)
 
 
-@pytest.mark.slow  # ~7 s of CPU: a sweep run and rendered
+@pytest.mark.slow  # ~1.4 s of CPU: the report of 40 variants
 def test_a_compact_sweep_keeps_the_report_within_its_lines(tmp_path):
     _, table, info = _many(tmp_path)
     report = _report(tmp_path, table, info)
