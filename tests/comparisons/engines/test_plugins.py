@@ -37,7 +37,11 @@ EXAMPLE_VERSION = "0.1.0"
 INSTALL_SECONDS = 120
 """pip may first fetch setuptools from the package index for an isolated build (about 3 s when cached)."""
 RUN_SECONDS = 120
-"""The tiny scene (SCENE) on core's rk4 and the example, two worker processes and the report: about 10 s."""
+"""The tiny scene (SCENE) on core's rk4 and the example, one worker process and the report: about 10 s."""
+
+NO_REPORT_ONE_JOB = ("--no-report", "--jobs", "1")
+"""For a run whose report no test reads and whose parallelism none tests: a report costs ~5 CPU-s, a second
+worker ~1 s."""
 
 EULER_ORDER_BAND = 0.1
 """Explicit Euler's global error is C dt (1 + O(dt)): on this smooth scene, over dt 0.01-0.04 s against a
@@ -157,15 +161,26 @@ def site(tmp_path, monkeypatch):
         sys.modules.pop(module, None)
 
 
-@pytest.fixture
-def scene_file(tmp_path) -> Path:
-    path = tmp_path / "toss.toml"
+def _scene(folder: Path) -> Path:
+    """SCENE written to a file in ``folder``."""
+    path = folder / "toss.toml"
     path.write_text(SCENE, encoding="utf-8")
     return path
 
 
+@pytest.fixture
+def scene_file(tmp_path) -> Path:
+    return _scene(tmp_path)
+
+
 def _rows(table: pd.DataFrame, engine: str) -> pd.DataFrame:
     return table[table.engine == engine]
+
+
+def _run(scene, engines: list[str]) -> pd.DataFrame:
+    """``run_scene`` of a scene file or a built-in's name, isolated as ``simparity run`` runs, in one worker (a
+    second worker costs a process start and no test here is about parallelism)."""
+    return run_scene(str(scene), engines=engines, repeats=0, jobs=1)
 
 
 # --- The installed example: listed, run beside core, failed by the gate ------------------------------------------
@@ -209,7 +224,7 @@ def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_
 
     out = tmp_path / "run"
     run = _simparity(["run", str(scene_file), "--engines", "core,example", "--check", "--out", str(out),
-                      "--repeats", "0", "--jobs", "2"], target, tmp_path)
+                      "--repeats", "0", "--jobs", "1"], target, tmp_path)
     assert run.returncode == EXIT_FAILED_CASES, run.stdout + run.stderr
     violations = [line for line in run.stdout.splitlines() if line.startswith("violation: ")]
     assert violations and all(re.match(r"violation: toss example rk4[ :]", line) for line in violations), run.stdout
@@ -231,8 +246,8 @@ def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_
 def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site, scene_file):
     """Asked for and never run, it must not pass the gate as n/a: its rows fail, naming the import error."""
     site.install({"ghost": "no_such_module_for_simparity_tests:Engine"})
-    dynamics = run_scene(load_scene(str(scene_file)), engines=["core", "ghost"], repeats=0)
-    kinematics = run_scene("lecture-planar-arm", engines=["core", "ghost"], repeats=0)
+    dynamics = _run(scene_file, ["core", "ghost"])
+    kinematics = _run("lecture-planar-arm", ["core", "ghost"])
     for table in (dynamics, kinematics):
         ghost = _rows(table, "ghost")
         cases = ghost[~ghost.metric.str.startswith("order_")]  # an order over cases that never ran: n/a, "too few"
@@ -246,7 +261,7 @@ def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site
 def test_a_mistyped_spec_module_fails_the_run_and_the_gate(tmp_path, capsys):
     out = tmp_path / "run"
     code = main(["run", "lecture-projectile", "--quick", "--engines", "core,no_such_module_for_simparity_tests:X",
-                 "--out", str(out), "--check"])
+                 "--out", str(out), "--check", *NO_REPORT_ONE_JOB])
     assert code == EXIT_FAILED_CASES
     assert "check FAILED" in capsys.readouterr().out
 
@@ -257,7 +272,7 @@ def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(si
     site.install({"exploding": "plugin_engines_a:Exploding"}, "plugin_engines_a")
     out = tmp_path / "run"
     code = main(["run", str(scene_file), "--engines", "core,exploding", "--out", str(out), "--repeats", "0",
-                 "--jobs", "1"], out=io.StringIO())
+                 *NO_REPORT_ONE_JOB], out=io.StringIO())
     assert code == EXIT_FAILED_CASES
     table = pd.read_csv(out / "results.csv", keep_default_na=False, na_values={"dt": ["", "nan"], "value": ["", "nan"]})
     exploding = _rows(table, "exploding")
@@ -265,6 +280,24 @@ def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(si
     assert exploding.detail.str.contains("ValueError: boom in the constructor", regex=False).all()
     core = _rows(table, "core")
     assert set(core[core.metric == "position_error_max"].status) == {OK}
+
+
+BROKEN_ATTRS = ("NoVersion", "ListedIntegrators", "RaisingOrder", "NotAnEngine", "NoSuchClass")
+"""The attributes of ENGINES_SOURCE (or not in it) that break the interface, each in its own way."""
+
+
+@pytest.fixture(scope="module")
+def broken_table(tmp_path_factory):
+    """One run shared by the interface tests: core beside a spec of each of BROKEN_ATTRS (each is described in a
+    probe of its own and fails alone: the others' rows do not touch its own), the specs' module on the path."""
+    folder = tmp_path_factory.mktemp("broken")
+    (folder / "plugin_engines_b.py").write_text(ENGINES_SOURCE, encoding="utf-8")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.syspath_prepend(str(folder))
+        try:
+            yield _run(_scene(folder), ["core", *(f"plugin_engines_b:{attr}" for attr in BROKEN_ATTRS)])
+        finally:
+            sys.modules.pop("plugin_engines_b", None)
 
 
 @pytest.mark.slow
@@ -276,10 +309,8 @@ def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(si
                     "subclass"),  # told without constructing it (#39)
     ("NoSuchClass", "AttributeError"),
 ])
-def test_an_engine_that_breaks_the_interface_fails_its_rows_with_the_reason(site, scene_file, attr, reason):
-    site.add_module("plugin_engines_b")
-    spec = f"plugin_engines_b:{attr}"
-    table = run_scene(load_scene(str(scene_file)), engines=["core", spec], repeats=0)
+def test_an_engine_that_breaks_the_interface_fails_its_rows_with_the_reason(broken_table, attr, reason):
+    spec, table = f"plugin_engines_b:{attr}", broken_table
     broken = _rows(table, spec)
     assert len(broken) and set(broken.status) == {FAILED}
     assert broken.detail.str.contains(reason, regex=False).all(), broken.detail.iloc[0]
@@ -300,7 +331,7 @@ def test_an_engine_declaring_a_bad_stage_count_is_broken_with_a_one_line_reason(
 @pytest.mark.slow
 def test_an_engine_whose_build_raises_fails_each_case_with_the_error(site, scene_file):
     site.add_module("plugin_engines_c")
-    table = run_scene(load_scene(str(scene_file)), engines=["plugin_engines_c:CrashingBuild"], repeats=0)
+    table = _run(scene_file, ["plugin_engines_c:CrashingBuild"])
     cases = table[(table.engine == "crashing") & table.dt.notna()]
     assert len(cases) and set(cases.status) == {FAILED}
     assert cases.detail.str.startswith("ZeroDivisionError: build failed").all()
@@ -312,7 +343,7 @@ def test_an_engine_whose_build_raises_fails_each_case_with_the_error(site, scene
 def test_a_module_class_spec_runs_under_the_engine_s_own_name(site, scene_file):
     site.add_module("plugin_engines_d")
     assert check_engine_names(["core", "plugin_engines_d:Renamed"]) == ("core", "plugin_engines_d:Renamed")
-    table = run_scene(load_scene(str(scene_file)), engines=["plugin_engines_d:Renamed"], repeats=0)
+    table = _run(scene_file, ["plugin_engines_d:Renamed"])
     assert set(table.engine) == {"mine"} and OK in set(table.status)
     assert make_engine("plugin_engines_d:factory").name == "mine"  # a zero-argument callable returning an Engine
     # a built-in's name is taken: the spec names the engine instead
@@ -398,11 +429,13 @@ def test_an_installed_plugin_a_run_does_not_name_is_never_asked(site, scene_file
     real = engine_probe.probe_engines
     monkeypatch.setattr(engine_probe, "probe_engines", lambda names, scenes=(): asked.append(list(names)) or
                         real(names, scenes))
-    assert main(["run", str(scene_file), "--quick", "--engines", "core", "--out", str(tmp_path / "a")]) == EXIT_OK
+    assert main(["run", str(scene_file), "--quick", "--engines", "core", "--out", str(tmp_path / "a"),
+                 *NO_REPORT_ONE_JOB]) == EXIT_OK
     assert main(["list"], out=io.StringIO()) == EXIT_OK
     assert asked == []
     leap = tmp_path / "leap.toml"
     leap.write_text(SCENE.replace('integrators = ["rk4"]', 'integrators = ["rk4", "leapfrog_demo"]'), encoding="utf-8")
-    code = main(["run", str(leap), "--quick", "--engines", "core,leap", "--out", str(tmp_path / "b")])
+    code = main(["run", str(leap), "--quick", "--engines", "core,leap", "--out", str(tmp_path / "b"),
+                 *NO_REPORT_ONE_JOB])
     assert code != EXIT_USAGE  # the scene file was accepted (the demo integrator's own cases may fail)
     assert asked and all(names == ["leap"] for names in asked)

@@ -93,7 +93,8 @@ def test_a_faithful_plugin_passes_and_a_planted_bug_fails_under_every_transform(
     scene.write_text(TWO_LEAVES, encoding="utf-8")
     out = tmp_path / "run"
     code = main(["run", str(scene), "--quick", "--check", "--engines", f"core,{faithful.spec},{mutant.spec}",
-                 "--transform", ",".join(TRANSFORM_NAMES), "--out", str(out), "--history", str(tmp_path / "h.db")])
+                 "--transform", ",".join(TRANSFORM_NAMES), "--out", str(out), "--history", str(tmp_path / "h.db"),
+                 "--no-report", "--jobs", "1"])  # what is read: the verdicts printed and results.csv
     lines = capsys.readouterr().out.splitlines()
     violations = [line for line in lines if line.startswith("violation: ")]
     assert code == 1 and violations
