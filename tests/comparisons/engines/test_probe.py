@@ -12,7 +12,6 @@ from simparity.comparisons.engines import probe as engine_probe
 from simparity.comparisons.cli.main import main
 from simparity.comparisons.engines.probe import PROBE_CHAIN, DescribedEngine, probe_engines
 from simparity.comparisons.engines.placeholders import BrokenEngine
-from simparity.core.model.engine import Engine, Support
 from simparity.core.inhouse import InHouseEngine
 from tests.helpers import THROWN_BALL, builtin
 
@@ -122,36 +121,6 @@ def test_an_engine_that_hung_while_described_is_not_built_again_by_the_cases(hos
     assert rows.detail.str.contains(f"took more than {SHORT_PROBE_SECONDS:g} s", regex=False).all()
 
 
-class OwnIntegrators(Engine):
-    """A user's engine with an integrator name no built-in has: core's RK4, called ``own_rk4``."""
-
-    name = "own"
-
-    def __init__(self) -> None:
-        self._core = InHouseEngine()
-
-    def version(self) -> str:
-        return self._core.version()
-
-    def integrators(self):
-        return ("own_rk4",)
-
-    def supports_dynamics(self, scene, integrator):
-        return self._core.supports_dynamics(scene, "rk4")
-
-    def build_dynamics(self, scene, integrator, dt):
-        return self._core.build_dynamics(scene, "rk4", dt)
-
-    def supports_kinematics(self, chain):
-        return Support.no("dynamics only")
-
-    def build_kinematics(self, chain):
-        raise NotImplementedError("dynamics only")
-
-    def theoretical_order(self, integrator):
-        return 4
-
-
 @pytest.mark.slow
 def test_a_scene_file_and_the_quick_profile_may_name_a_spec_engines_own_integrators(tmp_path):
     """Before, `own_rk4` was refused as no engine's integrator: only built-ins' and installed plugins' names were
@@ -160,7 +129,7 @@ def test_a_scene_file_and_the_quick_profile_may_name_a_spec_engines_own_integrat
     scene.write_text(THROWN_BALL.replace('integrators = ["rk4"]', 'integrators = ["own_rk4"]'), encoding="utf-8")
     for quick in ([], ["--quick"]):
         out = tmp_path / f"run{len(quick)}"
-        assert _run(scene, "core,tests.comparisons.engines.test_probe:OwnIntegrators", out, *quick) == 0
+        assert _run(scene, "core,tests.comparisons.engines.own_engine:OwnIntegrators", out, *quick) == 0
         table = pd.read_csv(out / "results.csv", keep_default_na=False)
         own = table[(table.engine == "own") & (table.metric == "position_error_max")]
         assert list(own.integrator) == ["own_rk4", "own_rk4"] and set(own.status) == {"ok"}
