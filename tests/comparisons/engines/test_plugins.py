@@ -177,6 +177,11 @@ def _rows(table: pd.DataFrame, engine: str) -> pd.DataFrame:
     return table[table.engine == engine]
 
 
+def _results(out: Path) -> pd.DataFrame:
+    """A run's results.csv, "n/a" kept as a status (only an empty dt or value is missing)."""
+    return pd.read_csv(out / "results.csv", keep_default_na=False, na_values={"dt": ["", "nan"], "value": ["", "nan"]})
+
+
 def _run(scene, engines: list[str]) -> pd.DataFrame:
     """``run_scene`` of a scene file or a built-in's name, isolated as ``simparity run`` runs, in one worker (a
     second worker costs a process start and no test here is about parallelism)."""
@@ -230,7 +235,7 @@ def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_
     assert violations and all(re.match(r"violation: toss example rk4[ :]", line) for line in violations), run.stdout
     assert any("order_position" in line and "bound >= 3.5" in line for line in violations)
 
-    table = pd.read_csv(out / "results.csv", keep_default_na=False, na_values={"dt": ["", "nan"], "value": ["", "nan"]})
+    table = _results(out)
     order = table[(table.metric == "order_position") & (table.integrator == "rk4")].set_index("engine")
     assert abs(order.loc["example", "value"] - 1.0) <= EULER_ORDER_BAND  # explicit Euler, whatever it claims
     assert abs(order.loc["core", "value"] - 4.0) <= RK4_ORDER_BAND
@@ -243,11 +248,14 @@ def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_
 # --- Plugins that cannot run ----------------------------------------------------------------------------------------
 
 @pytest.mark.slow
-def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site, scene_file):
+def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site, scene_file, tmp_path):
     """Asked for and never run, it must not pass the gate as n/a: its rows fail, naming the import error."""
     site.install({"ghost": "no_such_module_for_simparity_tests:Engine"})
-    dynamics = _run(scene_file, ["core", "ghost"])
-    kinematics = _run("lecture-planar-arm", ["core", "ghost"])
+    out = tmp_path / "run"  # one run of both scenes: one worker and one probe of ghost, not two
+    assert main(["run", str(scene_file), "lecture-planar-arm", "--engines", "core,ghost", "--repeats", "0",
+                 "--out", str(out), *NO_REPORT_ONE_JOB], out=io.StringIO()) == EXIT_FAILED_CASES
+    both = _results(out)
+    dynamics, kinematics = both[both.scene == "toss"], both[both.scene == "lecture-planar-arm"]
     for table in (dynamics, kinematics):
         ghost = _rows(table, "ghost")
         cases = ghost[~ghost.metric.str.startswith("order_")]  # an order over cases that never ran: n/a, "too few"
@@ -258,9 +266,9 @@ def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site
 
 
 @pytest.mark.slow
-def test_a_mistyped_spec_module_fails_the_run_and_the_gate(tmp_path, capsys):
+def test_a_mistyped_spec_module_fails_the_run_and_the_gate(scene_file, tmp_path, capsys):
     out = tmp_path / "run"
-    code = main(["run", "lecture-projectile", "--quick", "--engines", "core,no_such_module_for_simparity_tests:X",
+    code = main(["run", str(scene_file), "--quick", "--engines", "core,no_such_module_for_simparity_tests:X",
                  "--out", str(out), "--check", *NO_REPORT_ONE_JOB])
     assert code == EXIT_FAILED_CASES
     assert "check FAILED" in capsys.readouterr().out
@@ -274,7 +282,7 @@ def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(si
     code = main(["run", str(scene_file), "--engines", "core,exploding", "--out", str(out), "--repeats", "0",
                  *NO_REPORT_ONE_JOB], out=io.StringIO())
     assert code == EXIT_FAILED_CASES
-    table = pd.read_csv(out / "results.csv", keep_default_na=False, na_values={"dt": ["", "nan"], "value": ["", "nan"]})
+    table = _results(out)
     exploding = _rows(table, "exploding")
     assert len(exploding) and set(exploding.status) == {FAILED}
     assert exploding.detail.str.contains("ValueError: boom in the constructor", regex=False).all()
@@ -286,18 +294,24 @@ BROKEN_ATTRS = ("NoVersion", "ListedIntegrators", "RaisingOrder", "NotAnEngine",
 """The attributes of ENGINES_SOURCE (or not in it) that break the interface, each in its own way."""
 
 
+SHARED_MODULE = "plugin_engines_b"
+"""The module of ENGINES_SOURCE the shared run's specs name (on the import path while this module's tests run)."""
+
+
 @pytest.fixture(scope="module")
-def broken_table(tmp_path_factory):
-    """One run shared by the interface tests: core beside a spec of each of BROKEN_ATTRS (each is described in a
-    probe of its own and fails alone: the others' rows do not touch its own), the specs' module on the path."""
-    folder = tmp_path_factory.mktemp("broken")
-    (folder / "plugin_engines_b.py").write_text(ENGINES_SOURCE, encoding="utf-8")
+def shared_table(tmp_path_factory):
+    """One run shared by the tests of specs: core beside a spec of each of BROKEN_ATTRS, CrashingBuild and
+    Renamed (each is described in a probe of its own and its rows are its own: an engine that fails does not
+    touch another's), SHARED_MODULE on the path."""
+    folder = tmp_path_factory.mktemp("specs")
+    (folder / f"{SHARED_MODULE}.py").write_text(ENGINES_SOURCE, encoding="utf-8")
     with pytest.MonkeyPatch.context() as patch:
         patch.syspath_prepend(str(folder))
         try:
-            yield _run(_scene(folder), ["core", *(f"plugin_engines_b:{attr}" for attr in BROKEN_ATTRS)])
+            yield _run(_scene(folder), ["core", *(f"{SHARED_MODULE}:{attr}" for attr in
+                                                  (*BROKEN_ATTRS, "CrashingBuild", "Renamed"))])
         finally:
-            sys.modules.pop("plugin_engines_b", None)
+            sys.modules.pop(SHARED_MODULE, None)
 
 
 @pytest.mark.slow
@@ -309,8 +323,8 @@ def broken_table(tmp_path_factory):
                     "subclass"),  # told without constructing it (#39)
     ("NoSuchClass", "AttributeError"),
 ])
-def test_an_engine_that_breaks_the_interface_fails_its_rows_with_the_reason(broken_table, attr, reason):
-    spec, table = f"plugin_engines_b:{attr}", broken_table
+def test_an_engine_that_breaks_the_interface_fails_its_rows_with_the_reason(shared_table, attr, reason):
+    spec, table = f"{SHARED_MODULE}:{attr}", shared_table
     broken = _rows(table, spec)
     assert len(broken) and set(broken.status) == {FAILED}
     assert broken.detail.str.contains(reason, regex=False).all(), broken.detail.iloc[0]
@@ -329,9 +343,8 @@ def test_an_engine_declaring_a_bad_stage_count_is_broken_with_a_one_line_reason(
 
 
 @pytest.mark.slow
-def test_an_engine_whose_build_raises_fails_each_case_with_the_error(site, scene_file):
-    site.add_module("plugin_engines_c")
-    table = _run(scene_file, ["plugin_engines_c:CrashingBuild"])
+def test_an_engine_whose_build_raises_fails_each_case_with_the_error(shared_table):
+    table = shared_table  # SHARED_MODULE:CrashingBuild, named "crashing"
     cases = table[(table.engine == "crashing") & table.dt.notna()]
     assert len(cases) and set(cases.status) == {FAILED}
     assert cases.detail.str.startswith("ZeroDivisionError: build failed").all()
@@ -340,12 +353,12 @@ def test_an_engine_whose_build_raises_fails_each_case_with_the_error(site, scene
 # --- Names: specs, shadowing, unknown names --------------------------------------------------------------------------
 
 @pytest.mark.slow
-def test_a_module_class_spec_runs_under_the_engine_s_own_name(site, scene_file):
-    site.add_module("plugin_engines_d")
-    assert check_engine_names(["core", "plugin_engines_d:Renamed"]) == ("core", "plugin_engines_d:Renamed")
-    table = _run(scene_file, ["plugin_engines_d:Renamed"])
-    assert set(table.engine) == {"mine"} and OK in set(table.status)
-    assert make_engine("plugin_engines_d:factory").name == "mine"  # a zero-argument callable returning an Engine
+def test_a_module_class_spec_runs_under_the_engine_s_own_name(shared_table):
+    spec = f"{SHARED_MODULE}:Renamed"
+    assert check_engine_names(["core", spec]) == ("core", spec)
+    mine = _rows(shared_table, "mine")  # the shared run's other engines have names of their own
+    assert spec not in set(shared_table.engine) and len(mine) and OK in set(mine.status)
+    assert make_engine(f"{SHARED_MODULE}:factory").name == "mine"  # a zero-argument callable returning an Engine
     # a built-in's name is taken: the spec names the engine instead
     assert make_engine("simparity.core.inhouse:InHouseEngine").name == "simparity.core.inhouse:InHouseEngine"
 
