@@ -247,14 +247,34 @@ def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_
 
 # --- Plugins that cannot run ----------------------------------------------------------------------------------------
 
+@pytest.fixture(scope="module")
+def unrunnable_run(tmp_path_factory):
+    """One ``simparity run`` shared by the tests of installed plugins that cannot run, ghost (does not import) and
+    exploding (raises in its constructor), beside core on SCENE and on a kinematics scene (the planar arm), in a
+    worker process as 'simparity run' runs: its exit code and results. The plugins are installed for the run
+    only (the other tests install their own)."""
+    folder = tmp_path_factory.mktemp("unrunnable")
+    (folder / "site").mkdir()
+    site = _Site(folder / "site")
+    site.install({"ghost": "no_such_module_for_simparity_tests:Engine", "exploding": "plugin_engines_a:Exploding"},
+                 "plugin_engines_a")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.syspath_prepend(str(site.folder))
+        _forget_plugins()
+        try:
+            code = main(["run", str(_scene(folder)), "lecture-planar-arm", "--engines", "core,ghost,exploding",
+                         "--repeats", "0", "--out", str(folder / "run"), *NO_REPORT_ONE_JOB], out=io.StringIO())
+        finally:
+            _forget_plugins()
+            sys.modules.pop("plugin_engines_a", None)
+    return code, _results(folder / "run")
+
+
 @pytest.mark.slow
-def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site, scene_file, tmp_path):
+def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(unrunnable_run):
     """Asked for and never run, it must not pass the gate as n/a: its rows fail, naming the import error."""
-    site.install({"ghost": "no_such_module_for_simparity_tests:Engine"})
-    out = tmp_path / "run"  # one run of both scenes: one worker and one probe of ghost, not two
-    assert main(["run", str(scene_file), "lecture-planar-arm", "--engines", "core,ghost", "--repeats", "0",
-                 "--out", str(out), *NO_REPORT_ONE_JOB], out=io.StringIO()) == EXIT_FAILED_CASES
-    both = _results(out)
+    code, both = unrunnable_run
+    assert code == EXIT_FAILED_CASES
     dynamics, kinematics = both[both.scene == "toss"], both[both.scene == "lecture-planar-arm"]
     for table in (dynamics, kinematics):
         ghost = _rows(table, "ghost")
@@ -266,28 +286,24 @@ def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site
 
 
 @pytest.mark.slow
+def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(unrunnable_run):
+    """In worker processes, as 'simparity run' runs: exit 1 (an engine failed), every other case measured."""
+    code, table = unrunnable_run
+    assert code == EXIT_FAILED_CASES
+    exploding = _rows(table, "exploding")
+    assert len(exploding) and set(exploding.status) == {FAILED}
+    assert exploding.detail.str.contains("ValueError: boom in the constructor", regex=False).all()
+    core = _rows(table, "core")
+    assert set(core[core.metric == "position_error_max"].status) == {OK}
+
+
+@pytest.mark.slow
 def test_a_mistyped_spec_module_fails_the_run_and_the_gate(scene_file, tmp_path, capsys):
     out = tmp_path / "run"
     code = main(["run", str(scene_file), "--quick", "--engines", "core,no_such_module_for_simparity_tests:X",
                  "--out", str(out), "--check", *NO_REPORT_ONE_JOB])
     assert code == EXIT_FAILED_CASES
     assert "check FAILED" in capsys.readouterr().out
-
-
-@pytest.mark.slow
-def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(site, scene_file, tmp_path):
-    """In worker processes, as 'simparity run' runs: exit 1 (an engine failed), every other case measured."""
-    site.install({"exploding": "plugin_engines_a:Exploding"}, "plugin_engines_a")
-    out = tmp_path / "run"
-    code = main(["run", str(scene_file), "--engines", "core,exploding", "--out", str(out), "--repeats", "0",
-                 *NO_REPORT_ONE_JOB], out=io.StringIO())
-    assert code == EXIT_FAILED_CASES
-    table = _results(out)
-    exploding = _rows(table, "exploding")
-    assert len(exploding) and set(exploding.status) == {FAILED}
-    assert exploding.detail.str.contains("ValueError: boom in the constructor", regex=False).all()
-    core = _rows(table, "core")
-    assert set(core[core.metric == "position_error_max"].status) == {OK}
 
 
 BROKEN_ATTRS = ("NoVersion", "ListedIntegrators", "RaisingOrder", "NotAnEngine", "NoSuchClass")
