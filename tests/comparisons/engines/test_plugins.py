@@ -8,7 +8,6 @@ import re
 import importlib.util
 import io
 import json
-import os
 import shutil
 import subprocess
 import sys
@@ -36,8 +35,6 @@ EXAMPLE_VERSION = "0.1.0"
 
 INSTALL_SECONDS = 120
 """pip may first fetch setuptools from the package index for an isolated build (about 3 s when cached)."""
-RUN_SECONDS = 120
-"""The tiny scene (SCENE) on core's rk4 and the example, one worker process and the report: about 10 s."""
 
 NO_REPORT_ONE_JOB = ("--no-report", "--jobs", "1")
 """For a run whose report no test reads and whose parallelism none tests: a report costs ~5 CPU-s, a second
@@ -212,27 +209,41 @@ def _install_example(tmp_path: Path) -> Path:
     return target
 
 
-def _simparity(args: list[str], target: Path, cwd: Path) -> subprocess.CompletedProcess:
-    env = dict(os.environ, PYTHONPATH=str(target))
-    return subprocess.run([sys.executable, "-m", "simparity.comparisons.cli", *args], env=env, cwd=cwd,
-                          capture_output=True, text=True, timeout=RUN_SECONDS)
+def _simparity(args: list[str]) -> tuple[int, str]:
+    """``simparity ARGS`` in this process (its probes and workers are processes of their own, with this import
+    path): the exit code and what it printed. In a process of its own it cost a start and the imports again."""
+    out = io.StringIO()
+    return main(args, out=out), out.getvalue()
 
 
 @pytest.mark.slow
-def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_its_order(tmp_path, scene_file):
+def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_its_order(tmp_path, scene_file,
+                                                                                         monkeypatch):
     target = _install_example(tmp_path)
-    listing = _simparity(["engines"], target, tmp_path)
-    assert listing.returncode == EXIT_OK, listing.stderr
-    [line] = [line for line in listing.stdout.splitlines() if line.startswith("example ")]
+    monkeypatch.syspath_prepend(str(target))  # installed there: on the import path, as PYTHONPATH puts it
+    monkeypatch.chdir(tmp_path)
+    _forget_plugins()
+    try:
+        _the_example_is_listed_runs_and_fails(tmp_path, scene_file)
+    finally:
+        _forget_plugins()
+        for module in [name for name in sys.modules if name.startswith("simparity_example_engine")]:
+            del sys.modules[module]
+
+
+def _the_example_is_listed_runs_and_fails(tmp_path: Path, scene_file: Path) -> None:
+    code, listing = _simparity(["engines"])
+    assert code == EXIT_OK, listing
+    [line] = [line for line in listing.splitlines() if line.startswith("example ")]
     assert f"from simparity-example-engine {EXAMPLE_VERSION}" in line and f"version {EXAMPLE_VERSION}" in line
     assert "dynamics: rk4" in line and "kinematics: no" in line
 
     out = tmp_path / "run"
-    run = _simparity(["run", str(scene_file), "--engines", "core,example", "--check", "--out", str(out),
-                      "--repeats", "0", "--jobs", "1"], target, tmp_path)
-    assert run.returncode == EXIT_FAILED_CASES, run.stdout + run.stderr
-    violations = [line for line in run.stdout.splitlines() if line.startswith("violation: ")]
-    assert violations and all(re.match(r"violation: toss example rk4[ :]", line) for line in violations), run.stdout
+    code, printed = _simparity(["run", str(scene_file), "--engines", "core,example", "--check", "--out", str(out),
+                                "--repeats", "0", "--jobs", "1"])
+    assert code == EXIT_FAILED_CASES, printed
+    violations = [line for line in printed.splitlines() if line.startswith("violation: ")]
+    assert violations and all(re.match(r"violation: toss example rk4[ :]", line) for line in violations), printed
     assert any("order_position" in line and "bound >= 3.5" in line for line in violations)
 
     table = _results(out)
