@@ -258,12 +258,16 @@ def _the_example_is_listed_runs_and_fails(tmp_path: Path, scene_file: Path) -> N
 
 # --- Plugins that cannot run ----------------------------------------------------------------------------------------
 
+MISTYPED_SPEC = "no_such_module_for_simparity_tests:X"
+"""A spec whose module does not exist (a typing error)."""
+
+
 @pytest.fixture(scope="module")
 def unrunnable_run(tmp_path_factory):
-    """One ``simparity run`` shared by the tests of installed plugins that cannot run, ghost (does not import) and
-    exploding (raises in its constructor), beside core on SCENE and on a kinematics scene (the planar arm), in a
-    worker process as 'simparity run' runs: its exit code and results. The plugins are installed for the run
-    only (the other tests install their own)."""
+    """One ``simparity run --check`` shared by the tests of engines that cannot run, the installed plugins ghost
+    (does not import) and exploding (raises in its constructor) and MISTYPED_SPEC, beside core on SCENE and on a
+    kinematics scene (the planar arm), in a worker process as 'simparity run' runs: its exit code, results and
+    what it printed. The plugins are installed for the run only (the other tests install their own)."""
     folder = tmp_path_factory.mktemp("unrunnable")
     (folder / "site").mkdir()
     site = _Site(folder / "site")
@@ -273,18 +277,20 @@ def unrunnable_run(tmp_path_factory):
         patch.syspath_prepend(str(site.folder))
         _forget_plugins()
         try:
-            code = main(["run", str(_scene(folder)), "lecture-planar-arm", "--engines", "core,ghost,exploding",
-                         "--repeats", "0", "--out", str(folder / "run"), *NO_REPORT_ONE_JOB], out=io.StringIO())
+            printed = io.StringIO()
+            code = main(["run", str(_scene(folder)), "lecture-planar-arm", "--engines",
+                         f"core,ghost,exploding,{MISTYPED_SPEC}", "--repeats", "0", "--out", str(folder / "run"),
+                         "--check", *NO_REPORT_ONE_JOB], out=printed)
         finally:
             _forget_plugins()
             sys.modules.pop("plugin_engines_a", None)
-    return code, _results(folder / "run")
+    return code, _results(folder / "run"), printed.getvalue()
 
 
 @pytest.mark.slow
 def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(unrunnable_run):
     """Asked for and never run, it must not pass the gate as n/a: its rows fail, naming the import error."""
-    code, both = unrunnable_run
+    code, both, _ = unrunnable_run
     assert code == EXIT_FAILED_CASES
     dynamics, kinematics = both[both.scene == "toss"], both[both.scene == "lecture-planar-arm"]
     for table in (dynamics, kinematics):
@@ -299,7 +305,7 @@ def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(unru
 @pytest.mark.slow
 def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(unrunnable_run):
     """In worker processes, as 'simparity run' runs: exit 1 (an engine failed), every other case measured."""
-    code, table = unrunnable_run
+    code, table, _ = unrunnable_run
     assert code == EXIT_FAILED_CASES
     exploding = _rows(table, "exploding")
     assert len(exploding) and set(exploding.status) == {FAILED}
@@ -309,12 +315,12 @@ def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(un
 
 
 @pytest.mark.slow
-def test_a_mistyped_spec_module_fails_the_run_and_the_gate(scene_file, tmp_path, capsys):
-    out = tmp_path / "run"
-    code = main(["run", str(scene_file), "--quick", "--engines", "core,no_such_module_for_simparity_tests:X",
-                 "--out", str(out), "--check", *NO_REPORT_ONE_JOB])
+def test_a_mistyped_spec_module_fails_the_run_and_the_gate(unrunnable_run):
+    code, _, printed = unrunnable_run
     assert code == EXIT_FAILED_CASES
-    assert "check FAILED" in capsys.readouterr().out
+    violations = [line for line in printed.splitlines() if line.startswith("violation: ")]
+    # the gate fails the spec itself (ghost and exploding, failing beside it, have their own violations)
+    assert "check FAILED" in printed and any(f" {MISTYPED_SPEC} " in line for line in violations), printed
 
 
 BROKEN_ATTRS = ("NoVersion", "ListedIntegrators", "RaisingOrder", "NotAnEngine", "NoSuchClass")
