@@ -8,7 +8,6 @@ import re
 import importlib.util
 import io
 import json
-import os
 import shutil
 import subprocess
 import sys
@@ -36,8 +35,10 @@ EXAMPLE_VERSION = "0.1.0"
 
 INSTALL_SECONDS = 120
 """pip may first fetch setuptools from the package index for an isolated build (about 3 s when cached)."""
-RUN_SECONDS = 120
-"""The tiny scene (SCENE) on core's rk4 and the example, two worker processes and the report: about 10 s."""
+
+NO_REPORT_ONE_JOB = ("--no-report", "--jobs", "1")
+"""For a run whose report no test reads and whose parallelism none tests: a report costs ~5 CPU-s, a second
+worker ~1 s."""
 
 EULER_ORDER_BAND = 0.1
 """Explicit Euler's global error is C dt (1 + O(dt)): on this smooth scene, over dt 0.01-0.04 s against a
@@ -157,15 +158,31 @@ def site(tmp_path, monkeypatch):
         sys.modules.pop(module, None)
 
 
-@pytest.fixture
-def scene_file(tmp_path) -> Path:
-    path = tmp_path / "toss.toml"
+def _scene(folder: Path) -> Path:
+    """SCENE written to a file in ``folder``."""
+    path = folder / "toss.toml"
     path.write_text(SCENE, encoding="utf-8")
     return path
 
 
+@pytest.fixture
+def scene_file(tmp_path) -> Path:
+    return _scene(tmp_path)
+
+
 def _rows(table: pd.DataFrame, engine: str) -> pd.DataFrame:
     return table[table.engine == engine]
+
+
+def _results(out: Path) -> pd.DataFrame:
+    """A run's results.csv, "n/a" kept as a status (only an empty dt or value is missing)."""
+    return pd.read_csv(out / "results.csv", keep_default_na=False, na_values={"dt": ["", "nan"], "value": ["", "nan"]})
+
+
+def _run(scene, engines: list[str]) -> pd.DataFrame:
+    """``run_scene`` of a scene file or a built-in's name, isolated as ``simparity run`` runs, in one worker (a
+    second worker costs a process start and no test here is about parallelism)."""
+    return run_scene(str(scene), engines=engines, repeats=0, jobs=1)
 
 
 # --- The installed example: listed, run beside core, failed by the gate ------------------------------------------
@@ -192,30 +209,44 @@ def _install_example(tmp_path: Path) -> Path:
     return target
 
 
-def _simparity(args: list[str], target: Path, cwd: Path) -> subprocess.CompletedProcess:
-    env = dict(os.environ, PYTHONPATH=str(target))
-    return subprocess.run([sys.executable, "-m", "simparity.comparisons.cli", *args], env=env, cwd=cwd,
-                          capture_output=True, text=True, timeout=RUN_SECONDS)
+def _simparity(args: list[str]) -> tuple[int, str]:
+    """``simparity ARGS`` in this process (its probes and workers are processes of their own, with this import
+    path): the exit code and what it printed. In a process of its own it cost a start and the imports again."""
+    out = io.StringIO()
+    return main(args, out=out), out.getvalue()
 
 
 @pytest.mark.slow
-def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_its_order(tmp_path, scene_file):
+def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_its_order(tmp_path, scene_file,
+                                                                                         monkeypatch):
     target = _install_example(tmp_path)
-    listing = _simparity(["engines"], target, tmp_path)
-    assert listing.returncode == EXIT_OK, listing.stderr
-    [line] = [line for line in listing.stdout.splitlines() if line.startswith("example ")]
+    monkeypatch.syspath_prepend(str(target))  # installed there: on the import path, as PYTHONPATH puts it
+    monkeypatch.chdir(tmp_path)
+    _forget_plugins()
+    try:
+        _the_example_is_listed_runs_and_fails(tmp_path, scene_file)
+    finally:
+        _forget_plugins()
+        for module in [name for name in sys.modules if name.startswith("simparity_example_engine")]:
+            del sys.modules[module]
+
+
+def _the_example_is_listed_runs_and_fails(tmp_path: Path, scene_file: Path) -> None:
+    code, listing = _simparity(["engines"])
+    assert code == EXIT_OK, listing
+    [line] = [line for line in listing.splitlines() if line.startswith("example ")]
     assert f"from simparity-example-engine {EXAMPLE_VERSION}" in line and f"version {EXAMPLE_VERSION}" in line
     assert "dynamics: rk4" in line and "kinematics: no" in line
 
     out = tmp_path / "run"
-    run = _simparity(["run", str(scene_file), "--engines", "core,example", "--check", "--out", str(out),
-                      "--repeats", "0", "--jobs", "2"], target, tmp_path)
-    assert run.returncode == EXIT_FAILED_CASES, run.stdout + run.stderr
-    violations = [line for line in run.stdout.splitlines() if line.startswith("violation: ")]
-    assert violations and all(re.match(r"violation: toss example rk4[ :]", line) for line in violations), run.stdout
+    code, printed = _simparity(["run", str(scene_file), "--engines", "core,example", "--check", "--out", str(out),
+                                "--repeats", "0", "--jobs", "1"])
+    assert code == EXIT_FAILED_CASES, printed
+    violations = [line for line in printed.splitlines() if line.startswith("violation: ")]
+    assert violations and all(re.match(r"violation: toss example rk4[ :]", line) for line in violations), printed
     assert any("order_position" in line and "bound >= 3.5" in line for line in violations)
 
-    table = pd.read_csv(out / "results.csv", keep_default_na=False, na_values={"dt": ["", "nan"], "value": ["", "nan"]})
+    table = _results(out)
     order = table[(table.metric == "order_position") & (table.integrator == "rk4")].set_index("engine")
     assert abs(order.loc["example", "value"] - 1.0) <= EULER_ORDER_BAND  # explicit Euler, whatever it claims
     assert abs(order.loc["core", "value"] - 4.0) <= RK4_ORDER_BAND
@@ -227,12 +258,41 @@ def test_the_installed_example_is_listed_runs_beside_core_and_fails_the_gate_on_
 
 # --- Plugins that cannot run ----------------------------------------------------------------------------------------
 
+MISTYPED_SPEC = "no_such_module_for_simparity_tests:X"
+"""A spec whose module does not exist (a typing error)."""
+
+
+@pytest.fixture(scope="module")
+def unrunnable_run(tmp_path_factory):
+    """One ``simparity run --check`` shared by the tests of engines that cannot run, the installed plugins ghost
+    (does not import) and exploding (raises in its constructor) and MISTYPED_SPEC, beside core on SCENE and on a
+    kinematics scene (the planar arm), in a worker process as 'simparity run' runs: its exit code, results and
+    what it printed. The plugins are installed for the run only (the other tests install their own)."""
+    folder = tmp_path_factory.mktemp("unrunnable")
+    (folder / "site").mkdir()
+    site = _Site(folder / "site")
+    site.install({"ghost": "no_such_module_for_simparity_tests:Engine", "exploding": "plugin_engines_a:Exploding"},
+                 "plugin_engines_a")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.syspath_prepend(str(site.folder))
+        _forget_plugins()
+        try:
+            printed = io.StringIO()
+            code = main(["run", str(_scene(folder)), "lecture-planar-arm", "--engines",
+                         f"core,ghost,exploding,{MISTYPED_SPEC}", "--repeats", "0", "--out", str(folder / "run"),
+                         "--check", *NO_REPORT_ONE_JOB], out=printed)
+        finally:
+            _forget_plugins()
+            sys.modules.pop("plugin_engines_a", None)
+    return code, _results(folder / "run"), printed.getvalue()
+
+
 @pytest.mark.slow
-def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site, scene_file):
+def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(unrunnable_run):
     """Asked for and never run, it must not pass the gate as n/a: its rows fail, naming the import error."""
-    site.install({"ghost": "no_such_module_for_simparity_tests:Engine"})
-    dynamics = run_scene(load_scene(str(scene_file)), engines=["core", "ghost"], repeats=0)
-    kinematics = run_scene("lecture-planar-arm", engines=["core", "ghost"], repeats=0)
+    code, both, _ = unrunnable_run
+    assert code == EXIT_FAILED_CASES
+    dynamics, kinematics = both[both.scene == "toss"], both[both.scene == "lecture-planar-arm"]
     for table in (dynamics, kinematics):
         ghost = _rows(table, "ghost")
         cases = ghost[~ghost.metric.str.startswith("order_")]  # an order over cases that never ran: n/a, "too few"
@@ -243,28 +303,48 @@ def test_a_plugin_that_fails_to_import_fails_its_rows_with_the_import_error(site
 
 
 @pytest.mark.slow
-def test_a_mistyped_spec_module_fails_the_run_and_the_gate(tmp_path, capsys):
-    out = tmp_path / "run"
-    code = main(["run", "lecture-projectile", "--quick", "--engines", "core,no_such_module_for_simparity_tests:X",
-                 "--out", str(out), "--check"])
-    assert code == EXIT_FAILED_CASES
-    assert "check FAILED" in capsys.readouterr().out
-
-
-@pytest.mark.slow
-def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(site, scene_file, tmp_path):
+def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(unrunnable_run):
     """In worker processes, as 'simparity run' runs: exit 1 (an engine failed), every other case measured."""
-    site.install({"exploding": "plugin_engines_a:Exploding"}, "plugin_engines_a")
-    out = tmp_path / "run"
-    code = main(["run", str(scene_file), "--engines", "core,exploding", "--out", str(out), "--repeats", "0",
-                 "--jobs", "1"], out=io.StringIO())
+    code, table, _ = unrunnable_run
     assert code == EXIT_FAILED_CASES
-    table = pd.read_csv(out / "results.csv", keep_default_na=False, na_values={"dt": ["", "nan"], "value": ["", "nan"]})
     exploding = _rows(table, "exploding")
     assert len(exploding) and set(exploding.status) == {FAILED}
     assert exploding.detail.str.contains("ValueError: boom in the constructor", regex=False).all()
     core = _rows(table, "core")
     assert set(core[core.metric == "position_error_max"].status) == {OK}
+
+
+@pytest.mark.slow
+def test_a_mistyped_spec_module_fails_the_run_and_the_gate(unrunnable_run):
+    code, _, printed = unrunnable_run
+    assert code == EXIT_FAILED_CASES
+    violations = [line for line in printed.splitlines() if line.startswith("violation: ")]
+    # the gate fails the spec itself (ghost and exploding, failing beside it, have their own violations)
+    assert "check FAILED" in printed and any(f" {MISTYPED_SPEC} " in line for line in violations), printed
+
+
+BROKEN_ATTRS = ("NoVersion", "ListedIntegrators", "RaisingOrder", "NotAnEngine", "NoSuchClass")
+"""The attributes of ENGINES_SOURCE (or not in it) that break the interface, each in its own way."""
+
+
+SHARED_MODULE = "plugin_engines_b"
+"""The module of ENGINES_SOURCE the shared run's specs name (on the import path while this module's tests run)."""
+
+
+@pytest.fixture(scope="module")
+def shared_table(tmp_path_factory):
+    """One run shared by the tests of specs: core beside a spec of each of BROKEN_ATTRS, CrashingBuild and
+    Renamed (each is described in a probe of its own and its rows are its own: an engine that fails does not
+    touch another's), SHARED_MODULE on the path."""
+    folder = tmp_path_factory.mktemp("specs")
+    (folder / f"{SHARED_MODULE}.py").write_text(ENGINES_SOURCE, encoding="utf-8")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.syspath_prepend(str(folder))
+        try:
+            yield _run(_scene(folder), ["core", *(f"{SHARED_MODULE}:{attr}" for attr in
+                                                  (*BROKEN_ATTRS, "CrashingBuild", "Renamed"))])
+        finally:
+            sys.modules.pop(SHARED_MODULE, None)
 
 
 @pytest.mark.slow
@@ -276,10 +356,8 @@ def test_a_plugin_whose_constructor_raises_fails_its_rows_and_the_run_goes_on(si
                     "subclass"),  # told without constructing it (#39)
     ("NoSuchClass", "AttributeError"),
 ])
-def test_an_engine_that_breaks_the_interface_fails_its_rows_with_the_reason(site, scene_file, attr, reason):
-    site.add_module("plugin_engines_b")
-    spec = f"plugin_engines_b:{attr}"
-    table = run_scene(load_scene(str(scene_file)), engines=["core", spec], repeats=0)
+def test_an_engine_that_breaks_the_interface_fails_its_rows_with_the_reason(shared_table, attr, reason):
+    spec, table = f"{SHARED_MODULE}:{attr}", shared_table
     broken = _rows(table, spec)
     assert len(broken) and set(broken.status) == {FAILED}
     assert broken.detail.str.contains(reason, regex=False).all(), broken.detail.iloc[0]
@@ -298,9 +376,8 @@ def test_an_engine_declaring_a_bad_stage_count_is_broken_with_a_one_line_reason(
 
 
 @pytest.mark.slow
-def test_an_engine_whose_build_raises_fails_each_case_with_the_error(site, scene_file):
-    site.add_module("plugin_engines_c")
-    table = run_scene(load_scene(str(scene_file)), engines=["plugin_engines_c:CrashingBuild"], repeats=0)
+def test_an_engine_whose_build_raises_fails_each_case_with_the_error(shared_table):
+    table = shared_table  # SHARED_MODULE:CrashingBuild, named "crashing"
     cases = table[(table.engine == "crashing") & table.dt.notna()]
     assert len(cases) and set(cases.status) == {FAILED}
     assert cases.detail.str.startswith("ZeroDivisionError: build failed").all()
@@ -309,12 +386,12 @@ def test_an_engine_whose_build_raises_fails_each_case_with_the_error(site, scene
 # --- Names: specs, shadowing, unknown names --------------------------------------------------------------------------
 
 @pytest.mark.slow
-def test_a_module_class_spec_runs_under_the_engine_s_own_name(site, scene_file):
-    site.add_module("plugin_engines_d")
-    assert check_engine_names(["core", "plugin_engines_d:Renamed"]) == ("core", "plugin_engines_d:Renamed")
-    table = run_scene(load_scene(str(scene_file)), engines=["plugin_engines_d:Renamed"], repeats=0)
-    assert set(table.engine) == {"mine"} and OK in set(table.status)
-    assert make_engine("plugin_engines_d:factory").name == "mine"  # a zero-argument callable returning an Engine
+def test_a_module_class_spec_runs_under_the_engine_s_own_name(shared_table):
+    spec = f"{SHARED_MODULE}:Renamed"
+    assert check_engine_names(["core", spec]) == ("core", spec)
+    mine = _rows(shared_table, "mine")  # the shared run's other engines have names of their own
+    assert spec not in set(shared_table.engine) and len(mine) and OK in set(mine.status)
+    assert make_engine(f"{SHARED_MODULE}:factory").name == "mine"  # a zero-argument callable returning an Engine
     # a built-in's name is taken: the spec names the engine instead
     assert make_engine("simparity.core.inhouse:InHouseEngine").name == "simparity.core.inhouse:InHouseEngine"
 
@@ -398,11 +475,13 @@ def test_an_installed_plugin_a_run_does_not_name_is_never_asked(site, scene_file
     real = engine_probe.probe_engines
     monkeypatch.setattr(engine_probe, "probe_engines", lambda names, scenes=(): asked.append(list(names)) or
                         real(names, scenes))
-    assert main(["run", str(scene_file), "--quick", "--engines", "core", "--out", str(tmp_path / "a")]) == EXIT_OK
+    assert main(["run", str(scene_file), "--quick", "--engines", "core", "--out", str(tmp_path / "a"),
+                 *NO_REPORT_ONE_JOB]) == EXIT_OK
     assert main(["list"], out=io.StringIO()) == EXIT_OK
     assert asked == []
     leap = tmp_path / "leap.toml"
     leap.write_text(SCENE.replace('integrators = ["rk4"]', 'integrators = ["rk4", "leapfrog_demo"]'), encoding="utf-8")
-    code = main(["run", str(leap), "--quick", "--engines", "core,leap", "--out", str(tmp_path / "b")])
+    code = main(["run", str(leap), "--quick", "--engines", "core,leap", "--out", str(tmp_path / "b"),
+                 *NO_REPORT_ONE_JOB])
     assert code != EXIT_USAGE  # the scene file was accepted (the demo integrator's own cases may fail)
     assert asked and all(names == ["leap"] for names in asked)

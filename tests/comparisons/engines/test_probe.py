@@ -12,7 +12,6 @@ from simparity.comparisons.engines import probe as engine_probe
 from simparity.comparisons.cli.main import main
 from simparity.comparisons.engines.probe import PROBE_CHAIN, DescribedEngine, probe_engines
 from simparity.comparisons.engines.placeholders import BrokenEngine
-from simparity.core.model.engine import Engine, Support
 from simparity.core.inhouse import InHouseEngine
 from tests.helpers import THROWN_BALL, builtin
 
@@ -72,17 +71,39 @@ def test_a_hang_while_describing_is_a_broken_engine_within_the_limit(monkeypatch
     assert isinstance(hung, BrokenEngine) and f"took more than {SHORT_PROBE_SECONDS:g} s" in hung.reason
 
 
+SEGFAULT, EXITS, HANGS = (f"tests.hostile_engines:{name}" for name in
+                          ("SegfaultOnConstruction", "ExitInVersion", "HangInIntegrators"))
+
+
+def _run(scene, engines: str, out, *extra: str) -> int:
+    """``simparity run`` of a scene file into ``out``: one worker, no timing repeats and no report (no test here
+    reads one)."""
+    return main(["run", str(scene), "--engines", engines, "--repeats", "0", "--jobs", "1", "--no-report",
+                 "--out", str(out), *extra])
+
+
+@pytest.fixture(scope="module")
+def hostile_run(tmp_path_factory):
+    """One run shared by the two tests below: core beside an engine that segfaults as it is built, one that exits
+    as it is asked its version and one that hangs as it is described (the probe's limit cut to
+    SHORT_PROBE_SECONDS); its exit code, its seconds and its results table."""
+    folder = tmp_path_factory.mktemp("hostile")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(engine_probe, "PROBE_SECONDS", SHORT_PROBE_SECONDS)
+        start = time.monotonic()
+        scene = folder / "throw.toml"
+        scene.write_text(THROWN_BALL, encoding="utf-8")
+        code = _run(scene, f"core,{SEGFAULT},{EXITS},{HANGS}", folder / "run")
+        seconds = time.monotonic() - start
+    return code, seconds, pd.read_csv(folder / "run" / "results.csv")
+
+
 @pytest.mark.slow
-def test_a_run_goes_on_when_an_engine_crashes_as_it_is_built(tmp_path, monkeypatch):
+def test_a_run_goes_on_when_an_engine_crashes_as_it_is_built(hostile_run):
     """Before, the segfault in the constructor killed `simparity run` itself; now its cases fail, core's complete."""
-    scene = tmp_path / "throw.toml"
-    scene.write_text(THROWN_BALL, encoding="utf-8")
-    engines = "core,tests.hostile_engines:SegfaultOnConstruction,tests.hostile_engines:ExitInVersion"
-    assert main(["run", str(scene), "--engines", engines, "--repeats", "0", "--jobs", "1",
-                 "--out", str(tmp_path / "run")]) == 1
-    table = pd.read_csv(tmp_path / "run" / "results.csv")
-    for spec, cause in (("tests.hostile_engines:SegfaultOnConstruction", "SIGSEGV"),
-                        ("tests.hostile_engines:ExitInVersion", "exited with code 3")):
+    code, _, table = hostile_run
+    assert code == 1
+    for spec, cause in ((SEGFAULT, "SIGSEGV"), (EXITS, "exited with code 3")):
         rows = table[table.engine == spec]
         assert len(rows) and set(rows.status) == {"failed"} and rows.detail.str.contains(cause).all(), spec
     core = table[(table.engine == "core") & (table.metric == "position_error_max")]
@@ -90,49 +111,14 @@ def test_a_run_goes_on_when_an_engine_crashes_as_it_is_built(tmp_path, monkeypat
 
 
 @pytest.mark.slow
-def test_an_engine_that_hung_while_described_is_not_built_again_by_the_cases(tmp_path, monkeypatch):
+def test_an_engine_that_hung_while_described_is_not_built_again_by_the_cases(hostile_run):
     """Its cases fail at once with the probe's cause, instead of each hanging to the 900 s case limit."""
-    monkeypatch.setattr(engine_probe, "PROBE_SECONDS", SHORT_PROBE_SECONDS)
-    scene = tmp_path / "throw.toml"
-    scene.write_text(THROWN_BALL, encoding="utf-8")
-    start = time.monotonic()
-    assert main(["run", str(scene), "--engines", "core,tests.hostile_engines:HangInIntegrators", "--repeats", "0",
-                 "--jobs", "1", "--out", str(tmp_path / "run")]) == 1
-    assert time.monotonic() - start < RUN_SECONDS
-    table = pd.read_csv(tmp_path / "run" / "results.csv")
-    rows = table[table.engine == "tests.hostile_engines:HangInIntegrators"]
+    code, seconds, table = hostile_run
+    assert code == 1
+    assert seconds < RUN_SECONDS
+    rows = table[table.engine == HANGS]
     assert len(rows) and set(rows.status) == {"failed"}
     assert rows.detail.str.contains(f"took more than {SHORT_PROBE_SECONDS:g} s", regex=False).all()
-
-
-class OwnIntegrators(Engine):
-    """A user's engine with an integrator name no built-in has: core's RK4, called ``own_rk4``."""
-
-    name = "own"
-
-    def __init__(self) -> None:
-        self._core = InHouseEngine()
-
-    def version(self) -> str:
-        return self._core.version()
-
-    def integrators(self):
-        return ("own_rk4",)
-
-    def supports_dynamics(self, scene, integrator):
-        return self._core.supports_dynamics(scene, "rk4")
-
-    def build_dynamics(self, scene, integrator, dt):
-        return self._core.build_dynamics(scene, "rk4", dt)
-
-    def supports_kinematics(self, chain):
-        return Support.no("dynamics only")
-
-    def build_kinematics(self, chain):
-        raise NotImplementedError("dynamics only")
-
-    def theoretical_order(self, integrator):
-        return 4
 
 
 @pytest.mark.slow
@@ -143,8 +129,7 @@ def test_a_scene_file_and_the_quick_profile_may_name_a_spec_engines_own_integrat
     scene.write_text(THROWN_BALL.replace('integrators = ["rk4"]', 'integrators = ["own_rk4"]'), encoding="utf-8")
     for quick in ([], ["--quick"]):
         out = tmp_path / f"run{len(quick)}"
-        assert main(["run", str(scene), "--engines", "core,tests.comparisons.engines.test_probe:OwnIntegrators", "--repeats", "0",
-                     "--jobs", "1", "--out", str(out), *quick]) == 0
+        assert _run(scene, "core,tests.comparisons.engines.own_engine:OwnIntegrators", out, *quick) == 0
         table = pd.read_csv(out / "results.csv", keep_default_na=False)
         own = table[(table.engine == "own") & (table.metric == "position_error_max")]
         assert list(own.integrator) == ["own_rk4", "own_rk4"] and set(own.status) == {"ok"}
