@@ -207,7 +207,7 @@ def test_what_an_engine_starts_and_leaves_running_ends_with_its_cases(tmp_path):
         assert no_leftovers_within()
 
 
-SLOW_IMPORT_SECONDS = 2 * HANG_SECONDS
+SLOW_IMPORT_SECONDS = HANG_SECONDS + 1
 """A worker's start made longer than the case time limit (a machine loaded many times over, a cold disk): its imports
 must not count against the first case handed to it."""
 
