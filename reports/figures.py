@@ -500,11 +500,13 @@ class FigureWriter:
 
     def __exit__(self, *exc) -> None:
         failed = exc[0] is not None
-        for figure in self._waiting:
-            figure.discard() if failed else figure.result()
-        self._waiting = []
-        if self._pool is not None:
-            self._pool.shutdown(wait=True, cancel_futures=failed)
+        try:
+            for figure in self._waiting:
+                figure.discard() if failed else figure.result()
+        finally:  # a figure that cannot be written still lets the pool's processes go
+            self._waiting = []
+            if self._pool is not None:
+                self._pool.shutdown(wait=True, cancel_futures=failed)
 
     def submit(self, fig, folder: Path, name: str) -> WrittenFigure:
         folder.mkdir(parents=True, exist_ok=True)

@@ -228,17 +228,13 @@ class IsolatedPool:
             code = worker.kill()
             yield from self._replace(worker, death_cause(code, worker.stderr_tail()), pending)
             return
-        elapsed = time.monotonic() - worker.since
-        if not worker.ready and elapsed > self.limits.seconds + WORKER_START_SECONDS:
+        start = 0.0 if worker.ready else WORKER_START_SECONDS
+        if time.monotonic() - worker.since > self.limits.seconds + start:
             worker.kill()
-            yield from self._replace(worker, f"hung: the worker process did not start (its imports) within "
-                                     f"{WORKER_START_SECONDS:g} s and the per-case time limit of {self.limits.seconds:g}"
-                                     " s; the worker was killed", pending)
-            return
-        if worker.ready and elapsed > self.limits.seconds:
-            worker.kill()
-            yield from self._replace(worker, f"hung: no result within the per-case time limit of "
-                                     f"{self.limits.seconds:g} s; the worker was killed", pending)
+            late = (f"no result within the per-case time limit of {self.limits.seconds:g} s" if worker.ready else
+                    f"the worker process did not start (its imports) within {start:g} s and the per-case time limit "
+                    f"of {self.limits.seconds:g} s")
+            yield from self._replace(worker, f"hung: {late}; the worker was killed", pending)
             return
         limit = self.limits.memory_bytes
         if limit is not None and (status_bytes("VmRSS", worker.phase_pid) or 0) > limit:
