@@ -20,8 +20,9 @@ computed from the same run:
    (:mod:`comparisons.bench.small_batch`).
 
 Beside them, the peak memory of ``simparity run`` against the steps (:mod:`comparisons.bench.memory`) and its wall
-time and client memory against a sweep's variants (:mod:`comparisons.bench.sweep`), and a profile of core
-(:mod:`comparisons.bench.profiling`). :func:`comparisons.bench.run.run_bench` measures them all.
+time and client memory against a sweep's variants (:mod:`comparisons.bench.sweep`), the wall time of the default
+suite and of the quick CI gate as a user runs them (:mod:`comparisons.bench.suites`, a full bench only), and a
+profile of core (:mod:`comparisons.bench.profiling`). :func:`comparisons.bench.run.run_bench` measures them all.
 
 Results go to ``benchmarks.csv`` (one tidy row per measurement) and ``BENCHMARKS.md``
 (:mod:`comparisons.bench.report`), with a verdict on each of the issue's targets that says what it compared

@@ -17,6 +17,7 @@ from simparity.comparisons.bench.run_profile import profile_markdown, run_profil
 from simparity.comparisons.bench.report import cpus, machine, markdown, write_csv
 from simparity.comparisons.bench.rows import REPEATS, BenchRow, Meter, median_time
 from simparity.comparisons.bench.stepping import dynamics_rows
+from simparity.comparisons.bench.suites import suite_rows
 from simparity.comparisons.bench.targets import targets
 from simparity.comparisons.bench.verdict import TARGET_BATCH
 from simparity.comparisons.engines.registry import DEFAULT_ENGINES
@@ -67,6 +68,9 @@ def _measure(quick: bool, say: Callable[[str], None]) -> tuple[list[BenchRow], s
         ("memory of simparity run against the number of steps", lambda: _memory_rows(quick, say)),
         ("sweeps: simparity run's wall time and client memory against the number of variants",
          lambda: sweep.sweep_rows(quick, run_peak_memory, BenchRow, say))]
+    if not quick:  # minutes each, and a quick bench's suite time would say nothing of the targets
+        workloads.append(("suites: the wall time of the default suite and of the quick CI gate, as a user runs them",
+                          lambda: suite_rows(run_peak_memory, say)))
     rows: list[BenchRow] = []
     for title, measure in workloads:
         say(title)

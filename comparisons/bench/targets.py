@@ -9,6 +9,7 @@ from simparity.comparisons.bench import joint_dynamics
 from simparity.comparisons.bench.ik import FIVE_DOF_ARM
 from simparity.comparisons.bench.memory import memory_targets
 from simparity.comparisons.bench.rows import BenchRow
+from simparity.comparisons.bench.suites import suite_targets
 from simparity.comparisons.bench.verdict import TARGET_BATCH, TARGET_IK_TARGETS, Verdict, absolute, sized
 
 COMPARABLE_SOLVE_RATE = 0.5
@@ -122,5 +123,4 @@ def targets(rows: list[BenchRow], cpus: int) -> list[Verdict]:
                                    f"core damped_least_squares+restarts on {c.batch:,} targets: {1e3 / c.value:,.0f} "
                                    f"solves/s (CPU/wall {c.cpu_per_wall:.2f}, load {c.load:.2f} on {cpus} CPUs)",
                                    1e3 / c.value >= IK_SOLVES_PER_SECOND, *counted), c, cpus))
-
-    return out
+    return out + suite_targets(rows, cpus)

@@ -245,8 +245,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="Time rigid-body stepping (B = 1, 100, 10,000 bodies), FK + Jacobian, IK (the bench suite's "
         "arms, 10,000 targets each), the arms' joint-space dynamics and their motion (RK4 of B = 1, 100, 10,000 "
         "falling arms) for core and every engine in one run, each time with the error it reaches; "
-        "write BENCHMARKS.md and benchmarks.csv with the ratios and the targets met or missed. About 5 minutes "
-        "(--quick: about 1).")
+        "write BENCHMARKS.md and benchmarks.csv with the ratios and the targets met or missed. About 45 minutes "
+        "on an idle 2-core machine, the default suite and the quick gate timed too (--quick: a few minutes, "
+        "without them).")
     bench.add_argument("--out", type=path_argument, default=Path("."), metavar="DIR",
                        help="folder for BENCHMARKS.md and benchmarks.csv (default: the current folder)")
     bench.add_argument("--quick", action="store_true", help="B = 1 and 100 only, 300 IK targets per arm")
