@@ -13,6 +13,7 @@ from simparity.comparisons.cli.main import main
 from simparity.comparisons.engines.probe import PROBE_CHAIN, DescribedEngine, probe_engines
 from simparity.comparisons.engines.placeholders import BrokenEngine
 from simparity.core.inhouse import InHouseEngine
+from tests.comparisons.engines.probe_spy import counted_probes
 from tests.helpers import THROWN_BALL, builtin
 
 CORE_SPEC = "simparity.core.inhouse:InHouseEngine"
@@ -20,6 +21,9 @@ CORE_SPEC = "simparity.core.inhouse:InHouseEngine"
 
 SHORT_PROBE_SECONDS = 5.0
 """The hanging engine's limit in these tests: a probe's start and imports take ~1-2 s under load."""
+
+OWN_SPEC = "tests.comparisons.engines.own_engine:OwnIntegrators"
+"""A user's engine with an integrator of its own (``own_rk4``)."""
 
 RUN_SECONDS = 90.0
 """A run of the tiny scene on core takes ~5 s, ~30 s on a loaded machine; far under the 900 s a hung case would
@@ -122,14 +126,18 @@ def test_an_engine_that_hung_while_described_is_not_built_again_by_the_cases(hos
 
 
 @pytest.mark.slow
-def test_a_scene_file_and_the_quick_profile_may_name_a_spec_engines_own_integrators(tmp_path):
+def test_a_scene_file_and_the_quick_profile_may_name_a_spec_engines_own_integrators(tmp_path, monkeypatch):
     """Before, `own_rk4` was refused as no engine's integrator: only built-ins' and installed plugins' names were
-    known when the scene file was checked."""
+    known when the scene file was checked. Each run probes the engine once, though it asks it twice (what it
+    offers, for the scene file; the run's scenes): before, a probe per question."""
     scene = tmp_path / "throw.toml"
     scene.write_text(THROWN_BALL.replace('integrators = ["rk4"]', 'integrators = ["own_rk4"]'), encoding="utf-8")
+    probes = counted_probes(monkeypatch)
     for quick in ([], ["--quick"]):
         out = tmp_path / f"run{len(quick)}"
-        assert _run(scene, "core,tests.comparisons.engines.own_engine:OwnIntegrators", out, *quick) == 0
+        probes.clear()
+        assert _run(scene, f"core,{OWN_SPEC}", out, *quick) == 0
+        assert probes == {OWN_SPEC: 1}
         table = pd.read_csv(out / "results.csv", keep_default_na=False)
         own = table[(table.engine == "own") & (table.metric == "position_error_max")]
         assert list(own.integrator) == ["own_rk4", "own_rk4"] and set(own.status) == {"ok"}
