@@ -26,7 +26,7 @@ from simparity.comparisons.engines.registry import (ENGINE_NAMES, check_engine_n
 from simparity.core.model.errors import UnknownEngineError
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.results import FAILED, NOT_AVAILABLE, OK
-from tests.comparisons.engines.probe_spy import counted_probes
+from tests.comparisons.engines.probe_spy import spy_probes
 from tests.helpers import THROWN_INTO_WIND
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -470,7 +470,7 @@ def test_an_installed_plugin_a_run_does_not_name_is_never_asked(site, scene_file
     or the quick profile that does not need it never asks; a run naming it asks it alone, in one probe for the
     scene files and the run."""
     site.install({"leap": "plugin_engines_h:Leapfrog", "other": "plugin_engines_h:Renamed"}, "plugin_engines_h")
-    asked = counted_probes(monkeypatch)
+    asked = spy_probes(monkeypatch).started
     assert main(["run", str(scene_file), "--quick", "--engines", "core", "--out", str(tmp_path / "a"),
                  *NO_REPORT_ONE_JOB]) == EXIT_OK
     assert main(["list"], out=io.StringIO()) == EXIT_OK

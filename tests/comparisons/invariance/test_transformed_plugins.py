@@ -22,7 +22,7 @@ from simparity.comparisons.invariance.perturb import ulp_perturbed
 from simparity.comparisons.invariance.transforms import FIXED_TRANSFORMS, TRANSFORM_NAMES, transform_scene
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.errors import PluginError
-from tests.comparisons.engines.probe_spy import counted_probes
+from tests.comparisons.engines.probe_spy import spy_probes
 from tests.helpers import builtin
 from tests.mutation.catalogue import MUTANTS
 from tests.mutation.copy_of_core import FAITHFUL_NAME, materialise
@@ -96,7 +96,7 @@ def test_a_faithful_plugin_passes_and_a_planted_bug_fails_under_every_transform(
     # compiled once here: each probe and worker importing the copies (two probes and a worker) would compile them
     # anew where PYTHONDONTWRITEBYTECODE is set (~0.6 CPU-s a process)
     compileall.compile_dir(tmp_path, quiet=1)
-    probes = counted_probes(monkeypatch)
+    probes = spy_probes(monkeypatch).started
     scene = tmp_path / "two-leaves.toml"
     scene.write_text(TWO_LEAVES, encoding="utf-8")
     out = tmp_path / "run"
