@@ -201,12 +201,14 @@ class EngineProbes:
 
     def describe(self, names: Sequence[str], scenes: Sequence = ()) -> dict[str, Engine]:
         """:func:`probe_engines` of ``names`` asked about ``scenes``, each by its kept probe (a new one for a name
-        not asked before)."""
+        not asked before, or whose process ended)."""
         asking = [name for name in dict.fromkeys(names) if name not in self._final]
         for name in asking:
-            if name in self._live:
+            if name in self._live and self._live[name].process.poll() is None:
                 self._live[name].ask(list(scenes))
-            else:
+            else:  # not asked before, or its process ended while it waited (a new probe answers as it would have)
+                if name in self._live:
+                    self._live.pop(name).close()
                 self._live[name] = _Probe(name, list(scenes))
         deadline = time.monotonic() + PROBE_SECONDS
         while any(self._live[name].working() for name in asking):
