@@ -158,8 +158,13 @@ class EngineSet:
     @functools.cached_property
     def installed_integrators(self) -> tuple[str, ...]:
         """:attr:`integrators` and every installed plugin's, for a scene file that names an integrator the
-        command's engines do not offer."""
-        return _integrator_names(self.describe(ENGINE_NAMES + plugin_names() + self.users))
+        command's engines do not offer. The user's engines answer as described already; the other plugins are
+        described once, in probes ended here (nothing of them is asked again)."""
+        names = check_engine_names(ENGINE_NAMES + plugin_names() + self.users)
+        described = dict(zip(self.users, self._users_described))
+        others = [name for name in names if name not in described]
+        described.update(zip(others, describe_engines(others)))
+        return _integrator_names([described[name] for name in names])
 
     @property
     def other_variants(self) -> frozenset[str]:
