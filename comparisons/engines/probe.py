@@ -289,6 +289,9 @@ class _Probe:
             os.close(child_end)
         os.set_blocking(answers, False)
         self.answers = answers
+        assert self.process.stdin is not None  # a pipe, written without blocking: a request may outgrow it
+        self.requests = self.process.stdin.fileno()
+        os.set_blocking(self.requests, False)
         self._send((name, scenes))
 
     def ask(self, scenes: list) -> None:
@@ -297,11 +300,14 @@ class _Probe:
 
     def _send(self, request: object) -> None:
         self.received, self.stopped, self.errors_from = b"", "", os.fstat(self.stderr.fileno()).st_size
+        self.unsent = memoryview(pickle.dumps(request))
+
+    def _feed(self) -> None:
+        """Write what the pipe takes of the request not yet sent."""
         try:
-            assert self.process.stdin is not None  # a pipe
-            self.process.stdin.write(pickle.dumps(request))
-            self.process.stdin.flush()
-        except BrokenPipeError:  # it died: result() says how
+            while self.unsent:
+                self.unsent = self.unsent[os.write(self.requests, self.unsent):]
+        except (BlockingIOError, BrokenPipeError):  # full: the probe reads it as it goes; it died: result() says how
             pass
 
     def answered(self) -> bool:
@@ -316,6 +322,7 @@ class _Probe:
 
     def working(self) -> bool:
         """Whether the probe is still answering: not stopped, not answered, alive."""
+        self._feed()
         return not self.stopped and not self.answered() and self.process.poll() is None
 
     def enforce(self, deadline: float) -> None:
