@@ -12,6 +12,7 @@ engine in their worker (:mod:`comparisons.execute.case_worker`).
 
 from __future__ import annotations
 
+import contextlib
 import faulthandler
 import os
 import pickle
@@ -20,6 +21,7 @@ import subprocess
 import sys
 import tempfile
 import time
+import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import cast
@@ -46,6 +48,9 @@ loaded holds ~250 MiB; building an engine's description needs no scene's worth o
 
 POLL_SECONDS = 0.05
 """How often a probe's time and memory are looked at."""
+
+ANSWER_LENGTH = 8
+"""Bytes of the length (little-endian) before each pickled answer of a probe."""
 
 PROBE_CHAIN = Chain("probe", (Joint("joint", "revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.eye(3)),),
                     end_effector_xyz=np.array([1.0, 0.0, 0.0]))
@@ -172,25 +177,69 @@ def describe(engine: Engine, scenes: list) -> EngineDescription:
 def probe_engines(names: list[str], scenes: Sequence = ()) -> dict[str, Engine]:
     """Each of ``names`` (a plugin's name or a spec ``module:attr``) described in a process of its own, all at
     once: a :class:`DescribedEngine`, or a :class:`BrokenEngine` standing in for one that cannot run, naming
-    what went wrong: it does not import, an error, a crash, a hang, a memory blow-up."""
-    probes = {name: _Probe(name, list(scenes)) for name in names}
+    what went wrong: it does not import, an error, a crash, a hang, a memory blow-up. One question: its
+    processes end here (:class:`EngineProbes` keeps them to be asked again)."""
+    probes = EngineProbes()
     try:
-        deadline = time.monotonic() + PROBE_SECONDS
-        while any(p.process.poll() is None for p in probes.values()):
-            for probe in probes.values():
-                if probe.process.poll() is None:
-                    probe.enforce(deadline)
-            time.sleep(POLL_SECONDS)
-        return {name: probe.result() for name, probe in probes.items()}
+        return probes.describe(names, scenes)
     finally:
-        for probe in probes.values():
-            probe.close()
+        probes.close()
 
 
-def asked_about(engines: Sequence[Engine], scenes: Sequence, specs: dict[str, str] | None = None) -> list[Engine]:
+class EngineProbes:
+    """The probes of one command's outside engines, each process kept to be asked again: a run asks its engines
+    what they offer (a scene file's integrators), then about its scenes, then about its transformed scenes, and a
+    probe costs a process, simparity's imports and the engine's own (~1 CPU-s, up to a minute). Each question is
+    what a new probe would answer (:func:`describe` of the engine it built, under the same time and memory
+    limits); an engine that cannot run keeps its stand-in, asked nothing more. The processes end with
+    :meth:`close`, or when this object is collected."""
+
+    def __init__(self) -> None:
+        self._live: dict[str, _Probe] = {}
+        self._final: dict[str, Engine] = {}
+        weakref.finalize(self, _close_all, self._live, os.getpid())
+
+    def describe(self, names: Sequence[str], scenes: Sequence = ()) -> dict[str, Engine]:
+        """:func:`probe_engines` of ``names`` asked about ``scenes``, each by its kept probe (a new one for a name
+        not asked before, or whose process ended)."""
+        asking = [name for name in dict.fromkeys(names) if name not in self._final]
+        for name in asking:
+            if name in self._live and self._live[name].process.poll() is None:
+                self._live[name].ask(list(scenes))
+            else:  # not asked before, or its process ended while it waited (a new probe answers as it would have)
+                if name in self._live:
+                    self._live.pop(name).close()
+                self._live[name] = _Probe(name, list(scenes))
+        deadline = time.monotonic() + PROBE_SECONDS
+        while any(self._live[name].working() for name in asking):
+            for name in asking:
+                if self._live[name].working():
+                    self._live[name].enforce(deadline)
+            time.sleep(POLL_SECONDS)
+        answers = {name: self._live[name].result() for name in asking}
+        for name, answer in answers.items():
+            if not isinstance(answer, DescribedEngine):  # what a new probe would answer again: no process kept
+                self._final[name] = answer
+                self._live.pop(name).close()
+        return {name: answers[name] if name in answers else self._final[name] for name in names}
+
+    def close(self) -> None:
+        """End every kept probe."""
+        _close_all(self._live, os.getpid())
+
+
+def _close_all(probes: dict[str, "_Probe"], owner: int) -> None:
+    """End ``probes``, in the process ``owner`` (a pid) that started them only (not in a child forked from it)."""
+    if os.getpid() == owner:
+        while probes:
+            probes.popitem()[1].close()
+
+
+def asked_about(engines: Sequence[Engine], scenes: Sequence, specs: dict[str, str] | None,
+                probes: EngineProbes) -> list[Engine]:
     """``engines`` with every :class:`DescribedEngine` also asked about those of ``scenes`` its description does
-    not hold (a run's transformed and one-ulp perturbed scenes, made after the engines were described), as
-    :func:`probe_engines` asks: one probe per such engine, all at once. ``specs`` maps an engine's name to what
+    not hold (a run's transformed and one-ulp perturbed scenes, made after the engines were described) by its
+    probe in ``probes`` (:meth:`EngineProbes.describe`), all at once. ``specs`` maps an engine's name to what
     it is built from, when that is not its name. A probe that cannot answer (a crash, a hang) leaves its error
     as each new scene's answer: those cases fail with it. Other engines are returned as they are."""
     hashes = {scene_hash(scene): scene for scene in scenes}
@@ -200,7 +249,7 @@ def asked_about(engines: Sequence[Engine], scenes: Sequence, specs: dict[str, st
     if not asking:
         return list(engines)
     spec_of = {name: (specs or {}).get(name, name) for name in asking}
-    probed = probe_engines(list(spec_of.values()), [hashes[h] for h in dict.fromkeys(sum(asking.values(), []))])
+    probed = probes.describe(list(spec_of.values()), [hashes[h] for h in dict.fromkeys(sum(asking.values(), []))])
     out: list[Engine] = []
     for engine in engines:
         if engine.name not in asking:
@@ -223,22 +272,58 @@ def _memory_limit() -> int:
 
 
 class _Probe:
-    """One probe process: its request (on its standard input), the file it answers in (an inherited descriptor),
-    its standard error, why it was stopped ("" if not). Every file is anonymous: a killed run leaves none."""
+    """One probe process: its questions (pickled lists of scenes, on its standard input, after the engine's name),
+    the pipe it answers each on (:data:`ANSWER_LENGTH` bytes of length, then the pickled answer), its standard error
+    (an anonymous file), why it was stopped ("" if not). A killed run leaves no file."""
 
     def __init__(self, name: str, scenes: list) -> None:
         self.name = name
-        request = tempfile.TemporaryFile()
-        pickle.dump((name, scenes), request)
-        request.seek(0)
-        self.answer, self.stderr = tempfile.TemporaryFile(), tempfile.TemporaryFile()
-        self.stopped = ""
-        with request:
+        self.stderr = tempfile.TemporaryFile()
+        answers, child_end = os.pipe()
+        try:
             self.process = subprocess.Popen(
-                [sys.executable, "-m", "simparity.comparisons.engines.probe", str(self.answer.fileno()),
-                 str(os.getpid())],
-                stdin=request, stdout=subprocess.DEVNULL, stderr=self.stderr, pass_fds=(self.answer.fileno(),),
+                [sys.executable, "-m", "simparity.comparisons.engines.probe", str(child_end), str(os.getpid())],
+                stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=self.stderr, pass_fds=(child_end,),
                 env=worker_environment(), start_new_session=True)
+        finally:
+            os.close(child_end)
+        os.set_blocking(answers, False)
+        self.answers = answers
+        assert self.process.stdin is not None  # a pipe, written without blocking: a request may outgrow it
+        self.requests = self.process.stdin.fileno()
+        os.set_blocking(self.requests, False)
+        self._send((name, scenes))
+
+    def ask(self, scenes: list) -> None:
+        """Ask the probe about ``scenes``, once it answered its last question."""
+        self._send(scenes)
+
+    def _send(self, request: object) -> None:
+        self.received, self.stopped, self.errors_from = b"", "", os.fstat(self.stderr.fileno()).st_size
+        self.unsent = memoryview(pickle.dumps(request))
+
+    def _feed(self) -> None:
+        """Write what the pipe takes of the request not yet sent."""
+        try:
+            while self.unsent:
+                self.unsent = self.unsent[os.write(self.requests, self.unsent):]
+        except (BlockingIOError, BrokenPipeError):  # full: the probe reads it as it goes; it died: result() says how
+            pass
+
+    def answered(self) -> bool:
+        """Whether the whole answer to the last question came (what came is read)."""
+        try:
+            while chunk := os.read(self.answers, 1 << 16):
+                self.received += chunk
+        except BlockingIOError:
+            pass
+        head = self.received[:ANSWER_LENGTH]
+        return len(head) == ANSWER_LENGTH and len(self.received) >= ANSWER_LENGTH + int.from_bytes(head, "little")
+
+    def working(self) -> bool:
+        """Whether the probe is still answering: not stopped, not answered, alive."""
+        self._feed()
+        return not self.stopped and not self.answered() and self.process.poll() is None
 
     def enforce(self, deadline: float) -> None:
         """Kill the probe if it is past the deadline or its memory limit."""
@@ -256,45 +341,62 @@ class _Probe:
         self.process.wait()
 
     def result(self) -> Engine:
-        code = self.process.wait()
-        self.answer.seek(0)
-        if not self.stopped and code == 0 and (answer := self.answer.read()):
-            kind, value = pickle.loads(answer)
+        """The answer to the last question, once the probe is no longer :meth:`working`."""
+        if not self.stopped and self.answered():
+            kind, value = pickle.loads(self.received[ANSWER_LENGTH:])
             if kind == "described":
                 return DescribedEngine(value)
             return value
         if not self.stopped:
-            self.stderr.seek(0)
-            self.stopped = death_cause(code, self.stderr.read()[-64 * 1024:].decode("utf-8", "replace"),
-                                       "the process building it")
+            code = self.process.wait()
+            errors = os.pread(self.stderr.fileno(), 64 * 1024, max(self.errors_from,
+                                                                   os.fstat(self.stderr.fileno()).st_size - 64 * 1024))
+            self.stopped = death_cause(code, errors.decode("utf-8", "replace"), "the process building it")
         return BrokenEngine(self.name, self.stopped)
 
     def close(self) -> None:
         if self.process.poll() is None:
             self.kill()
+        assert self.process.stdin is not None  # a pipe
+        with contextlib.suppress(BrokenPipeError):
+            self.process.stdin.close()
         self.stderr.close()
-        self.answer.close()
+        os.close(self.answers)
 
 
 def main(argv: list[str]) -> int:
     """The probe process: build the engine its standard input names, write its description (or stand-in) to the
-    descriptor ``argv[1]``; ``argv[2]`` is the parent's pid."""
+    descriptor ``argv[1]``; ``argv[2]`` is the parent's pid. A described engine is then asked about each further list
+    of scenes its standard input gives, until it closes."""
     die_with_parent(int(argv[2]))
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
     faulthandler.enable()
     name, scenes = pickle.load(sys.stdin.buffer)
     engine = make_engine(name)
-    answer: tuple[str, object]
-    if isinstance(engine, StandInEngine):
-        answer = ("stand-in", engine)
-    else:
-        try:
-            answer = ("described", describe(engine, scenes))
-        except (Exception, SystemExit) as err:  # noqa: BLE001 - a user's code
-            answer = ("stand-in", BrokenEngine(name, f"describing it raised {one_line(error_text(err))}"))
-    with os.fdopen(int(argv[1]), "wb") as f:
-        pickle.dump(answer, f)
+    with os.fdopen(int(argv[1]), "wb") as answers:
+        while True:
+            answer = _answer(engine, name, scenes)
+            data = pickle.dumps(answer)
+            answers.write(len(data).to_bytes(ANSWER_LENGTH, "little") + data)
+            answers.flush()
+            if answer[0] != "described":
+                break
+            try:
+                scenes = pickle.load(sys.stdin.buffer)
+            except EOFError:
+                break
     os._exit(0)  # no interpreter shutdown: a user's atexit or finaliser cannot change the answer
+
+
+def _answer(engine: Engine, name: str, scenes: list) -> tuple[str, object]:
+    """What the probe answers of ``engine`` (built from ``name``) asked about ``scenes``: ("described",
+    EngineDescription) or ("stand-in", the engine standing in for it)."""
+    if isinstance(engine, StandInEngine):
+        return "stand-in", engine
+    try:
+        return "described", describe(engine, scenes)
+    except (Exception, SystemExit) as err:  # noqa: BLE001 - a user's code
+        return "stand-in", BrokenEngine(name, f"describing it raised {one_line(error_text(err))}")
 
 
 if __name__ == "__main__":  # run by its package name, so what it pickles names simparity's module, not __main__

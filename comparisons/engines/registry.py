@@ -11,11 +11,15 @@ from __future__ import annotations
 import functools
 import importlib
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from simparity.comparisons.engines.placeholders import NotAnEngine, UnavailableEngine
 from simparity.comparisons.engines.plugins import discover, is_spec, load_engine
 from simparity.core.model.engine import Engine
 from simparity.core.model.errors import UnknownEngineError, one_line
+
+if TYPE_CHECKING:
+    from simparity.comparisons.engines.probe import EngineProbes
 
 _ENGINES = {
     "core": ("simparity.core.inhouse", "InHouseEngine"),
@@ -72,15 +76,16 @@ def make_engine(name: str) -> Engine:
     return load_engine(name, taken=frozenset(ENGINE_NAMES) | frozenset(plugins))
 
 
-def describe_engines(names, scenes=()) -> list[Engine]:
+def describe_engines(names, scenes=(), probes: EngineProbes | None = None) -> list[Engine]:
     """The engines called ``names`` as simparity itself may hold them: a built-in built here, a plugin or spec
     described by a process of its own, asked about ``scenes`` (:mod:`comparisons.engines.probe`): a user's code
-    never runs in this process, so one that crashes or hangs there cannot take simparity down."""
+    never runs in this process, so one that crashes or hangs there cannot take simparity down. ``probes``: the
+    command's kept probes, asked again (None: a probe per engine, ended here)."""
     from simparity.comparisons.engines.probe import probe_engines  # it starts processes: only when asked
 
     names = check_engine_names(names)
     outside = [n for n in names if n not in _ENGINES]
-    probed = probe_engines(outside, scenes) if outside else {}
+    probed = (probes.describe if probes is not None else probe_engines)(outside, scenes) if outside else {}
     return [probed[n] if n in probed else make_engine(n) for n in names]
 
 
@@ -98,8 +103,19 @@ class EngineSet:
         return tuple(n for n in dict.fromkeys(self.names) if n not in _ENGINES)
 
     @functools.cached_property
+    def probes(self) -> EngineProbes:
+        """The probes of this set's outside engines, kept to be asked again (each question a process less)."""
+        from simparity.comparisons.engines.probe import EngineProbes  # it imports this module
+
+        return EngineProbes()
+
+    def describe(self, names, scenes=()) -> list[Engine]:
+        """:func:`describe_engines` by this set's :attr:`probes`."""
+        return describe_engines(names, scenes, self.probes)
+
+    @functools.cached_property
     def _users_described(self) -> list[Engine]:
-        return describe_engines(self.users) if self.users else []
+        return self.describe(self.users) if self.users else []
 
     @functools.cached_property
     def _described(self) -> list[Engine]:
@@ -142,8 +158,13 @@ class EngineSet:
     @functools.cached_property
     def installed_integrators(self) -> tuple[str, ...]:
         """:attr:`integrators` and every installed plugin's, for a scene file that names an integrator the
-        command's engines do not offer."""
-        return _integrator_names(describe_engines(ENGINE_NAMES + plugin_names() + self.users))
+        command's engines do not offer. The user's engines answer as described already; the other plugins are
+        described once, in probes ended here (nothing of them is asked again)."""
+        names = check_engine_names(ENGINE_NAMES + plugin_names() + self.users)
+        described = dict(zip(self.users, self._users_described))
+        others = [name for name in names if name not in described]
+        described.update(zip(others, describe_engines(others)))
+        return _integrator_names([described[name] for name in names])
 
     @property
     def other_variants(self) -> frozenset[str]:

@@ -10,7 +10,7 @@ compared.
 
 from __future__ import annotations
 
-from simparity.comparisons.engines.probe import asked_about
+from simparity.comparisons.engines.probe import EngineProbes, asked_about
 from simparity.comparisons.engines.registry import ENGINE_NAMES, make_engine
 from simparity.comparisons.execute.execution import Executor, run_scenes
 from simparity.comparisons.execute.journal import Journal
@@ -31,11 +31,11 @@ def _built_in(name: str) -> Engine | None:
 
 def invariance_rows(scenes: list, base_rows: list[list[ResultRow]], transforms: tuple[Transform, ...],
                     engines: list[Engine], executor: Executor, journal: Journal | None,
-                    specs: dict[str, str] | None, say) -> list[list[ResultRow]]:
-    """The invariance rows of each scene (in order) under ``transforms``, given its rows ``base_rows``; ``say``
-    hears one line per scene."""
+                    specs: dict[str, str] | None, probes: EngineProbes, say) -> list[list[ResultRow]]:
+    """The invariance rows of each scene (in order) under ``transforms``, given its rows ``base_rows``; a user's
+    engine is asked about the new scenes by its kept probe in ``probes``; ``say`` hears one line per scene."""
     def run(batch: list) -> list[list[ResultRow]]:
-        described = asked_about(engines, batch, specs)  # a user's engine knows only the run's own scenes
+        described = asked_about(engines, batch, specs, probes)  # a user's engine knows only the run's own scenes
         return [rows for _, rows, _ in run_scenes(batch, described, make_engine, INVARIANCE_REPEATS, executor, journal,
                                                  None, specs)]
 

@@ -25,7 +25,7 @@ from typing import Callable, Sequence, TypeVar
 
 import pandas as pd
 
-from simparity.comparisons.engines.registry import EngineSet, check_engine_names, describe_engines, make_engine
+from simparity.comparisons.engines.registry import EngineSet, check_engine_names, make_engine
 from simparity.comparisons.execute.execution import Executor, default_jobs, estimate, run_scenes
 from simparity.comparisons.execute.in_process import InProcessExecutor
 from simparity.comparisons.execute.isolation import DEFAULT_CASE_SECONDS, CaseLimits, IsolatedPool
@@ -196,7 +196,8 @@ class Session:
         if execution.where == IN_PROCESS:
             self.engines = [make_engine(n) for n in self.names]  # the caller asked for its engines in its process
         else:
-            self.engines = describe_engines(self.names, self.scenes)
+            self.engines = engines.describe(self.names, self.scenes)
+        self.probes = engines.probes  # kept to ask the engines about transformed scenes
         check_distinct(self.engines, self.names, self.scenes)
         self.specs = dict(zip((e.name for e in self.engines), self.names))
         if bounds is not None:  # before any case runs: a bound that can match nothing is bad input
@@ -264,7 +265,7 @@ class Session:
                     if bar is not None:
                         bar.clear()
                     for rows in invariance_rows(self.scenes, base_rows, self.transforms, self.engines, executor,
-                                                journal, self.specs, self.say):
+                                                journal, self.specs, self.probes, self.say):
                         store.append(rows)
                         failed += sum(1 for r in rows if r.status == FAILED)
         except KeyboardInterrupt:

@@ -26,6 +26,7 @@ from simparity.comparisons.engines.registry import (ENGINE_NAMES, check_engine_n
 from simparity.core.model.errors import UnknownEngineError
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.results import FAILED, NOT_AVAILABLE, OK
+from tests.comparisons.engines.probe_spy import spy_probes
 from tests.helpers import THROWN_INTO_WIND
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -466,22 +467,17 @@ def test_a_scene_file_may_name_a_plugin_s_integrator(site, tmp_path):
 @pytest.mark.slow
 def test_an_installed_plugin_a_run_does_not_name_is_never_asked(site, scene_file, tmp_path, monkeypatch):
     """Describing a plugin takes a process of its own (a slow one: up to the probe's minute): a run, a scene file
-    or the quick profile that does not need it never asks; a run naming it asks it alone, once per command
-    for the scene files and once for the run."""
-    from simparity.comparisons.engines import probe as engine_probe
-
+    or the quick profile that does not need it never asks; a run naming it asks it alone, in one probe for the
+    scene files and the run."""
     site.install({"leap": "plugin_engines_h:Leapfrog", "other": "plugin_engines_h:Renamed"}, "plugin_engines_h")
-    asked = []
-    real = engine_probe.probe_engines
-    monkeypatch.setattr(engine_probe, "probe_engines", lambda names, scenes=(): asked.append(list(names)) or
-                        real(names, scenes))
+    asked = spy_probes(monkeypatch).started
     assert main(["run", str(scene_file), "--quick", "--engines", "core", "--out", str(tmp_path / "a"),
                  *NO_REPORT_ONE_JOB]) == EXIT_OK
     assert main(["list"], out=io.StringIO()) == EXIT_OK
-    assert asked == []
+    assert not asked
     leap = tmp_path / "leap.toml"
     leap.write_text(SCENE.replace('integrators = ["rk4"]', 'integrators = ["rk4", "leapfrog_demo"]'), encoding="utf-8")
     code = main(["run", str(leap), "--quick", "--engines", "core,leap", "--out", str(tmp_path / "b"),
                  *NO_REPORT_ONE_JOB])
     assert code != EXIT_USAGE  # the scene file was accepted (the demo integrator's own cases may fail)
-    assert asked and all(names == ["leap"] for names in asked)
+    assert asked == {"leap": 1}

@@ -15,13 +15,14 @@ import pandas as pd
 import pytest
 
 from simparity.comparisons.cli.main import main
-from simparity.comparisons.engines.probe import DescribedEngine, asked_about, probe_engines
+from simparity.comparisons.engines.probe import DescribedEngine, EngineProbes, asked_about
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.invariance.metamorphic import CHANGES_METRIC, RATIO_METRIC
 from simparity.comparisons.invariance.perturb import ulp_perturbed
 from simparity.comparisons.invariance.transforms import FIXED_TRANSFORMS, TRANSFORM_NAMES, transform_scene
 from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.errors import PluginError
+from tests.comparisons.engines.probe_spy import spy_probes
 from tests.helpers import builtin
 from tests.mutation.catalogue import MUTANTS
 from tests.mutation.copy_of_core import FAITHFUL_NAME, materialise
@@ -66,7 +67,8 @@ RK4_MUTANT = next(m for m in MUTANTS if m.id == "rk4_weights")
 @pytest.mark.slow
 def test_a_described_engine_is_asked_about_scenes_made_after_it_was_described():
     scene = builtin("lecture-projectile")
-    described = probe_engines([CORE_SPEC], [scene])[CORE_SPEC]
+    probes = EngineProbes()
+    described = probes.describe([CORE_SPEC], [scene])[CORE_SPEC]
     assert isinstance(described, DescribedEngine)
     later = [transform_scene(scene, t) for t in FIXED_TRANSFORMS if t.name in ("translate", "rescale")]
     later.append(ulp_perturbed(scene, 1)[0])
@@ -74,12 +76,13 @@ def test_a_described_engine_is_asked_about_scenes_made_after_it_was_described():
         with pytest.raises(PluginError, match="was not asked about scene"):
             described.scene_integrators(other)
     core = make_engine("core")
-    again = asked_about([core, described], later, {described.name: CORE_SPEC})
+    again = asked_about([core, described], later, {described.name: CORE_SPEC}, probes)  # its kept probe
     assert again[0] is core  # a built-in is built here: nothing to ask
     real = InHouseEngine()
     for other in later + [scene]:
         assert again[1].scene_integrators(other) == real.scene_integrators(other)
-    assert asked_about(again, later, {described.name: CORE_SPEC})[1] is again[1]  # nothing new: no probe
+    assert asked_about(again, later, {described.name: CORE_SPEC}, probes)[1] is again[1]  # nothing new: no probe
+    probes.close()
 
 
 @pytest.mark.slow
@@ -90,15 +93,18 @@ def test_a_faithful_plugin_passes_and_a_planted_bug_fails_under_every_transform(
     monkeypatch.syspath_prepend(str(tmp_path))
     monkeypatch.setenv("PYTHONPATH", f"{tmp_path}:{':'.join(sys.path)}")  # the probes and workers import the copies
     faithful, mutant = materialise(None, tmp_path), materialise(RK4_MUTANT, tmp_path)
-    # compiled once here: each probe and worker importing the copies (six probes and a worker) would compile them
+    # compiled once here: each probe and worker importing the copies (two probes and a worker) would compile them
     # anew where PYTHONDONTWRITEBYTECODE is set (~0.6 CPU-s a process)
     compileall.compile_dir(tmp_path, quiet=1)
+    probes = spy_probes(monkeypatch).started
     scene = tmp_path / "two-leaves.toml"
     scene.write_text(TWO_LEAVES, encoding="utf-8")
     out = tmp_path / "run"
     code = main(["run", str(scene), "--quick", "--check", "--engines", f"core,{faithful.spec},{mutant.spec}",
                  "--transform", ",".join(TRANSFORM_NAMES), "--out", str(out), "--history", str(tmp_path / "h.db"),
                  "--no-report", "--jobs", "1"])  # what is read: the verdicts printed and results.csv
+    # before: each plugin probed anew for each question (what it offers, the run's scenes, the transformed ones...)
+    assert probes == {faithful.spec: 1, mutant.spec: 1}, "one probe per engine, asked again"
     lines = capsys.readouterr().out.splitlines()
     violations = [line for line in lines if line.startswith("violation: ")]
     assert code == 1 and violations
