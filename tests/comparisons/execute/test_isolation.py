@@ -53,13 +53,18 @@ class _Run:
         return pd.read_csv(self.out / "results.csv")
 
 
+def _throw_file(folder: Path) -> Path:
+    """The tiny scene (:data:`tests.helpers.THROWN_BALL`) written to ``folder``; its path."""
+    scene = folder / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    return scene
+
+
 def _run_throw(folder: Path, engines: str, *options: str) -> _Run:
     """``simparity run`` of the tiny scene (:data:`tests.helpers.THROWN_BALL`) on ``engines``, without a report (no
     test here reads one), into ``folder``/run."""
-    scene = folder / "throw.toml"
-    scene.write_text(THROWN_BALL, encoding="utf-8")
     printed = io.StringIO()
-    code = main(["run", str(scene), "--engines", engines, "--repeats", "0", "--no-report", *options,
+    code = main(["run", str(_throw_file(folder)), "--engines", engines, "--repeats", "0", "--no-report", *options,
                  "--out", str(folder / "run")], printed)
     return _Run(code, printed.getvalue(), folder / "run")
 
@@ -197,11 +202,9 @@ def test_workers_use_one_blas_thread_whatever_the_user_set(monkeypatch):
 def test_what_an_engine_starts_and_leaves_running_ends_with_its_cases(tmp_path):
     """An engine that starts a process in every case and never stops it: the processes are killed when its
     cases end, while the pool's workers live on (as a Dask worker's pool does between tasks)."""
-    scene = tmp_path / "throw.toml"
-    scene.write_text(THROWN_BALL, encoding="utf-8")
     engines = [make_engine("core"), make_engine("tests.hostile_engines:ForkingEngine")]
     with IsolatedPool(1, CaseLimits.default(1)) as pool:  # one worker: the forking engine's cases after core's
-        [(_, rows, _)] = run_scenes(library.load([str(scene)]), engines, make_engine, 0, pool,
+        [(_, rows, _)] = run_scenes(library.load([str(_throw_file(tmp_path))]), engines, make_engine, 0, pool,
                                     specs={"forking": "tests.hostile_engines:ForkingEngine"})
         assert {r.status for r in rows if r.engine == "forking" and r.metric == "position_error_max"} == {"ok"}
         assert no_leftovers_within()
