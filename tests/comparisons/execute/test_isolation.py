@@ -53,18 +53,25 @@ class _Run:
         return pd.read_csv(self.out / "results.csv")
 
 
-def _throw_file(folder: Path) -> Path:
-    """The tiny scene (:data:`tests.helpers.THROWN_BALL`) written to ``folder``; its path."""
+HOSTILE_DTS = (0.01,)
+"""The time steps [s] of the tiny scene in the segfault, memory and hang runs: one group, so one worker runs every
+engine's cases, core's before the hostile engine's and MuJoCo's after them (in the worker that replaces the killed
+one). Each worker killed is replaced at once (~1 CPU-s a start): the scene's two time steps, two groups on two
+workers, started four workers a run for the same property."""
+
+
+def _throw_file(folder: Path, text: str = THROWN_BALL) -> Path:
+    """The tiny scene (:data:`tests.helpers.THROWN_BALL`, or ``text``) written to ``folder``; its path."""
     scene = folder / "throw.toml"
-    scene.write_text(THROWN_BALL, encoding="utf-8")
+    scene.write_text(text, encoding="utf-8")
     return scene
 
 
-def _run_throw(folder: Path, engines: str, *options: str) -> _Run:
-    """``simparity run`` of the tiny scene (:data:`tests.helpers.THROWN_BALL`) on ``engines``, without a report (no
-    test here reads one), into ``folder``/run."""
+def _run_throw(folder: Path, engines: str, *options: str, text: str = THROWN_BALL) -> _Run:
+    """``simparity run`` of the tiny scene (:data:`tests.helpers.THROWN_BALL`, or ``text``) on ``engines``, without a
+    report (no test here reads one), into ``folder``/run."""
     printed = io.StringIO()
-    code = main(["run", str(_throw_file(folder)), "--engines", engines, "--repeats", "0", "--no-report", *options,
+    code = main(["run", str(_throw_file(folder, text)), "--engines", engines, "--repeats", "0", "--no-report", *options,
                  "--out", str(folder / "run")], printed)
     return _Run(code, printed.getvalue(), folder / "run")
 
@@ -73,16 +80,19 @@ def _run(tmp_path, hostile: dict, seconds: float) -> _Run:
     """Run the tiny scene on core, MuJoCo and the ``hostile`` engines ({name: (spec, cause)}); check that each hostile
     case failed with its cause, every other case completed, and the run kept its cases for --resume."""
     engines = ",".join(["core"] + [spec for spec, _ in hostile.values()] + ["mujoco"])
-    run = _run_throw(tmp_path, engines, "--jobs", "2", "--case-timeout", str(seconds), "--case-memory", str(CASE_GIB))
+    two_steps = "dt = [0.01, 0.005]"
+    assert THROWN_BALL.count(two_steps) == 1  # the tiny scene changed: choose its time step anew
+    run = _run_throw(tmp_path, engines, "--jobs", "1", "--case-timeout", str(seconds), "--case-memory", str(CASE_GIB),
+                     text=THROWN_BALL.replace(two_steps, f"dt = {list(HOSTILE_DTS)}"))
     assert run.code == 1  # failed cases: exit 1, not a crash of the run
     table = run.table
-    assert len(table[table.dt.notna()].groupby(["engine", "dt"])) == (2 + len(hostile)) * 2  # nothing lost
+    assert len(table[table.dt.notna()].groupby(["engine", "dt"])) == (2 + len(hostile)) * len(HOSTILE_DTS)  # none lost
     for name, (_, cause) in hostile.items():
         rows = table[(table.engine == name) & table.dt.notna()]
         assert set(rows.status) == {"failed"} and rows.detail.str.contains(cause, regex=False).all(), name
     for honest in ("core", "mujoco"):
         rows = table[(table.engine == honest) & (table.metric == "position_error_max")]
-        assert list(rows.status) == ["ok", "ok"], honest
+        assert list(rows.status) == ["ok"] * len(HOSTILE_DTS), honest
     assert (run.out / "cases").is_dir()  # kept for --resume, which tries the failed cases again
     return run
 
@@ -90,7 +100,7 @@ def _run(tmp_path, hostile: dict, seconds: float) -> _Run:
 @pytest.mark.slow
 def test_a_segfault_and_a_memory_blow_up_each_fail_alone(tmp_path):
     run = _run(tmp_path, CRASHING, CRASH_SECONDS)
-    assert "4 cases did not finish (crashed, hung or out of memory)" in run.printed
+    assert f"{len(CRASHING) * len(HOSTILE_DTS)} cases did not finish (crashed, hung or out of memory)" in run.printed
 
 
 @pytest.mark.slow
