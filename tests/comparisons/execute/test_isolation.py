@@ -128,11 +128,12 @@ def _core_values(table: pd.DataFrame) -> pd.DataFrame:
 
 
 @pytest.mark.slow
-def test_an_engine_that_changes_its_process_cannot_change_another_engines_results(tmp_path, one_worker_run):
+def test_an_engine_that_changes_its_process_cannot_change_another_engines_results(one_worker_run, slow_start_run):
     """The rounding engine switches the FPU to round upward before its cases; core's cases and the reference,
-    run after it by the same single worker, are bit-identical to a run without it: each engine's cases run in
-    a process of their own, forked from a worker no engine's code ran in."""
-    alone = _core_values(_run_throw(tmp_path, "core", "--jobs", "1").table)
+    run after it by the same single worker, are bit-identical to a run without it (core alone, the run of a slow
+    worker start: what it changes is when the clock starts, not a value): each engine's cases run in a process of
+    their own, forked from a worker no engine's code ran in."""
+    alone = _core_values(slow_start_run.table)
     beside = _core_values(one_worker_run.table)
     assert len(alone) > 10 and alone["status"].eq("ok").any()
     pd.testing.assert_frame_equal(alone, beside, check_exact=True)
@@ -225,14 +226,24 @@ SLOW_IMPORT_SECONDS = HANG_SECONDS + 1
 must not count against the first case handed to it."""
 
 
-@pytest.mark.slow
-def test_a_workers_imports_do_not_count_against_its_first_cases_time_limit(tmp_path, monkeypatch):
-    """The worker (started when its first job is handed over) takes longer to import than the per-case limit; its
-    cases, milliseconds each, complete: the clock starts when it says it is ready (before: every case 'hung')."""
-    slow = tmp_path / "slow-start"
+@pytest.fixture(scope="module")
+def slow_start_run(tmp_path_factory) -> _Run:
+    """One run of the tiny scene on core alone by one worker whose start (a ``sitecustomize`` that sleeps) takes
+    longer than the per-case limit, shared by the test of slow starts and, as the run without a hostile engine, by
+    the test of the rounding engine."""
+    folder = tmp_path_factory.mktemp("slow-start")
+    slow = folder / "slow-start"
     slow.mkdir()
     (slow / "sitecustomize.py").write_text(f"import time\ntime.sleep({SLOW_IMPORT_SECONDS})\n", encoding="utf-8")
-    monkeypatch.syspath_prepend(str(slow))  # a worker's import path is this process's (worker_environment)
-    run = _run_throw(tmp_path, "core", "--jobs", "1", "--case-timeout", str(HANG_SECONDS))
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        monkeypatch.syspath_prepend(str(slow))  # a worker's import path is this process's (worker_environment)
+        return _run_throw(folder, "core", "--jobs", "1", "--case-timeout", str(HANG_SECONDS))
+
+
+@pytest.mark.slow
+def test_a_workers_imports_do_not_count_against_its_first_cases_time_limit(slow_start_run):
+    """The worker (started when its first job is handed over) takes longer to import than the per-case limit; its
+    cases, milliseconds each, complete: the clock starts when it says it is ready (before: every case 'hung')."""
+    run = slow_start_run
     assert run.code == 0, run.printed
     assert set(run.table[run.table.dt.notna()].status) <= {"ok", "n/a"}
