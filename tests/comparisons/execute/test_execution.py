@@ -22,7 +22,7 @@ its impact and rebound metrics are measured at both time steps."""
 
 LEAN_INTEGRATORS = ("semi_implicit_euler", "rk4", "backup", "act_after", "exact", "euler")
 """The integrators of a dynamics scene in :func:`lean_scenes`: every engine still runs a case or two (core its
-contact schemes on the ball), 48 dynamics cases instead of 84: a worker's cost is mostly its cases' own
+contact schemes on the ball), 8 cases a time step instead of 14: a worker's cost is mostly its cases' own
 processes (each case is forked), not their steps."""
 
 LEAN_ITERATIONS = 20
@@ -30,9 +30,17 @@ LEAN_ITERATIONS = 20
 reports its failures (the case's every path), at a tenth of the 200 that dominated the mixed scenes' cost."""
 
 
+SPREAD_SCENES = ("ball-bounce-k05", "lecture-2link-ik")
+"""The fewest scenes whose groups spread over two workers: three groups (the IK scene's one, the ball's two time
+steps), so each worker runs one and one of them a second, forked from a worker that already ran one; contact (every
+engine's contact schemes) and iterative IK (every solver's loop), the cases that carry the most state. Each group costs
+a case process per engine, most of the test's CPU: the free-flight, rotating and kinematics scenes' five more groups
+ran the same code paths of the executors."""
+
+
 def lean_scenes():
-    """The mixed smoke scenes (every kind of case; 8 groups, several for each of two workers), shortened further for
-    the tests that run them whole several times: what they compare is bit-identity and what ran, not accuracy."""
+    """The :data:`SPREAD_SCENES` as smoke scenes, shortened further for the tests that run them whole several
+    times: what they compare is bit-identity and what ran, not accuracy."""
     def lean(scene):
         if hasattr(scene, "duration"):
             return dataclasses.replace(scene, duration=min(scene.duration, LEAN_STEPS * max(scene.dts)),
@@ -40,7 +48,7 @@ def lean_scenes():
         if hasattr(scene, "max_iterations"):
             return dataclasses.replace(scene, max_iterations=LEAN_ITERATIONS)
         return scene
-    return [lean(scene) for scene in smoke_scenes()]
+    return [lean(scene) for scene in smoke_scenes(SPREAD_SCENES)]
 
 
 @pytest.fixture(scope="module")

@@ -53,13 +53,25 @@ class _Run:
         return pd.read_csv(self.out / "results.csv")
 
 
-def _run_throw(folder: Path, engines: str, *options: str) -> _Run:
-    """``simparity run`` of the tiny scene (:data:`tests.helpers.THROWN_BALL`) on ``engines``, without a report (no
-    test here reads one), into ``folder``/run."""
+HOSTILE_DTS = (0.01,)
+"""The time steps [s] of the tiny scene in the segfault, memory and hang runs: one group, so one worker runs every
+engine's cases, core's before the hostile engine's and MuJoCo's after them (in the worker that replaces the killed
+one). Each worker killed is replaced at once (~1 CPU-s a start): the scene's two time steps, two groups on two
+workers, started four workers a run for the same property."""
+
+
+def _throw_file(folder: Path, text: str = THROWN_BALL) -> Path:
+    """The tiny scene (:data:`tests.helpers.THROWN_BALL`, or ``text``) written to ``folder``; its path."""
     scene = folder / "throw.toml"
-    scene.write_text(THROWN_BALL, encoding="utf-8")
+    scene.write_text(text, encoding="utf-8")
+    return scene
+
+
+def _run_throw(folder: Path, engines: str, *options: str, text: str = THROWN_BALL) -> _Run:
+    """``simparity run`` of the tiny scene (:data:`tests.helpers.THROWN_BALL`, or ``text``) on ``engines``, without a
+    report (no test here reads one), into ``folder``/run."""
     printed = io.StringIO()
-    code = main(["run", str(scene), "--engines", engines, "--repeats", "0", "--no-report", *options,
+    code = main(["run", str(_throw_file(folder, text)), "--engines", engines, "--repeats", "0", "--no-report", *options,
                  "--out", str(folder / "run")], printed)
     return _Run(code, printed.getvalue(), folder / "run")
 
@@ -68,16 +80,19 @@ def _run(tmp_path, hostile: dict, seconds: float) -> _Run:
     """Run the tiny scene on core, MuJoCo and the ``hostile`` engines ({name: (spec, cause)}); check that each hostile
     case failed with its cause, every other case completed, and the run kept its cases for --resume."""
     engines = ",".join(["core"] + [spec for spec, _ in hostile.values()] + ["mujoco"])
-    run = _run_throw(tmp_path, engines, "--jobs", "2", "--case-timeout", str(seconds), "--case-memory", str(CASE_GIB))
+    two_steps = "dt = [0.01, 0.005]"
+    assert THROWN_BALL.count(two_steps) == 1  # the tiny scene changed: choose its time step anew
+    run = _run_throw(tmp_path, engines, "--jobs", "1", "--case-timeout", str(seconds), "--case-memory", str(CASE_GIB),
+                     text=THROWN_BALL.replace(two_steps, f"dt = {list(HOSTILE_DTS)}"))
     assert run.code == 1  # failed cases: exit 1, not a crash of the run
     table = run.table
-    assert len(table[table.dt.notna()].groupby(["engine", "dt"])) == (2 + len(hostile)) * 2  # nothing lost
+    assert len(table[table.dt.notna()].groupby(["engine", "dt"])) == (2 + len(hostile)) * len(HOSTILE_DTS)  # none lost
     for name, (_, cause) in hostile.items():
         rows = table[(table.engine == name) & table.dt.notna()]
         assert set(rows.status) == {"failed"} and rows.detail.str.contains(cause, regex=False).all(), name
     for honest in ("core", "mujoco"):
         rows = table[(table.engine == honest) & (table.metric == "position_error_max")]
-        assert list(rows.status) == ["ok", "ok"], honest
+        assert list(rows.status) == ["ok"] * len(HOSTILE_DTS), honest
     assert (run.out / "cases").is_dir()  # kept for --resume, which tries the failed cases again
     return run
 
@@ -85,7 +100,7 @@ def _run(tmp_path, hostile: dict, seconds: float) -> _Run:
 @pytest.mark.slow
 def test_a_segfault_and_a_memory_blow_up_each_fail_alone(tmp_path):
     run = _run(tmp_path, CRASHING, CRASH_SECONDS)
-    assert "4 cases did not finish (crashed, hung or out of memory)" in run.printed
+    assert f"{len(CRASHING) * len(HOSTILE_DTS)} cases did not finish (crashed, hung or out of memory)" in run.printed
 
 
 @pytest.mark.slow
@@ -113,11 +128,12 @@ def _core_values(table: pd.DataFrame) -> pd.DataFrame:
 
 
 @pytest.mark.slow
-def test_an_engine_that_changes_its_process_cannot_change_another_engines_results(tmp_path, one_worker_run):
+def test_an_engine_that_changes_its_process_cannot_change_another_engines_results(one_worker_run, slow_start_run):
     """The rounding engine switches the FPU to round upward before its cases; core's cases and the reference,
-    run after it by the same single worker, are bit-identical to a run without it: each engine's cases run in
-    a process of their own, forked from a worker no engine's code ran in."""
-    alone = _core_values(_run_throw(tmp_path, "core", "--jobs", "1").table)
+    run after it by the same single worker, are bit-identical to a run without it (core alone, the run of a slow
+    worker start: what it changes is when the clock starts, not a value): each engine's cases run in a process of
+    their own, forked from a worker no engine's code ran in."""
+    alone = _core_values(slow_start_run.table)
     beside = _core_values(one_worker_run.table)
     assert len(alone) > 10 and alone["status"].eq("ok").any()
     pd.testing.assert_frame_equal(alone, beside, check_exact=True)
@@ -197,11 +213,9 @@ def test_workers_use_one_blas_thread_whatever_the_user_set(monkeypatch):
 def test_what_an_engine_starts_and_leaves_running_ends_with_its_cases(tmp_path):
     """An engine that starts a process in every case and never stops it: the processes are killed when its
     cases end, while the pool's workers live on (as a Dask worker's pool does between tasks)."""
-    scene = tmp_path / "throw.toml"
-    scene.write_text(THROWN_BALL, encoding="utf-8")
     engines = [make_engine("core"), make_engine("tests.hostile_engines:ForkingEngine")]
     with IsolatedPool(1, CaseLimits.default(1)) as pool:  # one worker: the forking engine's cases after core's
-        [(_, rows, _)] = run_scenes(library.load([str(scene)]), engines, make_engine, 0, pool,
+        [(_, rows, _)] = run_scenes(library.load([str(_throw_file(tmp_path))]), engines, make_engine, 0, pool,
                                     specs={"forking": "tests.hostile_engines:ForkingEngine"})
         assert {r.status for r in rows if r.engine == "forking" and r.metric == "position_error_max"} == {"ok"}
         assert no_leftovers_within()
@@ -212,14 +226,24 @@ SLOW_IMPORT_SECONDS = HANG_SECONDS + 1
 must not count against the first case handed to it."""
 
 
-@pytest.mark.slow
-def test_a_workers_imports_do_not_count_against_its_first_cases_time_limit(tmp_path, monkeypatch):
-    """The worker (started when its first job is handed over) takes longer to import than the per-case limit; its
-    cases, milliseconds each, complete: the clock starts when it says it is ready (before: every case 'hung')."""
-    slow = tmp_path / "slow-start"
+@pytest.fixture(scope="module")
+def slow_start_run(tmp_path_factory) -> _Run:
+    """One run of the tiny scene on core alone by one worker whose start (a ``sitecustomize`` that sleeps) takes
+    longer than the per-case limit, shared by the test of slow starts and, as the run without a hostile engine, by
+    the test of the rounding engine."""
+    folder = tmp_path_factory.mktemp("slow-start")
+    slow = folder / "slow-start"
     slow.mkdir()
     (slow / "sitecustomize.py").write_text(f"import time\ntime.sleep({SLOW_IMPORT_SECONDS})\n", encoding="utf-8")
-    monkeypatch.syspath_prepend(str(slow))  # a worker's import path is this process's (worker_environment)
-    run = _run_throw(tmp_path, "core", "--jobs", "1", "--case-timeout", str(HANG_SECONDS))
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        monkeypatch.syspath_prepend(str(slow))  # a worker's import path is this process's (worker_environment)
+        return _run_throw(folder, "core", "--jobs", "1", "--case-timeout", str(HANG_SECONDS))
+
+
+@pytest.mark.slow
+def test_a_workers_imports_do_not_count_against_its_first_cases_time_limit(slow_start_run):
+    """The worker (started when its first job is handed over) takes longer to import than the per-case limit; its
+    cases, milliseconds each, complete: the clock starts when it says it is ready (before: every case 'hung')."""
+    run = slow_start_run
     assert run.code == 0, run.printed
     assert set(run.table[run.table.dt.notna()].status) <= {"ok", "n/a"}

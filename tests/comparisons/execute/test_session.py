@@ -36,6 +36,11 @@ def _small():
     return smoke(load([SCENE])[0])
 
 
+ONE_WORKER = 1
+"""Workers of an isolated run here: a worker start (~1 CPU-s) less than one per time step, and the second time step's
+cases run in the worker that ran the first's (after the crash, where there is one)."""
+
+
 def _with_root_on_path() -> str:
     """PYTHONPATH with the repository first (tests.helpers, for a script run in a subprocess), the rest kept."""
     return os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)
@@ -44,7 +49,7 @@ def _with_root_on_path() -> str:
 @pytest.mark.slow  # ~10 s of CPU: worker processes, one of them crashing
 def test_run_scene_isolates_an_engine_that_segfaults():
     """The segfault kills the engine's case process, not this interpreter: its rows are failed, core's are ok."""
-    table = run_scene(_small(), engines=["core", SEGFAULTING], repeats=0)
+    table = run_scene(_small(), engines=["core", SEGFAULTING], repeats=0, jobs=ONE_WORKER)
     crashed = table[table["engine"] == "segfaulting"]
     assert FAILED in set(crashed["status"]) and OK not in set(crashed["status"])  # n/a: its orders, from no case
     assert crashed["detail"].str.contains("SIGSEGV|segmentation", case=False).any()
@@ -54,7 +59,7 @@ def test_run_scene_isolates_an_engine_that_segfaults():
 @pytest.mark.slow  # ~11 s of CPU: a run in worker processes and one in process
 def test_run_scene_in_process_gives_the_rows_of_the_isolated_run():
     """isolate=False is the same pipeline in this process: the same rows, timing aside."""
-    isolated = run_scene(_small(), engines=["core"], repeats=0)
+    isolated = run_scene(_small(), engines=["core"], repeats=0, jobs=ONE_WORKER)
     inline = run_scene(_small(), engines=["core"], repeats=0, isolate=False)
     untimed = ~isolated["metric"].str.startswith("time_per_")
     pd.testing.assert_frame_equal(isolated[untimed].reset_index(drop=True), inline[untimed].reset_index(drop=True))
@@ -108,8 +113,8 @@ def test_a_script_s_own_engine_is_refused_isolated_and_runs_in_process(tmp_path)
 @pytest.mark.slow  # ~17 s of CPU: a pytest session in a subprocess
 def test_the_fixture_fails_a_test_whose_engine_segfaults_and_the_session_goes_on(pytester, monkeypatch):
     monkeypatch.setenv("PYTHONPATH", str(ROOT))  # the hostile engines' module, for the test run and its workers
-    # the quick profile's two coarsest time steps, not smoke's 100 steps: check() judges core's rows by the shipped
-    # bounds, written for the scene's whole 6 s
+    # the quick profile's coarsest time step, not smoke's 100 steps: check() judges core's rows by the shipped bounds,
+    # written for the scene's whole 6 s; one time step is one group, so each check starts one worker, not two
     pytester.makepyfile(test_crash=f'''
 import dataclasses
 
@@ -119,7 +124,7 @@ from simparity.comparisons.scenes.profiles import quick
 
 def _coarse():
     scene = quick(load(["{SCENE}"])[0])
-    return dataclasses.replace(scene, dts=scene.dts[-2:])
+    return dataclasses.replace(scene, dts=scene.dts[-1:])
 
 
 def test_crash(simparity):
