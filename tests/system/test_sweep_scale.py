@@ -13,6 +13,7 @@ import weakref
 import pytest
 
 from simparity.comparisons.bench.sweep import SPEEDS, sweep_scene
+from simparity.comparisons.cli.main import main
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.execution import run_scenes
 from simparity.comparisons.execute.timing import PeakMemory
@@ -73,7 +74,7 @@ def test_the_cases_of_a_scene_handed_back_are_let_go(tmp_path):
 @pytest.mark.slow
 def test_a_sweep_killed_midway_and_resumed_stores_the_uninterrupted_results(tmp_path):
     scene = _scene(tmp_path, 3 * SPEEDS)
-    _killed_and_resumed(tmp_path, scene, 3 * SPEEDS, ["--jobs", "2"], report=False)
+    _killed_and_resumed(tmp_path, scene, 3 * SPEEDS, ["--jobs", "2"], report=False, whole_in_process=True)
 
 
 @pytest.mark.slow
@@ -85,18 +86,28 @@ def test_a_thousand_variants_on_dask_killed_and_resumed_store_the_uninterrupted_
     assert peak is None or peak.this_process_bytes < CLIENT_PEAK_MIB * 2**20
 
 
+def _arguments(scene, out, options: list[str]) -> list[str]:
+    return ["run", str(scene), "--engines", "core", "--repeats", "0", *options, "--out", str(out)]
+
+
 def _command(scene, out, options: list[str]) -> list[str]:
-    return [sys.executable, "-m", "simparity.comparisons.cli", "run", str(scene), "--engines", "core", "--repeats", "0",
-            *options, "--out", str(out)]
+    return [sys.executable, "-m", "simparity.comparisons.cli", *_arguments(scene, out, options)]
 
 
-def _killed_and_resumed(tmp_path, scene, variants: int, options: list[str], report: bool = True):
+def _killed_and_resumed(tmp_path, scene, variants: int, options: list[str], report: bool = True,
+                        whole_in_process: bool = False):
     """Run ``scene`` whole, and again killed once half its cases are kept, then resumed: the two stored runs must be
     the same, timing aside. Returns the whole run's folder. ``report`` False: no report drawn (what is compared is
-    the stored run, not its drawing)."""
+    the stored run, not its drawing). ``whole_in_process``: the whole run is ``main`` in this process, on one case
+    worker (a command's start and a second worker cost ~3.5 CPU-s; what is stored does not depend on either, and the
+    run killed beside it keeps ``options``), else a command of its own with ``options`` (its client's peak memory is
+    then the run's)."""
     whole, killed = tmp_path / "whole", tmp_path / "killed"
     drawn = () if report else ("--no-report",)
-    subprocess.run(_command(scene, whole, [*options, *drawn]), check=True, capture_output=True)
+    if whole_in_process:
+        assert main(_arguments(scene, whole, [*options, *drawn, "--jobs", "1"])) == 0  # the last --jobs counts
+    else:
+        subprocess.run(_command(scene, whole, [*options, *drawn]), check=True, capture_output=True)
     killed_and_resumed(_command(scene, killed, [*options, *drawn]), killed, CASES_PER_VARIANT * variants,
                        KILL_WAIT_SECONDS, drawn)
     assert differences(whole, killed) == []

@@ -1,5 +1,6 @@
 """Sampled series: bounded, extremes kept, values from hand-made trajectories, stored and read back."""
 
+import dataclasses
 import math
 
 import numpy as np
@@ -83,9 +84,15 @@ def test_runner_series_round_trip_through_the_store(tmp_path):
     assert energy.groupby(["engine", "integrator", "dt"]).size().max() <= SERIES_POINTS
 
 
+IK_SERIES_ITERATIONS = 30
+"""max_iterations of the IK scene whose series are tested: the distributions and the FK matrix are of whatever the
+solvers reached, and the stalled solves (the hard targets, the transpose method) were most of the test at the scene's
+200. Measured: the same 7 residual distributions of 101 points from its 500 targets, the same FK matrix."""
+
+
 @pytest.mark.slow
 def test_ik_series_hold_distributions_and_the_fk_matrix():
-    scene = builtin("lecture-2link-ik")
+    scene = dataclasses.replace(builtin("lecture-2link-ik"), max_iterations=IK_SERIES_ITERATIONS)
     engines = [make_engine("core"), make_engine("mujoco")]
     series = []
     run_scene(scene, engines, make_engine, repeats=0, series=series)
