@@ -156,8 +156,8 @@ class _Worker:
 
 class IsolatedPool:
     """Up to ``workers`` worker processes running jobs under ``limits``; replaced when one is killed. A process is
-    started when a job first needs it: a run of one group starts one, not one per CPU (each costs ~1.2 CPU-s of
-    imports before its first case)."""
+    started when a job needs it and none is free: a run of one group starts one, not one per CPU (each costs ~1.2
+    CPU-s of imports before its first case), and a killed one is replaced only if a job is waiting."""
 
     def __init__(self, workers: int, limits: CaseLimits) -> None:
         if workers < 1:
@@ -170,12 +170,13 @@ class IsolatedPool:
         """(job key, case index, outcome) of every case of ``jobs`` not skipped, as each finishes; jobs start
         in the given order."""
         pending = collections.deque(jobs)
-        while len(self._workers) < min(self._size, len(pending)):
-            self._workers.append(_Worker())
         while True:
             for k in range(len(self._workers)):
                 if self._workers[k].job is None and pending:
                     self._start(k, pending.popleft())
+            while pending and len(self._workers) < self._size:  # a job waits and no worker is free: one more
+                self._workers.append(_Worker())
+                self._start(len(self._workers) - 1, pending.popleft())
             busy = [w for w in self._workers if w.job is not None]
             if not busy:
                 return
@@ -245,10 +246,11 @@ class IsolatedPool:
             yield from self._replace(worker, cause, pending)
 
     def _replace(self, worker: _Worker, cause: str, pending: collections.deque) -> Iterator[tuple[object, int, CaseOutcome]]:
-        """A new process in ``worker``'s place; the case it ran fails with ``cause``, the rest of its job goes
-        first in the queue."""
+        """``worker`` (killed) let go; the case it ran fails with ``cause``, the rest of its job goes first in the
+        queue. A new process takes its place when a job waits for one (:meth:`run`), not before: the last case of a
+        run that hangs leaves no worker started for nothing."""
         worker.stderr.close()
-        self._workers[self._workers.index(worker)] = _Worker()
+        self._workers.remove(worker)
         yield from self._fail_phase(worker, cause, pending)
 
     def _fail_phase(self, worker: _Worker, cause: str, pending: collections.deque) -> Iterator[tuple[object, int, CaseOutcome]]:

@@ -4,6 +4,7 @@ or allocates without bound becomes failed rows naming the cause, and every other
 from __future__ import annotations
 
 import dataclasses
+import os
 import io
 import sysconfig
 from pathlib import Path
@@ -247,3 +248,32 @@ def test_a_workers_imports_do_not_count_against_its_first_cases_time_limit(slow_
     run = slow_start_run
     assert run.code == 0, run.printed
     assert set(run.table[run.table.dt.notna()].status) <= {"ok", "n/a"}
+
+
+def _live_workers() -> int:
+    """This process's children that are case workers and still alive (not zombies)."""
+    count = 0
+    for entry in Path("/proc").iterdir():
+        try:
+            stat = (entry / "stat").read_text()
+            fields = stat[stat.rindex(")") + 2:].split()
+            if fields[0] != "Z" and int(fields[1]) == os.getpid() and b"case_worker" in (entry / "cmdline").read_bytes():
+                count += 1
+        except (OSError, ValueError):  # not a process, or one that ended while read
+            continue
+    return count
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="counts processes through Linux's /proc")
+def test_a_worker_killed_for_the_last_case_is_not_replaced_for_nothing(tmp_path):
+    """The hanging engine's case, the run's last, kills the only worker: no job waits, so no worker is started in its
+    place (before: one, ~1.2 CPU-s of imports for nothing); core's case before it completed in that worker."""
+    engines = [make_engine("core"), make_engine(HANGING[0])]
+    scene = _throw_file(tmp_path, THROWN_BALL.replace("dt = [0.01, 0.005]", f"dt = {list(HOSTILE_DTS)}"))
+    with IsolatedPool(1, CaseLimits(HANG_SECONDS, None)) as pool:
+        [(_, rows, _)] = run_scenes(library.load([str(scene)]), engines, make_engine, 0, pool,
+                                    specs={"hanging": HANGING[0]})
+        assert _live_workers() == 0
+    finished = {r.engine: r.status for r in rows if r.metric == "position_error_max"}
+    assert finished == {"core": "ok", "hanging": "failed"}
