@@ -1,11 +1,13 @@
 """The report of a real (small) run: Markdown led by the summary, figures written as SVG and PNG, a
-self-contained HTML page, and ``simparity report`` on a copied run with no engine importable."""
+self-contained HTML page that headless Chromium renders without the network, and ``simparity report`` on a copied run
+with no engine importable."""
 
 import re
 import shutil
 import subprocess
 import sys
 import textwrap
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -31,7 +33,8 @@ MIN_PAGE_BYTES = 10_000
 
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
-    """A quick run of a dynamics, an IK, a kinematics and a contact scene on the default engines."""
+    """A quick run of a dynamics, an IK, a kinematics and a contact scene on the default engines, with its report:
+    every test here reads it (the ones that render again do so on a copy)."""
     out = tmp_path_factory.mktemp("report") / "run"
     assert main(["run", *SCENES, "--quick", "--repeats", "0", "--jobs", "1", "--out", str(out)]) == 0
     return out
@@ -150,6 +153,68 @@ def test_html_is_self_contained(run_dir):
     assert "<details>" in page   # the full tables, folded
 
 
+CHECKOUT = Path(__file__).resolve().parents[2]
+"""The folder tests/ is in (the no-engine subprocess below imports tests.reports.undrawn from it)."""
+ARTIFACTS = CHECKOUT / "test-artifacts"
+"""Where the screenshot is written (kept by CI as a test artifact; ignored by git)."""
+
+BROWSERS = ("chromium", "chromium-browser", "google-chrome")
+MIN_FIGURE_PIXELS = 100
+"""[CSS px] Every side of a rendered figure: a figure that failed to render collapses to 0 (or to the
+height of its caption, ~15); a drawn one is hundreds of pixels wide."""
+MIN_COLUMN_FRACTION = 0.9
+"""Of the content column's width, every figure's rendered width at least: a figure fills the column (scaled from its
+viewBox), where the SVG's own width in pt (10 in: 960 CSS px) once left it at ~70 % of it and its legend hard to read.
+Less than 1 for a scrollbar or rounding."""
+PAGE_WIDTH = 1400
+"""[CSS px] The browser window: wider than the page's 1200 px column, as a desktop reader's."""
+MIN_SCREENSHOT_BYTES = 10_000
+"""A blank full-page PNG compresses to a few kilobytes; a page of text and figures is far larger."""
+
+
+def _browser() -> str:
+    found = next((path for name in BROWSERS if (path := shutil.which(name))), None)
+    if found is None:
+        pytest.skip(f"no browser to open the report: none of {', '.join(BROWSERS)} on PATH (.ci/run installs Debian's "
+                    "chromium)")
+    return found
+
+
+@pytest.mark.slow
+def test_report_renders_in_chromium_without_network(run_dir):
+    """Headless Chromium (Debian's ``chromium``) opens report.html from disk: every figure renders with a non-zero
+    size and fills the content column, the page asks no host for anything, and a screenshot is kept."""
+    sync_api = pytest.importorskip("playwright.sync_api", reason="playwright (a test dependency) is not installed")
+    browser_path = _browser()
+    page_url = (run_dir / REPORT_HTML_FILE).resolve().as_uri()
+    requests: list[str] = []
+    with sync_api.sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=browser_path, args=["--no-sandbox"])
+        page = browser.new_page(viewport={"width": PAGE_WIDTH, "height": 900})
+        page.on("request", lambda request: requests.append(request.url))
+        page.goto(page_url, wait_until="load")
+        sizes = page.eval_on_selector_all(
+            "figure.plot svg", "els => els.map(e => { const r = e.getBoundingClientRect(); return [r.width, r.height]; })")
+        names = page.eval_on_selector_all("figure.plot", "els => els.map(e => e.dataset.name)")
+        column = page.evaluate("() => { const s = getComputedStyle(document.body); "
+                               "return document.body.clientWidth - parseFloat(s.paddingLeft) - parseFloat(s.paddingRight); }")
+        ARTIFACTS.mkdir(exist_ok=True)
+        screenshot = ARTIFACTS / "report.png"
+        page.screenshot(path=str(screenshot), full_page=True)
+        browser.close()
+    assert len(sizes) == len(names) >= 5, names
+    assert all(width > MIN_FIGURE_PIXELS and height > MIN_FIGURE_PIXELS for width, height in sizes), list(zip(names, sizes))
+    narrow = [(name, width) for name, (width, _) in zip(names, sizes) if width < MIN_COLUMN_FRACTION * column]
+    assert narrow == [], f"figures narrower than {MIN_COLUMN_FRACTION:.0%} of the {column:.0f} px column"
+    assert requests == [page_url], f"the page asked for more than itself: {requests[1:]}"
+    assert screenshot.stat().st_size > MIN_SCREENSHOT_BYTES
+
+
+COMPARED_FIGURE = "dzhanibekov-drift"
+"""The figure test_report_regenerates_a_copied_run_with_no_engine_importable compares with the run's own: the one
+figure its re-rendering saves (every figure is still made by its figure function there; saving them all would draw
+seven more no assertion reads)."""
+
 _NO_ENGINES = textwrap.dedent("""
     import sys
     class Block:
@@ -157,8 +222,11 @@ _NO_ENGINES = textwrap.dedent("""
             if name.split(".")[0] in ("mujoco", "pybullet", "pybullet_data", "pinocchio"):
                 raise ImportError(f"{name} blocked by the test")
     sys.meta_path.insert(0, Block())
+    sys.path.insert(0, sys.argv[2])
     from simparity.comparisons.cli.main import main
-    sys.exit(main(["report", sys.argv[1]]))
+    from tests.reports.undrawn import undrawn_figures
+    with undrawn_figures(frozenset(sys.argv[3:])):
+        sys.exit(main(["report", sys.argv[1]]))
 """)
 
 
@@ -169,10 +237,12 @@ def test_report_regenerates_a_copied_run_with_no_engine_importable(run_dir, tmp_
     shutil.rmtree(copy / "figures")
     for name in (REPORT_FILE, REPORT_HTML_FILE):
         (copy / name).unlink()
-    done = subprocess.run([sys.executable, "-c", _NO_ENGINES, str(copy)], capture_output=True, text=True, timeout=300)
+    done = subprocess.run([sys.executable, "-c", _NO_ENGINES, str(copy), str(CHECKOUT), COMPARED_FIGURE],
+                          capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert (copy / REPORT_FILE).read_text() == (run_dir / REPORT_FILE).read_text()
-    assert (copy / "figures" / "dzhanibekov-drift.svg").read_text() == (run_dir / "figures" / "dzhanibekov-drift.svg").read_text()
+    figure = f"figures/{COMPARED_FIGURE}.svg"
+    assert (copy / figure).read_text() == (run_dir / figure).read_text()
     assert (copy / REPORT_HTML_FILE).stat().st_size > MIN_PAGE_BYTES
 
 

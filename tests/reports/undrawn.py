@@ -1,22 +1,26 @@
 """Reports built for their text alone: each figure is still made by its figure function (so one that fails, fails the
-test), then closed unsaved. Saving (SVG and PNG, on a process pool) is most of a report's time and is what
-reports/figures.py's tests, the real runs of test_report.py and the sweep file's end-to-end run look at; the tests of
-the Markdown here never read a figure's file."""
+test), then closed unsaved, save for the few a test names to keep. Saving (SVG and PNG, on a process pool) is most of
+a report's time and is what reports/figures.py's tests and the real run of test_report.py look at; the tests of the
+Markdown here never read a figure's file."""
 
 import concurrent.futures
 import contextlib
+import functools
 from collections.abc import Iterator
 from unittest import mock
 
 from simparity.reports import figures
 
+UNDRAWN_SVG = "<svg></svg>"
+"""The SVG text handed back for a figure left unsaved: an empty one, which report.html embeds like any other."""
+
 
 class _UndrawnWriter:
-    """Stands for :class:`reports.figures.FigureWriter`: :meth:`submit` closes the figure and hands back its SVG text
-    as empty."""
+    """Stands for :class:`reports.figures.FigureWriter`: :meth:`submit` closes the figure and hands back
+    :data:`UNDRAWN_SVG`, unless its name is one of ``keep``: that one is saved (SVG and PNG) in this process."""
 
-    def __init__(self, *args, **kwargs) -> None:
-        pass
+    def __init__(self, *args, keep: frozenset[str] = frozenset(), **kwargs) -> None:
+        self._keep = keep
 
     def __enter__(self) -> "_UndrawnWriter":
         return self
@@ -25,14 +29,17 @@ class _UndrawnWriter:
         return None
 
     def submit(self, fig, folder, name) -> concurrent.futures.Future:
-        figures.plt.close(fig)
         done: concurrent.futures.Future = concurrent.futures.Future()
-        done.set_result("")
+        if name in self._keep:
+            done.set_result(figures.save(fig, folder, name))
+        else:
+            figures.plt.close(fig)
+            done.set_result(UNDRAWN_SVG)
         return done
 
 
 @contextlib.contextmanager
-def undrawn_figures() -> Iterator[None]:
-    """Within it, a report (:func:`reports.content.build`) makes its figures but saves none."""
-    with mock.patch.object(figures, "FigureWriter", _UndrawnWriter):
+def undrawn_figures(keep: frozenset[str] = frozenset()) -> Iterator[None]:
+    """Within it, a report (:func:`reports.content.build`) makes its figures but saves only those named in ``keep``."""
+    with mock.patch.object(figures, "FigureWriter", functools.partial(_UndrawnWriter, keep=keep)):
         yield
