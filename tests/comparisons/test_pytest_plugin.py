@@ -21,6 +21,7 @@ pytest_plugins = ["pytester"]
 
 EXAMPLE = Path(__file__).resolve().parents[2] / "docs" / "examples" / "test_my_numerics.py"
 EXAMPLE_TEST = "test_the_lecture_projectile_keeps_its_known_errors"
+EXAMPLE_CALL = 'simparity.check("lecture-projectile", engines=["core"], profile="quick")'
 
 IMPOSSIBLE_RK4 = ('integrator = "rk4"\nmetric = "order_velocity"\nexpected = 5.0\nband = 0.01\nstatus = ["ok", "n/a"]\n'
                   'reason = "impossible"\n')
@@ -152,13 +153,22 @@ def test_paths_are_found_beside_the_test_file_and_bad_input_is_a_one_line_failur
 
 @pytest.fixture(scope="module")
 def example_run():
-    """The example's scene as it checks it (quick, core) and the table run_scene gives for it: one run of ~10 s for
-    the baselines below, each built from its own copy."""
+    """The example's scene as it checks it (quick, core) and the table run_scene gives for it, its cases in this
+    process (where a case runs changes none of its values; isolated, the workers cost ~8 s of CPU): one run for the
+    baselines below, each built from its own copy."""
     from simparity.comparisons.api import load_scene, run_scene
     from simparity.comparisons.scenes.profiles import quick
 
     scene = quick(load_scene("lecture-projectile"))
-    return scene, run_scene(scene, engines=["core"], repeats=0)
+    return scene, run_scene(scene, engines=["core"], repeats=0, isolate=False)
+
+
+def _example_in_process() -> str:
+    """The documented example with its cases in the test's process, for the sessions that hold it to a baseline:
+    what they test is the comparison (the example as written, isolated, passes in :func:`inner`)."""
+    text = EXAMPLE.read_text(encoding="utf-8")
+    assert text.count(EXAMPLE_CALL) == 1, "the example's check call changed: update EXAMPLE_CALL"
+    return text.replace(EXAMPLE_CALL, EXAMPLE_CALL.replace(")", ", isolate=False)"))
 
 
 @pytest.mark.slow
@@ -173,7 +183,7 @@ def test_a_baseline_that_differs_fails(pytester, tmp_path, example_run):
     table.loc[table["metric"] == "position_error_final", "value"] *= 1.01
     writer = RunWriter(tmp_path / "base", describe_run([], "test", [scene]))
     writer.append([ResultRow(**row) for row in table.to_dict("records")])
-    pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
+    pytester.makepyfile(test_example=_example_in_process())
     result = pytester.runpytest_inprocess("--simparity-baseline", str(tmp_path / "base"))
     result.assert_outcomes(failed=1)
     result.stdout.fnmatch_lines(["*moved since*position_error_final*"])
@@ -195,7 +205,7 @@ def test_the_documented_example_passes_against_a_baseline_that_ran_more_engines(
     more = rows + [dataclasses.replace(r, engine="mujoco") for r in rows] + [
         dataclasses.replace(r, scene="wind") for r in rows]
     RunWriter(tmp_path / "base", describe_run([], "test", [scene], "quick")).append(more)
-    pytester.makepyfile(test_example=EXAMPLE.read_text(encoding="utf-8"))
+    pytester.makepyfile(test_example=_example_in_process())
     result = pytester.runpytest_inprocess("--simparity-baseline", str(tmp_path / "base"))
     result.assert_outcomes(passed=1)
 
