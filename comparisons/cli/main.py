@@ -14,74 +14,18 @@ import os
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import pandas as pd
-
-from simparity.comparisons.scenes import library
-from simparity.comparisons.gate.check import (
-    BASELINE_RELATIVE,
-    CheckResult,
-    check_table,
-    compare_with_baseline,
-    explain,
-    explain_lines,
-    explain_rows,
-    held_to,
-    refuse_strangers,
-)
-from simparity.comparisons.gate.bless import bless, write_blessed
-from simparity.comparisons.gate.violation import grouped
-from simparity.comparisons.gate.check_output import held_line, junit_xml, summary_markdown
-from simparity.comparisons.scenes.describe import describe
-from simparity.comparisons.cli.check_options import (
-    CHECK_OPTIONS,
-    baseline_run,
-    baseline_table,
-    checked_check_options,
-    refuse_check_options,
-)
 from simparity.comparisons.cli.console import EXIT_INTERRUPTED
-from simparity.comparisons.cli.destinations import writable_file, writable_folder, write_file
-from simparity.comparisons.engines.registry import (
-    ENGINE_NAMES,
-    EngineSet,
-    check_engine_names,
-    make_engine,
-)
-from simparity.comparisons.gate.history import (
-    check_usable,
-    history_path,
-    latest_before,
-    metric_history,
-    recorded_scenes,
-)
-from simparity.comparisons.execute.execution import default_jobs
-from simparity.comparisons.execute.isolation import (
-    GIB,
-    MAX_CASE_SECONDS,
-    MIN_CASE_MEMORY_BYTES,
-    MIN_CASE_SECONDS,
-    CaseLimits,
-)
-from simparity.comparisons.execute.journal import CASES_FOLDER, Journal, read_request
-from simparity.comparisons.engines.placeholders import BrokenEngine, UnavailableEngine
-from simparity.comparisons.execute.runner import DEFAULT_REPEATS
-from simparity.comparisons.pipeline.session import Execution, Session, write_run_report
 from simparity.comparisons.cli.parser import build_parser
-from simparity.comparisons.scenes.limits import Limits
-from simparity.comparisons.common.out_folder import default_out_dir
-from simparity.comparisons.execute.timing import record_peak_memory, resource_line
-from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, EngineNames, Gate, load_gate, load_tolerances
-from simparity.comparisons.invariance.transforms import fixed_transforms
 from simparity.core.model.errors import SimparityError, one_line
-from simparity.core.model.ranges import RANGES
-from simparity.core.model.results import RESULTS_FILE, RUN_INFO_FILE
-from simparity.core.model.scenes.dynamics import DynamicsScene
-from simparity.core.model.scenes.ik import IKScene
-from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
-from simparity.core.model.scenes.joint_motion import JointMotionScene
-from simparity.core.model.scenes.kinematics import KinematicsScene
-from simparity.reports.store import read_info, read_run
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from simparity.comparisons.execute.isolation import CaseLimits
+    from simparity.comparisons.gate.check import CheckResult
+    from simparity.comparisons.gate.tolerances import EngineNames, Gate
 
 EXIT_OK, EXIT_FAILED_CASES, EXIT_USAGE = 0, 1, 2
 MAX_JOBS = 256
@@ -94,6 +38,8 @@ MESSAGE_LIMIT = 1000
 
 
 def cmd_list(args, out) -> int:
+    from simparity.comparisons.scenes import library
+
     scenes = library.suite(args.suite) if args.suite else library.load(list(library.builtin_paths().values()))
     for scene in scenes:
         print(f"{scene.name:<28} {scene.kind:<11} reference={scene.reference:<10} {','.join(scene.suites):<14} "
@@ -112,6 +58,9 @@ def cmd_engines(args, out) -> int:
 def _out_dir(args) -> Path:
     """The run's folder, created and probed for writing before the run: --out (refused when it holds a run, unless
     --force), else a new one."""
+    from simparity.comparisons.cli.destinations import writable_folder
+    from simparity.comparisons.common.out_folder import default_out_dir
+
     if args.out is None:
         return writable_folder("--out (default)", default_out_dir())
     try:
@@ -122,6 +71,8 @@ def _out_dir(args) -> Path:
 
 
 def _checked_out_dir(out_dir: Path, force: bool) -> Path:
+    from simparity.core.model.results import RESULTS_FILE, RUN_INFO_FILE
+
     held = [name for name in (RESULTS_FILE, RUN_INFO_FILE) if (out_dir / name).exists()]
     if held and not force:
         raise SimparityError(f"--out {one_line(out_dir)}: already holds a run ({', '.join(held)}); nothing was "
@@ -131,6 +82,9 @@ def _checked_out_dir(out_dir: Path, force: bool) -> Path:
 
 def _resumed(args) -> None:
     """Fill ``args`` with what the run in ``--resume DIR`` was asked to do; refuse options that would change it."""
+    from simparity.comparisons.execute.journal import CASES_FOLDER, read_request
+    from simparity.core.model.results import RESULTS_FILE
+
     defaults = build_parser().parse_args(["run"])
     given = [name for name in RESUMED_OPTIONS if getattr(args, name) != getattr(defaults, name)]
     if given:
@@ -165,6 +119,14 @@ def _request(args, names: tuple[str, ...], repeats: int) -> dict:
 
 def _limits(args, jobs: int) -> CaseLimits:
     """The per-case limits from --case-timeout and --case-memory (default: a share of the machine a case runs on)."""
+    from simparity.comparisons.execute.isolation import (
+        GIB,
+        MAX_CASE_SECONDS,
+        MIN_CASE_MEMORY_BYTES,
+        MIN_CASE_SECONDS,
+        CaseLimits,
+    )
+
     if not MIN_CASE_SECONDS <= args.case_timeout <= MAX_CASE_SECONDS:  # False for nan
         raise SimparityError(f"--case-timeout {args.case_timeout:g}: out of range (allowed: seconds from "
                              f"{MIN_CASE_SECONDS:g}, a case's fixed cost with room, to {MAX_CASE_SECONDS:g})")
@@ -179,6 +141,27 @@ def _limits(args, jobs: int) -> CaseLimits:
 
 
 def cmd_run(args, out) -> int:
+    from simparity.comparisons.cli.check_options import (
+        CHECK_OPTIONS,
+        baseline_run,
+        checked_check_options,
+        refuse_check_options,
+    )
+    from simparity.comparisons.engines.placeholders import BrokenEngine, UnavailableEngine
+    from simparity.comparisons.engines.registry import EngineSet, check_engine_names
+    from simparity.comparisons.execute.execution import default_jobs
+    from simparity.comparisons.execute.journal import Journal
+    from simparity.comparisons.execute.runner import DEFAULT_REPEATS
+    from simparity.comparisons.execute.timing import record_peak_memory, resource_line
+    from simparity.comparisons.gate.check import refuse_strangers
+    from simparity.comparisons.gate.history import check_usable, history_path
+    from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, load_gate
+    from simparity.comparisons.invariance.transforms import fixed_transforms
+    from simparity.comparisons.pipeline.session import Execution, Session
+    from simparity.comparisons.scenes import library
+    from simparity.comparisons.scenes.limits import Limits
+    from simparity.core.model.results import RUN_INFO_FILE
+
     start = time.perf_counter()
     if args.resume is not None:
         _resumed(args)
@@ -268,6 +251,12 @@ def cmd_run(args, out) -> int:
 
 def _cost(scenes) -> str:
     """What the run will do, counted before it starts."""
+    from simparity.core.model.scenes.dynamics import DynamicsScene
+    from simparity.core.model.scenes.ik import IKScene
+    from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+    from simparity.core.model.scenes.joint_motion import JointMotionScene
+    from simparity.core.model.scenes.kinematics import KinematicsScene
+
     steps = sum(s.n_steps(dt) * len(s.bodies) for s in scenes if isinstance(s, DynamicsScene) for dt in s.dts)
     samples = sum(s.n_configurations for s in scenes if isinstance(s, KinematicsScene))
     targets = sum(s.n_targets + len(s.hard_targets) for s in scenes if isinstance(s, IKScene))
@@ -280,6 +269,8 @@ def _cost(scenes) -> str:
 
 def _engine_names(gate: Gate, args) -> tuple[EngineNames | None, EngineNames | None]:
     """The engines the gate holds and requires: the command line's, else the tolerances file's (None: not named)."""
+    from simparity.comparisons.gate.tolerances import EngineNames
+
     check = EngineNames(args.check_engines, "--check-engines") if args.check_engines else gate.check_engines
     require = EngineNames(args.require_engines, "--require-engines") if args.require_engines else gate.require_engines
     return check, require
@@ -304,6 +295,13 @@ def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = No
     """Print the verdict on a stored run (and the moves since the baseline); 0 passed, 1 not.
     ``result``: the run already held to ``gate``'s bounds; ``table``: its rows, as the run's writer handed them back
     (None: read from ``run_dir``)."""
+    from simparity.comparisons.cli.check_options import baseline_table
+    from simparity.comparisons.cli.destinations import write_file
+    from simparity.comparisons.gate.check import BASELINE_RELATIVE, check_table, compare_with_baseline, held_to
+    from simparity.comparisons.gate.check_output import held_line, junit_xml, summary_markdown
+    from simparity.comparisons.gate.violation import grouped
+    from simparity.reports.store import read_info, read_run
+
     table, info = read_run(run_dir) if table is None else (table, read_info(run_dir))
     result = held_to(check_table(table, gate.bounds) if result is None else result, *_engine_names(gate, args))
     diff = None
@@ -345,6 +343,11 @@ def _check(run_dir: Path, gate: Gate, args, out, result: CheckResult | None = No
 
 
 def cmd_check(args, out) -> int:
+    from simparity.comparisons.cli.check_options import CHECK_OPTIONS, checked_check_options, refuse_check_options
+    from simparity.comparisons.cli.destinations import writable_file
+    from simparity.comparisons.gate.history import history_path, latest_before
+    from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES, load_gate
+
     gate = load_gate(args.tolerances or DEFAULT_TOLERANCES)
     bounds = gate.bounds
     run_dir = args.run_dir
@@ -372,6 +375,10 @@ def cmd_check(args, out) -> int:
 def _bless(run_dir: Path, path: Path, spread: Path | None, tolerances: Path | None, out) -> int:
     """Write the tolerances file blessed from the run in ``run_dir`` (:mod:`comparisons.gate.bless`), extending
     ``tolerances`` (default: the shipped ones); a ``spread`` run of another profile is refused."""
+    from simparity.comparisons.gate.bless import bless, write_blessed
+    from simparity.comparisons.gate.tolerances import load_tolerances
+    from simparity.reports.store import read_run
+
     table, info = read_run(run_dir)
     other = read_run(spread) if spread is not None else None
     if other is not None and info.profile and other[1].profile and other[1].profile != info.profile:
@@ -389,6 +396,10 @@ def _bless(run_dir: Path, path: Path, spread: Path | None, tolerances: Path | No
 def _explain(run_dir: Path, bounds, engine: str, narrowed: dict[str, str], out) -> int:
     """What the gate holds ``engine`` to in the run of ``run_dir``: one line per scene and bound, or (``narrowed``
     to rows by scene, integrator or metric patterns) every bound that matched each row and which decided."""
+    from simparity.comparisons.engines.registry import ENGINE_NAMES
+    from simparity.comparisons.gate.check import explain, explain_lines, explain_rows
+    from simparity.reports.store import read_run
+
     table, _ = read_run(run_dir)
     engines = sorted(set(table["engine"]))
     if engine not in engines:
@@ -404,6 +415,8 @@ def _explain(run_dir: Path, bounds, engine: str, narrowed: dict[str, str], out) 
 
 
 def cmd_history(args, out) -> int:
+    from simparity.comparisons.gate.history import history_path, metric_history, recorded_scenes
+
     path = history_path(args.history)
     table = metric_history(path, args.scene, args.engine, args.metric)
     if table.empty:
@@ -418,6 +431,10 @@ def cmd_history(args, out) -> int:
 
 
 def cmd_export(args, out) -> int:
+    from simparity.comparisons.engines.registry import make_engine
+    from simparity.comparisons.scenes import library
+    from simparity.core.model.ranges import RANGES
+
     if args.dt is not None and not (args.dt > 0 and RANGES["dt"].allows(args.dt)):
         raise SimparityError(f"--dt {args.dt}: not a time step (allowed: a finite number of seconds > 0, "
                              f"{RANGES['dt'].text()})")
@@ -433,12 +450,16 @@ def cmd_export(args, out) -> int:
 
 
 def cmd_show(args, out) -> int:
+    from simparity.comparisons.scenes import library
+    from simparity.comparisons.scenes.describe import describe
+
     print("\n".join(describe(scene) for scene in library.load([args.scene])), file=out, end="")
     return EXIT_OK
 
 
 def cmd_bench(args, out) -> int:
     from simparity.comparisons.bench.run import run_bench  # imports every engine: only when asked
+    from simparity.comparisons.cli.destinations import writable_folder
 
     def say(line: str) -> None:
         print(line, file=out, flush=True)
@@ -449,6 +470,9 @@ def cmd_bench(args, out) -> int:
 
 
 def cmd_report(args, out) -> int:
+    from simparity.comparisons.gate.tolerances import load_gate
+    from simparity.comparisons.pipeline.session import write_run_report
+
     gate = load_gate(args.tolerances) if args.tolerances else None
     held = gate.check_engines.names if gate is not None and gate.check_engines is not None else None
     write_run_report(args.run_dir, lambda line: print(line, file=out), gate.bounds if gate else None, held)

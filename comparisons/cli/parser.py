@@ -4,23 +4,10 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Callable, cast
 
-from simparity.comparisons.engines.registry import DEFAULT_ENGINES, allowed_engines
-from simparity.comparisons.execute.execution import default_jobs
-from simparity.comparisons.execute.isolation import (
-    DEFAULT_CASE_SECONDS,
-    GIB,
-    MAX_CASE_SECONDS,
-    MIN_CASE_MEMORY_BYTES,
-    MIN_CASE_SECONDS,
-)
-from simparity.comparisons.execute.runner import DEFAULT_REPEATS
 from simparity.comparisons.common.out_folder import DEFAULT_OUT_ROOT
-from simparity.comparisons.gate.check import BASELINE_RELATIVE, UNBOUNDED_SHARE_MAX
 from simparity.comparisons.gate.tolerances import DEFAULT_TOLERANCES
-from simparity.comparisons.invariance.transforms import TRANSFORM_NAMES
-from simparity.comparisons.scenes.limits import DEFAULT_LIMITS
-from simparity.comparisons.scenes.profiles import QUICK_CONTACT_STEPS, QUICK_LADDER, QUICK_MAX_STEPS, QUICK_TARGETS
 from simparity.core.model.errors import UsageError, echo, one_line
 from simparity.core.model.scenes.suites import SUITES
 
@@ -36,6 +23,27 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message: str):
         allowed = "" if "(allowed: " in message else f" (allowed: see '{self.prog} --help')"
         raise UsageError(f"{self.prog}: {message}{allowed}")
+
+
+class _Commands(argparse._SubParsersAction):
+    """The subcommands, each given its options when it is the command parsed: their help quotes defaults of the
+    execution stack, the engines and the gate, which a command that needs none of them (``simparity list``,
+    ``--help``) never imports."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._options: dict[str, Callable[[argparse.ArgumentParser], None]] = {}
+
+    def add_command(self, name: str, options: Callable[[argparse.ArgumentParser], None], **kwargs) -> None:
+        """Command ``name`` (``kwargs``: its help and description); ``options(parser)`` adds its arguments."""
+        self.add_parser(name, **kwargs)
+        self._options[name] = options
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        options = self._options.pop(values[0], None)  # argparse checked the name against the commands
+        if options is not None:
+            options(self._name_parser_map[values[0]])
+        super().__call__(parser, namespace, values, option_string)
 
 
 def name_list(known: tuple[str, ...] = (), kind: str = "name"):
@@ -78,6 +86,8 @@ def path_argument(text: str) -> Path:
 
 
 def _add_check_options(parser: argparse.ArgumentParser) -> None:
+    from simparity.comparisons.gate.check import BASELINE_RELATIVE, UNBOUNDED_SHARE_MAX  # pandas: only when parsed
+
     parser.add_argument("--tolerances", type=path_argument, default=None, metavar="FILE",
                         help=f"bounds to hold the run to: your file extends the shipped {DEFAULT_TOLERANCES.name} "
                         "(extends = \"none\" in it starts empty) and its bounds win where they match")
@@ -110,31 +120,22 @@ def _add_history_option(parser: argparse.ArgumentParser) -> None:
                         help=f"run history database (default: $SIMPARITY_HISTORY or {DEFAULT_OUT_ROOT}/history.sqlite)")
 
 
-def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(
-        prog="simparity",
-        description="Run textbook IK and rigid-body methods beside MuJoCo, PyBullet and Pinocchio "
-        "on identical scenes; report error, drift and speed, and check them against tolerances.",
+def _add_run_arguments(run: argparse.ArgumentParser) -> None:
+    """The options of ``simparity run``: their help quotes the defaults of the engines and the execution stack."""
+    from simparity.comparisons.engines.registry import DEFAULT_ENGINES, allowed_engines
+    from simparity.comparisons.execute.execution import default_jobs
+    from simparity.comparisons.execute.isolation import (
+        DEFAULT_CASE_SECONDS,
+        GIB,
+        MAX_CASE_SECONDS,
+        MIN_CASE_MEMORY_BYTES,
+        MIN_CASE_SECONDS,
     )
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    from simparity.comparisons.execute.runner import DEFAULT_REPEATS
+    from simparity.comparisons.invariance.transforms import TRANSFORM_NAMES
+    from simparity.comparisons.scenes.limits import DEFAULT_LIMITS
+    from simparity.comparisons.scenes.profiles import QUICK_CONTACT_STEPS, QUICK_LADDER, QUICK_MAX_STEPS, QUICK_TARGETS
 
-    listing = sub.add_parser("list", help="list the built-in scenes",
-                             description="List the built-in scenes, one per line, with the suites they are in.")
-    listing.add_argument("--suite", default=None, choices=SUITES, help="only the scenes of this suite")
-
-    sub.add_parser(
-        "engines", help="list the engines: built-in and installed plugins, with what each supports",
-        description="List every engine, one per line: its name (what --engines takes), where it comes from (built-in, "
-        "or the installed package and entry point of a plugin in the group 'simparity.engines'), its version, its "
-        "dynamics integrators, IK solvers and whether it does kinematics; an engine that cannot run says why, a "
-        "plugin shadowed by a built-in of the same name says so. Code that is not packaged runs as "
-        "--engines module:Class. Writing one: docs/plugins.md.")
-
-    run = sub.add_parser(
-        "run", help="run scenes on engines and write results.csv and report.md",
-        description="Run scenes on engines; write results.csv, run.json and report.md into a new output folder, "
-        "and record the run in the history database.",
-    )
     run.add_argument("scenes", nargs="*", metavar="SCENE|FILE",
                      help="built-in scene names or scene files (default: the scenes of --suite)")
     run.add_argument("--suite", default=None, choices=SUITES,
@@ -194,11 +195,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_check_options(run)
     _add_history_option(run)
 
-    check = sub.add_parser(
-        "check", help="hold a stored run to tolerances (exit 1 on a violation)",
-        description="Hold every metric of a stored run to its bound; print each violation on one line. Exit 0 "
-        "when all are inside, 1 when any is not (or, with --baseline, when numerics moved), 2 on bad input.",
-    )
+
+def _add_check_arguments(check: argparse.ArgumentParser) -> None:
+    """The arguments of ``simparity check``."""
     check.add_argument("run_dir", nargs="?", type=path_argument, default=None, metavar="RUN_DIR",
                        help="a folder written by 'simparity run' (default: the latest run in the history)")
     check.add_argument("--explain", type=name_argument, default=None, metavar="ENGINE",
@@ -218,14 +217,47 @@ def build_parser() -> argparse.ArgumentParser:
     _add_check_options(check)
     _add_history_option(check)
 
-    history = sub.add_parser("history", help="how metrics moved across recorded runs",
-                             description="Show one metric (or all) across the runs recorded in the history database.")
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="simparity",
+        description="Run textbook IK and rigid-body methods beside MuJoCo, PyBullet and Pinocchio "
+        "on identical scenes; report error, drift and speed, and check them against tolerances.",
+    )
+    commands = cast(_Commands, parser.add_subparsers(dest="command", metavar="COMMAND", required=True,
+                                                     action=_Commands))
+
+    listing = commands.add_parser("list", help="list the built-in scenes",
+                                  description="List the built-in scenes, one per line, with the suites they are in.")
+    listing.add_argument("--suite", default=None, choices=SUITES, help="only the scenes of this suite")
+
+    commands.add_parser(
+        "engines", help="list the engines: built-in and installed plugins, with what each supports",
+        description="List every engine, one per line: its name (what --engines takes), where it comes from (built-in, "
+        "or the installed package and entry point of a plugin in the group 'simparity.engines'), its version, its "
+        "dynamics integrators, IK solvers and whether it does kinematics; an engine that cannot run says why, a "
+        "plugin shadowed by a built-in of the same name says so. Code that is not packaged runs as "
+        "--engines module:Class. Writing one: docs/plugins.md.")
+
+    commands.add_command(
+        "run", _add_run_arguments, help="run scenes on engines and write results.csv and report.md",
+        description="Run scenes on engines; write results.csv, run.json and report.md into a new output folder, "
+        "and record the run in the history database.")
+
+    commands.add_command(
+        "check", _add_check_arguments, help="hold a stored run to tolerances (exit 1 on a violation)",
+        description="Hold every metric of a stored run to its bound; print each violation on one line. Exit 0 "
+        "when all are inside, 1 when any is not (or, with --baseline, when numerics moved), 2 on bad input.")
+
+    history = commands.add_parser(
+        "history", help="how metrics moved across recorded runs",
+        description="Show one metric (or all) across the runs recorded in the history database.")
     history.add_argument("scene", nargs="?", type=name_argument, default=None, metavar="SCENE")
     history.add_argument("--engine", type=name_argument, default=None)
     history.add_argument("--metric", type=name_argument, default=None)
     _add_history_option(history)
 
-    export = sub.add_parser(
+    export = commands.add_parser(
         "export", help="print the model an adapter builds for a scene",
         description="Print the model (MJCF, URDF or Pinocchio's model) an engine is given for a scene.",
     )
@@ -234,13 +266,13 @@ def build_parser() -> argparse.ArgumentParser:
     export.add_argument("--integrator", type=name_argument, default=None, help="dynamics only (default: the engine's first)")
     export.add_argument("--dt", type=float, default=None, help="dynamics only, [s] (default: the scene's first)")
 
-    show = sub.add_parser(
+    show = commands.add_parser(
         "show", help="print a scene as the loader understood it",
         description="Print a scene in SI units as loaded: bodies (mass, COM and inertia tensor, computed for a body "
         "built from point masses), forces, planes (normalised), shapes and every body-plane material.")
     show.add_argument("scene", metavar="SCENE|FILE")
 
-    bench = sub.add_parser(
+    bench = commands.add_parser(
         "bench", help="measure speed with accuracy, core against the engines; write BENCHMARKS.md",
         description="Time rigid-body stepping (B = 1, 100, 10,000 bodies), FK + Jacobian, IK (the bench suite's "
         "arms, 10,000 targets each), the arms' joint-space dynamics and their motion (RK4 of B = 1, 100, 10,000 "
@@ -252,7 +284,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="folder for BENCHMARKS.md and benchmarks.csv (default: the current folder)")
     bench.add_argument("--quick", action="store_true", help="B = 1 and 100 only, 300 IK targets per arm")
 
-    report = sub.add_parser(
+    report = commands.add_parser(
         "report", help="re-render report.md, report.html and figures/ of a stored run",
         description="Re-render report.md, report.html and the figures (SVG, PNG) from a stored run's results.csv, "
         "series.csv.gz and run.json; runs no engine. Flagged findings hold the run to --tolerances.")
