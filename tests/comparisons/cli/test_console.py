@@ -23,9 +23,10 @@ loaded machine) the report; a run that finished first exits 0 and is also fine."
 @pytest.mark.slow  # each runs the console script; under a loaded CI one run went on to its end (35 s, exit 0: allowed)
 @pytest.mark.parametrize("seconds", INTERRUPT_AFTER)
 def test_ctrl_c_at_any_moment_is_one_line_and_exit_130(seconds, tmp_path):
-    # one worker (--jobs 1): the same phases, at half the CPU of two workers starting and running cases
+    # one worker (--jobs 1), the quick profile: the same phases, at a fraction of the CPU of the full profile on two
+    # workers, and a run the signal reaches only after it ended (a loaded machine) costs seconds, not a full run's ~35
     process = subprocess.Popen([str(SCRIPT), "run", "lecture-projectile", "lecture-2link-ik", "--repeats", "0",
-                                "--jobs", "1", "--out", str(tmp_path / "run")], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                "--quick", "--jobs", "1", "--out", str(tmp_path / "run")], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                text=True)
     time.sleep(seconds)
     process.send_signal(signal.SIGINT)
