@@ -131,6 +131,13 @@ class _NotDask(socketserver.BaseRequestHandler):
             time.sleep(UNREACHABLE_SECONDS)  # a web server waiting for the rest of a request
 
 
+class _NotDaskServer(socketserver.ThreadingTCPServer):
+    """Its handlers' threads are not waited for when it closes: the silent one sleeps on after the client gave up."""
+
+    daemon_threads = True
+    block_on_close = False
+
+
 @pytest.mark.parametrize("banner", [b"SSH-2.0-OpenSSH_9.6 not dask\r\n" * 4, pytest.param(b"", marks=pytest.mark.slow)])
 def test_a_service_that_is_not_dask_at_the_scheduler_address_is_a_one_line_error(tmp_path, capsys, monkeypatch,
                                                                                    banner):
@@ -138,7 +145,7 @@ def test_a_service_that_is_not_dask_at_the_scheduler_address_is_a_one_line_error
     on a silent server (a web server: the dashboard's port given by mistake)."""
     monkeypatch.setattr(dask_executor, "IDENTIFY_SECONDS", SHORT_IDENTIFY_SECONDS)
     handler = type("Handler", (_NotDask,), {"banner": banner})
-    with socketserver.ThreadingTCPServer(("127.0.0.1", 0), handler) as server:
+    with _NotDaskServer(("127.0.0.1", 0), handler) as server:
         threading.Thread(target=server.serve_forever, daemon=True).start()
         out = tmp_path / "run"
         address = f"tcp://127.0.0.1:{server.server_address[1]}"
