@@ -197,7 +197,9 @@ class Session:
             self.engines = [make_engine(n) for n in self.names]  # the caller asked for its engines in its process
         else:
             self.engines = engines.describe(self.names, self.scenes)
-        self.probes = engines.probes  # kept to ask the engines about transformed scenes
+        self.probes = engines.probes  # kept to ask the engines about transformed scenes; without any, ended now:
+        if not self.transforms:       # no idle process holds a user's engine through the run's cases
+            self.probes.close()
         check_distinct(self.engines, self.names, self.scenes)
         self.specs = dict(zip((e.name for e in self.engines), self.names))
         if bounds is not None:  # before any case runs: a bound that can match nothing is bad input

@@ -19,6 +19,8 @@ class ProbeSpy:
 
     started: Counter = field(default_factory=Counter)
     answers: dict[str, Engine] = field(default_factory=dict)
+    processes: list = field(default_factory=list)
+    """Every probe's process (a ``subprocess.Popen``), in the order started."""
 
 
 def spy_probes(monkeypatch: pytest.MonkeyPatch) -> ProbeSpy:
@@ -30,6 +32,7 @@ def spy_probes(monkeypatch: pytest.MonkeyPatch) -> ProbeSpy:
         def __init__(self, name: str, scenes: list) -> None:
             spy.started[name] += 1
             super().__init__(name, scenes)
+            spy.processes.append(self.process)
 
         def result(self) -> Engine:
             spy.answers[self.name] = answer = super().result()

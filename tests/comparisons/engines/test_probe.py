@@ -12,6 +12,10 @@ from simparity.comparisons.engines import probe as engine_probe
 from simparity.comparisons.cli.main import main
 from simparity.comparisons.engines.probe import PROBE_CHAIN, DescribedEngine, probe_engines
 from simparity.comparisons.engines.placeholders import BrokenEngine
+from simparity.comparisons.engines.registry import EngineSet
+from simparity.comparisons.execute.isolation import CaseLimits
+from simparity.comparisons.pipeline.session import ISOLATED, Execution, Session
+from simparity.comparisons.scenes.library import load
 from simparity.core.inhouse import InHouseEngine
 from tests.comparisons.engines.probe_spy import spy_probes
 from tests.helpers import THROWN_BALL, builtin
@@ -150,6 +154,19 @@ def test_a_scene_file_and_the_quick_profile_may_name_a_spec_engines_own_integrat
         own = table[(table.engine == "own") & (table.metric == "position_error_max")]
         assert list(own.integrator) == ["own_rk4", "own_rk4"] and set(own.status) == {"ok"}
         assert (table[table.engine == "core"].status == "n/a").all()  # core offers no own_rk4
+
+
+def test_a_run_without_transforms_ends_its_probes_before_its_cases(tmp_path, monkeypatch):
+    """A kept probe holds its engine's imports; a run with no transformed scenes to ask about keeps none while its
+    cases run."""
+    spy = spy_probes(monkeypatch)
+    engines = EngineSet(("core", OWN_SPEC))
+    scene = tmp_path / "throw.toml"
+    scene.write_text(THROWN_BALL, encoding="utf-8")
+    scenes = load([str(scene)], engines=engines)
+    Session(scenes, engines, profile="quick", execution=Execution(ISOLATED, 1, CaseLimits(60.0, None)))
+    assert spy.started == {OWN_SPEC: 1}
+    assert all(process.poll() is not None for process in spy.processes)
 
 
 def test_a_described_engine_runs_nothing(described_core):
