@@ -48,7 +48,7 @@ class Table:
 
 @dataclass(frozen=True)
 class Figure:
-    """A figure written by :func:`reports.figures.save` as ``figures/<name>.svg`` (and .png). ``caption`` is under
+    """A figure written by :func:`reports.figure_writer.save` as ``figures/<name>.svg`` (and .png). ``caption`` is under
     it in the HTML; report.md links it with its short ``alt`` (the figure's name when empty): docs/report.md says how
     to read each figure."""
 

@@ -14,7 +14,7 @@ import pandas as pd
 
 from simparity.core.model.results import STATUSES, case_counts
 from simparity.core.model.run_info import RunInfo
-from simparity.reports import figures, own_engine, sweep_sections, sweep_summary
+from simparity.reports import figure_writer, figures, own_engine, sweep_sections, sweep_summary
 from simparity.reports.blocks import Block, Bullets, Details, Heading, Paragraph, scene_heading
 from simparity.reports.markdown import LINE_CHARS
 from simparity.reports.sections import (
@@ -44,9 +44,9 @@ _DEFINITIONS = (
 def build(table: pd.DataFrame, info: RunInfo, series: pd.DataFrame, verdict: ToleranceVerdict | None,
           run_dir: Path) -> tuple[list[Block], dict[str, str]]:
     """(the report's blocks, the SVG text of each figure by name); figures are written to
-    ``run_dir/figures`` (:class:`reports.figures.FigureWriter`: a few in this process, many on one process per CPU),
+    ``run_dir/figures`` (:class:`reports.figure_writer.FigureWriter`: a few in this process, many on one process per CPU),
     each in the order drawn. ``verdict``: the run held to tolerances, None if it was not."""
-    with figures.FigureWriter() as writer:
+    with figure_writer.FigureWriter() as writer:
         ctx = ReportContext(table, info, series, verdict, Path(run_dir) / FIGURES_DIR, writer,
                             sweep_summary.sweeps(table, info))
         blocks = _blocks(ctx, table, info)

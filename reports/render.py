@@ -17,7 +17,7 @@ from simparity.reports.tolerance_verdict import ToleranceVerdict
 
 
 FIGURE_SUFFIXES = (".svg", ".png")
-"""What a figure is written as (:func:`reports.figures.save`)."""
+"""What a figure is written as (:func:`reports.figure_writer.save`)."""
 
 
 def _remove_stale_figures(folder: Path, drawn: set[str]) -> None:

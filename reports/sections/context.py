@@ -14,7 +14,7 @@ from simparity.core.model.metric_catalogue import (
     JOINT_ANGLE_ERROR_MAX, MASS_MATRIX_ERROR_MAX, ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE,
 )
 from simparity.core.model.run_info import RunInfo
-from simparity.reports import engine_summary, figures, summary, sweep_sections, sweep_summary
+from simparity.reports import engine_summary, figure_writer, figures, summary, sweep_sections, sweep_summary
 from simparity.reports.blocks import Block, Figure
 from simparity.reports.sweep_summary import Sweep, merge_variants
 from simparity.reports.tolerance_verdict import ToleranceVerdict
@@ -53,10 +53,10 @@ class ReportContext:
     count each scene's findings (``findings_per_scene``) before the scenes' sections say them."""
 
     def __init__(self, table: pd.DataFrame, info: RunInfo, series: pd.DataFrame, verdict: ToleranceVerdict | None,
-                 figure_dir: Path, writer: figures.FigureWriter, sweeps: list[Sweep]) -> None:
+                 figure_dir: Path, writer: figure_writer.FigureWriter, sweeps: list[Sweep]) -> None:
         self.table, self.info, self.series, self.verdict = table, info, series, verdict
         self.figure_dir, self.writer = figure_dir, writer
-        self.svgs: dict[str, figures.WrittenFigure] = {}
+        self.svgs: dict[str, figure_writer.WrittenFigure] = {}
         self.sweeps = sweeps
         self.sweep_of = {name: sweep for sweep in sweeps for name in sweep.variants}
         self.groups = sweep_summary.groups(sweeps)

@@ -18,7 +18,7 @@ from simparity.core.model.metric_catalogue import (
     SOLVE_RATE_OWN_STOP,
     TIME_PER_SOLVE,
 )
-from simparity.reports import figures
+from simparity.reports import figure_writer, figures
 from simparity.reports.figure_layout import finish, power_of_ten
 from simparity.reports.summary import ERROR_BUDGETS
 
@@ -326,7 +326,7 @@ KILLED_WRITER = """
 import os, signal, sys
 from pathlib import Path
 import matplotlib.pyplot as plt
-from simparity.reports.figures import FigureWriter
+from simparity.reports.figure_writer import FigureWriter
 with FigureWriter(2, in_process_max=0) as writer:  # the pool at once
     writer.submit(plt.figure(), Path(sys.argv[1]), "first").result()  # the pool's processes are up
     print(" ".join(str(pid) for pid in writer._pool._processes), flush=True)
@@ -367,10 +367,10 @@ def test_a_few_figures_are_written_here_and_more_on_the_pool_the_same_svg_either
     """Up to ``in_process_max`` figures wait and are written in this process (no pool started: a small report does not
     pay two interpreters' start-up); the next one starts the pool, which writes the waiting ones too. The SVG text
     and the files are the same whichever process wrote them."""
-    with figures.FigureWriter(2, in_process_max=2) as small:
+    with figure_writer.FigureWriter(2, in_process_max=2) as small:
         few = [small.submit(_line_figure(k), tmp_path / "few", f"f{k}") for k in (1, 2)]
         assert small._pool is None
-    with figures.FigureWriter(2, in_process_max=2) as large:
+    with figure_writer.FigureWriter(2, in_process_max=2) as large:
         many = [large.submit(_line_figure(k), tmp_path / "many", f"f{k}") for k in (1, 2, 3)]
         assert large._pool is not None
     for k, (here, pooled) in enumerate(zip(few, many), start=1):
@@ -379,8 +379,20 @@ def test_a_few_figures_are_written_here_and_more_on_the_pool_the_same_svg_either
     assert (tmp_path / "many" / "f3.svg").is_file()
 
 
+@pytest.mark.slow  # starts a pool of two figure processes (~2 CPU-s)
+def test_a_figure_process_imports_matplotlib_and_not_the_drawing_nor_pandas(tmp_path):
+    """A pool's process is a fresh interpreter: what it imports before its first figure is paid per process. It writes
+    pickled figures, so it needs matplotlib and the writer, not pandas nor the drawing code (~0.5 CPU-s each)."""
+    imported = "sorted({m for m in __import__('sys').modules if m.split('.')[0] in ('pandas', 'simparity', 'matplotlib')})"
+    with figure_writer.FigureWriter(2, in_process_max=0) as writer:
+        writer.submit(_line_figure(1.0), tmp_path, "f")  # starts the pool
+        modules = writer._pool.submit(eval, imported).result()  # eval: a builtin, so the process imports nothing more
+    assert "matplotlib.pyplot" in modules and "simparity.reports.figure_writer" in modules
+    assert not [m for m in modules if m.startswith("pandas") or m == "simparity.reports.figures"], modules
+
+
 def test_a_failed_report_writes_none_of_its_waiting_figures(tmp_path):
-    with pytest.raises(RuntimeError), figures.FigureWriter(2) as writer:
+    with pytest.raises(RuntimeError), figure_writer.FigureWriter(2) as writer:
         writer.submit(_line_figure(1.0), tmp_path, "unwritten")
         raise RuntimeError("the report failed")
     assert not list(tmp_path.iterdir())

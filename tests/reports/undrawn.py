@@ -9,14 +9,14 @@ import functools
 from collections.abc import Iterator
 from unittest import mock
 
-from simparity.reports import figures
+from simparity.reports import figure_writer
 
 UNDRAWN_SVG = "<svg></svg>"
 """The SVG text handed back for a figure left unsaved: an empty one, which report.html embeds like any other."""
 
 
 class _UndrawnWriter:
-    """Stands for :class:`reports.figures.FigureWriter`: :meth:`submit` closes the figure and hands back
+    """Stands for :class:`reports.figure_writer.FigureWriter`: :meth:`submit` closes the figure and hands back
     :data:`UNDRAWN_SVG`, unless its name is one of ``keep``: that one is saved (SVG and PNG) in this process."""
 
     def __init__(self, *args, keep: frozenset[str] = frozenset(), **kwargs) -> None:
@@ -31,9 +31,9 @@ class _UndrawnWriter:
     def submit(self, fig, folder, name) -> concurrent.futures.Future:
         done: concurrent.futures.Future = concurrent.futures.Future()
         if name in self._keep:
-            done.set_result(figures.save(fig, folder, name))
+            done.set_result(figure_writer.save(fig, folder, name))
         else:
-            figures.plt.close(fig)
+            figure_writer.plt.close(fig)
             done.set_result(UNDRAWN_SVG)
         return done
 
@@ -41,5 +41,5 @@ class _UndrawnWriter:
 @contextlib.contextmanager
 def undrawn_figures(keep: frozenset[str] = frozenset()) -> Iterator[None]:
     """Within it, a report (:func:`reports.content.build`) makes its figures but saves only those named in ``keep``."""
-    with mock.patch.object(figures, "FigureWriter", functools.partial(_UndrawnWriter, keep=keep)):
+    with mock.patch.object(figure_writer, "FigureWriter", functools.partial(_UndrawnWriter, keep=keep)):
         yield
