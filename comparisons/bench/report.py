@@ -69,9 +69,16 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
                                 f"judged: the load average around its row, less the bench's own thread, above "
                                 f"{OTHERS_LOAD_PER_CPU:g} per CPU, or its CPU / wall below {MIN_CPU_PER_WALL:g}."), "",
              "| target | compared | verdict |", "|---|---|---|"]
-    for verdict in targets(rows, cpus(info)):
+    verdicts = targets(rows, cpus(info))
+    for verdict in verdicts:
         label = "**MISSED**" if verdict.met is False else verdict.label
         lines.append(f"| {verdict.target} | {verdict.compared} | {label} |")
+    reasons = dict.fromkeys(v.because for v in verdicts if v.met is False and v.because)
+    if reasons:  # one paragraph per reason, naming the missed targets it explains
+        lines += ["", "### Why the missed targets are missed", ""]
+        for reason in reasons:
+            names = "; ".join(v.target for v in verdicts if v.met is False and v.because == reason)
+            lines += [f"- **{names}**: {reason}"]
     lines += ["", "The suites' times are judged on the load when their run started (their own worker processes load "
               "every CPU). The test run's (`python -m pytest`, target <= 300 s on 2 cores) is not the installed "
               "package's to measure: CI (`.ci/run`) measures it in a fresh clone, and the README gives it.", ""]

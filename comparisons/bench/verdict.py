@@ -1,6 +1,7 @@
 """The bench's verdict on one of the issue's targets, and the sizes the targets are set for: a target measured at
-another size (``--quick``) is "not comparable", never met or missed; an absolute target (a rate, not a ratio to
-something measured in the same run) measured while the machine was loaded is "not judged"."""
+another size (``--quick``) is "not comparable", never met or missed; a target whose rows were measured while the
+machine was loaded is "not judged" (an absolute rate reads low; a ratio of two rows timed minutes apart moves with
+the load of one and not the other); a missed target says why (``because``)."""
 
 from __future__ import annotations
 
@@ -36,7 +37,10 @@ class Verdict:
     set_for: str = ""
     """The size the target is set for (``B = 10,000``) where this run measured at another, ``measured_at``."""
     loaded: str = ""
-    """Why an absolute target was not judged: the machine's load during its row (:func:`machine_loaded`)."""
+    """Why a target was not judged: the machine's load during one of its rows (:func:`machine_loaded`)."""
+    because: str = ""
+    """Why the target is missed, as measured when it was last worked on: what its time goes to and what would close
+    it (BENCHMARKS.md prints it under the targets when the target is missed)."""
 
     @property
     def status(self) -> str:
@@ -78,6 +82,21 @@ def machine_loaded(row: BenchRow, cpus: int) -> str:
 def absolute(verdict: Verdict, row: BenchRow, cpus: int) -> Verdict:
     """The verdict on an absolute target measured in ``row``: not judged (saying why) when the machine was loaded
     during that row, as a rate measured then would read low whatever the code does."""
-    why = machine_loaded(row, cpus) if verdict.met is not None else ""
+    return judged_on(verdict, (row,), cpus)
+
+
+def judged_on(verdict: Verdict, rows: tuple[BenchRow, ...], cpus: int) -> Verdict:
+    """The verdict on a target measured in ``rows`` (one row: an absolute rate; two: a ratio of rows timed minutes
+    apart): not judged (saying which row's load) when the machine was loaded during any of them, as the load of one
+    row and not the other moves a ratio whatever the code does."""
+    why = next(filter(None, (machine_loaded(r, cpus) for r in rows)), "") if verdict.met is not None else ""
+    if why and len(rows) > 1:
+        loaded_row = next(r for r in rows if machine_loaded(r, cpus))
+        why = f"{why}, in the row of {loaded_row.engine} {loaded_row.method} at B = {loaded_row.batch:,}"
     return replace(verdict, met=None, loaded=why) if why else verdict
+
+
+def missed_because(verdict: Verdict, because: str) -> Verdict:
+    """``verdict`` with the reason it misses its target (printed only when it does)."""
+    return replace(verdict, because=because)
 
