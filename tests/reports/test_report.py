@@ -22,13 +22,14 @@ from simparity.reports.markdown import LINE_CHARS, to_markdown
 from simparity.reports.store import read_run
 
 DYNAMICS_SCENE = "dzhanibekov-first-flip"
-"""The Dzhanibekov flip (dzhanibekov) over 3.5 s, not the quick profile's 5: its first flip (the middle axis's
-angular velocity changes sign at 2.94 s) whole, every engine's orders as their theory says (measured: within 0.02),
-at 1,400 steps of its finest dt (above the 1,000 under which the quick profile adds every orientation variant)."""
+"""The Dzhanibekov flip (dzhanibekov) over 3.5 s, not the quick profile's 5: through its first flip (the
+middle axis's angular velocity changes sign at 2.94 s), every engine's orders as their theory says (measured: within
+0.02), at 1,400 steps of its finest dt (above the 1,000 under which the quick profile adds every orientation
+variant)."""
 IK_SCENE = "few-targets-2link-ik"
 """The lecture's planar 2-link arm (lecture-2link-ik) with 8 random targets and every hard one: the IK section's
-verdict, tables and three figures, at a fifth of the built-in scene's quick cost (its 50 random targets, each solved
-iteratively by core and Pinocchio, took 6.5 of the run's 21 s of CPU)."""
+verdict, tables and three figures, with a fifth of the built-in scene's quick solves (its 50 random targets, each
+solved iteratively by core and Pinocchio, took 6.5 of the run's 21 s of CPU)."""
 CONTACT_SCENE = "first-bounces-k05"
 """ball-bounce-k05 over its first 1 s, not the 2 s to rest: its bounces at 0.45 s and 0.90 s give every engine's
 measured restitution (core's backup exact at each dt, Pinocchio none: no contact), at two thirds of its cost."""
@@ -80,7 +81,8 @@ def test_markdown_starts_with_the_summary_and_links_existing_figures(run_dir):
     summary = text.split("## Summary", 1)[1].split("\n## ", 1)[0]
     assert f"[{DYNAMICS_SCENE}](#{DYNAMICS_SCENE}-dynamics)" in summary and f"[{IK_SCENE}](#{IK_SCENE}-ik)" in summary
     page = (run_dir / REPORT_HTML_FILE).read_text()
-    assert f'href="#{DYNAMICS_SCENE}-dynamics"' in page and f'<h2 id="{DYNAMICS_SCENE}-dynamics">' in page   # the link lands
+    anchor = f"{DYNAMICS_SCENE}-dynamics"
+    assert f'href="#{anchor}"' in page and f'<h2 id="{anchor}">' in page   # the link lands
     assert "### Cases without a result" in summary and "### Flagged findings" in summary
     for name in re.findall(r"\]\(figures/([^)]+)\.svg\)", text):
         for suffix in (".svg", ".png"):
