@@ -13,6 +13,7 @@ import pandas as pd
 import pytest
 
 from simparity.comparisons.cli.main import main
+from simparity.comparisons.scenes.library import builtin_paths
 from simparity.core.model.run_info import RunInfo
 from simparity.core.model.results import REPORT_FILE, REPORT_HTML_FILE, SERIES_COLUMNS, ResultRow
 from simparity.reports.content import build
@@ -20,7 +21,26 @@ from simparity.reports.tolerance_verdict import ToleranceVerdict
 from simparity.reports.markdown import LINE_CHARS, to_markdown
 from simparity.reports.store import read_run
 
-SCENES = ["dzhanibekov", "lecture-2link-ik", "iiwa-kinematics", "ball-bounce-k05"]
+DYNAMICS_SCENE = "dzhanibekov-first-flip"
+"""The Dzhanibekov flip (dzhanibekov) over 3.5 s, not the quick profile's 5: through its first flip (the
+middle axis's angular velocity changes sign at 2.94 s), every engine's orders as their theory says (measured: within
+0.02), at 1,400 steps of its finest dt (above the 1,000 under which the quick profile adds every orientation
+variant)."""
+IK_SCENE = "few-targets-2link-ik"
+"""The lecture's planar 2-link arm (lecture-2link-ik) with 8 random targets and every hard one: the IK section's
+verdict, tables and three figures, with a fifth of the built-in scene's quick solves (its 50 random targets, each
+solved iteratively by core and Pinocchio, took 6.5 of the run's 21 s of CPU)."""
+CONTACT_SCENE = "first-bounces-k05"
+"""ball-bounce-k05 over its first 1 s, not the 2 s to rest: its bounces at 0.45 s and 0.90 s give every engine's
+measured restitution (core's backup exact at each dt, Pinocchio none: no contact), at two thirds of its cost."""
+SMALLER = {DYNAMICS_SCENE: ("dzhanibekov", {"duration = 10.0": "duration = 3.5",
+                                             "flips over (10 s)": "flips over (its first flip, 3.5 s)"}),
+           IK_SCENE: ("lecture-2link-ik", {"count = 500": "count = 8"}),
+           CONTACT_SCENE: ("ball-bounce-k05", {"duration = 2.0": "duration = 1.0",
+                                               "bouncing to rest": "its first two bounces"})}
+"""The run's smaller copies of built-in scenes: name -> (the built-in scene, each line part it replaces)."""
+SCENES = ["iiwa-kinematics"]
+"""The built-in scenes of the run, beside :data:`SMALLER`'s."""
 ORDER_BAND = 0.5
 """Half the gap between neighbouring integer orders, as the shipped tolerances allow: an observed order
 within it of the theoretical one confirms the theory; outside it, the theory is wrong for the scheme."""
@@ -31,12 +51,25 @@ MIN_PAGE_BYTES = 10_000
 """The page's styles and summary alone come to a few kilobytes; with its inline figures it is far larger."""
 
 
+def _smaller_copy(folder: Path, name: str, scene: str, changes: dict[str, str]) -> str:
+    """The path of a copy, in ``folder``, of the built-in ``scene``'s file named ``name`` with ``changes`` made."""
+    text = builtin_paths()[scene].read_text(encoding="utf-8")
+    for old, new in {f'name = "{scene}"': f'name = "{name}"', **changes}.items():
+        assert text.count(old) == 1, (scene, old)  # the built-in file changed: update SMALLER
+        text = text.replace(old, new)
+    path = folder / f"{name}.toml"
+    path.write_text(text, encoding="utf-8")
+    return str(path)
+
+
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
     """A quick run of a dynamics, an IK, a kinematics and a contact scene on the default engines, with its report:
     every test here reads it (the ones that render again do so on a copy)."""
-    out = tmp_path_factory.mktemp("report") / "run"
-    assert main(["run", *SCENES, "--quick", "--repeats", "0", "--jobs", "1", "--out", str(out)]) == 0
+    folder = tmp_path_factory.mktemp("report")
+    files = [_smaller_copy(folder, name, *SMALLER[name]) for name in SMALLER]
+    out = folder / "run"
+    assert main(["run", *SCENES, *files, "--quick", "--repeats", "0", "--jobs", "1", "--out", str(out)]) == 0
     return out
 
 
@@ -46,16 +79,17 @@ def test_markdown_starts_with_the_summary_and_links_existing_figures(run_dir):
     headings = re.findall(r"^(#+) (.*)$", text, flags=re.M)
     assert headings[0] == ("#", "simparity report") and headings[1] == ("##", "Summary")
     summary = text.split("## Summary", 1)[1].split("\n## ", 1)[0]
-    assert "[dzhanibekov](#dzhanibekov-dynamics)" in summary and "[lecture-2link-ik](#lecture-2link-ik-ik)" in summary
+    assert f"[{DYNAMICS_SCENE}](#{DYNAMICS_SCENE}-dynamics)" in summary and f"[{IK_SCENE}](#{IK_SCENE}-ik)" in summary
     page = (run_dir / REPORT_HTML_FILE).read_text()
-    assert 'href="#dzhanibekov-dynamics"' in page and '<h2 id="dzhanibekov-dynamics">' in page   # the link lands
+    anchor = f"{DYNAMICS_SCENE}-dynamics"
+    assert f'href="#{anchor}"' in page and f'<h2 id="{anchor}">' in page   # the link lands
     assert "### Cases without a result" in summary and "### Flagged findings" in summary
     for name in re.findall(r"\]\(figures/([^)]+)\.svg\)", text):
         for suffix in (".svg", ".png"):
             assert (run_dir / "figures" / f"{name}{suffix}").stat().st_size > MIN_FIGURE_BYTES
     names = set(re.findall(r"\]\(figures/([^)]+)\.svg\)", text))
-    assert {"dzhanibekov-work-precision", "dzhanibekov-convergence", "dzhanibekov-drift",
-            "lecture-2link-ik-solve-rate", "lecture-2link-ik-residuals", "lecture-2link-ik-fk-agreement"} <= names
+    assert {f"{DYNAMICS_SCENE}-work-precision", f"{DYNAMICS_SCENE}-convergence", f"{DYNAMICS_SCENE}-drift",
+            f"{IK_SCENE}-solve-rate", f"{IK_SCENE}-residuals", f"{IK_SCENE}-fk-agreement"} <= names
 
 
 def _md_section(run_dir, heading: str) -> str:
@@ -79,13 +113,13 @@ def test_contact_section_shows_measured_restitution_at_every_dt_and_the_height_f
     """Issue #10: a contact scene's section has the height figure (no convergence figure: no order with
     impacts), per engine the range of the restitution it measured (report.md), and per engine × integrator the
     restitution at each dt next to the requested one (report.html)."""
-    section = _md_section(run_dir, "ball-bounce-k05 (dynamics)")
-    assert "figures/ball-bounce-k05-height.svg" in section and "ball-bounce-k05-convergence" not in section
+    section = _md_section(run_dir, f"{CONTACT_SCENE} (dynamics)")
+    assert f"figures/{CONTACT_SCENE}-height.svg" in section and f"{CONTACT_SCENE}-convergence" not in section
     head = _md_row(section, "| engine |")
     core, pinocchio = _md_row(section, "| core |"), _md_row(section, "| pinocchio |")
     assert core[head.index("restitution measured")].startswith("0.5")   # backup is exact: the range starts at 0.5
     assert pinocchio[-1].startswith("n/a") and "ok" not in pinocchio[-1]  # no contact in Pinocchio: every case n/a
-    rows = _html_rows(run_dir, "ball-bounce-k05-dynamics")
+    rows = _html_rows(run_dir, f"{CONTACT_SCENE}-dynamics")
     assert "requested restitution 0.5" in (run_dir / REPORT_HTML_FILE).read_text()
     header = next(row for row in rows if len(row) > 2 and row[2].startswith("restitution at dt"))
     assert sum(cell.startswith("restitution at dt") for cell in header) == 3   # the quick profile's three time steps
@@ -100,7 +134,7 @@ def test_scene_sections_lead_with_a_verdict_and_a_row_per_engine(run_dir):
     """Issue #26: report.md's scene section says its verdict in one line, then has one row per engine (core first,
     ground truths left out) naming its most accurate scheme and its cheapest within each error budget; the row per
     engine × integrator (with its force evaluations per simulated second) is in report.html."""
-    section = _md_section(run_dir, "dzhanibekov (dynamics)")
+    section = _md_section(run_dir, f"{DYNAMICS_SCENE} (dynamics)")
     assert section.splitlines()[1].startswith("- **Verdict**: most accurate: core ")
     assert "Reference: `analytic:exact`" in section
     head = _md_row(section, "| engine |")
@@ -108,7 +142,7 @@ def test_scene_sections_lead_with_a_verdict_and_a_row_per_engine(run_dir):
     engines = [line.split("|")[1].strip() for line in section.splitlines() if line.startswith("| ")][1:]
     assert engines == ["core", "mujoco", "pybullet", "pinocchio"]    # the user's engine first, no ground truth
     assert _md_row(section, "| mujoco |")[1].startswith("rk4 @ ")      # MuJoCo's most accurate is its RK4
-    rows = _html_rows(run_dir, "dzhanibekov-dynamics")
+    rows = _html_rows(run_dir, f"{DYNAMICS_SCENE}-dynamics")
     header = next(row for row in rows if row[:4] == ["engine", "integrator", "best dt [s]", "error [rad]"])
     rk4 = next(row for row in rows if row[:2] == ["mujoco", "rk4"] and len(row) == len(header))
     assert rk4[header.index("order (theory)")].endswith("(4)")   # the order column shows RK4's theory
@@ -130,7 +164,7 @@ def test_theoretical_orders_are_the_ones_observed(run_dir):
     table, info = read_run(run_dir)
     theory = info.theoretical_orders
     assert {"core", "mujoco", "pybullet", "pinocchio"} <= set(theory)
-    fitted = table[(table["scene"] == "dzhanibekov") & (table["metric"] == "order_orientation")
+    fitted = table[(table["scene"] == DYNAMICS_SCENE) & (table["metric"] == "order_orientation")
                    & (table["status"] == "ok")]
     checked = 0
     for _, row in fitted.iterrows():
@@ -210,7 +244,7 @@ def test_report_renders_in_chromium_without_network(run_dir):
     assert screenshot.stat().st_size > MIN_SCREENSHOT_BYTES
 
 
-COMPARED_FIGURE = "dzhanibekov-drift"
+COMPARED_FIGURE = f"{DYNAMICS_SCENE}-drift"
 """The figure test_report_regenerates_a_copied_run_with_no_engine_importable compares with the run's own: the one
 figure its re-rendering saves (every figure is still made by its figure function there; saving them all would draw
 seven more no assertion reads)."""
@@ -246,7 +280,7 @@ def test_report_regenerates_a_copied_run_with_no_engine_importable(run_dir, tmp_
     assert (copy / REPORT_HTML_FILE).stat().st_size > MIN_PAGE_BYTES
 
 
-KEPT_SCENE = "ball-bounce-k05"
+KEPT_SCENE = CONTACT_SCENE
 """The scene test_report_removes_the_figures_an_earlier_rendering_left keeps: the one with the fewest figures (two),
 so the re-rendering draws little while the six figures of the other scenes are left to remove."""
 
@@ -259,11 +293,11 @@ def test_report_removes_the_figures_an_earlier_rendering_left(run_dir, tmp_path)
     shutil.copytree(run_dir, copy)
     table = pd.read_csv(copy / "results.csv", keep_default_na=False, dtype=str)  # as written: "n/a" is a status
     table[table.scene == KEPT_SCENE].to_csv(copy / "results.csv", index=False)
-    assert any(p.name.startswith("dzhanibekov-") for p in (copy / "figures").iterdir())   # there to be removed
+    assert any(p.name.startswith(f"{DYNAMICS_SCENE}-") for p in (copy / "figures").iterdir())   # there to be removed
     (copy / "figures" / "notes.txt").write_text("mine", encoding="utf-8")
     assert main(["report", str(copy)]) == 0
     left = {p.name for p in (copy / "figures").iterdir()}
-    assert not any(name.startswith("dzhanibekov-") for name in left) and "notes.txt" in left
+    assert not any(name.startswith(f"{DYNAMICS_SCENE}-") for name in left) and "notes.txt" in left
     assert all(name.startswith(f"{KEPT_SCENE}-") for name in left - {"notes.txt"})   # no other scene's either
     linked = set(re.findall(r"\]\(figures/([^)]+\.svg)\)", (copy / REPORT_FILE).read_text()))
     assert linked and linked <= left
