@@ -104,7 +104,12 @@ UNREACHABLE_SECONDS = 10.0
 """A refused connection fails at once; this allows for the imports of a loaded machine (before: Dask's 30 s)."""
 
 SHORT_IDENTIFY_SECONDS = 2.0
-"""How long the tests give a server to say it is a Dask scheduler (a scheduler answers in milliseconds)."""
+"""How long the tests give a server to say it is a Dask scheduler (a scheduler answers in milliseconds): the banner's
+bytes are read within it, so what is told is Dask's protocol error, not the end of the wait."""
+
+SILENT_IDENTIFY_SECONDS = 0.5
+"""The same for the silent server, which never answers: the test waits all of it, and what it tells (the wait ends,
+in one line) holds whatever its length."""
 
 
 @pytest.mark.parametrize("address", ["tcp://127.0.0.1:9", "127.0.0.1:9", "no-port-here"])
@@ -138,12 +143,13 @@ class _NotDaskServer(socketserver.ThreadingTCPServer):
     block_on_close = False
 
 
-@pytest.mark.parametrize("banner", [b"SSH-2.0-OpenSSH_9.6 not dask\r\n" * 4, pytest.param(b"", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("banner, identify_seconds", [(b"SSH-2.0-OpenSSH_9.6 not dask\r\n" * 4, SHORT_IDENTIFY_SECONDS),
+                                                      pytest.param(b"", SILENT_IDENTIFY_SECONDS, marks=pytest.mark.slow)])
 def test_a_service_that_is_not_dask_at_the_scheduler_address_is_a_one_line_error(tmp_path, capsys, monkeypatch,
-                                                                                   banner):
+                                                                                   banner, identify_seconds):
     """Dask's own client raised a MemoryError from the banner's bytes read as a frame length, and waited for ever
     on a silent server (a web server: the dashboard's port given by mistake)."""
-    monkeypatch.setattr(dask_executor, "IDENTIFY_SECONDS", SHORT_IDENTIFY_SECONDS)
+    monkeypatch.setattr(dask_executor, "IDENTIFY_SECONDS", identify_seconds)
     handler = type("Handler", (_NotDask,), {"banner": banner})
     with _NotDaskServer(("127.0.0.1", 0), handler) as server:
         threading.Thread(target=server.serve_forever, daemon=True).start()

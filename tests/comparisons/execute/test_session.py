@@ -144,6 +144,8 @@ def test_crash(simparity):
 def test_after(simparity):
     simparity.check(_coarse(), engines=["core"])
 ''')
-    result = pytester.runpytest_subprocess()
+    # in this process (a pytest session started in a process of its own cost its start and imports again): the
+    # segfault, in a case process, would take this session down with the inner one were it not isolated
+    result = pytester.runpytest_inprocess()
     result.assert_outcomes(passed=1, failed=1)
     result.stdout.fnmatch_lines(["*lecture-projectile segfaulting*failed*"])
