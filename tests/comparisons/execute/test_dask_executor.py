@@ -21,7 +21,8 @@ from simparity.comparisons.execute.isolation import CaseLimits, IsolatedPool
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.results import RESULTS_FILE
-from tests.helpers import THROWN_BALL, InProcess, built_engines, comparable, no_leftovers_within, smoke_scenes
+from tests.helpers import (LEAN_INTEGRATORS, THROWN_BALL, InProcess, built_engines, comparable, no_leftovers_within,
+                           smoke_scenes)
 
 WORKERS = 2
 
@@ -38,9 +39,14 @@ rest, as at the scene's 200 (measured), where the IK scene was most of the test'
 
 def _mixed_scenes():
     """The smoke scenes of every kind (:func:`tests.helpers.smoke_scenes`), IK capped at
-    :data:`EXECUTOR_IK_ITERATIONS` iterations."""
-    return [dataclasses.replace(s, max_iterations=EXECUTOR_IK_ITERATIONS) if isinstance(s, IKScene) else s
-            for s in smoke_scenes()]
+    :data:`EXECUTOR_IK_ITERATIONS` iterations, dynamics on :data:`tests.helpers.LEAN_INTEGRATORS` (every engine still
+    has cases of each dynamics scene; the projectile and the rotating body cost half as much, ~1.5 CPU-s of the two
+    runs)."""
+    def lean(scene):
+        if isinstance(scene, IKScene):
+            return dataclasses.replace(scene, max_iterations=EXECUTOR_IK_ITERATIONS)
+        return dataclasses.replace(scene, integrators=LEAN_INTEGRATORS) if hasattr(scene, "integrators") else scene
+    return [lean(scene) for scene in smoke_scenes()]
 
 
 @pytest.fixture(scope="module")
