@@ -29,8 +29,9 @@ it: test_a_workers_imports_do_not_count_against_its_first_cases_time_limit)."""
 
 CRASH_SECONDS = 120
 """The limit while the hogging engine runs: far more than it needs to pass its memory limit (~0.4 GB/s of
-page faults measured on the 2-core machine under load: ~2 s), so it is caught by memory, not by time (a limit of 10 s,
-to share one run with the hanging engine, caught it by time on a machine loaded ~4 times over: a run each)."""
+page faults measured on the 2-core machine under load: ~1 s to CASE_GIB), so it is caught by memory, not by time (a
+limit of 10 s, to share one run with the hanging engine, caught it by time on a machine loaded ~4 times over: a run
+each)."""
 
 CASE_GIB = 0.5
 """The hogging engine's limit: ~2x what a worker running the tiny scene holds (~250 MiB), reached by the hog in half

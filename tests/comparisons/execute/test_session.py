@@ -120,7 +120,7 @@ def test_a_script_s_own_engine_is_refused_isolated_and_runs_in_process(tmp_path)
     assert lines[1].startswith("in process: ['mine']") and int(lines[1].split()[-1]) > 0
 
 
-@pytest.mark.slow  # ~17 s of CPU: a pytest session in a subprocess
+@pytest.mark.slow  # ~7 s of CPU: a pytest session, two isolated runs
 def test_the_fixture_fails_a_test_whose_engine_segfaults_and_the_session_goes_on(pytester, monkeypatch):
     monkeypatch.setenv("PYTHONPATH", str(ROOT))  # the hostile engines' module, for the test run and its workers
     # the quick profile's coarsest time step, not smoke's 100 steps: check() judges core's rows by the shipped bounds,
