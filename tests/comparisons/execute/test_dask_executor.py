@@ -21,7 +21,8 @@ from simparity.comparisons.execute.isolation import CaseLimits, IsolatedPool
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.results import RESULTS_FILE
-from tests.helpers import THROWN_BALL, InProcess, built_engines, comparable, no_leftovers_within, smoke_scenes
+from tests.helpers import (LEAN_INTEGRATORS, THROWN_BALL, InProcess, built_engines, comparable, no_leftovers_within,
+                           smoke_scenes)
 
 WORKERS = 2
 
@@ -38,9 +39,14 @@ rest, as at the scene's 200 (measured), where the IK scene was most of the test'
 
 def _mixed_scenes():
     """The smoke scenes of every kind (:func:`tests.helpers.smoke_scenes`), IK capped at
-    :data:`EXECUTOR_IK_ITERATIONS` iterations."""
-    return [dataclasses.replace(s, max_iterations=EXECUTOR_IK_ITERATIONS) if isinstance(s, IKScene) else s
-            for s in smoke_scenes()]
+    :data:`EXECUTOR_IK_ITERATIONS` iterations, dynamics on :data:`tests.helpers.LEAN_INTEGRATORS` (every engine still
+    has cases of each dynamics scene; the projectile and the rotating body cost half as much, ~1.5 CPU-s of the two
+    runs)."""
+    def lean(scene):
+        if isinstance(scene, IKScene):
+            return dataclasses.replace(scene, max_iterations=EXECUTOR_IK_ITERATIONS)
+        return dataclasses.replace(scene, integrators=LEAN_INTEGRATORS) if hasattr(scene, "integrators") else scene
+    return [lean(scene) for scene in smoke_scenes()]
 
 
 @pytest.fixture(scope="module")
@@ -104,7 +110,12 @@ UNREACHABLE_SECONDS = 10.0
 """A refused connection fails at once; this allows for the imports of a loaded machine (before: Dask's 30 s)."""
 
 SHORT_IDENTIFY_SECONDS = 2.0
-"""How long the tests give a server to say it is a Dask scheduler (a scheduler answers in milliseconds)."""
+"""How long the tests give a server to say it is a Dask scheduler (a scheduler answers in milliseconds): the banner's
+bytes are read within it, so what is told is Dask's protocol error, not the end of the wait."""
+
+SILENT_IDENTIFY_SECONDS = 0.5
+"""The same for the silent server, which never answers: the test waits all of it, and what it tells (the wait ends,
+in one line) holds whatever its length."""
 
 
 @pytest.mark.parametrize("address", ["tcp://127.0.0.1:9", "127.0.0.1:9", "no-port-here"])
@@ -138,12 +149,13 @@ class _NotDaskServer(socketserver.ThreadingTCPServer):
     block_on_close = False
 
 
-@pytest.mark.parametrize("banner", [b"SSH-2.0-OpenSSH_9.6 not dask\r\n" * 4, pytest.param(b"", marks=pytest.mark.slow)])
+@pytest.mark.parametrize("banner, identify_seconds", [(b"SSH-2.0-OpenSSH_9.6 not dask\r\n" * 4, SHORT_IDENTIFY_SECONDS),
+                                                      pytest.param(b"", SILENT_IDENTIFY_SECONDS, marks=pytest.mark.slow)])
 def test_a_service_that_is_not_dask_at_the_scheduler_address_is_a_one_line_error(tmp_path, capsys, monkeypatch,
-                                                                                   banner):
+                                                                                   banner, identify_seconds):
     """Dask's own client raised a MemoryError from the banner's bytes read as a frame length, and waited for ever
     on a silent server (a web server: the dashboard's port given by mistake)."""
-    monkeypatch.setattr(dask_executor, "IDENTIFY_SECONDS", SHORT_IDENTIFY_SECONDS)
+    monkeypatch.setattr(dask_executor, "IDENTIFY_SECONDS", identify_seconds)
     handler = type("Handler", (_NotDask,), {"banner": banner})
     with _NotDaskServer(("127.0.0.1", 0), handler) as server:
         threading.Thread(target=server.serve_forever, daemon=True).start()
@@ -200,8 +212,11 @@ def test_a_sweep_of_100_variants_on_two_dask_workers_gives_the_local_results(tmp
     assert [s.name for s, _, _ in on_dask] == [v.name for v in variants]
 
 
-STREAM_LIMIT_SECONDS = 6.0
-"""The per-case time limit of the streaming test: the hanging case fails this long after it starts."""
+STREAM_LIMIT_SECONDS = 3.0
+"""The per-case time limit of the streaming test: the hanging case fails this long after it starts. Core's case of
+the tiny scene takes milliseconds (its cases completed at --case-timeout's minimum of 1 s on the loaded 2-core
+machine; a worker's start does not count against the limit), so it arrives ~3 s before the hanging case fails, and
+sent group by group both would arrive together: the half-limit margin of the test tells the two apart."""
 
 
 @pytest.mark.slow

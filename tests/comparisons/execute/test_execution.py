@@ -13,17 +13,12 @@ from simparity.comparisons.execute.execution import count_cases, run_scenes
 from simparity.comparisons.execute.isolation import CaseLimits, IsolatedPool
 from simparity.comparisons.execute.journal import Journal
 from simparity.core.model.results import STATUSES, case_counts
-from tests.helpers import InProcess, built_engines, comparable, smoke_scenes
+from tests.helpers import LEAN_INTEGRATORS, InProcess, built_engines, comparable, smoke_scenes
 
 LEAN_STEPS = 60
 """Steps at a dynamics scene's coarsest time step in :func:`lean_scenes`: the bouncing ball (dropped from 1 m,
 coarsest dt 0.01 s) still meets the floor, at t = sqrt(2 h / g) = 0.45 s, and leaves it before the end (0.6 s):
 its impact and rebound metrics are measured at both time steps."""
-
-LEAN_INTEGRATORS = ("semi_implicit_euler", "rk4", "backup", "act_after", "exact", "euler")
-"""The integrators of a dynamics scene in :func:`lean_scenes`: every engine still runs a case or two (core its
-contact schemes on the ball), 8 cases a time step instead of 14: a worker's cost is mostly its cases' own
-processes (each case is forked), not their steps."""
 
 LEAN_ITERATIONS = 20
 """IK iterations in :func:`lean_scenes`: every solver still iterates, reaches its cap on the hard targets and

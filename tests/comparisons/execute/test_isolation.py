@@ -21,23 +21,27 @@ from simparity.comparisons.execute.isolation import CaseLimits, IsolatedPool
 from simparity.comparisons.scenes.library import builtin_paths
 from tests.helpers import THROWN_BALL, no_leftovers_within
 
-HANG_SECONDS = 5
-"""The hanging engine's limit: long enough for any honest case of the tiny scene (milliseconds) and a worker's
-start and first imports (~1-2 s under load), short enough for a quick test."""
+HANG_SECONDS = 2
+"""The hanging engine's limit: long enough for any honest case of the tiny scene (milliseconds; core's and MuJoCo's
+cases of one time step all completed at --case-timeout's minimum of 1 s on the 2-core machine loaded by three test
+runs), short enough that the hang and slow-start tests wait little (a worker's start and imports do not count against
+it: test_a_workers_imports_do_not_count_against_its_first_cases_time_limit)."""
 
 CRASH_SECONDS = 120
 """The limit while the hogging engine runs: far more than it needs to pass its memory limit (~0.4 GB/s of
-page faults measured on the 2-core machine under load: ~2 s), so it is caught by memory, not by time (a limit of 10 s,
-to share one run with the hanging engine, caught it by time on a machine loaded ~4 times over: a run each)."""
+page faults measured on the 2-core machine under load: ~1 s to CASE_GIB), so it is caught by memory, not by time (a
+limit of 10 s, to share one run with the hanging engine, caught it by time on a machine loaded ~4 times over: a run
+each)."""
 
-CASE_GIB = 1.0
-"""The hogging engine's limit: ~4x what a worker running the tiny scene holds (~250 MiB)."""
+CASE_GIB = 0.5
+"""The hogging engine's limit: ~2x what a worker running the tiny scene holds (~250 MiB), reached by the hog in half
+the time (and page faults) of 1 GiB."""
 
-HANGING = ("tests.hostile_engines:HangingEngine", "hung: no result within the per-case time limit of 5 s")
+HANGING = ("tests.hostile_engines:HangingEngine", f"hung: no result within the per-case time limit of {HANG_SECONDS} s")
 CRASHING = {
     "segfaulting": ("tests.hostile_engines:SegfaultingEngine", "killed by signal 11 (SIGSEGV)"),
     "hogging": ("tests.hostile_engines:HoggingEngine", "out of memory: the worker's resident memory went past the "
-                "per-case limit of 1 GiB; the worker was killed"),  # exactly: rows are the same in every run
+                f"per-case limit of {CASE_GIB:g} GiB; the worker was killed"),  # exactly: rows are the same in every run
 }
 
 

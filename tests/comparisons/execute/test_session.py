@@ -46,23 +46,33 @@ def _with_root_on_path() -> str:
     return os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH")) if p)
 
 
-@pytest.mark.slow  # ~10 s of CPU: worker processes, one of them crashing
-def test_run_scene_isolates_an_engine_that_segfaults():
+@pytest.fixture(scope="module")
+def isolated_with_a_segfault():
+    """The small scene run isolated on core and the segfaulting engine by one worker, shared by the test of the crash
+    and the test comparing core's rows with an in-process run (core's cases run in a process of their own, so the
+    engine beside them changes none of their rows: what the second test compares is the isolation)."""
+    return run_scene(_small(), engines=["core", SEGFAULTING], repeats=0, jobs=ONE_WORKER)
+
+
+@pytest.mark.slow  # worker processes, one of them crashing
+def test_run_scene_isolates_an_engine_that_segfaults(isolated_with_a_segfault):
     """The segfault kills the engine's case process, not this interpreter: its rows are failed, core's are ok."""
-    table = run_scene(_small(), engines=["core", SEGFAULTING], repeats=0, jobs=ONE_WORKER)
+    table = isolated_with_a_segfault
     crashed = table[table["engine"] == "segfaulting"]
     assert FAILED in set(crashed["status"]) and OK not in set(crashed["status"])  # n/a: its orders, from no case
     assert crashed["detail"].str.contains("SIGSEGV|segmentation", case=False).any()
     assert OK in set(table[table["engine"] == "core"]["status"])
 
 
-@pytest.mark.slow  # ~11 s of CPU: a run in worker processes and one in process
-def test_run_scene_in_process_gives_the_rows_of_the_isolated_run():
-    """isolate=False is the same pipeline in this process: the same rows, timing aside."""
-    isolated = run_scene(_small(), engines=["core"], repeats=0, jobs=ONE_WORKER)
+@pytest.mark.slow  # a run in process beside the shared isolated run
+def test_run_scene_in_process_gives_the_rows_of_the_isolated_run(isolated_with_a_segfault):
+    """isolate=False is the same pipeline in this process: the same rows, timing aside (core's rows of the isolated
+    run, the segfaulting engine's set aside)."""
+    isolated = isolated_with_a_segfault[isolated_with_a_segfault["engine"] != "segfaulting"]
     inline = run_scene(_small(), engines=["core"], repeats=0, isolate=False)
     untimed = ~isolated["metric"].str.startswith("time_per_")
-    pd.testing.assert_frame_equal(isolated[untimed].reset_index(drop=True), inline[untimed].reset_index(drop=True))
+    pd.testing.assert_frame_equal(isolated[untimed].reset_index(drop=True),
+                                  inline[~inline["metric"].str.startswith("time_per_")].reset_index(drop=True))
 
 
 def test_an_engine_class_is_run_by_its_spec():
@@ -110,7 +120,7 @@ def test_a_script_s_own_engine_is_refused_isolated_and_runs_in_process(tmp_path)
     assert lines[1].startswith("in process: ['mine']") and int(lines[1].split()[-1]) > 0
 
 
-@pytest.mark.slow  # ~17 s of CPU: a pytest session in a subprocess
+@pytest.mark.slow  # ~7 s of CPU: a pytest session, two isolated runs
 def test_the_fixture_fails_a_test_whose_engine_segfaults_and_the_session_goes_on(pytester, monkeypatch):
     monkeypatch.setenv("PYTHONPATH", str(ROOT))  # the hostile engines' module, for the test run and its workers
     # the quick profile's coarsest time step, not smoke's 100 steps: check() judges core's rows by the shipped bounds,
@@ -134,6 +144,8 @@ def test_crash(simparity):
 def test_after(simparity):
     simparity.check(_coarse(), engines=["core"])
 ''')
-    result = pytester.runpytest_subprocess()
+    # in this process (a pytest session started in a process of its own cost its start and imports again): the
+    # segfault, in a case process, would take this session down with the inner one were it not isolated
+    result = pytester.runpytest_inprocess()
     result.assert_outcomes(passed=1, failed=1)
     result.stdout.fnmatch_lines(["*lecture-projectile segfaulting*failed*"])
