@@ -62,6 +62,35 @@ def load_average() -> float:
         return math.nan
 
 
+QUIET_LOAD = 1.0
+"""The 1-minute load average :func:`settle` waits for while idle: once the bench's next thread starts, the average
+rises toward 1 + what others run, so from at most 1 its rows are judged by others' work alone (a row is loaded above
+1 + ``OTHERS_LOAD_PER_CPU`` per CPU, :mod:`comparisons.bench.verdict`)."""
+SETTLE_SECONDS_MAX = 240.0
+"""[s] The longest the bench waits for the machine to settle before a workload (:func:`settle`): four time constants
+of the 1-minute load average, enough for its own previous workload's processes (a suite's two workers: ~2.4) to fade
+below the quiet level; a machine others keep busy longer is measured anyway, and its rows say so."""
+SETTLE_POLL_SECONDS = 5.0
+"""[s] Between two readings of the load while settling."""
+
+
+def settle(quiet_load: float, say: Callable[[str], None], read_load: LoadReader = load_average,
+           sleep: Callable[[float], None] = time.sleep, most: float = SETTLE_SECONDS_MAX) -> float:
+    """Wait, idle, until the 1-minute load average is at most ``quiet_load`` or ``most`` seconds have passed; returns
+    the seconds waited. The average lags a minute behind: without the wait a workload run right after another (or
+    after the tests, or a suite's worker processes) inherits their load in its first rows, which are then judged
+    loaded though nobody else used the machine."""
+    waited = 0.0
+    load = read_load()
+    while load > quiet_load and waited < most:
+        sleep(SETTLE_POLL_SECONDS)
+        waited += SETTLE_POLL_SECONDS
+        load = read_load()
+    if waited:
+        say(f"  (waited {waited:.0f} s for the machine to settle: load {load:.2f}, quiet at {quiet_load:.2f})")
+    return waited
+
+
 def _cpu_with_children() -> float:
     """CPU time [s] of this process and of its children that have ended (``os.times``)."""
     spent = os.times()

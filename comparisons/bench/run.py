@@ -15,7 +15,7 @@ from simparity.comparisons.bench.memory import memory_rows, run_peak_memory
 from simparity.comparisons.bench.profiling import profile_summary
 from simparity.comparisons.bench.run_profile import profile_markdown, run_profile
 from simparity.comparisons.bench.report import cpus, machine, markdown, write_csv
-from simparity.comparisons.bench.rows import REPEATS, BenchRow, Meter, median_time
+from simparity.comparisons.bench.rows import QUIET_LOAD, REPEATS, BenchRow, Meter, median_time, settle
 from simparity.comparisons.bench.stepping import dynamics_rows
 from simparity.comparisons.bench.suites import suite_rows
 from simparity.comparisons.bench.targets import targets
@@ -74,6 +74,8 @@ def _measure(quick: bool, say: Callable[[str], None]) -> tuple[list[BenchRow], s
     rows: list[BenchRow] = []
     for title, measure in workloads:
         say(title)
+        if not quick:  # the previous workload's processes (or what ran before the bench) fade first; a quick bench
+            settle(QUIET_LOAD, say)  # judges no target and does not wait
         with Meter(children=True) as meter:
             rows += measure()
         say(f"  ({meter.wall_seconds:.0f} s wall, {meter.cpu_seconds:.0f} s CPU with the processes it started, load "

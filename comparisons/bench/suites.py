@@ -15,7 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from simparity.comparisons.bench.rows import BenchRow, Meter
+from simparity.comparisons.bench.rows import QUIET_LOAD, BenchRow, Meter, settle
 from simparity.comparisons.bench.sweep import RunMemory
 from simparity.comparisons.bench.verdict import OTHERS_LOAD_PER_CPU, Verdict, missed_because
 
@@ -53,13 +53,17 @@ SUITES = (SuiteTarget("default suite", (), 90.0), SuiteTarget("quick gate", ("--
 """The suites timed: ``simparity run`` (the default suite) and the README's CI gate."""
 
 
-def suite_rows(run: RunMemory, say: Callable[[str], None]) -> list[BenchRow]:
+def suite_rows(run: RunMemory, say: Callable[[str], None],
+               settle_first: Callable[[], object] | None = None) -> list[BenchRow]:
     """One row per suite of :data:`SUITES`: its wall time [s] (value) and the CPU time of the run and every process it
     started [s] (accuracy), each run by ``run`` (:func:`comparisons.bench.memory.run_peak_memory`) in a fresh folder
-    with a scratch history database (the bench's runs are not results)."""
+    with a scratch history database (the bench's runs are not results), after ``settle_first()`` (default: waiting for
+    the load of what ran before, the previous suite's workers included, to fade: :func:`comparisons.bench.rows.settle`)."""
+    wait = settle_first or (lambda: settle(QUIET_LOAD, say))
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         for index, suite in enumerate(SUITES):
+            wait()
             with Meter(children=True) as meter:
                 peak, seconds, stderr = run([*suite.arguments, "--history", str(Path(folder) / "history.sqlite")],
                                             Path(folder) / f"run-{index}")

@@ -12,7 +12,7 @@ import pytest
 
 from simparity.comparisons.bench import report, run
 from simparity.comparisons.bench.blas import describe_threads, loaded_blas, one_blas_thread
-from simparity.comparisons.bench.rows import BenchRow, Meter
+from simparity.comparisons.bench.rows import QUIET_LOAD, SETTLE_POLL_SECONDS, BenchRow, Meter, settle
 from simparity.comparisons.bench.targets import IK_SOLVES_PER_SECOND, targets
 from simparity.comparisons.bench.verdict import MIN_CPU_PER_WALL, OTHERS_LOAD_PER_CPU, TARGET_IK_TARGETS
 from simparity.comparisons.common.processes import BLAS_THREAD_VARIABLES
@@ -138,3 +138,14 @@ def test_the_bench_measures_on_one_blas_thread_and_writes_the_load_beside_each_r
     header, row = (tmp_path / "benchmarks.csv").read_text().splitlines()
     assert header.endswith("load_before,load_after,cpu_seconds,wall_seconds") and f",{BUSY_LOAD},{BUSY_LOAD}," in row
     assert any(line.startswith("not judged") and "machine loaded" in line for line in lines)
+
+
+def test_the_bench_waits_idle_for_the_load_its_last_workload_left_to_fade_and_no_longer_than_its_limit():
+    """The issue's finding again, self-inflicted: a workload right after another (a suite right after the default
+    suite's two workers, load 2.41) started on a load average still counting them, and was judged loaded."""
+    readings, slept, said = iter([2.41, 1.9, 1.4, 0.98, 0.5]), [], []
+    waited = settle(QUIET_LOAD, said.append, read_load=lambda: next(readings), sleep=slept.append)
+    assert waited == 3 * SETTLE_POLL_SECONDS == sum(slept) and "load 0.98" in said[0]
+    assert settle(QUIET_LOAD, said.append, read_load=lambda: 0.5, sleep=slept.append) == 0.0 and len(said) == 1
+    busy = settle(QUIET_LOAD, said.append, read_load=lambda: 3.0, sleep=lambda s: None, most=20.0)
+    assert busy == 20.0  # others keep the machine busy: measured anyway, and its rows say they were loaded

@@ -52,7 +52,9 @@ def test_each_suite_runs_once_with_its_own_arguments_and_a_scratch_history(tmp_p
         calls.append((arguments, folder))
         return (PeakMemory(1, 0), 12.5, "") if "--quick" in arguments else (None, 0.5, "simparity: error: broken")
 
-    rows = suite_rows(run, lambda line: None)
+    settled: list[int] = []
+    rows = suite_rows(run, lambda line: None, lambda: settled.append(len(calls)))
+    assert settled == [0, 1]  # the machine settles before each suite, the second after the first's run
     assert [args[:args.index("--history")] for args, _ in calls] == [[], ["--quick", "--check"]]
     assert all(Path(args[args.index("--history") + 1]).name == "history.sqlite" for args, _ in calls)
     assert len({folder for _, folder in calls}) == len(SUITES)
