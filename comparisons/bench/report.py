@@ -64,9 +64,9 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
              "from this run. The raw rows are in `benchmarks.csv`, each with the load average before and after its "
              "measurement and its CPU and wall time.", "",
              "## Targets", "", ("Each target as set, what this run compared for it, and the verdict; a target set for "
-                                "another size than this run measured (`--quick`) is not comparable; an absolute target "
-                                "(a rate, not a ratio to a row of this run) measured on a loaded machine is not "
-                                f"judged: the load average around its row, less the bench's own thread, above "
+                                "another size than this run measured (`--quick`) is not comparable; a target one of whose "
+                                "rows (an absolute rate's, or either of a ratio's two) was measured on a loaded machine "
+                                f"is not judged: the load average around the row, less the bench's own thread, above "
                                 f"{OTHERS_LOAD_PER_CPU:g} per CPU, or its CPU / wall below {MIN_CPU_PER_WALL:g}."), "",
              "| target | compared | verdict |", "|---|---|---|"]
     verdicts = targets(rows, cpus(info))

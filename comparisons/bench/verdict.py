@@ -89,11 +89,12 @@ def judged_on(verdict: Verdict, rows: tuple[BenchRow, ...], cpus: int) -> Verdic
     """The verdict on a target measured in ``rows`` (one row: an absolute rate; two: a ratio of rows timed minutes
     apart): not judged (saying which row's load) when the machine was loaded during any of them, as the load of one
     row and not the other moves a ratio whatever the code does."""
-    why = next(filter(None, (machine_loaded(r, cpus) for r in rows)), "") if verdict.met is not None else ""
-    if why and len(rows) > 1:
-        loaded_row = next(r for r in rows if machine_loaded(r, cpus))
-        why = f"{why}, in the row of {loaded_row.engine} {loaded_row.method} at B = {loaded_row.batch:,}"
-    return replace(verdict, met=None, loaded=why) if why else verdict
+    loaded = next((r for r in rows if machine_loaded(r, cpus)), None) if verdict.met is not None else None
+    if loaded is None:
+        return verdict
+    why = machine_loaded(loaded, cpus) + (f", in the row of {loaded.engine} {loaded.method} at B = {loaded.batch:,}"
+                                          if len(rows) > 1 else "")
+    return replace(verdict, met=None, loaded=why)
 
 
 def missed_because(verdict: Verdict, because: str) -> Verdict:
