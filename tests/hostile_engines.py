@@ -104,11 +104,17 @@ class ExitingEngine(_Misbehaving):
     simulation = _Exit
 
 
+def _parent(pid: int) -> int:
+    with open(f"/proc/{pid}/stat", encoding="ascii") as stat:
+        return int(stat.read().rsplit(")", 1)[1].split()[1])
+
+
 class _KillHost(Simulation):
     def run(self, n_steps: int):
-        worker = os.getppid()  # the case worker; its parent is the process that started it (a Dask worker)
-        with open(f"/proc/{worker}/stat", encoding="ascii") as stat:
-            host = int(stat.read().rsplit(")", 1)[1].split()[1])
+        host = _parent(os.getppid())  # the case worker's parent: the zygote it was forked from, or what started it
+        with open(f"/proc/{host}/cmdline", "rb") as command:
+            if b"simparity.comparisons.common.zygote" in command.read():
+                host = _parent(host)  # the zygote's parent started it: the Dask worker
         os.kill(host, signal.SIGKILL)
         while True:
             time.sleep(3600)

@@ -10,6 +10,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
+from simparity.comparisons.common.zygote import children_usage
+
 REPEATS = 5
 """Timed calls per measurement (median), after one warm-up call."""
 
@@ -92,9 +94,10 @@ def settle(quiet_load: float, say: Callable[[str], None], read_load: LoadReader 
 
 
 def _cpu_with_children() -> float:
-    """CPU time [s] of this process and of its children that have ended (``os.times``)."""
+    """CPU time [s] of this process and of its children that have ended, the zygote's included
+    (:func:`comparisons.common.zygote.children_usage`)."""
     spent = os.times()
-    return spent.user + spent.system + spent.children_user + spent.children_system
+    return spent.user + spent.system + children_usage().cpu_seconds
 
 
 class Meter:

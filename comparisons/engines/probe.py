@@ -1,7 +1,8 @@
 """A user's engine described without running its code in simparity itself.
 
 A plugin's or spec's import, constructor, ``version()``, ``integrators()`` and the rest of what an
-engine says of itself run in a child process (``python -m simparity.comparisons.engines.probe``) with a
+engine says of itself run in a child process (this module's :func:`main`, forked from the zygote of
+:mod:`comparisons.common.zygote`, or ``python -m simparity.comparisons.engines.probe`` when none answers) with a
 time limit (:data:`PROBE_SECONDS`) and a memory limit (:data:`PROBE_MEMORY_BYTES`). An engine that
 segfaults, exits, hangs or grows without bound there becomes a
 :class:`~comparisons.engines.placeholders.BrokenEngine` naming the cause, and simparity goes on. What it
@@ -12,12 +13,10 @@ engine in their worker (:mod:`comparisons.execute.case_worker`).
 
 from __future__ import annotations
 
-import contextlib
 import faulthandler
 import os
 import pickle
 import signal
-import subprocess
 import sys
 import tempfile
 import time
@@ -30,13 +29,17 @@ import numpy as np
 
 from simparity.comparisons.common.scene_hash import scene_hash
 from simparity.comparisons.engines.registry import make_engine
-from simparity.comparisons.common.processes import death_cause, status_bytes, worker_environment
+from simparity.comparisons.common import zygote
+from simparity.comparisons.common.processes import death_cause, status_bytes
 from simparity.comparisons.engines.placeholders import BrokenEngine, StandInEngine
 from simparity.comparisons.common.error_text import error_text
 from simparity.core.model.engine import Engine, KinematicsModel, Simulation, Support
 from simparity.core.model.errors import PluginError, one_line
 from simparity.core.runtime.processes import die_with_parent, kill_group
 from simparity.core.model.scenes.chain import Chain, Joint
+
+PROBE = "simparity.comparisons.engines.probe"
+"""This module, as its process is started (``python -m``, or forked from :mod:`comparisons.common.zygote`)."""
 
 PROBE_SECONDS = 60.0
 """Time limit [s] to import, build and describe one engine: MuJoCo takes ~0.3 s, a plugin that loads a large
@@ -189,7 +192,7 @@ def probe_engines(names: list[str], scenes: Sequence = ()) -> dict[str, Engine]:
 class EngineProbes:
     """The probes of one command's outside engines, each process kept to be asked again: a run asks its engines
     what they offer (a scene file's integrators), then about its scenes, then about its transformed scenes, and a
-    probe costs a process, simparity's imports and the engine's own (~1 CPU-s, up to a minute). Each question is
+    probe costs a process forked from the zygote and the engine's imports (up to a minute). Each question is
     what a new probe would answer (:func:`describe` of the engine it built, under the same time and memory
     limits); an engine that cannot run keeps its stand-in, asked nothing more. The processes end with
     :meth:`close`, or when this object is collected."""
@@ -280,18 +283,15 @@ class _Probe:
         self.name = name
         self.stderr = tempfile.TemporaryFile()
         answers, child_end = os.pipe()
+        child_reads, self.requests = os.pipe()
         try:
-            self.process = subprocess.Popen(
-                [sys.executable, "-m", "simparity.comparisons.engines.probe", str(child_end), str(os.getpid())],
-                stdin=subprocess.PIPE, stdout=subprocess.DEVNULL, stderr=self.stderr, pass_fds=(child_end,),
-                env=worker_environment(), start_new_session=True)
+            self.process = zygote.start(PROBE, child_reads, self.stderr, (child_end,))
         finally:
             os.close(child_end)
+            os.close(child_reads)
         os.set_blocking(answers, False)
         self.answers = answers
-        assert self.process.stdin is not None  # a pipe, written without blocking: a request may outgrow it
-        self.requests = self.process.stdin.fileno()
-        os.set_blocking(self.requests, False)
+        os.set_blocking(self.requests, False)  # written without blocking: a request may outgrow the pipe
         self._send((name, scenes))
 
     def ask(self, scenes: list) -> None:
@@ -357,9 +357,7 @@ class _Probe:
     def close(self) -> None:
         if self.process.poll() is None:
             self.kill()
-        assert self.process.stdin is not None  # a pipe
-        with contextlib.suppress(BrokenPipeError):
-            self.process.stdin.close()
+        os.close(self.requests)
         self.stderr.close()
         os.close(self.answers)
 

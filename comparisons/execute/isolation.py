@@ -1,6 +1,7 @@
 """Worker processes that run case groups with a time and a memory limit per case.
 
-Each worker is a fresh Python process (:mod:`comparisons.execute.case_worker`) speaking over two pipes. The
+Each worker is a Python process of its own (:mod:`comparisons.execute.case_worker`), forked from this process's
+zygote (:mod:`comparisons.common.zygote`: its imports done once, not once per worker), speaking over two pipes. The
 pool hands a worker one group at a time and watches it: a worker that dies (a segfault in an engine,
 ``os._exit``), goes past the per-case time limit or past the per-case memory limit (resident memory,
 read from /proc) is killed and replaced; the case it was running becomes ``failed`` rows naming the
@@ -13,20 +14,21 @@ from __future__ import annotations
 import collections
 import os
 import subprocess
-import sys
 import tempfile
 import time
 from dataclasses import dataclass, field
 from multiprocessing.connection import Connection, wait
 from typing import Iterator, cast
 
-from simparity.comparisons.common.processes import death_cause, status_bytes, worker_environment
+from simparity.comparisons.common import zygote
+from simparity.comparisons.common.processes import death_cause, status_bytes
 from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome
 from simparity.comparisons.execute.runner import failed_outcome
-from simparity.comparisons.common.processes import status_bytes
 from simparity.core.runtime.processes import kill_group
 
 GIB = 1024 ** 3
+
+CASE_WORKER = "simparity.comparisons.execute.case_worker"
 
 DEFAULT_CASE_SECONDS = 900.0
 """Per-case time limit [s] by default: 15 minutes, ~5x the longest case of the built-in suites (the
@@ -64,8 +66,9 @@ EXIT_GRACE_SECONDS = 1.0
 ``sys.exit`` takes milliseconds; killing it at once would report signal 9 instead of its exit code)."""
 
 WORKER_START_SECONDS = 60.0
-"""How long a new worker may take to say it is ready (a fresh interpreter importing simparity, NumPy and SciPy: ~1.2 s of
-CPU, ~10 s by the clock on a machine loaded ten times over), on top of the per-case limit of the job handed to it
+"""How long a new worker may take to say it is ready (forked from the zygote: milliseconds; a fresh interpreter, when no
+zygote answers, importing simparity, NumPy and SciPy: ~1.2 s of CPU, ~10 s by the clock on a machine loaded ten times
+over), on top of the per-case limit of the job handed to it
 meanwhile: its start does not count against that case, whose clock starts again when it is ready."""
 
 STDERR_TAIL_BYTES = 64 * 1024
@@ -109,13 +112,11 @@ class _Worker:
         child_reads, parent_writes = os.pipe()
         parent_reads, child_writes = os.pipe()
         self.stderr = tempfile.TemporaryFile(mode="a+b")  # append mode: the parent may truncate it
-        self.process = subprocess.Popen(
-            [sys.executable, "-m", "simparity.comparisons.execute.case_worker", str(child_reads), str(child_writes),
-             str(os.getpid())],
-            pass_fds=(child_reads, child_writes), stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-            stderr=self.stderr, env=worker_environment(), start_new_session=True)
-        os.close(child_reads)
-        os.close(child_writes)
+        try:
+            self.process = zygote.start(CASE_WORKER, None, self.stderr, (child_reads, child_writes))
+        finally:
+            os.close(child_reads)
+            os.close(child_writes)
         self.outbox = Connection(parent_writes, readable=False)
         self.inbox = Connection(parent_reads, writable=False)
         self.job: Job | None = None
@@ -156,8 +157,8 @@ class _Worker:
 
 class IsolatedPool:
     """Up to ``workers`` worker processes running jobs under ``limits``; replaced when one is killed. A process is
-    started when a job needs it and none is free: a run of one group starts one, not one per CPU (each costs ~1.2
-    CPU-s of imports before its first case), and a killed one is replaced only if a job is waiting."""
+    started when a job needs it and none is free: a run of one group starts one, not one per CPU (the zygote's imports,
+    ~1.2 CPU-s, are paid once per process), and a killed one is replaced only if a job is waiting."""
 
     def __init__(self, workers: int, limits: CaseLimits) -> None:
         if workers < 1:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import resource
-import sys
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, replace
@@ -11,6 +10,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from simparity.comparisons.common.processes import status_bytes
+from simparity.comparisons.common.zygote import RESIDENT_BYTES_PER_UNIT, children_usage
 from simparity.core.model.results import RUN_INFO_FILE
 from simparity.core.model.run_info import RunInfo
 
@@ -75,8 +75,8 @@ class PeakMemory:
     largest_child_bytes: int
     """[bytes] The largest child process it waited for: a case worker, or a child a worker forked to run one engine's
     cases (it holds the reference's and the engine's trajectories); engine probes and figure writers count too. Its
-    ru_maxrss, which on Linux includes the resident memory of the process that started it at that moment, so it is
-    at least the parent's size then; 0 without a child."""
+    ru_maxrss, which on Linux includes the resident memory of the process that started it at that moment (a worker:
+    the zygote it was forked from), so it is at least that size; 0 without a child."""
 
     @property
     def tree_bytes(self) -> int:
@@ -95,10 +95,10 @@ class PeakMemory:
 
 
 def peak_memory() -> PeakMemory:
-    """This process's and its largest finished child process's peak resident memory."""
-    scale = 1 if sys.platform == "darwin" else 1024  # ru_maxrss is in bytes on macOS, KiB on Linux
-    own = _high_water_mark_bytes() or resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * scale
-    return PeakMemory(own, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss * scale)
+    """This process's and its largest finished child process's peak resident memory (a worker forked by the zygote
+    included, :func:`comparisons.common.zygote.children_usage`)."""
+    own = _high_water_mark_bytes() or resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * RESIDENT_BYTES_PER_UNIT
+    return PeakMemory(own, children_usage().max_resident_bytes)
 
 
 def record_peak_memory(run_dir: Path) -> PeakMemory:

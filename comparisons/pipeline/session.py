@@ -7,10 +7,10 @@ journal and the stored run when it has a folder, the history it is recorded in, 
 held to. The CLI parses arguments into a session and prints what it hands back; the API and the fixture
 build one with their defaults. Nothing of a session outlives it: no module state, its engines are its own.
 
-Isolation costs a worker start per session (a Python process importing the engines, about a second) and
-cannot reach an engine that only exists in the calling process: a class defined in ``__main__`` (a script
-run directly, a notebook) cannot be imported by a worker, which starts as a fresh interpreter (like
-multiprocessing's *spawn*). Such an engine is refused with one line naming both ways out: move it into a
+Isolation costs a process's first session about a second (the zygote's imports, :mod:`comparisons.common.zygote`;
+each worker is forked from it) and cannot reach an engine that only exists in the calling process: a class defined
+in ``__main__`` (a script run directly, a notebook) cannot be imported by a worker, which starts as a fresh
+interpreter would (like multiprocessing's *spawn*). Such an engine is refused with one line naming both ways out: move it into a
 module on the import path, or run in this process (``isolate=False``), where a crash of the engine ends the
 caller's interpreter.
 """
@@ -159,7 +159,7 @@ def refuse_unreachable(specs: tuple[str, ...]) -> None:
         if attr and module == "__main__":
             raise SimparityError(
                 f"engine {one_line(spec)}: defined in __main__ (a script run directly, or a notebook), which a worker "
-                "process cannot import: isolated runs start each worker as a fresh interpreter (allowed: move the "
+                "process cannot import: isolated runs start each worker as a fresh interpreter would be (allowed: move the "
                 "engine into a module on the import path, or run it in this process with isolate=False, where a "
                 "crash of the engine ends this interpreter)")
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import io
+import sys
 import sysconfig
 from pathlib import Path
 
@@ -17,7 +18,8 @@ from simparity.comparisons.scenes import library
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.execute.execution import run_scenes
 from simparity.comparisons.common.processes import BLAS_THREAD_VARIABLES, death_cause, worker_environment
-from simparity.comparisons.execute.isolation import CaseLimits, IsolatedPool
+from simparity.comparisons.common import zygote
+from simparity.comparisons.execute.isolation import CASE_WORKER, CaseLimits, IsolatedPool
 from simparity.comparisons.scenes.library import builtin_paths
 from tests.helpers import THROWN_BALL, no_leftovers_within
 
@@ -61,8 +63,8 @@ class _Run:
 HOSTILE_DTS = (0.01,)
 """The time steps [s] of the tiny scene in the segfault, memory and hang runs: one group, so one worker runs every
 engine's cases, core's before the hostile engine's and MuJoCo's after them (in the worker that replaces the killed
-one). Each worker killed is replaced at once (~1 CPU-s a start): the scene's two time steps, two groups on two
-workers, started four workers a run for the same property."""
+one). Each worker killed is replaced at once: the scene's two time steps, two groups on two workers, started four
+workers a run for the same property."""
 
 
 def _throw_file(folder: Path, text: str = THROWN_BALL) -> Path:
@@ -255,24 +257,37 @@ def test_a_workers_imports_do_not_count_against_its_first_cases_time_limit(slow_
 
 
 def _live_workers() -> int:
-    """This process's children that are case workers and still alive (not zombies)."""
-    count = 0
+    """Case workers of this process still alive (not zombies): its children started as case workers, and the children
+    of its zygotes (each forked to be a worker or a probe; no probe runs here)."""
+    processes = _processes()
+    zygotes = {pid for pid, (_, parent, command) in processes.items()
+               if parent == os.getpid() and command.startswith(ZYGOTE_COMMAND)}
+    return sum(1 for state, parent, command in processes.values()
+               if state != "Z" and (parent in zygotes or (parent == os.getpid() and CASE_WORKER in command)))
+
+
+ZYGOTE_COMMAND = f"{sys.executable} -m {zygote.__name__}"
+
+
+def _processes() -> dict[int, tuple[str, int, str]]:
+    """Every process: {pid: (state, parent pid, command line with spaces)}."""
+    found = {}
     for entry in Path("/proc").iterdir():
         try:
             stat = (entry / "stat").read_text()
             fields = stat[stat.rindex(")") + 2:].split()
-            if fields[0] != "Z" and int(fields[1]) == os.getpid() and b"case_worker" in (entry / "cmdline").read_bytes():
-                count += 1
+            command = (entry / "cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+            found[int(entry.name)] = (fields[0], int(fields[1]), command)
         except (OSError, ValueError):  # not a process, or one that ended while read
             continue
-    return count
+    return found
 
 
 @pytest.mark.slow
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="counts processes through Linux's /proc")
 def test_a_worker_killed_for_the_last_case_is_not_replaced_for_nothing(tmp_path):
     """The hanging engine's case, the run's last, kills the only worker: no job waits, so no worker is started in its
-    place (before: one, ~1.2 CPU-s of imports for nothing); core's case before it completed in that worker."""
+    place (before: one, started for nothing); core's case before it completed in that worker."""
     engines = [make_engine("core"), make_engine(HANGING[0])]
     scene = _throw_file(tmp_path, THROWN_BALL.replace("dt = [0.01, 0.005]", f"dt = {list(HOSTILE_DTS)}"))
     with IsolatedPool(1, CaseLimits(HANG_SECONDS, None)) as pool:

@@ -37,7 +37,7 @@ def _small():
 
 
 ONE_WORKER = 1
-"""Workers of an isolated run here: a worker start (~1 CPU-s) less than one per time step, and the second time step's
+"""Workers of an isolated run here: one less than one per time step, and the second time step's
 cases run in the worker that ran the first's (after the crash, where there is one)."""
 
 
