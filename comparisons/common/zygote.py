@@ -217,7 +217,10 @@ def start(module: str, stdin: int | None, stderr: IO[bytes], argv_fds: tuple[int
                 for other in [k for k in mine if _zygotes[k].dead or k != key and not _zygotes[k].busy()]:
                     _zygotes.pop(other).close()
                 if key not in _zygotes:
-                    _zygotes[key] = Zygote()
+                    try:
+                        _zygotes[key] = Zygote()
+                    except OSError:  # no SOCK_SEQPACKET socket pair here (macOS), or no process to start
+                        break
                 zygote = _zygotes[key]
             forked = zygote.fork(module, null if stdin is None else stdin, stderr.fileno(), argv_fds)
             if forked is not None:

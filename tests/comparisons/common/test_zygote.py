@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
 import tempfile
 import time
 from pathlib import Path
@@ -14,6 +15,7 @@ import pytest
 
 from simparity.comparisons.common import zygote
 from simparity.comparisons.engines.probe import probe_engines
+from simparity.comparisons.execute.isolation import CASE_WORKER
 from simparity.core.inhouse import InHouseEngine
 
 MARK = "SIMPARITY_ZYGOTE_TEST_MARK"
@@ -105,3 +107,21 @@ def test_only_the_preloaded_modules_are_run():
         assert process.wait() == 1
         stderr.seek(0)
         assert "os is not one the zygote runs" in stderr.read().decode()
+
+
+def test_where_no_zygote_can_start_a_fresh_interpreter_runs_the_process(monkeypatch):
+    """macOS has no SOCK_SEQPACKET socket pairs: the worker starts as ``python -m`` and runs as it always did."""
+    def no_pair(*args, **kwargs):
+        raise OSError("socket type not supported")
+
+    monkeypatch.setattr(zygote, "_zygotes", {})
+    monkeypatch.setattr(zygote.socket, "socketpair", no_pair)
+    child_reads, parent_writes = os.pipe()
+    parent_reads, child_writes = os.pipe()
+    with tempfile.TemporaryFile() as stderr:
+        process = zygote.start(CASE_WORKER, None, stderr, (child_reads, child_writes))
+        for fd in (child_reads, child_writes, parent_writes):  # its inbox closed: it says it is ready, then exits
+            os.close(fd)
+        with os.fdopen(parent_reads, "rb") as outbox:
+            ready = outbox.read()
+        assert isinstance(process, subprocess.Popen) and process.wait() == 0 and b"ready" in ready
