@@ -11,3 +11,4 @@ from simparity.core.model.scenes.joint_motion import *  # noqa: F401,F403
 from simparity.core.model.scenes.kinematics import *  # noqa: F401,F403
 from simparity.core.model.scenes.kinds import *  # noqa: F401,F403
 from simparity.core.model.scenes.suites import *  # noqa: F401,F403
+from simparity.core.model.scenes.time_functions import *  # noqa: F401,F403

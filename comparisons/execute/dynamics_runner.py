@@ -30,6 +30,7 @@ from simparity.comparisons.measure.metrics import (
     saturation_scales_of,
     state_validity,
 )
+from simparity.comparisons.measure.held_forcing import forcing_scheme
 from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
 from simparity.comparisons.common.error_text import error_text
 from simparity.comparisons.measure.stability import STABILITY_METRICS, stable_dt_max
@@ -88,7 +89,7 @@ def dynamics_case(group: CaseGroup, shared: _DynamicsShared, index: int, engine_
     metrics = dynamics_metrics(scene)
     engine = engine_for(spec.engine)
     case = Case(scene.name, spec.engine, spec.integrator, dt, group.reference_label,
-                declared_scheme(engine, spec.integrator, scene))
+                forcing_scheme(declared_scheme(engine, spec.integrator, scene), scene))
     if spec.integrator == NO_INTEGRATOR:
         return CaseOutcome(_no_integrator_rows(scene, engine, case, metrics))
     rows: list[ResultRow] = []

@@ -26,6 +26,7 @@ from simparity.comparisons.measure.joint_motion_metrics import (
     REFERENCE_ERRORS, Horizon, OwnReading, divergence, energy_metrics, joint_scales, motion_metrics, parting_times,
     read_own, reach, reference_errors, reference_horizon,
 )
+from simparity.comparisons.measure.held_forcing import forcing_scheme
 from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
 from simparity.comparisons.common.error_text import error_text
 from simparity.core.model.engine import Engine, JointSimulation, Support
@@ -140,7 +141,7 @@ def motion_case(group: CaseGroup, shared: MotionShared, index: int, engine_for: 
     scene, spec = group.joint_motion_scene, group.cases[index]
     engine = engine_for(spec.engine)
     case = Case(scene.name, spec.engine, spec.integrator, group.dt, group.reference_label,
-                declared_scheme(engine, spec.integrator, scene))
+                forcing_scheme(declared_scheme(engine, spec.integrator, scene), scene))
     rows: list[ResultRow] = []
     with warnings_into_rows(rows):
         if spec.integrator == NO_INTEGRATOR:

@@ -41,6 +41,7 @@ from simparity.comparisons.measure.metrics import (
     dynamics_metrics,
     observed_order,
 )
+from simparity.comparisons.measure.held_forcing import HELD_DETAIL, HELD_ORDER, HELD_PREFIX
 from simparity.comparisons.measure.joint_dynamics_metrics import JOINT_DYNAMICS_METRICS
 from simparity.comparisons.measure.joint_motion_metrics import (
     JOINT_MOTION_ORDERS, JOINT_ORDER_SOURCES, motion_metrics,
@@ -82,10 +83,21 @@ class _Ladder:
         return schemes.pop() if len(schemes) == 1 else ""
 
     @property
+    def held(self) -> bool:
+        """Whether a held load jumps inside the steps of its cases (:mod:`comparisons.measure.held_forcing`)."""
+        return self.scheme.startswith(HELD_PREFIX)
+
+    @property
     def theory(self) -> int | None:
-        """The theoretical order the engine declares for the integrator (None unless its cases that say one agree)."""
+        """The theoretical order the engine declares for the integrator (None unless its cases that say one agree),
+        at most 1 where a held load jumps inside steps (:attr:`held`)."""
         orders = {case.theoretical_order for case in self.cases if case.theoretical_order is not None}
-        return orders.pop() if len(orders) == 1 else None
+        order = orders.pop() if len(orders) == 1 else None
+        return min(order, HELD_ORDER) if order is not None and self.held else order
+
+    def detail(self, ref_label: str) -> str:
+        """The order rows' detail: the reference, and the held load's order loss where there is one."""
+        return f"against {ref_label}" + (f"; {HELD_DETAIL}" if self.held else "")
 
 
 def _ignore_start(index: int | None) -> None:
@@ -146,7 +158,7 @@ def _orders(scene: DynamicsScene, ladders: dict[tuple[str, str], _Ladder], ref_l
             values[metric] = observed_order(ladder.dts, [c.errors.get(source, math.nan) for c in ladder.cases],
                                             [c.floors.get(source, 0.0) for c in ladder.cases],
                                             [c.saturation.get(source, 0.0) for c in ladder.cases], ladder.theory)
-        rows += case.rows(ORDER_METRICS, OK, f"against {ref_label}", values)
+        rows += case.rows(ORDER_METRICS, OK, ladder.detail(ref_label), values)
     return rows
 
 
@@ -164,7 +176,7 @@ def _joint_orders(scene: JointMotionScene, ladders: dict[tuple[str, str], _Ladde
                                              [c.floors.get(source, 0.0) for c in ladder.cases],
                                              [c.saturation.get(source, 0.0) for c in ladder.cases], ladder.theory)
                       for metric, source in JOINT_ORDER_SOURCES.items()}
-        rows += case.rows(JOINT_MOTION_ORDERS, OK, f"against {ref_label}", values)
+        rows += case.rows(JOINT_MOTION_ORDERS, OK, ladder.detail(ref_label), values)
     return rows
 
 

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from simparity.comparisons.invariance.units import Dimension
+from simparity.comparisons.measure.load_budget import load_budget
 from simparity.comparisons.measure.body_scales import contact_of
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.dynamics import DynamicsScene
@@ -94,9 +95,7 @@ def _dynamics_floors(scene: DynamicsScene) -> Floors:
     air = np.zeros(3) if forces.air_velocity_world is None else np.asarray(forces.air_velocity_world)
     speeds, spins, radii = [], [], []
     for index, body in enumerate(scene.bodies):
-        pushes = [a for a in forces.applied if a.body == index]
-        force = sum(float(np.linalg.norm(a.force_world)) for a in pushes)
-        torque = sum(float(np.linalg.norm(a.point_body) * np.linalg.norm(a.force_world)) for a in pushes)
+        force, torque = load_budget(scene, index)
         speed = float(np.linalg.norm(air) + np.linalg.norm(body.velocity_world - air)
                       + (gravity + force / body.mass) * duration)
         moment = float(np.linalg.eigvalsh(body.inertia_body)[0])

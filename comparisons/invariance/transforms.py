@@ -6,7 +6,10 @@ in another order, and counts mass and time in other units (M, T new units in one
 Every quantity of the scene follows its dimension: a velocity becomes (L / T) R v, gravity (L / T^2) R g,
 an angular velocity R omega / T, a body's inertia tensor M L^2 I (body axes do not turn with the world:
 the body's orientation does, q' = q_R q), a drag coefficient of N s/m becomes (M / T) b, a contact
-stiffness (M / T^2) k, the rest speed (L / T) v_rest, a time step T dt. Physics says the transformed scene
+stiffness (M / T^2) k, the rest speed (L / T) v_rest, a time step T dt. A load that changes with time follows its
+time too: f'(t') = s R f(t' / T) (s the factor of its unit, R only for world axes), so a polynomial's coefficient of
+t^k becomes s R c_k / T^k, a sinusoid's frequency f / T (its amplitude s R A, its phase unchanged), a hold's period
+and first instant T times theirs (its samples s R s_k). Physics says the transformed scene
 moves exactly as the transformed original, so every result, carried back into the scene's own units
 (:meth:`Transform.to_scene_units`), must be the same up to rounding: ``comparisons.invariance.metamorphic`` checks it.
 
@@ -46,6 +49,14 @@ from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.scenes.kinematics import KinematicsScene
+from simparity.core.model.scenes.time_functions import (
+    WORLD,
+    HeldFunction,
+    Sinusoid,
+    SmoothFunction,
+    TimedLoad,
+    TimeFunction,
+)
 from simparity.references.common.conventions import (
     matrix_to_quat_wxyz,
     matrix_to_rpy,
@@ -245,7 +256,34 @@ def _forces(forces: Forces, t: Transform, order: tuple[int, ...]) -> Forces:
         angular_quadratic_drag=_per_body(forces.angular_quadratic_drag, order, t.factor(length=2, mass=1)),
         applied=tuple(AppliedForce(new_index[a.body], t.vector(a.force_world, length=1, mass=1, time=-2),
                                    t.length_scale * a.point_body) for a in forces.applied),
+        timed=tuple(_timed_load(load, t, new_index) for load in forces.timed),
     )
+
+
+def _time_function(function: TimeFunction, t: Transform, scale, turned: bool) -> TimeFunction:
+    """``function`` in the transform's time unit, its values times ``scale`` (a number, or one per component) and
+    turned by R when ``turned`` (world axes): f'(t') = scale R f(t' / T) (module docstring)."""
+    def values(rows: np.ndarray) -> np.ndarray:
+        scaled = scale * np.asarray(rows, dtype=float)
+        return t.vector(scaled) if turned else scaled
+
+    if isinstance(function, HeldFunction):
+        return HeldFunction(values(function.samples), t.time_scale * function.period_s, t.time_scale * function.phase_s)
+    powers = t.time_scale ** -np.arange(len(function.polynomial), dtype=float)
+    return SmoothFunction(powers[:, None] * values(function.polynomial) if len(function.polynomial)
+                          else function.polynomial,
+                          tuple(Sinusoid(values(s.amplitude), s.frequency_hz / t.time_scale, s.phase_rad)
+                                for s in function.sinusoids))
+
+
+def _timed_load(load: TimedLoad, t: Transform, new_index: dict[int, int]) -> TimedLoad:
+    """A body's timed load: a force of N = kg m / s^2, a torque of N m; world axes turned, body axes not."""
+    turned = load.frame == WORLD
+    force, torque = load.force, load.torque
+    return TimedLoad(new_index[load.body], load.frame, t.length_scale * load.point_body,
+                     None if force is None else _time_function(force, t, t.factor(length=1, mass=1, time=-2), turned),
+                     None if torque is None else _time_function(torque, t, t.factor(length=2, mass=1, time=-2),
+                                                                turned))
 
 
 def _plane(plane: Plane, t: Transform) -> Plane:
@@ -358,14 +396,17 @@ def _joint_dynamics_scene(scene: JointDynamicsScene, t: Transform) -> JointDynam
 
 def _joint_motion_scene(scene: JointMotionScene, t: Transform) -> JointMotionScene:
     """The chain placed, scaled and given mass and time units as a joint-dynamics scene's; gravity turned and scaled;
-    the initial joint values, velocities and torques, the duration and the time steps in the new units."""
+    the initial joint values, velocities and torques (the timed one's time too), the duration and the time steps in
+    the new units."""
     chain = _timed_chain(scene.chain, t, scene.source)
     variable = np.array([1 if j.type == "prismatic" else 0 for j in scene.chain.joints])  # power of length: m or rad
-    gravity = scene.gravity_world
+    gravity, timed = scene.gravity_world, scene.timed_torque
+    torque_scale = t.length_scale ** (2 - variable) * t.factor(mass=1, time=-2)
     return replace(scene, chain=chain, gravity_world=None if gravity is None else t.vector(gravity, length=1, time=-2),
                    q0=t.length_scale ** variable * scene.q0,
                    qdot0=t.length_scale ** variable / t.time_scale * scene.qdot0,
-                   torque=t.length_scale ** (2 - variable) * t.factor(mass=1, time=-2) * scene.torque,
+                   torque=torque_scale * scene.torque,
+                   timed_torque=None if timed is None else _time_function(timed, t, torque_scale, turned=False),
                    duration=t.time_scale * scene.duration, dts=tuple(t.time_scale * dt for dt in scene.dts))
 
 

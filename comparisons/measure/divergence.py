@@ -3,7 +3,9 @@
 A run is diverged when, for some body,
 
 - its speed exceeds what its forces can give it: the drag pushes v toward the air velocity w
-  and never speeds the body up relative to it, so |v(t)| <= |w| + |v(0) - w| + (|g| + sum |f_i| / m) t;
+  and never speeds the body up relative to it, so |v(t)| <= |w| + |v(0) - w| + (|g| + sum |f_i| / m) t, the
+  loads that change with time counted at their largest magnitude over the run
+  (:func:`comparisons.measure.load_budget.largest_magnitude`);
 - its angular speed exceeds what its angular momentum allows: |omega| <= |L| / I_min, with
   |L(t)| <= |L(0)| + sum |p_i| |f_i| t (angular drag only takes momentum away); without applied
   forces also |omega| <= sqrt(2 KE_rot(0) / I_min), as the rotational energy cannot grow. With
@@ -26,6 +28,7 @@ from simparity.comparisons.measure.body_scales import body_sizes
 from simparity.comparisons.measure.contact_metrics import ContactReading, contact_blow_up, read_contact
 from simparity.comparisons.measure.extents import RunExtents
 from simparity.comparisons.measure.invariants import angular_momentum_world
+from simparity.comparisons.measure.load_budget import load_budget
 from simparity.comparisons.measure.metrics import energy_scale
 from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory
@@ -53,9 +56,8 @@ def _speed_bounds(scene: DynamicsScene) -> tuple[np.ndarray, np.ndarray]:
     air = np.zeros(3) if forces.air_velocity_world is None else forces.air_velocity_world
     linear, angular = [], []
     for index, body in enumerate(scene.bodies):
-        pushes = [a for a in forces.applied if a.body == index]
-        force = sum(float(np.linalg.norm(a.force_world)) for a in pushes)
-        torque = sum(float(np.linalg.norm(a.point_body) * np.linalg.norm(a.force_world)) for a in pushes)
+        pushed = any(a.body == index for a in forces.applied) or any(load.body == index for load in forces.timed)
+        force, torque = load_budget(scene, index)
         linear.append(np.linalg.norm(air) + np.linalg.norm(body.velocity_world - air)
                       + (gravity + force / body.mass) * duration)
         moments = np.linalg.eigvalsh(body.inertia_body)
@@ -71,7 +73,7 @@ def _speed_bounds(scene: DynamicsScene) -> tuple[np.ndarray, np.ndarray]:
             work = (body.mass * gravity + force) * linear[-1] * duration
             kinetic = spin_energy + body.mass * float(body.velocity_world @ body.velocity_world) / 2
             bound = max(bound, np.sqrt(2 * (kinetic + work) / moments[0]))
-        elif not pushes:
+        elif not pushed:
             bound = min(bound, np.sqrt(2 * spin_energy / moments[0]))
         angular.append(bound)
     return np.array(linear), np.array(angular)

@@ -16,6 +16,7 @@ from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.scenes.kinematics import KinematicsScene
+from simparity.core.model.scenes.time_functions import HeldFunction, TimeFunction
 from simparity.references.common.dynamics_urdf import model_changes
 
 
@@ -27,6 +28,18 @@ def _matrix(values) -> str:
     return "[" + ", ".join(_vector(row) for row in np.asarray(values)) + "]"
 
 
+def function_text(function: TimeFunction, unit: str) -> str:
+    """A time function in words and SI numbers: ``smooth: sum_k c_k t^k ... + sinusoids`` or ``held: ...``."""
+    if isinstance(function, HeldFunction):
+        return (f"held every {function.period_s:.10g} s from {function.phase_s:.10g} s: "
+                f"{len(function.samples)} samples {_matrix(function.samples[:4])}"
+                + (" ..." if len(function.samples) > 4 else "") + f" {unit} (0 before the first)")
+    terms = [f"{_vector(row)} t^{k}" for k, row in enumerate(function.polynomial)]
+    terms += [f"{_vector(s.amplitude)} sin(2 pi {s.frequency_hz:.10g} t + {s.phase_rad:.10g})"
+              for s in function.sinusoids]
+    return "smooth: " + " + ".join(terms) + f" {unit}"
+
+
 def _body_lines(scene: DynamicsScene) -> list[str]:
     lines = []
     for k, body in enumerate(scene.bodies):
@@ -34,6 +47,10 @@ def _body_lines(scene: DynamicsScene) -> list[str]:
                      f"quat_wxyz {_vector(body.quat_wxyz)}, velocity_world {_vector(body.velocity_world)} m/s, "
                      f"angular_velocity_world {_vector(body.angular_velocity_world)} rad/s")
         lines.append(f"  inertia_body about the COM {_matrix(body.inertia_body)} kg m^2")
+        for load in (load for load in scene.forces.timed if load.body == k):
+            lines.append(f"  load in {load.frame} axes at {_vector(load.point_body)} m"
+                         + (f"; force {function_text(load.force, 'N')}" if load.force is not None else "")
+                         + (f"; torque {function_text(load.torque, 'N m')}" if load.torque is not None else ""))
         points = body.point_masses
         if points is not None:
             lines.append(f"  computed from {len(points.masses)} point masses: M = sum m_i = {body.mass:.10g} kg; "
@@ -85,7 +102,9 @@ def _joint_motion_lines(scene: JointMotionScene) -> list[str]:
     gravity = "none" if scene.gravity_world is None else f"{_vector(scene.gravity_world)} m/s^2"
     accuracy = (f"self-consistency over {scene.segments} segments (each engine against itself at a 16 x smaller step)"
                 if scene.segments else "against the reference")
-    lines = [f"gravity_world {gravity} (in the base frame); joint torques {_vector(scene.torque)} (constant)",
+    timed = scene.timed_torque
+    lines = [f"gravity_world {gravity} (in the base frame); joint torques {_vector(scene.torque)} (constant)"
+             + (f" + timed {function_text(timed, 'N m or N')}" if timed is not None else ""),
              f"q0 {_vector(scene.q0[0])}; qdot0 {_vector(scene.qdot0[0])}"
              + (f" ({scene.copies} copies)" if scene.copies > 1 else ""),
              f"duration {scene.duration:.10g} s; dt {', '.join(f'{dt:.10g}' for dt in scene.dts)} s; accuracy {accuracy}"]

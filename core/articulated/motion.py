@@ -29,13 +29,14 @@ class CoreJointMotion(JointSimulation):
                        + ("; damping by ABA with armature + dt D" if scheme == stepping.IMPLICIT_DAMPING else ""))
 
     def run(self, n_steps: int) -> JointTrajectory:
-        q, qdot = stepping.run(self._step, np.asarray(self._scene.q0), np.asarray(self._scene.qdot0), n_steps)
+        q, qdot = stepping.run(self._step, np.asarray(self._scene.q0), np.asarray(self._scene.qdot0), n_steps,
+                               self._dt)
         return JointTrajectory(np.arange(n_steps + 1) * self._dt, q, qdot)
 
     def batched(self, copies: int) -> BatchedRun:
         q0 = np.repeat(np.asarray(self._scene.q0)[:1], copies, axis=0)
         qdot0 = np.repeat(np.asarray(self._scene.qdot0)[:1], copies, axis=0)
-        return lambda n_steps: stepping.run(self._step, q0, qdot0, n_steps)
+        return lambda n_steps: stepping.run(self._step, q0, qdot0, n_steps, self._dt)
 
     def energy(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Kinetic 1/2 qdot^T M qdot (CRBA, armature included); potential -sum m g.c from core's FK."""

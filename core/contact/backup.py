@@ -76,8 +76,8 @@ class _Flight:
             return self
         return _Flight(self.bodies.take(idx), self.normal[idx], self.slide[idx], self.stuck[idx], self.mu_k[idx])
 
-    def wrench(self, t, x, rotation, v, omega):
-        force, torque = self._external(t, x, rotation, v, omega)
+    def wrench(self, t, x, rotation, v, omega, step_start=None):
+        force, torque = self._external(t, x, rotation, v, omega, step_start)
         resting = np.any(self.normal != 0.0, axis=1)
         if not resting.any():
             return force, torque

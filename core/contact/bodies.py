@@ -368,15 +368,15 @@ def penalty_wrench(model: ContactModel, props: MassProperties, external: Wrench)
     At each point with E < 0: F_n = (-k_s E - k_d u.N)^+ N (:func:`core.contact.particle.penalty_force`)
     and regularised Coulomb friction -mu_k |F_n| u_t / max(|u_t|, v_reg)
     (:data:`FRICTION_REGULARISATION_SPEED`); torque r x F about the COM. Returns
-    f(t, x, R, v, omega) -> (force (B, 3) [N], torque (B, 3) [N m]).
+    f(t, x, R, v, omega, step_start) -> (force (B, 3) [N], torque (B, 3) [N m]).
     """
     # per plane, what its terms read (sliced once, not at every call): the plane, k_d (B, 1), mu_k (B, 1, 1)
     planes = [(p, Plane(n, d), model.damping[:, p, None], model.friction_kinetic[:, p, None, None])
               for p, (n, d) in enumerate(zip(model.normals, model.offsets))]
     weights = model.weights[..., None]
 
-    def wrench(t, x, rotation, v, omega):
-        force, torque = external(t, x, rotation, v, omega)
+    def wrench(t, x, rotation, v, omega, step_start=None):
+        force, torque = external(t, x, rotation, v, omega, step_start)
         lever = model.levers(rotation)
         for p, plane, damping, friction in planes:
             r = lever[:, p]

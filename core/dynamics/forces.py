@@ -4,7 +4,8 @@ F = M g - b (v - w) - c |v - w| (v - w) + sum f_i
 tau = -k omega - k_q |omega| omega + sum (R p_i) x f_i      (torques about each COM)
 
 with w the air velocity (wind), f_i constant world-frame forces applied at body-fixed
-points p_i. Terms absent from the scene contribute nothing and cost nothing.
+points p_i, plus each timed load's force and torque at the stage's time (:mod:`core.dynamics.time_loads`).
+Terms absent from the scene contribute nothing and cost nothing.
 """
 
 from __future__ import annotations
@@ -14,12 +15,13 @@ from dataclasses import replace
 import numpy as np
 
 from simparity.core.dynamics.rigid_body import MassProperties, Wrench
+from simparity.core.dynamics.time_loads import load_world
 from simparity.core.model.scenes.bodies import Forces
 from simparity.core.rotations import vector_lengths
 
 
 def make_wrench(forces: Forces, props: MassProperties) -> Wrench:
-    """f(t, x, R, v, omega) -> (force_world (B, 3) [N], torque_world (B, 3) [N m])."""
+    """f(t, x, R, v, omega, step_start) -> (force_world (B, 3) [N], torque_world (B, 3) [N m])."""
     n = len(props.mass)
     constant = np.zeros((n, 3))
     if forces.gravity_world is not None:
@@ -31,8 +33,9 @@ def make_wrench(forces: Forces, props: MassProperties) -> Wrench:
     np.add.at(constant, applied_body, applied_force)
     b, c = forces.linear_drag, forces.quadratic_drag
     k, kq = forces.angular_linear_drag, forces.angular_quadratic_drag
+    timed = forces.timed
 
-    def wrench(t, x, rotation, v, omega):
+    def wrench(t, x, rotation, v, omega, step_start=None):
         force = constant.copy()
         torque = np.zeros_like(force)
         if b is not None or c is not None:
@@ -48,6 +51,12 @@ def make_wrench(forces: Forces, props: MassProperties) -> Wrench:
         if len(applied_body):
             lever = np.einsum("aij,aj->ai", rotation[applied_body], applied_point)
             np.add.at(torque, applied_body, np.cross(lever, applied_force))
+        for load in timed:
+            start = t if step_start is None else step_start
+            at = (lambda time: time) if np.ndim(t) == 0 else (lambda time: np.asarray(time)[load.body])
+            f, tau = load_world(load, at(t), at(start), rotation[load.body])
+            force[load.body] += f
+            torque[load.body] += tau
         return force, torque
 
     return wrench

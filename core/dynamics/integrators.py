@@ -106,10 +106,12 @@ class _Derivative:
     torque_world: np.ndarray
 
 
-def _derivative(t: float, state: State, props: MassProperties, wrench: Wrench) -> _Derivative:
+def _derivative(t: float, state: State, props: MassProperties, wrench: Wrench,
+                step_start: float | None = None) -> _Derivative:
+    """The state's rate at stage time ``t`` of the step starting at ``step_start`` (None: ``t``)."""
     rotation = state.rotation_world
     v, omega = velocities(state, props, rotation)
-    force, torque = wrench(t, state.position_world, rotation, v, omega)
+    force, torque = wrench(t, state.position_world, rotation, v, omega, step_start)
     return _Derivative(v, omega, force, torque)
 
 
@@ -141,7 +143,7 @@ def runge_kutta_step(
                 s.momentum_world + combine("force_world"),
                 s.angular_momentum_world + combine("torque_world"),
             )
-            k = _derivative(t + c[i] * dt, stage, props, wrench)
+            k = _derivative(t + c[i] * dt, stage, props, wrench, t)
             ks.append(k)
             rot_incs.append(
                 dexpinv_so3(u, k.omega_world) if lie else _orientation_rate(stage.orientation, k.omega_world)

@@ -141,20 +141,23 @@ class PackedBodies:
 
 
 def _wrench(wrench: Wrench, t: float | np.ndarray, packed: np.ndarray, rotation: np.ndarray, v: np.ndarray,
-            omega: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The scene's wrench, called body-major on transposed views; returns (F, tau) as (3, B), or (3,) for a packed
-    state of one body without a batch axis (13,)."""
+            omega: np.ndarray, step_start: float | np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The scene's wrench at stage time ``t`` of the step starting at ``step_start`` (None: ``t``), called body-major
+    on transposed views; returns (F, tau) as (3, B), or (3,) for a packed state of one body without a batch axis
+    (13,)."""
     if packed.ndim == 1:
-        force, torque = wrench(t, packed[X][None], rotation[None], v[None], omega[None])
+        force, torque = wrench(t, packed[X][None], rotation[None], v[None], omega[None], step_start)
         return force[0], torque[0]
-    force, torque = wrench(t, packed[X].T, rotation.transpose(2, 0, 1), v.T, omega.T)
+    force, torque = wrench(t, packed[X].T, rotation.transpose(2, 0, 1), v.T, omega.T, step_start)
     return force.T, torque.T
 
 
-def _derivative(bodies: PackedBodies, wrench: Wrench, t: float | np.ndarray, packed: np.ndarray) -> np.ndarray:
-    """dS/dt = (v, 1/2 (0, omega) q, F, tau) of a packed state. (13, B) -> (13, B)."""
+def _derivative(bodies: PackedBodies, wrench: Wrench, t: float | np.ndarray, packed: np.ndarray,
+                step_start: float | np.ndarray) -> np.ndarray:
+    """dS/dt = (v, 1/2 (0, omega) q, F, tau) of a packed state at stage time ``t`` of the step starting at
+    ``step_start``. (13, B) -> (13, B)."""
     v, omega, rotation = bodies.velocities(packed)
-    force, torque = _wrench(wrench, t, packed, rotation, v, omega)
+    force, torque = _wrench(wrench, t, packed, rotation, v, omega, step_start)
     out = np.empty_like(packed)
     out[X], out[Q], out[P], out[L] = v, quat_rate(packed[Q], omega), force, torque
     return out
@@ -181,7 +184,7 @@ def runge_kutta(scheme: str, bodies: PackedBodies, wrench: Wrench) -> PackedStep
             for aij, k in zip(a[i], ks):
                 if aij:
                     stage = stage + (dt * aij) * k
-            ks.append(_derivative(bodies, wrench, t + c[i] * dt, stage))
+            ks.append(_derivative(bodies, wrench, t + c[i] * dt, stage, t))
         new = s.copy()
         for bi, k in zip(b, ks):
             if bi:

@@ -7,16 +7,22 @@ dS/dt = (v, omega* R, F, tau), with v = P / M, I(t) = R I_body R^T and omega = I
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Protocol
 
 import numpy as np
 
 from simparity.core.rotations import quat_wxyz_to_matrix
 from simparity.core.model.scenes.bodies import RigidBody
 
-Wrench = Callable[[float | np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
-"""f(t, x, R, v, omega) -> (force_world (B, 3) [N], torque_world about the COM (B, 3) [N m]); t [s] is a float,
-or (B,) one per body when a packed step is given one dt per body."""
+class Wrench(Protocol):
+    """f(t, x, R, v, omega, step_start=None) -> (force_world (B, 3) [N], torque_world about the COM (B, 3) [N m]).
+
+    ``t`` [s] is the stage's time, a float, or (B,) one per body when a packed step is given one dt per body;
+    ``step_start`` [s] (same shape) the start of the step the stage belongs to (None: ``t`` is a step's start),
+    which decides what a held load is (:mod:`core.dynamics.time_loads`)."""
+
+    def __call__(self, t: float | np.ndarray, x: np.ndarray, rotation: np.ndarray, v: np.ndarray, omega: np.ndarray,
+                 step_start: float | np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]: ...
 
 
 @dataclass(frozen=True)

@@ -48,6 +48,9 @@ SCHEME_KINDS = {
     "penalty": "a spring-damper force on penetration, integrated by a time integrator",
     "soft": "a soft constraint (MuJoCo's solref/solimp), with no restitution coefficient",
     "impulse": "velocity-level impulses with restitution and position correction (Bullet)",
+    # How a time integrator meets a load that changes with time (a prefix, as the contact treatments).
+    "held": "a held load whose jumps fall inside steps: each such step is first order, whatever the scheme "
+            "(comparisons.measure.held_forcing)",
     # How joint-space dynamics (mass matrix, bias forces, inverse and forward dynamics) are computed.
     "recursive": "Featherstone's recursive algorithms: Newton-Euler (RNEA), composite rigid body (CRBA), "
                  "articulated body (ABA) or a factorisation of M",

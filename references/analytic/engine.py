@@ -10,6 +10,9 @@ decouple (no force here couples them), and each is solved per body:
   precession), torque-free asymmetric (Jacobi elliptic functions + quadrature), linear
   angular drag on an isotropic body.
 
+- loads that change with time (:mod:`references.analytic.forced`): world-axes forces (smooth or held) on a body
+  without drag; torques along a fixed principal axis the body spins about (or from rest).
+
 Anything else (applied forces, both drags at once, quadratic angular drag, ...) gets
 ``n/a`` with the reason. Scenes with contact go to :mod:`references.analytic.contact`
 (translating bodies bouncing, resting and sliding on a plane, event by event).
@@ -51,8 +54,10 @@ from simparity.core.model.ik_result import IKReason, IKResult
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.time_functions import HeldFunction
 from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
 from simparity.references.analytic import contact as analytic_contact
+from simparity.references.analytic import forced
 from simparity.references.analytic import joint_dynamics as planar_dynamics
 from simparity.references.analytic import joint_motion
 from simparity.references.analytic import solutions as closed
@@ -64,6 +69,41 @@ from simparity.references.common.scene_inputs import derives_own_inputs
 _EQUAL_RTOL = 1e-12
 
 
+def _loads(scene: DynamicsScene, k: int):
+    """The loads that change with time on body k."""
+    return [load for load in scene.forces.timed if load.body == k]
+
+
+def _torque_vectors(function) -> np.ndarray:
+    """(N, 3) every vector a torque function is made of (its polynomial rows, amplitudes or samples)."""
+    if isinstance(function, HeldFunction):
+        return function.samples
+    return np.concatenate([function.polynomial] + [s.amplitude[None] for s in function.sinusoids])
+
+
+def fixed_torque_axis(scene: DynamicsScene, k: int) -> tuple[np.ndarray | None, str]:
+    """(the world axis (3,) body k turns about under its timed torques, or None with the reason there is none)."""
+    body = scene.bodies[k]
+    if any(load.force is not None and np.any(load.point_body) for load in _loads(scene, k)):
+        return None, f"no closed form for the moment of a time-varying force at a point of body '{body.name}'"
+    rotation0 = quat_wxyz_to_matrix(body.quat_wxyz)
+    vectors = [(rotation0 @ v.T).T if load.frame == "body" else v for load in _loads(scene, k)
+               if load.torque is not None for v in [_torque_vectors(load.torque)]]
+    every = np.concatenate(vectors) if vectors else np.zeros((0, 3))
+    nonzero = every[np.linalg.norm(every, axis=1) > 0]
+    axis = nonzero[0] / np.linalg.norm(nonzero[0])
+    if np.any(np.linalg.norm(np.cross(nonzero, axis), axis=1) > _EQUAL_RTOL * np.linalg.norm(nonzero, axis=1)):
+        return None, f"no closed form: the time-varying torques on body '{body.name}' do not share one axis"
+    axis_body = rotation0.T @ axis
+    inertia_axis = body.inertia_body @ axis_body
+    if np.linalg.norm(np.cross(inertia_axis, axis_body)) > _EQUAL_RTOL * np.linalg.norm(inertia_axis):
+        return None, f"no closed form: the time-varying torque on body '{body.name}' is not along a principal axis"
+    omega = body.angular_velocity_world
+    if np.linalg.norm(np.cross(omega, axis)) > _EQUAL_RTOL * np.linalg.norm(omega):
+        return None, f"no closed form: body '{body.name}' spins about another axis than its time-varying torque's"
+    return axis, ""
+
+
 def _rotation_kind(scene: DynamicsScene, k: int) -> tuple[str, str]:
     """(kind, reason-if-unsupported) of body k's rotation."""
     forces, body = scene.forces, scene.bodies[k]
@@ -71,6 +111,12 @@ def _rotation_kind(scene: DynamicsScene, k: int) -> tuple[str, str]:
     isotropic = np.ptp(moments) <= _EQUAL_RTOL * moments.max()
     if any(a.body == k for a in forces.applied):
         return "", f"no closed form for the torque of an applied force on body '{body.name}'"
+    twisting = [load for load in _loads(scene, k) if load.torque is not None or np.any(load.point_body)]
+    if twisting:
+        if any(drag is not None and drag[k] > 0 for drag in (forces.angular_linear_drag, forces.angular_quadratic_drag)):
+            return "", f"no closed form for a time-varying torque with angular drag on body '{body.name}'"
+        axis, why = fixed_torque_axis(scene, k)
+        return ("fixed_axis", "") if axis is not None else ("", why)
     if forces.angular_quadratic_drag is not None and forces.angular_quadratic_drag[k] > 0:
         return "", f"no closed form for quadratic angular drag on body '{body.name}'"
     if forces.angular_linear_drag is not None and forces.angular_linear_drag[k] > 0:
@@ -93,6 +139,13 @@ def _translation_kind(scene: DynamicsScene, k: int) -> tuple[str, str]:
     forces, name = scene.forces, scene.bodies[k].name
     linear = forces.linear_drag is not None and forces.linear_drag[k] > 0
     quadratic = forces.quadratic_drag is not None and forces.quadratic_drag[k] > 0
+    pushed = [load for load in _loads(scene, k) if load.force is not None]
+    if pushed:
+        if linear or quadratic:
+            return "", f"no closed form for a time-varying force with drag on body '{name}'"
+        if any(load.frame != "world" for load in pushed):
+            return "", f"no closed form for a time-varying force in the turning axes of body '{name}'"
+        return "forced", ""
     if linear and quadratic:
         return "", f"no closed form for linear and quadratic drag together on body '{name}'"
     if quadratic:
@@ -120,6 +173,9 @@ def _translation(scene: DynamicsScene, k: int, kind: str, times: np.ndarray) -> 
         assert forces.quadratic_drag is not None  # the kind says body k has quadratic drag
         return closed.quadratic_drag_along_line(body.position_world, body.velocity_world, g,
                                                 forces.quadratic_drag[k] / body.mass, times)
+    if kind == "forced":
+        return forced.forced_translation(body.position_world, body.velocity_world, g, body.mass,
+                                         [load.force for load in _loads(scene, k) if load.force is not None], times)
     return closed.projectile(body.position_world, body.velocity_world, g, times)
 
 
@@ -131,6 +187,14 @@ def _rotation(scene: DynamicsScene, k: int, kind: str, times: np.ndarray) -> tup
     if kind == "steady":
         rotation = rotvec_to_matrix(times[:, None] * omega) @ rotation0
         return matrix_to_quat_wxyz(rotation), np.broadcast_to(omega, (len(times), 3))
+    if kind == "fixed_axis":
+        axis, _ = fixed_torque_axis(scene, k)
+        assert axis is not None  # the kind says the axis exists
+        moment = float(axis @ rotation0 @ body.inertia_body @ rotation0.T @ axis)
+        torques = [(load.torque, rotation0.T @ axis if load.frame == "body" else axis)
+                   for load in _loads(scene, k) if load.torque is not None]
+        theta, omega_world = forced.fixed_axis_rotation(axis, moment, omega, torques, times)
+        return matrix_to_quat_wxyz(rotvec_to_matrix(theta[:, None] * axis) @ rotation0), omega_world
     moments, axes = principal_axes(body.inertia_body)
     if kind == "angular_drag":
         assert scene.forces.angular_linear_drag is not None  # the kind says body k has linear angular drag

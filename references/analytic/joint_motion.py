@@ -45,6 +45,7 @@ from scipy.special import ellipj, ellipk, ellipkinc
 from simparity.core.model.engine import JointSimulation, Support
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
+from simparity.references.analytic.forced import damped_drive_supported, driven_joint
 from simparity.references.analytic.solutions import linear_drag
 
 SEPARATRIX_BAND = 1e-9
@@ -239,6 +240,12 @@ def supports(scene: JointMotionScene) -> Support:
     joint, name = one_joint(scene), chain.joints[0].name
     if not joint.inertia > 0:
         return Support.no(f"no closed form: joint '{name}' moves no inertia along its axis (I = 0)")
+    if scene.timed_torque is not None:
+        if joint.is_pendulum():
+            return Support.no(f"no closed form for a pendulum driven by a torque that changes with time: joint "
+                              f"'{name}' swings under gravity")
+        why = damped_drive_supported(scene.timed_torque) if joint.damping > 0 else ""
+        return Support.no(f"{why} (joint '{name}')") if why else Support.yes()
     if not joint.is_pendulum():
         return Support.yes()
     if joint.damping > 0:
@@ -267,13 +274,21 @@ class ClosedFormJointMotion(JointSimulation):
             self.detail = (f"closed form: physical pendulum (Jacobi elliptic functions), omega0 = "
                            f"{self._pendulum.omega0:.6g} rad/s; joint limits not enforced")
         else:
-            self.detail = (f"closed form: one joint under a constant force, damping {self._joint.damping:g}, "
-                           f"inertia {self._joint.inertia:.6g}; joint limits not enforced")
+            self.detail = (f"closed form: one joint under a constant force"
+                           + (" and a torque that changes with time" if scene.timed_torque is not None else "")
+                           + f", damping {self._joint.damping:g}, inertia {self._joint.inertia:.6g}; joint limits "
+                           "not enforced")
 
     def run(self, n_steps: int) -> JointTrajectory:
         times = np.arange(n_steps + 1) * self._dt
         q0, qdot0 = self._scene.q0[:, 0], self._scene.qdot0[:, 0]
-        if self._pendulum is None:
+        if self._pendulum is None and self._scene.timed_torque is not None:
+            joint = self._joint
+            force = joint.torque + (0.0 if joint.revolute else joint.mass * float(joint.gravity @ joint.axis))
+            pairs = [driven_joint(a, b, joint.inertia, joint.damping, force, self._scene.timed_torque, times)
+                     for a, b in zip(q0, qdot0)]
+            q, qdot = np.stack([p for p, _ in pairs], axis=1), np.stack([v for _, v in pairs], axis=1)
+        elif self._pendulum is None:
             q, qdot = constant_force_motion(q0, qdot0, self._joint, times)
         else:
             psi = self._pendulum.psi

@@ -7,13 +7,16 @@ linear momentum [kg m/s] and angular momentum about the COM [kg m^2/s], both wor
 
     dx/dt = P / m
     dq/dt = 1/2 (0, omega) * q          omega = R I_body^-1 R^T L,  R = R(q / |q|)
-    dP/dt = m g + F_drag + sum f_i
-    dL/dt = tau_drag + sum (R p_i) x f_i
+    dP/dt = m g + F_drag + sum f_i + sum F_k(t)
+    dL/dt = tau_drag + sum (R p_i) x f_i + sum tau_k(t) + (R p_k) x F_k(t)
 
-Drag and the applied forces come from :mod:`simparity.references.common.external_forces`. SciPy's
-DOP853 (8th order, adaptive) integrates it at relative and absolute tolerance 1e-13 and
+Drag and the applied forces come from :mod:`simparity.references.common.external_forces`, loads that change with
+time (F_k(t), tau_k(t)) from :mod:`simparity.references.common.time_loads`, evaluated at the solver's own times.
+SciPy's DOP853 (8th order, adaptive) integrates it at relative and absolute tolerance 1e-13 and
 is evaluated at the sample times of the step being compared; the quaternion is normalised
-on output. Results name it ``tight:dop853``.
+on output. A held load jumps at its sample instants: the solve stops at each and starts again from there (an
+adaptive solver stepping across a jump would lose its order and its error estimate there). Results name it
+``tight:dop853``.
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ from simparity.core.model.engine import Engine, KinematicsModel, PieceSimulation
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.trajectory import Trajectory, piece_bounds
-from simparity.references.common import external_forces
+from simparity.references.common import external_forces, time_loads
 from simparity.references.common.scene_inputs import derives_own_inputs
 
 TOLERANCE = 1e-13
@@ -71,9 +74,13 @@ class _Simulation(PieceSimulation):
             self._mass[:, None] * np.stack([b.velocity_world for b in bodies]),
             np.einsum("bij,bj->bi", inertia_world, omega)], axis=1).ravel()
         self._dt = dt
+        self._jumps = time_loads.jump_times([f for load in scene.forces.timed for f in load.functions()],
+                                            scene.duration)
         self.detail = (f"SciPy {scipy.__version__} DOP853, rtol = atol = {TOLERANCE:g}, on its own right-hand side "
                        "(x, q, P, L)" + ("; " + external_forces.DETAIL if external_forces.has_drag(scene.forces)
-                                         or external_forces.has_angular_drag(scene.forces) else ""))
+                                         or external_forces.has_angular_drag(scene.forces) else "")
+                       + (f"; loads that change with time at the solver's own times, restarted at {len(self._jumps)} "
+                          "sample instants of held loads" if scene.forces.timed else ""))
 
     def _velocities(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(v (B, 3), omega (B, 3), R (B, 3, 3)) of the state rows y (B, 13)."""
@@ -82,25 +89,46 @@ class _Simulation(PieceSimulation):
         omega = np.einsum("bij,bj->bi", inertia_world_inv, y[:, 10:13])
         return y[:, 7:10] / self._mass[:, None], omega, rotation
 
-    def _derivative(self, t: float, flat: np.ndarray) -> np.ndarray:
+    def _derivative(self, t: float, flat: np.ndarray, interval_start: float) -> np.ndarray:
+        """dy/dt at time t inside the interval between two jumps of the held loads that starts at
+        ``interval_start`` (a held load is what it is inside that interval)."""
         y = flat.reshape(-1, _STATE)
         v, omega, rotation = self._velocities(y)
         applied_force, applied_torque = external_forces.applied_wrench_world(self._forces, rotation)
         force = self._weight + external_forces.drag_force_world(self._forces, v) + applied_force
         torque = external_forces.drag_torque_world(self._forces, omega) + applied_torque
+        for load in self._forces.timed:
+            f, tau = time_loads.load_wrench_world(load, t, rotation[load.body], interval_start)
+            force[load.body] += f
+            torque[load.body] += tau
         return np.concatenate([v, _quaternion_rate(y[:, 3:7], omega), force, torque], axis=1).ravel()
 
+    def _solve(self, end: float):
+        """The dense solutions of the run to ``end`` [s], one per interval between jumps of the held loads, and the
+        intervals' starts."""
+        starts = np.concatenate([[0.0], self._jumps[self._jumps < end]])
+        solutions, y0 = [], self._y0
+        for a, b in zip(starts, np.append(starts[1:], end)):
+            sol = solve_ivp(self._derivative, (a, b), y0, method="DOP853", dense_output=True, rtol=TOLERANCE,
+                            atol=TOLERANCE, args=(a,))
+            if not sol.success:
+                raise RuntimeError(f"DOP853 failed: {sol.message}")
+            solutions.append(sol.sol)
+            y0 = sol.y[:, -1]
+        return solutions, starts
+
     def stream(self, n_steps: int, samples_per_piece: int) -> Iterator[Trajectory]:
-        """One DOP853 solve over the run; each piece's samples from its dense output (the interpolant of the
-        step each time falls in, as ``t_eval`` would pick it: the same values), so memory grows with DOP853's
-        steps, not the run's."""
-        sol = solve_ivp(self._derivative, (0.0, n_steps * self._dt), self._y0, method="DOP853", dense_output=True,
-                        rtol=TOLERANCE, atol=TOLERANCE)
-        if not sol.success:
-            raise RuntimeError(f"DOP853 failed: {sol.message}")
+        """One DOP853 solve over the run (one per interval between the held loads' jumps); each piece's samples
+        from its dense output (the interpolant of the step each time falls in, as ``t_eval`` would pick it: the
+        same values), so memory grows with DOP853's steps, not the run's."""
+        solutions, starts = self._solve(n_steps * self._dt)
         for start, stop in piece_bounds(n_steps, samples_per_piece):
             times = np.arange(start, stop) * self._dt
-            y = sol.sol(times).T.reshape(len(times), -1, _STATE)
+            interval = np.clip(np.searchsorted(starts, times, side="right") - 1, 0, len(starts) - 1)
+            flat = np.empty((len(times), len(self._y0)))
+            for k in np.unique(interval):
+                flat[interval == k] = solutions[k](times[interval == k]).T
+            y = flat.reshape(len(times), -1, _STATE)
             samples = [self._velocities(row) for row in y]
             quat = y[..., 3:7] / np.linalg.norm(y[..., 3:7], axis=-1, keepdims=True)
             yield Trajectory(times, y[..., :3], quat, np.array([v for v, _, _ in samples]),

@@ -20,6 +20,10 @@ Conversions (each pinned by a test in ``tests/references/mujoco/test_adapter.py`
   ``xfrc_applied``. Both are set from the state at the start of each step (positions
   updated by ``mj_kinematics`` and ``mj_comPos`` first) and held over the step by an
   ``mj_step`` loop; its RK4 then sees them as constant within a step.
+- Loads that change with time (:mod:`references.common.time_loads`, independent of core) are evaluated at every
+  stage: MuJoCo calls its control callback (``mjcb_control``) in each ``mj_forward`` of a step, RK4's four with
+  ``d.time`` at the stage's time t + c dt (:mod:`references.mujoco.stage_loads`); the callback adds each load to
+  that step's ``qfrc_applied`` with ``mj_applyFT`` at the stage's body pose.
 - Instability: MuJoCo does not return NaN; it warns ("Nan, Inf or huge value in QACC") and
   RESETS the state to the model's initial one, so the trajectory stays finite and wrong.
   The adapter counts ``mjWARN_BADQACC``, ``mjWARN_BADQPOS`` and ``mjWARN_BADQVEL`` over the
@@ -71,12 +75,14 @@ from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
-from simparity.references.common import contact_params, external_forces
+from simparity.references.common import contact_params, external_forces, time_loads
 from simparity.references.mujoco import ik as mujoco_ik
 from simparity.references.mujoco import joint_motion
 from simparity.references.common.base_frame import BaseFrame
 from simparity.references.common.conventions import fmt, quat_wxyz_to_matrix
 from simparity.references.mujoco.mjcf import INTEGRATORS, arena_kib, chain_mjcf, dynamics_mjcf
+from simparity.references.mujoco.stage_loads import DETAIL as STAGE_DETAIL
+from simparity.references.mujoco.stage_loads import StepClock, stage_callback
 from simparity.references.common.quiet import captured_output
 from simparity.references.common.urdf_export import chain_export, chain_source, chain_urdf, urdf_support
 from simparity.references.mujoco.joint_dynamics import MujocoJointDynamics, mujoco_dynamics_problem
@@ -129,6 +135,9 @@ class _Simulation(PieceSimulation):
             self._xfrc[1:, :3] = wind
         self._drags = _quadratic_drags(forces)
         self._applied = forces.applied
+        self._timed = forces.timed
+        self._clock = StepClock()
+        self._qfrc_step = np.zeros(self.model.nv)
         qvel = self._data.qvel.reshape(self._n_bodies, 6)
         for k, body in enumerate(scene.bodies):
             qvel[k, :3] = body.velocity_world
@@ -139,7 +148,8 @@ class _Simulation(PieceSimulation):
         self._dt = dt
         native = [n for n in ("linear_drag", "angular_linear_drag") if n in forces.names()]
         stepwise = (["mj_applyFT at each applied force's world point"] if self._applied else []) + (
-            [f"quadratic drag as xfrc_applied ({external_forces.DETAIL})"] if self._drags else [])
+            [f"quadratic drag as xfrc_applied ({external_forces.DETAIL})"] if self._drags else []) + (
+            [STAGE_DETAIL] if self._timed else [])
         self.detail = (
             f"MuJoCo integrator {INTEGRATORS[integrator]}; explicit inertia; "
             + (f"contact disabled, arena {arena_kib(scene)} KiB (MuJoCo's default grows as nv^2)"
@@ -153,7 +163,18 @@ class _Simulation(PieceSimulation):
 
     @property
     def _stepwise(self) -> bool:
-        return bool(self._applied) or self._drags is not None
+        return bool(self._applied) or self._drags is not None or bool(self._timed)
+
+    def _stage_loads(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
+        """MuJoCo's control callback: the step's qfrc_applied plus each timed load at the stage's time, applied at
+        the load's point of the stage's body pose (:mod:`references.mujoco.stage_loads`)."""
+        d.qfrc_applied[:] = self._qfrc_step
+        for load in self._timed:
+            body = load.body + 1
+            rotation = d.xmat[body].reshape(3, 3)
+            force, torque = time_loads.load_world(load, d.time, rotation, self._clock.step_start)
+            point = d.xpos[body] + rotation @ load.point_body  # mj_applyFT adds the force's moment about the COM
+            mujoco.mj_applyFT(m, d, force, torque, point, body, d.qfrc_applied)
 
     def _rollout(self, initial: np.ndarray, n_steps: int) -> np.ndarray:
         """The states after each of ``n_steps`` steps from each initial state, (R, n_steps, nstate), by one
@@ -171,7 +192,8 @@ class _Simulation(PieceSimulation):
         every step (an ``mj_step`` loop), which a rollout cannot apply."""
         if self._stepwise:
             stepwise = (["applied forces (mj_applyFT)"] if self._applied else []) + (
-                ["quadratic drag (xfrc_applied)"] if self._drags else [])
+                ["quadratic drag (xfrc_applied)"] if self._drags else []) + (
+                ["loads that change with time (its control callback)"] if self._timed else [])
             raise NotBatchedError(f"the adapter sets {' and '.join(stepwise)} from Python at every step, which "
                                   "mujoco.rollout cannot apply: no batched timing of this scene")
         initial = np.repeat(self._state0[None], copies, axis=0)
@@ -193,6 +215,7 @@ class _Simulation(PieceSimulation):
             body = applied.body + 1
             point = d.xpos[body] + d.xmat[body].reshape(3, 3) @ applied.point_body
             mujoco.mj_applyFT(m, d, applied.force_world, np.zeros(3), point, body, d.qfrc_applied)
+        self._qfrc_step = d.qfrc_applied.copy()
 
     def _loop(self, n_steps: int) -> np.ndarray:
         """The states after each of ``n_steps`` further steps of the data as it stands, (n_steps, nstate)."""
@@ -200,6 +223,7 @@ class _Simulation(PieceSimulation):
         states = np.empty((n_steps, len(self._state0)))
         for i in range(n_steps):
             self._apply_forces()
+            self._clock.step_start = d.time
             mujoco.mj_step(m, d)
             mujoco.mj_getState(m, d, states[i], _STATE)
         return states
@@ -217,7 +241,8 @@ class _Simulation(PieceSimulation):
             if self._stepwise and first:
                 mujoco.mj_setState(self.model, self._data, initial, _STATE)
             if self._stepwise:
-                stepped = self._loop(n_steps)
+                with stage_callback(self._stage_loads if self._timed else None):
+                    stepped = self._loop(n_steps)
             else:
                 stepped = self._rollout(initial[None], n_steps)[0] if n_steps else np.empty((0, len(initial)))
         finally:
@@ -457,6 +482,9 @@ class MujocoEngine(Engine):
             extra += (f"<!-- each step, mj_applyFT of {fmt(applied.force_world)} N at body point "
                       f"{fmt(applied.point_body)} m (world position from the state at the step's start), "
                       f"body {applied.body + 1} -->\n")
+        for load in scene.forces.timed:
+            extra += (f"<!-- every stage (mjcb_control at d.time): mj_applyFT of a load that changes with time, "
+                      f"{load.frame} axes, at body point {fmt(load.point_body)} m, body {load.body + 1} -->\n")
         if scene.contact is not None:
             extra += f"<!-- {contact_detail(scene, dt)} -->\n"
         return dynamics_mjcf(scene, integrator, dt) + velocities + extra

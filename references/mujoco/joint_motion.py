@@ -13,7 +13,9 @@ What MuJoCo is given (each pinned by ``tests/references/mujoco/test_joint_motion
   the damping implicitly and drops the Coriolis derivatives; ``implicit`` keeps them. ``rk4`` is the classical
   Runge-Kutta of ``mj_RungeKutta`` (damping explicit, four ``mj_forward`` per step).
 - Applied joint forces: ``qfrc_applied`` = the scene's constant torque on the chain's dofs, given to
-  ``mujoco.rollout`` as a control of spec ``mjSTATE_QFRC_APPLIED`` (one row, held over every step and stage).
+  ``mujoco.rollout`` as a control of spec ``mjSTATE_QFRC_APPLIED`` (one row, held over every step and stage). A
+  timed torque (:mod:`references.common.time_loads`) is added at every stage by MuJoCo's control callback at the
+  stage's ``d.time`` (:mod:`references.mujoco.stage_loads`), in an ``mj_step`` loop per copy instead of the rollout.
 - Stepping: ``mujoco.rollout`` from the B initial states (``mjSTATE_FULLPHYSICS``: time, qpos, qvel) in one call on
   the calling thread, bit-identical to an ``mj_step`` loop; its rows are the states AFTER each step, the initial
   state is prepended and the samples are at k dt. qpos and qvel are read at the chain joints' addresses (mapped by
@@ -40,7 +42,10 @@ from simparity.core.model.errors import DivergedError
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common.conventions import fmt
+from simparity.references.common import time_loads
 from simparity.references.mujoco.joint_dynamics import ChainModel
+from simparity.references.mujoco.stage_loads import DETAIL as STAGE_DETAIL
+from simparity.references.mujoco.stage_loads import StepClock, stage_callback
 
 _STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
 
@@ -90,6 +95,8 @@ class MujocoJointMotion(JointSimulation):
         self._end_effector = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, scene.chain.end_effector_name)
         self._control = np.zeros((1, 1, self.model.nv))
         self._control[0, 0, self._dof] = scene.torque
+        self._timed = scene.timed_torque
+        self._clock = StepClock()
         self._qpos_at = mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_TIME)
         self._qvel_at = self._qpos_at + self.model.nq
         self._initial = self._states(scene.q0, scene.qdot0)
@@ -98,8 +105,10 @@ class MujocoJointMotion(JointSimulation):
                    "eulerdamp on (MuJoCo's default): damping implicit" if integrator == "euler" else "")
         self.detail = (f"{built.detail}; integrator {kind.name} at timestep {dt:g} s"
                        + (f", {damping}" if damping else "")
-                       + f"; qfrc_applied {fmt(scene.torque)} held constant (rollout control mjSTATE_QFRC_APPLIED); "
-                       "stepped by mujoco.rollout; no velocity clipping; a MuJoCo warning (bad state, reset) raises "
+                       + (f"; qfrc_applied {fmt(scene.torque)} held constant (rollout control mjSTATE_QFRC_APPLIED); "
+                          "stepped by mujoco.rollout" if self._timed is None else
+                          f"; qfrc_applied {fmt(scene.torque)} plus the timed torque, {STAGE_DETAIL}; mj_step loop")
+                       + "; no velocity clipping; a MuJoCo warning (bad state, reset) raises "
                        "DivergedError; energy by mj_mulM and -sum m g.xipos; end effector by mj_kinematics")
 
     def _states(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
@@ -112,9 +121,30 @@ class MujocoJointMotion(JointSimulation):
         return states
 
     def _rollout(self, initial: np.ndarray, n_steps: int) -> np.ndarray:
-        """(R, n_steps, nstate): the states after each step from each of the R initial states, one rollout call."""
+        """(R, n_steps, nstate): the states after each step from each of the R initial states, one rollout call (an
+        ``mj_step`` loop per state under a timed torque)."""
+        if self._timed is not None:
+            with stage_callback(self._stage_torque):
+                return np.stack([self._loop(state, n_steps) for state in initial])
         states, _ = rollout.rollout(self.model, self._data, initial, self._control,
                                     control_spec=mujoco.mjtState.mjSTATE_QFRC_APPLIED, nstep=n_steps)
+        return states
+
+    def _stage_torque(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
+        """MuJoCo's control callback: qfrc_applied = the constant torque plus the timed one at the stage's time."""
+        assert self._timed is not None  # installed only with a timed torque
+        d.qfrc_applied[:] = self._control[0, 0]
+        d.qfrc_applied[self._dof] += time_loads.at(self._timed, d.time, self._clock.step_start)
+
+    def _loop(self, initial: np.ndarray, n_steps: int) -> np.ndarray:
+        """(n_steps, nstate): the states after each of ``n_steps`` mj_steps from the state ``initial``."""
+        m, d = self.model, self._data
+        mujoco.mj_setState(m, d, initial, _STATE)
+        states = np.empty((n_steps, len(initial)))
+        for i in range(n_steps):
+            self._clock.step_start = d.time
+            mujoco.mj_step(m, d)
+            mujoco.mj_getState(m, d, states[i], _STATE)
         return states
 
     def run(self, n_steps: int) -> JointTrajectory:

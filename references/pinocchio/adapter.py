@@ -60,7 +60,7 @@ from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
-from simparity.references.common import external_forces
+from simparity.references.common import external_forces, time_loads
 from simparity.references.pinocchio import ik as pinocchio_ik
 from simparity.references.common.base_frame import BaseFrame
 from simparity.references.common.conventions import matrix_to_quat_wxyz, quat_wxyz_to_matrix
@@ -102,6 +102,8 @@ INTEGRATORS = ("euler", "rk4")
 # Classical RK4 tableau.
 _RK4_A = ((), (0.5,), (0.0, 0.5), (0.0, 0.0, 1.0))
 _RK4_B = (1 / 6, 1 / 3, 1 / 3, 1 / 6)
+_RK4_C = (0.0, 0.5, 0.5, 1.0)
+"""The stages' times as fractions of the step (each row's sum of _RK4_A): where timed loads are evaluated."""
 
 
 class _Simulation(PieceSimulation):
@@ -135,7 +137,7 @@ class _Simulation(PieceSimulation):
         self._tau = np.zeros(6)
         self._forces = scene.forces
         self._drag = external_forces.has_drag(scene.forces) or external_forces.has_angular_drag(scene.forces)
-        self._external = self._drag or bool(scene.forces.applied)
+        self._external = self._drag or bool(scene.forces.applied) or bool(scene.forces.timed)
         # aba's fext per body (universe, then its joint): the joint's entry is rewritten at every call.
         self._fext = [pin.StdVec_Force([pin.Force.Zero(), pin.Force.Zero()]) for _ in scene.bodies]
         self._at_points = [pin.SE3(np.eye(3), applied.point_body) for applied in scene.forces.applied]
@@ -144,7 +146,9 @@ class _Simulation(PieceSimulation):
         self.detail = ("harness-stepped: pin.aba accelerations, "
                        + ("RK4 with RKMK on SO(3)" if integrator == "rk4" else "engines' semi-implicit Euler on SO(3)")
                        + ("; applied forces as aba fext at their body points (SE3.act)" if scene.forces.applied else "")
-                       + (f"; {external_forces.DETAIL}, as aba fext" if self._drag else ""))
+                       + (f"; {external_forces.DETAIL}, as aba fext" if self._drag else "")
+                       + ("; loads that change with time as aba fext at each stage's time t + c dt (a held load as "
+                          "seen from inside the step)" if scene.forces.timed else ""))
 
     def batched(self, copies: int) -> BatchedRun:
         """The harness calls aba body by body: NotBatchedError."""
@@ -158,13 +162,14 @@ class _Simulation(PieceSimulation):
             pos, rot, vel, omg = (np.empty((stop - start, b) + s) for s in ((3,), (3, 3), (3,), (3,)))
             for j, i in enumerate(range(start, stop)):
                 if i:
-                    state = self._step(state, dt)
+                    state = self._step(state, dt, (i - 1) * dt)
                 (p, v, w), r = state
                 pos[j], rot[j], vel[j], omg[j] = p, r, v, np.einsum("bij,bj->bi", r, w)
             yield Trajectory(np.arange(start, stop) * dt, pos, matrix_to_quat_wxyz(rot), vel, omg)
 
-    def _set_fext(self, r: np.ndarray, v: np.ndarray, w_local: np.ndarray) -> None:
-        """aba's external force on each body's joint: LOCAL frame, about the COM."""
+    def _set_fext(self, r: np.ndarray, v: np.ndarray, w_local: np.ndarray, t: float, step_start: float) -> None:
+        """aba's external force on each body's joint: LOCAL frame, about the COM; timed loads at stage time t [s] of
+        the step starting at ``step_start``."""
         b = len(r)
         force, torque = np.zeros((b, 3)), np.zeros((b, 3))
         if self._drag:
@@ -174,17 +179,23 @@ class _Simulation(PieceSimulation):
         for applied, at_point in zip(self._forces.applied, self._at_points):
             k = applied.body
             per_body[k] = per_body[k] + at_point.act(pin.Force(r[k].T @ applied.force_world, _NO_TORQUE))
+        for load in self._forces.timed:
+            k = load.body
+            force_world, torque_world = time_loads.load_world(load, t, r[k], step_start)
+            at_point = pin.SE3(np.eye(3), load.point_body)
+            per_body[k] = per_body[k] + at_point.act(pin.Force(r[k].T @ force_world, r[k].T @ torque_world))
         for fext, spatial in zip(self._fext, per_body):
             fext[1] = spatial
 
-    def _accelerations(self, s: np.ndarray, r: np.ndarray, out: np.ndarray) -> None:
+    def _accelerations(self, s: np.ndarray, r: np.ndarray, out: np.ndarray, t: float, step_start: float) -> None:
         """(dv/dt world, dw/dt local) into ``out`` (2, B, 3), from aba at the state ``s`` = (p, v, w_local) (3, B, 3)
-        and rotations ``r`` (B, 3, 3); the scene's non-gravity forces as fext."""
+        and rotations ``r`` (B, 3, 3) at stage time t [s] of the step starting at ``step_start``; the scene's
+        non-gravity forces as fext."""
         p, v, w_local = s
         v_local = np.einsum("bji,bj->bi", r, v)
         qd = np.concatenate([v_local, w_local], axis=1)
         if self._external:
-            self._set_fext(r, v, w_local)
+            self._set_fext(r, v, w_local, t, step_start)
         a = np.empty((len(p), 6))
         for k, (model, data) in enumerate(self._models):
             q = pin.SE3ToXYZQUAT(pin.SE3(r[k], p[k]))
@@ -194,18 +205,18 @@ class _Simulation(PieceSimulation):
         out[0] = np.einsum("bij,bj->bi", r, a[:, :3] + _spin_cross(qd))
         out[1] = a[:, 3:]
 
-    def _euler(self, state, dt):
+    def _euler(self, state, dt, t):
         s, r = state
         stepped = np.empty_like(s)
-        self._accelerations(s, r, stepped[1:])
+        self._accelerations(s, r, stepped[1:], t, t)
         stepped[1:] = s[1:] + dt * stepped[1:]
         stepped[0] = s[0] + dt * stepped[1]
         return stepped, r @ _exp3(dt * stepped[2])
 
-    def _rk4(self, state, dt):
+    def _rk4(self, state, dt, t):
         s, r = state
         ks = []  # (dp, dv, dw, du) per stage, (4, B, 3)
-        for a_row in _RK4_A:
+        for a_row, c in zip(_RK4_A, _RK4_C):
             inc = np.zeros((4,) + s.shape[1:])
             for a, k in zip(a_row, ks):
                 inc = inc + (dt * a) * k
@@ -213,7 +224,7 @@ class _Simulation(PieceSimulation):
             rotation = _exp3(u)
             k = np.empty_like(inc)
             k[0] = stage[1]
-            self._accelerations(stage, r @ rotation, k[1:3])
+            self._accelerations(stage, r @ rotation, k[1:3], t + c * dt, t)
             k[3] = _dexp_inverse(rotation, stage[2])
             ks.append(k)
         total = sum((dt * b) * k for b, k in zip(_RK4_B, ks))
@@ -403,7 +414,8 @@ class PinocchioEngine(UrdfChains, Engine):
         return (
             f"# Pinocchio models built in code (no file): one model with one free-flyer per body.\n"
             f"# gravity: {gravity}; stepped by the harness ({integrator}, dt = {dt!r} s)\n"
-            + (f"# each step, aba's fext (local frame, about the COM): {', '.join(external)}\n" if external else "")
+            + (f"# each step, aba's fext (local frame, about the COM): {', '.join(external)}"
+               + (" (timed loads at each stage's time)" if scene.forces.timed else "") + "\n" if external else "")
             + (f"# contact: n/a, not simulated: {NO_CONTACT}\n" if scene.contact is not None else "")
             + (f"{models[0]}\n" if models else "") + inertias
         )

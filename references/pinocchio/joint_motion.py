@@ -9,8 +9,10 @@ What Pinocchio is given, and each default handled (each pinned by ``tests/refere
   URDF read by Pinocchio's own parser, ``model.gravity`` exactly the scene's (zero for None, where Pinocchio's
   default is (0, 0, -9.81)), the chain's armature as ``model.armature`` (``aba`` and ``crba`` include it), no
   ``<dynamics>`` (``aba`` ignores ``model.damping`` and ``model.friction`` anyway).
-- qddot = ``aba``(q, v, tau - D v): the scene's constant joint forces tau minus the chain's damping D = diag(damping),
-  evaluated at every stage. Pinocchio's ``aba`` never applies joint or velocity limits.
+- qddot = ``aba``(q, v, tau - D v): the scene's constant joint forces tau (plus its timed torque at each stage's own
+  time t + c dt, :mod:`references.common.time_loads`, a held one as seen from inside the step) minus the chain's
+  damping D = diag(damping), evaluated at every stage. The DOP853 solves stop and restart at each jump of a held
+  torque. Pinocchio's ``aba`` never applies joint or velocity limits.
 - Configurations: a continuous joint (a revolute joint without limits) has nq = 2, (cos q, sin q); the fixed-step
   schemes move the configuration with ``pin.integrate`` and give angles unwrapped: a continuous joint's angle
   accumulates each step's increment ``pin.difference`` (a spinning joint's q is continuous, never wrapped to
@@ -41,6 +43,7 @@ from simparity.core.model.engine import BatchedRun, JointSimulation
 from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
+from simparity.references.common import time_loads
 from simparity.references.pinocchio.joint_dynamics import ChainModel, chain_model
 
 SCHEMES = {
@@ -79,6 +82,7 @@ class PinocchioJointMotion(JointSimulation):
         self._model = self._chain.model
         self._data = self._model.createData()
         self._tau = self._chain.velocity(np.asarray(scene.torque))
+        self._timed = scene.timed_torque
         self._damping = self._chain.velocity(self._chain.damping)
         self._end_frame = self._model.getFrameId(scene.chain.end_effector_name, pin.BODY)
         continuous = np.array(self._chain.continuous, dtype=bool)
@@ -108,9 +112,12 @@ class PinocchioJointMotion(JointSimulation):
                 self._step_copy(self._scene.q0[k], self._scene.qdot0[k], q[:, k], qdot[:, k])
         return JointTrajectory(times, q, qdot)
 
-    def _acceleration(self, configuration: np.ndarray, v: np.ndarray) -> np.ndarray:
-        """(nv,) qddot = aba(q, v, tau - D v) [rad/s^2 or m/s^2] (a copy: ``aba`` returns its own array)."""
-        return pin.aba(self._model, self._data, configuration, v, self._tau - self._damping * v)
+    def _acceleration(self, configuration: np.ndarray, v: np.ndarray, t: float, step_start: float) -> np.ndarray:
+        """(nv,) qddot = aba(q, v, tau(t) - D v) [rad/s^2 or m/s^2] at stage time t [s] of the step starting at
+        ``step_start`` (a copy: ``aba`` returns its own array)."""
+        tau = self._tau if self._timed is None else (
+            self._tau + self._chain.velocity(time_loads.at(self._timed, t, step_start)))
+        return pin.aba(self._model, self._data, configuration, v, tau - self._damping * v)
 
     def _step_copy(self, q0: np.ndarray, qdot0: np.ndarray, q_out: np.ndarray, qdot_out: np.ndarray) -> None:
         """Step one copy from (q0, qdot0) ((n,) each) into q_out, qdot_out ((T, n) each, T - 1 steps)."""
@@ -120,54 +127,66 @@ class PinocchioJointMotion(JointSimulation):
         angles = np.array(q0, dtype=float)
         q_out[0], qdot_out[0] = q0, qdot0
         for i in range(1, len(q_out)):
-            new_configuration, v = step(configuration, v)
+            new_configuration, v = step((i - 1) * self._dt, configuration, v)
             angles[self._lin_n] = new_configuration[self._lin_q]
             if len(self._cont_n):
                 angles[self._cont_n] += pin.difference(model, configuration, new_configuration)[self._cont_v]
             configuration = new_configuration
             q_out[i], qdot_out[i] = angles, v[idx_v]
 
-    def _stepper(self) -> Callable[[np.ndarray, np.ndarray], State]:
-        """One step of the fixed-step integrator: (configuration, v) -> (configuration, v) after dt."""
+    def _stepper(self) -> Callable[[float, np.ndarray, np.ndarray], State]:
+        """One step of the fixed-step integrator from time t: (t, configuration, v) -> (configuration, v) after dt."""
         model, dt, acceleration = self._model, self._dt, self._acceleration
         half, sixth = 0.5 * dt, dt / 6
 
-        def explicit_euler(q: np.ndarray, v: np.ndarray) -> State:
-            return pin.integrate(model, q, dt * v), v + dt * acceleration(q, v)
+        def explicit_euler(t: float, q: np.ndarray, v: np.ndarray) -> State:
+            return pin.integrate(model, q, dt * v), v + dt * acceleration(q, v, t, t)
 
-        def semi_implicit_euler(q: np.ndarray, v: np.ndarray) -> State:
-            v = v + dt * acceleration(q, v)
+        def semi_implicit_euler(t: float, q: np.ndarray, v: np.ndarray) -> State:
+            v = v + dt * acceleration(q, v, t, t)
             return pin.integrate(model, q, dt * v), v
 
-        def rk4(q: np.ndarray, v: np.ndarray) -> State:
-            a1 = acceleration(q, v)
+        def rk4(t: float, q: np.ndarray, v: np.ndarray) -> State:
+            a1 = acceleration(q, v, t, t)
             v2 = v + half * a1
-            a2 = acceleration(pin.integrate(model, q, half * v), v2)
+            a2 = acceleration(pin.integrate(model, q, half * v), v2, t + half, t)
             v3 = v + half * a2
-            a3 = acceleration(pin.integrate(model, q, half * v2), v3)
+            a3 = acceleration(pin.integrate(model, q, half * v2), v3, t + half, t)
             v4 = v + dt * a3
-            a4 = acceleration(pin.integrate(model, q, dt * v3), v4)
+            a4 = acceleration(pin.integrate(model, q, dt * v3), v4, t + dt, t)
             return (pin.integrate(model, q, sixth * (v + v4 + 2.0 * (v2 + v3))),
                     v + sixth * (a1 + a4 + 2.0 * (a2 + a3)))
 
         return {"explicit_euler": explicit_euler, "semi_implicit_euler": semi_implicit_euler, "rk4": rk4}[
             self._integrator]
 
-    def _derivative(self, t: float, y: np.ndarray) -> np.ndarray:
-        """d/dt (angles, qdot) ((2n,)) = (qdot, aba) for DOP853."""
+    def _derivative(self, t: float, y: np.ndarray, interval_start: float) -> np.ndarray:
+        """d/dt (angles, qdot) ((2n,)) = (qdot, aba) for DOP853, inside the interval between a held torque's jumps
+        that starts at ``interval_start``."""
         n = len(y) // 2
         v = self._chain.velocity(y[n:])
-        return np.concatenate([y[n:], self._acceleration(self._chain.configuration(y[:n]), v)[self._chain.idx_v]])
+        return np.concatenate([y[n:], self._acceleration(self._chain.configuration(y[:n]), v, t,
+                                                         interval_start)[self._chain.idx_v]])
 
     def _solve(self, q0: np.ndarray, qdot0: np.ndarray, times: np.ndarray) -> State:
-        """One copy by DOP853 from (q0, qdot0) ((n,) each): (q, qdot), (T, n) each at ``times`` (T,) [s]."""
+        """One copy by DOP853 from (q0, qdot0) ((n,) each): (q, qdot), (T, n) each at ``times`` (T,) [s]; one solve
+        per interval between a held torque's jumps, each from where the one before ended."""
         tolerance = TOLERANCES[self._integrator]
-        n = len(q0)
-        sol = solve_ivp(self._derivative, (0.0, times[-1]), np.concatenate([q0, qdot0]), method="DOP853",
-                        t_eval=times, rtol=tolerance, atol=self._absolute_tolerance(tolerance, n, times[-1]))
-        if not sol.success:
-            raise DivergedError(f"pinocchio {self._integrator}: DOP853 failed: {sol.message}")
-        return sol.y[:n].T, sol.y[n:].T
+        n, end = len(q0), times[-1]
+        jumps = time_loads.jump_times([self._timed] if self._timed is not None else [], end)
+        starts = np.concatenate([[0.0], jumps])
+        y, y0 = np.empty((len(times), 2 * n)), np.concatenate([q0, qdot0])
+        for a, b in zip(starts, np.append(jumps, end)):
+            last = b == end
+            inside = (times >= a) & ((times < b) | last)
+            t_eval = times[inside] if last else np.append(times[inside], b)  # a jump's instant: where the next starts
+            sol = solve_ivp(self._derivative, (a, b), y0, method="DOP853", t_eval=t_eval, rtol=tolerance,
+                            atol=self._absolute_tolerance(tolerance, n, end), args=(a,))
+            if not sol.success:
+                raise DivergedError(f"pinocchio {self._integrator}: DOP853 failed: {sol.message}")
+            y[inside] = sol.y.T if last else sol.y[:, :-1].T
+            y0 = sol.y[:, -1]
+        return y[:, :n], y[:, n:]
 
     @staticmethod
     def _absolute_tolerance(tolerance: float, n: int, duration: float) -> np.ndarray:

@@ -102,7 +102,7 @@ from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
-from simparity.references.common import contact_params, external_forces
+from simparity.references.common import contact_params, external_forces, time_loads
 from simparity.references.pybullet import ik as pybullet_ik
 from simparity.references.common.base_frame import BaseFrame
 from simparity.references.common.conventions import (
@@ -286,6 +286,9 @@ class _Simulation(PieceSimulation):
             + ("" if contact is None else f"; {contact_detail(contact, dt)}; read back by "
                f"getPhysicsEngineParameters: {read_back}")
             + ("; applyExternalForce at each applied force's world point" if self._applied else "")
+            + ("; loads that change with time at each step's start (stepSimulation's one evaluation), by "
+               "applyExternalForce at the load's world point and applyExternalTorque (WORLD_FRAME)"
+               if scene.forces.timed else "")
             + (f"; {external_forces.DETAIL}, as applyExternalForce at the COM and applyExternalTorque"
                if self._drag else "")
         )
@@ -318,7 +321,7 @@ class _Simulation(PieceSimulation):
             raw = np.empty((stop - start, b, 13))  # position 3, quat xyzw 4, velocity 3, omega 3
             for j, i in enumerate(range(start, stop)):
                 if i:
-                    self._apply(raw[j - 1] if j else last)
+                    self._apply(raw[j - 1] if j else last, (i - 1) * self._dt)
                     pybullet.stepSimulation(physicsClientId=c)
                 for k, uid in enumerate(self._bodies):
                     pos, quat = pybullet.getBasePositionAndOrientation(uid, physicsClientId=c)
@@ -336,13 +339,20 @@ class _Simulation(PieceSimulation):
         rotation_inertial = quat_wxyz_to_matrix(wxyz_from_xyzw(quat_xyzw_inertial))
         return matrix_to_quat_wxyz(rotation_inertial @ np.swapaxes(self._axes, -1, -2))
 
-    def _apply(self, raw: np.ndarray) -> None:
-        """Apply the scene's non-gravity forces, evaluated at the state ``raw`` (B, 13)."""
+    def _apply(self, raw: np.ndarray, t: float) -> None:
+        """Apply the scene's non-gravity forces, evaluated at the state ``raw`` (B, 13) at the step's start t [s]."""
         c = self._client.id
         for k, force, point_inertial in self._applied:
             rotation = np.reshape(pybullet.getMatrixFromQuaternion(raw[k, 3:7]), (3, 3))
             point = raw[k, :3] + rotation @ point_inertial
             pybullet.applyExternalForce(self._bodies[k], -1, force, point, pybullet.WORLD_FRAME, physicsClientId=c)
+        for load in self._forces.timed:
+            k = load.body
+            rotation = np.reshape(pybullet.getMatrixFromQuaternion(raw[k, 3:7]), (3, 3)) @ self._axes[k].T
+            force, torque = time_loads.load_world(load, t, rotation)
+            point = raw[k, :3] + rotation @ load.point_body
+            pybullet.applyExternalForce(self._bodies[k], -1, force, point, pybullet.WORLD_FRAME, physicsClientId=c)
+            pybullet.applyExternalTorque(self._bodies[k], -1, torque, pybullet.WORLD_FRAME, physicsClientId=c)
         if not self._drag:
             return
         force = external_forces.drag_force_world(self._forces, raw[:, 7:10])
@@ -615,13 +625,17 @@ class PybulletEngine(UrdfChains, Engine):
             "activationState=ACTIVATION_STATE_DISABLE_SLEEPING), resetBasePositionAndOrientation and "
             "resetBaseVelocity to the scene's initial state (inertial frame). -->\n"
         )
-        drags = [n for n in scene.forces.names() if n not in ("gravity", "applied_force")]
+        drags = [n for n in scene.forces.names() if n not in ("gravity", "applied_force", "timed_load")]
         if drags:
             api += (f"<!-- each step: applyExternalForce at the COM / applyExternalTorque (WORLD_FRAME) of "
                     f"{', '.join(drags)}, from the state at the step's start -->\n")
         for applied in scene.forces.applied:
             api += (f"<!-- each step: applyExternalForce({fmt(applied.force_world)} N) at the world position of "
                     f"body point {fmt(applied.point_body)} m (WORLD_FRAME), body {applied.body} -->\n")
+        for load in scene.forces.timed:
+            api += (f"<!-- each step, at its start time: applyExternalForce / applyExternalTorque (WORLD_FRAME) of a "
+                    f"load that changes with time ({load.frame} axes) at body point {fmt(load.point_body)} m, body "
+                    f"{load.body} -->\n")
         contact = scene.contact
         if contact is None:
             return api + "".join(body_urdf(b) for b in scene.bodies)

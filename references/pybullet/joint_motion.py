@@ -18,7 +18,8 @@ pinned by ``tests/references/pybullet/test_joint_motion.py``:
   not the implicit -dt (M + dt D)^-1 D qdot), the same as a torque -D qdot sent before each step. It is stable only
   while dt b / I stays below 2 on every joint: the iiwa's last link (I = 1e-3 kg m^2, b = 0.5 N m s) blows up at
   dt = 4 ms (measured: finite at 3 ms).
-- Applied joint forces: ``setJointMotorControlArray(TORQUE_CONTROL)`` before EVERY step. Bullet clears the applied
+- Applied joint forces: ``setJointMotorControlArray(TORQUE_CONTROL)`` before EVERY step, the scene's timed torque
+  (:mod:`references.common.time_loads`) evaluated at the step's start (Bullet's step evaluates forces once). Bullet clears the applied
   joint torques after each step (measured: a torque sent once acts on one step only), so it is sent again each time.
 - PyBullet has no joint armature: a chain with armature > 0 is refused (:meth:`PybulletEngine.supports_joint_motion`).
 - B copies: one body per copy in the same world, stepped together by one ``stepSimulation``. They cannot touch (no
@@ -48,6 +49,7 @@ from simparity.core.model.engine import BatchedRun, JointSimulation
 from simparity.core.model.errors import DivergedError
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
+from simparity.references.common import time_loads
 from simparity.references.common.dynamics_urdf import dynamics_source
 from simparity.references.pybullet.adapter import PybulletChain
 from simparity.references.pybullet.joint_dynamics import CLIPPED, ChainBodies, axes_changed
@@ -103,8 +105,11 @@ class PybulletJointMotion(JointSimulation):
         for k in range(len(world.bodies)):
             world.reset(q0[k], qdot0[k], copy=k)
         q[0], qdot[0] = q0, qdot0
-        torque = np.asarray(self._scene.torque).tolist()
+        constant, timed = np.asarray(self._scene.torque), self._scene.timed_torque
+        torque = constant.tolist()
         for i in range(1, n_steps + 1):
+            if timed is not None:  # at the step's start: stepSimulation evaluates the forces once per step
+                torque = (constant + time_loads.at(timed, (i - 1) * self._dt)).tolist()
             for body in world.bodies:
                 pybullet.setJointMotorControlArray(body, world.joints, pybullet.TORQUE_CONTROL, forces=torque,
                                                    physicsClientId=c)

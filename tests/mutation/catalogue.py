@@ -41,6 +41,10 @@ JOINT_MOTION = ("default", "hard", "articulated")
 """Joint-space time stepping: the default suite's pendulum, damped joint and oblique arm, the hard suite's stiff
 damping and the articulated suite's chains and falling arms."""
 
+FORCED = ("default", "articulated")
+"""Loads that change with time: the default suite's forced bodies and driven joints, the articulated suite's driven
+joints."""
+
 MUTANTS: tuple[Mutation, ...] = (
     # --- Dynamics: integrators ------------------------------------------------------------------------------
     Mutation(
@@ -273,8 +277,8 @@ MUTANTS: tuple[Mutation, ...] = (
         JOINT_MOTION, "pendulum-large-amplitude"),
     Mutation(
         "joint_semi_implicit_old_velocity", "integrator stages", "articulated/stepping.py",
-        "            qdot = qdot + dt * qddot(q, qdot)\n            return q + dt * qdot, qdot\n        return semi_implicit",
-        "            new = qdot + dt * qddot(q, qdot)\n            return q + dt * qdot, new\n        return semi_implicit",
+        "            qdot = qdot + dt * qddot(q, qdot, t, t)\n            return q + dt * qdot, qdot\n        return semi_implicit",
+        "            new = qdot + dt * qddot(q, qdot, t, t)\n            return q + dt * qdot, new\n        return semi_implicit",
         "semi-implicit Euler moving the joints with the old velocity: explicit Euler under the semi-implicit name",
         JOINT_MOTION, "pendulum-large-amplitude"),
     Mutation(
@@ -285,10 +289,36 @@ MUTANTS: tuple[Mutation, ...] = (
         JOINT_MOTION, "damped-joint"),
     Mutation(
         "joint_torque_dropped", "applied forces", "articulated/stepping.py",
-        "torque = scene.torque[:, None]",
-        "torque = 0.0 * scene.torque[:, None]",
+        "constant, timed = scene.torque[:, None], scene.timed_torque",
+        "constant, timed = 0.0 * scene.torque[:, None], scene.timed_torque",
         "the scene's applied joint torques never reach the steps",
         JOINT_MOTION, "damped-joint"),
+    # --- Loads that change with time (issue #42) ----------------------------------------------------------------
+    Mutation(
+        "stage_time_at_step_start", "time-varying loads", "dynamics/quaternion_integrators.py",
+        "ks.append(_derivative(bodies, wrench, t + c[i] * dt, stage, t))",
+        "ks.append(_derivative(bodies, wrench, t, stage, t))",
+        "every Runge-Kutta stage evaluates the loads at the step's start time instead of its own t + c dt (first "
+        "order under a time-varying load)",
+        ("default",), "forced-particle"),
+    Mutation(
+        "joint_stage_time_at_step_start", "time-varying loads", "articulated/stepping.py",
+        "accelerations.append(qddot(q_i, qdot_i, t + c * dt, t))",
+        "accelerations.append(qddot(q_i, qdot_i, t, t))",
+        "a chain's Runge-Kutta stages evaluate the timed joint torque at the step's start time",
+        FORCED, "driven-damped-joint"),
+    Mutation(
+        "hold_one_period_late", "time-varying loads", "dynamics/time_loads.py",
+        "index = np.where(times > np.asarray(step_start, dtype=float), left, right).astype(int)",
+        "index = np.where(times > np.asarray(step_start, dtype=float), left, right).astype(int) - 1",
+        "a zero-order hold sampled one control period late (the sample before the one in force)",
+        FORCED, "torque-pulse"),
+    Mutation(
+        "sinusoid_phase_in_degrees", "time-varying loads", "dynamics/time_loads.py",
+        "np.sin(2 * np.pi * sinusoid.frequency_hz * times + sinusoid.phase_rad)",
+        "np.sin(2 * np.pi * sinusoid.frequency_hz * times + np.deg2rad(sinusoid.phase_rad))",
+        "a sinusoid's phase read as degrees (the scene gives radians)",
+        FORCED, "forced-particle"),
 )
 """The catalogue (issue #23 asks for at least a dozen, of the kinds listed there)."""
 

@@ -49,9 +49,9 @@ def _flipped_torque(make_wrench):
         right = make_wrench(forces, props)
         without_applied = make_wrench(dataclasses.replace(forces, applied=()), props)
 
-        def wrench(t, x, rotation, v, omega):
-            force, torque = right(t, x, rotation, v, omega)
-            _, base = without_applied(t, x, rotation, v, omega)
+        def wrench(t, x, rotation, v, omega, step_start=None):
+            force, torque = right(t, x, rotation, v, omega, step_start)
+            _, base = without_applied(t, x, rotation, v, omega, step_start)
             return force, base - (torque - base)
 
         return wrench

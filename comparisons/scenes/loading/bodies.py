@@ -1,5 +1,5 @@
 """The free bodies of a dynamics scene: ``[[body]]`` with its mass (given or from ``[[body.point_mass]]``), its
-state, drag and applied forces."""
+state, drag, applied forces and loads that change with time (``[[body.load]]``)."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ from simparity.references.common.conventions import quat_wxyz_to_matrix
 # Drag coefficients and the power of length in their units (for length_unit scaling).
 DRAG_KEYS = {"linear_drag": 0, "quadratic_drag": -1, "angular_linear_drag": 2, "angular_quadratic_drag": 2}
 BODY_KEYS = ("name", "mass", "inertia_body_diagonal", "inertia_body", "point_mass", "position_world", "quat_wxyz",
-             "velocity_world", "angular_velocity_world", "force") + tuple(DRAG_KEYS) + CONTACT_BODY_KEYS
+             "velocity_world", "angular_velocity_world", "force", "load") + tuple(DRAG_KEYS) + CONTACT_BODY_KEYS
 _POINT_MASS = ("mass", "position")
 _FORCE = ("force_world", "point_body")
 

@@ -9,6 +9,7 @@ from simparity.comparisons.engines.registry import EngineSet
 from simparity.comparisons.scenes.loading.bodies import BODY_KEYS, DRAG_KEYS, read_body, read_body_forces
 from simparity.comparisons.scenes.loading.contact import read_contact
 from simparity.comparisons.scenes.loading.reader import TableReader
+from simparity.comparisons.scenes.loading.time_functions import read_loads
 from simparity.comparisons.scenes.loading.time_steps import time_step_ladder
 from simparity.core.model.scenes.bodies import Forces
 from simparity.core.model.scenes.dynamics import DynamicsScene
@@ -30,13 +31,19 @@ def read_dynamics(top: TableReader, head: dict, engines: EngineSet) -> DynamicsS
     if world is not None and air is not None and drag["linear_drag"] is None and drag["quadratic_drag"] is None:
         raise world.fail("air_velocity_world", "wind needs a body with linear_drag or quadratic_drag to act on",
                          "wind with a drag on some body, or no air_velocity_world")
+    timed = tuple(load for i, r in enumerate(readers) for load in read_loads(r, i))
     forces = Forces(gravity_world=gravity, air_velocity_world=air,
-                    applied=tuple(a for _, applied in per_body for a in applied), **drag)
+                    applied=tuple(a for _, applied in per_body for a in applied), timed=timed, **drag)
     names = [b.name for b in bodies]
     if len(set(names)) != len(names):
         repeated = next(n for i, n in enumerate(names) if n in names[:i])
         raise top.fail("body", f"the body name {repeated!r} repeats", "distinct names")
     contact = read_contact(top, readers, bodies)
+    if contact is not None and timed:
+        loaded = next(i for i, r in enumerate(readers) if r.has("load"))
+        raise readers[loaded].fail("load", "a load that changes with time on a scene with contact planes",
+                                   "time-varying loads on free bodies without [[plane]] (contact methods step "
+                                   "constant forces only)")
     sim = top.subtable("simulation", ("duration", "dt", "rate_hz", "integrators"))
     duration = sim.number("duration", positive=True)
     if sim.has("dt") == sim.has("rate_hz"):

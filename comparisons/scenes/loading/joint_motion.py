@@ -15,6 +15,7 @@ from simparity.comparisons.scenes.loading.chain import (
     within_limits,
 )
 from simparity.comparisons.scenes.loading.reader import MAX_SEED, TableReader
+from simparity.comparisons.scenes.loading.time_functions import FUNCTION_KEYS, read_time_function
 from simparity.comparisons.scenes.loading.time_steps import STEP_COUNT_RTOL, time_step_ladder
 from simparity.core.model.errors import echo
 from simparity.core.model.scenes.chain import Chain, sample_configurations
@@ -64,9 +65,12 @@ def read_joint_motion(top: TableReader, head: dict, engines: EngineSet) -> Joint
                                                                     top.limits)
     q0 = _initial_q(initial, chain)
     qdot0 = joint_values(initial, "qdot", chain, joint_powers(chain, 0, 1))
-    drive = top.optional_subtable("drive", ("torque", "damping"))
-    torque = (joint_values(drive, "torque", chain, joint_powers(chain, 2, 1)) if drive
+    drive = top.optional_subtable("drive", ("torque", "damping", "timed_torque"))
+    torque = (joint_values(drive, "torque", chain, joint_powers(chain, 2, 1)) if drive and drive.has("torque")
               else np.zeros(chain.n_joints))  # N m = kg m^2 / s^2 (mass and time fixed) or N = kg m / s^2
+    timed_table = drive.optional_subtable("timed_torque", FUNCTION_KEYS) if drive else None
+    timed = (read_time_function(timed_table, np.asarray(joint_powers(chain, 2, 1), dtype=float))
+             if timed_table else None)
     if drive and drive.has("damping"):  # replaces the chain's own (a URDF's <dynamics damping>)
         chain = _with_damping(drive, chain)
     sim = top.subtable("simulation", _MOTION_SIMULATION)
@@ -84,6 +88,6 @@ def read_joint_motion(top: TableReader, head: dict, engines: EngineSet) -> Joint
                        f"0 (none) to {MAX_PERTURBATION:g} rad: a small change of the start, for predictability")
     integrators = (sim.strings("integrators", engines.joint_motion_integrators, "no engine steps a chain with {}")
                    if sim.has("integrators") else ())
-    return JointMotionScene(chain=chain, gravity_world=gravity, q0=q0, qdot0=qdot0, torque=torque,
+    return JointMotionScene(chain=chain, gravity_world=gravity, q0=q0, qdot0=qdot0, torque=torque, timed_torque=timed,
                             duration=duration, dts=dts, integrators=integrators, segments=segments,
                             perturbation=perturbation, **head)

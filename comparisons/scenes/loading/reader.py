@@ -81,6 +81,10 @@ class TableReader:
             raise self.fail(key, f"{value:.6g} is outside the physical range", allowed.text())
         return value
 
+    def checked(self, key: str, value) -> float:
+        """``value`` as a float if it is a finite, normal number (what every number of a scene file must be)."""
+        return self._checked(key, value, False)
+
     def _checked(self, key: str, value, positive: bool) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.fail(key, f"expected a number, got {echo(value)}", "a number" + (" > 0" if positive else ""))

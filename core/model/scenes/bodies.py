@@ -10,6 +10,7 @@ import numpy as np
 from simparity.core.model.arrays import readonly
 from simparity.core.model.errors import SceneError
 from simparity.core.model.scenes.checks import check_symmetric, unit_vector
+from simparity.core.model.scenes.time_functions import TimedLoad
 
 
 @dataclass(frozen=True)
@@ -107,6 +108,8 @@ class Forces:
     angular_quadratic_drag : (B,) ndarray or None
         tau = -k |omega| omega [N m s^2].
     applied : tuple of AppliedForce
+    timed : tuple of TimedLoad
+        Forces and torques that change with time (:mod:`core.model.scenes.time_functions`).
     """
 
     gravity_world: np.ndarray | None = None
@@ -116,6 +119,7 @@ class Forces:
     angular_linear_drag: np.ndarray | None = None
     angular_quadratic_drag: np.ndarray | None = None
     applied: tuple[AppliedForce, ...] = ()
+    timed: tuple[TimedLoad, ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("gravity_world", "air_velocity_world"):
@@ -124,6 +128,7 @@ class Forces:
         for name in ("linear_drag", "quadratic_drag", "angular_linear_drag", "angular_quadratic_drag"):
             object.__setattr__(self, name, _per_body(getattr(self, name)))
         object.__setattr__(self, "applied", tuple(self.applied))
+        object.__setattr__(self, "timed", tuple(self.timed))
 
     def names(self) -> tuple[str, ...]:
         """Names of the forces present, e.g. ``("gravity", "linear_drag")``."""
@@ -133,17 +138,19 @@ class Forces:
             ("angular_linear_drag", self.angular_linear_drag),
             ("angular_quadratic_drag", self.angular_quadratic_drag),
             ("applied_force", self.applied or None),
+            ("timed_load", self.timed or None),
         ]
         return tuple(name for name, value in present if value is not None)
 
     @property
     def exerts_torque(self) -> bool:
-        """True when some force has a torque about a body's COM (angular drag, applied forces)."""
-        return bool({"angular_linear_drag", "angular_quadratic_drag", "applied_force"} & set(self.names()))
+        """True when some force has a torque about a body's COM (angular drag, applied forces, timed loads)."""
+        return bool({"angular_linear_drag", "angular_quadratic_drag", "applied_force", "timed_load"}
+                    & set(self.names()))
 
     @property
     def conserves_energy(self) -> bool:
-        """True when kinetic plus gravitational potential energy is conserved (no drag, no applied force)."""
+        """True when kinetic plus gravitational potential energy is conserved (no drag, no applied or timed load)."""
         return set(self.names()) <= {"gravity"}
 
     @property

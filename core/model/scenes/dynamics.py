@@ -63,7 +63,7 @@ class DynamicsScene:
 
     def replicated(self, copies: int) -> DynamicsScene:
         """The scene ``copies`` times over, as one scene of ``copies * N`` bodies: copy c's body k is body
-        ``c * N + k``, with its forces (per-body arrays tiled, applied forces re-indexed) and its contact shape and
+        ``c * N + k``, with its forces (per-body arrays tiled, applied forces and timed loads re-indexed) and its contact shape and
         materials. Bodies never interact, so every copy moves as the scene does: an engine batched over bodies
         steps all copies together."""
         n, forces = len(self.bodies), self.forces
@@ -72,7 +72,8 @@ class DynamicsScene:
             return None if values is None else np.tile(values, copies)
 
         applied = tuple(replace(a, body=a.body + c * n) for c in range(copies) for a in forces.applied)
-        forces = replace(forces, linear_drag=tiled(forces.linear_drag), quadratic_drag=tiled(forces.quadratic_drag),
+        timed = tuple(replace(load, body=load.body + c * n) for c in range(copies) for load in forces.timed)
+        forces = replace(forces, timed=timed, linear_drag=tiled(forces.linear_drag), quadratic_drag=tiled(forces.quadratic_drag),
                          angular_linear_drag=tiled(forces.angular_linear_drag),
                          angular_quadratic_drag=tiled(forces.angular_quadratic_drag), applied=applied)
         contact = None if self.contact is None else replace(self.contact, shapes=self.contact.shapes * copies,

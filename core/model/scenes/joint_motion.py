@@ -10,16 +10,17 @@ from simparity.core.model.arrays import readonly
 from simparity.core.model.errors import SceneError
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.suites import SweepPoint
+from simparity.core.model.scenes.time_functions import TimeFunction
 
 
 @dataclass(frozen=True)
 class JointMotionScene:
-    """A chain's motion through time: its joints stepped from an initial state under gravity, its joints' damping
-    and constant joint forces, for ``duration`` at each time step of ``dts``.
+    """A chain's motion through time: its joints stepped from an initial state under gravity, its joints' damping,
+    constant joint forces and a joint force that changes with time, for ``duration`` at each time step of ``dts``.
 
     The chain's base link is fixed in the world and its frame is the world frame. Every engine is given the same
-    model; the applied joint forces are constant in time, so an engine that holds them over a step (MuJoCo holds
-    ``qfrc_applied`` over an RK4 step) and one that evaluates them at every stage see the same forces.
+    model. The constant joint forces are the same at every stage; the timed one is evaluated at each stage's time
+    where the engine can (:mod:`core.model.scenes.time_functions`).
 
     Attributes
     ----------
@@ -34,6 +35,8 @@ class JointMotionScene:
         Initial joint values and velocities of B copies [rad or m, rad/s or m/s] (one copy: B = 1).
     torque : (n,) ndarray
         Constant applied joint forces [N m or N].
+    timed_torque : TimeFunction or None
+        Applied joint forces that change with time, n components [N m or N], added to ``torque``; None: none.
     duration : float
         [s].
     dts : tuple of float
@@ -66,6 +69,7 @@ class JointMotionScene:
     integrators: tuple[str, ...] = ()
     segments: int = 0
     perturbation: float = 0.0
+    timed_torque: TimeFunction | None = None
     source: str = field(default="<code>", compare=False)
     suites: tuple[str, ...] = ("default",)
     sweep: SweepPoint | None = None
@@ -88,6 +92,9 @@ class JointMotionScene:
             raise SceneError(self.source, "qdot0", f"{self.qdot0.shape[0]} copies, q0 has {self.q0.shape[0]}",
                              "as many initial velocities as initial joint values")
         object.__setattr__(self, "torque", readonly(np.asarray(self.torque, dtype=float), shape=(n,)))
+        if self.timed_torque is not None and self.timed_torque.size != n:
+            raise SceneError(self.source, "timed_torque", f"{self.timed_torque.size} components",
+                             f"one per joint ({n})")
         if not (np.isfinite(self.duration) and self.duration > 0):
             raise SceneError(self.source, "duration", f"{self.duration}", "a finite number of seconds > 0")
         if not self.dts or not all(np.isfinite(dt) and 0 < dt <= self.duration for dt in self.dts):

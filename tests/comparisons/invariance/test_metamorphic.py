@@ -175,7 +175,7 @@ CONTACT_RESTING = CONTACT_SLIDING + ("box-flat-drop",)
 IK_SCENES = ("*-ik",)
 
 MOTION_SCENES = ("pendulum-large-amplitude", "damped-joint", "double-pendulum", "chain-20", "hard-stiff-joint-damping",
-                 "hard-whip")
+                 "hard-whip", "driven-damped-joint", "driven-arm")
 """The built-in chains in motion written in their scene files (the URDF arms take no frame transform)."""
 
 KNOWN_METRIC_FINDINGS: tuple[KnownFinding, ...] = ()

@@ -123,14 +123,14 @@ def test_the_tableau_steps_sum_as_the_written_out_schemes_to_the_bit():
     q, qdot = rng.normal(size=(3, 5)), rng.normal(size=(3, 5))
     dt = 0.013
 
-    def qddot(q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+    def qddot(q: np.ndarray, qdot: np.ndarray, t: float = 0.0, step_start: float = 0.0) -> np.ndarray:
         return -np.sin(q) - 0.3 * qdot * np.abs(qdot)
 
-    rk4 = stepping.runge_kutta(TABLEAUX[stepping.RK4], qddot, dt)(q, qdot)
+    rk4 = stepping.runge_kutta(TABLEAUX[stepping.RK4], qddot, dt)(0.0, q, qdot)
     assert all(np.array_equal(x, y) for x, y in zip(rk4, _rk4_by_hand(qddot, q, qdot, dt)))
     half = qdot + 0.5 * dt * qddot(q, qdot)
     midpoint = (q + dt * half, qdot + dt * qddot(q + 0.5 * dt * qdot, half))
-    got = stepping.runge_kutta(TABLEAUX[stepping.MIDPOINT], qddot, dt)(q, qdot)
+    got = stepping.runge_kutta(TABLEAUX[stepping.MIDPOINT], qddot, dt)(0.0, q, qdot)
     assert all(np.array_equal(x, y) for x, y in zip(got, midpoint))
-    got = stepping.runge_kutta(TABLEAUX[stepping.EXPLICIT_EULER], qddot, dt)(q, qdot)
+    got = stepping.runge_kutta(TABLEAUX[stepping.EXPLICIT_EULER], qddot, dt)(0.0, q, qdot)
     assert all(np.array_equal(x, y) for x, y in zip(got, (q + dt * qdot, qdot + dt * qddot(q, qdot))))
