@@ -101,6 +101,10 @@ class JointMotionScene:
             raise SceneError(self.source, "dt", f"{list(self.dts)}", "time steps > 0 and at most the duration")
         if self.segments < 0:
             raise SceneError(self.source, "segments", f"{self.segments}", "0 (against the reference) or more")
+        if self.segments and self.timed_torque is not None:
+            raise SceneError(self.source, "simulation.segments", f"{self.segments} segments with a timed torque: each "
+                             "segment is stepped from its own start at t = 0, where the torque would restart",
+                             "segments = 0 (against the reference) with [drive.timed_torque]")
         if not (np.isfinite(self.perturbation) and self.perturbation >= 0):
             raise SceneError(self.source, "perturbation", f"{self.perturbation}", "a finite number >= 0 (0: none)")
 

@@ -102,6 +102,12 @@ def test_a_body_s_loads_are_read_in_si_units(tmp_path):
     assert (small.torque.period_s, small.force.sinusoids[0].frequency_hz) == (0.05, 3.0)
 
 
+def test_self_consistency_segments_and_a_timed_torque_are_refused_together(tmp_path):
+    """Each segment is stepped from t = 0: a torque that changes with time would restart in every one."""
+    with pytest.raises(SceneError, match=r"simulation\.segments: 2 segments with a timed torque"):
+        load_scene(_write(tmp_path, JOINT.replace("dt = [0.01]", "dt = [0.01]\nsegments = 2")))
+
+
 def test_a_chain_s_timed_torque_has_one_component_per_joint(tmp_path):
     scene = load_scene(_write(tmp_path, JOINT))
     assert isinstance(scene.timed_torque, HeldFunction)
