@@ -32,12 +32,18 @@ class Bullets:
     items: tuple[str, ...]
 
 
+SCENE_TABLE_TRIM_ORDER = 5
+"""Where a scene section's table of its engines stands among the tables report.md may shorten: last of all, down to no
+row ("… N more rows: report.html"), since the section's verdict line above it names each engine's best and its
+findings; a default suite past ~30 scenes (issue #42 added six) outgrew 400 lines with every section whole."""
+
+
 @dataclass(frozen=True)
 class Table:
     """``trim_order``: for a table that report.md may shorten to keep within its line budget
     (:data:`reports.markdown.MAX_LINES`), saying how many rows the HTML has beyond it: the lowest is shortened first
-    (1 the cases without a result, 2 the flagged findings, 3 a user's engine's table, 4 the summary's row per scene);
-    0 (the default) never."""
+    (1 the cases without a result, 2 the flagged findings, 3 a user's engine's table, 4 the summary's row per scene,
+    :data:`SCENE_TABLE_TRIM_ORDER` a scene section's row per engine); 0 (the default) never."""
 
     head: tuple[str, ...]
     rows: tuple[tuple[str, ...], ...]

@@ -114,9 +114,12 @@ def _render(blocks: list[Block], figure_dir: str) -> list[str]:
     return lines
 
 
-def _trimmed(table: Table, keep: int) -> Table:
-    """``table`` with its first ``keep`` rows and a last one saying how many more report.html has."""
+def _trimmed(table: Table, keep: int) -> Table | Paragraph:
+    """``table`` with its first ``keep`` rows and a last one saying how many more report.html has; none kept: one line
+    saying where its rows are."""
     more = len(table.rows) - keep
+    if keep == 0:
+        return Paragraph(f"Its table ({table.head[0]}: {more} rows): report.html.")
     note = (f"… {more} more rows: report.html",) + ("",) * (len(table.head) - 1)
     return Table(table.head, table.rows[:keep] + (note,))
 
@@ -130,8 +133,8 @@ def _within_budget(blocks: list[Block], excess: int) -> list[Block]:
     least = {i: MIN_TRIMMED_ROWS if b.keep_at_least is None else b.keep_at_least
              for i, b in enumerate(blocks) if i in full and isinstance(b, Table)}
 
-    def saved() -> int:
-        return sum(full[i] - keep[i] - (keep[i] < full[i]) for i in keep)
+    def saved() -> int:  # a table of r rows takes r + 3 lines; trimmed to k rows k + 4, to none 2 (a line and a blank)
+        return sum(full[i] + 1 if keep[i] == 0 else full[i] - keep[i] - (keep[i] < full[i]) for i in keep)
     while saved() < excess:
         cuttable = [i for i in keep if keep[i] > least[i]]
         if not cuttable:

@@ -13,6 +13,7 @@ import numpy as np
 
 from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome, EngineFor
 from simparity.comparisons.measure.metrics import KINEMATICS_METRICS, frame_validity, kinematics_errors
+from simparity.comparisons.measure.model_parity import MODEL_METRICS, configurations, model_parity
 from simparity.comparisons.measure.joint_dynamics_metrics import (
     JOINT_DYNAMICS_METRICS,
     REFERENCE_ERRORS,
@@ -30,6 +31,7 @@ from simparity.core.model.engine import Engine, JointDynamicsModel, Support
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.rigid_groups import RigidGroups
 from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.core.model.metric_catalogue import TIME_PER_FK, TIME_PER_JACOBIAN
 
@@ -114,6 +116,8 @@ class _JointDynamicsShared:
     reference: dict | None
     problem: tuple[str, str]
     scale: ForceScale | None = None
+    groups: RigidGroups | None = None
+    groups_problem: str = ""
 
 
 def prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_failure: str) -> _JointDynamicsShared:
@@ -134,7 +138,26 @@ def prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_fa
     if evaluated is None:
         return _JointDynamicsShared(states, None, problem)
     values, scale = cast(tuple[dict, ForceScale], evaluated)
-    return _JointDynamicsShared(states, values, problem, scale)
+    try:
+        model = engine_for(scene.reference).build_joint_dynamics(scene.chain, method, scene.gravity_world)
+        groups, why = model.rigid_groups(configurations(states[0])), ""
+    except NotImplementedError as err:
+        groups, why = None, f"the reference {label} reports no compiled model: {err}"
+    except Exception as err:  # noqa: BLE001 - a user's reference: its model rows say why
+        groups, why = None, f"the reference {label}'s compiled model could not be read: {error_text(err)}"
+    return _JointDynamicsShared(states, values, problem, scale, groups, why)
+
+
+def _model_parity(model: JointDynamicsModel, shared: _JointDynamicsShared, chain) -> dict[str, Measured]:
+    """The model-parity values of ``model`` against the reference's compiled model (n/a with why where either
+    engine reports none; an engine's failure to report one fails the case with its error)."""
+    if shared.groups is None:
+        return {m: Measured(math.nan, u, unmeasurable=shared.groups_problem) for m, u in MODEL_METRICS.items()}
+    try:
+        own = model.rigid_groups(configurations(shared.states[0]))
+    except NotImplementedError as err:
+        return {m: Measured(math.nan, u, unmeasurable=str(err)) for m, u in MODEL_METRICS.items()}
+    return model_parity(own, shared.groups, tuple(j.name for j in chain.joints))
 
 
 def _force_scale(scene: JointDynamicsScene, engine: Engine, method: str, model: JointDynamicsModel,
@@ -185,4 +208,8 @@ def _joint_dynamics_rows(scene: JointDynamicsScene, engine: Engine, case: Case, 
                       + case.rows({m: JOINT_DYNAMICS_METRICS[m] for m in REFERENCE_ERRORS}, status, problem),
                       key=lambda row: order.index(row.metric))
     values.update(reference_errors(own, shared.reference, scale))
+    try:
+        values.update(_model_parity(model, shared, scene.chain))
+    except Exception as err:  # noqa: BLE001 - reported in the rows
+        return case.rows(JOINT_DYNAMICS_METRICS, FAILED, f"its compiled model (rigid_groups): {error_text(err)}")
     return case.rows(JOINT_DYNAMICS_METRICS, OK, detail, {m: values[m] for m in JOINT_DYNAMICS_METRICS})

@@ -52,6 +52,7 @@ from simparity.core.model.metric_catalogue import (
     TIME_PER_MASS_MATRIX,
     units,
 )
+from simparity.comparisons.measure.model_parity import MODEL_METRICS
 from simparity.core.model.scenes.chain import Chain
 
 JOINT_DYNAMICS_METRICS = units(
@@ -69,10 +70,12 @@ JOINT_DYNAMICS_METRICS = units(
     TIME_PER_MASS_MATRIX,
     TIME_PER_INVERSE_DYNAMICS,
     TIME_PER_FORWARD_DYNAMICS,
-)
-"""Every metric of a joint-dynamics case, in row order."""
+) | MODEL_METRICS
+"""Every metric of a joint-dynamics case, in row order: the model-parity ones (:mod:`comparisons.measure.model_parity`)
+last."""
 
-REFERENCE_ERRORS = (MASS_MATRIX_ERROR_MAX, BIAS_FORCE_ERROR_MAX, INVERSE_DYNAMICS_ERROR_MAX, FORWARD_DYNAMICS_ERROR_MAX)
+REFERENCE_ERRORS = (MASS_MATRIX_ERROR_MAX, BIAS_FORCE_ERROR_MAX, INVERSE_DYNAMICS_ERROR_MAX,
+                    FORWARD_DYNAMICS_ERROR_MAX) + tuple(MODEL_METRICS)
 """The metrics that need the reference; the others need only the engine."""
 
 DIFFERENCE_STEP = 1e-4

@@ -35,6 +35,7 @@ from simparity.core.model.results import NOTHING_TO_MEASURE, ROUNDING_FLOOR, SAT
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
+from simparity.references.common import time_loads
 
 JOINT_MOTION_METRICS = units(
     JOINT_ANGLE_ERROR_MAX,
@@ -76,8 +77,10 @@ so 10 keeps clear of it)."""
 
 
 def exchanges_energy(scene: JointMotionScene) -> bool:
-    """Whether the chain is damped or driven (its energy changes by the work done on it), else conservative."""
-    return bool(np.any(np.asarray(scene.torque) != 0) or any(j.damping > 0 for j in scene.chain.joints))
+    """Whether the chain is damped or driven (a constant or a timed torque: its energy changes by the work done on
+    it), else conservative."""
+    return bool(np.any(np.asarray(scene.torque) != 0) or scene.timed_torque is not None
+                or any(j.damping > 0 for j in scene.chain.joints))
 
 
 def motion_metrics(scene: JointMotionScene) -> dict[str, str]:
@@ -174,14 +177,17 @@ def read_own(sim: JointSimulation, traj: JointTrajectory) -> OwnReading:
 
 
 def _work(scene: JointMotionScene, traj: JointTrajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(W, W_in, W_floor), each (T, B) [J]: the work done on the chain from t = 0 by the applied forces less the
-    damping (the power qdot^T tau - qdot^T D qdot integrated by the composite Simpson rule over every step, fourth
+    """(W, W_in, W_floor), each (T, B) [J]: the work done on the chain from t = 0 by the applied forces (the constant
+    torque and the timed one at each sample's time) less the damping (the power qdot^T tau - qdot^T D qdot integrated by the composite Simpson rule over every step, fourth
     order), the work the applied forces put in at most (their positive power integrated), and what the quadrature of
     W cannot resolve: |W - W over every other sample| (Simpson's error at twice the step is 16 x its own, so this
     overestimates W's quadrature error some 15 times; 0 between the coarse samples' points, taken as its running
     maximum)."""
     damping = np.array([j.damping for j in scene.chain.joints])
-    drive = traj.qdot @ np.asarray(scene.torque)
+    torque = np.broadcast_to(np.asarray(scene.torque, dtype=float), (len(traj.times), scene.chain.n_joints))
+    if scene.timed_torque is not None:  # the references' evaluation at each sample's time (none of core's code)
+        torque = torque + np.array([time_loads.at(scene.timed_torque, t) for t in traj.times])
+    drive = np.einsum("tbi,ti->tb", traj.qdot, torque)
     power = drive - np.einsum("tbi,i,tbi->tb", traj.qdot, damping, traj.qdot)
     zero = np.zeros_like(power)
     if len(traj.times) < 3:

@@ -7,19 +7,13 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.core.model.scenes.dynamics import DynamicsScene
-from simparity.core.model.scenes.time_functions import HeldFunction, TimeFunction
+from simparity.core.model.scenes.time_functions import TimeFunction
 
 
 def largest_magnitude(function: TimeFunction | None, duration: float) -> float:
-    """An upper bound of |f(t)| over [0, duration] [s]: the largest sample of a hold; sum |c_k| T^k + sum |A_s| of a
-    smooth function (0 for None)."""
-    if function is None:
-        return 0.0
-    if isinstance(function, HeldFunction):
-        return float(np.max(np.linalg.norm(function.samples, axis=1)))
-    powers = duration ** np.arange(len(function.polynomial))
-    return (float(np.linalg.norm(function.polynomial, axis=1) @ powers)
-            + sum(float(np.linalg.norm(s.amplitude)) for s in function.sinusoids))
+    """An upper bound of |f(t)| over [0, duration] [s] (0 for None): :meth:`SmoothFunction.largest_magnitude`,
+    :meth:`HeldFunction.largest_magnitude`."""
+    return 0.0 if function is None else function.largest_magnitude(duration)
 
 
 def load_budget(scene: DynamicsScene, index: int) -> tuple[float, float]:

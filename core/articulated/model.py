@@ -7,7 +7,9 @@ import numpy as np
 from simparity.core.articulated.chain_arrays import chain_arrays
 from simparity.core.articulated.jacobian_sum import JacobianSum
 from simparity.core.articulated.recursive import Recursive
+from simparity.core.kinematics import forward_kinematics
 from simparity.core.model.engine import JointDynamicsModel
+from simparity.core.model.rigid_groups import RigidGroups
 from simparity.core.model.scenes.chain import Chain
 
 RECURSIVE, JACOBIAN_SUM = "recursive", "jacobian_sum"
@@ -30,11 +32,29 @@ def _rows(values: np.ndarray, n: int) -> np.ndarray:
     return np.ascontiguousarray(_batch(values, n).T)
 
 
+def chain_rigid_groups(chain: Chain, q: np.ndarray) -> RigidGroups:
+    """Core's reading of the chain, joint by joint (:class:`RigidGroups`): each link's mass properties as core's URDF
+    parser merged them (the links welded to a chain link folded into it), placed by core's forward kinematics."""
+    q = _batch(q, chain.n_joints)
+    poses = forward_kinematics(chain, q)
+    n = chain.n_joints
+    position, rotation = poses.position_world[:, :n], poses.rotation_world[:, :n]  # (B, n, 3), (B, n, 3, 3)
+    links = [joint.link for joint in chain.joints]
+    mass = np.array([0.0 if link is None else link.mass for link in links])
+    com = np.array([np.zeros(3) if link is None else link.com_xyz for link in links])
+    inertia = np.array([np.zeros((3, 3)) if link is None else link.inertia_com for link in links])
+    axes = np.array([joint.axis for joint in chain.joints])
+    return RigidGroups(mass=np.broadcast_to(mass, q.shape),
+                       com_world=position + np.einsum("bnij,nj->bni", rotation, com),
+                       inertia_world=rotation @ inertia @ np.swapaxes(rotation, -1, -2),
+                       axis_world=np.einsum("bnij,nj->bni", rotation, axes), origin_world=position)
+
+
 class RecursiveDynamics(JointDynamicsModel):
     """CRBA for M, RNEA for h and tau, ABA for qddot (:mod:`core.articulated.recursive`)."""
 
     def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
-        self._n = chain.n_joints
+        self._n, self._chain = chain.n_joints, chain
         self._algorithms = Recursive(chain_arrays(chain), np.zeros(3) if gravity_world is None else gravity_world)
         self.detail = ("in-house recursive (Featherstone): CRBA for M, RNEA for h and tau, ABA for qddot; "
                        "batched component-major, body frames with z along the joint axis")
@@ -57,13 +77,16 @@ class RecursiveDynamics(JointDynamicsModel):
     def link_kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         return self._algorithms.kinetic_energy(_rows(q, self._n), _rows(qdot, self._n))
 
+    def rigid_groups(self, q: np.ndarray) -> RigidGroups:
+        return chain_rigid_groups(self._chain, q)
+
 
 class JacobianSumDynamics(JointDynamicsModel):
     """The lecture's M and h summed over link Jacobians (:mod:`core.articulated.jacobian_sum`); inverse dynamics
     M qddot + h + D qdot, forward dynamics a linear solve."""
 
     def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
-        self._n = chain.n_joints
+        self._n, self._chain = chain.n_joints, chain
         self._sum = JacobianSum(chain, np.zeros(3) if gravity_world is None else gravity_world)
         self._damping = np.array([j.damping for j in chain.joints])
         self.detail = ("in-house jacobian_sum: the lecture's sum over link Jacobians at the centres of mass; "
@@ -87,6 +110,9 @@ class JacobianSumDynamics(JointDynamicsModel):
 
     def link_kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         return self._sum.kinetic_energy(_batch(q, self._n), _batch(qdot, self._n))
+
+    def rigid_groups(self, q: np.ndarray) -> RigidGroups:
+        return chain_rigid_groups(self._chain, q)
 
 
 def build(chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:

@@ -16,6 +16,7 @@ import numpy as np
 
 from simparity.core.model.errors import NotBatchedError, SimparityError
 from simparity.core.model.ik_problem import IKTolerances
+from simparity.core.model.rigid_groups import RigidGroups
 from simparity.core.model.ik_result import IKResult
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.dynamics import DynamicsScene
@@ -287,6 +288,13 @@ class JointDynamicsModel(abc.ABC):
         forward kinematics of each link (its centre-of-mass velocity and angular velocity) and its own link masses
         and inertias, never from its mass matrix: an independent check of M (1/2 qdot^T M qdot, armature
         aside)."""
+
+    def rigid_groups(self, q: np.ndarray) -> RigidGroups:
+        """What the engine compiled, joint by joint, at configurations q (B, n): each chain joint's rigid group (its
+        child link and the links welded to it) as mass, centre of mass and inertia about it, with the joint's axis
+        and origin, all in the base frame (:class:`core.model.rigid_groups.RigidGroups`). Optional: an engine that
+        does not report its compiled model raises NotImplementedError, and its model-parity rows are n/a."""
+        raise NotImplementedError(f"{type(self).__name__} does not report its compiled model (rigid_groups)")
 
 
 @dataclass(frozen=True)

@@ -111,6 +111,12 @@ CORIOLIS_SKEW_RESIDUAL = "coriolis_skew_residual"
 TIME_PER_MASS_MATRIX = "time_per_mass_matrix"
 TIME_PER_INVERSE_DYNAMICS = "time_per_inverse_dynamics"
 TIME_PER_FORWARD_DYNAMICS = "time_per_forward_dynamics"
+# Model-level parity: what each engine compiled from the robot file, rigid group by rigid group, against the reference.
+MODEL_MASS_ERROR_MAX = "model_mass_error_max"
+MODEL_COM_ERROR_MAX = "model_com_error_max"
+MODEL_INERTIA_ERROR_MAX = "model_inertia_error_max"
+MODEL_AXIS_ERROR_MAX = "model_axis_error_max"
+MODEL_ORIGIN_ERROR_MAX = "model_origin_error_max"
 # Joint motion: unitless errors of a chain's motion against the reference, each engine's own energy balance.
 JOINT_ANGLE_ERROR_MAX = "joint_angle_error_max"
 JOINT_VELOCITY_ERROR_MAX = "joint_velocity_error_max"
@@ -204,6 +210,11 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(TIME_PER_MASS_MATRIX, "s", TIMING),
     Metric(TIME_PER_INVERSE_DYNAMICS, "s", TIMING),
     Metric(TIME_PER_FORWARD_DYNAMICS, "s", TIMING),
+    Metric(MODEL_MASS_ERROR_MAX, DIMENSIONLESS, ERROR, theory="the same file read alike: 0 up to rounding"),
+    Metric(MODEL_COM_ERROR_MAX, DIMENSIONLESS, ERROR, theory="the same file read alike: 0 up to rounding"),
+    Metric(MODEL_INERTIA_ERROR_MAX, DIMENSIONLESS, ERROR, theory="the same file read alike: 0 up to rounding"),
+    Metric(MODEL_AXIS_ERROR_MAX, "rad", ERROR, theory="the same file read alike: 0 up to rounding"),
+    Metric(MODEL_ORIGIN_ERROR_MAX, DIMENSIONLESS, ERROR, theory="the same file read alike: 0 up to rounding"),
     Metric(JOINT_ANGLE_ERROR_MAX, DIMENSIONLESS, ERROR, headline=True, scale="joint_angle"),
     Metric(JOINT_VELOCITY_ERROR_MAX, DIMENSIONLESS, ERROR, scale="joint_velocity"),
     Metric(END_EFFECTOR_ERROR_MAX, DIMENSIONLESS, ERROR, scale="reach"),

@@ -111,7 +111,8 @@ def _rotation_kind(scene: DynamicsScene, k: int) -> tuple[str, str]:
     isotropic = np.ptp(moments) <= _EQUAL_RTOL * moments.max()
     if any(a.body == k for a in forces.applied):
         return "", f"no closed form for the torque of an applied force on body '{body.name}'"
-    twisting = [load for load in _loads(scene, k) if load.torque is not None or np.any(load.point_body)]
+    twisting = [load for load in _loads(scene, k) if (load.torque is not None and np.any(_torque_vectors(load.torque)))
+                or (load.force is not None and np.any(load.point_body))]
     if twisting:
         if any(drag is not None and drag[k] > 0 for drag in (forces.angular_linear_drag, forces.angular_quadratic_drag)):
             return "", f"no closed form for a time-varying torque with angular drag on body '{body.name}'"

@@ -172,7 +172,8 @@ class _Simulation(PieceSimulation):
         for load in self._timed:
             body = load.body + 1
             rotation = d.xmat[body].reshape(3, 3)
-            force, torque = time_loads.load_world(load, d.time, rotation, self._clock.step_start)
+            force, torque = time_loads.load_world(load, self._clock.stage_time(d.time), rotation,
+                                                  self._clock.step_start)
             point = d.xpos[body] + rotation @ load.point_body  # mj_applyFT adds the force's moment about the COM
             mujoco.mj_applyFT(m, d, force, torque, point, body, d.qfrc_applied)
 
@@ -217,21 +218,22 @@ class _Simulation(PieceSimulation):
             mujoco.mj_applyFT(m, d, applied.force_world, np.zeros(3), point, body, d.qfrc_applied)
         self._qfrc_step = d.qfrc_applied.copy()
 
-    def _loop(self, n_steps: int) -> np.ndarray:
-        """The states after each of ``n_steps`` further steps of the data as it stands, (n_steps, nstate)."""
+    def _loop(self, n_steps: int, first_step: int) -> np.ndarray:
+        """The states after each of ``n_steps`` further steps of the data as it stands, the first of them step
+        ``first_step`` of the run, (n_steps, nstate)."""
         m, d = self.model, self._data
         states = np.empty((n_steps, len(self._state0)))
         for i in range(n_steps):
             self._apply_forces()
-            self._clock.step_start = d.time
+            self._clock.start(first_step + i, self._dt, d.time)
             mujoco.mj_step(m, d)
             mujoco.mj_getState(m, d, states[i], _STATE)
         return states
 
-    def _steps(self, initial: np.ndarray, n_steps: int, first: bool) -> np.ndarray:
+    def _steps(self, initial: np.ndarray, n_steps: int, first: bool, first_step: int = 0) -> np.ndarray:
         """The states after each of ``n_steps`` steps from the state ``initial`` (the data's own state unless
-        ``first``: the mj_step loop carries on), (n_steps, nstate); raises DivergedError when MuJoCo reset the
-        simulation."""
+        ``first``: the mj_step loop carries on), the first of them step ``first_step`` of the run, (n_steps,
+        nstate); raises DivergedError when MuJoCo reset the simulation."""
         warnings = [self._data.warning[w] for w in _RESET_WARNINGS]
         for warning in warnings:
             warning.number = 0
@@ -242,7 +244,7 @@ class _Simulation(PieceSimulation):
                 mujoco.mj_setState(self.model, self._data, initial, _STATE)
             if self._stepwise:
                 with stage_callback(self._stage_loads if self._timed else None):
-                    stepped = self._loop(n_steps)
+                    stepped = self._loop(n_steps, first_step)
             else:
                 stepped = self._rollout(initial[None], n_steps)[0] if n_steps else np.empty((0, len(initial)))
         finally:
@@ -256,7 +258,7 @@ class _Simulation(PieceSimulation):
         state, or the mj_step loop carried on)."""
         state = self._state0
         for start, stop in piece_bounds(n_steps, samples_per_piece):
-            stepped = self._steps(state, stop - max(start, 1), start == 0)
+            stepped = self._steps(state, stop - max(start, 1), start == 0, max(start, 1) - 1)
             states = np.concatenate([self._state0[None], stepped], axis=0) if start == 0 else stepped
             state = states[-1]
             nq, b = self.model.nq, self._n_bodies

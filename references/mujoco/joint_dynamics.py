@@ -47,10 +47,12 @@ import mujoco
 import numpy as np
 
 from simparity.core.model.engine import JointDynamicsModel
+from simparity.core.model.rigid_groups import RigidGroups
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt
 from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
+from simparity.references.common.rigid_groups import summed
 
 
 def _compiled(chain: Chain, gravity_world: np.ndarray | None) -> mujoco.MjModel:
@@ -183,3 +185,30 @@ class MujocoJointDynamics(JointDynamicsModel):
                 out[k] += 0.5 * (m.body_mass[body] * velocity[3:] @ velocity[3:]
                                  + omega_inertial @ (m.body_inertia[body] * omega_inertial))
         return out
+
+    def rigid_groups(self, q: np.ndarray) -> RigidGroups:
+        """Each chain joint's bodies (MuJoCo keeps fixed-joint links as bodies: ``fusestatic`` off) summed with the
+        references' own code (:mod:`references.common.rigid_groups`): ``body_mass``, ``xipos``, ``ximat`` and the
+        principal ``body_inertia`` after ``mj_kinematics``; the joint's ``xaxis`` and its body's ``xpos``."""
+        m, d = self.model, self.data
+        joints = [m.dof_jntid[dof] for dof in self.dof]
+        bodies = [int(m.jnt_bodyid[j]) for j in joints]
+        groups: dict[int, list[int]] = {b: [] for b in bodies}
+        for body in range(1, m.nbody):
+            mover = body
+            while mover and m.body_jntnum[mover] == 0:
+                mover = int(m.body_parentid[mover])
+            if mover in groups:
+                groups[mover].append(body)
+        out = [np.empty((len(q), len(bodies)) + tail) for tail in ((), (3,), (3, 3), (3,), (3,))]
+        for k, row in enumerate(q):
+            d.qpos[self.qpos] = row
+            mujoco.mj_kinematics(m, d)
+            for i, (joint, body) in enumerate(zip(joints, bodies)):
+                members = groups[body]
+                rotations = d.ximat[members].reshape(-1, 3, 3)
+                inertias = rotations @ (m.body_inertia[members][:, :, None] * np.swapaxes(rotations, -1, -2))
+                mass, com, inertia = summed(m.body_mass[members], d.xipos[members], inertias, d.xpos[body])
+                out[0][k, i], out[1][k, i], out[2][k, i] = mass, com, inertia
+                out[3][k, i], out[4][k, i] = d.xaxis[joint], d.xpos[body]
+        return RigidGroups(*out)

@@ -134,7 +134,8 @@ class MujocoJointMotion(JointSimulation):
         """MuJoCo's control callback: qfrc_applied = the constant torque plus the timed one at the stage's time."""
         assert self._timed is not None  # installed only with a timed torque
         d.qfrc_applied[:] = self._control[0, 0]
-        d.qfrc_applied[self._dof] += time_loads.at(self._timed, d.time, self._clock.step_start)
+        d.qfrc_applied[self._dof] += time_loads.at(self._timed, self._clock.stage_time(d.time),
+                                                   self._clock.step_start)
 
     def _loop(self, initial: np.ndarray, n_steps: int) -> np.ndarray:
         """(n_steps, nstate): the states after each of ``n_steps`` mj_steps from the state ``initial``."""
@@ -142,7 +143,7 @@ class MujocoJointMotion(JointSimulation):
         mujoco.mj_setState(m, d, initial, _STATE)
         states = np.empty((n_steps, len(initial)))
         for i in range(n_steps):
-            self._clock.step_start = d.time
+            self._clock.start(i, self._dt, d.time)
             mujoco.mj_step(m, d)
             mujoco.mj_getState(m, d, states[i], _STATE)
         return states

@@ -33,6 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from simparity.core.model.engine import JointDynamicsModel
+from simparity.core.model.rigid_groups import RigidGroups
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt
 from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
@@ -152,3 +153,26 @@ class PinocchioJointDynamics(JointDynamicsModel):
             pin.forwardKinematics(self.model, self.data, self._configuration(row), self._velocity(rates))
             out[k] = sum(0.5 * self.model.inertias[i].vtiv(self.data.v[i]) for i in self.joint_ids)
         return out
+
+    def rigid_groups(self, q: np.ndarray) -> RigidGroups:
+        """Pinocchio merges every link welded by a fixed joint into its joint's body (``model.inertias``: mass,
+        lever and inertia about the centre of mass in the joint frame); placed by ``forwardKinematics``' ``oMi``. The
+        axis is the joint's motion subspace (``getJointJacobian`` in its LOCAL frame: the angular part of a revolute
+        joint, the linear part of a prismatic one) turned into the base frame."""
+        model, data = self.model, self.data
+        out = [np.empty((len(q), len(self.joint_ids)) + tail) for tail in ((), (3,), (3, 3), (3,), (3,))]
+        for k, row in enumerate(q):
+            configuration = self._configuration(row)
+            pin.forwardKinematics(model, data, configuration)
+            pin.computeJointJacobians(model, data, configuration)
+            for i, (joint, column) in enumerate(zip(self.joint_ids, self.idx_v)):
+                placement, inertia = data.oMi[joint], model.inertias[joint]
+                rotation = placement.rotation
+                motion = pin.getJointJacobian(model, data, joint, pin.ReferenceFrame.LOCAL)[:, column]
+                axis = motion[3:] if np.linalg.norm(motion[3:]) > np.linalg.norm(motion[:3]) else motion[:3]
+                out[0][k, i] = inertia.mass
+                out[1][k, i] = placement.act(inertia.lever)
+                out[2][k, i] = rotation @ inertia.inertia @ rotation.T
+                out[3][k, i] = rotation @ axis
+                out[4][k, i] = placement.translation
+        return RigidGroups(*out)

@@ -63,10 +63,12 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
+from simparity.core.model.rigid_groups import RigidGroups
 from simparity.core.model.engine import JointDynamicsModel
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt, quat_wxyz_to_matrix, wxyz_from_xyzw
+from simparity.references.common.rigid_groups import summed
 from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
 from simparity.references.pybullet.adapter import _Client, _load_urdf
@@ -261,3 +263,42 @@ class PybulletJointDynamics(JointDynamicsModel):
             omega_principal = np.einsum("lji,lj->li", rotation, np.array([s[7] for s in states]))
             out[k] = 0.5 * (mass @ np.sum(velocity**2, axis=1) + np.sum(moments * omega_principal**2))
         return out
+
+    def rigid_groups(self, q: np.ndarray) -> RigidGroups:
+        """PyBullet keeps every fixed-joint link as a link of its own: each chain joint's group is the links whose
+        nearest movable joint up the tree (``getJointInfo``'s parent index) is that joint, summed with the references'
+        own code (:mod:`references.common.rigid_groups`) from ``getDynamicsInfo`` (mass, principal moments) and
+        ``getLinkStates`` (the centre of mass and its inertial frame, double). The link frame is the inertial frame
+        moved back by ``getDynamicsInfo``'s local inertial pose (double), not ``worldLinkFramePosition`` (float32);
+        the axis is ``getJointInfo``'s (the file's, made unit by the export), which PyBullet gives in the link's inertial
+        frame (its link frame), not the URDF link frame."""
+        q, _ = _rows(q, np.zeros_like(q))
+        t = self._tree
+        c = t.client
+        info = {link: pybullet.getJointInfo(t.body, link, physicsClientId=c) for link in t.links}
+        dynamics = {link: pybullet.getDynamicsInfo(t.body, link, physicsClientId=c) for link in t.links}
+        mover = {}
+        for link in t.links:
+            up = link
+            while up != -1 and info[up][2] == pybullet.JOINT_FIXED:
+                up = info[up][16]
+            mover[link] = up
+        members = [[link for link in t.links if mover[link] == joint] for joint in t.joints]
+        local = {link: (np.array(dynamics[link][3]), quat_wxyz_to_matrix(wxyz_from_xyzw(np.array(dynamics[link][4]))))
+                 for link in t.links}
+        out = [np.empty((len(q), len(t.joints)) + tail) for tail in ((), (3,), (3, 3), (3,), (3,))]
+        for k in range(len(q)):
+            t.reset(q[k], np.zeros_like(q[k]))
+            states = dict(zip(t.links, pybullet.getLinkStates(t.body, t.links, computeForwardKinematics=1,
+                                                              physicsClientId=c)))
+            com = {link: np.array(states[link][0]) for link in t.links}
+            frame = {link: quat_wxyz_to_matrix(wxyz_from_xyzw(np.array(states[link][1]))) for link in t.links}
+            for i, (joint, group) in enumerate(zip(t.joints, members)):
+                link_rotation = frame[joint] @ local[joint][1].T
+                origin = com[joint] - link_rotation @ local[joint][0]
+                inertias = np.array([frame[m] @ np.diag(dynamics[m][2]) @ frame[m].T for m in group])
+                mass, centre, inertia = summed(np.array([dynamics[m][0] for m in group]),
+                                               np.array([com[m] for m in group]), inertias, origin)
+                out[0][k, i], out[1][k, i], out[2][k, i] = mass, centre, inertia
+                out[3][k, i], out[4][k, i] = frame[joint] @ np.array(info[joint][13]), origin
+        return RigidGroups(*out)

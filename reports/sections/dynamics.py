@@ -13,7 +13,7 @@ from simparity.core.model.metric_catalogue import (
 )
 from simparity.core.model.results import OK
 from simparity.reports import engine_summary, figures, summary, tables
-from simparity.reports.blocks import Block, Bullets, Details, Paragraph, Table, number
+from simparity.reports.blocks import SCENE_TABLE_TRIM_ORDER, Block, Bullets, Details, Paragraph, Table, number
 from simparity.reports.sections import contact
 from simparity.reports.sections.context import HEADLINE_NAMES, ReportContext, headline
 
@@ -141,7 +141,7 @@ def _per_engine(ctx: ReportContext, scene: str, cases: pd.DataFrame, fits: pd.Da
     measured = (("restitution measured", "penetration max [m]") if touching else ("orders vs theory",))
     return Table(("engine", f"most accurate [{unit}]") + tuple(engine_summary.cheapest_head(ctx.by, b)
                                                              for b in summary.ERROR_BUDGETS)
-                 + measured + ("cases",), tuple(rows))
+                 + measured + ("cases",), tuple(rows), trim_order=SCENE_TABLE_TRIM_ORDER, keep_at_least=0)
 
 
 def _per_scheme(ctx: ReportContext, cases: pd.DataFrame, observed: dict, about: dict, unit: str) -> Details:

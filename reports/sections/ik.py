@@ -12,7 +12,7 @@ from simparity.core.model.metric_catalogue import (
 )
 from simparity.core.model.results import HARD_VERDICT_SUFFIXES, NOT_AVAILABLE, OK
 from simparity.reports import engine_summary, figures, summary, tables
-from simparity.reports.blocks import Block, Bullets, Details, Paragraph, Table, number
+from simparity.reports.blocks import SCENE_TABLE_TRIM_ORDER, Block, Bullets, Details, Paragraph, Table, number
 from simparity.reports.sections.context import ReportContext
 from simparity.reports.sections.shared import names
 
@@ -81,7 +81,7 @@ def section(ctx: ReportContext, scene, rows, about, reference, series) -> tuple[
                            f"{solved} of {len(own)} solve any target"))
     blocks.append(Table(("engine", "best solve rate, time per solve", f"fastest at ≥ {summary.SOLVED_ENOUGH:.0%}",
                          "solvers"),
-                        tuple(per_engine)))
+                        tuple(per_engine), trim_order=SCENE_TABLE_TRIM_ORDER, keep_at_least=0))
     plain = rows[~rows["metric"].str.startswith("hard_")].rename(columns={"integrator": "solver"})
     measured = plain.groupby(["engine", "solver"], sort=False)["status"].transform(lambda s: (s != NOT_AVAILABLE).any())
     compact = [c for c in tables.IK_COLUMNS if c[0] in _COMPACT]

@@ -61,8 +61,8 @@ def test_figures_share_a_line_with_short_alt_texts_and_html_only_blocks_stay_out
 
 def test_a_table_trimmed_last_may_give_up_every_row_and_the_report_keeps_its_budget():
     """A suite whose every shortenable table is at its minimum still outgrew report.md's budget (28 scenes: 414 lines);
-    a table that may give up every row (``keep_at_least=0``) is shortened last, down to the line saying how many rows
-    report.html has, and never below another table's minimum."""
+    a table that may give up every row (``keep_at_least=0``) is shortened last, down to one line saying how many rows
+    report.html has (no header left), and never below another table's minimum."""
     from simparity.reports.blocks import Paragraph, Table
     from simparity.reports.markdown import MAX_LINES, MIN_TRIMMED_ROWS, to_markdown
     findings = Table(("finding",), tuple((f"f{i}",) for i in range(40)), trim_order=1)
@@ -71,4 +71,5 @@ def test_a_table_trimmed_last_may_give_up_every_row_and_the_report_keeps_its_bud
     lines = to_markdown([findings, per_scene, *filler]).splitlines()
     assert len(lines) <= MAX_LINES
     assert "| f4 |" in lines and "| f5 |" not in lines  # the first table at its minimum
-    assert "| s0 |" not in lines and "| … 40 more rows: report.html |" in lines  # the last one gave up every row
+    assert "| s0 |" not in lines and "| scene |" not in lines  # the last one gave up every row, its header too
+    assert "Its table (scene: 40 rows): report.html." in lines

@@ -31,7 +31,9 @@ def read_dynamics(top: TableReader, head: dict, engines: EngineSet) -> DynamicsS
     if world is not None and air is not None and drag["linear_drag"] is None and drag["quadratic_drag"] is None:
         raise world.fail("air_velocity_world", "wind needs a body with linear_drag or quadratic_drag to act on",
                          "wind with a drag on some body, or no air_velocity_world")
-    timed = tuple(load for i, r in enumerate(readers) for load in read_loads(r, i))
+    sim = top.subtable("simulation", ("duration", "dt", "rate_hz", "integrators"))
+    duration = sim.number("duration", positive=True)
+    timed = tuple(load for i, r in enumerate(readers) for load in read_loads(r, i, duration))
     forces = Forces(gravity_world=gravity, air_velocity_world=air,
                     applied=tuple(a for _, applied in per_body for a in applied), timed=timed, **drag)
     names = [b.name for b in bodies]
@@ -44,8 +46,6 @@ def read_dynamics(top: TableReader, head: dict, engines: EngineSet) -> DynamicsS
         raise readers[loaded].fail("load", "a load that changes with time on a scene with contact planes",
                                    "time-varying loads on free bodies without [[plane]] (contact methods step "
                                    "constant forces only)")
-    sim = top.subtable("simulation", ("duration", "dt", "rate_hz", "integrators"))
-    duration = sim.number("duration", positive=True)
     if sim.has("dt") == sim.has("rate_hz"):
         raise sim.fail("dt", "give exactly one of dt and rate_hz", "dt = [time steps in s] or rate_hz = [steps per s]")
     dts = time_step_ladder(sim, duration, len(bodies))

@@ -15,7 +15,7 @@ from simparity.comparisons.scenes.loading.chain import (
     within_limits,
 )
 from simparity.comparisons.scenes.loading.reader import MAX_SEED, TableReader
-from simparity.comparisons.scenes.loading.time_functions import FUNCTION_KEYS, read_time_function
+from simparity.comparisons.scenes.loading.time_functions import FUNCTION_KEYS, read_time_function, within_range_over
 from simparity.comparisons.scenes.loading.time_steps import STEP_COUNT_RTOL, time_step_ladder
 from simparity.core.model.errors import echo
 from simparity.core.model.scenes.chain import Chain, sample_configurations
@@ -68,13 +68,14 @@ def read_joint_motion(top: TableReader, head: dict, engines: EngineSet) -> Joint
     drive = top.optional_subtable("drive", ("torque", "damping", "timed_torque"))
     torque = (joint_values(drive, "torque", chain, joint_powers(chain, 2, 1)) if drive and drive.has("torque")
               else np.zeros(chain.n_joints))  # N m = kg m^2 / s^2 (mass and time fixed) or N = kg m / s^2
-    timed_table = drive.optional_subtable("timed_torque", FUNCTION_KEYS) if drive else None
-    timed = (read_time_function(timed_table, np.asarray(joint_powers(chain, 2, 1), dtype=float))
-             if timed_table else None)
-    if drive and drive.has("damping"):  # replaces the chain's own (a URDF's <dynamics damping>)
-        chain = _with_damping(drive, chain)
     sim = top.subtable("simulation", _MOTION_SIMULATION)
     duration = sim.number("duration", positive=True)
+    timed_table = drive.optional_subtable("timed_torque", FUNCTION_KEYS) if drive else None
+    timed = (within_range_over(drive, "timed_torque",
+                               read_time_function(timed_table, np.asarray(joint_powers(chain, 2, 1), dtype=float)),
+                               duration) if drive and timed_table else None)
+    if drive and drive.has("damping"):  # replaces the chain's own (a URDF's <dynamics damping>)
+        chain = _with_damping(drive, chain)
     dts = time_step_ladder(sim, duration, 1)
     segments = sim.integer("segments", 0, maximum=MAX_SEGMENTS, why="") if sim.has("segments") else 0
     for i, dt in enumerate(dts if segments else ()):  # each segment a whole number of every step

@@ -24,6 +24,7 @@ import numpy as np
 
 from simparity.comparisons.scenes.loading.reader import SAMPLES_WHY, TableReader
 from simparity.core.model.errors import echo
+from simparity.core.model.ranges import RANGES
 from simparity.core.model.scenes.time_functions import (
     FUNCTIONS,
     HELD,
@@ -104,8 +105,21 @@ def read_time_function(r: TableReader, powers: np.ndarray) -> TimeFunction:
     return SmoothFunction(polynomial, tuple(sinusoids))
 
 
-def read_loads(r: TableReader, index: int) -> list[TimedLoad]:
-    """The ``[[body.load]]`` entries of body ``index``'s table ``r`` (none without the key)."""
+def within_range_over(r: TableReader, key: str, function: TimeFunction, duration: float) -> TimeFunction:
+    """``function`` if its largest magnitude over the run (:meth:`SmoothFunction.largest_magnitude`) stays within the
+    range of a load's values: a polynomial of coefficients each in range can still reach 1e42 N at t = 100 s, which no
+    engine steps (the tight solve never finishes)."""
+    allowed = RANGES["amplitude"]
+    bound = function.largest_magnitude(duration)
+    if not (np.isfinite(bound) and bound <= allowed.high):
+        raise r.fail(key, f"reaches {bound:.3g} over the run's {duration:g} s (sum |c_k| T^k + sum |A|)",
+                     f"a load that stays within {allowed.text()} over the whole run")
+    return function
+
+
+def read_loads(r: TableReader, index: int, duration: float) -> list[TimedLoad]:
+    """The ``[[body.load]]`` entries of body ``index``'s table ``r`` (none without the key), each within range over a
+    run of ``duration`` [s]."""
     if not r.has("load"):
         return []
     loads = []
@@ -115,7 +129,8 @@ def read_loads(r: TableReader, index: int) -> list[TimedLoad]:
         for key, power in (("force", 1), ("torque", 2)):
             table = entry.optional_subtable(key, FUNCTION_KEYS)
             if table is not None:
-                functions[key] = read_time_function(table, np.full(3, power))
+                functions[key] = within_range_over(entry, key, read_time_function(table, np.full(3, power)),
+                                                   duration)
         if not functions:
             raise entry.fail("force", "a load with neither a force nor a torque",
                              f"[{entry.path}.force], [{entry.path}.torque] or both, each a time function")

@@ -98,6 +98,13 @@ class SmoothFunction:
         """d, the components of each value."""
         return self.polynomial.shape[1]
 
+    def largest_magnitude(self, duration: float) -> float:
+        """An upper bound of |f(t)| over [0, ``duration``] [s]: sum_k |c_k| T^k + sum_s |A_s|."""
+        powers = float(duration) ** np.arange(len(self.polynomial))
+        with np.errstate(over="ignore", invalid="ignore"):
+            bound = float(np.linalg.norm(self.polynomial, axis=1) @ powers) if len(self.polynomial) else 0.0
+        return bound + sum(float(np.linalg.norm(s.amplitude)) for s in self.sinusoids)
+
 
 @dataclass(frozen=True)
 class HeldFunction:
@@ -132,6 +139,10 @@ class HeldFunction:
     def size(self) -> int:
         """d, the components of each value."""
         return self.samples.shape[1]
+
+    def largest_magnitude(self, duration: float) -> float:
+        """|f(t)| at most over any run: the largest sample's norm."""
+        return float(np.max(np.linalg.norm(self.samples, axis=1)))
 
     def instants(self) -> np.ndarray:
         """(m,) the sample instants t_k [s], where the held value may jump."""

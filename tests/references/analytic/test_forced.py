@@ -9,6 +9,9 @@ import warnings
 import numpy as np
 from scipy.integrate import IntegrationWarning, quad, solve_ivp
 
+from simparity.comparisons.engines.registry import make_engine
+from simparity.comparisons.scenes.library import resolve
+from simparity.comparisons.scenes.loading.scene_file import load_scene
 from simparity.core.model.scenes.time_functions import HeldFunction, Sinusoid, SmoothFunction
 from simparity.references.analytic.forced import driven_joint, integrals
 from simparity.references.common.time_loads import at, jump_times
@@ -75,3 +78,16 @@ def test_a_driven_joint_matches_a_tight_solve_with_and_without_damping():
             scale = max(np.abs(q_ref).max(), np.abs(qdot_ref).max())
             np.testing.assert_allclose(q, q_ref, rtol=0, atol=CLOSED_FORM_AGREEMENT * scale)
             np.testing.assert_allclose(qdot, qdot_ref, rtol=0, atol=CLOSED_FORM_AGREEMENT * scale)
+
+
+def test_a_timed_torque_that_is_zero_throughout_leaves_the_body_torque_free(tmp_path):
+    """A held-out case: every sample 0 made the analytic engine look for the torque's axis among no vectors (an
+    IndexError, a traceback from `simparity show`); such a load exerts nothing, and the closed form is torque-free."""
+    text = resolve("torque-pulse").read_text(encoding="utf-8").replace("[0.0, 0.0, 0.5]", "[0.0, 0.0, 0.0]")
+    path = tmp_path / "idle.toml"
+    path.write_text(text.replace('name = "torque-pulse"', 'name = "idle"'), encoding="utf-8")
+    scene = load_scene(path)
+    analytic = make_engine("analytic")
+    assert analytic.supports_dynamics(scene, "exact").ok
+    run = analytic.build_dynamics(scene, "exact", 0.01).run(10)
+    assert not run.angular_velocity_world.any()

@@ -10,7 +10,7 @@ import pytest
 
 from simparity.references.analytic.engine import AnalyticEngine
 from simparity.references.mujoco.adapter import MujocoEngine
-from simparity.references.mujoco.stage_loads import stage_callback
+from simparity.references.mujoco.stage_loads import StepClock, stage_callback
 from tests.helpers import builtin
 
 SLIDER = """<mujoco><option integrator="RK4" gravity="0 0 0" timestep="0.1"/>
@@ -51,3 +51,17 @@ def test_mujoco_rk4_keeps_its_order_under_a_sinusoidal_force():
     coarse, fine = _error(scene, "rk4", 0.02), _error(scene, "rk4", 0.01)
     assert RK4_RATIO[0] < coarse / fine < RK4_RATIO[1], coarse / fine
     assert mujoco.get_mjcb_control() is None
+
+
+def test_a_stage_s_time_is_the_step_s_own_start_plus_mujoco_s_offset_not_its_drifting_clock():
+    """MuJoCo's d.time sums dt step by step: after 40,000 steps of 2.5 ms it is off k dt by ~1e-11 s, more than a
+    hold's tolerance near a sample instant (a held-out run saw the wrong sample applied from t = 50.85 s)."""
+    dt, steps = 0.0025, 40_000
+    drifted = 0.0
+    for _ in range(steps):
+        drifted += dt
+    assert abs(drifted - steps * dt) > 1e-12
+    clock = StepClock()
+    clock.start(steps, dt, drifted)
+    assert clock.stage_time(drifted) == steps * dt
+    assert clock.stage_time(drifted + 0.5 * dt) == pytest.approx(steps * dt + 0.5 * dt, rel=0, abs=1e-13)

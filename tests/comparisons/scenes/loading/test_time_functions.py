@@ -163,3 +163,19 @@ def test_a_load_with_nothing_in_it_or_on_a_scene_with_contact_is_refused(tmp_pat
                                          '0.0]\n\n[contact]\nmethods = ["backup"]\nrestitution = 0.5\n\n[simulation]')
     with pytest.raises(SceneError, match="body\\[0\\]\\.load: a load that changes with time on a scene with contact"):
         load_scene(_write(tmp_path, plane))
+
+
+def test_a_load_that_outgrows_its_range_over_the_run_is_refused(tmp_path):
+    """Each coefficient in range, the whole polynomial not: c_15 = 1e11 over 100 s reaches 1e41 N, which no engine
+    steps (a held-out run's tight solve never finished); refused naming the load, as a constant force of that size is."""
+    text = BODY.format(head="").replace("polynomial = [[0.0, 0.0, 1.0], [0.5, 0.0, 0.0]]",
+                                        "polynomial = " + str([[0.0, 0.0, 0.0]] * 15 + [[0.0, 0.0, 1e11]]))
+    assert load_scene(_write(tmp_path, text)).forces.timed  # over 1 s: at most 1e11 N
+    with pytest.raises(SceneError, match=r"body\[0\]\.load\[0\]\.force: reaches 1e\+41 over the run's 100 s"):
+        load_scene(_write(tmp_path, text.replace("duration = 1.0", "duration = 100.0")))
+    with pytest.raises(SceneError, match=r"drive\.timed_torque\.samples\[1\]\[0\]: -5e\+14 is outside the physical"):
+        load_scene(_write(tmp_path, JOINT.replace("samples = [[0.5], [-0.5]]", "samples = [[0.5], [-5e14]]")))
+    grown = JOINT.replace('function = "held"\nperiod = 0.1\nsamples = [[0.5], [-0.5]]',
+                          'function = "smooth"\npolynomial = ' + str([[0.0]] * 15 + [[1e11]]))
+    with pytest.raises(SceneError, match=r"drive\.timed_torque: reaches 1e\+41 over the run's 100 s"):
+        load_scene(_write(tmp_path, grown.replace("duration = 1.0", "duration = 100.0")))

@@ -1,0 +1,86 @@
+"""Model-level parity: what an engine compiled from the chain's robot file against what the reference compiled,
+rigid group by rigid group (:class:`core.model.rigid_groups.RigidGroups`), before any dynamics are compared.
+
+A judge: it reads the engines' reports only (core's data model). Each field is a metric of its own, the largest over
+the chain's joints and over the configurations (q = 0 and the scene's states), relative to a scale that means the
+same in any unit, and its row names the joint where it is largest with both engines' values:
+
+- mass: |m - m_ref| over the larger of the two (0 when both groups are massless);
+- centre of mass: |c - c_ref| over the chain's extent X (the farthest joint origin or centre of mass from the first
+  joint's origin, as the reference has it); a group massless in both engines has no centre of mass to compare;
+- inertia: the largest entry of |I - I_ref| (about each one's own centre of mass, base-frame axes) over the larger
+  of the two tensors' largest entries (0 when both are zero);
+- axis: the angle between the joints' axes [rad];
+- origin: |o - o_ref| over X.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simparity.comparisons.measure.rows import Measured
+from simparity.core.model.metric_catalogue import (
+    MODEL_AXIS_ERROR_MAX,
+    MODEL_COM_ERROR_MAX,
+    MODEL_INERTIA_ERROR_MAX,
+    MODEL_MASS_ERROR_MAX,
+    MODEL_ORIGIN_ERROR_MAX,
+    units,
+)
+from simparity.core.model.rigid_groups import RigidGroups
+
+MODEL_METRICS = units(MODEL_MASS_ERROR_MAX, MODEL_COM_ERROR_MAX, MODEL_INERTIA_ERROR_MAX, MODEL_AXIS_ERROR_MAX,
+                      MODEL_ORIGIN_ERROR_MAX)
+"""The model-parity metrics of a joint-dynamics case, in row order."""
+
+
+def configurations(q: np.ndarray) -> np.ndarray:
+    """The configurations the models are compared at: q = 0 (the file's own placement) and the scene's (B, n)."""
+    return np.vstack([np.zeros((1, q.shape[1])), q])
+
+
+def _ratio(difference: np.ndarray, scale: np.ndarray) -> np.ndarray:
+    """difference / scale, 0 where both are 0 (nothing there to differ), (B, n)."""
+    return np.divide(difference, scale, out=np.zeros_like(difference), where=scale > 0)
+
+
+def _worst(values: np.ndarray, unit: str, joints: tuple[str, ...], what: str, own: np.ndarray, ref: np.ndarray,
+           text) -> Measured:
+    """The largest of ``values`` (B, n) with a note naming its joint and both engines' values there."""
+    b, j = np.unravel_index(int(np.argmax(values)), values.shape)
+    at = "q = 0" if b == 0 else f"state {b}"
+    return Measured(float(values[b, j]), unit,
+                    note=f"largest at joint '{joints[j]}' ({at}): {what} {text(own[b, j])} against the reference's "
+                         f"{text(ref[b, j])}")
+
+
+def _vector(values: np.ndarray) -> str:
+    return "[" + ", ".join(f"{v:.6g}" for v in np.ravel(values)) + "]"
+
+
+def model_parity(own: RigidGroups, ref: RigidGroups, joints: tuple[str, ...]) -> dict[str, Measured]:
+    """Each field of ``own`` against ``ref`` (the same configurations, :func:`configurations`) as the module docstring
+    says; ``joints`` names the chain's joints."""
+    extent = max(float(np.max(np.linalg.norm(ref.origin_world - ref.origin_world[:, :1], axis=-1))),
+                 float(np.max(np.linalg.norm(ref.com_world - ref.origin_world[:, :1], axis=-1))))
+    if not extent > 0:
+        extent = 1.0  # every group at the first joint's origin: lengths in metres (said by no row: all are 0)
+    mass = _ratio(np.abs(own.mass - ref.mass), np.maximum(np.abs(own.mass), np.abs(ref.mass)))
+    weighed = (own.mass > 0) | (ref.mass > 0)
+    com = np.where(weighed, np.linalg.norm(own.com_world - ref.com_world, axis=-1), 0.0) / extent
+    largest = np.maximum(np.max(np.abs(own.inertia_world), axis=(-1, -2)), np.max(np.abs(ref.inertia_world),
+                                                                                 axis=(-1, -2)))
+    inertia = _ratio(np.max(np.abs(own.inertia_world - ref.inertia_world), axis=(-1, -2)), largest)
+    axis = np.arctan2(np.linalg.norm(np.cross(own.axis_world, ref.axis_world), axis=-1),
+                      np.einsum("bni,bni->bn", own.axis_world, ref.axis_world))
+    origin = np.linalg.norm(own.origin_world - ref.origin_world, axis=-1) / extent
+    return {
+        MODEL_MASS_ERROR_MAX: _worst(mass, "1", joints, "mass", own.mass, ref.mass, lambda v: f"{v:.10g} kg"),
+        MODEL_COM_ERROR_MAX: _worst(com, "1", joints, "centre of mass", own.com_world, ref.com_world,
+                                    lambda v: f"{_vector(v)} m"),
+        MODEL_INERTIA_ERROR_MAX: _worst(inertia, "1", joints, "inertia about the centre of mass", own.inertia_world,
+                                        ref.inertia_world, lambda v: f"{_vector(v)} kg m^2"),
+        MODEL_AXIS_ERROR_MAX: _worst(axis, "rad", joints, "axis", own.axis_world, ref.axis_world, _vector),
+        MODEL_ORIGIN_ERROR_MAX: _worst(origin, "1", joints, "origin", own.origin_world, ref.origin_world,
+                                       lambda v: f"{_vector(v)} m"),
+    }
