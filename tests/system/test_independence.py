@@ -28,6 +28,7 @@ from simparity.comparisons.scenes.loading import chain as loading_chain
 from simparity.comparisons.scenes.loading.scene_file import parse_scene
 from simparity.core import dh as core_dh
 from simparity.core import rotations as core_rotations
+from simparity.core import urdf as core_urdf
 from simparity.core.dynamics import forces as core_forces
 from simparity.core.dynamics import inertia as core_inertia
 from simparity.core.model.scenes.bodies import Forces
@@ -387,3 +388,34 @@ def test_the_numbers_as_given_follow_every_transform_and_perturbation(name):
         for own, core in zip(_derived(as_given(moved)), _derived(moved)):
             scale = max(float(np.max(np.abs(core), initial=0.0)), 1.0)
             np.testing.assert_allclose(own, core, rtol=0, atol=DERIVED_RTOL * scale, err_msg=name)
+
+
+def _rpy_in_the_wrong_order(rpy):
+    """A planted bug in core's URDF parser: roll-pitch-yaw composed Rx Ry Rz instead of Rz Ry Rx."""
+    roll, pitch, yaw = np.asarray(rpy, dtype=float)
+    cx, sx, cy, sy, cz, sz = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
+    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return rx @ ry @ rz
+
+
+def test_a_bug_in_core_s_urdf_parser_moves_core_s_model_rows_only(monkeypatch):
+    """Issue #43: every engine reads the robot file with its own importer. An rpy order planted in core's parser
+    moves core's compiled model (its groups' origins, axes and inertias in the base frame) and leaves every other
+    engine's bit for bit: the model-parity rows name core."""
+    q = np.random.default_rng(43).uniform(-1.0, 1.0, size=(3, 5))
+
+    def groups(engine: str) -> dict:
+        scene = builtin("crafted-arm-dynamics")
+        built = make_engine(engine)
+        model = built.build_joint_dynamics(scene.chain, built.joint_dynamics_methods()[0], scene.gravity_world)
+        reported = model.rigid_groups(q[:, :scene.chain.n_joints])
+        return {f: np.array(getattr(reported, f)) for f in ("origin_world", "axis_world", "inertia_world")}
+
+    right = {e: groups(e) for e in ("core", "mujoco", "pinocchio", "pybullet")}
+    monkeypatch.setattr(core_urdf, "rpy_to_matrix", _rpy_in_the_wrong_order)
+    wrong = {e: groups(e) for e in ("core", "mujoco", "pinocchio", "pybullet")}
+    for engine in ("mujoco", "pinocchio", "pybullet"):
+        assert all(np.array_equal(right[engine][f], wrong[engine][f]) for f in right[engine])
+    assert max(np.abs(right["core"][f] - wrong["core"][f]).max() for f in right["core"]) > 1e-3
