@@ -31,7 +31,7 @@ from simparity.core.model.engine import Engine, JointDynamicsModel, Support
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
-from simparity.core.model.rigid_groups import RigidGroups
+from simparity.core.model.rigid_groups import FIELDS, RigidGroups
 from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.core.model.metric_catalogue import TIME_PER_FK, TIME_PER_JACOBIAN
 
@@ -157,6 +157,9 @@ def _model_parity(model: JointDynamicsModel, shared: _JointDynamicsShared, chain
         own = model.rigid_groups(configurations(shared.states[0]))
     except NotImplementedError as err:
         return {m: Measured(math.nan, u, unmeasurable=str(err)) for m, u in MODEL_METRICS.items()}
+    bad = [f for f in FIELDS if not np.all(np.isfinite(getattr(own, f)))]
+    if bad:
+        raise ValueError(f"non-finite {', '.join(bad)}")
     return model_parity(own, shared.groups, tuple(j.name for j in chain.joints))
 
 

@@ -47,3 +47,18 @@ def test_an_importer_s_flipped_axes_are_caught_naming_the_engine(tmp_path, monke
     assert {line.split()[2] for line in violations} == {"flipped-axes"}
     assert all("model_axis_error_max" in line for line in violations), violations
     assert any("3.14" in line for line in violations), violations
+
+
+NAN_REPORT = PLANTED_ADAPTER.replace("FlippedAxes", "NanMasses").replace('"flipped-axes"', '"nan-masses"').replace(
+    "return replace(groups, axis_world=-groups.axis_world)", "return replace(groups, mass=groups.mass * float('nan'))")
+
+
+@pytest.mark.slow
+def test_a_compiled_model_with_nan_fails_its_rows_instead_of_passing_as_n_a(tmp_path, monkeypatch, capsys):
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setenv("PYTHONPATH", f"{tmp_path}:{':'.join(sys.path)}")
+    (tmp_path / "nan_importer.py").write_text(NAN_REPORT, encoding="utf-8")
+    code = main(["run", "oblique-arm-dynamics", "--quick", "--check", "--engines", "core,nan_importer:NanMasses",
+                 "--out", str(tmp_path / "run"), "--history", str(tmp_path / "h.db"), "--no-report", "--jobs", "1"])
+    out = capsys.readouterr().out
+    assert code == 1 and "nan-masses" in out and "non-finite mass" in out, out[-1500:]
