@@ -123,6 +123,7 @@ from simparity.references.common.urdf_export import (
     chain_source,
     chain_urdf,
     movable_joints_above_base,
+    urdf_support,
 )
 from simparity.references.common.scene_inputs import derives_own_inputs
 
@@ -497,7 +498,11 @@ def _links_support(urdf_text: str) -> Support:
 
 
 def _dynamics_support(chain: Chain) -> Support:
-    """Whether PyBullet can hold the chain's dynamics: no armature, at most :data:`MAX_LINKS` links."""
+    """Whether PyBullet can hold the chain's dynamics: a chain URDF can express (a prismatic joint needs limits
+    there), no armature, at most :data:`MAX_LINKS` links."""
+    expressible = urdf_support(chain) if chain.urdf_path is None else Support.yes()
+    if not expressible.ok:
+        return expressible
     armature = _armature_support(chain)
     return _links_support(dynamics_urdf(chain)) if armature.ok else armature
 
