@@ -393,7 +393,7 @@ class InHouseEngine(Engine):
 
     def supports_joint_dynamics(self, chain: Chain, method: str) -> Support:
         named = super().supports_joint_dynamics(chain, method)
-        problem = chain.dynamics_problem()
+        problem = chain.dynamics_problem() or joint_dynamics.floating_problem(chain, method)
         return Support.no(problem) if named.ok and problem else named
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:

@@ -107,6 +107,7 @@ def chain_from_urdf(
     max_joints: int = MAX_MOVABLE_JOINTS,
     max_bytes: int = MAX_FILE_BYTES,
     dynamics: bool = False,
+    floating_base: bool = False,
 ) -> Chain:
     """Build the serial :class:`~core.scene.Chain` from ``base_link`` to ``tip_link``.
 
@@ -130,6 +131,10 @@ def chain_from_urdf(
         Whether the chain's dynamics will be computed: then a non-physical inertia tensor on a link riding on a
         chain link is refused (real URDFs have such placeholders, e.g. pybullet_data's xarm6, which kinematics never
         sees: a kinematics or IK scene loads them as before).
+    floating_base : bool
+        Whether the base link floats free (:attr:`Chain.floating_base`): its rigid group (the base link, the links
+        welded to it and the branches off the chain held at 0) is then the chain's ``base_inertia``, held to the
+        physical rules as a chain link's (a fixed base's placeholder tensor moves now).
 
     Returns
     -------
@@ -185,8 +190,11 @@ def chain_from_urdf(
     held = tuple(joint["name"] for joint in joints
                  if joint["type"] != "fixed" and joint["name"] not in on_path and joint["parent"] in inertials)
     is_file = not os.fspath(path_or_text).lstrip().startswith("<")
-    return replace(chain, joints=chain_joints, held_joints=held,
-                   urdf_path=os.fspath(path_or_text) if is_file else None, base_link=base)
+    base_inertia = (_rigid_body({"child": base}, movable[0], inertials, child_joints, source, True,
+                                "the floating base")
+                    if floating_base else None)
+    return replace(chain, joints=chain_joints, held_joints=held, floating_base=floating_base,
+                   base_inertia=base_inertia, urdf_path=os.fspath(path_or_text) if is_file else None, base_link=base)
 
 
 def _parse(path_or_text: str | os.PathLike, source: str | None, max_bytes: int) -> tuple[ET.Element, str]:
@@ -645,7 +653,7 @@ def _hold(values: np.ndarray, allowed: Range, key: str, where: str, source: str)
 
 
 def _rigid_body(joint: dict, following: dict | None, inertials: dict[str, _Inertial],
-                children: dict[str, list[dict]], source: str, dynamics: bool) -> LinkInertia:
+                children: dict[str, list[dict]], source: str, dynamics: bool, riding: str = "the chain") -> LinkInertia:
     """Everything rigidly attached to ``joint``'s child link, in its frame: the links below it except the
     subtree of the next chain joint ``following``; every other joint at its zero position (its origin).
     For ``dynamics``, a non-physical inertia tensor among them is refused."""
@@ -655,7 +663,7 @@ def _rigid_body(joint: dict, following: dict | None, inertials: dict[str, _Inert
         link, position, rotation = stack.pop()
         inertial = inertials[link]
         if inertial.problem and dynamics:
-            raise SceneError(source, inertial.key, f"{inertial.problem} ({inertial.where}, riding on the chain)",
+            raise SceneError(source, inertial.key, f"{inertial.problem} ({inertial.where}, riding on {riding})",
                              LINK_TENSOR_RULE)
         parts.append((inertial, position, rotation))
         for child in children.get(link, []):

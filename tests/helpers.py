@@ -329,3 +329,28 @@ def killed_and_resumed(command: list[str], killed, total: int, wait_seconds: flo
     assert main(["run", "--resume", str(killed), *resume_options], printed) == 0, printed.getvalue()
     assert f"resuming {finished} finished cases" in printed.getvalue()
     return finished
+
+
+def floating_states(chain, count: int, seed: int) -> tuple[np.ndarray, ...]:
+    """(q (count, 7 + n), v, a, tau (count, 6 + n)) of a floating-base chain: the base's origin and the joints
+    uniform in [-1, 1], its orientation uniform over the rotations (SciPy's), velocities, accelerations and forces
+    uniform in [-1, 1]; seeded."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(seed)
+    turn = Rotation.random(count, random_state=seed).as_quat(scalar_first=True)
+    q = np.concatenate([rng.uniform(-1, 1, (count, 3)), turn, rng.uniform(-1, 1, (count, chain.n_joints))], axis=1)
+    v, a, tau = (rng.uniform(-1, 1, (count, chain.nv)) for _ in range(3))
+    return q, v, a, tau
+
+
+def solo12_leg():
+    """Solo-12 (example-robot-data) from base_link to FL_FOOT with a floating base, the other legs held."""
+    from importlib import metadata
+
+    from simparity.comparisons.scenes.loading.chain import EXAMPLE_ROBOT_DATA_ROBOTS
+    from simparity.core.urdf import chain_from_urdf
+
+    robots = metadata.distribution("example-robot-data").locate_file(EXAMPLE_ROBOT_DATA_ROBOTS)
+    return chain_from_urdf(str(robots / "solo_description/robots/solo12.urdf"), "base_link", "FL_FOOT", dynamics=True,
+                           floating_base=True)

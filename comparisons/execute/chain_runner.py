@@ -127,7 +127,7 @@ def prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_fa
     def evaluate() -> tuple[dict, ForceScale]:
         model = engine_for(scene.reference).build_joint_dynamics(scene.chain, method, scene.gravity_world)
         values = reference_values(model, states)
-        problem = shape_problem(values, len(states[0]), scene.chain.n_joints)
+        problem = shape_problem(values, len(states[0]), scene.chain.nv)
         if problem:
             raise SimparityError(f"unusable: {problem}")
         return values, _force_scale(scene, engine_for(scene.reference), method, model, states, values)
@@ -140,7 +140,7 @@ def prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_fa
     values, scale = cast(tuple[dict, ForceScale], evaluated)
     try:
         model = engine_for(scene.reference).build_joint_dynamics(scene.chain, method, scene.gravity_world)
-        groups, why = model.rigid_groups(configurations(states[0])), ""
+        groups, why = model.rigid_groups(configurations(scene.chain.joint_values(states[0]))), ""
     except NotImplementedError as err:
         groups, why = None, f"the reference {label} reports no compiled model: {err}"
     except Exception as err:  # noqa: BLE001 - a user's reference: its model rows say why
@@ -154,7 +154,7 @@ def _model_parity(model: JointDynamicsModel, shared: _JointDynamicsShared, chain
     if shared.groups is None:
         return {m: Measured(math.nan, u, unmeasurable=shared.groups_problem) for m, u in MODEL_METRICS.items()}
     try:
-        own = model.rigid_groups(configurations(shared.states[0]))
+        own = model.rigid_groups(configurations(chain.joint_values(shared.states[0])))
     except NotImplementedError as err:
         return {m: Measured(math.nan, u, unmeasurable=str(err)) for m, u in MODEL_METRICS.items()}
     bad = [f for f in FIELDS if not np.all(np.isfinite(getattr(own, f)))]
@@ -193,13 +193,13 @@ def _joint_dynamics_rows(scene: JointDynamicsScene, engine: Engine, case: Case, 
             return case.rows(JOINT_DYNAMICS_METRICS, NOT_AVAILABLE, support.reason)
         model = engine.build_joint_dynamics(scene.chain, case.integrator, scene.gravity_world)
         own, values = timed_values(model, shared.states, lambda fn: best_of(fn, repeats))
-        problem = shape_problem(own, len(shared.states[0]), scene.chain.n_joints)
+        problem = shape_problem(own, len(shared.states[0]), scene.chain.nv)
         if problem:
             status = DIVERGED if problem.startswith("non-finite") else FAILED
             return case.rows(JOINT_DYNAMICS_METRICS, status, problem, values)
         scale = (shared.scale if shared.scale is not None  # else its own: identities need no reference
                  else _force_scale(scene, engine, case.integrator, model, shared.states, own))
-        values.update(identities(model, scene.chain, shared.states, own, scale))
+        values.update(identities(model, scene.chain, shared.states, own, scale, scene.gravity_world))
     except Exception as err:  # noqa: BLE001 - reported in the rows
         return case.rows(JOINT_DYNAMICS_METRICS, FAILED, error_text(err))
     detail = ("this is the reference; " if is_reference else "") + model.detail

@@ -568,6 +568,11 @@ def _case_rows(comparisons: list[RowComparison], transform: Transform, engine: s
     else:
         ratio = row(ratio_metric, math.nan, NOT_AVAILABLE, f"transform {text}: no metric measured (ok) in both runs"
                     + tail)
+    if not compared and not changes and not at_threshold and not any(OK in (c.status, c.status_transformed)
+                                                                      for c in comparisons):
+        # nothing measured in either run (every row n/a or failed alike): no status could change, nothing to count
+        return [ratio, row(changes_metric, math.nan, NOT_AVAILABLE,
+                           f"transform {text}: no metric measured (ok) in either run, every status unchanged{tail}")]
     listed = f": {_listed(changes)}" if changes else ""
     return [ratio, row(changes_metric, float(len(changes)), OK,
                        f"transform {text}: {len(changes)} status change(s) rounding does not explain{listed}{tail}")]

@@ -386,7 +386,7 @@ def _joint_dynamics_scene(scene: JointDynamicsScene, t: Transform) -> JointDynam
     in the new units (a prismatic joint's variable is a length, a revolute one's an angle), so that the same seeded
     draws are the same states."""
     chain = _timed_chain(scene.chain, t, scene.source)
-    variable = np.array([1 if j.type == "prismatic" else 0 for j in scene.chain.joints])  # power of length: m or rad
+    variable = scene.chain.length_powers  # power of length: m or rad
     gravity = scene.gravity_world
     return replace(scene, chain=chain, gravity_world=None if gravity is None else t.vector(gravity, length=1, time=-2),
                    velocity_scale=t.length_scale ** variable / t.time_scale * scene.velocity_scale,
@@ -399,7 +399,7 @@ def _joint_motion_scene(scene: JointMotionScene, t: Transform) -> JointMotionSce
     the initial joint values, velocities and torques (the timed one's time too), the duration and the time steps in
     the new units."""
     chain = _timed_chain(scene.chain, t, scene.source)
-    variable = np.array([1 if j.type == "prismatic" else 0 for j in scene.chain.joints])  # power of length: m or rad
+    variable = scene.chain.length_powers  # power of length: m or rad
     gravity, timed = scene.gravity_world, scene.timed_torque
     torque_scale = t.length_scale ** (2 - variable) * t.factor(mass=1, time=-2)
     return replace(scene, chain=chain, gravity_world=None if gravity is None else t.vector(gravity, length=1, time=-2),

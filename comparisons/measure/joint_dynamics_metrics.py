@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from simparity.comparisons.measure.configuration_flow import moved
 from simparity.comparisons.measure.joint_force_scale import ForceScale
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointDynamicsModel
@@ -39,6 +40,7 @@ from simparity.core.model.metric_catalogue import (
     BIAS_FORCE_ERROR_MAX,
     CORIOLIS_SKEW_RESIDUAL,
     FORWARD_DYNAMICS_ERROR_MAX,
+    GRAVITY_EQUIVALENCE_RESIDUAL,
     GRAVITY_IDENTITY_RESIDUAL,
     INVERSE_DYNAMICS_ERROR_MAX,
     KINETIC_ENERGY_RESIDUAL,
@@ -67,6 +69,7 @@ JOINT_DYNAMICS_METRICS = units(
     MASS_MATRIX_DEFINITENESS_MIN,
     KINETIC_ENERGY_RESIDUAL,
     CORIOLIS_SKEW_RESIDUAL,
+    GRAVITY_EQUIVALENCE_RESIDUAL,
     TIME_PER_MASS_MATRIX,
     TIME_PER_INVERSE_DYNAMICS,
     TIME_PER_FORWARD_DYNAMICS,
@@ -148,21 +151,24 @@ def _rounded_force(mass: np.ndarray, qddot: np.ndarray) -> np.ndarray:
 
 
 def identities(model: JointDynamicsModel, chain: Chain, states: tuple[np.ndarray, ...],
-               own: dict[str, np.ndarray], scale: ForceScale) -> dict[str, Measured]:
+               own: dict[str, np.ndarray], scale: ForceScale, gravity_world: np.ndarray | None) -> dict[str, Measured]:
     """The identities of the engine's own outputs ``own`` (:func:`reference_values` of the engine, at ``states``) of
     ``chain``: RNEA(q, 0, 0) = g(q) = h(q, 0); RNEA(q, 0, e_i) - g = M e_i; RNEA(ABA(RNEA(qddot))) = RNEA(qddot) (the
     round trip in torque space); M symmetric and
     positive definite; 1/2 qdot^T M qdot (armature aside) = the links' kinetic energy from the engine's own
-    kinematics; qdot^T (Mdot - 2 C) qdot = 0. The joint-force identities are floored at the chain's force ``scale``."""
+    kinematics; qdot^T (Mdot - 2 C) qdot = 0; for a floating base, g(q) = -M(q)[:, :3] ``gravity_world`` (the
+    equivalence principle: weight is what a uniform acceleration -g of the base takes). The joint-force identities are
+    floored at the chain's force ``scale``."""
     q, qd, qdd, _ = states
-    n = chain.n_joints
+    n = chain.nv
     mass, tau = own["M"], own["tau"]
     torque_scale = float(np.max(np.abs(tau)))
-    zeros = np.zeros_like(q)
+    zeros = np.zeros_like(qd)
     gravity = model.bias_forces(q, zeros)
     values = {GRAVITY_IDENTITY_RESIDUAL: _over(model.inverse_dynamics(q, zeros, zeros) - gravity, torque_scale,
-                                               scale.floor, "the joint force", scale)}
-    columns = np.stack([model.inverse_dynamics(q, zeros, np.broadcast_to(np.eye(n)[i], q.shape).copy()) - gravity
+                                               scale.floor, "the joint force", scale),
+              GRAVITY_EQUIVALENCE_RESIDUAL: _equivalence(chain, mass, gravity, gravity_world, scale)}
+    columns = np.stack([model.inverse_dynamics(q, zeros, np.broadcast_to(np.eye(n)[i], qd.shape).copy()) - gravity
                         for i in range(n)], axis=-1)
     values[MASS_COLUMN_RESIDUAL] = _over(columns - mass, float(np.max(np.abs(mass))), 0.0, "the mass matrix")
     there = model.forward_dynamics(q, qd, tau)  # ~ qdd
@@ -172,13 +178,25 @@ def identities(model: JointDynamicsModel, chain: Chain, states: tuple[np.ndarray
     values[MASS_MATRIX_ASYMMETRY] = _over(mass - np.swapaxes(mass, -1, -2), float(np.max(np.abs(mass))), 0.0,
                                           "the mass matrix")
     values[MASS_MATRIX_DEFINITENESS_MIN] = _definiteness(mass)
-    armature = np.array([joint.armature for joint in chain.joints])
+    armature = np.array([0.0] * chain.base_dofs + [joint.armature for joint in chain.joints])
     quadratic = 0.5 * np.einsum("bi,bij,bj->b", qd, mass, qd) - 0.5 * np.sum(armature * qd**2, axis=-1)
     kinetic = model.link_kinetic_energy(q, qd)
     values[KINETIC_ENERGY_RESIDUAL] = _over(quadratic - kinetic, float(np.max(np.abs(kinetic))), 0.0,
                                             "the links' kinetic energy")
-    values[CORIOLIS_SKEW_RESIDUAL] = _skew_residual(model, q, qd, own["h"] - gravity, mass)
+    values[CORIOLIS_SKEW_RESIDUAL] = _skew_residual(model, chain, q, qd, own["h"] - gravity, mass)
     return values
+
+
+def _equivalence(chain: Chain, mass: np.ndarray, gravity: np.ndarray, gravity_world: np.ndarray | None,
+                 scale: ForceScale) -> Measured:
+    """|g(q) + M(q)[:, :3] g_world| over the largest |g(q)|, floored at the force ``scale``: n/a for a fixed base or
+    without gravity."""
+    if not chain.floating_base:
+        return Measured(np.nan, "1", unmeasurable="the base is fixed: no base acceleration stands for gravity")
+    if gravity_world is None or not np.any(gravity_world):
+        return Measured(np.nan, "1", unmeasurable="no gravity: nothing to be equivalent to")
+    residual = gravity + np.einsum("bij,j->bi", mass[:, :, :3], np.asarray(gravity_world, dtype=float))
+    return _over(residual, float(np.max(np.abs(gravity))), scale.floor, "the weight's generalized force", scale)
 
 
 def _definiteness(mass: np.ndarray) -> Measured:
@@ -194,15 +212,17 @@ def _definiteness(mass: np.ndarray) -> Measured:
     return Measured(float(np.min(np.linalg.eigvalsh(scaled)[:, 0])), "1")
 
 
-def _skew_residual(model: JointDynamicsModel, q: np.ndarray, qd: np.ndarray, coriolis: np.ndarray,
+def _skew_residual(model: JointDynamicsModel, chain: Chain, q: np.ndarray, qd: np.ndarray, coriolis: np.ndarray,
                    mass: np.ndarray) -> Measured:
-    """|qdot^T Mdot qdot - 2 qdot^T C qdot| over max |M| |qdot|^3, Mdot by central differences along qdot at
-    :data:`DIFFERENCE_STEP` and half of it, extrapolated (Richardson)."""
+    """|qdot^T Mdot qdot - 2 qdot^T C qdot| over max |M| |qdot|^3, Mdot by central differences along the motion at
+    qdot (:func:`comparisons.measure.configuration_flow.moved`) at :data:`DIFFERENCE_STEP` and half of it,
+    extrapolated (Richardson)."""
     speed = np.max(np.abs(qd), axis=-1, keepdims=True)
     direction = np.divide(qd, speed, out=np.zeros_like(qd), where=speed > 0)
 
     def central(step: float) -> np.ndarray:
-        return (model.mass_matrix(q + step * direction) - model.mass_matrix(q - step * direction)) / (2 * step)
+        return (model.mass_matrix(moved(chain, q, direction, step))
+                - model.mass_matrix(moved(chain, q, direction, -step))) / (2 * step)
 
     mass_dot = (4 * central(DIFFERENCE_STEP / 2) - central(DIFFERENCE_STEP)) / 3 * speed[..., None]
     power = np.einsum("bi,bij,bj->b", qd, mass_dot, qd) - 2 * np.einsum("bi,bi->b", qd, coriolis)
@@ -227,7 +247,8 @@ def timed_values(model: JointDynamicsModel, states: tuple[np.ndarray, ...], time
 
 
 def shape_problem(own: dict[str, np.ndarray], count: int, n: int) -> str:
-    """Why an engine's outputs are not usable ("" when they are): a wrong shape or a non-finite value."""
+    """Why an engine's outputs are not usable ("" when they are): a wrong shape (``n``: the velocity's length,
+    :attr:`Chain.nv`) or a non-finite value."""
     expected = {"M": (count, n, n), "h": (count, n), "tau": (count, n), "qdd": (count, n)}
     for key, shape in expected.items():
         if own[key].shape != shape:

@@ -73,16 +73,16 @@ def force_scale(model: JointDynamicsModel, build: Callable[[np.ndarray], JointDy
                 gravity_world: np.ndarray | None, states: tuple[np.ndarray, ...],
                 values: dict[str, np.ndarray]) -> ForceScale:
     """The :class:`ForceScale` of ``model`` (built under ``gravity_world``, (3,) [m/s^2] or None) at ``states``
-    (q, qdot, qddot, tau), each (B, n), from its ``values`` there ({"M": (B, n, n), "h", "tau": (B, n)});
+    (q, qdot, qddot, tau), (B, nq) and (B, nv), from its ``values`` there ({"M": (B, n, n), "h", "tau": (B, n)});
     ``build(g)`` builds the same engine's model of the same chain under gravity ``g`` (3,), for the weight."""
     q, qd, qdd, _ = states
-    zeros = np.zeros_like(q)
+    zeros = np.zeros_like(qd)
     mass, bias = values["M"], values["h"]
     inertia = np.einsum("bij,bj->bi", np.abs(mass), np.abs(qdd))
     damping = np.abs(values["tau"] - np.einsum("bij,bj->bi", mass, qdd) - bias)
     velocity = np.abs(bias - model.bias_forces(q, zeros))
     magnitude = 0.0 if gravity_world is None else float(np.linalg.norm(gravity_world))
-    weight = np.zeros_like(q)
+    weight = np.zeros_like(qd)
     if magnitude > 0:
         per_unit = np.stack([np.asarray(build(axis).bias_forces(q, zeros), dtype=float) for axis in np.eye(3)])
         weight = magnitude * np.linalg.norm(per_unit, axis=0)

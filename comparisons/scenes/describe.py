@@ -13,7 +13,7 @@ from simparity.comparisons.scenes.sweep import value_text
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.scenes.ik import IKScene
-from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.joint_dynamics import BASE_POSITION_RANGE, JointDynamicsScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.core.model.scenes.time_functions import HeldFunction, TimeFunction
@@ -92,10 +92,19 @@ def _scales(values) -> str:
 
 def _joint_dynamics_lines(scene: JointDynamicsScene) -> list[str]:
     gravity = "none" if scene.gravity_world is None else f"{_vector(scene.gravity_world)} m/s^2"
-    lines = [f"gravity_world {gravity} (in the base frame); {scene.n_states} states (seed {scene.seed}): q within the "
-             f"limits, |qdot| <= {_scales(scene.velocity_scale)}, |qddot| <= {_scales(scene.acceleration_scale)}, "
-             f"|tau| <= {_scales(scene.torque_scale)} per joint"]
-    return lines + _link_lines(scene.chain)
+    chain = scene.chain
+    frame = "world" if chain.floating_base else "base"
+    lines = [f"gravity_world {gravity} (in the {frame} frame); {scene.n_states} states (seed {scene.seed}): q within "
+             f"the limits, |qdot| <= {_scales(scene.velocity_scale)}, |qddot| <= {_scales(scene.acceleration_scale)}, "
+             f"|tau| <= {_scales(scene.torque_scale)} per component"]
+    base = chain.base_inertia
+    if chain.floating_base and base is not None:
+        lines.append(f"floating base {chain.base_link}: origin uniform in [-{BASE_POSITION_RANGE:g}, "
+                     f"{BASE_POSITION_RANGE:g}]^3 m, orientation uniform; its velocity (linear, angular), acceleration "
+                     f"and wrench (force, torque about its origin) in world axes first in qdot, qddot and tau; mass "
+                     f"{base.mass:.10g} kg, centre of mass {_vector(base.com_xyz)} m, inertia diagonal "
+                     f"{_vector(np.diag(base.inertia_com))} kg m^2 (everything welded to it and the held branches)")
+    return lines + _link_lines(chain)
 
 
 def _joint_motion_lines(scene: JointMotionScene) -> list[str]:

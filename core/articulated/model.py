@@ -5,9 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 from simparity.core.articulated.chain_arrays import chain_arrays
+from simparity.core.articulated.floating import FloatingRecursiveDynamics
+from simparity.core.articulated.groups import chain_rigid_groups
 from simparity.core.articulated.jacobian_sum import JacobianSum
 from simparity.core.articulated.recursive import Recursive
-from simparity.core.kinematics import forward_kinematics
 from simparity.core.model.engine import JointDynamicsModel
 from simparity.core.model.rigid_groups import RigidGroups
 from simparity.core.model.scenes.chain import Chain
@@ -32,22 +33,13 @@ def _rows(values: np.ndarray, n: int) -> np.ndarray:
     return np.ascontiguousarray(_batch(values, n).T)
 
 
-def chain_rigid_groups(chain: Chain, q: np.ndarray) -> RigidGroups:
-    """Core's reading of the chain, joint by joint (:class:`RigidGroups`): each link's mass properties as core's URDF
-    parser merged them (the links welded to a chain link folded into it), placed by core's forward kinematics."""
-    q = _batch(q, chain.n_joints)
-    poses = forward_kinematics(chain, q)
-    n = chain.n_joints
-    position, rotation = poses.position_world[:, :n], poses.rotation_world[:, :n]  # (B, n, 3), (B, n, 3, 3)
-    links = [joint.link for joint in chain.joints]
-    mass = np.array([0.0 if link is None else link.mass for link in links])
-    com = np.array([np.zeros(3) if link is None else link.com_xyz for link in links])
-    inertia = np.array([np.zeros((3, 3)) if link is None else link.inertia_com for link in links])
-    axes = np.array([joint.axis for joint in chain.joints])
-    return RigidGroups(mass=np.broadcast_to(mass, q.shape),
-                       com_world=position + np.einsum("bnij,nj->bni", rotation, com),
-                       inertia_world=rotation @ inertia @ np.swapaxes(rotation, -1, -2),
-                       axis_world=np.einsum("bnij,nj->bni", rotation, axes), origin_world=position)
+def floating_problem(chain: Chain, method: str) -> str:
+    """Why core's ``method`` cannot do ``chain``'s dynamics ("" when it can): the lecture's sum over link Jacobians is
+    written for a fixed base."""
+    if chain.floating_base and method != RECURSIVE:
+        return (f"core's {method} is the lecture's sum over link Jacobians of a fixed-base chain; a floating base is "
+                f"core's {RECURSIVE} (ABA and RNEA with a 6-DOF root)")
+    return ""
 
 
 class RecursiveDynamics(JointDynamicsModel):
@@ -116,7 +108,12 @@ class JacobianSumDynamics(JointDynamicsModel):
 
 
 def build(chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
-    """Core's joint-space dynamics of ``chain`` by ``method`` (one of :data:`METHODS`)."""
+    """Core's joint-space dynamics of ``chain`` by ``method`` (one of :data:`METHODS`; a floating base by
+    :data:`RECURSIVE` only: :func:`floating_problem`)."""
+    if chain.floating_base and method == RECURSIVE:
+        return FloatingRecursiveDynamics(chain, gravity_world)
+    if problem := floating_problem(chain, method):
+        raise ValueError(problem)
     if method == RECURSIVE:
         return RecursiveDynamics(chain, gravity_world)
     if method == JACOBIAN_SUM:

@@ -119,6 +119,40 @@ def _span(bodies: list[int]) -> slice | list[int]:
     return slice(first, first + len(bodies)) if bodies == list(range(first, first + len(bodies))) else bodies
 
 
+def unpack_symmetric(packed: np.ndarray) -> np.ndarray:
+    """(21, B) packed symmetric 6 x 6 matrices -> (B, 6, 6)."""
+    return np.ascontiguousarray(packed[PACKED].transpose(2, 0, 1))
+
+
+class FloatingBase:
+    """The base body of ABA's floating-base pass: its velocity, its own inertia and the wrench applied to it, and
+    what its children carry into it (Featherstone, section 9.3: I^A_0 = I_0 + sum X^T I^a_i X, p^A_0 = v_0 x* I_0
+    v_0 - f_0 + sum X^T p^a_i; then a_0 = -(I^A_0)^-1 p^A_0).
+
+    Parameters
+    ----------
+    velocity : (6, B) ndarray
+        v_0 in base coordinates.
+    inertia_packed : (21,) ndarray
+        I_0, the base body's spatial inertia about its origin in base coordinates, packed.
+    inertia : (6, 6) ndarray
+        The same, unpacked.
+    applied : (6, B) ndarray
+        f_0, the wrench applied to the base (torque about its origin, force), in base coordinates.
+    """
+
+    def __init__(self, velocity: np.ndarray, inertia_packed: np.ndarray, inertia: np.ndarray,
+                 applied: np.ndarray) -> None:
+        self.velocity = velocity
+        self.articulated = np.repeat(np.asarray(inertia_packed, dtype=float)[:, None], velocity.shape[1], axis=1)
+        self.bias = cross_force(velocity, inertia @ velocity) - applied
+
+    def solve(self) -> np.ndarray:
+        """a_0 (6, B) in base coordinates, gravity's -g included (the fictitious base acceleration): contiguous."""
+        return np.ascontiguousarray(-np.linalg.solve(unpack_symmetric(self.articulated),
+                                                     self.bias.T[:, :, None])[:, :, 0].T)
+
+
 class Recursive:
     """RNEA, CRBA and ABA of one kinematic tree (a chain today) under one gravity.
 
@@ -174,11 +208,16 @@ class Recursive:
             packed = slide_inertia(packed, q[i])
         return self.arrays.tree_congruence[i] @ packed
 
-    def _velocities(self, q: np.ndarray, qdot: np.ndarray, cos: np.ndarray, sin: np.ndarray) -> list[np.ndarray]:
-        """Each body's spatial velocity v_i (6, B) in body coordinates: v_i = X_i v_lambda(i) + S_i qdot_i."""
+    def _velocities(self, q: np.ndarray, qdot: np.ndarray, cos: np.ndarray, sin: np.ndarray,
+                    base_velocity: np.ndarray | None = None) -> list[np.ndarray]:
+        """Each body's spatial velocity v_i (6, B) in body coordinates: v_i = X_i v_lambda(i) + S_i qdot_i, the base's
+        ``base_velocity`` (6, B) in base coordinates (None: the base does not move)."""
         out: list[np.ndarray] = []
         for i, (k, parent) in enumerate(zip(self.arrays.subspace, self.parents)):
-            if parent < 0:  # the base does not move
+            if parent < 0 and base_velocity is not None:
+                v = self._to_child(i, base_velocity, cos, sin, q)
+                v[k] += qdot[i]
+            elif parent < 0:  # the base does not move
                 v = np.zeros((6, q.shape[1]))
                 v[k] = qdot[i]
             else:
@@ -233,12 +272,19 @@ class Recursive:
 
     def inverse_dynamics(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray, damped: bool) -> np.ndarray:
         """RNEA: tau (n, B) = M qddot + h (+ D qdot when ``damped``), armature included in M."""
+        return self.rnea(q, qdot, qddot, damped, self._base(q.shape[1]))[0]
+
+    def rnea(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray, damped: bool, base: np.ndarray,
+             base_velocity: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """RNEA with the base at acceleration ``base`` (6, B) (gravity's -g included) and velocity ``base_velocity``
+        (6, B) (None: at rest), both in base coordinates: (tau (n, B), the force (6, B) the root bodies exert on the
+        base, in base coordinates: sum over roots of X_i^T f_i)."""
         arrays = self.arrays
         cos, sin = self._trig(q)
-        velocities = self._velocities(q, qdot, cos, sin)
+        velocities = self._velocities(q, qdot, cos, sin, base_velocity)
         forces: list[np.ndarray] = []
         accelerations: list[np.ndarray | None] = []
-        base = self._base(q.shape[1])
+        on_base = np.zeros((6, q.shape[1]))
         for i, (k, v) in enumerate(zip(arrays.subspace, velocities)):
             acceleration = self._from_parent(i, accelerations, base, cos, sin, q)
             acceleration[k] += qddot[i]
@@ -255,11 +301,21 @@ class Recursive:
             parent = self.parents[i]
             if parent >= 0:
                 forces[parent] += self._to_parent(i, forces[i], cos, sin, q)
-        return tau
+            elif base_velocity is not None:
+                on_base += self._to_parent(i, forces[i], cos, sin, q)
+        return tau, on_base
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         """CRBA: M (n, n, B), armature included. Entries of two bodies on different branches are 0."""
+        return self.crba(q, False)[0]
+
+    def crba(self, q: np.ndarray, floating: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """CRBA: (M (n, n, B) of the joints, armature included; for a ``floating`` base also the composite inertia
+        of every body on it (21, B) packed and the columns X^T I^c_j S_j of every joint j (6, n, B), both in base
+        coordinates: the base's rows of the floating-base M; empty arrays otherwise)."""
         arrays, n, batch = self.arrays, self.arrays.n, q.shape[1]
+        on_base = np.zeros((21, batch)) if floating else np.empty(0)
+        base_columns = np.zeros((6, n, batch)) if floating else np.empty(0)
         cos, sin = self._trig(q)
         out = np.empty((n, n, batch)) if self._is_chain else np.zeros((n, n, batch))  # a chain fills every entry
         carried: list[np.ndarray | None] = [None] * n  # the children's composite inertias, in body i's coordinates
@@ -283,13 +339,22 @@ class Recursive:
                 self._add_to(carried, parent, self._inertia_to_parent(i, composite, cos, sin, q))
                 beyond[parent].append(self._to_parent(i, columns, cos, sin, q))
                 beyond_bodies[parent] += subtree
-        return out
+            elif floating:
+                on_base += self._inertia_to_parent(i, composite, cos, sin, q)
+                base_columns[:, subtree] = self._to_parent(i, columns, cos, sin, q)
+        return out, on_base, base_columns
 
     def forward_dynamics(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """ABA: qddot (n, B) = M^-1 (tau - h - D qdot)."""
+        return self.aba(q, qdot, tau)[0]
+
+    def aba(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray, floating: FloatingBase | None = None
+            ) -> tuple[np.ndarray, np.ndarray]:
+        """ABA: (qddot (n, B), the base's acceleration (6, B) in base coordinates, gravity's -g included: the fixed
+        base's, or for a ``floating`` base its solution (Featherstone, section 9.3))."""
         arrays, n, batch = self.arrays, self.arrays.n, q.shape[1]
         cos, sin = self._trig(q)
-        velocities = self._velocities(q, qdot, cos, sin)
+        velocities = self._velocities(q, qdot, cos, sin, None if floating is None else floating.velocity)
         biases = [self._bias_acceleration(i, v, qdot) for i, v in enumerate(velocities)]
         bias_forces = [cross_force(v, arrays.inertia[i] @ v) for i, v in enumerate(velocities)]  # p^A_i
         u = tau - arrays.damping[:, None] * qdot
@@ -311,7 +376,7 @@ class Recursive:
             u[i] -= bias_forces[i][k]
             U[i] = U_i
             parent = self.parents[i]
-            if parent < 0:
+            if parent < 0 and floating is None:
                 continue
             scaled = U_i * inverse_D[i]
             force = bias_forces[i]
@@ -331,11 +396,16 @@ class Recursive:
                     for m, value in biases[i]:
                         np.multiply(reduced[PACKED[r, m]], value, out=scratch)
                         force[r] += scratch
+            if parent < 0:
+                assert floating is not None
+                floating.articulated += self._inertia_to_parent(i, reduced, cos, sin, q)
+                floating.bias += self._to_parent(i, force, cos, sin, q)
+                continue
             self._add_to(carried, parent, self._inertia_to_parent(i, reduced, cos, sin, q))
             bias_forces[parent] += self._to_parent(i, force, cos, sin, q)
         qddot = np.empty_like(q)
         accelerations: list[np.ndarray | None] = []
-        base = self._base(batch)
+        base = self._base(batch) if floating is None else floating.solve()
         for i, k in enumerate(arrays.subspace):
             acceleration = self._from_parent(i, accelerations, base, cos, sin, q)  # a'_i before S_i qddot_i
             for row, value in biases[i]:
@@ -349,15 +419,16 @@ class Recursive:
             np.multiply(u[i] - dot, inverse_D[i], out=qddot[i])
             acceleration[k] += qddot[i]
             accelerations.append(acceleration)
-        return qddot
+        return qddot, base
 
-    def kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+    def kinetic_energy(self, q: np.ndarray, qdot: np.ndarray, base_velocity: np.ndarray | None = None) -> np.ndarray:
         """(B,) [J]: sum over bodies of 1/2 m |v_c|^2 + 1/2 omega^T I_c omega from the forward pass's body
-        velocities (v_c = v_o + omega x c in body coordinates)."""
+        velocities (v_c = v_o + omega x c in body coordinates); the base moving at ``base_velocity`` (6, B) (None: at
+        rest; its own energy is not included)."""
         arrays = self.arrays
         cos, sin = self._trig(q)
         energy = np.zeros(q.shape[1])
-        for i, v in enumerate(self._velocities(q, qdot, cos, sin)):
+        for i, v in enumerate(self._velocities(q, qdot, cos, sin, base_velocity)):
             w, c = v[:3], arrays.com_body[i]
             v_com = v[3:] + np.stack([w[1] * c[2] - w[2] * c[1], w[2] * c[0] - w[0] * c[2],
                                       w[0] * c[1] - w[1] * c[0]])

@@ -251,10 +251,13 @@ class KinematicsModel(abc.ABC):
 
 
 class JointDynamicsModel(abc.ABC):
-    """A chain's joint-space dynamics built for one engine and method: the base fixed, its frame the world's.
+    """A chain's joint-space dynamics built for one engine and method: the base fixed, its frame the world's, or
+    floating free (:attr:`Chain.floating_base`).
 
     Every function is batched over states: q, qdot, qddot, tau are (B, n) [rad or m, per second, per second
-    squared; N m or N]. The equation of motion is M(q) qddot + h(q, qdot) + D qdot = tau, with D the joints'
+    squared; N m or N]; with a floating base q is (B, 7 + n) and the others (B, 6 + n), the base's pose and velocity
+    first in the project's convention (:class:`core.model.scenes.chain.Chain`: world axes, the base origin's linear
+    velocity, quat_wxyz). The equation of motion is M(q) qddot + h(q, qdot) + D qdot = tau, with D the joints'
     viscous damping (diagonal) and M including each joint's armature.
 
     Attributes
@@ -290,7 +293,8 @@ class JointDynamicsModel(abc.ABC):
         aside)."""
 
     def rigid_groups(self, q: np.ndarray) -> RigidGroups:
-        """What the engine compiled, joint by joint, at configurations q (B, n): each chain joint's rigid group (its
+        """What the engine compiled, joint by joint, at joint values q (B, n) (a floating base at the world's origin,
+        unturned): each chain joint's rigid group (its
         child link and the links welded to it) as mass, centre of mass and inertia about it, with the joint's axis
         and origin, all in the base frame (:class:`core.model.rigid_groups.RigidGroups`). Optional: an engine that
         does not report its compiled model raises NotImplementedError, and its model-parity rows are n/a."""

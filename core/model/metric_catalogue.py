@@ -108,6 +108,7 @@ MASS_MATRIX_ASYMMETRY = "mass_matrix_asymmetry"
 MASS_MATRIX_DEFINITENESS_MIN = "mass_matrix_definiteness_min"
 KINETIC_ENERGY_RESIDUAL = "kinetic_energy_residual"
 CORIOLIS_SKEW_RESIDUAL = "coriolis_skew_residual"
+GRAVITY_EQUIVALENCE_RESIDUAL = "gravity_equivalence_residual"
 TIME_PER_MASS_MATRIX = "time_per_mass_matrix"
 TIME_PER_INVERSE_DYNAMICS = "time_per_inverse_dynamics"
 TIME_PER_FORWARD_DYNAMICS = "time_per_forward_dynamics"
@@ -207,6 +208,9 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
            theory="1/2 qdot^T M qdot = the links' kinetic energy: 0 up to rounding"),
     Metric(CORIOLIS_SKEW_RESIDUAL, DIMENSIONLESS, VALIDITY,
            theory="qdot^T (Mdot - 2 C) qdot = 0: 0 up to finite differences"),
+    Metric(GRAVITY_EQUIVALENCE_RESIDUAL, DIMENSIONLESS, VALIDITY,
+           theory="a floating base: h(q, 0) = -M(q)[:, base linear] g, gravity a uniform acceleration of the base: 0 up "
+                  "to rounding"),
     Metric(TIME_PER_MASS_MATRIX, "s", TIMING),
     Metric(TIME_PER_INVERSE_DYNAMICS, "s", TIMING),
     Metric(TIME_PER_FORWARD_DYNAMICS, "s", TIMING),

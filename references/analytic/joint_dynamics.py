@@ -113,6 +113,8 @@ def _reduce(chain: Chain) -> tuple[_Reduction | None, str]:
     problem = chain.dynamics_problem()
     if problem:
         return None, problem
+    if chain.floating_base:
+        return None, "no closed form: the base floats (the closed form is for a planar chain on a fixed base)"
     if chain.n_joints not in (1, 2):
         return None, f"no closed form: the chain has {chain.n_joints} joints (the closed form is for 1 or 2)"
     origins: list[np.ndarray] = []

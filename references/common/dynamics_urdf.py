@@ -16,8 +16,9 @@ only these changes, each made with :mod:`xml.etree.ElementTree` on the parsed fi
   hang from in every engine alike.
 - A link without ``<inertial>`` is massless (the URDF specification) and gets an explicit zero one: PyBullet
   would otherwise give it 1 kg and a unit inertia.
-- The base link and every link welded to it by fixed joints never move: their ``<inertial>`` is replaced by the
-  explicit zero (a placeholder tensor there, as ANYmal's base has, made MuJoCo refuse the whole model).
+- For a fixed base, the base link and every link welded to it by fixed joints never move: their ``<inertial>`` is
+  replaced by the explicit zero (a placeholder tensor there, as ANYmal's base has, made MuJoCo refuse the whole
+  model). A floating base moves: its links keep theirs.
 
 ``<inertial>`` elements of links that move are never touched (one of mass 0 with a non-zero inertia included: every
 engine keeps its rotational inertia). :class:`ModelChanges` names each change link by link (joint by joint) for the
@@ -137,7 +138,7 @@ def _changed(chain: Chain) -> tuple[ET.Element, ModelChanges]:
             for tag in HELD_JOINT_CHILDREN:
                 for element in joint.findall(tag):
                     joint.remove(element)
-    welded = _welded_to_base(root, cast(str, chain.base_link))
+    welded = set() if chain.floating_base else _welded_to_base(root, cast(str, chain.base_link))
     no_inertial, massless_with_inertia = [], []
     for link in root.findall("link"):
         name = cast(str, link.get("name"))

@@ -85,6 +85,7 @@ from simparity.references.mujoco.stage_loads import DETAIL as STAGE_DETAIL
 from simparity.references.mujoco.stage_loads import StepClock, stage_callback
 from simparity.references.common.quiet import captured_output
 from simparity.references.common.urdf_export import chain_export, chain_source, chain_urdf, urdf_support
+from simparity.references.mujoco.floating import MujocoFloatingDynamics
 from simparity.references.mujoco.joint_dynamics import MujocoJointDynamics, mujoco_dynamics_problem
 from simparity.references.common.scene_inputs import derives_own_inputs
 
@@ -437,7 +438,8 @@ class MujocoEngine(Engine):
         return _dynamics_support(chain) if named.ok else named
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
-        return MujocoJointDynamics(chain, gravity_world)
+        return (MujocoFloatingDynamics(chain, gravity_world) if chain.floating_base
+                else MujocoJointDynamics(chain, gravity_world))
 
     def joint_motion_integrators(self) -> tuple[str, ...]:
         """MuJoCo's integrators stepping the joint-dynamics model (:mod:`references.mujoco.joint_motion`), Euler

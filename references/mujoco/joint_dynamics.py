@@ -67,6 +67,8 @@ def _compiled(chain: Chain, gravity_world: np.ndarray | None) -> mujoco.MjModel:
         spec.compiler.discardvisual = True
         spec.option.gravity = np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float)
         spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+        if chain.floating_base:
+            spec.worldbody.first_body().add_freejoint()
         return spec.compile()
 
 
@@ -122,11 +124,15 @@ class MujocoJointDynamics(JointDynamicsModel):
     model, data : mujoco.MjModel, mujoco.MjData
     dof, qpos : (n,) int ndarray
         The chain joints' dof and qpos addresses.
+    state_dof, state_qpos : int ndarray
+        The addresses of a state's velocity and configuration rows: ``dof`` and ``qpos``, a floating base's free joint
+        first (:mod:`references.mujoco.floating`).
     """
 
     def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
         built = ChainModel(chain, gravity_world)
         self.model, self.dof, self.qpos = built.model, built.dof, built.qpos
+        self.state_dof, self.state_qpos = self.dof, self.qpos  # the state's addresses: a free joint's first if any
         self.data = mujoco.MjData(self.model)
         self.detail = (f"{built.detail}; mj_fullM, qfrc_bias, mj_inverse, mj_forward's qacc; kinetic energy from "
                        "mj_objectVelocity at each body's centre of mass")
@@ -134,43 +140,44 @@ class MujocoJointDynamics(JointDynamicsModel):
     def _set(self, q_row: np.ndarray, qdot_row: np.ndarray, tau_row: np.ndarray | None = None) -> None:
         """Put the state (and applied joint forces, zero if None) in, and run ``mj_forward``."""
         d = self.data
-        d.qpos[self.qpos], d.qvel[self.dof] = q_row, qdot_row
+        d.qpos[self.state_qpos], d.qvel[self.state_dof] = q_row, qdot_row
         d.qfrc_applied[:] = 0.0
         if tau_row is not None:
-            d.qfrc_applied[self.dof] = tau_row
+            d.qfrc_applied[self.state_dof] = tau_row
         mujoco.mj_forward(self.model, d)
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         full = np.empty((self.model.nv, self.model.nv))
-        out = np.empty((len(q), len(self.dof), len(self.dof)))
+        dofs = self.state_dof
+        out = np.empty((len(q), len(dofs), len(dofs)))
         for k, row in enumerate(q):
-            self._set(row, np.zeros_like(row))
+            self._set(row, np.zeros(len(dofs)))
             mujoco.mj_fullM(self.model, self.data, full)
-            out[k] = full[np.ix_(self.dof, self.dof)]
+            out[k] = full[np.ix_(dofs, dofs)]
         return out
 
     def bias_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        out = np.empty(np.shape(q))
+        out = np.empty(np.shape(qdot))
         for k, (row, velocity) in enumerate(zip(q, qdot)):
             self._set(row, velocity)
-            out[k] = self.data.qfrc_bias[self.dof]
+            out[k] = self.data.qfrc_bias[self.state_dof]
         return out
 
     def inverse_dynamics(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
-        out = np.empty(np.shape(q))
+        out = np.empty(np.shape(qdot))
         d = self.data
         for k, (row, velocity, acceleration) in enumerate(zip(q, qdot, qddot)):
-            d.qpos[self.qpos], d.qvel[self.dof], d.qacc[self.dof] = row, velocity, acceleration
+            d.qpos[self.state_qpos], d.qvel[self.state_dof], d.qacc[self.state_dof] = row, velocity, acceleration
             d.qfrc_applied[:] = 0.0
             mujoco.mj_inverse(self.model, d)
-            out[k] = d.qfrc_inverse[self.dof]
+            out[k] = d.qfrc_inverse[self.state_dof]
         return out
 
     def forward_dynamics(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        out = np.empty(np.shape(q))
+        out = np.empty(np.shape(qdot))
         for k, (row, velocity, force) in enumerate(zip(q, qdot, tau)):
             self._set(row, velocity, force)
-            out[k] = self.data.qacc[self.dof]
+            out[k] = self.data.qacc[self.state_dof]
         return out
 
     def link_kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:

@@ -68,6 +68,7 @@ from simparity.references.common.quiet import captured_output
 from simparity.references.pinocchio.joints import configuration
 from simparity.references.common.urdf_export import UrdfChains, chain_export, chain_source, chain_urdf, urdf_support
 from simparity.references.pinocchio import joint_motion
+from simparity.references.pinocchio.floating import PinocchioFloatingDynamics
 from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics
 from simparity.references.common.scene_inputs import derives_own_inputs
 
@@ -383,7 +384,8 @@ class PinocchioEngine(UrdfChains, Engine):
         return _dynamics_support(chain) if named.ok else named
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
-        return PinocchioJointDynamics(chain, gravity_world)
+        return (PinocchioFloatingDynamics(chain, gravity_world) if chain.floating_base
+                else PinocchioJointDynamics(chain, gravity_world))
 
     def joint_motion_integrators(self) -> tuple[str, ...]:
         """The harness's steppers of ``pin.aba`` and the DOP853 solves (:mod:`references.pinocchio.joint_motion`)."""

@@ -87,7 +87,8 @@ def chain_model(chain: Chain, gravity_world: np.ndarray | None) -> ChainModel:
     """``chain``'s dynamics model read by Pinocchio's URDF parser, ``gravity_world`` ((3,) [m/s^2] in the base
     frame, None for none) as ``model.gravity`` and the chain's armature as ``model.armature``."""
     with captured_output():
-        model = pin.buildModelFromXML(dynamics_urdf(chain))
+        model = (pin.buildModelFromXML(dynamics_urdf(chain), pin.JointModelFreeFlyer()) if chain.floating_base
+                 else pin.buildModelFromXML(dynamics_urdf(chain)))
     model.gravity = pin.Motion(np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float),
                                np.zeros(3))
     joint_ids = [model.getJointId(j.name) for j in chain.joints]
@@ -97,7 +98,9 @@ def chain_model(chain: Chain, gravity_world: np.ndarray | None) -> ChainModel:
     armature[idx_v] = [j.armature for j in chain.joints]
     model.armature = armature
     gravity = "none" if gravity_world is None else fmt(gravity_world)
-    source = f"pinocchio.buildModelFromXML of {dynamics_source(chain)}; gravity {gravity}; armature as model.armature"
+    root = "; the base a JointModelFreeFlyer" if chain.floating_base else ""
+    source = (f"pinocchio.buildModelFromXML of {dynamics_source(chain)}{root}; gravity {gravity}; armature as "
+              "model.armature")
     return ChainModel(model, joint_ids, [j.idx_q for j in joints], [j.nq == 2 for j in joints], idx_v,
                       np.array([j.damping for j in chain.joints]), source)
 

@@ -516,6 +516,17 @@ def _armature_support(chain: Chain) -> Support:
     return Support.yes()
 
 
+FLOATING_BASE_WHY = (
+    "PyBullet's floating-base dynamics are not comparable at rounding: calculateInverseDynamics of a floating base "
+    "(7 + n positions, 6 + n velocities, flags=0) agrees with the other engines with the base unturned and not once it "
+    "is turned (Solo-12's leg at rest at a random pose: joint forces (-0.140, -0.128, -0.023) N m against Pinocchio's "
+    "(-0.123, 0.050, 0.023): docs/examples/pybullet_floating_base.py), "
+    "with flags=1 it corrupted the process's heap (malloc(): invalid size; NaNs in bullet3 issues 3149 and 4045), "
+    "and its forward dynamics is a step of its simulator, which turns the base during the step "
+    "(docs/floating-bases.md, PyBullet 3.2.7)")
+"""Why PyBullet's rows are n/a on a floating-base chain (pinned by tests/references/test_floating_base_conventions.py)."""
+
+
 @derives_own_inputs
 class PybulletEngine(UrdfChains, Engine):
     """PyBullet (Bullet multibody), built from URDF the adapter writes or a chain's URDF file."""
@@ -578,6 +589,8 @@ class PybulletEngine(UrdfChains, Engine):
         problem = chain.dynamics_problem() if named.ok else ""
         if problem:
             return Support.no(problem)
+        if named.ok and chain.floating_base:
+            return Support.no(FLOATING_BASE_WHY)
         return _dynamics_support(chain) if named.ok else named
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:

@@ -400,10 +400,27 @@ def _rpy_in_the_wrong_order(rpy):
     return rx @ ry @ rz
 
 
-def test_a_bug_in_core_s_urdf_parser_moves_core_s_model_rows_only(monkeypatch):
-    """Issue #43: every engine reads the robot file with its own importer. An rpy order planted in core's parser
-    moves core's compiled model (its groups' origins, axes and inertias in the base frame) and leaves every other
-    engine's bit for bit: the model-parity rows name core."""
+def _axis_in_the_parent_frame(assemble):
+    """A planted bug in core's URDF parser: each joint's <axis> read in the parent link's frame instead of the joint
+    frame (the axis turned back by the joint origin's rotation)."""
+    def planted(*args, **kwargs):
+        chain = assemble(*args, **kwargs)
+        joints = tuple(dataclasses.replace(j, axis=np.asarray(j.origin_rotation).T @ j.axis) for j in chain.joints)
+        return dataclasses.replace(chain, joints=joints)
+
+    return planted
+
+
+PARSER_BUGS = {"rpy_order": ("rpy_to_matrix", lambda _: _rpy_in_the_wrong_order),
+               "axis_frame": ("_assemble", _axis_in_the_parent_frame)}
+"""Issue #43's planted bugs in core's URDF parser: (what is replaced in core.urdf, the replacement of the original)."""
+
+
+@pytest.mark.parametrize("bug", sorted(PARSER_BUGS))
+def test_a_bug_in_core_s_urdf_parser_moves_core_s_model_rows_only(monkeypatch, bug):
+    """Issue #43: every engine reads the robot file with its own importer. An rpy order or an axis frame planted in
+    core's parser moves core's compiled model (its groups' origins, axes and inertias in the base frame) and leaves
+    every other engine's bit for bit: the model-parity rows name core."""
     q = np.random.default_rng(43).uniform(-1.0, 1.0, size=(3, 5))
 
     def groups(engine: str) -> dict:
@@ -414,7 +431,8 @@ def test_a_bug_in_core_s_urdf_parser_moves_core_s_model_rows_only(monkeypatch):
         return {f: np.array(getattr(reported, f)) for f in ("origin_world", "axis_world", "inertia_world")}
 
     right = {e: groups(e) for e in ("core", "mujoco", "pinocchio", "pybullet")}
-    monkeypatch.setattr(core_urdf, "rpy_to_matrix", _rpy_in_the_wrong_order)
+    name, replacement = PARSER_BUGS[bug]
+    monkeypatch.setattr(core_urdf, name, replacement(getattr(core_urdf, name)))
     wrong = {e: groups(e) for e in ("core", "mujoco", "pinocchio", "pybullet")}
     for engine in ("mujoco", "pinocchio", "pybullet"):
         assert all(np.array_equal(right[engine][f], wrong[engine][f]) for f in right[engine])

@@ -22,7 +22,10 @@ from simparity.core.urdf import chain_from_urdf
 
 JOINT_TYPES = ("revolute", "prismatic")
 _CHAIN = ("name", "joint", "end_effector", "end_effector_xyz", "end_effector_rpy", "urdf", "base_link", "tip_link",
-          "dh")
+          "dh", "floating_base")
+FLOATING_SCENES = "a joint_dynamics scene's URDF chain"
+"""What may have a floating base: its state is compared instant by instant, and its base link's mass properties come
+from the file."""
 _DH = ("convention", "a", "alpha", "d", "theta_offset", "lower", "upper")
 PYBULLET_DATA_PREFIX = "pybullet_data:"
 """A ``urdf`` path starting with this is inside the installed pybullet_data package."""
@@ -126,13 +129,13 @@ def _urdf_path(c: TableReader) -> Path:
     return path
 
 
-def _urdf_chain(c: TableReader, dynamics: bool) -> Chain:
+def _urdf_chain(c: TableReader, dynamics: bool, floating: bool) -> Chain:
     """The chain of a ``urdf`` scene; an error in the URDF names the scene file, and the URDF as the scene does."""
     base, tip = (c.name(key) if c.has(key) else None for key in ("base_link", "tip_link"))
     path = _urdf_path(c)
     try:
         return chain_from_urdf(str(path), base_link=base, tip_link=tip, max_joints=c.limits.max_joints,
-                               max_bytes=c.limits.max_file_bytes, dynamics=dynamics)
+                               max_bytes=c.limits.max_file_bytes, dynamics=dynamics, floating_base=floating)
     except SceneError as err:
         raise c.fail("urdf", f"{one_line(c.table['urdf'], 120)}: {err.key}: {err.problem}", err.allowed) from None
 
@@ -159,15 +162,22 @@ def _dh_chain(c: TableReader, name: str) -> Chain:
     return replace(chain_from_dh(name, convention=convention, limits=limits, **values), dh=table)
 
 
-def read_chain(top: TableReader, name: str, dynamics: bool = False) -> Chain:
-    """The scene's ``[chain]``; for ``dynamics``, a URDF's inertia tensors must be physical."""
+def read_chain(top: TableReader, name: str, dynamics: bool = False, floating_allowed: bool = False) -> Chain:
+    """The scene's ``[chain]``; for ``dynamics``, a URDF's inertia tensors must be physical; ``floating_base = true``
+    only where ``floating_allowed`` (:data:`FLOATING_SCENES`)."""
     c = top.subtable("chain", _CHAIN)
     sources = [key for key in ("joint", "urdf", "dh") if c.has(key)]
     if len(sources) != 1:
         raise c.fail("joint", f"give exactly one chain source, got {sources or 'none'}",
                      "one of [[chain.joint]], urdf, [chain.dh]")
+    floating = c.boolean("floating_base", False)
+    if floating and not (floating_allowed and sources == ["urdf"]):
+        where = (f"a {top.table.get('scene', {}).get('kind', 'this')} scene" if not floating_allowed
+                 else f"a chain given as {sources[0]}")
+        raise c.fail("floating_base", f"a floating base is not available for {where}",
+                     f"{FLOATING_SCENES} (false elsewhere)")
     if sources == ["urdf"]:
-        return _urdf_chain(c, dynamics)
+        return _urdf_chain(c, dynamics, floating)
     if sources == ["dh"]:
         return _dh_chain(c, c.name("name", name))
     joints: tuple[Joint, ...] = ()
@@ -186,10 +196,14 @@ def read_chain(top: TableReader, name: str, dynamics: bool = False) -> Chain:
     )
 
 
-def read_dynamics_chain(top: TableReader, head: dict) -> Chain:
-    """The ``[chain]`` of a joint-dynamics or joint-motion scene: every link with mass properties."""
-    chain = read_chain(top, head["name"], dynamics=True)
+def read_dynamics_chain(top: TableReader, head: dict, floating_allowed: bool = False) -> Chain:
+    """The ``[chain]`` of a joint-dynamics or joint-motion scene: every link with mass properties (a floating base's
+    too, where ``floating_allowed``)."""
+    chain = read_chain(top, head["name"], dynamics=True, floating_allowed=floating_allowed)
     problem = chain.dynamics_problem()
+    if problem and chain.floating_base and problem.startswith("the floating"):
+        raise top.fail("chain", problem, "a floating base link with a mass and a rotational inertia about every axis "
+                       "(its own <inertial>, or a body welded to it by a fixed joint)")
     if problem:
         raise top.fail("chain", problem, "a chain whose every link has mass properties: a URDF file with <inertial> "
                        "elements or [[chain.joint]] with mass, com_xyz and inertia ([chain.dh] declares none)")

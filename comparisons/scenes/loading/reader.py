@@ -55,6 +55,13 @@ class TableReader:
             raise self.fail(key, f"{echo(value)} is not allowed", allowed)
         return value
 
+    def boolean(self, key: str, default: bool) -> bool:
+        """A TOML boolean (``true`` / ``false``); ``default`` when the key is absent."""
+        value = self._get(key, default, "true or false")
+        if not isinstance(value, bool):
+            raise self.fail(key, f"expected true or false, got {echo(value)}", "true or false")
+        return value
+
     def text(self, key: str, default: str) -> str:
         """Free text for people (a description): one line of printable characters (:mod:`core.model.names`); ``default``
         when the key is absent."""

@@ -1,4 +1,4 @@
-"""A fixed-base serial chain, what every chain scene is built on: :class:`Chain` of :class:`Joint` with
+"""A serial chain (its base fixed or floating), what every chain scene is built on: :class:`Chain` of :class:`Joint` with
 :class:`LinkInertia`, the :class:`DHTable` a file may give it as, and :func:`sample_configurations`."""
 
 from __future__ import annotations
@@ -159,7 +159,7 @@ class Joint:
 
 @dataclass(frozen=True)
 class Chain:
-    """A fixed-base serial chain of joints ending in an end-effector frame.
+    """A serial chain of joints ending in an end-effector frame, its base fixed in the world or floating free.
 
     Attributes
     ----------
@@ -189,6 +189,18 @@ class Chain:
     dh : DHTable or None
         For a chain a scene file gave as a DH table: the table, from which every joint origin and the end
         effector were computed (by core); None otherwise.
+    floating_base : bool
+        False: the base link is fixed in the world, its frame the world frame. True: the base link floats
+        free (a 6-DOF root joint), and the state starts with its pose and velocity: configurations
+        (:attr:`nq` = 7 + n) are (base origin position in the world [m] (3), base orientation quat_wxyz (4),
+        joint values (n)); velocities, accelerations and generalized forces (:attr:`nv` = 6 + n) are
+        (base origin linear velocity in world axes [m/s] (3), base angular velocity in world axes [rad/s] (3),
+        joint rates (n)), their time derivatives, and (a force on the base in world axes [N] (3), a torque about
+        the base origin in world axes [N m] (3), joint forces (n)).
+    base_inertia : LinkInertia or None
+        For a floating base: the mass properties of the base link and everything rigidly attached to it (links
+        welded to it, branches off the chain held at 0), in the base link's frame. None for a fixed base (its
+        mass never matters) or when not declared (refused for dynamics).
     """
 
     name: str
@@ -201,6 +213,8 @@ class Chain:
     held_joints: tuple[str, ...] = ()
     end_effector_rpy: np.ndarray | None = None
     dh: DHTable | None = None
+    floating_base: bool = False
+    base_inertia: LinkInertia | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "end_effector_xyz", readonly(self.end_effector_xyz, shape=(3,)))
@@ -218,6 +232,21 @@ class Chain:
         return len(self.joints)
 
     @property
+    def base_dofs(self) -> int:
+        """The base's velocity components: 6 for a floating base, 0 for a fixed one."""
+        return 6 if self.floating_base else 0
+
+    @property
+    def nq(self) -> int:
+        """The configuration's length: n, or 7 + n with a floating base (:attr:`floating_base`)."""
+        return self.n_joints + (7 if self.floating_base else 0)
+
+    @property
+    def nv(self) -> int:
+        """The velocity's (acceleration's, generalized force's) length: n, or 6 + n with a floating base."""
+        return self.n_joints + self.base_dofs
+
+    @property
     def lower(self) -> np.ndarray:
         """(n,) lower joint limits, -inf when unlimited."""
         return np.array([j.lower for j in self.joints])
@@ -227,6 +256,17 @@ class Chain:
         """(n,) upper joint limits, inf when unlimited."""
         return np.array([j.upper for j in self.joints])
 
+    def joint_values(self, q: np.ndarray) -> np.ndarray:
+        """(B, n): the joints' part of configurations q (B, nq) (a floating base's pose dropped)."""
+        return np.asarray(q)[:, self.nq - self.n_joints:]
+
+    @property
+    def length_powers(self) -> np.ndarray:
+        """(nv,) int: the power of length in each velocity component's unit (m/s or rad/s): a floating base's linear
+        velocity 1 and angular 0 first, then 1 for a prismatic joint and 0 for a revolute one."""
+        base = [1, 1, 1, 0, 0, 0] if self.floating_base else []
+        return np.array(base + [1 if j.type == "prismatic" else 0 for j in self.joints], dtype=int)
+
     def frame_names(self) -> tuple[str, ...]:
         """Names of the frames FK returns: one per joint (its child link), then the end effector."""
         return tuple(j.name for j in self.joints) + (self.end_effector_name,)
@@ -235,10 +275,17 @@ class Chain:
         """Why the chain has no joint-space dynamics ("" when it has): a link without declared mass
         properties, or a joint that moves no mass (its link and everything beyond it massless: the mass
         matrix would be singular)."""
+        if self.floating_base and self.base_inertia is None:
+            return ("the floating base link declares no mass properties: a floating base needs the base link's "
+                    "(a URDF file's <inertial>)")
         missing = [j.name for j in self.joints if j.link is None]
         if missing:
             return (f"joint {missing[0]!r}'s link declares no mass properties (mass, com_xyz, inertia): "
                     "dynamics needs every link's; a URDF file's <inertial> or [[chain.joint]] mass keys give them")
+        if self.floating_base and self.base_inertia is not None and (problem := _free_body_problem(self.base_inertia)):
+            return (f"the floating base {self.base_link or 'link'!r} (with everything welded to it) {problem}: a free "
+                    "body needs a mass and a rotational inertia about every axis, else its motion is undefined (M is "
+                    "singular)")
         carried = 0.0
         for joint in reversed(self.joints):
             link = joint.link
@@ -248,6 +295,23 @@ class Chain:
                 return f"joint {joint.name!r} moves no mass (its link and all beyond it are massless)"
         return ""
 
+
+
+FREE_BODY_ROUNDING = 64 * float(np.finfo(float).eps)
+"""A principal moment at most this fraction of the inertia's trace is rounding of zero (the tensor's own entries are
+summed and turned with ~10 roundings of the trace each)."""
+
+
+def _free_body_problem(link: LinkInertia) -> str:
+    """Why a floating base's rigid group is no free body ("" when it is): no mass, or a principal moment of inertia
+    about its centre of mass that is zero up to rounding (a point mass, a thin rod)."""
+    if link.mass <= 0:
+        return "has no mass"
+    moments = np.linalg.eigvalsh(link.inertia_com)
+    if moments[0] <= FREE_BODY_ROUNDING * max(float(np.trace(link.inertia_com)), 0.0):
+        return (f"has no rotational inertia about some axis (principal moments "
+                f"{', '.join(f'{m:.3g}' for m in moments)} kg m^2)")
+    return ""
 
 
 def sample_configurations(chain: Chain, count: int, seed: int | np.random.Generator) -> np.ndarray:

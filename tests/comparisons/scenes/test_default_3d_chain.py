@@ -53,8 +53,9 @@ def _axes(chain: Chain) -> np.ndarray:
 
 
 def _three_dimensional(chain: Chain) -> bool:
-    """Two axes not parallel, an axis off z (the joint frames are turned), a link inertia with products of inertia
-    and a centre of mass off its joint's axis."""
+    """Two axes not parallel, an axis along none of x, y and z (the joint frames are turned obliquely: a quarter turn
+    onto x or y and its transpose can map an inertia alike), a link inertia with products of inertia and a centre of
+    mass off its joint's axis."""
     axes = _axes(chain)
     crossed = [np.linalg.norm(np.cross(a, b)) for i, a in enumerate(axes) for b in axes[i + 1:]]
     links = [j.link for j in chain.joints if j.link is not None]
@@ -63,7 +64,8 @@ def _three_dimensional(chain: Chain) -> bool:
     off_axis = [np.linalg.norm(np.cross(j.link.com_xyz, np.asarray(j.axis) / np.linalg.norm(j.axis)))
                 for j in chain.joints if j.link is not None]
     return (max(crossed, default=0.0) > PARALLEL_TOLERANCE
-            and any(abs(a[2]) < 1 - PARALLEL_TOLERANCE for a in (np.asarray(j.axis) for j in chain.joints))
+            and any(np.max(np.abs(a)) < 1 - PARALLEL_TOLERANCE
+                    for a in (np.asarray(j.axis) / np.linalg.norm(j.axis) for j in chain.joints))
             and max(products, default=0.0) > PRODUCT_OF_INERTIA_FRACTION
             and max(off_axis, default=0.0) > PARALLEL_TOLERANCE)
 
@@ -98,15 +100,21 @@ def _mass_matrices(modules, chain: Chain, q: np.ndarray) -> np.ndarray:
 
 def test_a_link_inertia_in_the_wrong_frame_shows_on_the_3d_chains_only(wrong_frame_copy):
     """The mutant's mass matrix departs from the faithful copy's on every 3-D chain of the default suite, and not at
-    all on its planar ones: those alone could not catch it."""
+    all on its planar ones (every axis z): those alone could not catch it. (A chain between the two, axes off z with
+    diagonal inertias such as Solo-12's leg, may show it or not.)"""
     rng = np.random.default_rng(SEED)
     seen = {}
     for scene in _joint_scenes():
         q = rng.uniform(-1.0, 1.0, size=(scene.chain.n_joints, STATES))
         faithful = _mass_matrices(wrong_frame_copy[True], scene.chain, q)
         mutant = _mass_matrices(wrong_frame_copy[False], scene.chain, q)
-        seen[scene.name] = (_three_dimensional(scene.chain),
+        planar = bool(np.all(np.abs(_axes(scene.chain)[:, 2]) > 1 - PARALLEL_TOLERANCE))
+        seen[scene.name] = (_three_dimensional(scene.chain), planar,
                             float(np.max(np.abs(mutant - faithful)) / np.max(np.abs(faithful))))
-    assert {three_d for three_d, _ in seen.values()} == {True, False}, seen  # both kinds of chain are there
-    for name, (three_d, change) in seen.items():
-        assert change > VISIBLE if three_d else change == 0.0, (name, change)
+    assert {three_d for three_d, _, _ in seen.values()} == {True, False}, seen  # both kinds of chain are there
+    assert any(planar for _, planar, _ in seen.values()), seen
+    for name, (three_d, planar, change) in seen.items():
+        if three_d:
+            assert change > VISIBLE, (name, change)
+        if planar:
+            assert change == 0.0, (name, change)

@@ -1,0 +1,66 @@
+"""A floating-base chain's dynamics in MuJoCo: a free joint (``add_freejoint`` on the URDF's root body, through
+``MjSpec``) converted to the project's convention by :mod:`references.common.floating_base` (both pinned by
+``tests/references/test_floating_base_conventions.py``).
+
+Everything else is :mod:`references.mujoco.joint_dynamics`'s (compiler options, constraints off, damping, armature,
+gravity). MuJoCo's free joint: qpos (body origin position, quat_wxyz), qvel (linear velocity in WORLD axes, angular
+velocity in the BODY frame); qacc is the time derivative of qvel, so only the angular parts turn (by R^T in, by R
+out) and no velocity product enters. The kinetic energy sums every body, the base's included.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from simparity.core.model.rigid_groups import RigidGroups
+from simparity.core.model.scenes.chain import Chain
+from simparity.references.common.floating_base import BASE_Q, BASE_V, base_rotations, turned_base, turned_mass
+from simparity.references.mujoco.joint_dynamics import MujocoJointDynamics
+
+IDENTITY_POSE = np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+"""A free joint's qpos at the world's origin, unturned (quat_wxyz)."""
+
+
+class MujocoFloatingDynamics(MujocoJointDynamics):
+    """The module docstring's: q (B, 7 + n), qdot, qddot and tau (B, 6 + n) in the project's convention."""
+
+    def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
+        super().__init__(chain, gravity_world)
+        m = self.model
+        free = [j for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE]
+        if len(free) != 1:
+            raise ValueError(f"MuJoCo's model has {len(free)} free joints, expected the base's one")
+        self._free_qpos = int(m.jnt_qposadr[free[0]])
+        self.state_qpos = np.r_[self._free_qpos:self._free_qpos + BASE_Q, self.qpos]
+        self.state_dof = np.r_[int(m.jnt_dofadr[free[0]]):int(m.jnt_dofadr[free[0]]) + BASE_V, self.dof]
+        self.detail += ("; the base a free joint (MjSpec add_freejoint on the root body), its BODY-frame angular "
+                        "velocity turned to world axes")
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        return turned_mass(base_rotations(q), super().mass_matrix(q), False, True)
+
+    def bias_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        rotation = base_rotations(q)
+        own = super().bias_forces(q, turned_base(rotation, qdot, False, True, inverse=True))
+        return turned_base(rotation, own, False, True)
+
+    def inverse_dynamics(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
+        rotation = base_rotations(q)
+        own = super().inverse_dynamics(q, turned_base(rotation, qdot, False, True, inverse=True),
+                                       turned_base(rotation, qddot, False, True, inverse=True))
+        return turned_base(rotation, own, False, True)
+
+    def forward_dynamics(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        rotation = base_rotations(q)
+        own = super().forward_dynamics(q, turned_base(rotation, qdot, False, True, inverse=True),
+                                       turned_base(rotation, tau, False, True, inverse=True))
+        return turned_base(rotation, own, False, True)
+
+    def link_kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        return super().link_kinetic_energy(q, turned_base(base_rotations(q), qdot, False, True, inverse=True))
+
+    def rigid_groups(self, q: np.ndarray) -> RigidGroups:
+        """The joints' groups with the base at the world's origin, unturned (q: the joint values (B, n))."""
+        self.data.qpos[self._free_qpos:self._free_qpos + BASE_Q] = IDENTITY_POSE
+        return super().rigid_groups(q)

@@ -1,0 +1,95 @@
+"""A floating-base chain's dynamics in Pinocchio: its free flyer (``JointModelFreeFlyer``) converted to the project's
+convention by :mod:`references.common.floating_base` (both pinned by ``tests/references/test_floating_base_conventions.py``).
+
+Everything else is :mod:`references.pinocchio.joint_dynamics`'s (the model, armature, damping, gravity). Pinocchio's
+free-flyer velocity is (linear, angular) in the base's LOCAL frame and its acceleration the time derivative of that
+vector, so the project's acceleration reaches it as (R^T p_ddot - w_b x v_b, R^T omega_dot); h is ``rnea`` at that
+acceleration of a zero project acceleration (``nle`` is h in Pinocchio's own velocity coordinates). The kinetic energy
+sums ``Inertia.vtiv`` over every joint's body, the free flyer's (the base) included.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from simparity.core.model.scenes.chain import Chain
+from simparity.references.common.conventions import xyzw_from_wxyz
+from simparity.references.common.floating_base import (
+    BASE_Q,
+    BASE_V,
+    base_rotations,
+    local_offset,
+    turned_base,
+    turned_mass,
+)
+from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics
+
+
+class PinocchioFloatingDynamics(PinocchioJointDynamics):
+    """The module docstring's: q (B, 7 + n), qdot, qddot and tau (B, 6 + n) in the project's convention."""
+
+    def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
+        super().__init__(chain, gravity_world)
+        self._index = np.r_[0:BASE_V, self.idx_v]
+        self.detail += ("; the free flyer's LOCAL (linear, angular) velocity turned to world axes, its acceleration "
+                        "given w_b x v_b")
+
+    def _full(self, q_row: np.ndarray) -> np.ndarray:
+        """Pinocchio's configuration (nq,) of a project configuration (7 + n,): quat_xyzw."""
+        out = self._configuration(q_row[BASE_Q:])
+        out[:3], out[3:7] = q_row[:3], xyzw_from_wxyz(q_row[3:7])
+        return out
+
+    def _vector(self, local_row: np.ndarray) -> np.ndarray:
+        """Pinocchio's (nv,) of a base-local vector (6 + n,) (velocity, acceleration or force)."""
+        out = np.zeros(self.model.nv)
+        out[self._index] = local_row
+        return out
+
+    def mass_matrix(self, q: np.ndarray) -> np.ndarray:
+        out = np.empty((len(q), len(self._index), len(self._index)))
+        for k, row in enumerate(q):
+            upper = np.triu(pin.crba(self.model, self.data, self._full(row)))
+            out[k] = (upper + np.triu(upper, 1).T)[np.ix_(self._index, self._index)]
+        return turned_mass(base_rotations(q), out, True, True)
+
+    def _rnea(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
+        """The project's tau (B, 6 + n) without damping."""
+        rotation = base_rotations(q)
+        velocity = turned_base(rotation, qdot, True, True, inverse=True)
+        acceleration = turned_base(rotation, qddot, True, True, inverse=True)
+        acceleration[:, :3] -= local_offset(rotation, qdot)
+        local = np.array([pin.rnea(self.model, self.data, self._full(row), self._vector(rates),
+                                   self._vector(accelerations))[self._index]
+                          for row, rates, accelerations in zip(q, velocity, acceleration)])
+        return turned_base(rotation, local, True, True)
+
+    def bias_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        return self._rnea(q, qdot, np.zeros_like(qdot))
+
+    def inverse_dynamics(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
+        out = self._rnea(q, qdot, qddot)
+        out[:, BASE_V:] += self.damping * qdot[:, BASE_V:]
+        return out
+
+    def forward_dynamics(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        rotation = base_rotations(q)
+        damped = np.array(tau, dtype=float)
+        damped[:, BASE_V:] -= self.damping * qdot[:, BASE_V:]
+        velocity = turned_base(rotation, qdot, True, True, inverse=True)
+        force = turned_base(rotation, damped, True, True, inverse=True)
+        local = np.array([pin.aba(self.model, self.data, self._full(row), self._vector(rates),
+                                  self._vector(forces))[self._index]
+                          for row, rates, forces in zip(q, velocity, force)])
+        local[:, :3] += local_offset(rotation, qdot)
+        return turned_base(rotation, local, True, True)
+
+    def link_kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        rotation = base_rotations(q)
+        velocity = turned_base(rotation, qdot, True, True, inverse=True)
+        out = np.empty(len(q))
+        for k, (row, rates) in enumerate(zip(q, velocity)):
+            pin.forwardKinematics(self.model, self.data, self._full(row), self._vector(rates))
+            out[k] = sum(0.5 * self.model.inertias[i].vtiv(self.data.v[i]) for i in range(1, self.model.njoints))
+        return out
