@@ -7,13 +7,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Callable, cast
+from typing import Any, Callable, cast
 
 import numpy as np
 
 from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome, EngineFor
 from simparity.comparisons.measure.metrics import KINEMATICS_METRICS, frame_validity, kinematics_errors
-from simparity.comparisons.measure.model_parity import MODEL_METRICS, configurations, model_parity
+from simparity.comparisons.measure.model_parity import (
+    GROUP_METRICS,
+    JOINT_METRICS,
+    configurations,
+    joint_parity,
+    model_parity,
+)
 from simparity.comparisons.measure.joint_dynamics_metrics import (
     JOINT_DYNAMICS_METRICS,
     REFERENCE_ERRORS,
@@ -31,7 +37,7 @@ from simparity.core.model.engine import Engine, JointDynamicsModel, Support
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
-from simparity.core.model.rigid_groups import FIELDS, RigidGroups
+from simparity.core.model.rigid_groups import FIELDS, CompiledJoints, RigidGroups
 from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.core.model.metric_catalogue import TIME_PER_FK, TIME_PER_JACOBIAN
 
@@ -118,6 +124,8 @@ class _JointDynamicsShared:
     scale: ForceScale | None = None
     groups: RigidGroups | None = None
     groups_problem: str = ""
+    joints: CompiledJoints | None = None
+    joints_problem: str = ""
 
 
 def prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_failure: str) -> _JointDynamicsShared:
@@ -138,29 +146,54 @@ def prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_fa
     if evaluated is None:
         return _JointDynamicsShared(states, None, problem)
     values, scale = cast(tuple[dict, ForceScale], evaluated)
+    built, why = _reported(lambda: engine_for(scene.reference).build_joint_dynamics(scene.chain, method,
+                                                                                   scene.gravity_world), label)
+    if built is None:
+        return _JointDynamicsShared(states, values, problem, scale, None, why, None, why)
+    groups, why = _reported(lambda: built.rigid_groups(configurations(scene.chain.joint_values(states[0]))), label)
+    joints, joints_why = _reported(built.compiled_joints, label)
+    return _JointDynamicsShared(states, values, problem, scale, groups, why, joints, joints_why)
+
+
+def _reported(report: Callable[[], Any], label: str) -> tuple[Any, str]:
+    """(what the reference ``label`` reports of its compiled model, "") or (None, why it reports nothing)."""
     try:
-        model = engine_for(scene.reference).build_joint_dynamics(scene.chain, method, scene.gravity_world)
-        groups, why = model.rigid_groups(configurations(scene.chain.joint_values(states[0]))), ""
+        return report(), ""
     except NotImplementedError as err:
-        groups, why = None, f"the reference {label} reports no compiled model: {err}"
+        return None, f"the reference {label} reports no compiled model: {err}"
     except Exception as err:  # noqa: BLE001 - a user's reference: its model rows say why
-        groups, why = None, f"the reference {label}'s compiled model could not be read: {error_text(err)}"
-    return _JointDynamicsShared(states, values, problem, scale, groups, why)
+        return None, f"the reference {label}'s compiled model could not be read: {error_text(err)}"
+
+
+def _not_measured(metrics: dict[str, str], why: str) -> dict[str, Measured]:
+    return {m: Measured(math.nan, u, unmeasurable=why) for m, u in metrics.items()}
 
 
 def _model_parity(model: JointDynamicsModel, shared: _JointDynamicsShared, chain) -> dict[str, Measured]:
     """The model-parity values of ``model`` against the reference's compiled model (n/a with why where either
     engine reports none; an engine's failure to report one fails the case with its error)."""
-    if shared.groups is None:
-        return {m: Measured(math.nan, u, unmeasurable=shared.groups_problem) for m, u in MODEL_METRICS.items()}
-    try:
-        own = model.rigid_groups(configurations(chain.joint_values(shared.states[0])))
-    except NotImplementedError as err:
-        return {m: Measured(math.nan, u, unmeasurable=str(err)) for m, u in MODEL_METRICS.items()}
-    bad = [f for f in FIELDS if not np.all(np.isfinite(getattr(own, f)))]
-    if bad:
-        raise ValueError(f"non-finite {', '.join(bad)}")
-    return model_parity(own, shared.groups, tuple(j.name for j in chain.joints))
+    names = tuple(j.name for j in chain.joints)
+    out = _not_measured(GROUP_METRICS, shared.groups_problem) | _not_measured(JOINT_METRICS, shared.joints_problem)
+    if shared.groups is not None:
+        try:
+            own = model.rigid_groups(configurations(chain.joint_values(shared.states[0])))
+        except NotImplementedError as err:
+            out |= _not_measured(GROUP_METRICS, str(err))
+        else:
+            bad = [f for f in FIELDS if not np.all(np.isfinite(getattr(own, f)))]
+            if bad:
+                raise ValueError(f"non-finite {', '.join(bad)}")
+            out |= model_parity(own, shared.groups, names)
+    if shared.joints is not None:
+        try:
+            compiled = model.compiled_joints()
+        except NotImplementedError as err:
+            out |= _not_measured(JOINT_METRICS, str(err))
+        else:
+            if np.any(np.isnan(compiled.lower)) or np.any(np.isnan(compiled.upper)):
+                raise ValueError("non-finite limits (NaN)")
+            out |= joint_parity(compiled, shared.joints, names)
+    return out
 
 
 def _force_scale(scene: JointDynamicsScene, engine: Engine, method: str, model: JointDynamicsModel,

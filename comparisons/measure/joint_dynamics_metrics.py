@@ -37,6 +37,7 @@ from simparity.comparisons.measure.joint_force_scale import ForceScale
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointDynamicsModel
 from simparity.core.model.metric_catalogue import (
+    BASE_MOMENTUM_RESIDUAL,
     BIAS_FORCE_ERROR_MAX,
     CORIOLIS_SKEW_RESIDUAL,
     FORWARD_DYNAMICS_ERROR_MAX,
@@ -70,6 +71,7 @@ JOINT_DYNAMICS_METRICS = units(
     KINETIC_ENERGY_RESIDUAL,
     CORIOLIS_SKEW_RESIDUAL,
     GRAVITY_EQUIVALENCE_RESIDUAL,
+    BASE_MOMENTUM_RESIDUAL,
     TIME_PER_MASS_MATRIX,
     TIME_PER_INVERSE_DYNAMICS,
     TIME_PER_FORWARD_DYNAMICS,
@@ -157,7 +159,9 @@ def identities(model: JointDynamicsModel, chain: Chain, states: tuple[np.ndarray
     round trip in torque space); M symmetric and
     positive definite; 1/2 qdot^T M qdot (armature aside) = the links' kinetic energy from the engine's own
     kinematics; qdot^T (Mdot - 2 C) qdot = 0; for a floating base, g(q) = -M(q)[:, :3] ``gravity_world`` (the
-    equivalence principle: weight is what a uniform acceleration -g of the base takes). The joint-force identities are
+    equivalence principle: weight is what a uniform acceleration -g of the base takes) and M's base rows times qdot
+    = the robot's momentum from its links (the centroidal momentum A_G qdot moved to the base origin). The
+    joint-force identities are
     floored at the chain's force ``scale``."""
     q, qd, qdd, _ = states
     n = chain.nv
@@ -184,7 +188,24 @@ def identities(model: JointDynamicsModel, chain: Chain, states: tuple[np.ndarray
     values[KINETIC_ENERGY_RESIDUAL] = _over(quadratic - kinetic, float(np.max(np.abs(kinetic))), 0.0,
                                             "the links' kinetic energy")
     values[CORIOLIS_SKEW_RESIDUAL] = _skew_residual(model, chain, q, qd, own["h"] - gravity, mass)
+    values[BASE_MOMENTUM_RESIDUAL] = _momentum(model, chain, q, qd, mass)
     return values
+
+
+def _momentum(model: JointDynamicsModel, chain: Chain, q: np.ndarray, qd: np.ndarray, mass: np.ndarray) -> Measured:
+    """|M[:6] qdot - (P, L_o)| over the largest |(P, L_o)|: the robot's momentum from the engine's own link velocities
+    (:meth:`JointDynamicsModel.momentum`, about the world origin) moved to the base origin, L_o = L - p x P."""
+    if not chain.floating_base:
+        return Measured(np.nan, "1", unmeasurable="the base is fixed: M's rows are the joints', not the robot's momentum")
+    try:
+        reported = np.asarray(model.momentum(q, qd), dtype=float)
+    except NotImplementedError as err:
+        return Measured(np.nan, "1", unmeasurable=str(err))
+    if reported.shape != (len(q), 6) or not np.all(np.isfinite(reported)):
+        raise ValueError(f"momentum has shape {reported.shape} or non-finite values, expected finite (B, 6)")
+    about_base = np.concatenate([reported[:, :3], reported[:, 3:] - np.cross(q[:, :3], reported[:, :3])], axis=1)
+    expected = np.einsum("bij,bj->bi", mass[:, :6, :], qd)
+    return _over(expected - about_base, float(np.max(np.abs(about_base))), 0.0, "the robot's momentum")
 
 
 def _equivalence(chain: Chain, mass: np.ndarray, gravity: np.ndarray, gravity_world: np.ndarray | None,

@@ -11,7 +11,11 @@ same in any unit, and its row names the joint where it is largest with both engi
 - inertia: the largest entry of |I - I_ref| (about each one's own centre of mass, base-frame axes) over the larger
   of the two tensors' largest entries (0 when both are zero);
 - axis: the angle between the joints' axes [rad];
-- origin: |o - o_ref| over X.
+- origin: |o - o_ref| over X;
+
+and of each joint as compiled (:class:`core.model.rigid_groups.CompiledJoints`), counts of joints: its type
+(revolute or prismatic) differing, and its limits differing (limited in one engine and not the other, or a limit
+apart by more than :data:`LIMIT_ROUNDING`), the first such joint named with both engines' values.
 """
 
 from __future__ import annotations
@@ -23,15 +27,25 @@ from simparity.core.model.metric_catalogue import (
     MODEL_AXIS_ERROR_MAX,
     MODEL_COM_ERROR_MAX,
     MODEL_INERTIA_ERROR_MAX,
+    MODEL_JOINT_TYPE_MISMATCHES,
+    MODEL_LIMIT_MISMATCHES,
     MODEL_MASS_ERROR_MAX,
     MODEL_ORIGIN_ERROR_MAX,
     units,
 )
-from simparity.core.model.rigid_groups import RigidGroups
+from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 
-MODEL_METRICS = units(MODEL_MASS_ERROR_MAX, MODEL_COM_ERROR_MAX, MODEL_INERTIA_ERROR_MAX, MODEL_AXIS_ERROR_MAX,
+GROUP_METRICS = units(MODEL_MASS_ERROR_MAX, MODEL_COM_ERROR_MAX, MODEL_INERTIA_ERROR_MAX, MODEL_AXIS_ERROR_MAX,
                       MODEL_ORIGIN_ERROR_MAX)
+"""The rigid groups' metrics (:func:`model_parity`)."""
+JOINT_METRICS = units(MODEL_JOINT_TYPE_MISMATCHES, MODEL_LIMIT_MISMATCHES)
+"""The compiled joints' metrics (:func:`joint_parity`)."""
+MODEL_METRICS = GROUP_METRICS | JOINT_METRICS
 """The model-parity metrics of a joint-dynamics case, in row order."""
+
+LIMIT_ROUNDING = 4 * float(np.finfo(float).eps)
+"""Limits apart by more than this fraction of the larger (and of 1 rad or 1 m near zero) differ: every importer parses
+the same decimal of the same file, to the same double or within a rounding of a unit it converts through."""
 
 
 def configurations(q: np.ndarray) -> np.ndarray:
@@ -84,3 +98,31 @@ def model_parity(own: RigidGroups, ref: RigidGroups, joints: tuple[str, ...]) ->
         MODEL_ORIGIN_ERROR_MAX: _worst(origin, "1", joints, "origin", own.origin_world, ref.origin_world,
                                        lambda v: f"{_vector(v)} m"),
     }
+
+
+def _limit_text(lower: float, upper: float) -> str:
+    return "unlimited" if np.isinf(lower) and np.isinf(upper) else f"[{lower:.10g}, {upper:.10g}]"
+
+
+def joint_parity(own: CompiledJoints, ref: CompiledJoints, joints: tuple[str, ...]) -> dict[str, Measured]:
+    """Counts of ``own``'s joints whose type, or whose limits, differ from ``ref``'s (the module docstring); the note
+    names the first with both engines' values."""
+    kind = np.flatnonzero(own.prismatic != ref.prismatic)
+    limits = []
+    for i in range(len(joints)):
+        pairs = ((own.lower[i], ref.lower[i]), (own.upper[i], ref.upper[i]))
+        if any(np.isinf(a) != np.isinf(b) or (np.isfinite(a) and abs(a - b) > LIMIT_ROUNDING * max(abs(a), abs(b), 1.0))
+               or (np.isinf(a) and np.isinf(b) and a != b) for a, b in pairs):
+            limits.append(i)
+
+    def count(found, what: str, text) -> Measured:
+        if not len(found):
+            return Measured(0.0, "1")
+        i = int(found[0])
+        return Measured(float(len(found)), "1",
+                        note=f"first at joint '{joints[i]}': {what} {text(own, i)} against the reference's "
+                             f"{text(ref, i)}")
+
+    return {MODEL_JOINT_TYPE_MISMATCHES: count(kind, "type",
+                                               lambda c, i: "prismatic" if c.prismatic[i] else "revolute"),
+            MODEL_LIMIT_MISMATCHES: count(limits, "limits", lambda c, i: _limit_text(c.lower[i], c.upper[i]))}

@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 from simparity.core.articulated.chain_arrays import chain_arrays, pack_symmetric, spatial_inertia
-from simparity.core.articulated.groups import chain_rigid_groups
+from simparity.core.articulated.groups import chain_compiled_joints, chain_rigid_groups
 from simparity.core.articulated.recursive import FloatingBase, Recursive, cross_force, unpack_symmetric
 from simparity.core.model.engine import JointDynamicsModel
-from simparity.core.model.rigid_groups import RigidGroups
+from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.rotations import quat_wxyz_to_matrix
 
@@ -126,6 +126,18 @@ class FloatingRecursiveDynamics(JointDynamicsModel):
         own = 0.5 * np.einsum("ib,ij,jb->b", velocity, self._base_inertia, velocity)
         return self._algorithms.kinetic_energy(joints, rates, velocity) + own
 
+    def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """Each body's I v carried to the base and summed (:meth:`Recursive.momentum`) with the base's own, turned
+        into world axes; the angular part moved from the base origin to the world's (+ p x linear)."""
+        rotation, joints, rates, velocity = self._state(q, qdot)
+        local = self._algorithms.momentum(joints, rates, velocity) + self._base_inertia @ velocity
+        linear, angular = _turned(rotation, local[3:]), _turned(rotation, local[:3])
+        position = np.atleast_2d(np.asarray(q, dtype=float))[:, :3]
+        return np.concatenate([linear, angular + np.cross(position, linear)], axis=1)
+
     def rigid_groups(self, q: np.ndarray) -> RigidGroups:
         """Core's compiled model with the base at the world's origin, unturned: q is the joint values (B, n)."""
         return chain_rigid_groups(self._chain, q)
+
+    def compiled_joints(self) -> CompiledJoints:
+        return chain_compiled_joints(self._chain)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 from simparity.core.kinematics import forward_kinematics
-from simparity.core.model.rigid_groups import RigidGroups
+from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
 
 
@@ -24,3 +24,8 @@ def chain_rigid_groups(chain: Chain, q: np.ndarray) -> RigidGroups:
                        com_world=position + np.einsum("bnij,nj->bni", rotation, com),
                        inertia_world=rotation @ inertia @ np.swapaxes(rotation, -1, -2),
                        axis_world=np.einsum("bnij,nj->bni", rotation, axes), origin_world=position)
+
+
+def chain_compiled_joints(chain: Chain) -> CompiledJoints:
+    """Core's reading of each chain joint: its type and limits as core's parser (or the scene file) gave them."""
+    return CompiledJoints(np.array([j.type == "prismatic" for j in chain.joints], dtype=bool), chain.lower, chain.upper)

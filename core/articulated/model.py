@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 from simparity.core.articulated.chain_arrays import chain_arrays
 from simparity.core.articulated.floating import FloatingRecursiveDynamics
-from simparity.core.articulated.groups import chain_rigid_groups
+from simparity.core.articulated.groups import chain_compiled_joints, chain_rigid_groups
 from simparity.core.articulated.jacobian_sum import JacobianSum
 from simparity.core.articulated.recursive import Recursive
 from simparity.core.model.engine import JointDynamicsModel
-from simparity.core.model.rigid_groups import RigidGroups
+from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
 
 RECURSIVE, JACOBIAN_SUM = "recursive", "jacobian_sum"
@@ -72,6 +72,9 @@ class RecursiveDynamics(JointDynamicsModel):
     def rigid_groups(self, q: np.ndarray) -> RigidGroups:
         return chain_rigid_groups(self._chain, q)
 
+    def compiled_joints(self) -> CompiledJoints:
+        return chain_compiled_joints(self._chain)
+
 
 class JacobianSumDynamics(JointDynamicsModel):
     """The lecture's M and h summed over link Jacobians (:mod:`core.articulated.jacobian_sum`); inverse dynamics
@@ -105,6 +108,9 @@ class JacobianSumDynamics(JointDynamicsModel):
 
     def rigid_groups(self, q: np.ndarray) -> RigidGroups:
         return chain_rigid_groups(self._chain, q)
+
+    def compiled_joints(self) -> CompiledJoints:
+        return chain_compiled_joints(self._chain)
 
 
 def build(chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:

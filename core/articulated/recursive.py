@@ -421,6 +421,21 @@ class Recursive:
             accelerations.append(acceleration)
         return qddot, base
 
+    def momentum(self, q: np.ndarray, qdot: np.ndarray, base_velocity: np.ndarray | None = None) -> np.ndarray:
+        """(6, B): the bodies' spatial momenta I_i v_i, each carried to the base (X_i^T) and summed: the chain's
+        momentum (angular about the base origin, linear) in base coordinates, the base's own not included."""
+        cos, sin = self._trig(q)
+        momenta = [self.arrays.inertia[i] @ v for i, v in enumerate(self._velocities(q, qdot, cos, sin, base_velocity))]
+        total = np.zeros((6, q.shape[1]))
+        for i in reversed(range(self.arrays.n)):
+            parent = self.parents[i]
+            carried = self._to_parent(i, momenta[i], cos, sin, q)
+            if parent >= 0:
+                momenta[parent] += carried
+            else:
+                total += carried
+        return total
+
     def kinetic_energy(self, q: np.ndarray, qdot: np.ndarray, base_velocity: np.ndarray | None = None) -> np.ndarray:
         """(B,) [J]: sum over bodies of 1/2 m |v_c|^2 + 1/2 omega^T I_c omega from the forward pass's body
         velocities (v_c = v_o + omega x c in body coordinates); the base moving at ``base_velocity`` (6, B) (None: at

@@ -16,7 +16,7 @@ import numpy as np
 
 from simparity.core.model.errors import NotBatchedError, SimparityError
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.rigid_groups import RigidGroups
+from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.ik_result import IKResult
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.dynamics import DynamicsScene
@@ -299,6 +299,18 @@ class JointDynamicsModel(abc.ABC):
         and origin, all in the base frame (:class:`core.model.rigid_groups.RigidGroups`). Optional: an engine that
         does not report its compiled model raises NotImplementedError, and its model-parity rows are n/a."""
         raise NotImplementedError(f"{type(self).__name__} does not report its compiled model (rigid_groups)")
+
+    def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """(B, 6): the whole robot's momentum from the engine's own link velocities and masses (never from M):
+        linear momentum [kg m/s] and angular momentum about the WORLD origin [kg m^2/s], world axes, the base's and
+        every link's. Optional: checked against M's base rows on a floating base (``base_momentum_residual``), n/a
+        where an engine raises NotImplementedError."""
+        raise NotImplementedError(f"{type(self).__name__} does not report the robot's momentum (momentum)")
+
+    def compiled_joints(self) -> CompiledJoints:
+        """What the engine compiled of each chain joint, configuration aside: its type and limits
+        (:class:`core.model.rigid_groups.CompiledJoints`). Optional, as :meth:`rigid_groups`."""
+        raise NotImplementedError(f"{type(self).__name__} does not report its compiled joints (compiled_joints)")
 
 
 @dataclass(frozen=True)

@@ -109,6 +109,7 @@ MASS_MATRIX_DEFINITENESS_MIN = "mass_matrix_definiteness_min"
 KINETIC_ENERGY_RESIDUAL = "kinetic_energy_residual"
 CORIOLIS_SKEW_RESIDUAL = "coriolis_skew_residual"
 GRAVITY_EQUIVALENCE_RESIDUAL = "gravity_equivalence_residual"
+BASE_MOMENTUM_RESIDUAL = "base_momentum_residual"
 TIME_PER_MASS_MATRIX = "time_per_mass_matrix"
 TIME_PER_INVERSE_DYNAMICS = "time_per_inverse_dynamics"
 TIME_PER_FORWARD_DYNAMICS = "time_per_forward_dynamics"
@@ -118,6 +119,8 @@ MODEL_COM_ERROR_MAX = "model_com_error_max"
 MODEL_INERTIA_ERROR_MAX = "model_inertia_error_max"
 MODEL_AXIS_ERROR_MAX = "model_axis_error_max"
 MODEL_ORIGIN_ERROR_MAX = "model_origin_error_max"
+MODEL_JOINT_TYPE_MISMATCHES = "model_joint_type_mismatches"
+MODEL_LIMIT_MISMATCHES = "model_limit_mismatches"
 # Joint motion: unitless errors of a chain's motion against the reference, each engine's own energy balance.
 JOINT_ANGLE_ERROR_MAX = "joint_angle_error_max"
 JOINT_VELOCITY_ERROR_MAX = "joint_velocity_error_max"
@@ -211,6 +214,9 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(GRAVITY_EQUIVALENCE_RESIDUAL, DIMENSIONLESS, VALIDITY,
            theory="a floating base: h(q, 0) = -M(q)[:, base linear] g, gravity a uniform acceleration of the base: 0 up "
                   "to rounding"),
+    Metric(BASE_MOMENTUM_RESIDUAL, DIMENSIONLESS, VALIDITY,
+           theory="a floating base: M's base rows times qdot = the robot's momentum (linear, angular about the base "
+                  "origin) summed from the engine's own link velocities: 0 up to rounding"),
     Metric(TIME_PER_MASS_MATRIX, "s", TIMING),
     Metric(TIME_PER_INVERSE_DYNAMICS, "s", TIMING),
     Metric(TIME_PER_FORWARD_DYNAMICS, "s", TIMING),
@@ -219,6 +225,11 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(MODEL_INERTIA_ERROR_MAX, DIMENSIONLESS, ERROR, theory="the same file read alike: 0 up to rounding"),
     Metric(MODEL_AXIS_ERROR_MAX, "rad", ERROR, theory="the same file read alike: 0 up to rounding"),
     Metric(MODEL_ORIGIN_ERROR_MAX, DIMENSIONLESS, ERROR, theory="the same file read alike: 0 up to rounding"),
+    Metric(MODEL_JOINT_TYPE_MISMATCHES, DIMENSIONLESS, ERROR,
+           theory="the same file read alike: 0 joints revolute in one engine and prismatic in the other"),
+    Metric(MODEL_LIMIT_MISMATCHES, DIMENSIONLESS, ERROR,
+           theory="the same file read alike: 0 joints whose limits differ (limited in one engine only, or apart by "
+                  "more than rounding)"),
     Metric(JOINT_ANGLE_ERROR_MAX, DIMENSIONLESS, ERROR, headline=True, scale="joint_angle"),
     Metric(JOINT_VELOCITY_ERROR_MAX, DIMENSIONLESS, ERROR, scale="joint_velocity"),
     Metric(END_EFFECTOR_ERROR_MAX, DIMENSIONLESS, ERROR, scale="reach"),

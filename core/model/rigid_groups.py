@@ -51,3 +51,29 @@ class RigidGroups:
         for name, tail in zip(FIELDS, ((), (3,), (3, 3), (3,), (3,))):
             object.__setattr__(self, name, readonly(np.asarray(getattr(self, name), dtype=float),
                                                     shape=(b, n) + tail))
+
+
+@dataclass(frozen=True)
+class CompiledJoints:
+    """Each chain joint as one engine compiled it, configuration aside: its type and limits.
+
+    Attributes
+    ----------
+    prismatic : (n,) bool ndarray
+        True for a prismatic (slide) joint, False for a revolute (hinge) one.
+    lower, upper : (n,) ndarray
+        Its position limits [rad or m] as the engine holds them, -inf / inf where it holds none (each engine's own way
+        of saying "unlimited" read by its adapter: MuJoCo's ``jnt_limited``, Pinocchio's unbounded joint types,
+        PyBullet's upper < lower).
+    """
+
+    prismatic: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+
+    def __post_init__(self) -> None:
+        prismatic = np.asarray(self.prismatic, dtype=bool)
+        object.__setattr__(self, "prismatic", readonly(prismatic, shape=prismatic.shape))
+        for name in ("lower", "upper"):
+            object.__setattr__(self, name, readonly(np.asarray(getattr(self, name), dtype=float),
+                                                    shape=prismatic.shape))

@@ -11,9 +11,10 @@ only these changes, each made with :mod:`xml.etree.ElementTree` on the parsed fi
 - Every ``<dynamics>`` is removed: MuJoCo would turn ``friction`` into Coulomb ``frictionloss`` and read
   ``damping``, PyBullet would damp while stepping, Pinocchio keeps both and its ``aba`` ignores them. Each adapter
   sets the chain's damping (and armature) itself.
-- Every movable joint not on the chain (``Chain.held_joints``: fingers, branches, joints past the tip, mimic
+- Every movable joint not on the chain (fingers, branches, joints past the tip, mimic
   joints) becomes a fixed joint at its zero position (its ``<origin>``), so its links ride on the chain link they
-  hang from in every engine alike.
+  hang from in every engine alike. The chain is the file's path from the scene's base link to its tip link, walked
+  here (:func:`chain_joint_names`), never taken from core's parse: each adapter finds its joints by these names.
 - A link without ``<inertial>`` is massless (the URDF specification) and gets an explicit zero one: PyBullet
   would otherwise give it 1 kg and a unit inertia.
 - For a fixed base, the base link and every link welded to it by fixed joints never move: their ``<inertial>`` is
@@ -115,13 +116,46 @@ class ModelChanges:
         return [f"{what}: {', '.join(names)}" for names, what in said if names]
 
 
-def _changed(chain: Chain) -> tuple[ET.Element, ModelChanges]:
-    """The chain's file as every engine reads it for dynamics (see the module docstring), and what was changed."""
+def _file(chain: Chain) -> ET.Element:
+    """The chain's URDF file, parsed (the references' own reading: ElementTree)."""
     path = cast(str, chain.urdf_path)
     with open(path, "rb") as handle:
-        root = parse_xml(handle.read(), path, "robot")
-    links, joints = _subtree(root, cast(str, chain.base_link))
-    held = set(chain.held_joints)
+        return parse_xml(handle.read(), path, "robot")
+
+
+def _path_joints(root: ET.Element, base: str, tip: str) -> list[ET.Element]:
+    """The joints from ``base`` down to ``tip`` in file order along the path (fixed ones included), walked up from the
+    tip by each link's parent joint; a tip not below the base is a SimparityError."""
+    parent = {cast(str, cast(ET.Element, j.find("child")).get("link")): j for j in root.findall("joint")}
+    path, link = [], tip
+    while link != base:
+        if link not in parent:
+            raise SimparityError(f"link {tip!r} is not below base link {base!r} in {root.get('name', 'the file')}")
+        path.append(parent[link])
+        link = cast(str, cast(ET.Element, parent[link].find("parent")).get("link"))
+    return path[::-1]
+
+
+def chain_joint_names(chain: Chain) -> tuple[str, ...]:
+    """The chain's joints as the references select them: for a chain from a URDF file, the movable joints on the
+    file's own path from the base link to the tip link (the scene's ``base_link`` and ``tip_link``), found by the
+    references' own walk of the file, never from core's parse (a path core chose wrongly then shows as a
+    disagreement); for a chain without a file, its joints."""
+    if chain.urdf_path is None:
+        return tuple(j.name for j in chain.joints)
+    path = _path_joints(_file(chain), cast(str, chain.base_link), chain.end_effector_name)
+    return tuple(cast(str, j.get("name")) for j in path if j.get("type") != "fixed")
+
+
+def _changed(chain: Chain) -> tuple[ET.Element, ModelChanges]:
+    """The chain's file as every engine reads it for dynamics (see the module docstring), and what was changed."""
+    root = _file(chain)
+    base = cast(str, chain.base_link)
+    links, joints = _subtree(root, base)
+    on_path = {j.get("name") for j in _path_joints(root, base, chain.end_effector_name)}
+    held_in_order = tuple(cast(str, j.get("name")) for j in root.findall("joint")
+                          if j.get("name") in joints and j.get("type") != "fixed" and j.get("name") not in on_path)
+    held = set(held_in_order)
     removed = tuple(cast(str, element.get("name")) for element in root.findall("link")
                     if element.get("name") not in links)
     for element in list(root):
@@ -155,7 +189,7 @@ def _changed(chain: Chain) -> tuple[ET.Element, ModelChanges]:
         if link.find("inertial") is None:
             zero_inertial(link)
     order = [cast(str, link.get("name")) for link in root.findall("link")]
-    return root, ModelChanges(removed, chain.held_joints, tuple(n for n in order if n in welded),
+    return root, ModelChanges(removed, held_in_order, tuple(n for n in order if n in welded),
                               tuple(no_inertial), friction, tuple(massless_with_inertia))
 
 

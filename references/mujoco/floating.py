@@ -60,6 +60,19 @@ class MujocoFloatingDynamics(MujocoJointDynamics):
     def link_kinetic_energy(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         return super().link_kinetic_energy(q, turned_base(base_rotations(q), qdot, False, True, inverse=True))
 
+    def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """``mj_subtreeVel`` at the free body after ``mj_forward``: its subtree's mass x ``subtree_linvel`` (the
+        centre of mass's velocity) and ``subtree_angmom`` (about ``subtree_com``), moved to the world origin."""
+        m, d = self.model, self.data
+        body = int(m.jnt_bodyid[[j for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE][0]])
+        out = np.empty((len(q), 6))
+        for k, (row, rates) in enumerate(zip(q, turned_base(base_rotations(q), qdot, False, True, inverse=True))):
+            self._set(row, rates)
+            mujoco.mj_subtreeVel(m, d)
+            linear = m.body_subtreemass[body] * d.subtree_linvel[body]
+            out[k] = np.r_[linear, d.subtree_angmom[body] + np.cross(d.subtree_com[body], linear)]
+        return out
+
     def rigid_groups(self, q: np.ndarray) -> RigidGroups:
         """The joints' groups with the base at the world's origin, unturned (q: the joint values (B, n))."""
         self.data.qpos[self._free_qpos:self._free_qpos + BASE_Q] = IDENTITY_POSE

@@ -47,10 +47,10 @@ import mujoco
 import numpy as np
 
 from simparity.core.model.engine import JointDynamicsModel
-from simparity.core.model.rigid_groups import RigidGroups
+from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt
-from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
+from simparity.references.common.dynamics_urdf import chain_joint_names, dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
 from simparity.references.common.rigid_groups import summed
 
@@ -98,7 +98,7 @@ class ChainModel:
 
     def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
         model = _compiled(chain, gravity_world)
-        joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j.name) for j in chain.joints]
+        joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in chain_joint_names(chain)]
         self.dof, self.qpos = model.jnt_dofadr[joints], model.jnt_qposadr[joints]
         model.dof_damping[:] = 0.0
         model.dof_damping[self.dof] = [j.damping for j in chain.joints]
@@ -219,3 +219,13 @@ class MujocoJointDynamics(JointDynamicsModel):
                 out[0][k, i], out[1][k, i], out[2][k, i] = mass, com, inertia
                 out[3][k, i], out[4][k, i] = d.xaxis[joint], d.xpos[body]
         return RigidGroups(*out)
+
+    def compiled_joints(self) -> CompiledJoints:
+        """``jnt_type`` (slide: prismatic) and ``jnt_range`` where ``jnt_limited``, else unlimited: the importer's
+        reading of each ``<limit>`` (the adapter disables the constraints that would apply them)."""
+        m = self.model
+        joints = [m.dof_jntid[dof] for dof in self.dof]
+        limited = np.array([bool(m.jnt_limited[j]) for j in joints])
+        ranges = np.array([m.jnt_range[j] for j in joints]).reshape(-1, 2)
+        return CompiledJoints(np.array([m.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE for j in joints]),
+                              np.where(limited, ranges[:, 0], -np.inf), np.where(limited, ranges[:, 1], np.inf))

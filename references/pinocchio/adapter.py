@@ -69,7 +69,7 @@ from simparity.references.pinocchio.joints import configuration
 from simparity.references.common.urdf_export import UrdfChains, chain_export, chain_source, chain_urdf, urdf_support
 from simparity.references.pinocchio import joint_motion
 from simparity.references.pinocchio.floating import PinocchioFloatingDynamics
-from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics
+from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics, pinocchio_dynamics_problem
 from simparity.references.common.scene_inputs import derives_own_inputs
 
 
@@ -327,7 +327,11 @@ def _dynamics_support(chain: Chain) -> Support:
     problem = chain.dynamics_problem()
     if problem:
         return Support.no(problem)
-    return urdf_support(chain) if chain.urdf_path is None else Support.yes()
+    expressible = urdf_support(chain) if chain.urdf_path is None else Support.yes()
+    if not expressible.ok:
+        return expressible
+    refused = pinocchio_dynamics_problem(chain)
+    return Support.no(refused) if refused else Support.yes()
 
 
 @derives_own_inputs

@@ -93,3 +93,14 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
             pin.forwardKinematics(self.model, self.data, self._full(row), self._vector(rates))
             out[k] = sum(0.5 * self.model.inertias[i].vtiv(self.data.v[i]) for i in range(1, self.model.njoints))
         return out
+
+    def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """``computeCentroidalMomentum``: ``hg`` (linear, angular about the centre of mass ``com[0]``, world axes),
+        the angular part moved to the world origin."""
+        velocity = turned_base(base_rotations(q), qdot, True, True, inverse=True)
+        out = np.empty((len(q), 6))
+        for k, (row, rates) in enumerate(zip(q, velocity)):
+            momentum = pin.computeCentroidalMomentum(self.model, self.data, self._full(row), self._vector(rates))
+            linear = np.array(momentum.linear)
+            out[k] = np.r_[linear, np.array(momentum.angular) + np.cross(self.data.com[0], linear)]
+        return out

@@ -33,10 +33,10 @@ import numpy as np
 import pinocchio as pin
 
 from simparity.core.model.engine import JointDynamicsModel
-from simparity.core.model.rigid_groups import RigidGroups
+from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt
-from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
+from simparity.references.common.dynamics_urdf import chain_joint_names, dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
 from simparity.references.pinocchio.joints import configuration
 
@@ -86,12 +86,18 @@ class ChainModel:
 def chain_model(chain: Chain, gravity_world: np.ndarray | None) -> ChainModel:
     """``chain``'s dynamics model read by Pinocchio's URDF parser, ``gravity_world`` ((3,) [m/s^2] in the base
     frame, None for none) as ``model.gravity`` and the chain's armature as ``model.armature``."""
-    with captured_output():
-        model = (pin.buildModelFromXML(dynamics_urdf(chain), pin.JointModelFreeFlyer()) if chain.floating_base
-                 else pin.buildModelFromXML(dynamics_urdf(chain)))
+    printed = None
+    try:
+        with captured_output() as printed:
+            model = (pin.buildModelFromXML(dynamics_urdf(chain), pin.JointModelFreeFlyer()) if chain.floating_base
+                     else pin.buildModelFromXML(dynamics_urdf(chain)))
+    except (RuntimeError, ValueError) as err:  # urdfdom says why on stderr ("joint [j]: limit has no effort")
+        said = [line.strip()[len("Error:"):].strip() for line in (printed.text if printed else "").splitlines()
+                if line.strip().startswith("Error:")]
+        raise ValueError(f"{err}{f' (urdfdom: {said[0]})' if said else ''}") from None
     model.gravity = pin.Motion(np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float),
                                np.zeros(3))
-    joint_ids = [model.getJointId(j.name) for j in chain.joints]
+    joint_ids = [model.getJointId(name) for name in chain_joint_names(chain)]
     joints = [model.joints[i] for i in joint_ids]
     idx_v = np.array([j.idx_v for j in joints])
     armature = np.zeros(model.nv)
@@ -103,6 +109,15 @@ def chain_model(chain: Chain, gravity_world: np.ndarray | None) -> ChainModel:
               "model.armature")
     return ChainModel(model, joint_ids, [j.idx_q for j in joints], [j.nq == 2 for j in joints], idx_v,
                       np.array([j.damping for j in chain.joints]), source)
+
+
+def pinocchio_dynamics_problem(chain: Chain) -> str:
+    """Why Pinocchio cannot build the chain's dynamics ("" when it can): its URDF parser's refusal, in its words."""
+    try:
+        chain_model(chain, None)
+    except (RuntimeError, ValueError) as error:
+        return f"Pinocchio's URDF parser refuses the file: {' '.join(str(error).split())}"
+    return ""
 
 
 class PinocchioJointDynamics(JointDynamicsModel):
@@ -179,3 +194,16 @@ class PinocchioJointDynamics(JointDynamicsModel):
                 out[3][k, i] = rotation @ axis
                 out[4][k, i] = placement.translation
         return RigidGroups(*out)
+
+    def compiled_joints(self) -> CompiledJoints:
+        """The joint model's type (``shortname``: a prismatic one's names ``Prismatic`` or ``JointModelP``) and
+        ``lowerPositionLimit`` / ``upperPositionLimit`` at its configuration index; an unbounded revolute joint
+        (``RevoluteUnbounded``, ``RUB``: a URDF continuous joint, nq = 2) holds none (its +-1.01 bound the cosine and
+        sine)."""
+        joints = [self.model.joints[i] for i in self.joint_ids]
+        names = [j.shortname() for j in joints]
+        unbounded = np.array(["Unbounded" in name or name.startswith("JointModelRUB") for name in names])
+        lower = np.array([self.model.lowerPositionLimit[j.idx_q] for j in joints])
+        upper = np.array([self.model.upperPositionLimit[j.idx_q] for j in joints])
+        return CompiledJoints(np.array(["Prismatic" in name or name.startswith("JointModelP") for name in names]),
+                              np.where(unbounded, -np.inf, lower), np.where(unbounded, np.inf, upper))

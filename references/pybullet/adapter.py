@@ -504,7 +504,21 @@ def _dynamics_support(chain: Chain) -> Support:
     if not expressible.ok:
         return expressible
     armature = _armature_support(chain)
-    return _links_support(dynamics_urdf(chain)) if armature.ok else armature
+    if not armature.ok:
+        return armature
+    text = dynamics_urdf(chain)
+    links = _links_support(text)
+    return _loader_support(text) if links.ok else links
+
+
+def _loader_support(text: str) -> Support:
+    """No, in PyBullet's own words, when its URDF loader refuses the file every engine is given."""
+    client = _Client()  # disconnected when let go
+    try:
+        _load_urdf(client.id, text, useFixedBase=True)
+    except pybullet.error as err:
+        return Support.no(f"PyBullet's URDF loader refuses the file: {' '.join(str(err).split())}")
+    return Support.yes()
 
 
 def _armature_support(chain: Chain) -> Support:

@@ -63,13 +63,13 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 
-from simparity.core.model.rigid_groups import RigidGroups
+from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.engine import JointDynamicsModel
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt, quat_wxyz_to_matrix, wxyz_from_xyzw
 from simparity.references.common.rigid_groups import summed
-from simparity.references.common.dynamics_urdf import dynamics_source, dynamics_urdf
+from simparity.references.common.dynamics_urdf import chain_joint_names, dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
 from simparity.references.pybullet.adapter import _Client, _load_urdf
 from simparity.references.pybullet.quiet import pybullet
@@ -100,10 +100,12 @@ def _axes(root: ET.Element) -> list[tuple[ET.Element, ET.Element, np.ndarray]]:
 
 
 def unit_axes(text: str) -> str:
-    """URDF ``text`` with every joint ``<axis>`` normalised (see the module docstring)."""
+    """URDF ``text`` with every joint ``<axis>`` normalised (see the module docstring); a zero axis (on a fixed or
+    held joint, which has none: real files write ``0 0 0`` there) is left as written."""
     root = ET.fromstring(text)
     for _, axis, xyz in _axes(root):
-        axis.set("xyz", fmt(xyz / np.linalg.norm(xyz)))
+        if np.any(xyz):
+            axis.set("xyz", fmt(xyz / np.linalg.norm(xyz)))
     return ET.tostring(root, encoding="unicode")
 
 
@@ -149,7 +151,7 @@ class ChainBodies:
                 for j in range(pybullet.getNumJoints(b, physicsClientId=c))]
         index = {i[1].decode(): i[0] for i in info}
         movable = [i[0] for i in info if i[2] != pybullet.JOINT_FIXED]
-        self.joints = [index[j.name] for j in chain.joints]
+        self.joints = [index[name] for name in chain_joint_names(chain)]
         self.columns = [movable.index(j) for j in self.joints]
         self.links = [i[0] for i in info]
         self._movable = movable
@@ -302,3 +304,13 @@ class PybulletJointDynamics(JointDynamicsModel):
                 out[0][k, i], out[1][k, i], out[2][k, i] = mass, centre, inertia
                 out[3][k, i], out[4][k, i] = frame[joint] @ np.array(info[joint][13]), origin
         return RigidGroups(*out)
+
+    def compiled_joints(self) -> CompiledJoints:
+        """``getJointInfo``'s jointType (``JOINT_PRISMATIC``) and jointLowerLimit / jointUpperLimit; upper < lower is
+        PyBullet's "no limit" (a continuous joint loads as (0, -1))."""
+        t = self._tree
+        info = [pybullet.getJointInfo(t.body, joint, physicsClientId=t.client) for joint in t.joints]
+        lower, upper = np.array([i[8] for i in info], dtype=float), np.array([i[9] for i in info], dtype=float)
+        unlimited = upper < lower
+        return CompiledJoints(np.array([i[2] == pybullet.JOINT_PRISMATIC for i in info]),
+                              np.where(unlimited, -np.inf, lower), np.where(unlimited, np.inf, upper))

@@ -160,3 +160,20 @@ def test_pybullet_is_n_a_on_a_floating_base_with_its_reason(solo):
     support = PybulletEngine().supports_joint_dynamics(solo, "recursive")
     assert not support.ok and support.reason == FLOATING_BASE_WHY
     assert "calculateInverseDynamics" in support.reason and "turns the base" in support.reason
+
+
+@pytest.mark.parametrize("engine", sorted(ENGINES))
+def test_the_robot_s_momentum_from_its_links_is_m_s_base_rows_times_qdot(engine, solo):
+    """The centroidal momentum moved to the base origin: M[:6] qdot = (P, L_o) from each engine's own link velocities;
+    a base sliding at v with every joint still carries P = m v and, about its own origin, L_o = m c x v."""
+    model = ENGINES[engine](solo)
+    q, v, _, _ = floating_states(solo, 4, seed=6)
+    mass = model.mass_matrix(q)
+    reported = model.momentum(q, v)
+    about_base = np.concatenate([reported[:, :3], reported[:, 3:] - np.cross(q[:, :3], reported[:, :3])], axis=1)
+    expected = np.einsum("bij,bj->bi", mass[:, :6, :], v)
+    assert np.max(np.abs(expected - about_base)) <= ROUNDING * np.max(np.abs(expected))
+    sliding = np.zeros_like(v)
+    sliding[:, :3] = [0.5, -1.0, 2.0]
+    total = model.mass_matrix(q)[:, 0, 0]
+    assert np.allclose(model.momentum(q, sliding)[:, :3], total[:, None] * [0.5, -1.0, 2.0], rtol=ROUNDING, atol=0)

@@ -437,3 +437,16 @@ def test_a_bug_in_core_s_urdf_parser_moves_core_s_model_rows_only(monkeypatch, b
     for engine in ("mujoco", "pinocchio", "pybullet"):
         assert all(np.array_equal(right[engine][f], wrong[engine][f]) for f in right[engine])
     assert max(np.abs(right["core"][f] - wrong["core"][f]).max() for f in right["core"]) > 1e-3
+
+
+def test_the_references_select_the_sub_chain_from_the_file_themselves():
+    """Issue #43: each engine's chain is the file's path from the scene's base link to its tip link as the references
+    walk it, never core's parse: a planted error in core's selection (its held joints forgotten, its joints in the
+    wrong order) changes neither the file every engine reads nor the joints each adapter maps, so core alone moves."""
+    from simparity.references.common.dynamics_urdf import chain_joint_names, dynamics_urdf, model_changes
+
+    chain = builtin("crafted-arm-dynamics").chain
+    planted = dataclasses.replace(chain, held_joints=(), joints=chain.joints[::-1])
+    assert chain_joint_names(planted) == chain_joint_names(chain) == tuple(j.name for j in chain.joints)
+    assert dynamics_urdf(planted) == dynamics_urdf(chain)
+    assert model_changes(planted).held == chain.held_joints == ("finger",)

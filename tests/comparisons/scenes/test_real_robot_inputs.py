@@ -162,12 +162,13 @@ DYNAMICS_FILE = """<robot name="arm">
   <link name="tool"><inertial><origin xyz="0.1 0 0"/><mass value="0.5"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial></link>
   <joint name="mount" type="fixed"><parent link="base"/><child link="plate"/></joint>
   <joint name="shoulder" type="revolute"><parent link="plate"/><child link="upper"/><axis xyz="0 0 1"/>
-    <limit lower="-1" upper="1"/><dynamics damping="0.1" friction="0.4"/></joint>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/><dynamics damping="0.1" friction="0.4"/></joint>
   <joint name="sensor" type="fixed"><parent link="upper"/><child link="sensor_frame"/></joint>
   <joint name="spin" type="fixed"><parent link="upper"/><child link="rotor"/></joint>
-  <joint name="grip" type="prismatic"><parent link="upper"/><child link="finger"/><limit lower="0" upper="0.1"/></joint>
+  <joint name="grip" type="prismatic"><parent link="upper"/><child link="finger"/>
+    <limit lower="0" upper="0.1" effort="1" velocity="1"/></joint>
   <joint name="elbow" type="revolute"><parent link="upper"/><child link="tool"/><origin xyz="0.2 0 0"/>
-    <axis xyz="0 0 1"/><limit lower="-1" upper="1"/></joint>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
 </robot>
 """
 
