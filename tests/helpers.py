@@ -354,3 +354,44 @@ def solo12_leg():
     robots = metadata.distribution("example-robot-data").locate_file(EXAMPLE_ROBOT_DATA_ROBOTS)
     return chain_from_urdf(str(robots / "solo_description/robots/solo12.urdf"), "base_link", "FL_FOOT", dynamics=True,
                            floating_base=True)
+
+
+PLANTED_ENGINE_FACTORY = '''
+
+def _engine(base, model_class, engine_name):
+    """An engine like ``base`` whose joint-dynamics models are ``model_class`` (a planted copy of an adapter's)."""
+    class Planted(base):
+        name = engine_name
+
+        def build_joint_dynamics(self, chain, method, gravity_world):
+            return model_class(chain, gravity_world)
+
+    Planted.__name__ = model_class.__name__ + "Engine"
+    return Planted
+'''
+"""Source for a planted plugin module: ``_engine(base, model_class, name)`` makes its engine classes."""
+
+
+def run_planted(tmp_path, monkeypatch, capsys, module: str, source: str, scene: str, plugin: str,
+                engines: str = "core,mujoco,pybullet,pinocchio") -> tuple[int, list[str], str]:
+    """``simparity run <scene> --quick --check`` with the plugin ``module:plugin`` (its ``source`` written into
+    tmp_path, importable by the workers) beside ``engines``: (exit code, the violation lines, the output)."""
+    import sys
+
+    from simparity.comparisons.cli.main import main
+
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.setenv("PYTHONPATH", f"{tmp_path}:{':'.join(sys.path)}")  # the probes and workers import it
+    (tmp_path / f"{module}.py").write_text(source, encoding="utf-8")
+    code = main(["run", scene, "--quick", "--check", "--engines", f"{engines},{module}:{plugin}", "--out",
+                 str(tmp_path / "run"), "--history", str(tmp_path / "h.db"), "--no-report", "--jobs", "1"])
+    out = capsys.readouterr().out
+    return code, [line for line in out.splitlines() if line.startswith("violation: ")], out
+
+
+def assert_caught(result: tuple[int, list[str], str], engine: str, metric: str) -> None:
+    """A :func:`run_planted` result is red with violations naming ``engine`` only, ``metric`` among them."""
+    code, violations, out = result
+    assert code == 1, out[-2000:]
+    assert {line.split()[2] for line in violations} == {engine}, violations
+    assert any(metric in line for line in violations), violations

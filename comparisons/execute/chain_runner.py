@@ -29,10 +29,12 @@ from simparity.comparisons.measure.joint_dynamics_metrics import (
     shape_problem,
     timed_values,
 )
+from simparity.comparisons.measure.derivative_metrics import DERIVATIVE_METRICS, derivative_errors
 from simparity.comparisons.measure.joint_force_scale import ForceScale, force_scale
 from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
 from simparity.comparisons.common.error_text import error_text
 from simparity.comparisons.execute.timing import best_of
+from simparity.core.model.derivatives import PARTIALS, DynamicsDerivatives
 from simparity.core.model.engine import Engine, JointDynamicsModel, Support
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
@@ -126,11 +128,28 @@ class _JointDynamicsShared:
     groups_problem: str = ""
     joints: CompiledJoints | None = None
     joints_problem: str = ""
+    truth: DynamicsDerivatives | None = None
+    truth_problem: str = ""
+
+
+def _derivative_truth(scene: JointDynamicsScene, states: tuple[np.ndarray, ...]) -> tuple[Any, str]:
+    """(the complex-step truth of the dynamics' derivatives at the scene's states, "") or (None, why there is none)."""
+    q, qd, _, tau = states
+    if scene.chain.floating_base:
+        return None, ("no complex-step truth on a floating base yet: its orientation needs a complex-safe exponential "
+                      "map (issue #44)")
+    try:
+        from simparity.references.derivatives import complex_step  # Pinocchio's parser: only where a case runs
+
+        return complex_step.derivatives(complex_step.tree_from_chain(scene.chain, scene.gravity_world), q, qd, tau), ""
+    except Exception as err:  # noqa: BLE001 - every derivative row says why
+        return None, f"no complex-step truth: {error_text(err)}"
 
 
 def prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_failure: str) -> _JointDynamicsShared:
     scene, label = group.joint_dynamics_scene, group.reference_label
     states, method = scene.states(), label.split(":", 1)[1]
+    truth, truth_why = _derivative_truth(scene, states)
 
     def evaluate() -> tuple[dict, ForceScale]:
         model = engine_for(scene.reference).build_joint_dynamics(scene.chain, method, scene.gravity_world)
@@ -144,15 +163,15 @@ def prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_fa
                                            lambda: engine_for(scene.reference).supports_joint_dynamics(scene.chain,
                                                                                                       method), evaluate)
     if evaluated is None:
-        return _JointDynamicsShared(states, None, problem)
+        return _JointDynamicsShared(states, None, problem, truth=truth, truth_problem=truth_why)
     values, scale = cast(tuple[dict, ForceScale], evaluated)
     built, why = _reported(lambda: engine_for(scene.reference).build_joint_dynamics(scene.chain, method,
                                                                                    scene.gravity_world), label)
     if built is None:
-        return _JointDynamicsShared(states, values, problem, scale, None, why, None, why)
+        return _JointDynamicsShared(states, values, problem, scale, None, why, None, why, truth, truth_why)
     groups, why = _reported(lambda: built.rigid_groups(configurations(scene.chain.joint_values(states[0]))), label)
     joints, joints_why = _reported(built.compiled_joints, label)
-    return _JointDynamicsShared(states, values, problem, scale, groups, why, joints, joints_why)
+    return _JointDynamicsShared(states, values, problem, scale, groups, why, joints, joints_why, truth, truth_why)
 
 
 def _reported(report: Callable[[], Any], label: str) -> tuple[Any, str]:
@@ -163,6 +182,22 @@ def _reported(report: Callable[[], Any], label: str) -> tuple[Any, str]:
         return None, f"the reference {label} reports no compiled model: {err}"
     except Exception as err:  # noqa: BLE001 - a user's reference: its model rows say why
         return None, f"the reference {label}'s compiled model could not be read: {error_text(err)}"
+
+
+def _derivatives(model: JointDynamicsModel, shared: _JointDynamicsShared, mass: np.ndarray) -> dict[str, Measured]:
+    """The derivative rows of ``model`` against the complex-step truth (n/a with why where there is none or the engine
+    reports none)."""
+    if shared.truth is None:
+        return _not_measured(DERIVATIVE_METRICS, shared.truth_problem)
+    q, qd, _, tau = shared.states
+    try:
+        own = model.derivatives(q, qd, tau)
+    except NotImplementedError as err:
+        return _not_measured(DERIVATIVE_METRICS, str(err))
+    bad = [name for name in PARTIALS if getattr(own, name) is not None and not np.all(np.isfinite(getattr(own, name)))]
+    if bad:
+        raise ValueError(f"non-finite {', '.join(bad)}")
+    return derivative_errors(own, shared.truth, mass)
 
 
 def _not_measured(metrics: dict[str, str], why: str) -> dict[str, Measured]:
@@ -233,6 +268,7 @@ def _joint_dynamics_rows(scene: JointDynamicsScene, engine: Engine, case: Case, 
         scale = (shared.scale if shared.scale is not None  # else its own: identities need no reference
                  else _force_scale(scene, engine, case.integrator, model, shared.states, own))
         values.update(identities(model, scene.chain, shared.states, own, scale, scene.gravity_world))
+        values.update(_derivatives(model, shared, own["M"]))
     except Exception as err:  # noqa: BLE001 - reported in the rows
         return case.rows(JOINT_DYNAMICS_METRICS, FAILED, error_text(err))
     detail = ("this is the reference; " if is_reference else "") + model.detail

@@ -37,9 +37,11 @@ from simparity.comparisons.measure.joint_force_scale import ForceScale
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointDynamicsModel
 from simparity.core.model.metric_catalogue import (
+    ABA_DERIVATIVE_ERROR_MAX,
     BASE_MOMENTUM_RESIDUAL,
     BIAS_FORCE_ERROR_MAX,
     CORIOLIS_SKEW_RESIDUAL,
+    DERIVATIVE_IDENTITY_RESIDUAL,
     FORWARD_DYNAMICS_ERROR_MAX,
     GRAVITY_EQUIVALENCE_RESIDUAL,
     GRAVITY_IDENTITY_RESIDUAL,
@@ -49,6 +51,7 @@ from simparity.core.model.metric_catalogue import (
     MASS_MATRIX_ASYMMETRY,
     MASS_MATRIX_DEFINITENESS_MIN,
     MASS_MATRIX_ERROR_MAX,
+    RNEA_DERIVATIVE_ERROR_MAX,
     ROUND_TRIP_RESIDUAL,
     TIME_PER_FORWARD_DYNAMICS,
     TIME_PER_INVERSE_DYNAMICS,
@@ -72,6 +75,9 @@ JOINT_DYNAMICS_METRICS = units(
     CORIOLIS_SKEW_RESIDUAL,
     GRAVITY_EQUIVALENCE_RESIDUAL,
     BASE_MOMENTUM_RESIDUAL,
+    RNEA_DERIVATIVE_ERROR_MAX,
+    ABA_DERIVATIVE_ERROR_MAX,
+    DERIVATIVE_IDENTITY_RESIDUAL,
     TIME_PER_MASS_MATRIX,
     TIME_PER_INVERSE_DYNAMICS,
     TIME_PER_FORWARD_DYNAMICS,

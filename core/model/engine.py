@@ -16,6 +16,7 @@ import numpy as np
 
 from simparity.core.model.errors import NotBatchedError, SimparityError
 from simparity.core.model.ik_problem import IKTolerances
+from simparity.core.model.derivatives import DynamicsDerivatives
 from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.ik_result import IKResult
 from simparity.core.model.scenes.chain import Chain
@@ -306,6 +307,13 @@ class JointDynamicsModel(abc.ABC):
         every link's. Optional: checked against M's base rows on a floating base (``base_momentum_residual``), n/a
         where an engine raises NotImplementedError."""
         raise NotImplementedError(f"{type(self).__name__} does not report the robot's momentum (momentum)")
+
+    def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
+        """The partial derivatives of inverse dynamics at (q, q̇, q̈ = its forward dynamics of tau) and of forward
+        dynamics at (q, q̇, tau), B states (:class:`core.model.derivatives.DynamicsDerivatives`; the damping's D in
+        ∂τ/∂q̇). Optional: checked against the complex-step truth (``*_derivative_error_max``), n/a where an engine
+        raises NotImplementedError."""
+        raise NotImplementedError(f"{type(self).__name__} does not report derivatives of its dynamics (derivatives)")
 
     def compiled_joints(self) -> CompiledJoints:
         """What the engine compiled of each chain joint, configuration aside: its type and limits

@@ -110,6 +110,10 @@ KINETIC_ENERGY_RESIDUAL = "kinetic_energy_residual"
 CORIOLIS_SKEW_RESIDUAL = "coriolis_skew_residual"
 GRAVITY_EQUIVALENCE_RESIDUAL = "gravity_equivalence_residual"
 BASE_MOMENTUM_RESIDUAL = "base_momentum_residual"
+# Derivatives of the dynamics against the complex-step truth (issue #44).
+RNEA_DERIVATIVE_ERROR_MAX = "rnea_derivative_error_max"
+ABA_DERIVATIVE_ERROR_MAX = "aba_derivative_error_max"
+DERIVATIVE_IDENTITY_RESIDUAL = "derivative_identity_residual"
 TIME_PER_MASS_MATRIX = "time_per_mass_matrix"
 TIME_PER_INVERSE_DYNAMICS = "time_per_inverse_dynamics"
 TIME_PER_FORWARD_DYNAMICS = "time_per_forward_dynamics"
@@ -214,6 +218,14 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(GRAVITY_EQUIVALENCE_RESIDUAL, DIMENSIONLESS, VALIDITY,
            theory="a floating base: h(q, 0) = -M(q)[:, base linear] g, gravity a uniform acceleration of the base: 0 up "
                   "to rounding"),
+    Metric(RNEA_DERIVATIVE_ERROR_MAX, DIMENSIONLESS, ERROR,
+           theory="dtau/dq and dtau/dqdot against the complex-step truth: rounding for analytic derivatives, the "
+                  "truncation of a finite difference's step"),
+    Metric(ABA_DERIVATIVE_ERROR_MAX, DIMENSIONLESS, ERROR,
+           theory="dqddot/dq, dqddot/dqdot, dqddot/dtau against the complex-step truth, in torque space: rounding for "
+                  "analytic derivatives"),
+    Metric(DERIVATIVE_IDENTITY_RESIDUAL, DIMENSIONLESS, VALIDITY,
+           theory="dqddot/dtau M = I with the engine's own M: 0 up to rounding"),
     Metric(BASE_MOMENTUM_RESIDUAL, DIMENSIONLESS, VALIDITY,
            theory="a floating base: M's base rows times qdot = the robot's momentum (linear, angular about the base "
                   "origin) summed from the engine's own link velocities: 0 up to rounding"),

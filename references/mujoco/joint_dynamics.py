@@ -47,6 +47,7 @@ import mujoco
 import numpy as np
 
 from simparity.core.model.engine import JointDynamicsModel
+from simparity.core.model.derivatives import DynamicsDerivatives
 from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt
@@ -114,6 +115,12 @@ class ChainModel:
                        "balanceinertia off, boundmass = boundinertia = 0, inertiafromgeom false; gravity "
                        f"{gravity}; constraints (joint limits) disabled; dof_damping and dof_armature from the "
                        "chain, frictionloss and stiffness 0")
+
+
+INVERSE_FD_STEP = 1e-6
+"""mjd_inverseFD's eps (forward differences): truncation ~ eps |d2 tau| / 2, rounding ~ eps_machine |tau| / eps."""
+FORWARD_MISSING = ("MuJoCo differentiates forward dynamics only through a time step (mjd_transitionFD): no "
+                   "continuous-time dqddot to compare")
 
 
 class MujocoJointDynamics(JointDynamicsModel):
@@ -229,3 +236,24 @@ class MujocoJointDynamics(JointDynamicsModel):
         ranges = np.array([m.jnt_range[j] for j in joints]).reshape(-1, 2)
         return CompiledJoints(np.array([m.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE for j in joints]),
                               np.where(limited, ranges[:, 0], -np.inf), np.where(limited, ranges[:, 1], np.inf))
+
+    def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
+        """``mjd_inverseFD`` (forward differences at :data:`INVERSE_FD_STEP`, constraints off, passive damping in
+        qfrc_inverse) at q̈ = ``mj_forward``'s qacc of τ; its outputs are transposed (DfDq[j, i] = ∂f_i/∂q_j), turned
+        back here. No forward-dynamics partials (:data:`FORWARD_MISSING`)."""
+        m, d = self.model, self.data
+        if not np.array_equal(self.state_dof, self.dof):
+            raise NotImplementedError("MuJoCo's floating-base derivatives are not converted to the project's "
+                                      "convention yet")
+        accelerations = self.forward_dynamics(q, qdot, tau)
+        nv, index = m.nv, np.ix_(self.dof, self.dof)
+        by_q, by_v = np.zeros((nv, nv)), np.zeros((nv, nv))
+        out = [np.empty((len(q), len(self.dof), len(self.dof))) for _ in range(2)]
+        for k, (row, rates, acceleration) in enumerate(zip(q, qdot, accelerations)):
+            d.qpos[self.qpos], d.qvel[self.dof] = row, rates
+            d.qacc[:] = 0.0
+            d.qacc[self.dof] = acceleration
+            d.qfrc_applied[:] = 0.0
+            mujoco.mjd_inverseFD(m, d, INVERSE_FD_STEP, False, by_q, by_v, None, None, None, None, None)
+            out[0][k], out[1][k] = by_q.T[index], by_v.T[index]
+        return DynamicsDerivatives(out[0], out[1], forward_missing=FORWARD_MISSING)

@@ -104,3 +104,8 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
             linear = np.array(momentum.linear)
             out[k] = np.r_[linear, np.array(momentum.angular) + np.cross(self.data.com[0], linear)]
         return out
+
+    def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray):
+        """Not yet on a floating base: Pinocchio's derivatives are in its free flyer's LOCAL tangent, not converted."""
+        raise NotImplementedError("Pinocchio's floating-base derivatives are not converted to the project's convention "
+                                  "yet")

@@ -33,6 +33,7 @@ import numpy as np
 import pinocchio as pin
 
 from simparity.core.model.engine import JointDynamicsModel
+from simparity.core.model.derivatives import DynamicsDerivatives
 from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt
@@ -207,3 +208,21 @@ class PinocchioJointDynamics(JointDynamicsModel):
         upper = np.array([self.model.upperPositionLimit[j.idx_q] for j in joints])
         return CompiledJoints(np.array(["Prismatic" in name or name.startswith("JointModelP") for name in names]),
                               np.where(unbounded, -np.inf, lower), np.where(unbounded, np.inf, upper))
+
+    def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
+        """Pinocchio's analytic derivatives: ``computeRNEADerivatives`` at q̈ = ``aba``(τ - D q̇) (+ D on ∂τ/∂q̇) and
+        ``computeABADerivatives`` at τ - D q̇ (∂q̈/∂q̇ - ∂q̈/∂τ D); a continuous joint on its angle (the tangent)."""
+        index = np.ix_(self.idx_v, self.idx_v)
+        damping = np.diag(self.damping)
+        out = [np.empty((len(q), len(self.idx_v), len(self.idx_v))) for _ in range(5)]
+        accelerations = self.forward_dynamics(q, qdot, tau)
+        for k, (row, rates, force, acceleration) in enumerate(zip(q, qdot, tau, accelerations)):
+            configuration, velocity = self._configuration(row), self._velocity(rates)
+            dq, dv, _ = pin.computeRNEADerivatives(self.model, self.data, configuration, velocity,
+                                                  self._velocity(acceleration))
+            out[0][k], out[1][k] = np.asarray(dq)[index], np.asarray(dv)[index] + damping
+            aq, av, atau = pin.computeABADerivatives(self.model, self.data, configuration, velocity,
+                                                    self._velocity(force - self.damping * rates))
+            atau = np.asarray(atau)[index]
+            out[2][k], out[3][k], out[4][k] = np.asarray(aq)[index], np.asarray(av)[index] - atau @ damping, atau
+        return DynamicsDerivatives(out[0], out[1], out[2], out[3], out[4])

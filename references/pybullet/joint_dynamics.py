@@ -314,3 +314,8 @@ class PybulletJointDynamics(JointDynamicsModel):
         unlimited = upper < lower
         return CompiledJoints(np.array([i[2] == pybullet.JOINT_PRISMATIC for i in info]),
                               np.where(unlimited, -np.inf, lower), np.where(unlimited, np.inf, upper))
+
+    def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray):
+        """PyBullet has none: its API computes no derivative of its dynamics."""
+        raise NotImplementedError("PyBullet exposes no derivatives of its dynamics (no analytic or finite-difference "
+                                  "Jacobian of calculateInverseDynamics or of its step)")

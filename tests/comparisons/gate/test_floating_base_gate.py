@@ -6,13 +6,11 @@ faithful copy of the same adapter passes beside the built-in engines."""
 
 from __future__ import annotations
 
-import sys
-
 import pytest
 
-from simparity.comparisons.cli.main import main
+from tests.helpers import PLANTED_ENGINE_FACTORY, assert_caught, run_planted
 
-PLANTED = '''
+PLANTED = PLANTED_ENGINE_FACTORY + '''
 import numpy as np
 
 from simparity.references.common.floating_base import base_rotations, turned_base
@@ -77,35 +75,17 @@ class EnergyUnturned(MujocoFloatingDynamics):
         return MujocoJointDynamics.link_kinetic_energy(self, q, qdot)
 
 
-def _engine(model_class, engine_name):
-    class Planted(MujocoEngine):
-        name = engine_name
-
-        def build_joint_dynamics(self, chain, method, gravity_world):
-            return model_class(chain, gravity_world)
-
-    Planted.__name__ = model_class.__name__ + "Engine"
-    return Planted
-
-
-FaithfulEngine = _engine(Faithful, "mujoco-copy")
-BodyAngularEngine = _engine(BodyAngular, "mujoco-body-angular")
-UnturnedMassEngine = _engine(UnturnedMass, "mujoco-unturned-mass")
-LocalLinearEngine = _engine(LocalLinear, "mujoco-local-linear")
-XyzwQuatEngine = _engine(XyzwQuat, "mujoco-xyzw")
-EnergyUnturnedEngine = _engine(EnergyUnturned, "mujoco-energy-unturned")
+FaithfulEngine = _engine(MujocoEngine, Faithful, "mujoco-copy")
+BodyAngularEngine = _engine(MujocoEngine, BodyAngular, "mujoco-body-angular")
+UnturnedMassEngine = _engine(MujocoEngine, UnturnedMass, "mujoco-unturned-mass")
+LocalLinearEngine = _engine(MujocoEngine, LocalLinear, "mujoco-local-linear")
+XyzwQuatEngine = _engine(MujocoEngine, XyzwQuat, "mujoco-xyzw")
+EnergyUnturnedEngine = _engine(MujocoEngine, EnergyUnturned, "mujoco-energy-unturned")
 '''
 
 
 def _run(tmp_path, monkeypatch, capsys, plugin: str) -> tuple[int, list[str], str]:
-    monkeypatch.syspath_prepend(str(tmp_path))
-    monkeypatch.setenv("PYTHONPATH", f"{tmp_path}:{':'.join(sys.path)}")  # the probes and workers import it
-    (tmp_path / "planted_floating.py").write_text(PLANTED, encoding="utf-8")
-    code = main(["run", "solo12-floating-dynamics", "--quick", "--check", "--engines",
-                 f"core,mujoco,pybullet,pinocchio,planted_floating:{plugin}", "--out", str(tmp_path / "run"),
-                 "--history", str(tmp_path / "h.db"), "--no-report", "--jobs", "1"])
-    out = capsys.readouterr().out
-    return code, [line for line in out.splitlines() if line.startswith("violation: ")], out
+    return run_planted(tmp_path, monkeypatch, capsys, "planted_floating", PLANTED, "solo12-floating-dynamics", plugin)
 
 
 @pytest.mark.slow
@@ -118,10 +98,7 @@ def _run(tmp_path, monkeypatch, capsys, plugin: str) -> tuple[int, list[str], st
 ])
 def test_a_planted_floating_base_convention_bug_is_caught_naming_the_engine(tmp_path, monkeypatch, capsys, plugin,
                                                                            name, metric):
-    code, violations, out = _run(tmp_path, monkeypatch, capsys, plugin)
-    assert code == 1, out[-2000:]
-    assert {line.split()[2] for line in violations} == {name}, violations
-    assert any(metric in line for line in violations), violations
+    assert_caught(_run(tmp_path, monkeypatch, capsys, plugin), name, metric)
 
 
 @pytest.mark.slow

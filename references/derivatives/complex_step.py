@@ -1,0 +1,223 @@
+"""The truth of the dynamics' derivatives (issue #44): an RNEA of the references' own, written to run on complex
+numbers, differentiated by complex step.
+
+Complex-step differentiation: for f analytic and real on real inputs, df/dx = Im f(x + i h) / h + O(h^2) with no
+subtraction, so h = :data:`STEP` (1e-30) leaves the derivative exact to the rounding of f itself. The RNEA here is
+complex-safe: only +, -, *, sin, cos and matrix products (no ``abs``, ``np.linalg.norm``, ``cholesky``, ``vdot`` or
+conjugation; no comparison on a perturbed value; nothing assigned into a float array), and it runs with
+``ComplexWarning`` as an error (:func:`rnea`).
+
+The model is NOT core's: it is the kinematic tree Pinocchio's URDF parser compiled from the file every engine reads
+(:func:`references.pinocchio.joint_dynamics.chain_model`: joint placements, motion subspaces, spatial inertias with
+fixed and held links merged, armature), read here as numbers, and every algorithm below is this module's own
+(Featherstone's RNEA, spatial vectors (angular, linear) in body coordinates). Damping D q̇ is added to τ.
+
+From it, batched over states and over the 3n complex directions at once:
+∂τ/∂q, ∂τ/∂q̇ (damping included), M = ∂τ/∂q̈ (exact: τ is linear in q̈), and forward dynamics' derivatives by
+∂q̈/∂x = -M⁻¹ ∂τ/∂x at q̈ = M⁻¹ (τ - h), ∂q̈/∂τ = M⁻¹.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from simparity.core.model.derivatives import DynamicsDerivatives
+from simparity.core.model.scenes.chain import Chain
+from simparity.references.common.scene_inputs import own_chain
+from simparity.references.pinocchio.joint_dynamics import chain_model
+
+STEP = 1e-30
+"""The complex step h: far below any rounding of q, so h^2 terms vanish; Im f(x + i h) / h has no cancellation."""
+
+
+@dataclass(frozen=True)
+class Tree:
+    """A kinematic tree as arrays (body i's parent numbered before it), read from Pinocchio's compiled model.
+
+    Attributes
+    ----------
+    parents : list of int
+        -1 for a body on the fixed base.
+    rotation, translation : (N, 3, 3), (N, 3) ndarray
+        Each joint frame's placement in its parent body's frame (Pinocchio's ``jointPlacements``).
+    axis : (N, 3) ndarray
+        The joint's unit axis in its own frame.
+    revolute : (N,) bool ndarray
+    inertia : (N, 6, 6) ndarray
+        Each body's spatial inertia about its origin, body axes, (angular, linear) order.
+    armature, damping : (N,) ndarray
+    gravity : (3,) ndarray
+        [m/s^2] in the base frame.
+    columns : (N,) int ndarray
+        The chain joint each body is (its velocity index among the chain's joints).
+    """
+
+    parents: list[int]
+    rotation: np.ndarray
+    translation: np.ndarray
+    axis: np.ndarray
+    revolute: np.ndarray
+    inertia: np.ndarray
+    armature: np.ndarray
+    damping: np.ndarray
+    gravity: np.ndarray
+    columns: np.ndarray
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) [v]x of (..., 3), complex-safe."""
+    zero = np.zeros_like(v[..., 0])
+    return np.stack([np.stack([zero, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], zero, -v[..., 0]], -1),
+                     np.stack([-v[..., 1], v[..., 0], zero], -1)], -2)
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a x b for (..., 3), written out (complex-safe)."""
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], -1)
+
+
+def tree_from_chain(chain: Chain, gravity_world: np.ndarray | None) -> Tree:
+    """The chain's tree as Pinocchio's parser compiled it (fixed base only: a floating base is refused)."""
+    if chain.floating_base:
+        raise ValueError("the complex-step truth has no floating base yet")
+    built = chain_model(own_chain(chain), gravity_world)  # the scene's numbers as given, never core's derivations
+    model = built.model
+    data = model.createData()
+    pin.forwardKinematics(model, data, pin.neutral(model))
+    bodies = range(1, model.njoints)
+    axes, revolute = [], []
+    for i in bodies:
+        joint = model.joints[i]
+        joint_data = joint.createData()
+        joint.calc(joint_data, pin.neutral(model))
+        subspace = np.asarray(joint_data.S).reshape(6, -1)[:, 0]  # Pinocchio's order: (linear, angular)
+        turns = bool(np.any(subspace[3:] != 0))
+        axes.append(subspace[3:] if turns else subspace[:3])
+        revolute.append(turns)
+    inertia = np.array([_spatial(model.inertias[i]) for i in bodies])
+    column_of = {int(j): k for k, j in enumerate(built.joint_ids)}
+    return Tree(parents=[int(model.parents[i]) - 1 for i in bodies],
+                rotation=np.array([model.jointPlacements[i].rotation for i in bodies]),
+                translation=np.array([model.jointPlacements[i].translation for i in bodies]),
+                axis=np.array(axes), revolute=np.array(revolute), inertia=inertia,
+                armature=np.array([model.armature[model.joints[i].idx_v] for i in bodies]),
+                damping=np.array([built.damping[column_of[i]] for i in bodies]),
+                gravity=np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float),
+                columns=np.array([column_of[i] for i in bodies]))
+
+
+def _spatial(inertia) -> np.ndarray:
+    """(6, 6) spatial inertia about the body origin, (angular, linear), from Pinocchio's (mass, lever, I about the
+    centre of mass)."""
+    mass, lever = float(inertia.mass), np.asarray(inertia.lever, dtype=float)
+    c = _skew(lever)
+    out = np.zeros((6, 6))
+    out[:3, :3] = np.asarray(inertia.inertia) - mass * c @ c
+    out[:3, 3:], out[3:, :3], out[3:, 3:] = mass * c, -mass * c, mass * np.eye(3)
+    return out
+
+
+def _joint(tree: Tree, i: int, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(R (K, 3, 3), p (K, 3)): body i's axes and origin in its parent's frame at joint values q (K,) (complex)."""
+    base_rotation, base_translation, axis = tree.rotation[i], tree.translation[i], tree.axis[i]
+    if tree.revolute[i]:
+        k = _skew(axis)
+        turn = (np.eye(3) + np.sin(q)[:, None, None] * k + (1 - np.cos(q))[:, None, None] * (k @ k))
+        return base_rotation @ turn, np.broadcast_to(base_translation, (len(q), 3)) + 0 * q[:, None]
+    slide = q[:, None] * (base_rotation @ axis)
+    return np.broadcast_to(base_rotation, (len(q), 3, 3)) + 0 * q[:, None, None], base_translation + slide
+
+
+def _to_child(rotation: np.ndarray, position: np.ndarray, motion: np.ndarray) -> np.ndarray:
+    """A motion vector (K, 6) of the parent in the child's coordinates: (R^T w, R^T (v - p x w))."""
+    w, v = motion[:, :3], motion[:, 3:]
+    return np.concatenate([np.einsum("kji,kj->ki", rotation, w),
+                           np.einsum("kji,kj->ki", rotation, v - _cross(position, w))], axis=1)
+
+
+def _to_parent(rotation: np.ndarray, position: np.ndarray, force: np.ndarray) -> np.ndarray:
+    """A force (K, 6) of the child in the parent's coordinates: (R n + p x R f, R f)."""
+    turned_force = np.einsum("kij,kj->ki", rotation, force[:, 3:])
+    return np.concatenate([np.einsum("kij,kj->ki", rotation, force[:, :3]) + _cross(position, turned_force),
+                           turned_force], axis=1)
+
+
+def _motion_cross(v: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """v x m for motion vectors (K, 6): (w x mw, w x mv + v x mw)."""
+    return np.concatenate([_cross(v[:, :3], m[:, :3]), _cross(v[:, :3], m[:, 3:]) + _cross(v[:, 3:], m[:, :3])], 1)
+
+
+def _force_cross(v: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """v x* f: (w x n + v x f, w x f)."""
+    return np.concatenate([_cross(v[:, :3], f[:, :3]) + _cross(v[:, 3:], f[:, 3:]), _cross(v[:, :3], f[:, 3:])], 1)
+
+
+def rnea(tree: Tree, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
+    """τ (K, n) = M q̈ + h + D q̇ at K states (K, n) of the chain's joints (real or complex), ComplexWarning an error."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", np.exceptions.ComplexWarning)
+        n = len(tree.parents)
+        body_q, body_qd, body_qdd = (x[:, tree.columns] for x in (q, qdot, qddot))
+        dtype = np.result_type(q, qdot, qddot, float)
+        count = len(q)
+        base_acceleration = np.zeros((count, 6), dtype=dtype)
+        base_acceleration[:, 3:] = -tree.gravity
+        frames: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        velocities: list[tuple[np.ndarray, np.ndarray]] = []
+        forces: list[np.ndarray] = []
+        for i in range(n):
+            rotation, position = _joint(tree, i, body_q[:, i])
+            subspace = np.zeros(6)
+            subspace[:3 if tree.revolute[i] else 6][-3:] = tree.axis[i]
+            parent = tree.parents[i]
+            parent_velocity = np.zeros((count, 6), dtype=dtype) if parent < 0 else velocities[parent][0]
+            parent_acceleration = base_acceleration if parent < 0 else velocities[parent][1]
+            moving = subspace[None, :] * body_qd[:, i, None]
+            v = _to_child(rotation, position, parent_velocity) + moving
+            a = (_to_child(rotation, position, parent_acceleration) + subspace[None, :] * body_qdd[:, i, None]
+                 + _motion_cross(v, moving))
+            inertia_v = np.einsum("ij,kj->ki", tree.inertia[i], v)
+            forces.append(np.einsum("ij,kj->ki", tree.inertia[i], a) + _force_cross(v, inertia_v))
+            frames.append((rotation, position, subspace))
+            velocities.append((v, a))
+        tau = np.zeros((count, n), dtype=dtype)
+        for i in reversed(range(n)):
+            rotation, position, subspace = frames[i]
+            tau[:, tree.columns[i]] = (forces[i] @ subspace + tree.armature[i] * body_qdd[:, i]
+                                       + tree.damping[i] * body_qd[:, i])
+            if tree.parents[i] >= 0:
+                forces[tree.parents[i]] = forces[tree.parents[i]] + _to_parent(rotation, position, forces[i])
+        return tau
+
+
+def derivatives(tree: Tree, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
+    """The truth at B states (B, n): RNEA's derivatives at q̈ = the model's forward dynamics of ``tau``, and forward
+    dynamics' (the module docstring), every partial (B, n, n), column j the derivative by joint j's variable."""
+    count, n = q.shape
+    mass, bias = _mass_and_bias(tree, q, qdot)
+    qddot = np.linalg.solve(mass, (tau - bias)[:, :, None])[:, :, 0]
+    # 3n directions per state: q_j, then qdot_j, then qddot_j, each perturbed by i h
+    stacked = [np.repeat(x, 3 * n, axis=0).astype(complex) for x in (q, qdot, qddot)]
+    for part in range(3):
+        offsets = np.zeros((3 * n, n))
+        offsets[part * n:(part + 1) * n] = np.eye(n)
+        stacked[part] = stacked[part] + 1j * STEP * np.tile(offsets, (count, 1))
+    slopes = (rnea(tree, *stacked).imag / STEP).reshape(count, 3, n, n).transpose(0, 1, 3, 2)  # [b, x, i, j]
+    dtau_dq, dtau_dqdot, exact_mass = slopes[:, 0], slopes[:, 1], slopes[:, 2]
+    inverse = np.linalg.inv(exact_mass)
+    return DynamicsDerivatives(dtau_dq=dtau_dq, dtau_dqdot=dtau_dqdot, dqddot_dq=-inverse @ dtau_dq,
+                               dqddot_dqdot=-inverse @ dtau_dqdot, dqddot_dtau=inverse)
+
+
+def _mass_and_bias(tree: Tree, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(M (B, n, n), h + D q̇ (B, n)) from the real RNEA: h at q̈ = 0, M's columns at q̈ = e_j without velocity."""
+    count, n = q.shape
+    bias = rnea(tree, q, qdot, np.zeros_like(q)).real
+    gravity = rnea(tree, q, np.zeros_like(q), np.zeros_like(q)).real
+    columns = rnea(tree, np.repeat(q, n, axis=0), np.zeros((count * n, n)), np.tile(np.eye(n), (count, 1))).real
+    return columns.reshape(count, n, n).transpose(0, 2, 1) - gravity[:, :, None], bias
