@@ -395,3 +395,44 @@ def assert_caught(result: tuple[int, list[str], str], engine: str, metric: str) 
     assert code == 1, out[-2000:]
     assert {line.split()[2] for line in violations} == {engine}, violations
     assert any(metric in line for line in violations), violations
+
+
+SPONG = {"m1": 1.3, "m2": 0.8, "l1": 0.9, "lc1": 0.4, "lc2": 0.35, "i1": 0.07, "i2": 0.03, "d1": 0.2, "d2": 0.1}
+"""The planar elbow arm of :func:`spong_chain`: masses [kg], lengths [m], inertias [kg m^2], damping [N m s/rad]."""
+SPONG_GRAVITY = 9.81
+"""[m/s^2] along -y."""
+
+
+def spong_chain():
+    """Spong's planar elbow arm about z (gravity along -y in the tests): centres of mass on their links' x axes."""
+    from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
+
+    def link(mass, lc, inertia):
+        return LinkInertia(mass, np.array([lc, 0.0, 0.0]), np.diag([inertia, inertia, inertia]))
+
+    z = np.array([0.0, 0.0, 1.0])
+    return Chain("spong", (
+        Joint("q1", "revolute", z, np.zeros(3), np.eye(3), link=link(SPONG["m1"], SPONG["lc1"], SPONG["i1"]),
+              damping=SPONG["d1"]),
+        Joint("q2", "revolute", z, np.array([SPONG["l1"], 0.0, 0.0]), np.eye(3),
+              link=link(SPONG["m2"], SPONG["lc2"], SPONG["i2"]), damping=SPONG["d2"])))
+
+
+def spong_partials(q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(dtau/dq, dtau/dqdot) (B, 2, 2) of tau = M(q2) qdd + C(q, qd) qd + g(q) + D qd of :func:`spong_chain` under
+    gravity -y (Spong, Hutchinson and Vidyasagar, the elbow manipulator), differentiated by hand."""
+    m1, m2, l1, lc1, lc2 = (SPONG[k] for k in ("m1", "m2", "l1", "lc1", "lc2"))
+    g0 = SPONG_GRAVITY
+    b = m2 * l1 * lc2
+    s2, c2 = np.sin(q[:, 1]), np.cos(q[:, 1])
+    s1, s12 = np.sin(q[:, 0]), np.sin(q[:, 0] + q[:, 1])
+    weight1, weight2 = (m1 * lc1 + m2 * l1) * g0, m2 * lc2 * g0
+    by_q = np.stack([
+        np.stack([-weight1 * s1 - weight2 * s12,
+                  -2 * b * s2 * qdd[:, 0] - b * s2 * qdd[:, 1] - b * c2 * (2 * qd[:, 0] * qd[:, 1] + qd[:, 1] ** 2)
+                  - weight2 * s12], -1),
+        np.stack([-weight2 * s12, -b * s2 * qdd[:, 0] + b * c2 * qd[:, 0] ** 2 - weight2 * s12], -1)], 1)
+    by_qd = np.stack([
+        np.stack([-2 * b * s2 * qd[:, 1] + SPONG["d1"], -2 * b * s2 * (qd[:, 0] + qd[:, 1])], -1),
+        np.stack([2 * b * s2 * qd[:, 0], np.full(len(q), SPONG["d2"])], -1)], 1)
+    return by_q, by_qd

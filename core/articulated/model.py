@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 from simparity.core.articulated.chain_arrays import chain_arrays
+from simparity.core.articulated.derivatives import rnea_derivatives
 from simparity.core.articulated.floating import FloatingRecursiveDynamics
 from simparity.core.articulated.groups import chain_compiled_joints, chain_rigid_groups
 from simparity.core.articulated.jacobian_sum import JacobianSum
 from simparity.core.articulated.recursive import Recursive
+from simparity.core.model.derivatives import DynamicsDerivatives
 from simparity.core.model.engine import JointDynamicsModel
 from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
@@ -47,9 +49,11 @@ class RecursiveDynamics(JointDynamicsModel):
 
     def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
         self._n, self._chain = chain.n_joints, chain
-        self._algorithms = Recursive(chain_arrays(chain), np.zeros(3) if gravity_world is None else gravity_world)
+        self._gravity = np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float)
+        self._algorithms = Recursive(chain_arrays(chain), self._gravity)
         self.detail = ("in-house recursive (Featherstone): CRBA for M, RNEA for h and tau, ABA for qddot; "
-                       "batched component-major, body frames with z along the joint axis")
+                       "batched component-major, body frames with z along the joint axis; derivatives: RNEA in "
+                       "forward mode, ABA's as -M^-1 dtau/dx")
 
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         return self._algorithms.mass_matrix(_rows(q, self._n)).transpose(2, 0, 1)
@@ -74,6 +78,15 @@ class RecursiveDynamics(JointDynamicsModel):
 
     def compiled_joints(self) -> CompiledJoints:
         return chain_compiled_joints(self._chain)
+
+    def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
+        """RNEA differentiated in forward mode (:mod:`core.articulated.derivatives`) at q̈ = ABA(τ); forward dynamics'
+        partials -M⁻¹ ∂τ/∂x with core's CRBA M."""
+        q, qdot, tau = (_batch(x, self._n) for x in (q, qdot, tau))
+        qddot = self.forward_dynamics(q, qdot, tau)
+        by_q, by_qdot = rnea_derivatives(self._algorithms.arrays, self._gravity, q, qdot, qddot)
+        inverse = np.linalg.inv(self.mass_matrix(q))
+        return DynamicsDerivatives(by_q, by_qdot, -inverse @ by_q, -inverse @ by_qdot, inverse)
 
 
 class JacobianSumDynamics(JointDynamicsModel):

@@ -118,7 +118,10 @@ class ChainModel:
 
 
 INVERSE_FD_STEP = 1e-6
-"""mjd_inverseFD's eps (forward differences): truncation ~ eps |d2 tau| / 2, rounding ~ eps_machine |tau| / eps."""
+"""mjd_inverseFD's eps for q [rad or m] (forward differences): truncation ~ eps |d2 tau| / 2, rounding ~
+eps_machine |tau| / eps. For qdot it is this fraction of the state's largest |qdot| (:meth:`MujocoJointDynamics.derivatives`):
+tau is quadratic in qdot, so a forward difference's relative error is ~ eps / |qdot|, and an absolute step would make it
+depend on the unit of time (measured: 1000 x worse in milliseconds)."""
 FORWARD_MISSING = ("MuJoCo differentiates forward dynamics only through a time step (mjd_transitionFD): no "
                    "continuous-time dqddot to compare")
 
@@ -238,8 +241,8 @@ class MujocoJointDynamics(JointDynamicsModel):
                               np.where(limited, ranges[:, 0], -np.inf), np.where(limited, ranges[:, 1], np.inf))
 
     def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
-        """``mjd_inverseFD`` (forward differences at :data:`INVERSE_FD_STEP`, constraints off, passive damping in
-        qfrc_inverse) at q̈ = ``mj_forward``'s qacc of τ; its outputs are transposed (DfDq[j, i] = ∂f_i/∂q_j), turned
+        """``mjd_inverseFD`` (forward differences at :data:`INVERSE_FD_STEP` for q, that fraction of the largest |qdot|
+        for qdot: two calls; constraints off, passive damping in qfrc_inverse) at q̈ = ``mj_forward``'s qacc of τ; its outputs are transposed (DfDq[j, i] = ∂f_i/∂q_j), turned
         back here. No forward-dynamics partials (:data:`FORWARD_MISSING`)."""
         m, d = self.model, self.data
         if not np.array_equal(self.state_dof, self.dof):
@@ -254,6 +257,9 @@ class MujocoJointDynamics(JointDynamicsModel):
             d.qacc[:] = 0.0
             d.qacc[self.dof] = acceleration
             d.qfrc_applied[:] = 0.0
-            mujoco.mjd_inverseFD(m, d, INVERSE_FD_STEP, False, by_q, by_v, None, None, None, None, None)
+            speed = float(np.max(np.abs(rates), initial=0.0))
+            mujoco.mjd_inverseFD(m, d, INVERSE_FD_STEP, False, by_q, None, None, None, None, None, None)
+            mujoco.mjd_inverseFD(m, d, INVERSE_FD_STEP * (speed if speed > 0 else 1.0), False, None, by_v, None, None,
+                                 None, None, None)
             out[0][k], out[1][k] = by_q.T[index], by_v.T[index]
         return DynamicsDerivatives(out[0], out[1], forward_missing=FORWARD_MISSING)

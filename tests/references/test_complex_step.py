@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.scenes import library
-from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
 from simparity.references.derivatives.complex_step import _mass_and_bias, derivatives, rnea, tree_from_chain
 from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics
+from tests.helpers import SPONG_GRAVITY, spong_chain, spong_partials
 
 ROUNDING = 1e-13
 """Two double evaluations of the same sums of O(n^2) products, relative to the largest entry (measured <= 3e-14)."""
@@ -54,44 +54,16 @@ def test_its_derivatives_match_central_differences(case):
     assert np.max(np.abs(exact_mass - mass)) <= ROUNDING * np.max(np.abs(mass))  # dtau/dqddot = M
 
 
-def _spong(m1=1.3, m2=0.8, l1=0.9, lc1=0.4, lc2=0.35, i1=0.07, i2=0.03, damping=(0.2, 0.1)) -> Chain:
-    """Spong's planar elbow arm about z, gravity along -y: every centre of mass on its link's x axis."""
-    def link(mass, lc, inertia):
-        return LinkInertia(mass, np.array([lc, 0.0, 0.0]), np.diag([inertia, inertia, inertia]))
-
-    return Chain("spong", (
-        Joint("q1", "revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.eye(3), link=link(m1, lc1, i1),
-              damping=damping[0]),
-        Joint("q2", "revolute", np.array([0.0, 0.0, 1.0]), np.array([l1, 0.0, 0.0]), np.eye(3), link=link(m2, lc2, i2),
-              damping=damping[1])))
-
-
 def test_the_planar_arm_s_closed_form_derivatives_to_rounding():
-    """tau = M(q2) qdd + C(q, qd) qd + g(q) + D qd of the elbow manipulator (Spong, Hutchinson and Vidyasagar),
-    differentiated by hand."""
-    m1, m2, l1, lc1, lc2, i1, i2, g0 = 1.3, 0.8, 0.9, 0.4, 0.35, 0.07, 0.03, 9.81
-    chain = _spong()
-    tree = tree_from_chain(chain, np.array([0.0, -g0, 0.0]))
+    """The elbow manipulator's partials differentiated by hand (tests.helpers.spong_partials)."""
+    tree = tree_from_chain(spong_chain(), np.array([0.0, -SPONG_GRAVITY, 0.0]))
     rng = np.random.default_rng(44)
     q, qd, tau = (rng.uniform(-2, 2, (5, 2)) for _ in range(3))
     truth = derivatives(tree, q, qd, tau)
     mass, bias = _mass_and_bias(tree, q, qd)
-    qdd = np.linalg.solve(mass, (tau - bias)[:, :, None])[:, :, 0]
-    b = m2 * l1 * lc2
-    s2, c2 = np.sin(q[:, 1]), np.cos(q[:, 1])
-    s1, s12 = np.sin(q[:, 0]), np.sin(q[:, 0] + q[:, 1])
-    weight1, weight2 = (m1 * lc1 + m2 * l1) * g0, m2 * lc2 * g0
-    by_q = np.stack([
-        np.stack([-weight1 * s1 - weight2 * s12,
-                  -2 * b * s2 * qdd[:, 0] - b * s2 * qdd[:, 1] - b * c2 * (2 * qd[:, 0] * qd[:, 1] + qd[:, 1] ** 2)
-                  - weight2 * s12], -1),
-        np.stack([-weight2 * s12, -b * s2 * qdd[:, 0] + b * c2 * qd[:, 0] ** 2 - weight2 * s12], -1)], 1)
-    by_qd = np.stack([
-        np.stack([-2 * b * s2 * qd[:, 1] + 0.2, -2 * b * s2 * (qd[:, 0] + qd[:, 1])], -1),
-        np.stack([2 * b * s2 * qd[:, 0], np.full(len(q), 0.1)], -1)], 1)
+    by_q, by_qd = spong_partials(q, qd, np.linalg.solve(mass, (tau - bias)[:, :, None])[:, :, 0])
     assert np.max(np.abs(truth.dtau_dq - by_q)) <= 1e-14 * np.max(np.abs(by_q))
     assert np.max(np.abs(truth.dtau_dqdot - by_qd)) <= 1e-14 * np.max(np.abs(by_qd))
-    del i1, i2  # the inertias enter M, not these partials at the solved qddot
 
 
 def test_it_is_complex_safe():

@@ -182,6 +182,13 @@ KNOWN_METRIC_FINDINGS: tuple[KnownFinding, ...] = ()
 """Absolute choices in simparity's judging code: remove an entry when its choice is made relative."""
 
 KNOWN_ENGINE_FINDINGS: tuple[KnownFinding, ...] = (
+    KnownFinding(("*-dynamics",), ("mujoco",), ANY, ("translate", "rotate", "rescale"), ("rnea_derivative_error_max",), (
+        "MuJoCo's mjd_inverseFD is forward differences (references/mujoco/joint_dynamics.py INVERSE_FD_STEP = 1e-6, "
+        "for qdot that fraction of the state's speed: invariant under ms): its error, truncation plus rounding "
+        "eps_machine |tau| / eps, follows the rounding of the world coordinates it runs in and a slide's unit of length "
+        "(one eps for every joint), so it is not invariant beyond its own size (scara-slow-dynamics rotate 5.9e-7 -> "
+        "5.9e-6, armature-arm-dynamics rescale 1.9e-6 -> 5.2e-7), always within the bound 1e-4"),
+        machine_dependent=True),
     KnownFinding(CONTACT_SLIDING, ("mujoco",), ANY, ("ms",), ANY, (
         "MuJoCo's constraint solver stops when its improvement (x T^-4) or gradient (x T^-2), scaled by the mean "
         "inertia only, falls below mjOption.tolerance 1e-8 (engine_solver.c mj_solCGNewton, CGsearch): in ms the "

@@ -1,0 +1,106 @@
+"""Core's analytic derivatives of its joint-space dynamics (issue #44): RNEA differentiated in forward mode, and
+forward dynamics' derivatives from them, ∂q̈/∂x = -M⁻¹ ∂τ/∂x at q̈ = ABA(τ) (the route Pinocchio takes).
+
+Forward mode carries, beside each body's velocity v_i, acceleration a_i and force f_i, their derivatives along every
+direction at once: q_j and q̇_j for each joint j (D = 2n directions), batched over states. With X_i = X_J(q_i) X_T,i the
+parent-to-body transform (:mod:`core.articulated.chain_arrays`: body frames with z along the joint axis) and S_i = e_k
+its motion subspace, dX_i/dq_i m = -S_i x (X_i m), so (Featherstone's recursions, differentiated term by term):
+
+    δv_i = X_i δv_λ - (S_i δq_i) x v_i + S_i δq̇_i                                   (S_i x S_i = 0)
+    δa_i = X_i δa_λ - (S_i δq_i) x (X_i a_λ) + δv_i x S_i q̇_i + v_i x S_i δq̇_i
+    δf_i = I_i δa_i + δv_i x* I_i v_i + v_i x* I_i δv_i
+    δτ_i = S_iᵀ δf_i + damping_i δq̇_i,      δf_λ += X_iᵀ (δf_i + (S_i δq_i) x* f_i)
+
+the last from d(X_iᵀ f)/dq_i = X_iᵀ (S_i x* f). Gravity is the base's constant acceleration -g: its derivative is 0.
+Written on plain (B, ..., 6) arrays, one body at a time; spatial vectors (angular, linear) in body coordinates.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simparity.core.articulated.chain_arrays import ChainArrays
+
+
+def motion_cross(v: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """v x m of motion vectors (..., 6), broadcast: (w x m_w, w x m_v + v_o x m_w)."""
+    w, vo = v[..., :3], v[..., 3:]
+    return np.concatenate([np.cross(w, m[..., :3]), np.cross(w, m[..., 3:]) + np.cross(vo, m[..., :3])], axis=-1)
+
+
+def force_cross(v: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """v x* f of a motion and a force vector (..., 6), broadcast: (w x n + v_o x f, w x f)."""
+    w, vo = v[..., :3], v[..., 3:]
+    return np.concatenate([np.cross(w, f[..., :3]) + np.cross(vo, f[..., 3:]), np.cross(w, f[..., 3:])], axis=-1)
+
+
+def _joint_transforms(arrays: ChainArrays, q: np.ndarray) -> np.ndarray:
+    """(B, n, 6, 6): X_i = X_J(q_i) X_T,i for B configurations (B, n)."""
+    count, n = q.shape
+    joint = np.tile(np.eye(6), (count, n, 1, 1))
+    c, s = np.cos(q), np.sin(q)
+    for i in range(n):
+        if arrays.revolute[i]:  # E = Rz(q)^T on both halves
+            for half in (0, 3):
+                joint[:, i, half, half], joint[:, i, half, half + 1] = c[:, i], s[:, i]
+                joint[:, i, half + 1, half], joint[:, i, half + 1, half + 1] = -s[:, i], c[:, i]
+        else:  # a slide r = q z: the linear rows get -r x w
+            joint[:, i, 3, 1], joint[:, i, 4, 0] = q[:, i], -q[:, i]
+    return joint @ arrays.tree_transform[None]
+
+
+def rnea_derivatives(arrays: ChainArrays, gravity_world: np.ndarray, q: np.ndarray, qdot: np.ndarray,
+                     qddot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(∂τ/∂q, ∂τ/∂q̇), each (B, n, n) with column j the derivative by joint j's variable, of τ = M q̈ + h + D q̇ at B
+    states (B, n) (armature and damping included; the module docstring)."""
+    count, n = q.shape
+    transforms = _joint_transforms(arrays, q)
+    directions = 2 * n
+    along_q = np.zeros((n, directions))
+    along_q[:, :n] = np.eye(n)  # δq_i in each direction
+    along_qd = np.zeros((n, directions))
+    along_qd[:, n:] = np.eye(n)
+    base_acceleration = np.concatenate([np.zeros(3), -np.asarray(gravity_world, dtype=float)])
+    v: list[np.ndarray] = []
+    a: list[np.ndarray] = []
+    dv: list[np.ndarray] = []
+    da: list[np.ndarray] = []
+    f: list[np.ndarray] = []
+    df: list[np.ndarray] = []
+    moved: list[np.ndarray] = []
+    for i in range(n):
+        x = transforms[:, i]
+        subspace = np.zeros(6)
+        subspace[arrays.subspace[i]] = 1.0
+        parent = int(arrays.parents[i])
+        parent_v = np.zeros((count, 6)) if parent < 0 else v[parent]
+        parent_a = np.broadcast_to(base_acceleration, (count, 6)) if parent < 0 else a[parent]
+        parent_dv = np.zeros((count, directions, 6)) if parent < 0 else dv[parent]
+        parent_da = np.zeros((count, directions, 6)) if parent < 0 else da[parent]
+        spin = subspace * qdot[:, i, None]  # S q̇_i (B, 6)
+        carried_a = np.einsum("bij,bj->bi", x, parent_a)
+        v_i = np.einsum("bij,bj->bi", x, parent_v) + spin
+        a_i = carried_a + subspace * qddot[:, i, None] + motion_cross(v_i, spin)
+        turned = subspace * along_q[i][:, None]  # S δq_i per direction (D, 6)
+        rate = subspace * along_qd[i][:, None]  # S δq̇_i (D, 6)
+        dv_i = (np.einsum("bij,bdj->bdi", x, parent_dv) - motion_cross(turned[None], v_i[:, None]) + rate[None])
+        da_i = (np.einsum("bij,bdj->bdi", x, parent_da) - motion_cross(turned[None], carried_a[:, None])
+                + motion_cross(dv_i, spin[:, None]) + motion_cross(v_i[:, None], rate[None]))
+        inertia = arrays.inertia[i]
+        momentum = v_i @ inertia.T
+        f.append(a_i @ inertia.T + force_cross(v_i, momentum))
+        df.append(da_i @ inertia.T + force_cross(dv_i, momentum[:, None]) + force_cross(v_i[:, None], dv_i @ inertia.T))
+        v.append(v_i)
+        a.append(a_i)
+        dv.append(dv_i)
+        da.append(da_i)
+        moved.append(turned)
+    dtau = np.empty((count, n, directions))
+    for i in reversed(range(n)):
+        dtau[:, i] = df[i][..., arrays.subspace[i]] + arrays.damping[i] * along_qd[i]
+        parent = int(arrays.parents[i])
+        if parent >= 0:
+            x = transforms[:, i]
+            df[parent] = df[parent] + np.einsum("bji,bdj->bdi", x, df[i] + force_cross(moved[i][None], f[i][:, None]))
+            f[parent] = f[parent] + np.einsum("bji,bj->bi", x, f[i])
+    return dtau[:, :, :n], dtau[:, :, n:]
