@@ -29,7 +29,7 @@ from simparity.comparisons.measure.joint_dynamics_metrics import (
     shape_problem,
     timed_values,
 )
-from simparity.comparisons.measure.derivative_metrics import DERIVATIVE_METRICS, derivative_errors
+from simparity.comparisons.measure.derivative_metrics import DERIVATIVE_METRICS, derivative_errors, partial_floors
 from simparity.comparisons.measure.joint_force_scale import ForceScale, force_scale
 from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
 from simparity.comparisons.common.error_text import error_text
@@ -184,9 +184,10 @@ def _reported(report: Callable[[], Any], label: str) -> tuple[Any, str]:
         return None, f"the reference {label}'s compiled model could not be read: {error_text(err)}"
 
 
-def _derivatives(model: JointDynamicsModel, shared: _JointDynamicsShared, mass: np.ndarray) -> dict[str, Measured]:
-    """The derivative rows of ``model`` against the complex-step truth (n/a with why where there is none or the engine
-    reports none)."""
+def _derivatives(model: JointDynamicsModel, shared: _JointDynamicsShared, mass: np.ndarray,
+                 scale: ForceScale) -> dict[str, Measured]:
+    """The derivative rows of ``model`` against the complex-step truth, floored at the chain's force ``scale`` (n/a
+    with why where there is no truth or the engine reports none)."""
     if shared.truth is None:
         return _not_measured(DERIVATIVE_METRICS, shared.truth_problem)
     q, qd, _, tau = shared.states
@@ -197,7 +198,7 @@ def _derivatives(model: JointDynamicsModel, shared: _JointDynamicsShared, mass: 
     bad = [name for name in PARTIALS if getattr(own, name) is not None and not np.all(np.isfinite(getattr(own, name)))]
     if bad:
         raise ValueError(f"non-finite {', '.join(bad)}")
-    return derivative_errors(own, shared.truth, mass)
+    return derivative_errors(own, shared.truth, mass, partial_floors(scale.floor, qd))
 
 
 def _not_measured(metrics: dict[str, str], why: str) -> dict[str, Measured]:
@@ -268,7 +269,7 @@ def _joint_dynamics_rows(scene: JointDynamicsScene, engine: Engine, case: Case, 
         scale = (shared.scale if shared.scale is not None  # else its own: identities need no reference
                  else _force_scale(scene, engine, case.integrator, model, shared.states, own))
         values.update(identities(model, scene.chain, shared.states, own, scale, scene.gravity_world))
-        values.update(_derivatives(model, shared, own["M"]))
+        values.update(_derivatives(model, shared, own["M"], scale))
     except Exception as err:  # noqa: BLE001 - reported in the rows
         return case.rows(JOINT_DYNAMICS_METRICS, FAILED, error_text(err))
     detail = ("this is the reference; " if is_reference else "") + model.detail

@@ -303,3 +303,25 @@ def test_a_users_method_of_any_name_is_held_to_the_joint_dynamics_bounds():
     assert set(table[table["engine"] == "featherstone-user"]["integrator"]) == {"featherstone"}
     violations = check_table(table, load_tolerances()).violations
     assert any(v.engine == "featherstone-user" and v.metric == "bias_force_error_max" for v in violations)
+
+
+def test_a_partial_tiny_but_not_zero_is_judged_against_the_chain_s_forces():
+    """Found by a held-out review of #44: one joint whose axis is 1e-6 rad off gravity has ∂τ/∂q ~1e-5 N m/rad beside
+    a weight of ~1 N m; relative to itself, MuJoCo's correct forward difference read 4.3e-4 (over its bound) and core's
+    rounding 1.7e-11 on a real arm. Floored at the chain's force scale per radian, every engine passes."""
+    import simparity
+    from simparity.comparisons.gate.check import check_table
+    from simparity.comparisons.gate.tolerances import load_tolerances
+
+    data = {"scene": {"name": "tilted", "kind": "joint_dynamics", "reference": "pinocchio"},
+            "chain": {"end_effector_xyz": [0.1, 0.0, 0.0], "joint": [{
+                "name": "pan", "type": "revolute", "axis": [1e-6, 0.0, 1.0], "origin_xyz": [0.0, 0.0, 0.1],
+                "lower": -2.0, "upper": 2.0, "mass": 1.0, "com_xyz": [0.1, 0.0, 0.05],
+                "inertia": [[0.01, 0.0, 0.0], [0.0, 0.01, 0.0], [0.0, 0.0, 0.01]]}]},
+            "world": {"gravity_world": [0.0, 0.0, -9.81]}, "sampling": {"states": 20, "seed": 3}}
+    table = simparity.run_scene(parse_scene(data, "tilted.toml"), ("core", "mujoco", "pinocchio"), repeats=0,
+                                isolate=False)
+    result = check_table(table, load_tolerances())
+    assert result.passed, [str(v) for v in result.violations][:3]
+    rows = table[(table["metric"] == "rnea_derivative_error_max") & (table["status"] == "ok")]
+    assert set(rows["engine"]) == {"core", "mujoco", "pinocchio"} and rows["value"].max() < 1e-6
