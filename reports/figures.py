@@ -407,3 +407,46 @@ def figure_stem(name: str) -> str:
     """A figure's file name (without suffix) from a name built of a scene's: every character but letters, digits and
     ``_ . -`` made ``_`` and no leading dot, so no name (``../x``, ``/abs``, ``a/b``) leads out of the folder."""
     return _UNSAFE.sub("_", name).lstrip(".") or "figure"
+
+
+_DIFFERENCE_QUANTITIES = (("forward_difference_error", "-"), ("central_difference_error", "--"))
+"""The step sweep's series (comparisons.execute.derivative_runner) and their line styles: forward solid, centred
+dashed."""
+
+
+def difference_step_figure(series: pd.DataFrame):
+    """The error of dtau/dq by finite differences of each engine's own inverse dynamics against the step, one panel
+    per joint-dynamics scene (stacked on one step axis), one colour per engine x method, forward differences solid
+    and centred dashed, each line's best step marked: the V of truncation against rounding."""
+    swept = series[series["quantity"].isin([q for q, _ in _DIFFERENCE_QUANTITIES])]
+    if swept.empty:
+        return None
+    scenes = list(dict.fromkeys(swept["scene"]))
+    fig, axes = plt.subplots(len(scenes), 1, figsize=(_WIDTH, 1.9 * len(scenes) + 0.6), sharex=True, squeeze=False)
+    schemes = list(dict.fromkeys(zip(swept["engine"], swept["integrator"])))
+    for ax, scene in zip(axes[:, 0], scenes):
+        for i, (engine, method) in enumerate(schemes):
+            for quantity, line in _DIFFERENCE_QUANTITIES:
+                g = swept[(swept["scene"] == scene) & (swept["engine"] == engine) & (swept["integrator"] == method)
+                          & (swept["quantity"] == quantity)].dropna(subset=["value"])
+                if g.empty:
+                    continue
+                style = _style(i, engine) | {"marker": None, "linestyle": line}
+                label = f"{engine} {method}" if line == "-" else None
+                ax.plot(g["x"], _positive(g["value"]), label=label, **style)
+                best = g.loc[g["value"].idxmin()]
+                ax.plot([best["x"]], [max(best["value"], 1e-17)], linestyle="none",
+                        **(_style(i, engine) | {"markersize": 5}))
+        ax.set(xscale="log", yscale="log", ylabel="dtau/dq error")
+        ax.text(0.01, 0.04, scene, transform=ax.transAxes, fontsize=8, ha="left", va="bottom")
+        ax.grid(True, which="major", alpha=0.3)
+    shown = set(axes[0, 0].get_legend_handles_labels()[1])
+    for i, (engine, method) in enumerate(schemes):  # the legend (on the top panel) names every panel's lines
+        if f"{engine} {method}" not in shown:
+            axes[0, 0].plot([], [], label=f"{engine} {method}", **(_style(i, engine) | {"marker": None}))
+    axes[-1, 0].set_xlabel("finite-difference step h [rad or m]")
+    axes[-1, 0].invert_xaxis()
+    title(axes[0, 0], "dtau/dq by finite differences of each engine's inverse dynamics against the complex-step "
+                      "truth (solid: forward, dashed: centred; marker: the best step)")
+    legend(axes[0, 0])
+    return finish(fig, row_gap=_PANEL_GAP)

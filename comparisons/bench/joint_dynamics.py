@@ -16,7 +16,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from simparity.comparisons.bench.rows import Meter
+from simparity.comparisons.bench.rows import Meter, by_batch
 from simparity.comparisons.engines.registry import make_engine
 from simparity.comparisons.scenes import library
 
@@ -133,11 +133,7 @@ def markdown_lines(rows: list) -> list[str]:
              "thread.", "",
              "| arm | engine | method | " + " | ".join(f"B = {b:,}" for b in batches) + " | difference |",
              "|---|---|---|" + "---|" * (len(batches) + 1)]
-    for arm, engine, method in dict.fromkeys((r.workload, r.engine, r.method) for r in mine):
-        cells = {r.batch: r for r in mine if (r.workload, r.engine, r.method) == (arm, engine, method)}
-        values = " | ".join(f"{cells[b].value:.3g}" if b in cells and math.isfinite(cells[b].value) else "n/a"
-                            for b in batches)
-        difference = max((c.accuracy for c in cells.values() if math.isfinite(c.accuracy)), default=math.nan)
+    for (arm, engine, method), _, values, difference in by_batch(mine):
         lines.append(f"| {arm} | {engine} | {method} | {values} | {difference:.1e} |")
     return lines + [""]
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from simparity.comparisons.bench import joint_dynamics, joint_motion, small_batch, sweep
+from simparity.comparisons.bench import derivatives, joint_dynamics, joint_motion, small_batch, sweep
 from simparity.comparisons.bench.blas import describe_threads
 from simparity.comparisons.bench.memory import MEMORY_CHILD, MEMORY_PROCESS
 from simparity.comparisons.bench.rows import BenchRow
@@ -121,6 +121,7 @@ def markdown(rows: list[BenchRow], info: dict[str, str], command: str, profile: 
         lines.append("")
     lines += small_batch.markdown_lines(rows)
     lines += joint_dynamics.markdown_lines(rows)
+    lines += derivatives.markdown_lines(rows)
     lines += joint_motion.markdown_lines(rows)
     lines += sweep.markdown_lines(rows)
     ik = [r for r in rows if r.section == "ik"]

@@ -7,7 +7,7 @@ import math
 import os
 import statistics
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 
 from simparity.comparisons.common.zygote import children_usage
@@ -140,3 +140,15 @@ def median_time(fn: Callable[[], object], repeats: int) -> float:
         fn()
         times.append(time.perf_counter() - start)
     return statistics.median(times)
+
+
+def by_batch(rows: list) -> Iterator[tuple[tuple[str, str, str], dict[int, BenchRow], str, float]]:
+    """Per (workload, engine, method) of ``rows``, in their order: its rows by batch, the markdown cells of its values
+    at every batch of ``rows`` ("n/a" where none is finite) and its largest finite accuracy (NaN when none)."""
+    batches = sorted({r.batch for r in rows})
+    for key in dict.fromkeys((r.workload, r.engine, r.method) for r in rows):
+        cells = {r.batch: r for r in rows if (r.workload, r.engine, r.method) == key}
+        values = " | ".join(f"{cells[b].value:.3g}" if b in cells and math.isfinite(cells[b].value) else "n/a"
+                            for b in batches)
+        yield key, cells, values, max((c.accuracy for c in cells.values() if math.isfinite(c.accuracy)),
+                                      default=math.nan)

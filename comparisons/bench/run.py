@@ -7,7 +7,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from simparity.comparisons.bench import joint_dynamics, joint_motion, small_batch, sweep
+from simparity.comparisons.bench import derivatives, joint_dynamics, joint_motion, small_batch, sweep
 from simparity.comparisons.bench.blas import one_blas_thread
 from simparity.comparisons.bench.ik import ik_rows
 from simparity.comparisons.bench.kinematics import kinematics_rows
@@ -62,6 +62,8 @@ def _measure(quick: bool, say: Callable[[str], None]) -> tuple[list[BenchRow], s
         ("forward kinematics + Jacobian", lambda: kinematics_rows(batches, say)),
         ("joint-space dynamics (time per state, with the difference to Pinocchio)",
          lambda: joint_dynamics.joint_dynamics_rows(batches, lambda fn: median_time(fn, REPEATS), BenchRow, say)),
+        ("derivatives of the dynamics (time per state, with the error against the complex-step truth)",
+         lambda: derivatives.derivative_rows(batches, lambda fn: median_time(fn, REPEATS), BenchRow, say)),
         ("joint motion (time per copy-step, with the error against DOP853 and the difference to Pinocchio's RK4)",
          lambda: joint_motion.joint_motion_rows(batches, median_time, BenchRow, say)),
         ("IK", lambda: ik_rows(300 if quick else None, say)),

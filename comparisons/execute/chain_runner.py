@@ -12,6 +12,12 @@ from typing import Any, Callable, cast
 import numpy as np
 
 from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome, EngineFor
+from simparity.comparisons.execute.derivative_runner import (
+    DerivativeTruth,
+    derivative_truth,
+    derivative_values,
+    with_derivative_scheme,
+)
 from simparity.comparisons.measure.metrics import KINEMATICS_METRICS, frame_validity, kinematics_errors
 from simparity.comparisons.measure.model_parity import (
     GROUP_METRICS,
@@ -29,15 +35,13 @@ from simparity.comparisons.measure.joint_dynamics_metrics import (
     shape_problem,
     timed_values,
 )
-from simparity.comparisons.measure.derivative_metrics import DERIVATIVE_METRICS, derivative_errors, partial_floors
 from simparity.comparisons.measure.joint_force_scale import ForceScale, force_scale
 from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
 from simparity.comparisons.common.error_text import error_text
 from simparity.comparisons.execute.timing import best_of
-from simparity.core.model.derivatives import PARTIALS, DynamicsDerivatives
 from simparity.core.model.engine import Engine, JointDynamicsModel, Support
 from simparity.core.model.errors import SimparityError
-from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow
+from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, ResultRow, SeriesRecord
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 from simparity.core.model.rigid_groups import FIELDS, CompiledJoints, RigidGroups
 from simparity.core.model.scenes.kinematics import KinematicsScene
@@ -128,28 +132,14 @@ class _JointDynamicsShared:
     groups_problem: str = ""
     joints: CompiledJoints | None = None
     joints_problem: str = ""
-    truth: DynamicsDerivatives | None = None
+    truth: DerivativeTruth | None = None
     truth_problem: str = ""
-
-
-def _derivative_truth(scene: JointDynamicsScene, states: tuple[np.ndarray, ...]) -> tuple[Any, str]:
-    """(the complex-step truth of the dynamics' derivatives at the scene's states, "") or (None, why there is none)."""
-    q, qd, _, tau = states
-    if scene.chain.floating_base:
-        return None, ("no complex-step truth on a floating base yet: its orientation needs a complex-safe exponential "
-                      "map (issue #44)")
-    try:
-        from simparity.references.derivatives import complex_step  # Pinocchio's parser: only where a case runs
-
-        return complex_step.derivatives(complex_step.tree_from_chain(scene.chain, scene.gravity_world), q, qd, tau), ""
-    except Exception as err:  # noqa: BLE001 - every derivative row says why
-        return None, f"no complex-step truth: {error_text(err)}"
 
 
 def prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_failure: str) -> _JointDynamicsShared:
     scene, label = group.joint_dynamics_scene, group.reference_label
     states, method = scene.states(), label.split(":", 1)[1]
-    truth, truth_why = _derivative_truth(scene, states)
+    truth, truth_why = derivative_truth(scene, states)
 
     def evaluate() -> tuple[dict, ForceScale]:
         model = engine_for(scene.reference).build_joint_dynamics(scene.chain, method, scene.gravity_world)
@@ -182,23 +172,6 @@ def _reported(report: Callable[[], Any], label: str) -> tuple[Any, str]:
         return None, f"the reference {label} reports no compiled model: {err}"
     except Exception as err:  # noqa: BLE001 - a user's reference: its model rows say why
         return None, f"the reference {label}'s compiled model could not be read: {error_text(err)}"
-
-
-def _derivatives(model: JointDynamicsModel, shared: _JointDynamicsShared, mass: np.ndarray,
-                 scale: ForceScale) -> dict[str, Measured]:
-    """The derivative rows of ``model`` against the complex-step truth, floored at the chain's force ``scale`` (n/a
-    with why where there is no truth or the engine reports none)."""
-    if shared.truth is None:
-        return _not_measured(DERIVATIVE_METRICS, shared.truth_problem)
-    q, qd, _, tau = shared.states
-    try:
-        own = model.derivatives(q, qd, tau)
-    except NotImplementedError as err:
-        return _not_measured(DERIVATIVE_METRICS, str(err))
-    bad = [name for name in PARTIALS if getattr(own, name) is not None and not np.all(np.isfinite(getattr(own, name)))]
-    if bad:
-        raise ValueError(f"non-finite {', '.join(bad)}")
-    return derivative_errors(own, shared.truth, mass, partial_floors(scale.floor, qd))
 
 
 def _not_measured(metrics: dict[str, str], why: str) -> dict[str, Measured]:
@@ -246,16 +219,18 @@ def joint_dynamics_case(group: CaseGroup, shared: _JointDynamicsShared, index: i
     case = Case(scene.name, spec.engine, spec.integrator, math.nan, group.reference_label,
                 declared_scheme(engine, spec.integrator, scene))
     rows: list[ResultRow] = []
+    series: list[SeriesRecord] = []
     with warnings_into_rows(rows):
         rows += _joint_dynamics_rows(scene, engine, case, shared, group.repeats,
-                                     f"{spec.engine}:{spec.integrator}" == group.reference_label)
-    return CaseOutcome(rows)
+                                     f"{spec.engine}:{spec.integrator}" == group.reference_label, series)
+    return CaseOutcome(rows, series)
 
 
 def _joint_dynamics_rows(scene: JointDynamicsScene, engine: Engine, case: Case, shared: _JointDynamicsShared,
-                         repeats: int, is_reference: bool) -> list[ResultRow]:
+                         repeats: int, is_reference: bool, series: list[SeriesRecord]) -> list[ResultRow]:
     """Rows of one engine's joint-space dynamics at the scene's states: errors against the reference's values,
-    the identities of its own, its times."""
+    the identities of its own, its derivatives, its times; the step sweep's series appended to ``series``."""
+    kind = ""
     try:
         support = engine.supports_joint_dynamics(scene.chain, case.integrator)
         if not support.ok:
@@ -269,9 +244,19 @@ def _joint_dynamics_rows(scene: JointDynamicsScene, engine: Engine, case: Case, 
         scale = (shared.scale if shared.scale is not None  # else its own: identities need no reference
                  else _force_scale(scene, engine, case.integrator, model, shared.states, own))
         values.update(identities(model, scene.chain, shared.states, own, scale, scene.gravity_world))
-        values.update(_derivatives(model, shared, own["M"], scale))
+        derivatives, kind, found = derivative_values(model, shared.truth, shared.truth_problem, shared.states,
+                                                     own["M"], scale.floor, case)
+        values.update(derivatives)
+        series += found
     except Exception as err:  # noqa: BLE001 - reported in the rows
         return case.rows(JOINT_DYNAMICS_METRICS, FAILED, error_text(err))
+    return with_derivative_scheme(_judged_rows(scene, case, shared, model, own, values, scale, is_reference), kind)
+
+
+def _judged_rows(scene: JointDynamicsScene, case: Case, shared: _JointDynamicsShared, model: JointDynamicsModel,
+                 own: dict, values: dict[str, Measured], scale: ForceScale, is_reference: bool) -> list[ResultRow]:
+    """The case's rows from its measured ``values``, with the errors against the reference's and model parity where
+    there is a reference."""
     detail = ("this is the reference; " if is_reference else "") + model.detail
     if shared.reference is None:
         problem, status = shared.problem

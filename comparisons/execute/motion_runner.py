@@ -21,12 +21,15 @@ import numpy as np
 from simparity.comparisons.execute.case_cost import case_cost, theory
 from simparity.comparisons.common.integrators import NO_INTEGRATOR
 from simparity.comparisons.execute.cases import CaseGroup, CaseOutcome, EngineFor
+from simparity.comparisons.execute.derivative_runner import with_derivative_scheme
+from simparity.comparisons.execute.step_jacobian_runner import step_jacobian_values
 from simparity.comparisons.execute.timing import best_of
 from simparity.comparisons.measure.joint_motion_metrics import (
     REFERENCE_ERRORS, Horizon, OwnReading, divergence, energy_metrics, joint_scales, motion_metrics, parting_times,
     read_own, reach, reference_errors, reference_horizon,
 )
 from simparity.comparisons.measure.held_forcing import forcing_scheme
+from simparity.comparisons.measure.step_jacobian_metrics import STEP_JACOBIAN_METRICS
 from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
 from simparity.comparisons.common.error_text import error_text
 from simparity.core.model.engine import Engine, JointSimulation, Support
@@ -196,7 +199,10 @@ def _motion_case(scene: JointMotionScene, engine: Engine, case: Case, shared: Mo
         return CaseOutcome(case.rows(metrics, FAILED, f"its trajectory does not sample the scene: {problem}",
                                      timed))
     try:
-        return _measured(run_scene, engine, sim, case, traj, timed, shared, is_reference)
+        jacobian, kind = step_jacobian_values(sim, run_scene, case.scheme, case.dt)
+        outcome = _measured(run_scene, engine, sim, case, traj, timed | jacobian, shared, is_reference)
+        outcome.rows = with_derivative_scheme(outcome.rows, kind, STEP_JACOBIAN_METRICS)
+        return outcome
     except Exception as err:  # noqa: BLE001 - a user's engine returned what cannot be measured
         return CaseOutcome(case.rows(metrics, FAILED,
                                      f"its motion cannot be measured: {error_text(err)}", timed))

@@ -52,7 +52,7 @@ from simparity.comparisons.invariance.rounding_allowance import rounding_floors
 from simparity.comparisons.invariance.transforms import Transform, transform_scene
 from simparity.comparisons.invariance.units import Dimension, unit_dimensions
 from simparity.core.model.engine import Engine
-from simparity.core.model.metric_catalogue import is_timing
+from simparity.core.model.metric_catalogue import is_probe, is_timing
 from simparity.core.model.errors import TransformError, UnitError, one_line
 from simparity.core.model.results import DIMENSIONLESS, FAILED, NOT_AVAILABLE, OK, ROUNDING_FLOOR, ResultRow
 from simparity.comparisons.common.integrators import motion_reference_integrator
@@ -411,13 +411,13 @@ def _row_unit(scene, unit: str) -> str:
 
 
 def _keyed(scene, rows, transform: Transform | None) -> dict:
-    """{key: _Row} of ``rows``, timing left out; ``transform``: the rows are of ``scene`` transformed by it (its
+    """{key: _Row} of ``rows``, timing and floating-point probes left out; ``transform``: the rows are of ``scene`` transformed by it (its
     time steps and values are carried back), None: of ``scene`` itself."""
     steps = list(scene.dts) if isinstance(scene, (DynamicsScene, JointMotionScene)) else []
     scale = transform.time_scale if transform else 1.0
     out = {}
     for row in rows:
-        if is_timing(row.metric):
+        if is_timing(row.metric) or is_probe(row.metric):  # wall times; where an engine's rounding shows
             continue
         dt = None if row.dt != row.dt else next(
             (step for step in steps if abs(row.dt - scale * step) <= DT_MATCH * row.dt), row.dt)

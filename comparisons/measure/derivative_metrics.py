@@ -13,7 +13,11 @@ N m/rad beside a weight of 0.04 N m) is then judged against the forces its round
 - ABA, in torque space as forward dynamics is judged (a solve amplifies rounding by M's condition number, the force
   does not): max |M (D - T)| over the floored max |M T|, M the truth's (M ∂q̈/∂τ = I: scale 1);
 - the identity: max over states of |∂q̈/∂τ M - I| over κ₁(M), M the engine's own: an inverse rounds to ~ε κ(M)
-  (~1e9 with a 1 g link at the tip), so the residual is judged against its conditioning.
+  (~1e9 with a 1 g link at the tip), so the residual is judged against its conditioning;
+- a difference's step excess: partials an engine declares differenced (:class:`FiniteDifferences`: forward or
+  centred, its steps) are held to the error the truth's own RNEA gives under the same scheme at the same steps (its
+  truncation; rounding ~ ε |τ| / h where that is larger): the ratio is ~1 for a scheme that is what it claims, ~1e3
+  for a forward difference claimed centred.
 """
 
 from __future__ import annotations
@@ -25,12 +29,20 @@ from simparity.core.model.derivatives import DynamicsDerivatives
 from simparity.core.model.metric_catalogue import (
     ABA_DERIVATIVE_ERROR_MAX,
     DERIVATIVE_IDENTITY_RESIDUAL,
+    DERIVATIVE_STEP_EXCESS,
     RNEA_DERIVATIVE_ERROR_MAX,
     units,
 )
 
-DERIVATIVE_METRICS = units(RNEA_DERIVATIVE_ERROR_MAX, ABA_DERIVATIVE_ERROR_MAX, DERIVATIVE_IDENTITY_RESIDUAL)
+DERIVATIVE_METRICS = units(RNEA_DERIVATIVE_ERROR_MAX, ABA_DERIVATIVE_ERROR_MAX, DERIVATIVE_IDENTITY_RESIDUAL,
+                           DERIVATIVE_STEP_EXCESS)
 """The derivative rows of a joint-dynamics case, in row order."""
+
+DIFFERENCE_ROUNDING = 64.0
+"""[ε] A difference's rounding, in units of ε |τ| / h: an inverse dynamics rounds to a few tens of ε of the largest
+joint force (sums over the links of an arm of up to ~30), and the difference of two such values divided by h
+carries that. Where the truth's own difference at the claimed step is smaller than this, the engine is held to this
+(a centred difference at 1e-5 on a slow arm is at its rounding, not its truncation)."""
 
 _RNEA = ("dtau_dq", "dtau_dqdot")
 _ABA = ("dqddot_dq", "dqddot_dqdot", "dqddot_dtau")
@@ -52,6 +64,39 @@ def partial_floors(force_floor: float, qdot: np.ndarray) -> dict[str, float]:
     by_qdot = force_floor / speed if speed > 0 else 0.0
     return {"dtau_dq": force_floor, "dtau_dqdot": by_qdot, "dqddot_dq": force_floor, "dqddot_dqdot": by_qdot,
             "dqddot_dtau": 0.0}
+
+
+def worst_excess(blocks: list[tuple[str, np.ndarray, np.ndarray, np.ndarray, np.ndarray]]) -> tuple[float, str, int]:
+    """(the largest ratio, its block, its state) over ``blocks`` of (name, an engine's differenced block (B, ., .), the
+    truth's, the truth's own differences of the declared scheme, the rounding allowance (B,) [the block's units]):
+    per state, the engine's max |D - T| over the larger of the claimed scheme's max |E - T| and the allowance."""
+    worst: tuple[float, str, int] = (-1.0, "", 0)
+    for name, own, truth, expected, rounding in blocks:
+        own_error = np.max(np.abs(own - truth), axis=(-1, -2))
+        allowed = np.maximum(np.max(np.abs(expected - truth), axis=(-1, -2)), rounding)
+        ratios = np.divide(own_error, allowed, out=np.zeros_like(own_error), where=allowed > 0)
+        k = int(np.argmax(ratios))
+        if ratios[k] > worst[0]:
+            worst = (float(ratios[k]), name, k)
+    return worst
+
+
+def step_excess(own: DynamicsDerivatives, truth: DynamicsDerivatives, expected: dict[str, np.ndarray],
+                tau_scale: np.ndarray) -> Measured:
+    """How many times the error of ``own``'s differenced ∂τ/∂q and ∂τ/∂q̇ exceeds that of its declared scheme:
+    ``expected`` ({partial: (B, n, n)}) is the truth's own inverse dynamics differenced the same way at the same
+    steps, ``tau_scale`` (B,) [N m or N] each state's largest joint force (floored), setting the rounding
+    allowance :data:`DIFFERENCE_ROUNDING` ε |τ| / h. The largest ratio over states and partials (1); n/a for
+    analytic partials."""
+    differences = own.differences
+    if differences is None:
+        return Measured(np.nan, "1", unmeasurable="analytic derivatives: no step whose truncation to hold them to")
+    rounding = DIFFERENCE_ROUNDING * np.finfo(float).eps * tau_scale
+    value, name, k = worst_excess([(name, getattr(own, name), getattr(truth, name), expected[name], rounding / step)
+                                   for name, step in (("dtau_dq", differences.step_q),
+                                                      ("dtau_dqdot", differences.step_qdot))])
+    return Measured(value, "1", note=f"largest in {name} at state {k}, {differences.kind} at steps "
+                                     f"{differences.step_q[k]:.3g} (q), {differences.step_qdot[k]:.3g} (qdot)")
 
 
 def derivative_errors(own: DynamicsDerivatives, truth: DynamicsDerivatives, own_mass: np.ndarray,

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import cumulative_simpson
 
+from simparity.comparisons.measure.step_jacobian_metrics import STEP_JACOBIAN_METRICS
 from simparity.comparisons.measure.divergence import CONSERVED_GROWTH_LIMIT
 from simparity.comparisons.measure.metrics import (
     ROUNDING_FLOOR_FACTOR, SATURATED_DRIFT, SATURATED_FRACTION, SATURATED_ORIENTATION,
@@ -87,7 +88,7 @@ def motion_metrics(scene: JointMotionScene) -> dict[str, str]:
     """The metrics of a case of ``scene``: its energy balance as a drift where the chain is conservative, as the
     power balance where it is damped or driven."""
     left_out = ENERGY_DRIFT_MAX if exchanges_energy(scene) else POWER_BALANCE_RESIDUAL_MAX
-    metrics = {m: u for m, u in JOINT_MOTION_METRICS.items() if m != left_out}
+    metrics = {m: u for m, u in JOINT_MOTION_METRICS.items() if m != left_out} | STEP_JACOBIAN_METRICS
     if scene.segments:
         return metrics | units(SEGMENT_REFERENCE_ERROR_MAX)
     return metrics | (PREDICTABILITY_METRICS if scene.perturbation > 0 else {})

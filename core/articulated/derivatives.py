@@ -17,6 +17,8 @@ Written on plain (B, ..., 6) arrays, one body at a time; spatial vectors (angula
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from simparity.core.articulated.chain_arrays import ChainArrays
@@ -49,18 +51,39 @@ def _joint_transforms(arrays: ChainArrays, q: np.ndarray) -> np.ndarray:
     return joint @ arrays.tree_transform[None]
 
 
+@dataclass(frozen=True)
+class Root:
+    """What a chain's bodies on the base see of it: its spatial velocity and acceleration (B, 6) in base coordinates
+    (gravity as its fictitious acceleration -g), and their derivatives (B, D, 6) along the D directions."""
+
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    d_velocity: np.ndarray
+    d_acceleration: np.ndarray
+
+
 def rnea_derivatives(arrays: ChainArrays, gravity_world: np.ndarray, q: np.ndarray, qdot: np.ndarray,
                      qddot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(∂τ/∂q, ∂τ/∂q̇), each (B, n, n) with column j the derivative by joint j's variable, of τ = M q̈ + h + D q̇ at B
     states (B, n) (armature and damping included; the module docstring)."""
     count, n = q.shape
-    transforms = _joint_transforms(arrays, q)
     directions = 2 * n
-    along_q = np.zeros((n, directions))
-    along_q[:, :n] = np.eye(n)  # δq_i in each direction
-    along_qd = np.zeros((n, directions))
-    along_qd[:, n:] = np.eye(n)
-    base_acceleration = np.concatenate([np.zeros(3), -np.asarray(gravity_world, dtype=float)])
+    fixed = Root(np.zeros((count, 6)), np.broadcast_to(np.r_[np.zeros(3), -np.asarray(gravity_world, dtype=float)],
+                                                      (count, 6)),
+                 np.zeros((count, directions, 6)), np.zeros((count, directions, 6)))
+    dtau, _, _ = forward_mode(arrays, q, qdot, qddot, fixed, np.eye(n, directions), np.eye(n, directions, n))
+    return dtau[:, :, :n], dtau[:, :, n:]
+
+
+def forward_mode(arrays: ChainArrays, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray, root: Root,
+                 along_q: np.ndarray, along_qd: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The joints' RNEA differentiated along D directions at B states of the joints (B, n) on a ``root`` (a fixed
+    base, or a floating one's): (∂τ (B, n, D), the wrench the bodies put on the root (B, 6) and its derivative
+    (B, D, 6), both (n, f) in base coordinates). ``along_q``, ``along_qd`` (n, D): each joint's δq_i and δq̇_i in each
+    direction."""
+    count, n = q.shape
+    transforms = _joint_transforms(arrays, q)
+    directions = along_q.shape[1]
     v: list[np.ndarray] = []
     a: list[np.ndarray] = []
     dv: list[np.ndarray] = []
@@ -73,10 +96,10 @@ def rnea_derivatives(arrays: ChainArrays, gravity_world: np.ndarray, q: np.ndarr
         subspace = np.zeros(6)
         subspace[arrays.subspace[i]] = 1.0
         parent = int(arrays.parents[i])
-        parent_v = np.zeros((count, 6)) if parent < 0 else v[parent]
-        parent_a = np.broadcast_to(base_acceleration, (count, 6)) if parent < 0 else a[parent]
-        parent_dv = np.zeros((count, directions, 6)) if parent < 0 else dv[parent]
-        parent_da = np.zeros((count, directions, 6)) if parent < 0 else da[parent]
+        parent_v = root.velocity if parent < 0 else v[parent]
+        parent_a = root.acceleration if parent < 0 else a[parent]
+        parent_dv = root.d_velocity if parent < 0 else dv[parent]
+        parent_da = root.d_acceleration if parent < 0 else da[parent]
         spin = subspace * qdot[:, i, None]  # S q̇_i (B, 6)
         carried_a = np.einsum("bij,bj->bi", x, parent_a)
         v_i = np.einsum("bij,bj->bi", x, parent_v) + spin
@@ -96,11 +119,16 @@ def rnea_derivatives(arrays: ChainArrays, gravity_world: np.ndarray, q: np.ndarr
         da.append(da_i)
         moved.append(turned)
     dtau = np.empty((count, n, directions))
+    on_root, d_on_root = np.zeros((count, 6)), np.zeros((count, directions, 6))
     for i in reversed(range(n)):
         dtau[:, i] = df[i][..., arrays.subspace[i]] + arrays.damping[i] * along_qd[i]
         parent = int(arrays.parents[i])
+        x = transforms[:, i]
+        carried_df = np.einsum("bji,bdj->bdi", x, df[i] + force_cross(moved[i][None], f[i][:, None]))
+        carried_f = np.einsum("bji,bj->bi", x, f[i])
         if parent >= 0:
-            x = transforms[:, i]
-            df[parent] = df[parent] + np.einsum("bji,bdj->bdi", x, df[i] + force_cross(moved[i][None], f[i][:, None]))
-            f[parent] = f[parent] + np.einsum("bji,bj->bi", x, f[i])
-    return dtau[:, :, :n], dtau[:, :, n:]
+            df[parent] = df[parent] + carried_df
+            f[parent] = f[parent] + carried_f
+        else:
+            d_on_root, on_root = d_on_root + carried_df, on_root + carried_f
+    return dtau, on_root, d_on_root

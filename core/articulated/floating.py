@@ -18,8 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 from simparity.core.articulated.chain_arrays import chain_arrays, pack_symmetric, spatial_inertia
+from simparity.core.articulated.floating_derivatives import floating_rnea_derivatives
 from simparity.core.articulated.groups import chain_compiled_joints, chain_rigid_groups
 from simparity.core.articulated.recursive import FloatingBase, Recursive, cross_force, unpack_symmetric
+from simparity.core.model.derivatives import DynamicsDerivatives
 from simparity.core.model.engine import JointDynamicsModel
 from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
@@ -134,6 +136,18 @@ class FloatingRecursiveDynamics(JointDynamicsModel):
         linear, angular = _turned(rotation, local[3:]), _turned(rotation, local[:3])
         position = np.atleast_2d(np.asarray(q, dtype=float))[:, :3]
         return np.concatenate([linear, angular + np.cross(position, linear)], axis=1)
+
+    def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
+        """RNEA differentiated in forward mode on the floating root (:mod:`core.articulated.floating_derivatives`: q's
+        tangent with the base moved and turned in world axes) at q̈ = ABA(τ); forward dynamics' partials -M⁻¹ ∂τ/∂x
+        with core's CRBA M."""
+        q, qdot, tau = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (q, qdot, tau))
+        self._state(q, qdot)  # the shapes, said in one line
+        qddot = self.forward_dynamics(q, qdot, tau)
+        by_q, by_qdot = floating_rnea_derivatives(self._algorithms.arrays, self._base_inertia, self._gravity, q, qdot,
+                                                  qddot)
+        inverse = np.linalg.inv(self.mass_matrix(q))
+        return DynamicsDerivatives(by_q, by_qdot, -inverse @ by_q, -inverse @ by_qdot, inverse)
 
     def rigid_groups(self, q: np.ndarray) -> RigidGroups:
         """Core's compiled model with the base at the world's origin, unturned: q is the joint values (B, n)."""

@@ -7,8 +7,11 @@ import numpy as np
 
 from simparity.core.articulated import stepping
 from simparity.core.articulated.chain_arrays import chain_arrays
+from simparity.core.articulated.model import RecursiveDynamics
 from simparity.core.articulated.recursive import Recursive
+from simparity.core.articulated.step_jacobian import step_jacobian
 from simparity.core.kinematics import forward_kinematics
+from simparity.core.model.derivatives import StepJacobian
 from simparity.core.model.engine import BatchedRun, JointSimulation
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
@@ -18,7 +21,7 @@ class CoreJointMotion(JointSimulation):
     """A chain stepped by one of core's schemes at a fixed step, every copy of the scene in one batch."""
 
     def __init__(self, scene: JointMotionScene, scheme: str, dt: float) -> None:
-        self._scene, self._dt = scene, dt
+        self._scene, self._dt, self._scheme = scene, dt, scheme
         self._step = stepping.stepper(scene, scheme, dt)
         gravity = np.zeros(3) if scene.gravity_world is None else scene.gravity_world
         self._gravity = np.asarray(gravity, dtype=float)
@@ -32,6 +35,16 @@ class CoreJointMotion(JointSimulation):
         q, qdot = stepping.run(self._step, np.asarray(self._scene.q0), np.asarray(self._scene.qdot0), n_steps,
                                self._dt)
         return JointTrajectory(np.arange(n_steps + 1) * self._dt, q, qdot)
+
+    def step_jacobian(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> StepJacobian:
+        """Carried analytically through the scheme with core's derivatives (:mod:`core.articulated.step_jacobian`;
+        implicit damping on the chain with armature + dt D, as it steps)."""
+        chain = self._scene.chain
+        if self._scheme == stepping.IMPLICIT_DAMPING:
+            chain = stepping.damped_armature(chain, self._dt)
+        model = RecursiveDynamics(chain, self._gravity)
+        return step_jacobian(model, self._scheme, self._dt, *(np.atleast_2d(np.asarray(x, dtype=float))
+                                                             for x in (q, qdot, tau)))
 
     def batched(self, copies: int) -> BatchedRun:
         q0 = np.repeat(np.asarray(self._scene.q0)[:1], copies, axis=0)

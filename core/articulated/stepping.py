@@ -52,7 +52,7 @@ Step = Callable[[float, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
 """step(t, q, qdot) -> (q', qdot'): one step from time t [s]; q and qdot (n, B)."""
 
 
-def _damped_armature(chain: Chain, dt: float) -> Chain:
+def damped_armature(chain: Chain, dt: float) -> Chain:
     """``chain`` with each joint's armature increased by dt times its damping (the implicit damping's M + dt D)."""
     return replace(chain, joints=tuple(replace(j, armature=j.armature + dt * j.damping) for j in chain.joints))
 
@@ -119,7 +119,7 @@ def stepper(scene: JointMotionScene, scheme: str, dt: float) -> Step:
             return q + dt * qdot, qdot
         return semi_implicit
     if scheme == IMPLICIT_DAMPING:
-        implicit = Recursive(chain_arrays(_damped_armature(scene.chain, dt)), gravity)
+        implicit = Recursive(chain_arrays(damped_armature(scene.chain, dt)), gravity)
 
         def implicit_damping(t: float, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             qdot = qdot + dt * implicit.forward_dynamics(q, qdot, torque(q, t, t))

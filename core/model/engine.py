@@ -16,7 +16,7 @@ import numpy as np
 
 from simparity.core.model.errors import NotBatchedError, SimparityError
 from simparity.core.model.ik_problem import IKTolerances
-from simparity.core.model.derivatives import DynamicsDerivatives
+from simparity.core.model.derivatives import DynamicsDerivatives, StepJacobian
 from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.ik_result import IKResult
 from simparity.core.model.scenes.chain import Chain
@@ -57,6 +57,10 @@ SCHEME_KINDS = {
     "recursive": "Featherstone's recursive algorithms: Newton-Euler (RNEA), composite rigid body (CRBA), "
                  "articulated body (ABA) or a factorisation of M",
     "jacobian_sum": "the lecture's route: M and h summed over every link's centre-of-mass Jacobians, O(n^3)",
+    # How the derivatives of joint-space dynamics are found (after a '+': "recursive+forward_differences").
+    "analytic_derivatives": "derivatives in closed form (differentiated algorithms): exact up to rounding",
+    "forward_differences": "forward differences (f(x + h) - f(x)) / h: truncation ~ h |d2f| / 2",
+    "central_differences": "centred differences (f(x + h) - f(x - h)) / 2h: truncation ~ h^2 |d3f| / 6",
     # How an IK solver steps.
     "jacobian_inverse": "Newton steps with J^-1 (square, invertible Jacobians only)",
     "pseudo_inverse": "Newton steps with the Moore-Penrose pseudo-inverse of J",
@@ -210,6 +214,13 @@ class JointSimulation(abc.ABC):
         """``run(n_steps)`` stepping ``copies`` copies of the scene's first initial state together (as
         :meth:`Simulation.batched`); raises :class:`NotBatchedError` with the reason when the engine cannot."""
         raise NotBatchedError("the engine's joint simulation declares no batched stepping (JointSimulation.batched)")
+
+    def step_jacobian(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> StepJacobian:
+        """The Jacobian of one step of this simulation's scheme and time step at B states q, qdot ((B, n) each) under
+        joint forces ``tau`` (B, n) held over the step (the scene's timed torque left out): ∂(q', q̇')/∂(q, q̇) and
+        ∂(q', q̇')/∂τ (:class:`core.model.derivatives.StepJacobian`). Optional: checked against the complex-step truth
+        carried through the scheme's formula (``step_jacobian_error_max``), n/a where an engine does not say."""
+        raise NotImplementedError(f"{type(self).__name__} does not report the Jacobian of its step (step_jacobian)")
 
 
 class KinematicsModel(abc.ABC):

@@ -17,15 +17,18 @@ from dataclasses import dataclass
 
 from simparity.core.model.results import DIMENSIONLESS
 
-ERROR, DRIFT, ORDER, TIMING, COST, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE, PREDICTABILITY = (
+ERROR, DRIFT, ORDER, TIMING, COST, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE, PREDICTABILITY, PROBE = (
     "error", "drift", "order", "timing", "cost", "contact", "ik", "validity", "stability", "invariance",
-    "predictability")
-KINDS = (ERROR, DRIFT, ORDER, TIMING, COST, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE, PREDICTABILITY)
+    "predictability", "probe")
+KINDS = (ERROR, DRIFT, ORDER, TIMING, COST, CONTACT, IK, VALIDITY, STABILITY, INVARIANCE, PREDICTABILITY, PROBE)
 """What a metric measures: an error against the reference; a relative drift of a conserved quantity; an observed
 order of convergence; a wall time (never compared between runs); a hardware-neutral cost (exact, from what the
 engine declares: the same on every machine, and no measure of its numerics); a contact event's quantity; an IK
 solver's outcome; a reported state's validity (unit quaternion, orthonormal matrix); a measured stability limit; a
-metamorphic invariance check; a chaotic motion's predictability (when two runs part)."""
+metamorphic invariance check; a chaotic motion's predictability (when two runs part); a probe of an engine's
+floating-point behaviour (the finite-difference step sweep's best steps and the error there: where its rounding meets
+a truncation, which moves with the rounding of the coordinates it computes in, so never held invariant under a change
+of frame or units)."""
 
 
 @dataclass(frozen=True)
@@ -114,6 +117,13 @@ BASE_MOMENTUM_RESIDUAL = "base_momentum_residual"
 RNEA_DERIVATIVE_ERROR_MAX = "rnea_derivative_error_max"
 ABA_DERIVATIVE_ERROR_MAX = "aba_derivative_error_max"
 DERIVATIVE_IDENTITY_RESIDUAL = "derivative_identity_residual"
+DERIVATIVE_STEP_EXCESS = "derivative_step_excess"
+STEP_JACOBIAN_ERROR_MAX = "step_jacobian_error_max"
+STEP_JACOBIAN_STEP_EXCESS = "step_jacobian_step_excess"
+FORWARD_DIFFERENCE_BEST_STEP = "forward_difference_best_step"
+FORWARD_DIFFERENCE_FLOOR = "forward_difference_floor"
+CENTRAL_DIFFERENCE_BEST_STEP = "central_difference_best_step"
+CENTRAL_DIFFERENCE_FLOOR = "central_difference_floor"
 TIME_PER_MASS_MATRIX = "time_per_mass_matrix"
 TIME_PER_INVERSE_DYNAMICS = "time_per_inverse_dynamics"
 TIME_PER_FORWARD_DYNAMICS = "time_per_forward_dynamics"
@@ -226,6 +236,23 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
                   "analytic derivatives"),
     Metric(DERIVATIVE_IDENTITY_RESIDUAL, DIMENSIONLESS, VALIDITY,
            theory="dqddot/dtau M = I with the engine's own M: 0 up to rounding"),
+    Metric(DERIVATIVE_STEP_EXCESS, DIMENSIONLESS, ERROR,
+           theory="a differenced partial's error over that of the scheme it declares at its steps (the truth's own "
+                  "inverse dynamics differenced alike): ~1"),
+    Metric(STEP_JACOBIAN_ERROR_MAX, DIMENSIONLESS, ERROR,
+           theory="dx'/d(x, tau) of one step against the complex-step truth through the scheme's formula, over kappa_1(M): "
+                  "rounding for an analytic Jacobian"),
+    Metric(STEP_JACOBIAN_STEP_EXCESS, DIMENSIONLESS, ERROR,
+           theory="a differenced step Jacobian's error over that of the truth's own step differenced alike: ~1"),
+    Metric(FORWARD_DIFFERENCE_BEST_STEP, DIMENSIONLESS, PROBE,
+           theory="the step [rad or m] where forward differences of the engine's inverse dynamics err least: "
+                  "~sqrt(eps) ~ 1e-8 where truncation meets rounding"),
+    Metric(FORWARD_DIFFERENCE_FLOOR, DIMENSIONLESS, PROBE,
+           theory="dtau/dq by forward differences at the best step, against the complex-step truth: ~sqrt(eps)"),
+    Metric(CENTRAL_DIFFERENCE_BEST_STEP, DIMENSIONLESS, PROBE,
+           theory="the step [rad or m] where centred differences err least: ~eps^(1/3) ~ 6e-6"),
+    Metric(CENTRAL_DIFFERENCE_FLOOR, DIMENSIONLESS, PROBE,
+           theory="dtau/dq by centred differences at the best step, against the complex-step truth: ~eps^(2/3)"),
     Metric(BASE_MOMENTUM_RESIDUAL, DIMENSIONLESS, VALIDITY,
            theory="a floating base: M's base rows times qdot = the robot's momentum (linear, angular about the base "
                   "origin) summed from the engine's own link velocities: 0 up to rounding"),
@@ -338,6 +365,12 @@ def units(*names: str) -> dict[str, str]:
 def is_timing(name: str) -> bool:
     """Whether a metric measures wall time: never compared between runs, never a numerics change."""
     return name in CATALOGUE and CATALOGUE[name].is_timing
+
+
+def is_probe(name: str) -> bool:
+    """Whether a metric probes an engine's floating-point behaviour (kind ``probe``): never held invariant under a
+    change of frame or units."""
+    return name in CATALOGUE and CATALOGUE[name].kind == PROBE
 
 
 def is_cost(name: str) -> bool:

@@ -176,6 +176,10 @@ SERIES_QUANTITIES = {
     "iterations": "IK iterations at cumulative fraction x of the random targets (failed solves included)",
     "fk_disagreement_max": "largest end-effector distance [m] between the FK of `engine` and of the engine in "
                            "`integrator`, over every solver's solutions (x: 0)",
+    "forward_difference_error": "joint-dynamics scenes: dtau/dq by forward differences of the engine's own inverse "
+                                "dynamics, max |D - T| over the floored max |T| against the complex-step truth (x: the "
+                                "step [rad or m])",
+    "central_difference_error": "as forward_difference_error, by centred differences (x: the step [rad or m])",
 }
 """What each series quantity holds. Time series keep, of each of at most ``SERIES_POINTS`` runs of
 consecutive samples, the sample of largest magnitude (at its own time), so their maxima are the

@@ -58,3 +58,53 @@ def local_offset(rotation: np.ndarray, qdot: np.ndarray) -> np.ndarray:
     """(B, 3): w_b x v_b, what d/dt (R^T v) adds to R^T p_ddot (w_b = R^T omega, v_b = R^T v)."""
     local = turned_base(rotation, qdot[:, :6], True, True, inverse=True)
     return np.cross(local[:, 3:6], local[:, :3])
+
+
+def _skew_rows(x: np.ndarray) -> np.ndarray:
+    """(B, 3, 3) [x]x of (B, 3)."""
+    zero = np.zeros(len(x))
+    return np.stack([np.stack([zero, -x[:, 2], x[:, 1]], -1), np.stack([x[:, 2], zero, -x[:, 0]], -1),
+                     np.stack([-x[:, 1], x[:, 0], zero], -1)], -2)
+
+
+def project_partials(rotation: np.ndarray, qdot: np.ndarray, qddot: np.ndarray, tau: np.ndarray, by_q: np.ndarray,
+                     by_v: np.ndarray, mass: np.ndarray, linear: bool, angular: bool,
+                     offset: bool) -> tuple[np.ndarray, np.ndarray]:
+    """(∂τ/∂q, ∂τ/∂q̇) (B, 6 + n, 6 + n) in the project's convention of an engine's RNEA partials ``by_q``, ``by_v``
+    and its M ``mass``, all in its own coordinates, whose base velocity is the project's turned by R^T in its
+    ``linear`` and/or ``angular`` part, whose q tangent turns the same parts into the base frame, and whose linear
+    acceleration carries -w_b x v_b when ``offset`` (Pinocchio's free flyer: all three; MuJoCo's free joint: angular
+    only). ``qdot``, ``qddot``, ``tau`` (B, 6 + n): the project's state and τ there.
+
+    The project's q tangent is (δp, δθ, joints) with the base moved and turned in world axes (R' = exp([δθ]x) R). With
+    T = diag(R^T or 1, R^T or 1, 1) the engine's map of velocities, forces and q tangents (orthogonal), τ = T^T
+    τ_engine(q_engine, T v, T a - offset): d(R^T x)/dθ = R^T [x]x, d(R y)/dθ = -[R y]x, so
+
+        ∂τ/∂q = T^T (J_q T + J_v V_θ + M A_θ) + F_θ,    ∂τ/∂q̇ = T^T (J_v T + M C),
+
+    V_θ, A_θ, F_θ nonzero in the δθ columns only (R^T [v]x, R^T [ω]x; R^T [a - ω x v]x, R^T [ω̇]x; -[f]x, -[n]x, each
+    on a turned part), C the offset's -d(R^T (ω x v))/dq̇ = (-R^T [ω]x, R^T [v]x) on the linear rows."""
+    count, nv = qdot.shape
+    turn = np.tile(np.eye(nv), (count, 1, 1))
+    back = np.swapaxes(rotation, -1, -2)
+    parts = [(part, rows) for part, rows in ((linear, slice(0, 3)), (angular, slice(3, 6))) if part]
+    for _, rows in parts:
+        turn[:, rows, rows] = back
+    v, omega, a, alpha = qdot[:, :3], qdot[:, 3:6], qddot[:, :3], qddot[:, 3:6]
+    linear_acceleration = a - np.cross(omega, v) if offset else a
+    by_turn_v, by_turn_a, by_turn_f = (np.zeros((count, nv, 3)) for _ in range(3))
+    for rows, velocity, acceleration, force in ((slice(0, 3), v, linear_acceleration, tau[:, :3]),
+                                                (slice(3, 6), omega, alpha, tau[:, 3:6])):
+        if (rows.start == 0 and linear) or (rows.start == 3 and angular):
+            by_turn_v[:, rows] = back @ _skew_rows(velocity)
+            by_turn_a[:, rows] = back @ _skew_rows(acceleration)
+            by_turn_f[:, rows] = -_skew_rows(force)
+    widen = np.zeros((3, nv))
+    widen[:, 3:6] = np.eye(3)  # into the δθ columns
+    transposed = np.swapaxes(turn, -1, -2)
+    dq = transposed @ (by_q @ turn + by_v @ (by_turn_v @ widen) + mass @ (by_turn_a @ widen)) + by_turn_f @ widen
+    coupling = np.zeros((count, nv, nv))
+    if offset:
+        coupling[:, :3, :3] = -back @ _skew_rows(omega)
+        coupling[:, :3, 3:6] = back @ _skew_rows(v)
+    return dq, transposed @ (by_v @ turn + mass @ coupling)

@@ -15,8 +15,16 @@ import numpy as np
 
 from simparity.core.model.rigid_groups import RigidGroups
 from simparity.core.model.scenes.chain import Chain
-from simparity.references.common.floating_base import BASE_Q, BASE_V, base_rotations, turned_base, turned_mass
-from simparity.references.mujoco.joint_dynamics import MujocoJointDynamics
+from simparity.core.model.derivatives import DynamicsDerivatives, FiniteDifferences
+from simparity.references.common.floating_base import (
+    BASE_Q,
+    BASE_V,
+    base_rotations,
+    project_partials,
+    turned_base,
+    turned_mass,
+)
+from simparity.references.mujoco.joint_dynamics import FORWARD_MISSING, INVERSE_FD_STEP, MujocoJointDynamics
 
 IDENTITY_POSE = np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
 """A free joint's qpos at the world's origin, unturned (quat_wxyz)."""
@@ -72,6 +80,19 @@ class MujocoFloatingDynamics(MujocoJointDynamics):
             linear = m.body_subtreemass[body] * d.subtree_linvel[body]
             out[k] = np.r_[linear, d.subtree_angmom[body] + np.cross(d.subtree_com[body], linear)]
         return out
+
+    def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
+        """``mjd_inverseFD`` in MuJoCo's own coordinates (its q tangent: position in world axes, the quaternion turned
+        in the body frame; its qvel and qacc) converted to the project's
+        (:func:`references.common.floating_base.project_partials`); forward differences at the steps of
+        :meth:`MujocoJointDynamics.derivatives`."""
+        rotation = base_rotations(q)
+        accelerations = self.forward_dynamics(q, qdot, tau)
+        by_q, by_v, mass, steps = self.own_partials(q, turned_base(rotation, qdot, False, True, inverse=True),
+                                                    turned_base(rotation, accelerations, False, True, inverse=True))
+        by_q, by_v = project_partials(rotation, qdot, accelerations, tau, by_q, by_v, mass, False, True, False)
+        return DynamicsDerivatives(by_q, by_v, forward_missing=FORWARD_MISSING,
+                                   differences=FiniteDifferences(False, np.full(len(q), INVERSE_FD_STEP), steps))
 
     def rigid_groups(self, q: np.ndarray) -> RigidGroups:
         """The joints' groups with the base at the world's origin, unturned (q: the joint values (B, n))."""

@@ -47,7 +47,7 @@ import mujoco
 import numpy as np
 
 from simparity.core.model.engine import JointDynamicsModel
-from simparity.core.model.derivatives import DynamicsDerivatives
+from simparity.core.model.derivatives import DynamicsDerivatives, FiniteDifferences
 from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt
@@ -56,8 +56,10 @@ from simparity.references.common.quiet import captured_output
 from simparity.references.common.rigid_groups import summed
 
 
-def _compiled(chain: Chain, gravity_world: np.ndarray | None) -> mujoco.MjModel:
-    """The chain's dynamics model with the compiler options of the module docstring; raises MuJoCo's error."""
+def _compiled(chain: Chain, gravity_world: np.ndarray | None, motors: bool = False) -> mujoco.MjModel:
+    """The chain's dynamics model with the compiler options of the module docstring; raises MuJoCo's error. With
+    ``motors``, a motor (gear 1, no control limits) on each chain joint in the chain's order: ctrl is τ, for
+    ``mjd_transitionFD``'s control block (a URDF declares no actuator)."""
     with captured_output():
         spec = mujoco.MjSpec.from_string(dynamics_urdf(chain))
         spec.compiler.fusestatic = False
@@ -70,6 +72,11 @@ def _compiled(chain: Chain, gravity_world: np.ndarray | None) -> mujoco.MjModel:
         spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
         if chain.floating_base:
             spec.worldbody.first_body().add_freejoint()
+        for name in chain_joint_names(chain) if motors else ():
+            motor = spec.add_actuator()
+            motor.name, motor.trntype, motor.target = f"simparity_motor_{name}", mujoco.mjtTrn.mjTRN_JOINT, name
+            motor.set_to_motor()
+            motor.ctrllimited = mujoco.mjtLimited.mjLIMITED_FALSE
         return spec.compile()
 
 
@@ -97,8 +104,8 @@ class ChainModel:
         What MuJoCo was given, for the rows' detail.
     """
 
-    def __init__(self, chain: Chain, gravity_world: np.ndarray | None) -> None:
-        model = _compiled(chain, gravity_world)
+    def __init__(self, chain: Chain, gravity_world: np.ndarray | None, motors: bool = False) -> None:
+        model = _compiled(chain, gravity_world, motors)
         joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in chain_joint_names(chain)]
         self.dof, self.qpos = model.jnt_dofadr[joints], model.jnt_qposadr[joints]
         model.dof_damping[:] = 0.0
@@ -242,24 +249,30 @@ class MujocoJointDynamics(JointDynamicsModel):
 
     def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
         """``mjd_inverseFD`` (forward differences at :data:`INVERSE_FD_STEP` for q, that fraction of the largest |qdot|
-        for qdot: two calls; constraints off, passive damping in qfrc_inverse) at q̈ = ``mj_forward``'s qacc of τ; its outputs are transposed (DfDq[j, i] = ∂f_i/∂q_j), turned
-        back here. No forward-dynamics partials (:data:`FORWARD_MISSING`)."""
+        for qdot: two calls; constraints off, passive damping in qfrc_inverse) at q̈ = ``mj_forward``'s qacc of τ; its
+        outputs are transposed (DfDq[j, i] = ∂f_i/∂q_j), turned back here. No forward-dynamics partials
+        (:data:`FORWARD_MISSING`)."""
+        by_q, by_v, _, steps = self.own_partials(q, qdot, self.forward_dynamics(q, qdot, tau))
+        return DynamicsDerivatives(by_q, by_v, forward_missing=FORWARD_MISSING,
+                                   differences=FiniteDifferences(False, np.full(len(q), INVERSE_FD_STEP), steps))
+
+    def own_partials(self, q: np.ndarray, qdot: np.ndarray,
+                     qddot: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(∂τ/∂q, ∂τ/∂q̇, M), each (B, nv, nv) in MuJoCo's own coordinates (its q tangent, qvel), by ``mjd_inverseFD``
+        at states in its own coordinates (qpos, qvel, qacc rows), and the q̇ step of each state (B,)."""
         m, d = self.model, self.data
-        if not np.array_equal(self.state_dof, self.dof):
-            raise NotImplementedError("MuJoCo's floating-base derivatives are not converted to the project's "
-                                      "convention yet")
-        accelerations = self.forward_dynamics(q, qdot, tau)
-        nv, index = m.nv, np.ix_(self.dof, self.dof)
-        by_q, by_v = np.zeros((nv, nv)), np.zeros((nv, nv))
-        out = [np.empty((len(q), len(self.dof), len(self.dof))) for _ in range(2)]
-        for k, (row, rates, acceleration) in enumerate(zip(q, qdot, accelerations)):
-            d.qpos[self.qpos], d.qvel[self.dof] = row, rates
+        index = np.ix_(self.state_dof, self.state_dof)
+        by_q, by_v, by_a = np.zeros((m.nv, m.nv)), np.zeros((m.nv, m.nv)), np.zeros((m.nv, m.nv))
+        out = [np.empty((len(q), len(self.state_dof), len(self.state_dof))) for _ in range(3)]
+        steps_qdot = np.empty(len(q))
+        for k, (row, rates, acceleration) in enumerate(zip(q, qdot, qddot)):
+            d.qpos[self.state_qpos], d.qvel[self.state_dof] = row, rates
             d.qacc[:] = 0.0
-            d.qacc[self.dof] = acceleration
+            d.qacc[self.state_dof] = acceleration
             d.qfrc_applied[:] = 0.0
             speed = float(np.max(np.abs(rates), initial=0.0))
-            mujoco.mjd_inverseFD(m, d, INVERSE_FD_STEP, False, by_q, None, None, None, None, None, None)
-            mujoco.mjd_inverseFD(m, d, INVERSE_FD_STEP * (speed if speed > 0 else 1.0), False, None, by_v, None, None,
-                                 None, None, None)
-            out[0][k], out[1][k] = by_q.T[index], by_v.T[index]
-        return DynamicsDerivatives(out[0], out[1], forward_missing=FORWARD_MISSING)
+            steps_qdot[k] = INVERSE_FD_STEP * (speed if speed > 0 else 1.0)
+            mujoco.mjd_inverseFD(m, d, INVERSE_FD_STEP, False, by_q, None, by_a, None, None, None, None)
+            mujoco.mjd_inverseFD(m, d, steps_qdot[k], False, None, by_v, None, None, None, None, None)
+            out[0][k], out[1][k], out[2][k] = by_q.T[index], by_v.T[index], by_a.T[index]
+        return out[0], out[1], out[2], steps_qdot

@@ -37,6 +37,7 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
+from simparity.core.model.derivatives import FiniteDifferences, StepJacobian
 from simparity.core.model.engine import BatchedRun, JointSimulation
 from simparity.core.model.errors import DivergedError
 from simparity.core.model.scenes.joint_motion import JointMotionScene
@@ -48,6 +49,9 @@ from simparity.references.mujoco.stage_loads import DETAIL as STAGE_DETAIL
 from simparity.references.mujoco.stage_loads import StepClock, stage_callback
 
 _STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
+TRANSITION_FD_STEP = 1e-6
+"""``mjd_transitionFD``'s eps, centred: truncation eps^2 / 6 |d3 x'| ~ 1e-13, rounding eps_machine |x'| / eps ~ 1e-10
+of the step's scale."""
 
 INTEGRATORS = {
     "euler": (mujoco.mjtIntegrator.mjINT_EULER, 0),
@@ -86,6 +90,7 @@ class MujocoJointMotion(JointSimulation):
     """
 
     def __init__(self, scene: JointMotionScene, integrator: str, dt: float) -> None:
+        self._scene, self._integrator = scene, integrator
         built = ChainModel(scene.chain, scene.gravity_world)
         self.model, self._dof, self._qpos = built.model, built.dof, built.qpos
         kind, disabled = INTEGRATORS[integrator]
@@ -162,6 +167,31 @@ class MujocoJointMotion(JointSimulation):
         states = np.concatenate([self._initial[:, None], stepped], axis=1).transpose(1, 0, 2)  # (T, B, nstate)
         return JointTrajectory(np.arange(n_steps + 1) * self._dt, states[..., self._qpos_at + self._qpos],
                                states[..., self._qvel_at + self._dof])
+
+    def step_jacobian(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> StepJacobian:
+        """``mjd_transitionFD`` (centred differences at :data:`TRANSITION_FD_STEP` of the state and the controls) on
+        the same model, integrator and timestep with a motor on each chain joint (``ChainModel(motors=True)``: ctrl
+        is τ; the stepping model has none), at B states with qfrc_applied 0: A's and B's rows and columns of the
+        chain's dofs (MuJoCo's x = (the q tangent, qvel): a hinge's or slide's tangent is its qpos)."""
+        kind, disabled = INTEGRATORS[self._integrator]
+        if kind == mujoco.mjtIntegrator.mjINT_RK4:
+            raise NotImplementedError("MuJoCo's mjd_transitionFD does not differentiate its RK4 step (\"RK4 "
+                                      "integrator is not supported\")")
+        built = ChainModel(self._scene.chain, self._scene.gravity_world, motors=True)
+        m = built.model
+        m.opt.integrator, m.opt.timestep = kind, self._dt
+        m.opt.disableflags |= disabled
+        d = mujoco.MjData(m)
+        index = np.r_[built.dof, m.nv + built.dof]
+        by_state, by_force = np.zeros((2 * m.nv, 2 * m.nv)), np.zeros((2 * m.nv, m.nu))
+        out = np.empty((len(q), len(index), len(index))), np.empty((len(q), len(index), len(built.dof)))
+        for k, (row, rates, force) in enumerate(zip(q, qdot, tau)):
+            d.qpos[built.qpos], d.qvel[built.dof], d.ctrl[:] = row, rates, force
+            d.qfrc_applied[:] = 0.0
+            mujoco.mjd_transitionFD(m, d, TRANSITION_FD_STEP, True, by_state, by_force, None, None)
+            out[0][k], out[1][k] = by_state[np.ix_(index, index)], by_force[index]
+        steps = np.full(len(q), TRANSITION_FD_STEP)
+        return StepJacobian(out[0], out[1], FiniteDifferences(True, steps, steps))
 
     def batched(self, copies: int) -> BatchedRun:
         """``copies`` rollouts of the first initial state in one ``mujoco.rollout`` call, as :meth:`run` makes; it

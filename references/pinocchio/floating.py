@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from simparity.core.model.derivatives import DynamicsDerivatives
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import xyzw_from_wxyz
 from simparity.references.common.floating_base import (
@@ -20,6 +21,7 @@ from simparity.references.common.floating_base import (
     BASE_V,
     base_rotations,
     local_offset,
+    project_partials,
     turned_base,
     turned_mass,
 )
@@ -105,7 +107,25 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
             out[k] = np.r_[linear, np.array(momentum.angular) + np.cross(self.data.com[0], linear)]
         return out
 
-    def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray):
-        """Not yet on a floating base: Pinocchio's derivatives are in its free flyer's LOCAL tangent, not converted."""
-        raise NotImplementedError("Pinocchio's floating-base derivatives are not converted to the project's convention "
-                                  "yet")
+    def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
+        """``computeRNEADerivatives`` in the free flyer's LOCAL coordinates (its tangent R exp(δφ), its velocity and
+        acceleration) at q̈ = this model's forward dynamics of τ, converted to the project's
+        (:func:`references.common.floating_base.project_partials`), + D on the joints' ∂τ/∂q̇; forward dynamics'
+        partials -M⁻¹ ∂τ/∂x with Pinocchio's M (its computeABADerivatives' local outputs are not converted)."""
+        rotation = base_rotations(q)
+        accelerations = self.forward_dynamics(q, qdot, tau)
+        velocity = turned_base(rotation, qdot, True, True, inverse=True)
+        acceleration = turned_base(rotation, accelerations, True, True, inverse=True)
+        acceleration[:, :3] -= local_offset(rotation, qdot)
+        index = np.ix_(self._index, self._index)
+        own = [np.empty((len(q), len(self._index), len(self._index))) for _ in range(3)]
+        for k, (row, rates, rate_of_rates) in enumerate(zip(q, velocity, acceleration)):
+            found = pin.computeRNEADerivatives(self.model, self.data, self._full(row), self._vector(rates),
+                                               self._vector(rate_of_rates))
+            for out, matrix in zip(own, found):
+                out[k] = np.asarray(matrix)[index]
+        mass = np.triu(own[2]) + np.swapaxes(np.triu(own[2], 1), -1, -2)  # Pinocchio fills M's upper triangle
+        by_q, by_v = project_partials(rotation, qdot, accelerations, tau, own[0], own[1], mass, True, True, True)
+        by_v[:, BASE_V:, BASE_V:] += np.diag(self.damping)
+        inverse = np.linalg.inv(self.mass_matrix(q))
+        return DynamicsDerivatives(by_q, by_v, -inverse @ by_q, -inverse @ by_v, inverse)

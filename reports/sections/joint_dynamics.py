@@ -6,12 +6,13 @@ from __future__ import annotations
 import pandas as pd
 
 from simparity.core.model.metric_catalogue import (
-    BASE_MOMENTUM_RESIDUAL, BIAS_FORCE_ERROR_MAX, FORWARD_DYNAMICS_ERROR_MAX, GRAVITY_EQUIVALENCE_RESIDUAL, GRAVITY_IDENTITY_RESIDUAL,
+    BASE_MOMENTUM_RESIDUAL, BIAS_FORCE_ERROR_MAX, CENTRAL_DIFFERENCE_BEST_STEP, CENTRAL_DIFFERENCE_FLOOR,
+    FORWARD_DIFFERENCE_BEST_STEP, FORWARD_DIFFERENCE_FLOOR, FORWARD_DYNAMICS_ERROR_MAX, GRAVITY_EQUIVALENCE_RESIDUAL, GRAVITY_IDENTITY_RESIDUAL,
     INVERSE_DYNAMICS_ERROR_MAX,
     KINETIC_ENERGY_RESIDUAL, MASS_COLUMN_RESIDUAL, MASS_MATRIX_ASYMMETRY, MASS_MATRIX_ERROR_MAX, ROUND_TRIP_RESIDUAL,
 )
 from simparity.core.model.results import OK
-from simparity.reports import tables
+from simparity.reports import figures, tables
 from simparity.reports.blocks import Block, Bullets, Details, Heading, Paragraph, Table, number
 from simparity.reports.markdown import LINE_CHARS
 from simparity.reports.sections.context import ReportContext
@@ -80,4 +81,31 @@ def section(ctx: ReportContext, rows: pd.DataFrame) -> list[Block]:
                                       "the engine's own outputs; each metric, times and the reasons for n/a: the HTML "
                                       "report (docs/metrics.md).",)),
                            table, Details("Every joint-dynamics metric", (full,), markdown=False, open=True)]
+    blocks += _differences(ctx, rows, scenes)
     return blocks + engine_notes(rows)
+
+
+def _differences(ctx: ReportContext, rows: pd.DataFrame, scenes: list[str]) -> list[Block]:
+    """The finite-difference step sweep: its figure, and each engine's best steps in one line per scheme (the
+    smallest error over the scenes and the range of the steps that gave it)."""
+    series = ctx.series[ctx.series["scene"].isin(scenes)] if not ctx.series.empty else ctx.series
+    figure = ctx.figure(figures.difference_step_figure(series), "finite-difference-steps",
+                        "Finite differences as users take them: the error of dtau/dq against the step, from the "
+                        "stored series (comparisons/measure/finite_differences.py).")
+    if not figure:
+        return []
+    lines = []
+    for label, step_metric, error_metric in (("forward", FORWARD_DIFFERENCE_BEST_STEP, FORWARD_DIFFERENCE_FLOOR),
+                                             ("centred", CENTRAL_DIFFERENCE_BEST_STEP, CENTRAL_DIFFERENCE_FLOOR)):
+        cells = []
+        for (engine, method), case in rows[rows["status"] == OK].groupby(["engine", "integrator"], sort=False):
+            steps = case[case["metric"] == step_metric]["value"]
+            errors = case[case["metric"] == error_metric]["value"]
+            if not steps.empty:
+                low, high = number(float(steps.min())), number(float(steps.max()))
+                cells.append(f"{engine} {method} {low if low == high else f'{low}-{high}'} "
+                             f"(error {number(float(errors.min()))}-{number(float(errors.max()))})")
+        if cells:
+            lines.append(f"**Best {label}-difference step** per engine over the scenes (error there): "
+                         + "; ".join(cells) + ".")
+    return [Heading(3, "Finite differences against the step"), *figure, *(Paragraph(line) for line in lines)]

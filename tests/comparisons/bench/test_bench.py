@@ -210,3 +210,30 @@ def test_the_run_records_its_largest_workers_peak_measured_independently(tmp_pat
     assert peak.largest_child_bytes == pytest.approx(high_water, rel=PEAK_TOLERANCE)
     assert peak.this_process_bytes < ALLOCATION_BYTES  # the run's own process never held the allocation
     assert peak.tree_bytes == peak.this_process_bytes + peak.largest_child_bytes
+
+
+ANALYTIC_DERIVATIVES = 1e-11
+"""The shipped bound on analytic derivatives against the complex-step truth (rnea_derivative_error_max)."""
+FORWARD_DIFFERENCES = 1e-4
+"""MuJoCo's mjd_inverseFD at eps 1e-6: truncation ~1e-6 of the partial's scale, 1e-4 leaves it room."""
+
+
+def test_the_derivative_rows_time_every_route_with_its_error_and_a_ratio_to_pinocchio(monkeypatch):
+    """#44: every route's time per state, its error against the complex-step truth (analytic to rounding,
+    differences to their truncation) and, in BENCHMARKS.md, Pinocchio's time over its own in the same run."""
+    from simparity.comparisons.bench import derivatives
+
+    monkeypatch.setattr(derivatives, "ARMS", ("ur5-dynamics",))
+    lines: list[str] = []
+    rows = derivatives.derivative_rows([2], lambda fn: median_time(fn, 1), BenchRow, lines.append)
+    by_route = {(r.engine, r.method): r for r in rows}
+    assert set(by_route) == {("core", "recursive"), ("core", "central differences"), ("pinocchio", "recursive"),
+                             ("mujoco", "recursive")}
+    assert all(math.isfinite(r.value) and r.value > 0 for r in rows)
+    assert by_route["core", "recursive"].accuracy <= ANALYTIC_DERIVATIVES
+    assert by_route["pinocchio", "recursive"].accuracy <= ANALYTIC_DERIVATIVES
+    assert ANALYTIC_DERIVATIVES < by_route["mujoco", "recursive"].accuracy <= FORWARD_DIFFERENCES
+    table = derivatives.markdown_lines(rows)
+    pinocchio = next(line for line in table if line.startswith("| ur5-dynamics | pinocchio |"))
+    assert pinocchio.split(" | ")[-2] == "1.00"  # its own time over its own
+    assert all(float(line.split(" | ")[-2]) > 0 for line in table if line.startswith("| ur5-dynamics |"))

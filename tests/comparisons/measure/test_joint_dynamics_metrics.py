@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from simparity.comparisons.measure.derivative_metrics import DERIVATIVE_METRICS
+from simparity.comparisons.execute.derivative_runner import ALL_DERIVATIVE_METRICS
 from simparity.comparisons.measure.model_parity import MODEL_METRICS
 from simparity.comparisons.measure.joint_dynamics_metrics import (
     JOINT_DYNAMICS_METRICS,
@@ -97,7 +97,7 @@ def test_an_exact_model_passes_every_identity_and_agrees_with_itself():
     scene = _scene(damping=0.3)
     values = _judged(Pendulum(damping=0.3), Pendulum(damping=0.3), scene)
     assert set(values) == set(JOINT_DYNAMICS_METRICS) - {m for m in JOINT_DYNAMICS_METRICS if m.startswith("time_")} - set(
-        MODEL_METRICS) - set(DERIVATIVE_METRICS)  # tests/comparisons/measure/test_model_parity.py, test_complex_step.py
+        MODEL_METRICS) - set(ALL_DERIVATIVE_METRICS)  # tests/comparisons/measure/test_model_parity.py, test_complex_step.py
     for metric, measured in values.items():
         if metric == MASS_MATRIX_DEFINITENESS_MIN:
             assert measured.value == 1.0  # one joint: its one eigenvalue over itself

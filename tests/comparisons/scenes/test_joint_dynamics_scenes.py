@@ -263,7 +263,7 @@ def test_a_floating_scene_passes_the_check_in_milliseconds(tmp_path):
 @pytest.mark.slow  # ~3 s of CPU: a checked and reported run
 def test_a_run_checks_and_reports_joint_dynamics(tmp_path):
     """simparity run --check on the lecture's arm and the crafted arm: green, every engine in the report's section
-    and the summary, each row of report.md within 300 characters."""
+    and the summary, each row of report.md within 300 characters, the finite-difference figure and best steps."""
     from simparity.comparisons.cli.main import EXIT_OK, main
 
     out = tmp_path / "run"
@@ -277,6 +277,13 @@ def test_a_run_checks_and_reports_joint_dynamics(tmp_path):
         assert case in section and case in before, case
     assert "crafted-arm-dynamics |" in section and "lecture-2link-dynamics |" in section
     assert max(len(line) for line in report.splitlines()) <= 300
+    # the finite-difference step sweep (#44): its figure from the stored series, every engine's best steps
+    assert "### Finite differences against the step" in section
+    assert (out / "figures" / "finite-difference-steps.svg").is_file()
+    for scheme in ("forward", "centred"):
+        line = " ".join(section[section.index(f"**Best {scheme}-difference step**"):].split("\n\n")[0].split())
+        assert all(case in line for case in ("core recursive", "mujoco recursive", "pybullet recursive",
+                                              "pinocchio recursive")), line
 
 
 class Featherstone(InHouseEngine):

@@ -1,0 +1,78 @@
+"""Issue #44's planted bugs in a user's step Jacobian, through the gate: a copy of core whose RK4 step Jacobian is
+its explicit Euler one, or a copy of MuJoCo's adapter whose mjd_transitionFD is one-sided while it declares centred
+differences, turns the check red naming it on a driven arm; faithful copies of both pass beside the built-in
+engines."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.helpers import assert_caught, run_planted
+
+PLANTED = '''
+import mujoco
+
+from simparity.core.articulated.motion import CoreJointMotion
+from simparity.core.inhouse import InHouseEngine
+from simparity.references.mujoco.adapter import MujocoEngine
+from simparity.references.mujoco.joint_motion import MujocoJointMotion
+
+
+def _engine(base, motion_class, engine_name):
+    """An engine like ``base`` whose joint-motion simulations are ``motion_class`` (a planted copy)."""
+    class Planted(base):
+        name = engine_name
+
+        def build_joint_motion(self, scene, integrator, dt):
+            return motion_class(scene, integrator, dt)
+
+    return Planted
+
+
+class EulerForRk4(CoreJointMotion):
+    """RK4 steps, its Jacobian carried as if the step were explicit Euler's."""
+
+    def step_jacobian(self, q, qdot, tau):
+        scheme, self._scheme = self._scheme, "explicit_euler" if self._scheme == "rk4" else self._scheme
+        try:
+            return super().step_jacobian(q, qdot, tau)
+        finally:
+            self._scheme = scheme
+
+
+class OneSided(MujocoJointMotion):
+    """mjd_transitionFD called forward (flg_centered 0), the Jacobian still declared centred."""
+
+    def step_jacobian(self, q, qdot, tau):
+        original = mujoco.mjd_transitionFD
+        mujoco.mjd_transitionFD = lambda m, d, eps, centred, *rest: original(m, d, eps, False, *rest)
+        try:
+            return super().step_jacobian(q, qdot, tau)
+        finally:
+            mujoco.mjd_transitionFD = original
+
+
+CoreCopy = _engine(InHouseEngine, CoreJointMotion, "core-copy")
+EulerForRk4Engine = _engine(InHouseEngine, EulerForRk4, "core-euler-jacobian")
+MujocoCopy = _engine(MujocoEngine, MujocoJointMotion, "mujoco-copy")
+OneSidedEngine = _engine(MujocoEngine, OneSided, "mujoco-one-sided")
+'''
+
+
+def _run(tmp_path, monkeypatch, capsys, plugin: str) -> tuple[int, list[str], str]:
+    return run_planted(tmp_path, monkeypatch, capsys, "planted_step_jacobians", PLANTED, "driven-arm", plugin)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("plugin, name, metric", [
+    ("EulerForRk4Engine", "core-euler-jacobian", "step_jacobian_error_max"),
+    ("OneSidedEngine", "mujoco-one-sided", "step_jacobian_step_excess")])
+def test_a_planted_step_jacobian_bug_is_caught_naming_the_engine(tmp_path, monkeypatch, capsys, plugin, name, metric):
+    assert_caught(_run(tmp_path, monkeypatch, capsys, plugin), name, metric)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("plugin", ["CoreCopy", "MujocoCopy"])
+def test_faithful_copies_of_the_step_jacobians_pass(tmp_path, monkeypatch, capsys, plugin):
+    code, violations, out = _run(tmp_path, monkeypatch, capsys, plugin)
+    assert code == 0 and not violations, out[-2000:]
