@@ -244,8 +244,8 @@ def _joint_dynamics_rows(scene: JointDynamicsScene, engine: Engine, case: Case, 
         scale = (shared.scale if shared.scale is not None  # else its own: identities need no reference
                  else _force_scale(scene, engine, case.integrator, model, shared.states, own))
         values.update(identities(model, scene.chain, shared.states, own, scale, scene.gravity_world))
-        derivatives, kind, found = derivative_values(model, shared.truth, shared.truth_problem, shared.states,
-                                                     own["M"], scale.floor, case)
+        derivatives, kind, found = derivative_values(model, shared.truth, shared.truth_problem, shared.states, own,
+                                                     scale.floor, case)
         values.update(derivatives)
         series += found
     except Exception as err:  # noqa: BLE001 - reported in the rows

@@ -15,6 +15,7 @@ import numpy as np
 from simparity.comparisons.common.error_text import error_text
 from simparity.comparisons.measure.derivative_metrics import (
     DERIVATIVE_METRICS,
+    SANE_STEP,
     derivative_errors,
     partial_floors,
     step_excess,
@@ -87,8 +88,8 @@ def _expected(truth: DerivativeTruth, own: DynamicsDerivatives, q: np.ndarray, q
     def inverse_dynamics(*state: np.ndarray) -> np.ndarray:
         return complex_step.inverse_dynamics(truth.tree, *state)
 
-    return {name: difference_partial(inverse_dynamics, q, qd, truth.qddot, wrt, step, differences.centred,
-                                     _retraction(q, qd))
+    return {name: difference_partial(inverse_dynamics, q, qd, truth.qddot, wrt, np.minimum(step, SANE_STEP),
+                                     differences.centred, _retraction(q, qd))
             for name, wrt, step in (("dtau_dq", "q", differences.step_q), ("dtau_dqdot", "qdot", differences.step_qdot))}
 
 
@@ -98,31 +99,37 @@ def _retraction(q: np.ndarray, qdot: np.ndarray) -> Retraction:
 
 
 def derivative_values(model: JointDynamicsModel, truth: DerivativeTruth | None, truth_problem: str,
-                      states: tuple[np.ndarray, ...], mass: np.ndarray, floor: float,
+                      states: tuple[np.ndarray, ...], own_values: dict[str, np.ndarray], floor: float,
                       case: Case) -> tuple[dict[str, Measured], str, list[SeriesRecord]]:
     """(the derivative and step-sweep values of ``model`` at the ``states`` against the ``truth`` (n/a with why where
     there is none, or the engine reports no derivatives), the scheme kind its partials declare ("" when it reports
-    none), the sweep's series). ``mass`` (B, n, n): the engine's own M; ``floor``: the chain's force floor [N m]."""
+    none), the sweep's series). ``own_values``: the engine's values at the states (its M "M", its q̈ "qdd" of their τ: the
+    truth's partials are taken at that q̈, so that the engine's forward solve, ~ε κ(M) off, is judged by
+    forward_dynamics_error_max and not again here); ``floor``: the chain's force floor [N m]."""
     if truth is None:
         return _not_measured(ALL_DERIVATIVE_METRICS, truth_problem), "", []
     q, qd, _, tau = states
     sweep, series = _sweep(model, truth, states, floor, case)
     try:
-        own = model.derivatives(q, qd, tau)
+        partials = model.derivatives(q, qd, tau)
     except NotImplementedError as err:
         return _not_measured(DERIVATIVE_METRICS, str(err)) | sweep, "", series
     expected_shape = truth.partials.dtau_dq.shape
-    if own.dtau_dq.shape != expected_shape:
-        raise ValueError(f"derivatives: dtau_dq has shape {own.dtau_dq.shape}, expected {expected_shape} (B states x "
-                         "n x n, column j by joint j)")
-    bad = [name for name in PARTIALS if getattr(own, name) is not None and not np.all(np.isfinite(getattr(own, name)))]
+    if partials.dtau_dq.shape != expected_shape:
+        raise ValueError(f"derivatives: dtau_dq has shape {partials.dtau_dq.shape}, expected {expected_shape} (B "
+                         "states x n x n, column j by joint j)")
+    bad = [name for name in PARTIALS
+           if getattr(partials, name) is not None and not np.all(np.isfinite(getattr(partials, name)))]
     if bad:
         raise ValueError(f"non-finite {', '.join(bad)}")
-    values = derivative_errors(own, truth.partials, mass, partial_floors(floor, qd))
-    expected = _expected(truth, own, q, qd) if own.differences is not None else {}
+    from simparity.references.derivatives import complex_step
+
+    at_own = complex_step.derivatives(truth.tree, q, qd, tau, own_values["qdd"])
+    values = derivative_errors(partials, at_own, own_values["M"], partial_floors(floor, qd))
+    expected = _expected(truth, partials, q, qd) if partials.differences is not None else {}
     tau_scale = np.maximum(np.max(np.abs(tau), axis=-1), floor)
-    values[DERIVATIVE_STEP_EXCESS] = step_excess(own, truth.partials, expected, tau_scale)
-    return values | sweep, own.kind, series
+    values[DERIVATIVE_STEP_EXCESS] = step_excess(partials, at_own, expected, tau_scale)
+    return values | sweep, partials.kind, series
 
 
 def _sweep(model: JointDynamicsModel, truth: DerivativeTruth, states: tuple[np.ndarray, ...], floor: float,

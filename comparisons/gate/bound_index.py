@@ -18,6 +18,7 @@ import math
 from typing import TYPE_CHECKING, Hashable
 
 from simparity.comparisons.gate.metric_names import WILDCARDS
+from simparity.core.model.derivatives import ANALYTIC, DIFFERENCE_KINDS
 
 if TYPE_CHECKING:
     from simparity.comparisons.gate.tolerances import Bound
@@ -97,6 +98,18 @@ class _StepIndex:
         return self._found[dt]
 
 
+DERIVATIVE_KINDS = (ANALYTIC, *DIFFERENCE_KINDS.values())
+"""The scheme kinds a derivative row's scheme ends with (core.model.derivatives)."""
+
+
+def case_schemes(scheme: str) -> tuple[str, ...]:
+    """The labels a bound's ``scheme`` may match for a row of scheme ``scheme``: itself, and for a derivative row
+    ("rk4+analytic_derivatives": its case's scheme joined with what its derivatives declare) also its case's, so that
+    a bound keyed by the case's scheme (a hard case's verdict) holds its derivative rows too."""
+    case, _, kind = scheme.rpartition("+")
+    return (scheme, case) if case and kind in DERIVATIVE_KINDS else (scheme,)
+
+
 class BoundIndex:
     """The bounds of a tolerances file (and the files it extends), found by row (module docstring)."""
 
@@ -123,8 +136,10 @@ class BoundIndex:
     def _matching_groups(self, scene: str, engine: str, integrator: str, metric: str, dt: float, scheme: str,
                          own_reference: bool) -> list[list[Bound]]:
         """The groups that match a row (each sorted, the deciding bound first), noted as having matched one."""
-        values = {"scene": scene, "engine": engine, "integrator": integrator, "metric": metric, "scheme": scheme}
+        values = {"scene": scene, "engine": engine, "integrator": integrator, "metric": metric}
         choices = [self._patterns[key].groups(value) for key, value in values.items()] + [self._steps.groups(dt)]
+        choices.append(tuple(dict.fromkeys(number for label in case_schemes(scheme)
+                                           for number in self._patterns["scheme"].groups(label))))
         candidates = min(choices, key=len)
         self.attempts += len(candidates)
         found = [number for number in candidates

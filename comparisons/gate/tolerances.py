@@ -55,7 +55,7 @@ from typing import Any
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from simparity.comparisons.gate.bound_index import DT_MATCH, BoundIndex
+from simparity.comparisons.gate.bound_index import DT_MATCH, BoundIndex, case_schemes
 from simparity.comparisons.gate.metric_names import allowed_text, non_negative, unknown_metric
 from simparity.core.model.errors import SceneError, ToleranceError, one_line
 from simparity.core.model.files import read_toml
@@ -167,7 +167,7 @@ class Bound:
             return False
         if isinstance(self.dt, float) and not abs(dt - self.dt) <= DT_MATCH * self.dt:
             return False
-        return any(fnmatch.fnmatchcase(scheme, p) for p in self.scheme) and all(
+        return any(fnmatch.fnmatchcase(label, p) for p in self.scheme for label in case_schemes(scheme)) and all(
             fnmatch.fnmatchcase(value, pattern) for value, pattern in
             zip((scene, engine, integrator, metric), (self.scene, self.engine, self.integrator, self.metric)))
 

@@ -38,6 +38,12 @@ DERIVATIVE_METRICS = units(RNEA_DERIVATIVE_ERROR_MAX, ABA_DERIVATIVE_ERROR_MAX, 
                            DERIVATIVE_STEP_EXCESS)
 """The derivative rows of a joint-dynamics case, in row order."""
 
+SANE_STEP = 1e-3
+"""[rad, m, rad/s, m/s, N m or N] The largest step whose truncation a declared difference is held to: a claim of a
+coarser step is judged as if it were this one (a forward difference at 1e-3 rad errs by ~5e-4 of the partial, at
+1.0 by half of it), so that no declared step excuses an error a useful one would not make (found by a held-out
+review: a step Jacobian 10 % off, declared forward at 1.0, passed)."""
+
 DIFFERENCE_ROUNDING = 64.0
 """[ε] A difference's rounding, in units of ε |τ| / h: an inverse dynamics rounds to a few tens of ε of the largest
 joint force (sums over the links of an arm of up to ~30), and the difference of two such values divided by h
@@ -49,7 +55,8 @@ _ABA = ("dqddot_dq", "dqddot_dqdot", "dqddot_dtau")
 
 
 def _worst(pairs: list[tuple[str, float]], what: str) -> Measured:
-    """The largest of (partial, relative error), named; n/a when every partial was skipped."""
+    """The largest of (partial, relative error), named; n/a when every partial was skipped (zero in truth, floor and
+    engine alike)."""
     if not pairs:
         return Measured(np.nan, "1", unmeasurable=f"every {what} partial is zero at every state: nothing to be "
                                                   "relative to")
@@ -74,7 +81,7 @@ def worst_excess(blocks: list[tuple[str, np.ndarray, np.ndarray, np.ndarray, np.
     for name, own, truth, expected, rounding in blocks:
         own_error = np.max(np.abs(own - truth), axis=(-1, -2))
         allowed = np.maximum(np.max(np.abs(expected - truth), axis=(-1, -2)), rounding)
-        ratios = np.divide(own_error, allowed, out=np.zeros_like(own_error), where=allowed > 0)
+        ratios = own_error / np.maximum(allowed, np.finfo(float).tiny)  # no allowance at all: any error is too much
         k = int(np.argmax(ratios))
         if ratios[k] > worst[0]:
             worst = (float(ratios[k]), name, k)
@@ -107,8 +114,9 @@ def derivative_errors(own: DynamicsDerivatives, truth: DynamicsDerivatives, own_
     for name in _RNEA:
         reference = getattr(truth, name)
         scale = max(float(np.max(np.abs(reference))), floors[name])
-        if scale > 0:
-            rnea.append((name, float(np.max(np.abs(getattr(own, name) - reference))) / scale))
+        error = float(np.max(np.abs(getattr(own, name) - reference)))
+        if scale > 0 or error > 0:  # a partial zero in truth and floor: the engine's own entries, against 1
+            rnea.append((name, error / (scale if scale > 0 else 1.0)))
     out = {RNEA_DERIVATIVE_ERROR_MAX: _worst(rnea, "RNEA")}
     if own.dqddot_dtau is None or truth.dqddot_dtau is None:
         missing = Measured(np.nan, "1", unmeasurable=own.forward_missing or truth.forward_missing)
@@ -118,8 +126,9 @@ def derivative_errors(own: DynamicsDerivatives, truth: DynamicsDerivatives, own_
     for name in _ABA:
         reference = getattr(truth, name)
         scale = max(float(np.max(np.abs(mass @ reference))), floors[name])
-        if scale > 0:
-            aba.append((name, float(np.max(np.abs(mass @ (getattr(own, name) - reference)))) / scale))
+        error = float(np.max(np.abs(mass @ (getattr(own, name) - reference))))
+        if scale > 0 or error > 0:
+            aba.append((name, error / (scale if scale > 0 else 1.0)))
     out[ABA_DERIVATIVE_ERROR_MAX] = _worst(aba, "ABA")
     identity = np.max(np.abs(own.dqddot_dtau @ own_mass - np.eye(own_mass.shape[-1])), axis=(-1, -2))
     conditioning = np.linalg.cond(own_mass, 1)

@@ -3,8 +3,10 @@ complex-step truth carried through that scheme's formula (:mod:`references.deriv
 
 A judge: it imports core's data model only.
 
-- ``step_jacobian_error_max``: per state, the larger of the two blocks' max |D - T| over the block's max |T|,
-  divided by κ₁(M) at the state (M the truth's): a step's Jacobian carries M⁻¹ (∂x'/∂τ = h M⁻¹ for an Euler step),
+- ``step_jacobian_error_max``: per state, the larger of the two blocks' max |D - T| over the block's max |T|
+  (∂x'/∂x's is the identity's at least: its representation rounds to ε of that, whatever the step's own change; a
+  differenced Jacobian's error is held to its scheme by the excess below, with any declared step above
+  ``SANE_STEP`` judged at it), divided by κ₁(M) at the state (M the truth's): a step's Jacobian carries M⁻¹ (∂x'/∂τ = h M⁻¹ for an Euler step),
   whose every computation, the truth's own solve included, rounds to ~ε κ(M) (measured 3e-11 relative on a 20-link
   chain with κ 6.6e5, 4.5e-17 over κ), so its error is judged against its conditioning as an inverse is
   (``derivative_identity_residual``); a wrong term is O(1) relative, read as 1/κ (1e-6 at κ = 1e6);
@@ -30,17 +32,16 @@ worst case, ε κ of its result, is the margin itself (MuJoCo's own differences 
 ~1/200 of it, of chain-20 turned to ~1e-4; a forward difference claimed centred reads ~100 on the driven arm)."""
 STEP_JACOBIAN_METRICS = units(STEP_JACOBIAN_ERROR_MAX, STEP_JACOBIAN_STEP_EXCESS)
 """The step-Jacobian rows of a joint-motion case, in row order."""
-_BLOCKS = ("by_state", "by_force")
 
 
 def _block_errors(own: StepJacobian, truth: StepJacobian) -> list[tuple[str, np.ndarray]]:
-    """(block, per-state |D - T| max over the block's |T| max (B,)) of each block."""
+    """(block, per-state |D - T| max over the block's max |T| (B,)) of each block; a block zero in truth is judged
+    against 1."""
     out = []
-    for name in _BLOCKS:
-        reference = getattr(truth, name)
-        scale = np.max(np.abs(reference), axis=(-1, -2))
-        error = np.max(np.abs(getattr(own, name) - reference), axis=(-1, -2))
-        out.append((name, np.divide(error, scale, out=np.zeros_like(error), where=scale > 0)))
+    for name in ("by_state", "by_force"):
+        scale = np.max(np.abs(getattr(truth, name)), axis=(-1, -2))
+        error = np.max(np.abs(getattr(own, name) - getattr(truth, name)), axis=(-1, -2))
+        out.append((name, error / np.where(scale > 0, scale, 1.0)))
     return out
 
 

@@ -72,6 +72,8 @@ class StepJacobian:
             raise ValueError(f"step Jacobian blocks of shapes {state} and {force}, expected (B, 2n, 2n) and (B, 2n, n)")
         object.__setattr__(self, "by_state", readonly(np.asarray(self.by_state, dtype=float), shape=state))
         object.__setattr__(self, "by_force", readonly(np.asarray(self.by_force, dtype=float), shape=force))
+        if self.differences is not None and len(self.differences.step_q) != state[0]:
+            raise ValueError(f"{len(self.differences.step_q)} difference steps for {state[0]} states")
 
     @property
     def kind(self) -> str:

@@ -268,13 +268,17 @@ def _bodies(tree: Tree, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray, root
         return tau, on_root
 
 
-def derivatives(tree: Tree, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
-    """The truth at B states (B, n): RNEA's derivatives at q̈ = the model's forward dynamics of ``tau``, and forward
-    dynamics' (the module docstring), every partial (B, n, n), column j the derivative by joint j's variable."""
+def derivatives(tree: Tree, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray,
+                qddot: np.ndarray | None = None) -> DynamicsDerivatives:
+    """The truth at B states (B, n): RNEA's derivatives at q̈ = the model's forward dynamics of ``tau`` (or at
+    ``qddot`` when given: an engine's own q̈ of τ, so that its forward solve's rounding, ~ε κ(M), is not counted in
+    its derivatives), and forward dynamics' (the module docstring), every partial (B, n, n), column j the derivative
+    by joint j's variable."""
+    if qddot is None:
+        qddot = forward_dynamics(tree, q, qdot, tau)
     if tree.base_inertia is not None:
-        return _floating_derivatives(tree, q, qdot, tau)
+        return _floating_derivatives(tree, q, qdot, qddot)
     count, n = q.shape
-    qddot = forward_dynamics(tree, q, qdot, tau)
     # 3n directions per state: q_j, then qdot_j, then qddot_j, each perturbed by i h
     stacked = [np.repeat(x, 3 * n, axis=0).astype(complex) for x in (q, qdot, qddot)]
     for part in range(3):
@@ -292,12 +296,11 @@ def _partials(dtau_dq: np.ndarray, dtau_dqdot: np.ndarray, exact_mass: np.ndarra
                                dqddot_dqdot=-inverse @ dtau_dqdot, dqddot_dtau=inverse)
 
 
-def _floating_derivatives(tree: Tree, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
+def _floating_derivatives(tree: Tree, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> DynamicsDerivatives:
     """A floating base's truth, every partial (B, 6 + n, 6 + n): q's tangent (δp, δθ, δq_joints) with the base moved
     and turned in world axes (R' = exp([δθ]x) R by :func:`exp_so3`), then q̇ and q̈ entry by entry, 3 (6 + n)
     complex directions per state. Position does not enter (gravity is uniform): its columns are 0."""
     count, nv = qdot.shape
-    qddot = forward_dynamics(tree, q, qdot, tau)
     directions = 3 * nv
     rotation = np.repeat(_rotation(q[:, 3:7]), directions, axis=0).astype(complex)
     joints = np.repeat(q[:, 7:], directions, axis=0).astype(complex)

@@ -172,3 +172,36 @@ def test_matching_bounds_lists_the_deciding_bound_first(tmp_path):
     matched = matching_bounds(bounds, "s", "e", "rk4", "order_position", math.nan, "rk4")
     assert matched[0] is bound_for(bounds, "s", "e", "rk4", "order_position", math.nan, "rk4")
     assert len(matched) >= 3 and [b.precedence for b in matched] == sorted((b.precedence for b in matched), reverse=True)
+
+
+def test_a_bound_keyed_by_a_case_s_scheme_holds_its_derivative_rows(tmp_path):
+    """A derivative row's scheme is its case's joined with what its derivatives declare ("rk4+analytic_derivatives"):
+    a hard case's verdict keyed by the case's scheme holds it (it beat the row's metric bound before: a bounded RK4
+    case read its derivative rows against the diverged verdict of the other schemes), and a bound keyed by the
+    derivative kind holds only the rows that declare it."""
+    bounds = load_tolerances(_write(tmp_path, """
+[[bound]]
+scene = "whip"
+metric = "*"
+status = "diverged"
+reason = "every scheme diverges"
+[[bound]]
+scene = "whip"
+scheme = ["rk4"]
+metric = "*"
+status = ["ok", "n/a"]
+reason = "RK4 holds"
+[[bound]]
+scheme = "*differences"
+metric = "step_jacobian_error_max"
+max = 1e-3
+reason = "differenced"
+"""))
+    assert bound_for(bounds, "whip", "core", "rk4", "step_jacobian_error_max", scheme="rk4+analytic_derivatives"
+                     ).reason == "RK4 holds"
+    assert bound_for(bounds, "whip", "core", "euler", "step_jacobian_error_max", scheme="semi_implicit_euler"
+                     ).reason == "every scheme diverges"
+    assert bound_for(bounds, "calm", "mujoco", "euler", "step_jacobian_error_max",
+                     scheme="implicit_damping+central_differences").reason == "differenced"
+    assert bound_for(bounds, "calm", "core", "rk4", "step_jacobian_error_max", scheme="rk4+analytic_derivatives") \
+        is None

@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from simparity.comparisons.measure.derivative_metrics import DIFFERENCE_ROUNDING, step_excess
+from simparity.comparisons.measure.derivative_metrics import DIFFERENCE_ROUNDING, derivative_errors, step_excess
+from simparity.core.model.metric_catalogue import RNEA_DERIVATIVE_ERROR_MAX
 from simparity.core.model.derivatives import DynamicsDerivatives, FiniteDifferences
 
 EPS = np.finfo(float).eps
@@ -64,3 +65,25 @@ def test_as_many_steps_as_states():
     truth = _truth(np.random.default_rng(3))
     with pytest.raises(ValueError, match="2 difference steps for 3 states"):
         _partials(truth.dtau_dq, truth.dtau_dqdot, FiniteDifferences(True, np.ones(2), np.ones(2)))
+
+
+def test_no_allowance_at_all_is_no_excuse():
+    """A claimed scheme exact at every state and no rounding allowance (a force scale of 0): any error of the engine is
+    an excess, never a ratio of 0 (found by a held-out review: 0 / 0 read as 0)."""
+    rng = np.random.default_rng(4)
+    truth = _truth(rng)
+    own = _partials(truth.dtau_dq + 1.0, truth.dtau_dqdot, FiniteDifferences(False, np.full(3, 1e-6), np.full(3, 1e-6)))
+    found = step_excess(own, truth, {"dtau_dq": truth.dtau_dq, "dtau_dqdot": truth.dtau_dqdot}, np.zeros(3))
+    assert found.value > 1e100
+
+
+def test_a_partial_zero_in_truth_and_floor_is_judged_against_one():
+    """∂τ/∂q̇ of a chain at rest without damping is 0: an engine's non-zero entries there are errors (relative to 1),
+    not a partial skipped (found by a held-out review)."""
+    rng = np.random.default_rng(5)
+    truth = _truth(rng)
+    zero = _partials(truth.dtau_dq, np.zeros_like(truth.dtau_dqdot))
+    wrong = _partials(truth.dtau_dq, np.full_like(truth.dtau_dqdot, 5.0))
+    floors = {name: 0.0 for name in ("dtau_dq", "dtau_dqdot", "dqddot_dq", "dqddot_dqdot", "dqddot_dtau")}
+    found = derivative_errors(wrong, zero, np.tile(np.eye(2), (3, 1, 1)), floors)
+    assert found[RNEA_DERIVATIVE_ERROR_MAX].value == pytest.approx(5.0)
