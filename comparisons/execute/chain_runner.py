@@ -141,24 +141,20 @@ def prepare_joint_dynamics(group: CaseGroup, engine_for: EngineFor, reference_fa
     states, method = scene.states(), label.split(":", 1)[1]
     truth, truth_why = derivative_truth(scene, states)
 
-    def evaluate() -> tuple[dict, ForceScale]:
+    def evaluate() -> tuple[dict, ForceScale, JointDynamicsModel]:
         model = engine_for(scene.reference).build_joint_dynamics(scene.chain, method, scene.gravity_world)
         values = reference_values(model, states)
         problem = shape_problem(values, len(states[0]), scene.chain.nv)
         if problem:
             raise SimparityError(f"unusable: {problem}")
-        return values, _force_scale(scene, engine_for(scene.reference), method, model, states, values)
+        return values, _force_scale(scene, engine_for(scene.reference), method, model, states, values), model
 
     evaluated, problem = _reference_values(label, reference_failure,
                                            lambda: engine_for(scene.reference).supports_joint_dynamics(scene.chain,
                                                                                                       method), evaluate)
     if evaluated is None:
         return _JointDynamicsShared(states, None, problem, truth=truth, truth_problem=truth_why)
-    values, scale = cast(tuple[dict, ForceScale], evaluated)
-    built, why = _reported(lambda: engine_for(scene.reference).build_joint_dynamics(scene.chain, method,
-                                                                                   scene.gravity_world), label)
-    if built is None:
-        return _JointDynamicsShared(states, values, problem, scale, None, why, None, why, truth, truth_why)
+    values, scale, built = cast(tuple[dict, ForceScale, JointDynamicsModel], evaluated)
     groups, why = _reported(lambda: built.rigid_groups(configurations(scene.chain.joint_values(states[0]))), label)
     joints, joints_why = _reported(built.compiled_joints, label)
     return _JointDynamicsShared(states, values, problem, scale, groups, why, joints, joints_why, truth, truth_why)

@@ -116,12 +116,13 @@ class ChainModel:
         model.dof_frictionloss[:] = 0.0
         model.jnt_stiffness[:] = 0.0
         model.jnt_stiffnesspoly[:] = 0.0
+        model.jnt_actfrclimited[:] = 0  # the URDF's <limit effort> as MuJoCo's actuatorfrcrange: clamps any motor
         self.model = model
         gravity = "none" if gravity_world is None else fmt(gravity_world)
         self.detail = (f"MuJoCo's URDF importer (MjSpec.from_string) on {dynamics_source(chain)}; fusestatic and "
                        "balanceinertia off, boundmass = boundinertia = 0, inertiafromgeom false; gravity "
                        f"{gravity}; constraints (joint limits) disabled; dof_damping and dof_armature from the "
-                       "chain, frictionloss and stiffness 0")
+                       "chain, frictionloss and stiffness 0, the URDF's effort limits (actuatorfrcrange) off")
 
 
 INVERSE_FD_STEP = 1e-6

@@ -26,6 +26,8 @@ ANALYTIC = 1e-14
 TRANSITION_FD = 1e-5
 """MuJoCo's centred differences at eps 1e-6: rounding eps_machine kappa / eps (measured <= 1e-6 on chain-20)."""
 DT = 0.01
+PANDA_EFFORT = 87.0
+"""[N m] The largest <limit effort> of the Panda's URDF (its first four joints)."""
 
 
 def _case(name: str):
@@ -119,3 +121,18 @@ def test_mujoco_s_transition_differences_match_the_truth(case):
         assert found.differences is not None and found.differences.centred
         truth = step_truth.step_jacobian(tree, MUJOCO_SCHEMES[integrator], DT, q, qd, tau)
         assert _relative(found, truth) <= TRANSITION_FD, integrator
+
+
+def test_mujoco_s_motors_are_not_clamped_by_the_urdf_s_effort_limits():
+    """MuJoCo's URDF importer turns <limit effort> into a joint's actuatorfrcrange, which clamps the motors added for
+    mjd_transitionFD's control block: switched off (found by the articulated suite: the Panda's 87 N m clamped forces of
+    170 N m, its step Jacobian 2e-3 off), and the Jacobian agrees with the truth at forces beyond the effort limits."""
+    from simparity.comparisons.execute.step_jacobian_runner import jacobian_states
+    from simparity.references.mujoco.joint_dynamics import ChainModel
+
+    scene, tree, _ = _case("panda-falling")
+    assert not np.any(ChainModel(scene.chain, scene.gravity_world, motors=True).model.jnt_actfrclimited)
+    q, qd, tau = jacobian_states(scene)
+    assert np.max(np.abs(tau)) > PANDA_EFFORT
+    found = make_engine("mujoco").build_joint_motion(scene, "euler_explicit_damping", DT).step_jacobian(q, qd, tau)
+    assert _relative(found, step_truth.step_jacobian(tree, "semi_implicit_euler", DT, q, qd, tau)) <= TRANSITION_FD
