@@ -25,6 +25,9 @@ What MuJoCo is given, and each default switched off (each pinned by ``tests/refe
   diagonal by ``mj_crb``), and zero ``dof_dampingpoly``, ``jnt_stiffness``, ``jnt_stiffnesspoly`` and
   ``dof_frictionloss`` (MuJoCo's importer turns ``<dynamics friction>`` into Coulomb ``frictionloss`` and reads
   ``damping``: ``dynamics_urdf`` strips ``<dynamics>``, and the adapter sets them anyway).
+- Effort limits off: the importer turns ``<limit effort>`` into the joint's ``actuatorfrcrange``, which clamps the
+  force of any actuator on it; ``jnt_actfrclimited`` is 0, so the motors added for ``mjd_transitionFD``'s control
+  block (:mod:`references.mujoco.joint_motion`) apply the τ they are given (the model stepped has none).
 - Functions, state by state after ``mj_forward``: M = ``mj_fullM`` (armature included); h = ``qfrc_bias``
   (Coriolis, centrifugal and gravity; damping is in ``qfrc_passive``, not in it); tau = ``qfrc_inverse`` of
   ``mj_inverse`` (continuous time: ``invdiscrete`` off), which is M qacc + qfrc_bias - qfrc_passive -
