@@ -279,14 +279,21 @@ def derivatives(tree: Tree, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray,
     if tree.base_inertia is not None:
         return _floating_derivatives(tree, q, qdot, qddot)
     count, n = q.shape
-    # 3n directions per state: q_j, then qdot_j, then qddot_j, each perturbed by i h
-    stacked = [np.repeat(x, 3 * n, axis=0).astype(complex) for x in (q, qdot, qddot)]
-    for part in range(3):
-        offsets = np.zeros((3 * n, n))
+    slopes = (rnea(tree, *complex_directions(q, qdot, qddot)).imag / STEP).reshape(count, 3, n, n).transpose(0, 1, 3, 2)  # [b, x, i, j]
+    return _partials(slopes[:, 0], slopes[:, 1], slopes[:, 2])
+
+
+def complex_directions(*parts: np.ndarray) -> list[np.ndarray]:
+    """The P inputs (each (B, n)) repeated for P n complex directions per state, in order: entry j of part 0, ..., then
+    entry j of part P - 1, each perturbed by i :data:`STEP` ((B P n, n) complex each)."""
+    count, n = parts[0].shape
+    directions = len(parts) * n
+    stacked = [np.repeat(x, directions, axis=0).astype(complex) for x in parts]
+    for part in range(len(parts)):
+        offsets = np.zeros((directions, n))
         offsets[part * n:(part + 1) * n] = np.eye(n)
         stacked[part] = stacked[part] + 1j * STEP * np.tile(offsets, (count, 1))
-    slopes = (rnea(tree, *stacked).imag / STEP).reshape(count, 3, n, n).transpose(0, 1, 3, 2)  # [b, x, i, j]
-    return _partials(slopes[:, 0], slopes[:, 1], slopes[:, 2])
+    return stacked
 
 
 def _partials(dtau_dq: np.ndarray, dtau_dqdot: np.ndarray, exact_mass: np.ndarray) -> DynamicsDerivatives:

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from simparity.core.model.derivatives import StepJacobian
-from simparity.references.derivatives.complex_step import STEP, Tree, complex_mass_and_bias
+from simparity.references.derivatives.complex_step import STEP, Tree, complex_directions, complex_mass_and_bias
 
 TABLEAUX = {
     "explicit_euler": (np.zeros((1, 1)), np.array([1.0])),
@@ -77,10 +77,5 @@ def step_jacobian(tree: Tree, scheme: str, dt: float, q: np.ndarray, qdot: np.nd
     """∂x'/∂x (B, 2n, 2n) and ∂x'/∂τ (B, 2n, n) of one step at B states (each (B, n)), by complex step through
     :func:`step`: 3n directions per state (q_j, q̇_j, τ_j), each perturbed by i h."""
     count, n = q.shape
-    stacked = [np.repeat(x, 3 * n, axis=0).astype(complex) for x in (q, qdot, tau)]
-    for part in range(3):
-        offsets = np.zeros((3 * n, n))
-        offsets[part * n:(part + 1) * n] = np.eye(n)
-        stacked[part] = stacked[part] + 1j * STEP * np.tile(offsets, (count, 1))
-    slopes = (step(tree, scheme, dt, *stacked).imag / STEP).reshape(count, 3 * n, 2 * n).transpose(0, 2, 1)
+    slopes = (step(tree, scheme, dt, *complex_directions(q, qdot, tau)).imag / STEP).reshape(count, 3 * n, 2 * n).transpose(0, 2, 1)
     return StepJacobian(slopes[:, :, :2 * n], slopes[:, :, 2 * n:])

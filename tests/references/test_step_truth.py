@@ -131,7 +131,10 @@ def test_mujoco_s_motors_are_not_clamped_by_the_urdf_s_effort_limits():
     from simparity.references.mujoco.joint_dynamics import ChainModel
 
     scene, tree, _ = _case("panda-falling")
-    assert not np.any(ChainModel(scene.chain, scene.gravity_world, motors=True).model.jnt_actfrclimited)
+    motors = ChainModel(scene.chain, scene.gravity_world, motors=True).model
+    assert not np.any(motors.jnt_actfrclimited)
+    assert motors.nu == scene.chain.n_joints and not np.any(motors.actuator_ctrllimited)
+    assert not np.any(motors.actuator_forcelimited) and np.all(motors.actuator_gear[:, 0] == 1.0)
     q, qd, tau = jacobian_states(scene)
     assert np.max(np.abs(tau)) > PANDA_EFFORT
     found = make_engine("mujoco").build_joint_motion(scene, "euler_explicit_damping", DT).step_jacobian(q, qd, tau)
