@@ -393,7 +393,8 @@ class InHouseEngine(Engine):
 
     def supports_joint_dynamics(self, chain: Chain, method: str) -> Support:
         named = super().supports_joint_dynamics(chain, method)
-        problem = chain.dynamics_problem() or joint_dynamics.floating_problem(chain, method)
+        problem = (chain.dynamics_problem() or _declined_mass(chain)
+                   or joint_dynamics.floating_problem(chain, method))
         return Support.no(problem) if named.ok and problem else named
 
     def build_joint_dynamics(self, chain: Chain, method: str, gravity_world: np.ndarray | None) -> JointDynamicsModel:
@@ -402,6 +403,11 @@ class InHouseEngine(Engine):
     def joint_motion_integrators(self) -> tuple[str, ...]:
         """The free-body family on the joints, plus implicit damping (:mod:`core.articulated.stepping`)."""
         return joint_stepping.SCHEMES
+
+    def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
+        named = super().supports_joint_motion(scene, integrator)
+        problem = _declined_mass(scene.chain)
+        return Support.no(problem) if named.ok and problem else named
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         return CoreJointMotion(scene, integrator, dt)
@@ -425,3 +431,9 @@ class InHouseEngine(Engine):
     def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:
         # The scene's tolerances and cap; the in-house settings keep their defaults unless given.
         return _InHouseIK(chain, solver, options if isinstance(options, IKOptions) else IKOptions(**asdict(options)))
+
+
+def _declined_mass(chain: Chain) -> str:
+    """Why core declines a robot file's mass properties ("" when it takes them): a non-physical inertia tensor on a
+    moving link, which engines that accept the file compute with as written (:attr:`Chain.mass_problem`)."""
+    return f"core refuses the file's mass properties: {chain.mass_problem}" if chain.mass_problem else ""

@@ -108,6 +108,7 @@ def chain_from_urdf(
     max_bytes: int = MAX_FILE_BYTES,
     dynamics: bool = False,
     floating_base: bool = False,
+    refuse_mass: bool = True,
 ) -> Chain:
     """Build the serial :class:`~core.scene.Chain` from ``base_link`` to ``tip_link``.
 
@@ -135,6 +136,12 @@ def chain_from_urdf(
         Whether the base link floats free (:attr:`Chain.floating_base`): its rigid group (the base link, the links
         welded to it and the branches off the chain held at 0) is then the chain's ``base_inertia``, held to the
         physical rules as a chain link's (a fixed base's placeholder tensor moves now).
+    refuse_mass : bool
+        With ``dynamics``: True refuses a non-physical inertia tensor on a moving link (raises); False loads the file
+        as written and records the first one as the chain's ``mass_problem`` (the one-line refusal), for a run in
+        which the engines that accept the file compute with it and core declines (issue #45: a file is refused
+        only where every reader refuses it). A floating base's own rigid group is refused either way: the scene chose
+        to float it, and no free body has a non-physical tensor.
 
     Returns
     -------
@@ -182,19 +189,32 @@ def chain_from_urdf(
     child_joints = _child_joints(joints)
     inertials = _modelled_inertials(base, links, child_joints, parent_joint, source)
     movable = [joint for joint in path if joint["type"] != "fixed"]
+    problems: list[SceneError] = []  # the non-physical tensors met, when they are recorded rather than raised
+    held_to = _PhysicalRule(dynamics, refuse_mass, problems)
     chain_joints = tuple(
-        replace(chain_joint, link=_rigid_body(joint, following, inertials, child_joints, source, dynamics),
+        replace(chain_joint, link=_rigid_body(joint, following, inertials, child_joints, source, held_to),
                 damping=_damping(joint, parent_joint, source))
         for chain_joint, joint, following in zip(chain.joints, movable, movable[1:] + [None]))
     on_path = {joint["name"] for joint in path}
     held = tuple(joint["name"] for joint in joints
                  if joint["type"] != "fixed" and joint["name"] not in on_path and joint["parent"] in inertials)
     is_file = not os.fspath(path_or_text).lstrip().startswith("<")
-    base_inertia = (_rigid_body({"child": base}, movable[0], inertials, child_joints, source, True,
-                                "the floating base")
+    base_inertia = (_rigid_body({"child": base}, movable[0], inertials, child_joints, source,
+                                _PhysicalRule(True, True, problems), "the floating base")
                     if floating_base else None)
     return replace(chain, joints=chain_joints, held_joints=held, floating_base=floating_base,
-                   base_inertia=base_inertia, urdf_path=os.fspath(path_or_text) if is_file else None, base_link=base)
+                   base_inertia=base_inertia, urdf_path=os.fspath(path_or_text) if is_file else None, base_link=base,
+                   mass_problem=f"{problems[0].key}: {problems[0].problem}" if problems else "")
+
+
+@dataclass(frozen=True)
+class _PhysicalRule:
+    """How a moving link's non-physical inertia tensor is met: ignored (``held`` False: kinematics), refused
+    (``refuse``), or recorded in ``problems`` (the file loads as written)."""
+
+    held: bool
+    refuse: bool
+    problems: list[SceneError]
 
 
 def _parse(path_or_text: str | os.PathLike, source: str | None, max_bytes: int) -> tuple[ET.Element, str]:
@@ -653,18 +673,22 @@ def _hold(values: np.ndarray, allowed: Range, key: str, where: str, source: str)
 
 
 def _rigid_body(joint: dict, following: dict | None, inertials: dict[str, _Inertial],
-                children: dict[str, list[dict]], source: str, dynamics: bool, riding: str = "the chain") -> LinkInertia:
+                children: dict[str, list[dict]], source: str, rule: _PhysicalRule,
+                riding: str = "the chain") -> LinkInertia:
     """Everything rigidly attached to ``joint``'s child link, in its frame: the links below it except the
     subtree of the next chain joint ``following``; every other joint at its zero position (its origin).
-    For ``dynamics``, a non-physical inertia tensor among them is refused."""
+    A non-physical inertia tensor among them is met by ``rule``."""
     parts: list[tuple[_Inertial, np.ndarray, np.ndarray]] = []  # (inertial, position, rotation of its link)
     stack = [(joint["child"], np.zeros(3), np.eye(3))]
     while stack:
         link, position, rotation = stack.pop()
         inertial = inertials[link]
-        if inertial.problem and dynamics:
-            raise SceneError(source, inertial.key, f"{inertial.problem} ({inertial.where}, riding on {riding})",
-                             LINK_TENSOR_RULE)
+        if inertial.problem and rule.held:
+            refusal = SceneError(source, inertial.key, f"{inertial.problem} ({inertial.where}, riding on {riding})",
+                                 LINK_TENSOR_RULE)
+            if rule.refuse:
+                raise refusal
+            rule.problems.append(refusal)
         parts.append((inertial, position, rotation))
         for child in children.get(link, []):
             if child is not following:

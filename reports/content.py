@@ -18,7 +18,7 @@ from simparity.reports import figure_writer, figures, own_engine, sweep_sections
 from simparity.reports.blocks import Block, Bullets, Details, Heading, Paragraph, scene_heading
 from simparity.reports.markdown import LINE_CHARS
 from simparity.reports.sections import (
-    dynamics, hard_cases, ik, joint_dynamics, kinematics, summary_tables,
+    dynamics, hard_cases, ik, joint_dynamics, kinematics, robots, summary_tables,
 )
 from simparity.reports.sections.context import TABULATED_KINDS, ReportContext, heading_kind, headline, scene_kind
 from simparity.reports.sections.shared import clip, engine_notes
@@ -77,6 +77,8 @@ def _blocks(ctx: ReportContext, table: pd.DataFrame, info: RunInfo) -> list[Bloc
     for scene, rows in table.groupby("scene", sort=False):
         own_section = kinds[scene] not in TABULATED_KINDS and ctx.listed(scene)
         blocks += _scene(ctx, scene, rows) if own_section else []
+    robot_files = robots.robot_scenes(table, [s for s in ctx.joint_dynamics_scenes if s not in ctx.sweep_of])
+    blocks += robots.section(ctx, robot_files) if robot_files else []
     for kind, section in (("joint_dynamics", joint_dynamics.section), ("kinematics", kinematics.section)):
         chosen = table[(table["scene"].map(kinds) == kind) & ~table["scene"].isin(ctx.sweep_of)]
         blocks += section(ctx, chosen) if not chosen.empty else []

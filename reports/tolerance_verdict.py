@@ -24,6 +24,9 @@ class ToleranceVerdict:
     held: tuple[str, ...] | None = None
     """The engines the gate holds (None: every engine of the run): a user's engine among them has a section of its
     own first (:mod:`reports.own_engine`)."""
+    cases: tuple[tuple[str, str], ...] = ()
+    """The (scene, first metric) each line of ``violations`` is about (empty: not said): the robot table names a
+    cell's first disagreement by them (:mod:`reports.sections.robots`)."""
 
     @property
     def outside_count(self) -> int:

@@ -140,8 +140,10 @@ def _add_run_arguments(run: argparse.ArgumentParser) -> None:
                      help="built-in scene names or scene files (default: the scenes of --suite)")
     run.add_argument("--suite", default=None, choices=SUITES,
                      help="run a built-in suite: default (what 'simparity run' runs), contact (every scene with "
-                     "planes), hard (the numerical-stability cases, each with the verdict it must earn) or bench (the "
-                     "arms 'simparity bench' times, 10,000 IK targets each)")
+                     "planes), hard (the numerical-stability cases, each with the verdict it must earn), bench (the "
+                     "arms 'simparity bench' times, 10,000 IK targets each), articulated (real arms' joint-space "
+                     "dynamics and chains in motion) or robots (every robot file the dependencies ship, each through "
+                     "every engine's importer: docs/robots.md)")
     run.add_argument("--engines", type=name_list(), default=DEFAULT_ENGINES, metavar="A,B,...",
                      help=f"comma-separated engines to run (default: {','.join(DEFAULT_ENGINES)}; "
                      f"known: {allowed_engines()}; 'simparity engines' lists them)")

@@ -45,7 +45,8 @@ def report_verdict(result: CheckResult, held: tuple[str, ...] | None = None) -> 
     groups = grouped(result.violations + result.findings)
     return ToleranceVerdict(result.checked, result.unchecked, tuple(g.line() for g in groups),
                             len(result.violations) + len(result.findings),
-                            tuple(g.violations[0].engine for g in groups), held if held is not None else result.held)
+                            tuple(g.violations[0].engine for g in groups), held if held is not None else result.held,
+                            tuple((g.violations[0].scene, g.violations[0].metric) for g in groups))
 
 
 def _case_name(key: tuple) -> tuple[str, str]:

@@ -9,7 +9,8 @@ same in any unit, and its row names the joint where it is largest with both engi
 - centre of mass: |c - c_ref| over the chain's extent X (the farthest joint origin or centre of mass from the first
   joint's origin, as the reference has it); a group massless in both engines has no centre of mass to compare;
 - inertia: the largest entry of |I - I_ref| (about each one's own centre of mass, base-frame axes) over the larger
-  of the two tensors' largest entries (0 when both are zero);
+  of the two tensors' largest entries (0 when both are zero), floored at :data:`INERTIA_ROUNDING` of the group's
+  m X^2 (a tensor of rounding size, iCub's 1.9e-35 kg m^2 against 0, is no difference);
 - axis: the angle between the joints' axes [rad];
 - origin: |o - o_ref| over X;
 
@@ -48,6 +49,12 @@ LIMIT_ROUNDING = 4 * float(np.finfo(float).eps)
 the same decimal of the same file, to the same double or within a rounding of a unit it converts through."""
 
 
+INERTIA_ROUNDING = 64 * float(np.finfo(float).eps)
+"""A tensor difference below this fraction of the group's m X^2 (its mass at the chain's extent: the rotational scale the
+dynamics sees it against) is rounding: the written decimals of a tensor ~1e-35 kg m^2 and the sums of the group's
+tensors, each rounded relative to m X^2."""
+
+
 def configurations(q: np.ndarray) -> np.ndarray:
     """The configurations the models are compared at: q = 0 (the file's own placement) and the scene's (B, n)."""
     return np.vstack([np.zeros((1, q.shape[1])), q])
@@ -84,7 +91,8 @@ def model_parity(own: RigidGroups, ref: RigidGroups, joints: tuple[str, ...]) ->
     com = np.where(weighed, np.linalg.norm(own.com_world - ref.com_world, axis=-1), 0.0) / extent
     largest = np.maximum(np.max(np.abs(own.inertia_world), axis=(-1, -2)), np.max(np.abs(ref.inertia_world),
                                                                                  axis=(-1, -2)))
-    inertia = _ratio(np.max(np.abs(own.inertia_world - ref.inertia_world), axis=(-1, -2)), largest)
+    floor = INERTIA_ROUNDING * np.maximum(own.mass, ref.mass) * extent ** 2
+    inertia = _ratio(np.max(np.abs(own.inertia_world - ref.inertia_world), axis=(-1, -2)), np.maximum(largest, floor))
     axis = np.arctan2(np.linalg.norm(np.cross(own.axis_world, ref.axis_world), axis=-1),
                       np.einsum("bni,bni->bn", own.axis_world, ref.axis_world))
     origin = np.linalg.norm(own.origin_world - ref.origin_world, axis=-1) / extent

@@ -32,6 +32,10 @@ UNLIMITED = ("lower", "upper")
 UNUSED_ZERO = ("radius", "half_extents_body")
 """A shape's sizes its kind does not use are 0 in the data model (a box's radius, a sphere's half extents)."""
 
+MASSLESS = "LinkInertia"
+"""The data-model type whose ``mass`` may be exactly 0: a chain's massless link (a URDF link without ``<inertial>``,
+human.urdf's virtual links), which the chain's dynamics check judges as a whole (``Chain.dynamics_problem``)."""
+
 
 def check_scene_ranges(scene) -> None:
     """Raise :class:`SceneError` (source, key path, value, the allowed range) for the first number of ``scene`` (any
@@ -45,7 +49,10 @@ def check_scene_ranges(scene) -> None:
 def _first_problem(node, path: str) -> tuple[str, float, str] | None:
     if dataclasses.is_dataclass(node) and not isinstance(node, type):
         for item in dataclasses.fields(node):
-            found = _field_problem(item.name, getattr(node, item.name), f"{path}.{item.name}" if path else item.name)
+            value = getattr(node, item.name)
+            if type(node).__name__ == MASSLESS and item.name == "mass" and value == 0:
+                continue
+            found = _field_problem(item.name, value, f"{path}.{item.name}" if path else item.name)
             if found is not None:
                 return found
     elif isinstance(node, (tuple, list)):

@@ -95,6 +95,7 @@ from simparity.core.model.engine import (
     Support,
 )
 from simparity.core.model.errors import DivergedError, NotBatchedError
+from simparity.core.model.files import parse_xml
 from simparity.core.model.ik_problem import IKTolerances
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.dynamics import DynamicsScene
@@ -512,13 +513,38 @@ def _dynamics_support(chain: Chain) -> Support:
 
 
 def _loader_support(text: str) -> Support:
-    """No, in PyBullet's own words, when its URDF loader refuses the file every engine is given."""
+    """No, in PyBullet's own words, when its URDF loader refuses the file every engine is given; no, naming the link,
+    when it loads the file as another model (:func:`_zeroed_inertias`)."""
     client = _Client()  # disconnected when let go
     try:
-        _load_urdf(client.id, text, useFixedBase=True)
+        body = _load_urdf(client.id, text, useFixedBase=True)
     except pybullet.error as err:
         return Support.no(f"PyBullet's URDF loader refuses the file: {' '.join(str(err).split())}")
+    zeroed = _zeroed_inertias(client.id, body, text)
+    if zeroed:
+        return Support.no(f"PyBullet's URDF loader sets the inertia of {len(zeroed)} link(s) to zero, first "
+                          f"{zeroed[0]!r} (its rule for a tensor that is not physical: 'Bad inertia tensor properties, "
+                          "setting inertia to zero', BulletUrdfImporter.cpp): its model is not the file's")
     return Support.yes()
+
+
+def _zeroed_inertias(client: int, body: int, text: str) -> list[str]:
+    """The links whose ``<inertia>`` in ``text`` has a non-zero entry but whose principal moments PyBullet holds as
+    zero: its URDF importer replaces a tensor failing its physical check (a principal moment negative, or the triangle
+    inequality broken) by zero, with a warning only (pybullet_data's xarm6_robot.urdf link2, example-robot-data's
+    allegro_right_hand.urdf link_3.0; pinned by tests/references/pybullet/test_joint_dynamics.py)."""
+    written = {}
+    for link in parse_xml(text.encode(), "<dynamics urdf>", "robot").findall("link"):
+        inertia = link.find("inertial/inertia")
+        if inertia is not None:
+            written[link.get("name")] = any(float(value) != 0.0 for value in inertia.attrib.values())
+    zeroed = []
+    for index in range(pybullet.getNumJoints(body, physicsClientId=client)):
+        name = pybullet.getJointInfo(body, index, physicsClientId=client)[12].decode()
+        moments = pybullet.getDynamicsInfo(body, index, physicsClientId=client)[2]
+        if written.get(name) and not any(moments):
+            zeroed.append(name)
+    return zeroed
 
 
 def _armature_support(chain: Chain) -> Support:

@@ -18,8 +18,8 @@ from simparity.reports.markdown import LINE_CHARS
 from simparity.reports.sections.context import ReportContext
 from simparity.reports.sections.shared import engine_notes
 
-_ERRORS = (MASS_MATRIX_ERROR_MAX, BIAS_FORCE_ERROR_MAX, INVERSE_DYNAMICS_ERROR_MAX, FORWARD_DYNAMICS_ERROR_MAX)
-_IDENTITIES = (GRAVITY_IDENTITY_RESIDUAL, MASS_COLUMN_RESIDUAL, ROUND_TRIP_RESIDUAL, MASS_MATRIX_ASYMMETRY,
+DYNAMICS_ERRORS = (MASS_MATRIX_ERROR_MAX, BIAS_FORCE_ERROR_MAX, INVERSE_DYNAMICS_ERROR_MAX, FORWARD_DYNAMICS_ERROR_MAX)
+DYNAMICS_IDENTITIES = (GRAVITY_IDENTITY_RESIDUAL, MASS_COLUMN_RESIDUAL, ROUND_TRIP_RESIDUAL, MASS_MATRIX_ASYMMETRY,
                KINETIC_ENERGY_RESIDUAL, GRAVITY_EQUIVALENCE_RESIDUAL, BASE_MOMENTUM_RESIDUAL)
 
 
@@ -35,7 +35,7 @@ def _worst_cell(case: pd.DataFrame) -> str:
         return "—"
     ok = case[case["status"] == OK]
     parts = []
-    for label, metrics in (("", _ERRORS), ("id ", _IDENTITIES)):
+    for label, metrics in (("", DYNAMICS_ERRORS), ("id ", DYNAMICS_IDENTITIES)):
         values = ok[ok["metric"].isin(metrics)]["value"]
         parts.append(f"{label}{number(float(values.max()))}" if not values.empty else f"{label}n/a")
     if all(part.endswith("n/a") for part in parts):

@@ -135,7 +135,8 @@ def _urdf_chain(c: TableReader, dynamics: bool, floating: bool) -> Chain:
     path = _urdf_path(c)
     try:
         return chain_from_urdf(str(path), base_link=base, tip_link=tip, max_joints=c.limits.max_joints,
-                               max_bytes=c.limits.max_file_bytes, dynamics=dynamics, floating_base=floating)
+                               max_bytes=c.limits.max_file_bytes, dynamics=dynamics, floating_base=floating,
+                               refuse_mass=False)
     except SceneError as err:
         raise c.fail("urdf", f"{one_line(c.table['urdf'], 120)}: {err.key}: {err.problem}", err.allowed) from None
 

@@ -175,10 +175,15 @@ class Chain:
         The URDF file the chain was read from; engines then load that file themselves (the
         end effector is its link of the same name). None for chains defined otherwise,
         which engines receive as the adapters' export.
+    mjcf_path : str or None
+        The MJCF file the chain was read from (``core.mjcf``); engines then load that file themselves, each with
+        its own MJCF importer (the end effector is its body of the same name). None otherwise; at most one of
+        ``urdf_path`` and ``mjcf_path`` is set.
     base_link : str or None
         For a chain read from a URDF file: the link whose frame is the world frame (the
         file's root link unless the scene chose another); engines express every pose in
-        it. None otherwise.
+        it. For one read from an MJCF file: that body (the worldbody's one child unless the scene chose another).
+        None otherwise.
     held_joints : tuple of str
         For a chain read from a URDF file: the file's movable joints below the base link that are not on the
         chain (fingers, branches, joints past the tip), held at 0 in the dynamics model (their links ride on
@@ -197,6 +202,12 @@ class Chain:
         (base origin linear velocity in world axes [m/s] (3), base angular velocity in world axes [rad/s] (3),
         joint rates (n)), their time derivatives, and (a force on the base in world axes [N] (3), a torque about
         the base origin in world axes [N m] (3), joint forces (n)).
+    mass_problem : str
+        For a chain read from a robot file: why its mass properties are physically meaningless (the first
+        non-physical inertia tensor on a moving link, as one line naming the element; "" when every one is physical).
+        The engines that accept such a file compute with it as written; core declines it (issue #45: a file is
+        refused only where every reader refuses it). Not part of :meth:`dynamics_problem`, which says why no engine
+        can compute.
     base_inertia : LinkInertia or None
         For a floating base: the mass properties of the base link and everything rigidly attached to it (links
         welded to it, branches off the chain held at 0), in the base link's frame. None for a fixed base (its
@@ -215,8 +226,12 @@ class Chain:
     dh: DHTable | None = None
     floating_base: bool = False
     base_inertia: LinkInertia | None = None
+    mjcf_path: str | None = None
+    mass_problem: str = ""
 
     def __post_init__(self) -> None:
+        if self.urdf_path is not None and self.mjcf_path is not None:
+            raise SceneError("<code>", "chain", "a chain read from both a URDF and an MJCF file", "at most one file")
         object.__setattr__(self, "end_effector_xyz", readonly(self.end_effector_xyz, shape=(3,)))
         object.__setattr__(
             self, "end_effector_rotation", readonly(self.end_effector_rotation, shape=(3, 3))

@@ -6,12 +6,13 @@ from dataclasses import dataclass
 
 from simparity.core.model.errors import SceneError
 
-SUITES = ("default", "hard", "contact", "bench", "articulated")
+SUITES = ("default", "hard", "contact", "bench", "articulated", "robots")
 """Named groups of built-in scenes (``simparity run --suite``): ``default`` is what ``simparity
 run`` runs; ``hard`` gathers the numerical-stability cases, each with the verdict it must earn
 in the shipped tolerances; ``contact`` every scene with planes; ``bench`` the real arms whose IK
 ``simparity bench`` times (10,000 targets each); ``articulated`` the joint-space dynamics of real robot arms and
-the crafted arm. A scene may be in several."""
+the crafted arm; ``robots`` the robot corpus: every robot description the dependencies' wheels ship, each file through
+every importer (``docs/robots.md``). A scene may be in several."""
 
 
 

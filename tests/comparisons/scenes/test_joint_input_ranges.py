@@ -403,7 +403,7 @@ def test_fuzzed_joint_inputs_are_each_refused_on_one_line(tmp_path, capsys):
             variants.append((f"two <{tag}> in <{parent}>", URDF_SCENE,
                              _duplicated(tag, "link name=\"upper\"" if parent != "joint" else "joint")))
     assert len(variants) >= 50
-    loaded = []
+    loaded, declined = [], []
     for k, (what, scene, urdf) in enumerate(variants):
         folder = tmp_path / f"v{k}"
         folder.mkdir()
@@ -412,11 +412,16 @@ def test_fuzzed_joint_inputs_are_each_refused_on_one_line(tmp_path, capsys):
         try:
             _refusal(path)
         except pytest.fail.Exception:
-            loaded.append(what)
+            # A URDF whose tensor on a moving link is not physical loads (the engines that accept the file compute
+            # with it, issue #45) with the refusal recorded: core declines it, naming the element.
+            problem = load_scenes(path)[0].chain.mass_problem
+            (declined if "inertial/inertia:" in problem else loaded).append(what)
     assert not loaded, f"loaded (a silent acceptance): {loaded}"
+    assert declined == ["urdf ixx='-1'"], declined
     for what, scene, urdf in variants[::10]:  # and through the CLI: exit 2, one line
-        _write(tmp_path, urdf, "arm.urdf")
-        _refused_by_cli(capsys, _write(tmp_path, scene))
+        if what not in declined:
+            _write(tmp_path, urdf, "arm.urdf")
+            _refused_by_cli(capsys, _write(tmp_path, scene))
 
 
 RANDOM_VARIANTS = 400

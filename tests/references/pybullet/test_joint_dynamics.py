@@ -413,3 +413,31 @@ def test_an_unlimited_prismatic_joint_is_n_a_as_in_every_urdf_engine():
         engine = make_engine(name)
         support = engine.supports_joint_dynamics(chain, engine.joint_dynamics_methods()[0])
         assert not support.ok and "unlimited prismatic joint 'hinge'" in support.reason, (name, support.reason)
+
+
+def test_a_non_physical_tensor_is_zeroed_by_pybullet_and_its_dynamics_are_n_a_naming_the_link():
+    """PyBullet's URDF importer replaces a tensor that breaks the triangle inequality by zero, with a console warning
+    only ('Bad inertia tensor properties, setting inertia to zero'; pybullet_data's xarm6_robot.urdf, issue #45's
+    corpus): its model is not the file's, so its rows are n/a naming the link; Pinocchio computes with the file's."""
+    with open(CRAFTED, encoding="utf-8") as handle:
+        moving = '<inertia ixx="0.021" ixy="0.0031" ixz="-0.0022" iyy="0.034" iyz="0.0017" izz="0.027"/>'
+        text = handle.read().replace(moving, '<inertia ixx="1e-3" ixy="0" ixz="0" iyy="1e-3" iyz="0" izz="3e-3"/>')
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "bad.urdf")
+        with open(path, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        chain = chain_from_urdf(path, tip_link="flange", dynamics=True, refuse_mass=False)
+        assert "triangle inequality" in chain.mass_problem and "inertial/inertia" in chain.mass_problem
+        client = pybullet.connect(pybullet.DIRECT)
+        try:
+            body = _load(dynamics_urdf(chain), client)
+            moments = [pybullet.getDynamicsInfo(body, i, physicsClientId=client)[2]
+                       for i in range(pybullet.getNumJoints(body, physicsClientId=client))]
+        finally:
+            pybullet.disconnect(client)
+        assert (0.0, 0.0, 0.0) in moments  # zeroed, not the file's (1e-3, 1e-3, 3e-3)
+        support = ENGINE.supports_joint_dynamics(chain, "recursive")
+        assert not support.ok and "sets the inertia of 1 link(s) to zero" in support.reason
+        core = make_engine("core").supports_joint_dynamics(chain, "recursive")
+        assert not core.ok and core.reason.startswith("core refuses the file's mass properties:")
+        assert make_engine("pinocchio").supports_joint_dynamics(chain, "recursive").ok
