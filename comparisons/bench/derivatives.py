@@ -112,7 +112,7 @@ def markdown_lines(rows: list) -> list[str]:
     for (arm, engine, method), cells, values, error in by_batch(mine):
         pinocchio = next((r for r in mine if (r.workload, r.engine, r.batch) == (arm, "pinocchio", batches[-1])), None)
         own = cells.get(batches[-1])
-        ratio = (f"{pinocchio.value / own.value:.2f}" if pinocchio is not None and own is not None
+        ratio = (f"{pinocchio.value / own.value:.3g}" if pinocchio is not None and own is not None
                  and own.value > 0 else "n/a")
         lines.append(f"| {arm} | {engine} | {method} | {values} | {ratio} | {error:.1e} |")
     return lines + [""]

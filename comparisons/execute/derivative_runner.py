@@ -60,9 +60,16 @@ class DerivativeTruth:
     qddot: np.ndarray
 
 
+MJCF_TRUTH = ("no complex-step truth for an MJCF file: the truth runs on the tree Pinocchio's parser compiles, and "
+              "Pinocchio's MJCF parser reads some files otherwise than MuJoCo, MJCF's own reader (docs/robots.md)")
+"""Why a chain from an MJCF file has no derivative rows."""
+
+
 def derivative_truth(scene: JointDynamicsScene, states: tuple[np.ndarray, ...]) -> tuple[DerivativeTruth | None, str]:
     """(the complex-step truth at the scene's states, "") or (None, why there is none)."""
     q, qd, _, tau = states
+    if scene.chain.mjcf_path is not None:
+        return None, MJCF_TRUTH
     try:
         from simparity.references.derivatives import complex_step  # Pinocchio's parser: only where a case runs
 

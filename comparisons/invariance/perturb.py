@@ -58,10 +58,10 @@ def ulp_nudge(values: np.ndarray, rng: np.random.Generator) -> np.ndarray:
 
 
 def ulp_transform(seed: int, scene) -> Transform:
-    """The one-ulp change of units of perturbation ``seed`` for ``scene`` (a URDF chain keeps its lengths and masses:
-    every engine reads both from the file, so only the unit of time can change)."""
+    """The one-ulp change of units of perturbation ``seed`` for ``scene`` (a chain from a robot file keeps its lengths and
+    masses: every engine reads both from the file, so only the unit of time can change)."""
     length, mass, time = np.random.default_rng([seed, UNITS_STREAM]).choice(ULP_FACTORS, size=3)
-    if getattr(getattr(scene, "chain", None), "urdf_path", None) is not None:
+    if getattr(getattr(scene, "chain", None), "robot_file", None) is not None:
         length = mass = 1.0
     return Transform(f"ulp-{seed}", length_scale=float(length), mass_scale=float(mass), time_scale=float(time),
                      description="units one ulp off")
@@ -75,7 +75,7 @@ def _nudged(scene, rng: np.random.Generator):
                        for b in scene.bodies)
         return replace(scene, bodies=bodies)
     chain = scene.chain
-    if chain.urdf_path is None:
+    if chain.robot_file is None:
         chain = replace(chain, joints=tuple(replace(j, origin_xyz=ulp_nudge(j.origin_xyz, rng)) for j in chain.joints),
                         end_effector_xyz=ulp_nudge(chain.end_effector_xyz, rng))
     if isinstance(scene, KinematicsScene):

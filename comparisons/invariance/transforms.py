@@ -338,9 +338,10 @@ def _joint(joint: Joint, t: Transform, first: bool) -> Joint:
 
 
 def _chain(chain: Chain, t: Transform, source: str) -> Chain:
-    if chain.urdf_path is not None:
-        raise TransformError(source, f"transform {t.name}", f"chain {one_line(chain.name)} is read from the URDF file "
-                             f"{one_line(chain.urdf_path)}, which every engine loads itself with its base link as the "
+    if chain.robot_file is not None:
+        raise TransformError(source, f"transform {t.name}", f"chain {one_line(chain.name)} is read from the "
+                             f"{'URDF' if chain.urdf_path is not None else 'MJCF'} file "
+                             f"{one_line(chain.robot_file)}, which every engine loads itself with its base link as the "
                              "world: the scene cannot move its base or scale its lengths (or masses)",
                              "a chain written in the scene file (joints or dh), or the transform applied to the URDF "
                              "file itself")

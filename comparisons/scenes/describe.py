@@ -17,6 +17,7 @@ from simparity.core.model.scenes.joint_dynamics import BASE_POSITION_RANGE, Join
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.core.model.scenes.time_functions import HeldFunction, TimeFunction
+from simparity.references.common.dynamics_mjcf import mjcf_source
 from simparity.references.common.dynamics_urdf import model_changes
 
 
@@ -130,6 +131,8 @@ def _link_lines(chain: Chain) -> list[str]:
         lines.append(f"  {joint.name} ({joint.type}): link mass {link.mass:.10g} kg, centre of mass "
                      f"{_vector(link.com_xyz)} m, inertia diagonal {_vector(link.inertia_com.diagonal())} kg m^2, "
                      f"damping {joint.damping:.10g}, armature {joint.armature:.10g}")
+    if chain.mjcf_path is not None:
+        return lines + [f"every engine reads {mjcf_source(chain)}"]
     changes = model_changes(chain).sentences(str(chain.base_link))
     if chain.urdf_path is not None:
         lines.append(f"every engine reads {chain.urdf_path} below {chain.base_link} without geometry and <dynamics>"

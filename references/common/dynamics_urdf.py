@@ -40,6 +40,7 @@ import numpy as np
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.files import parse_xml
 from simparity.core.model.scenes.chain import Chain
+from simparity.references.common.dynamics_mjcf import mjcf_joint_names, mjcf_source
 from simparity.references.common.urdf_export import exported_chain_urdf, zero_inertial
 
 REMOVED_FROM_LINKS = ("visual", "collision")
@@ -137,10 +138,13 @@ def _path_joints(root: ET.Element, base: str, tip: str) -> list[ET.Element]:
 
 
 def chain_joint_names(chain: Chain) -> tuple[str, ...]:
-    """The chain's joints as the references select them: for a chain from a URDF file, the movable joints on the
+    """The chain's joints as the references select them: for a chain from an MJCF file, :func:`mjcf_joint_names`; for
+    a chain from a URDF file, the movable joints on the
     file's own path from the base link to the tip link (the scene's ``base_link`` and ``tip_link``), found by the
     references' own walk of the file, never from core's parse (a path core chose wrongly then shows as a
     disagreement); for a chain without a file, its joints."""
+    if chain.mjcf_path is not None:
+        return mjcf_joint_names(chain)
     if chain.urdf_path is None:
         return tuple(j.name for j in chain.joints)
     path = _path_joints(_file(chain), cast(str, chain.base_link), chain.end_effector_name)
@@ -249,6 +253,8 @@ def dynamics_urdf(chain: Chain) -> str:
 
 def dynamics_source(chain: Chain) -> str:
     """Where an engine's dynamics model of ``chain`` comes from, for the rows' detail."""
+    if chain.mjcf_path is not None:
+        return mjcf_source(chain)
     changes = model_changes(chain).sentences(str(chain.base_link))
     if chain.urdf_path is None:
         return "; ".join(["the chain's declared mass properties written as URDF"] + changes)

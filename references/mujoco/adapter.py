@@ -500,7 +500,7 @@ def _dynamics_support(chain: Chain) -> Support:
     problem = chain.dynamics_problem()
     if problem:
         return Support.no(problem)
-    expressible = urdf_support(chain) if chain.urdf_path is None else Support.yes()
+    expressible = urdf_support(chain) if chain.robot_file is None else Support.yes()
     if not expressible.ok:
         return expressible
     problem = mujoco_dynamics_problem(chain)

@@ -54,6 +54,7 @@ from simparity.core.model.derivatives import DynamicsDerivatives, FiniteDifferen
 from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt
+from simparity.references.common.dynamics_mjcf import dynamics_mjcf
 from simparity.references.common.dynamics_urdf import chain_joint_names, dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
 from simparity.references.common.rigid_groups import summed
@@ -64,15 +65,21 @@ def _compiled(chain: Chain, gravity_world: np.ndarray | None, motors: bool = Fal
     ``motors``, a motor (gear 1, no control limits) on each chain joint in the chain's order: ctrl is τ, for
     ``mjd_transitionFD``'s control block (a URDF declares no actuator)."""
     with captured_output():
-        spec = mujoco.MjSpec.from_string(dynamics_urdf(chain))
+        mjcf = chain.mjcf_path is not None
+        spec = mujoco.MjSpec.from_string(dynamics_mjcf(chain) if mjcf else dynamics_urdf(chain))
         spec.compiler.fusestatic = False
         spec.compiler.balanceinertia = False
         spec.compiler.boundmass = 0.0
         spec.compiler.boundinertia = 0.0
-        spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
-        spec.compiler.discardvisual = True
+        if not mjcf:  # an MJCF body without <inertial> takes its mass from its geoms (visual ones too): kept
+            spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+            spec.compiler.discardvisual = True
         spec.option.gravity = np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float)
-        spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT
+        spec.option.density = spec.option.viscosity = 0.0  # no fluid forces (an MJCF <option> may set them)
+        spec.option.wind = np.zeros(3)
+        spec.option.disableflags = mujoco.mjtDisableBit.mjDSBL_CONSTRAINT  # an MJCF <option> may disable more
+        spec.option.enableflags = 0
+        spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER  # an MJCF file's RK4: mjd_inverseFD refuses it
         if chain.floating_base:
             spec.worldbody.first_body().add_freejoint()
         for name in chain_joint_names(chain) if motors else ():
@@ -120,10 +127,14 @@ class ChainModel:
         model.jnt_stiffness[:] = 0.0
         model.jnt_stiffnesspoly[:] = 0.0
         model.jnt_actfrclimited[:] = 0  # the URDF's <limit effort> as MuJoCo's actuatorfrcrange: clamps any motor
+        model.body_gravcomp[:] = 0.0  # an MJCF body's gravity compensation
         self.model = model
         gravity = "none" if gravity_world is None else fmt(gravity_world)
-        self.detail = (f"MuJoCo's URDF importer (MjSpec.from_string) on {dynamics_source(chain)}; fusestatic and "
-                       "balanceinertia off, boundmass = boundinertia = 0, inertiafromgeom false; gravity "
+        importer, geoms = (("MJCF", "inertiafromgeom as the file sets it, visual geoms kept") if chain.mjcf_path
+                           is not None else ("URDF", "inertiafromgeom false, visual geoms discarded"))
+        self.detail = (f"MuJoCo's {importer} importer (MjSpec.from_string) on {dynamics_source(chain)}; fusestatic "
+                       f"and balanceinertia off, boundmass = boundinertia = 0, {geoms}; no fluid forces, no gravity "
+                       "compensation; gravity "
                        f"{gravity}; constraints (joint limits) disabled; dof_damping and dof_armature from the "
                        "chain, frictionloss and stiffness 0, the URDF's effort limits (actuatorfrcrange) off")
 
@@ -217,7 +228,9 @@ class MujocoJointDynamics(JointDynamicsModel):
     def rigid_groups(self, q: np.ndarray) -> RigidGroups:
         """Each chain joint's bodies (MuJoCo keeps fixed-joint links as bodies: ``fusestatic`` off) summed with the
         references' own code (:mod:`references.common.rigid_groups`): ``body_mass``, ``xipos``, ``ximat`` and the
-        principal ``body_inertia`` after ``mj_kinematics``; the joint's ``xaxis`` and its body's ``xpos``."""
+        principal ``body_inertia`` after ``mj_kinematics``; the joint's ``xaxis`` and ``xanchor`` (its body's origin from
+        a URDF file; an MJCF joint's ``pos`` moves it), a slide's moved by its own motion as the other engines' frames. Of a body's several joints (MJCF) the last carries its bodies,
+        the others none (core's massless links between them)."""
         m, d = self.model, self.data
         joints = [m.dof_jntid[dof] for dof in self.dof]
         bodies = [int(m.jnt_bodyid[j]) for j in joints]
@@ -228,17 +241,23 @@ class MujocoJointDynamics(JointDynamicsModel):
                 mover = int(m.body_parentid[mover])
             if mover in groups:
                 groups[mover].append(body)
+        # a body's several joints (MJCF): its bodies ride on the last of them, the others move nothing of their own
+        last = {body: i for i, body in enumerate(bodies)}
         out = [np.empty((len(q), len(bodies)) + tail) for tail in ((), (3,), (3, 3), (3,), (3,))]
         for k, row in enumerate(q):
             d.qpos[self.qpos] = row
             mujoco.mj_kinematics(m, d)
             for i, (joint, body) in enumerate(zip(joints, bodies)):
-                members = groups[body]
+                members = groups[body] if last[body] == i else []
                 rotations = d.ximat[members].reshape(-1, 3, 3)
                 inertias = rotations @ (m.body_inertia[members][:, :, None] * np.swapaxes(rotations, -1, -2))
-                mass, com, inertia = summed(m.body_mass[members], d.xipos[members], inertias, d.xpos[body])
+                anchor = d.xanchor[joint]  # a slide's before its own motion: moved by it, as every engine's frame
+                if m.jnt_type[joint] == mujoco.mjtJoint.mjJNT_SLIDE:
+                    address = m.jnt_qposadr[joint]
+                    anchor = anchor + d.xaxis[joint] * (d.qpos[address] - m.qpos0[address])
+                mass, com, inertia = summed(m.body_mass[members], d.xipos[members], inertias, anchor)
                 out[0][k, i], out[1][k, i], out[2][k, i] = mass, com, inertia
-                out[3][k, i], out[4][k, i] = d.xaxis[joint], d.xpos[body]
+                out[3][k, i], out[4][k, i] = d.xaxis[joint], anchor
         return RigidGroups(*out)
 
     def compiled_joints(self) -> CompiledJoints:

@@ -27,6 +27,9 @@ What Pinocchio is given, and each default handled (each pinned by ``tests/refere
 
 from __future__ import annotations
 
+import os
+import tempfile
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,6 +40,7 @@ from simparity.core.model.derivatives import DynamicsDerivatives
 from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
 from simparity.references.common.conventions import fmt
+from simparity.references.common.dynamics_mjcf import dynamics_mjcf
 from simparity.references.common.dynamics_urdf import chain_joint_names, dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
 from simparity.references.pinocchio.joints import configuration
@@ -90,8 +94,9 @@ def chain_model(chain: Chain, gravity_world: np.ndarray | None) -> ChainModel:
     printed = None
     try:
         with captured_output() as printed:
-            model = (pin.buildModelFromXML(dynamics_urdf(chain), pin.JointModelFreeFlyer()) if chain.floating_base
-                     else pin.buildModelFromXML(dynamics_urdf(chain)))
+            model = _mjcf_model(chain) if chain.mjcf_path is not None else (
+                pin.buildModelFromXML(dynamics_urdf(chain), pin.JointModelFreeFlyer()) if chain.floating_base
+                else pin.buildModelFromXML(dynamics_urdf(chain)))
     except (RuntimeError, ValueError) as err:  # urdfdom says why on stderr ("joint [j]: limit has no effort")
         said = [line.strip()[len("Error:"):].strip() for line in (printed.text if printed else "").splitlines()
                 if line.strip().startswith("Error:")]
@@ -99,6 +104,12 @@ def chain_model(chain: Chain, gravity_world: np.ndarray | None) -> ChainModel:
     model.gravity = pin.Motion(np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float),
                                np.zeros(3))
     joint_ids = [model.getJointId(name) for name in chain_joint_names(chain)]
+    missing = [name for name, i in zip(chain_joint_names(chain), joint_ids) if i >= model.njoints]
+    if missing:
+        composite = [name for name, joint in zip(model.names, model.joints) if joint.shortname() == COMPOSITE]
+        raise PinocchioModelError(f"the chain's joints {missing[:3]} are no Pinocchio joints of their own"
+                                  + (f": its MJCF parser merges a body's several joints into one composite joint "
+                                     f"({', '.join(composite[:3])}), addressed as a whole" if composite else ""))
     joints = [model.joints[i] for i in joint_ids]
     idx_v = np.array([j.idx_v for j in joints])
     armature = np.zeros(model.nv)
@@ -106,18 +117,43 @@ def chain_model(chain: Chain, gravity_world: np.ndarray | None) -> ChainModel:
     model.armature = armature
     gravity = "none" if gravity_world is None else fmt(gravity_world)
     root = "; the base a JointModelFreeFlyer" if chain.floating_base else ""
-    source = (f"pinocchio.buildModelFromXML of {dynamics_source(chain)}{root}; gravity {gravity}; armature as "
+    parser = "buildModelFromMJCF" if chain.mjcf_path is not None else "buildModelFromXML"
+    source = (f"pinocchio.{parser} of {dynamics_source(chain)}{root}; gravity {gravity}; armature as "
               "model.armature")
     return ChainModel(model, joint_ids, [j.idx_q for j in joints], [j.nq == 2 for j in joints], idx_v,
                       np.array([j.damping for j in chain.joints]), source)
 
 
+def _mjcf_model(chain: Chain) -> pin.Model:
+    """Pinocchio's MJCF parser on :func:`references.common.dynamics_mjcf.dynamics_mjcf` (it reads files only: the
+    text is written to a temporary one), a floating base its free flyer."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "model.xml")
+        with open(path, "w", encoding="utf-8") as handle:
+            handle.write(dynamics_mjcf(chain))
+        return (pin.buildModelFromMJCF(path, pin.JointModelFreeFlyer()) if chain.floating_base
+                else pin.buildModelFromMJCF(path))
+
+
+COMPOSITE = "JointModelComposite"
+"""The joint Pinocchio's MJCF parser makes of a body's several joints (the MuJoCo humanoid's hips: Composite_right_hip_x
+of right_hip_x, right_hip_z and right_hip_y), one joint with one placement and one inertia."""
+
+
+class PinocchioModelError(ValueError):
+    """Pinocchio's model of the file does not hold the chain's joints one by one."""
+
+
 def pinocchio_dynamics_problem(chain: Chain) -> str:
-    """Why Pinocchio cannot build the chain's dynamics ("" when it can): its URDF parser's refusal, in its words."""
+    """Why Pinocchio cannot build the chain's dynamics ("" when it can): its parser's refusal, in its words, or the
+    chain's joints it does not keep apart."""
+    parser = "MJCF" if chain.mjcf_path is not None else "URDF"
     try:
         chain_model(chain, None)
+    except PinocchioModelError as error:
+        return f"Pinocchio's {parser} parser loads the file, but {error}"
     except (RuntimeError, ValueError) as error:
-        return f"Pinocchio's URDF parser refuses the file: {' '.join(str(error).split())}"
+        return f"Pinocchio's {parser} parser refuses the file: {' '.join(str(error).split())}"
     return ""
 
 

@@ -79,7 +79,9 @@ from __future__ import annotations
 import importlib.metadata
 import os
 import tempfile
+import xml.etree.ElementTree as ET
 from collections.abc import Iterator
+from typing import cast
 
 import numpy as np
 
@@ -116,6 +118,7 @@ from simparity.references.common.conventions import (
 )
 from simparity.references.pybullet.quiet import pybullet
 from simparity.references.common.quiet import captured_output
+from simparity.references.common.dynamics_mjcf import WORLD, dynamics_mjcf
 from simparity.references.common.dynamics_urdf import dynamics_urdf
 from simparity.references.common.urdf_export import (
     UrdfChains,
@@ -142,6 +145,64 @@ def _load_urdf(client: int, text: str, **kwargs) -> int:
             return pybullet.loadURDF(path, flags=pybullet.URDF_USE_INERTIA_FROM_FILE, physicsClientId=client, **kwargs)
     finally:
         os.unlink(path)
+
+
+FIXED_BASE_JOINT = {"name": "simparity_fixed_base", "type": "fixed", "pos": "0 0 0", "axis": "0 0 1", "limited": "false",
+                    "armature": "0", "damping": "0", "stiffness": "0"}
+"""PyBullet's own MJCF extension that fixes a body to the world (pybullet_data's humanoid_fixed.xml): MJCF has no fixed
+joint, and PyBullet's MJCF importer makes a root body without one free (measured: the ant's M 8 x 8 for 2 hinges).
+Every attribute is written: without ``limited`` PyBullet 3.2.7's parser aborts the process (std::logic_error)."""
+
+
+def pybullet_mjcf(chain: Chain) -> str:
+    """The MJCF text PyBullet reads for a chain from an MJCF file: :func:`references.common.dynamics_mjcf.dynamics_mjcf`
+    with :data:`FIXED_BASE_JOINT` on its base body."""
+    root = ET.fromstring(dynamics_mjcf(chain))
+    world = cast(ET.Element, root.find("worldbody"))
+    body = cast(ET.Element, world.find("body"))
+    if chain.base_link == WORLD and body.get("name") != WORLD:  # the root body's joints move it: anchor it to the world
+        world.remove(body)
+        anchor = ET.SubElement(world, "body", name="simparity_world")
+        anchor.append(body)
+        body = anchor
+    body.insert(0, ET.Element("joint", FIXED_BASE_JOINT))
+    return ET.tostring(root, encoding="unicode")
+
+
+def _load_mjcf(client: int, text: str) -> int:
+    """loadMJCF needs a file: the text written to a temporary one, PyBullet's output kept off the console; the one body
+    it makes (a file of :func:`pybullet_mjcf` has one root body)."""
+    with tempfile.TemporaryDirectory() as folder:
+        path = os.path.join(folder, "model.xml")
+        with open(path, "w", encoding="utf-8") as handle:
+            handle.write(text)
+        with captured_output():
+            bodies = pybullet.loadMJCF(path, physicsClientId=client)
+    if len(bodies) != 1:
+        raise pybullet.error(f"loadMJCF made {len(bodies)} bodies of one root body")
+    return int(bodies[0])
+
+
+def _mjcf_loader_support(text: str) -> Support:
+    """No, in PyBullet's words, when its MJCF loader refuses ``text`` or crashes on it: tried in a forked child, since
+    PyBullet 3.2.7's MJCF parser aborts the process on some input (:data:`FIXED_BASE_JOINT`)."""
+    read, write = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: load, say why not (or nothing), and leave without running any cleanup of the parent's
+        said, client = "", _Client()  # kept: a client let go disconnects
+        try:
+            _load_mjcf(client.id, text)
+        except Exception as err:  # noqa: BLE001 - reported to the parent as text
+            said = " ".join(str(err).split()) or type(err).__name__
+        os.write(write, said.encode()[:4000])
+        os._exit(0)
+    os.close(write)
+    with os.fdopen(read, "rb") as reader:
+        said = reader.read().decode(errors="replace")
+    _, status = os.waitpid(pid, 0)
+    if os.WIFSIGNALED(status):
+        return Support.no(f"PyBullet's MJCF loader crashes on the file (signal {os.WTERMSIG(status)})")
+    return Support.no(f"PyBullet's MJCF loader refuses the file: {said}") if said else Support.yes()
 
 
 CONTACT_ERP = 0.0
@@ -501,12 +562,14 @@ def _links_support(urdf_text: str) -> Support:
 def _dynamics_support(chain: Chain) -> Support:
     """Whether PyBullet can hold the chain's dynamics: a chain URDF can express (a prismatic joint needs limits
     there), no armature, at most :data:`MAX_LINKS` links."""
-    expressible = urdf_support(chain) if chain.urdf_path is None else Support.yes()
+    expressible = urdf_support(chain) if chain.robot_file is None else Support.yes()
     if not expressible.ok:
         return expressible
     armature = _armature_support(chain)
     if not armature.ok:
         return armature
+    if chain.mjcf_path is not None:
+        return _mjcf_loader_support(pybullet_mjcf(chain))
     text = dynamics_urdf(chain)
     links = _links_support(text)
     return _loader_support(text) if links.ok else links

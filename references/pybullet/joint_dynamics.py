@@ -71,7 +71,7 @@ from simparity.references.common.conventions import fmt, quat_wxyz_to_matrix, wx
 from simparity.references.common.rigid_groups import summed
 from simparity.references.common.dynamics_urdf import chain_joint_names, dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
-from simparity.references.pybullet.adapter import _Client, _load_urdf
+from simparity.references.pybullet.adapter import _Client, _load_mjcf, _load_urdf, pybullet_mjcf
 from simparity.references.pybullet.quiet import pybullet
 
 STEP = 1.0  # [s]
@@ -144,8 +144,12 @@ class ChainBodies:
         pybullet.setPhysicsEngineParameter(numSubSteps=0, physicsClientId=c)
         pybullet.setGravity(*(np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float)),
                             physicsClientId=c)
-        text = unit_axes(dynamics_urdf(chain))
-        self.bodies = [_load_urdf(c, text, useFixedBase=True) for _ in range(copies)]
+        if chain.mjcf_path is not None:
+            mjcf = pybullet_mjcf(chain)
+            self.bodies = [_load_mjcf(c, mjcf) for _ in range(copies)]
+        else:
+            text = unit_axes(dynamics_urdf(chain))
+            self.bodies = [_load_urdf(c, text, useFixedBase=True) for _ in range(copies)]
         self.body = b = self.bodies[0]
         info = [pybullet.getJointInfo(b, j, physicsClientId=c)
                 for j in range(pybullet.getNumJoints(b, physicsClientId=c))]
@@ -207,8 +211,11 @@ class PybulletJointDynamics(JointDynamicsModel):
         self._tree.build_tree()
         self._stepped = ChainBodies(chain, gravity_world)
         self._damping = np.array([j.damping for j in chain.joints])
-        self.detail = (f"loadURDF(useFixedBase, URDF_USE_INERTIA_FROM_FILE) of {dynamics_source(chain)}; "
-                       f"{axes_changed(chain)}; gravity set; link damping 0, jointDamping = the chain's, joint limits, "
+        loader = ("loadMJCF (the base fixed by PyBullet's own fixed root joint) of" if chain.mjcf_path is not None
+                  else "loadURDF(useFixedBase, URDF_USE_INERTIA_FROM_FILE) of")
+        axes = ("axes normalised by PyBullet's MJCF importer" if chain.mjcf_path is not None
+                else axes_changed(chain))
+        self.detail = (f"{loader} {dynamics_source(chain)}; {axes}; gravity set; link damping 0, jointDamping = the chain's, joint limits, "
                        f"velocity cap and braking motors off; M, h, tau from calculateMassMatrix / "
                        f"calculateInverseDynamics (+ D qdot); qddot from one stepSimulation of {STEP:g} s under TORQUE_CONTROL; kinetic energy "
                        f"from getLinkStates' centre-of-mass velocities and inertial frames")

@@ -18,12 +18,13 @@ from simparity.core.model.files import file_problem
 from simparity.core.model.ranges import RANGES
 from simparity.core.model.scenes.chain import Chain, DHTable, Joint, LinkInertia
 from simparity.core.rotations import rpy_to_matrix
+from simparity.core.mjcf import chain_from_mjcf
 from simparity.core.urdf import chain_from_urdf
 
 JOINT_TYPES = ("revolute", "prismatic")
-_CHAIN = ("name", "joint", "end_effector", "end_effector_xyz", "end_effector_rpy", "urdf", "base_link", "tip_link",
-          "dh", "floating_base")
-FLOATING_SCENES = "a joint_dynamics scene's URDF chain"
+_CHAIN = ("name", "joint", "end_effector", "end_effector_xyz", "end_effector_rpy", "urdf", "mjcf", "base_link",
+          "tip_link", "dh", "floating_base")
+FLOATING_SCENES = "a joint_dynamics scene's URDF or MJCF chain"
 """What may have a floating base: its state is compared instant by instant, and its base link's mass properties come
 from the file."""
 _DH = ("convention", "a", "alpha", "d", "theta_offset", "lower", "upper")
@@ -38,6 +39,9 @@ _LINK = ("mass", "com_xyz", "inertia")
 _JOINT = ("name", "type", "axis", "origin_xyz", "origin_rpy", "lower", "upper", "damping", "armature") + _LINK
 _WHERE_URDF = (f"a URDF file relative to the scene file, or {PYBULLET_DATA_PREFIX}... or "
                f"{EXAMPLE_ROBOT_DATA_PREFIX}... inside that package")
+_WHERE_MJCF = (f"an MJCF file relative to the scene file, or {PYBULLET_DATA_PREFIX}... or "
+               f"{EXAMPLE_ROBOT_DATA_PREFIX}... inside that package")
+_WHERE = {"urdf": _WHERE_URDF, "mjcf": _WHERE_MJCF}
 
 
 def _joint(r: TableReader, before: tuple[str, ...]) -> Joint:
@@ -96,8 +100,8 @@ def _link(r: TableReader, where: str) -> LinkInertia | None:
     return LinkInertia(mass, com, inertia)
 
 
-def _package_root(c: TableReader, prefix: str) -> Path:
-    """The folder a prefixed ``urdf`` path is relative to."""
+def _package_root(c: TableReader, prefix: str, key: str) -> Path:
+    """The folder a prefixed ``urdf`` or ``mjcf`` path (``key``) is relative to."""
     if prefix == PYBULLET_DATA_PREFIX:
         import pybullet_data  # data files only; ships with pybullet
 
@@ -107,38 +111,45 @@ def _package_root(c: TableReader, prefix: str) -> Path:
     try:
         robots = metadata.distribution("example-robot-data").locate_file(EXAMPLE_ROBOT_DATA_ROBOTS)
     except metadata.PackageNotFoundError:
-        raise c.fail("urdf", "the example-robot-data package is not installed",
-                     "pip install example-robot-data, or the path of a URDF file") from None
+        raise c.fail(key, "the example-robot-data package is not installed",
+                     "pip install example-robot-data, or the path of a robot file") from None
     return Path(str(robots))
 
 
-def _urdf_path(c: TableReader) -> Path:
-    """The URDF file a scene names: relative to the scene file, absolute, or inside a package."""
-    text = c.string("urdf")
+def _robot_path(c: TableReader, key: str) -> Path:
+    """The robot file a scene names under ``key`` (``urdf`` or ``mjcf``): relative to the scene file, absolute, or
+    inside a package."""
+    text = c.string(key)
     prefix = next((p for p in (PYBULLET_DATA_PREFIX, EXAMPLE_ROBOT_DATA_PREFIX) if text.startswith(p)), None)
     if prefix:
-        root = _package_root(c, prefix)
+        root = _package_root(c, prefix, key)
         path = root / text[len(prefix):]
         if not os.path.realpath(path).startswith(os.path.realpath(root) + os.sep):
-            raise c.fail("urdf", f"{echo(text)} leaves the {prefix[:-1]} package", _WHERE_URDF)
+            raise c.fail(key, f"{echo(text)} leaves the {prefix[:-1]} package", _WHERE[key])
     else:
         path = Path(os.path.abspath(Path(c.source).parent / text))  # absolute: the same file however the scene was named
-    problem = file_problem(path, "URDF file")
+    problem = file_problem(path, f"{key.upper()} file")
     if problem:
-        raise c.fail("urdf", f"{problem}: {one_line(path)}", _WHERE_URDF)
+        raise c.fail(key, f"{problem}: {one_line(path)}", _WHERE[key])
     return path
 
 
-def _urdf_chain(c: TableReader, dynamics: bool, floating: bool) -> Chain:
-    """The chain of a ``urdf`` scene; an error in the URDF names the scene file, and the URDF as the scene does."""
-    base, tip = (c.name(key) if c.has(key) else None for key in ("base_link", "tip_link"))
-    path = _urdf_path(c)
+def _file_chain(c: TableReader, key: str, dynamics: bool, floating: bool) -> Chain:
+    """The chain of a ``urdf`` or ``mjcf`` scene (``key``); an error in the file names the scene file, and the robot
+    file as the scene does. A robot file's non-physical tensor on a moving link loads, recorded as the chain's
+    ``mass_problem``: core declines it, the engines that accept the file compute with it (issue #45)."""
+    base, tip = (c.name(name) if c.has(name) else None for name in ("base_link", "tip_link"))
+    path = _robot_path(c, key)
     try:
+        if key == "mjcf":
+            return chain_from_mjcf(str(path), base_body=base, tip_body=tip, max_joints=c.limits.max_joints,
+                                   max_bytes=c.limits.max_file_bytes, dynamics=dynamics, floating_base=floating,
+                                   refuse_mass=False)
         return chain_from_urdf(str(path), base_link=base, tip_link=tip, max_joints=c.limits.max_joints,
                                max_bytes=c.limits.max_file_bytes, dynamics=dynamics, floating_base=floating,
                                refuse_mass=False)
     except SceneError as err:
-        raise c.fail("urdf", f"{one_line(c.table['urdf'], 120)}: {err.key}: {err.problem}", err.allowed) from None
+        raise c.fail(key, f"{one_line(c.table[key], 120)}: {err.key}: {err.problem}", err.allowed) from None
 
 
 def _dh_chain(c: TableReader, name: str) -> Chain:
@@ -167,18 +178,21 @@ def read_chain(top: TableReader, name: str, dynamics: bool = False, floating_all
     """The scene's ``[chain]``; for ``dynamics``, a URDF's inertia tensors must be physical; ``floating_base = true``
     only where ``floating_allowed`` (:data:`FLOATING_SCENES`)."""
     c = top.subtable("chain", _CHAIN)
-    sources = [key for key in ("joint", "urdf", "dh") if c.has(key)]
+    sources = [key for key in ("joint", "urdf", "mjcf", "dh") if c.has(key)]
     if len(sources) != 1:
         raise c.fail("joint", f"give exactly one chain source, got {sources or 'none'}",
-                     "one of [[chain.joint]], urdf, [chain.dh]")
+                     "one of [[chain.joint]], urdf, mjcf, [chain.dh]")
+    if sources == ["mjcf"] and not floating_allowed:
+        raise c.fail("mjcf", f"an MJCF chain is read for joint_dynamics scenes only, not for a "
+                     f"{top.table.get('scene', {}).get('kind', 'this')} scene", "urdf, [[chain.joint]] or [chain.dh]")
     floating = c.boolean("floating_base", False)
-    if floating and not (floating_allowed and sources == ["urdf"]):
+    if floating and not (floating_allowed and sources[0] in ("urdf", "mjcf")):
         where = (f"a {top.table.get('scene', {}).get('kind', 'this')} scene" if not floating_allowed
                  else f"a chain given as {sources[0]}")
         raise c.fail("floating_base", f"a floating base is not available for {where}",
                      f"{FLOATING_SCENES} (false elsewhere)")
-    if sources == ["urdf"]:
-        return _urdf_chain(c, dynamics, floating)
+    if sources[0] in ("urdf", "mjcf"):
+        return _file_chain(c, sources[0], dynamics, floating)
     if sources == ["dh"]:
         return _dh_chain(c, c.name("name", name))
     joints: tuple[Joint, ...] = ()

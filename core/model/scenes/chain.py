@@ -243,6 +243,12 @@ class Chain:
                              "one row per joint")
 
     @property
+    def robot_file(self) -> str | None:
+        """The robot file the chain was read from (:attr:`urdf_path` or :attr:`mjcf_path`); None for a chain defined
+        otherwise."""
+        return self.urdf_path if self.urdf_path is not None else self.mjcf_path
+
+    @property
     def n_joints(self) -> int:
         return len(self.joints)
 

@@ -235,5 +235,6 @@ def test_the_derivative_rows_time_every_route_with_its_error_and_a_ratio_to_pino
     assert ANALYTIC_DERIVATIVES < by_route["mujoco", "recursive"].accuracy <= FORWARD_DIFFERENCES
     table = derivatives.markdown_lines(rows)
     pinocchio = next(line for line in table if line.startswith("| ur5-dynamics | pinocchio |"))
-    assert pinocchio.split(" | ")[-2] == "1.00"  # its own time over its own
+    assert pinocchio.split(" | ")[-2] == "1"  # its own time over its own
+    # three significant digits: a route 1,000 times slower on a loaded machine is 0.001, never 0
     assert all(float(line.split(" | ")[-2]) > 0 for line in table if line.startswith("| ur5-dynamics |"))

@@ -42,13 +42,14 @@ def test_default_suite_is_every_scene_marked_default_and_hard_is_its_own():
     contact = {s.name for s in library.suite("contact")}
     bench = {s.name for s in library.suite("bench")}
     articulated = {s.name for s in library.suite("articulated")}
+    robots = {s.name for s in library.suite("robots")}
     assert "lecture-projectile" in default and "lecture-projectile" not in hard
     assert "hard-stiff-drag" in hard and "hard-stiff-drag" not in default
     assert "fast-spinner" in default & hard
-    assert default | hard | contact | bench | articulated == {
+    assert default | hard | contact | bench | articulated | robots == {
         s.name for s in library.load(list(library.builtin_paths()))}
-    files = {s.sweep.base if s.sweep else s.name for name in ("default", "hard", "contact", "bench", "articulated")
-             for s in library.suite(name)}   # a sweep's variants are named after their file's scene
+    files = {s.sweep.base if s.sweep else s.name
+             for name in ("default", "hard", "contact", "bench", "articulated", "robots") for s in library.suite(name)}   # a sweep's variants are named after their file's scene
     assert files == set(library.builtin_paths())
 
 
