@@ -457,6 +457,18 @@ def cmd_show(args, out) -> int:
     return EXIT_OK
 
 
+def cmd_import(args, out) -> int:
+    from simparity.comparisons.cli.importers import verdicts  # imports every engine: only when asked
+
+    kind, said = verdicts(args.file)
+    for verdict in said:
+        print(f"{verdict.reader}: {verdict.said}", file=out)
+    if not any(verdict.loads for verdict in said):
+        raise SimparityError(f"{one_line(args.file)}: no reader reads this {kind.upper()} file (allowed: a file one of "
+                             "core, MuJoCo, Pinocchio or PyBullet reads)")
+    return EXIT_OK
+
+
 def cmd_bench(args, out) -> int:
     from simparity.comparisons.bench.run import run_bench  # imports every engine: only when asked
     from simparity.comparisons.cli.destinations import writable_folder
@@ -480,7 +492,7 @@ def cmd_report(args, out) -> int:
 
 
 _COMMANDS = {"list": cmd_list, "engines": cmd_engines, "run": cmd_run, "check": cmd_check, "history": cmd_history, "export": cmd_export,
-             "show": cmd_show, "report": cmd_report, "bench": cmd_bench}
+             "show": cmd_show, "report": cmd_report, "bench": cmd_bench, "import": cmd_import}
 
 
 def main(argv: list[str] | None = None, out=None) -> int:

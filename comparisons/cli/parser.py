@@ -274,6 +274,13 @@ def build_parser() -> argparse.ArgumentParser:
         "built from point masses), forces, planes (normalised), shapes and every body-plane material.")
     show.add_argument("scene", metavar="SCENE|FILE")
 
+    robot = commands.add_parser(
+        "import", help="say which readers read a robot file (URDF or MJCF): core's and each engine's importer",
+        description="Read a URDF or MJCF file with core's reader and with MuJoCo's, Pinocchio's and PyBullet's "
+        "importers, as the file is, and print one line per reader: what it compiled, or why it does not read the "
+        "file. Exit 2 only when no reader reads it (docs/robots.md).")
+    robot.add_argument("file", metavar="FILE")
+
     bench = commands.add_parser(
         "bench", help="measure speed with accuracy, core against the engines; write BENCHMARKS.md",
         description="Time rigid-body stepping (B = 1, 100, 10,000 bodies), FK + Jacobian, IK (the bench suite's "

@@ -101,8 +101,8 @@ def _joint_type(joint: ET.Element, cls: str, classes: dict[str, tuple[str | None
 
 
 def _tree(root: ET.Element) -> _Tree:
-    world = root.find("worldbody")
-    if world is None:
+    worlds = root.findall("worldbody")
+    if not worlds:
         raise SimparityError("the MJCF file has no <worldbody>")
     classes = _default_types(root)
     parent: dict[ET.Element, ET.Element | None] = {}
@@ -121,7 +121,8 @@ def _tree(root: ET.Element) -> _Tree:
                 joints[body].append(child)
                 types[child] = _joint_type(child, cls, classes)
 
-    walk(world, None, "main")
+    for world in worlds:
+        walk(world, None, "main")
     return _Tree(parent, joints, types)
 
 
@@ -208,16 +209,39 @@ def _changed(chain: Chain) -> tuple[ET.Element, MjcfChanges]:
                 if tree.types[joint] != "free":
                     held.append(joint.get("name") or "(unnamed)")
                 _remove(body, joint)
-    world = cast(ET.Element, root.find("worldbody"))
+    holder = {child: parent for parent in root.iter() for child in parent}
+    around = [top]  # top and the <frame> elements it sits in, up to its <worldbody>
+    while holder[around[-1]].tag != "worldbody":
+        around.append(holder[around[-1]])
+    world = holder[around[-1]]
     left_out = []
-    for child in list(world):
-        if child is not top:
-            left_out.append(f"{child.tag} {child.get('name')!r}" if child.get("name") else child.tag)
-            world.remove(child)
-    if top not in list(world):  # nested below a body or frame of <worldbody> (left out above): moved up
-        world.append(top)
-    for attribute in ("pos",) + ORIENTATIONS if base is not None else ():
-        top.attrib.pop(attribute, None)
+
+    def leave_out(parent: ET.Element, child: ET.Element) -> None:
+        left_out.append(f"{child.tag} {child.get('name')!r}" if child.get("name") else child.tag)
+        parent.remove(child)
+
+    for other in root.findall("worldbody"):  # a file may write several; MuJoCo merges them
+        if other is not world:
+            for child in list(other):
+                leave_out(other, child)
+            root.remove(other)
+    if base is not None:  # the base at the world's origin, out of any frame, the class it inherited kept
+        inherited = next((element.get("childclass") for element in around[1:] if element.get("childclass")), None)
+        if top.get("childclass") is None and inherited is not None:
+            top.set("childclass", inherited)
+        for child in list(world):
+            if child is not around[-1]:
+                leave_out(world, child)
+        if top is not around[-1]:
+            world.remove(around[-1])
+            world.append(top)
+        for attribute in ("pos",) + ORIENTATIONS:
+            top.attrib.pop(attribute, None)
+    else:  # the world as the base: the frames around the root body kept with their poses, all beside them left out
+        for parent, kept in zip([world] + around[:0:-1], around[::-1]):
+            for child in list(parent):
+                if child is not kept:
+                    leave_out(parent, child)
     sections = []
     for element in list(root):
         if element.tag in REMOVED_SECTIONS:

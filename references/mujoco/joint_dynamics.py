@@ -92,7 +92,15 @@ def _compiled(chain: Chain, gravity_world: np.ndarray | None, motors: bool = Fal
 
 def mujoco_dynamics_problem(chain: Chain) -> str:
     """Why MuJoCo cannot build the chain's dynamics unchanged ("" when it can): its compiler's refusal, e.g. of a
-    moving body without mass or rotational inertia, or of an inertia breaking the triangle inequality."""
+    moving body without mass or rotational inertia, or of an inertia breaking the triangle inequality. An MJCF file is
+    first compiled as it is: the text every engine is given drops what it does not need, and MuJoCo must read the
+    file the user has (a held joint's zero axis, a UTF-16 file: refused there, never seen by the model)."""
+    if chain.mjcf_path is not None:
+        try:
+            with captured_output():
+                mujoco.MjModel.from_xml_path(chain.mjcf_path)
+        except ValueError as error:
+            return f"MuJoCo refuses the file: {' '.join(str(error).split())}"
     try:
         _compiled(chain, None)
     except ValueError as error:

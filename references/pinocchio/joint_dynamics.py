@@ -223,7 +223,9 @@ class PinocchioJointDynamics(JointDynamicsModel):
             for i, (joint, column) in enumerate(zip(self.joint_ids, self.idx_v)):
                 placement, inertia = data.oMi[joint], model.inertias[joint]
                 rotation = placement.rotation
-                motion = pin.getJointJacobian(model, data, joint, pin.ReferenceFrame.LOCAL)[:, column]
+                # (6, nv): reshaped, for the binding returns a (6,) vector when nv is 1
+                jacobian = np.asarray(pin.getJointJacobian(model, data, joint, pin.ReferenceFrame.LOCAL))
+                motion = jacobian.reshape(6, model.nv)[:, column]
                 axis = motion[3:] if np.linalg.norm(motion[3:]) > np.linalg.norm(motion[:3]) else motion[:3]
                 out[0][k, i] = inertia.mass
                 out[1][k, i] = placement.act(inertia.lever)

@@ -119,7 +119,8 @@ from simparity.references.common.conventions import (
 from simparity.references.pybullet.quiet import pybullet
 from simparity.references.common.quiet import captured_output
 from simparity.references.common.dynamics_mjcf import WORLD, dynamics_mjcf
-from simparity.references.common.dynamics_urdf import dynamics_urdf
+from simparity.references.common.dynamics_urdf import chain_joint_names, dynamics_urdf
+from simparity.references.common.forked import asked_in_child
 from simparity.references.common.urdf_export import (
     UrdfChains,
     body_urdf,
@@ -159,7 +160,7 @@ def pybullet_mjcf(chain: Chain) -> str:
     with :data:`FIXED_BASE_JOINT` on its base body."""
     root = ET.fromstring(dynamics_mjcf(chain))
     world = cast(ET.Element, root.find("worldbody"))
-    body = cast(ET.Element, world.find("body"))
+    body = list(world)[0]  # the base body, or (the world as the base) the root body or the frame around it
     if chain.base_link == WORLD and body.get("name") != WORLD:  # the root body's joints move it: anchor it to the world
         world.remove(body)
         anchor = ET.SubElement(world, "body", name="simparity_world")
@@ -183,26 +184,29 @@ def _load_mjcf(client: int, text: str) -> int:
     return int(bodies[0])
 
 
-def _mjcf_loader_support(text: str) -> Support:
-    """No, in PyBullet's words, when its MJCF loader refuses ``text`` or crashes on it: tried in a forked child, since
-    PyBullet 3.2.7's MJCF parser aborts the process on some input (:data:`FIXED_BASE_JOINT`)."""
-    read, write = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # the child: load, say why not (or nothing), and leave without running any cleanup of the parent's
-        said, client = "", _Client()  # kept: a client let go disconnects
+def _mjcf_loader_support(text: str, names: tuple[str, ...]) -> Support:
+    """No, in PyBullet's words, when its MJCF loader refuses ``text`` or crashes on it, or when the body it makes lacks
+    a chain joint of ``names`` (its importer drops a joint written without ``type`` or inheriting one from a
+    ``childclass``): asked in a forked child, since PyBullet 3.2.7's MJCF parser aborts the process on some input
+    (:data:`FIXED_BASE_JOINT`)."""
+
+    def question() -> str:
+        client = _Client()  # kept: a client let go disconnects
         try:
-            _load_mjcf(client.id, text)
+            body = _load_mjcf(client.id, text)
         except Exception as err:  # noqa: BLE001 - reported to the parent as text
-            said = " ".join(str(err).split()) or type(err).__name__
-        os.write(write, said.encode()[:4000])
-        os._exit(0)
-    os.close(write)
-    with os.fdopen(read, "rb") as reader:
-        said = reader.read().decode(errors="replace")
-    _, status = os.waitpid(pid, 0)
-    if os.WIFSIGNALED(status):
-        return Support.no(f"PyBullet's MJCF loader crashes on the file (signal {os.WTERMSIG(status)})")
-    return Support.no(f"PyBullet's MJCF loader refuses the file: {said}") if said else Support.yes()
+            return f"refuses the file: {' '.join(str(err).split()) or type(err).__name__}"
+        made = {pybullet.getJointInfo(body, j, physicsClientId=client.id)[1].decode()
+                for j in range(pybullet.getNumJoints(body, physicsClientId=client.id))
+                if pybullet.getJointInfo(body, j, physicsClientId=client.id)[2] != pybullet.JOINT_FIXED}
+        dropped = [name for name in names if name not in made]
+        return (f"loads the file, but its body lacks the chain's joints {dropped[:3]} (it drops the joints it does not "
+                "read: written without type, taking it from a default class, or inside a <frame>)") if dropped else ""
+
+    said, signal = asked_in_child(question)
+    if signal is not None:
+        return Support.no(f"PyBullet's MJCF loader crashes on the file (signal {signal})")
+    return Support.no(f"PyBullet's MJCF loader {said}") if said else Support.yes()
 
 
 CONTACT_ERP = 0.0
@@ -569,7 +573,7 @@ def _dynamics_support(chain: Chain) -> Support:
     if not armature.ok:
         return armature
     if chain.mjcf_path is not None:
-        return _mjcf_loader_support(pybullet_mjcf(chain))
+        return _mjcf_loader_support(pybullet_mjcf(chain), chain_joint_names(chain))
     text = dynamics_urdf(chain)
     links = _links_support(text)
     return _loader_support(text) if links.ok else links

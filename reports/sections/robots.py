@@ -33,8 +33,9 @@ NOTE_CHARS = LINE_CHARS - 20
 
 
 def robot_scenes(table: pd.DataFrame, joint_dynamics_scenes: list[str]) -> list[str]:
-    """The joint-dynamics scenes of a robot file: those with model-parity rows."""
-    with_model = set(table.loc[table["metric"].isin(MODEL_METRICS), "scene"])
+    """The joint-dynamics scenes of a robot file: those where some engine reported its compiled model (a chain written in
+    the scene file has model rows too, n/a in every engine)."""
+    with_model = set(table.loc[table["metric"].isin(MODEL_ERRORS) & (table["status"] == OK), "scene"])
     return [scene for scene in joint_dynamics_scenes if scene in with_model]
 
 
@@ -85,8 +86,8 @@ def _cell(case: pd.DataFrame, violations: list[str], notes: _Notes) -> str:
 def section(ctx: ReportContext, scenes: list[str]) -> list[Block]:
     """The table of robot files x engines (the module docstring), the reference's column saying it is."""
     rows = ctx.table[ctx.table["scene"].isin(scenes)]
-    compiled = rows[rows["metric"].isin(MODEL_ERRORS) & (rows["status"] == OK)]
-    engines = [e for e in dict.fromkeys(rows["engine"]) if e in set(compiled["engine"])]  # a closed form compiles none
+    # every engine with model rows: one that declines every file here (core on non-physical tensors) keeps its column
+    engines = [e for e in dict.fromkeys(rows["engine"]) if e in set(rows.loc[rows["metric"].isin(MODEL_ERRORS), "engine"])]
     verdict = ctx.verdict
     against: dict[tuple[str, str], list[str]] = {}
     if verdict is not None:

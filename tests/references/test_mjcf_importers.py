@@ -152,3 +152,41 @@ def test_pybullet_needs_its_own_fixed_joint_to_fix_an_mjcf_base():
             mass_matrix = pybullet.calculateMassMatrix(body, [0.0] * len(movable), physicsClientId=client.id)
         assert np.shape(mass_matrix) == (size, size)
     assert ET.fromstring(pybullet_mjcf(chain)).find("worldbody/body/joint").get("type") == "fixed"
+
+
+def test_pinocchio_ignores_a_default_class_geom_mass():
+    """A ``<default><geom mass>`` sets the geom's mass in MuJoCo; Pinocchio infers it from the density instead
+    (dm_control's acrobot: 8.38 kg against 1.0; a held-out review's finding)."""
+    text = ('<mujoco><compiler angle="radian"/><default><geom mass="1"/></default><worldbody><body name="a">'
+            '<joint name="j" axis="1 0 0"/><geom type="sphere" size="0.1"/></body></worldbody></mujoco>')
+    assert mujoco.MjModel.from_xml_string(text).body_mass[1] == 1.0
+    assert _pinocchio(text).inertias[1].mass == pytest.approx(4.18879020478639, rel=ROUNDING)
+
+
+def test_pinocchio_shifts_a_hinge_s_range_by_its_ref():
+    """A hinge with ref 60 degrees and range [-90, 120]: MuJoCo's range is qpos's, [-90, 120]; Pinocchio's q is qpos
+    too (its dynamics agree) but its limits are the range less ref, [-150, 60]."""
+    text = ('<mujoco><worldbody><body name="a"><joint name="j" axis="0 1 0" ref="60" range="-90 120" limited="true"/>'
+            '<geom type="sphere" size="0.1" pos="0.2 0 0"/></body></worldbody></mujoco>')
+    assert np.allclose(np.degrees(mujoco.MjModel.from_xml_string(text).jnt_range[0]), [-90.0, 120.0])
+    model = _pinocchio(text)
+    assert np.allclose(np.degrees([model.lowerPositionLimit[0], model.upperPositionLimit[0]]), [-150.0, 60.0])
+
+
+def test_pybullet_gives_an_ellipsoid_no_mass():
+    """PyBullet's MJCF importer makes a body whose only geom is an ellipsoid massless (MuJoCo: its volume times 1000)."""
+    geom = 'type="ellipsoid" size="0.1 0.05 0.03"'
+    assert mujoco.MjModel.from_xml_string(_one_body(geom)).body_mass[1] > 0
+    assert _pybullet_link(_anchored(geom), "a")[0] == 0.0
+
+
+def test_pybullet_is_n_a_naming_the_joints_its_mjcf_importer_drops(tmp_path):
+    """A hinge written without ``type`` (MJCF's default) is a joint for MuJoCo and core, none for PyBullet's MJCF
+    importer: its rows are n/a naming the joint, never a failed case (a held-out review's finding)."""
+    path = _write(tmp_path, '<mujoco><worldbody><body name="base"><body name="a"><joint name="j1" axis="0 1 0"/>'
+                            '<geom type="sphere" size="0.1" pos="0.2 0 0"/></body></body></worldbody></mujoco>')
+    chain = chain_from_mjcf(path, "base", "a", dynamics=True)
+    support = make_engine("pybullet").supports_joint_dynamics(chain, "recursive")
+    assert not support.ok and "lacks the chain's joints ['j1']" in support.reason
+    assert make_engine("mujoco").supports_joint_dynamics(chain, "recursive").ok
+
