@@ -161,8 +161,11 @@ def mjcf_joint_names(chain: Chain) -> tuple[str, ...]:
     """The chain's joints as the references select them: the hinge and slide joints of the bodies on the file's own
     path from the base body to the tip body (the scene's ``base_link`` and ``tip_link``), in the file's order, found by
     the references' own walk of the file, never from core's parse."""
-    root = _file(chain)
-    tree = _tree(root)
+    return _chain_joints(_tree(_file(chain)), chain)
+
+
+def _chain_joints(tree: _Tree, chain: Chain) -> tuple[str, ...]:
+    """:func:`mjcf_joint_names` in a file already walked."""
     path = _path(tree, _base(tree, cast(str, chain.base_link)), _body(tree, chain.end_effector_name))
     return tuple(cast(str, joint.get("name")) for body in path for joint in tree.joints[body]
                  if tree.types[joint] in MOVING_TYPES)
@@ -198,7 +201,7 @@ def _changed(chain: Chain) -> tuple[ET.Element, MjcfChanges]:
     folder = os.path.dirname(os.path.abspath(cast(str, chain.mjcf_path)))
     tree = _tree(root)
     base = _base(tree, cast(str, chain.base_link))
-    on_chain = set(mjcf_joint_names(chain))
+    on_chain = set(_chain_joints(tree, chain))  # the file walked once
     # the world as the base: the chain's root body (the tip's top ancestor) stays where the file puts it
     top = base if base is not None else _path(tree, None, _body(tree, chain.end_effector_name))[0]
     subtree = [body for body in tree.parent if body is top or _below(tree, body, top)]
