@@ -65,10 +65,11 @@ def _cell(case: pd.DataFrame, violations: list[str], notes: _Notes) -> str:
     if case.empty:
         return "—"
     engine = str(case["engine"].iloc[0])
-    for status in (FAILED, NOT_AVAILABLE):
-        if (case["status"] == status).all() or (status == FAILED and (case["status"] == FAILED).any()):
-            detail = str(case.loc[case["status"] == status, "detail"].iloc[0])
-            return f"{status} [{notes.number_of(f'{engine}: {detail}')}]"
+    statuses = case["status"]
+    unmeasured = FAILED if (statuses == FAILED).any() else NOT_AVAILABLE if (statuses == NOT_AVAILABLE).all() else None
+    if unmeasured is not None:
+        detail = str(case.loc[statuses == unmeasured, "detail"].iloc[0])
+        return f"{unmeasured} [{notes.number_of(f'{engine}: {detail}')}]"
     ok = case[case["status"] == OK]
     model = ok[ok["metric"].isin(MODEL_ERRORS)]["value"]
     counts = ok[ok["metric"].isin(MODEL_COUNTS)]["value"]
