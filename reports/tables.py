@@ -12,7 +12,7 @@ import pandas as pd
 from simparity.core.model.results import OK
 from simparity.reports.blocks import Table, number
 from simparity.core.model.metric_catalogue import (
-    ANGULAR_MOMENTUM_DRIFT_MAX, ANGULAR_VELOCITY_ERROR_MAX, APEX_HEIGHT_ERROR, CROSS_EVAL_DISAGREEMENT_MAX,
+    ANGULAR_MOMENTUM_DRIFT_MAX, ANGULAR_VELOCITY_ERROR_MAX, CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, LINEAR_MOMENTUM_DRIFT_MAX, APEX_HEIGHT_ERROR, CROSS_EVAL_DISAGREEMENT_MAX,
     CROSS_EVAL_SOLVE_RATE_MIN, ENERGY_DRIFT_MAX, ENERGY_GAIN_MAX, IMPACTS_MISSED, IMPACT_TIME_ERROR,
     ITERATIONS_MEDIAN, JACOBIAN_ERROR_MAX, LIMIT_VIOLATIONS, ORDER_ANGULAR_VELOCITY, ORDER_ORIENTATION,
     ORDER_POSITION, ORDER_VELOCITY, ORIENTATION_ERROR_MAX, ORIENTATION_RESIDUAL_MAX, PENETRATION_MAX,
@@ -75,6 +75,8 @@ JOINT_MOTION_COLUMNS = [
     (SEGMENT_REFERENCE_ERROR_MAX, "segment ends at dt/16 vs reference"),
     (ENERGY_DRIFT_MAX, "energy drift max (rel.)"),
     (POWER_BALANCE_RESIDUAL_MAX, "power balance residual max (rel.)"),
+    (LINEAR_MOMENTUM_DRIFT_MAX, "linear momentum drift max (rel.)"),
+    (CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, "angular momentum drift max (rel.)"),
     (SELF_PARTING_TIME, "parts from itself [s]"),
     (REFERENCE_PARTING_TIME, "parts from the reference [s]"),
     (TIME_PER_STEP, "time per step [s]"),

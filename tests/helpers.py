@@ -371,6 +371,21 @@ def _engine(base, model_class, engine_name):
 '''
 """Source for a planted plugin module: ``_engine(base, model_class, name)`` makes its engine classes."""
 
+PLANTED_MOTION_FACTORY = '''
+
+def _engine(base, motion_class, engine_name):
+    """An engine like ``base`` whose joint-motion simulations are ``motion_class`` (a planted copy)."""
+    class Planted(base):
+        name = engine_name
+
+        def build_joint_motion(self, scene, integrator, dt):
+            return motion_class(scene, integrator, dt)
+
+    Planted.__name__ = motion_class.__name__ + "Engine"
+    return Planted
+'''
+"""Source for a planted plugin module of joint-motion bugs: ``_engine(base, motion_class, name)``."""
+
 
 def run_planted(tmp_path, monkeypatch, capsys, module: str, source: str, scene: str, plugin: str,
                 engines: str = "core,mujoco,pybullet,pinocchio") -> tuple[int, list[str], str]:

@@ -25,8 +25,8 @@ from simparity.comparisons.execute.derivative_runner import with_derivative_sche
 from simparity.comparisons.execute.step_jacobian_runner import step_jacobian_values
 from simparity.comparisons.execute.timing import best_of
 from simparity.comparisons.measure.joint_motion_metrics import (
-    REFERENCE_ERRORS, Horizon, OwnReading, divergence, energy_metrics, joint_scales, motion_metrics, parting_times,
-    read_own, reach, reference_errors, reference_horizon,
+    REFERENCE_ERRORS, Horizon, OwnReading, divergence, energy_metrics, momentum_metrics, motion_metrics, parting_times,
+    reach, read_own, reference_errors, reference_horizon, state_scales,
 )
 from simparity.comparisons.measure.held_forcing import forcing_scheme
 from simparity.comparisons.measure.step_jacobian_metrics import STEP_JACOBIAN_METRICS
@@ -127,9 +127,12 @@ def sampling_problem(scene: JointMotionScene, traj: object, n: int, dt: float) -
     if not isinstance(traj, JointTrajectory):
         return (f"run() returned a value of type {type(traj).__name__} "
                 "(allowed: a simparity.core.trajectory.JointTrajectory)")
-    expected = (n + 1, scene.copies, scene.chain.n_joints)
+    expected = (n + 1, scene.copies, scene.chain.nq)
     if traj.q.shape != expected:
         return f"its joint values have shape {traj.q.shape} (expected {expected}: samples, copies, joints)"
+    if traj.qdot.shape != expected[:2] + (scene.chain.nv,):
+        return (f"its joint velocities have shape {traj.qdot.shape} (expected {expected[:2] + (scene.chain.nv,)}: "
+                "samples, copies, velocity components)")
     with np.errstate(all="ignore"):
         off = np.abs(np.asarray(traj.times) - np.arange(n + 1) * dt) / dt
     bad = np.flatnonzero(~(off <= 1e-3))
@@ -217,6 +220,8 @@ def _measured(scene: JointMotionScene, engine: Engine, sim: JointSimulation, cas
     if blown or own is None:
         return CaseOutcome(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values))
     values.update(energy_metrics(scene, traj, own))
+    if scene.chain.floating_base:
+        values.update(momentum_metrics(scene, sim, traj, own))
     detail = ("this is the reference; " if is_reference else "") + sim.detail
     if scene.segments and shared.starts is not None:
         errors = _consistency_errors(scene, engine, case, traj, own, shared.ends)
@@ -270,14 +275,14 @@ def _consistency_errors(scene: JointMotionScene, engine: Engine, case: Case, tra
         why = problem or "non-finite joint state"
         return {m: Measured(math.nan, "1", unmeasurable=f"its run at dt / {REFINEMENT} failed: {why}")
                 for m in REFERENCE_ERRORS + (SEGMENT_REFERENCE_ERROR_MAX,)}
-    scales = joint_scales(scene.chain, fine)
-    speed = max(float((np.abs(fine.qdot) / scales).max()), 1.0 / scene.duration)
+    scales, rate_scales = state_scales(scene.chain, fine)
+    speed = max(float((np.abs(fine.qdot) / rate_scales).max()), 1.0 / scene.duration)
     end_effector = np.asarray(fine_sim.end_effector_world(np.asarray(fine.q[-1])), dtype=float)
     note = (f"self-consistency: {scene.copies} segments of {scene.duration:.3g} s from the reference's motion, "
             f"each end against the same integrator at dt / {REFINEMENT}, the largest over segments")
     values = {
         JOINT_ANGLE_ERROR_MAX: float((np.abs(traj.q[-1] - fine.q[-1]) / scales).max()),
-        JOINT_VELOCITY_ERROR_MAX: float((np.abs(traj.qdot[-1] - fine.qdot[-1]) / scales).max()) / speed,
+        JOINT_VELOCITY_ERROR_MAX: float((np.abs(traj.qdot[-1] - fine.qdot[-1]) / rate_scales).max()) / speed,
         END_EFFECTOR_ERROR_MAX: float(np.linalg.norm(own.end_effector[-1] - end_effector, axis=-1).max())
                                 / reach(scene.chain),
     }

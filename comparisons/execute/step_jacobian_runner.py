@@ -63,6 +63,9 @@ def step_jacobian_values(sim: JointSimulation, scene: JointMotionScene, scheme: 
     the kind its Jacobian declares ("" when none)). ``scheme``: the case's declared scheme kind (its last part: a
     held load's prefix says how a timed torque meets the steps, which the Jacobian leaves out)."""
     kind = scheme.split("+")[-1]
+    if scene.chain.floating_base:
+        return _not_measured("the step's complex-step truth is carried on a fixed base only (a floating base's "
+                             "quaternion step is not differentiated yet)"), ""
     q, qdot, tau = jacobian_states(scene)
     try:
         from simparity.references.derivatives import complex_step, step_truth  # Pinocchio's parser: where a case runs

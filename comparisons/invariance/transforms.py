@@ -400,12 +400,12 @@ def _joint_motion_scene(scene: JointMotionScene, t: Transform) -> JointMotionSce
     the initial joint values, velocities and torques (the timed one's time too), the duration and the time steps in
     the new units."""
     chain = _timed_chain(scene.chain, t, scene.source)
-    variable = scene.chain.length_powers  # power of length: m or rad
+    variable = scene.chain.length_powers[scene.chain.base_dofs:]  # the joints' power of length: m or rad
     gravity, timed = scene.gravity_world, scene.timed_torque
     torque_scale = t.length_scale ** (2 - variable) * t.factor(mass=1, time=-2)
     return replace(scene, chain=chain, gravity_world=None if gravity is None else t.vector(gravity, length=1, time=-2),
-                   q0=t.length_scale ** variable * scene.q0,
-                   qdot0=t.length_scale ** variable / t.time_scale * scene.qdot0,
+                   q0=t.length_scale ** scene.chain.configuration_length_powers * scene.q0,
+                   qdot0=t.length_scale ** scene.chain.length_powers / t.time_scale * scene.qdot0,
                    torque=torque_scale * scene.torque,
                    timed_torque=None if timed is None else _time_function(timed, t, torque_scale, turned=False),
                    duration=t.time_scale * scene.duration, dts=tuple(t.time_scale * dt for dt in scene.dts))

@@ -27,7 +27,8 @@ from simparity.comparisons.measure.metrics import (
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointSimulation
 from simparity.core.model.metric_catalogue import (
-    END_EFFECTOR_ERROR_MAX, ENERGY_DRIFT_MAX, EVALUATIONS_PER_SECOND, JOINT_ANGLE_ERROR_MAX, JOINT_VELOCITY_ERROR_MAX,
+    CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, END_EFFECTOR_ERROR_MAX, ENERGY_DRIFT_MAX, EVALUATIONS_PER_SECOND,
+    LINEAR_MOMENTUM_DRIFT_MAX, JOINT_ANGLE_ERROR_MAX, JOINT_VELOCITY_ERROR_MAX,
     ORDER_JOINT_ANGLE, ORDER_JOINT_VELOCITY, POWER_BALANCE_RESIDUAL_MAX, REFERENCE_PARTING_TIME,
     SEGMENT_REFERENCE_ERROR_MAX, SELF_PARTING_TIME,
     TIME_PER_STEP, TIME_PER_STEP_BATCHED, order_source, units,
@@ -49,6 +50,8 @@ JOINT_MOTION_METRICS = units(
     EVALUATIONS_PER_SECOND,
 )
 """Every metric a joint-motion case may have; :func:`motion_metrics` those of one scene."""
+MOMENTUM_METRICS = units(LINEAR_MOMENTUM_DRIFT_MAX, CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX)
+"""Of a floating base: its momentum against the laws it obeys under joint forces alone (:func:`momentum_metrics`)."""
 PREDICTABILITY_METRICS = units(SELF_PARTING_TIME, REFERENCE_PARTING_TIME)
 """Of a scene with a perturbation: when each engine's two runs part, and when it parts from the reference."""
 JOINT_MOTION_ORDERS = units(ORDER_JOINT_ANGLE, ORDER_JOINT_VELOCITY)
@@ -86,9 +89,11 @@ def exchanges_energy(scene: JointMotionScene) -> bool:
 
 def motion_metrics(scene: JointMotionScene) -> dict[str, str]:
     """The metrics of a case of ``scene``: its energy balance as a drift where the chain is conservative, as the
-    power balance where it is damped or driven."""
+    power balance where it is damped or driven; a floating base's momentum (:func:`momentum_metrics`)."""
     left_out = ENERGY_DRIFT_MAX if exchanges_energy(scene) else POWER_BALANCE_RESIDUAL_MAX
     metrics = {m: u for m, u in JOINT_MOTION_METRICS.items() if m != left_out} | STEP_JACOBIAN_METRICS
+    if scene.chain.floating_base:
+        metrics |= MOMENTUM_METRICS
     if scene.segments:
         return metrics | units(SEGMENT_REFERENCE_ERROR_MAX)
     return metrics | (PREDICTABILITY_METRICS if scene.perturbation > 0 else {})
@@ -98,10 +103,24 @@ def joint_scales(chain: Chain, motion: JointTrajectory) -> np.ndarray:
     """(n,) what one unit of each joint's error is: 1 rad for a revolute joint; for a prismatic one the larger of the
     chain's reach and the joint's own range of motion in ``motion`` (the reference's), so that joint errors are
     unitless, invariant under a change of length unit, and never scaled by joint limits (which do not act)."""
-    travel = np.ptp(np.asarray(motion.q), axis=0).max(axis=0)  # (n,) over samples and copies
+    travel = np.ptp(np.asarray(motion.q)[..., -chain.n_joints:], axis=0).max(axis=0)  # (n,) over samples and copies
     length = reach(chain)
     return np.array([1.0 if j.type == "revolute" else max(length, float(travel[k]), np.finfo(float).tiny)
                      for k, j in enumerate(chain.joints)])
+
+
+def state_scales(chain: Chain, motion: JointTrajectory) -> tuple[np.ndarray, np.ndarray]:
+    """((nq,), (nv,)) what one unit of each configuration and velocity component's error is: the joints'
+    (:func:`joint_scales`), after a floating base's: its position and linear velocity the larger of the chain's reach
+    and the base's travel in ``motion`` (as a prismatic joint's), its quaternion's components and angular velocity 1
+    (a quaternion's component error is half the angle it turns by, in radians: unitless as a revolute joint's)."""
+    joints = joint_scales(chain, motion)
+    if not chain.floating_base:
+        return joints, joints
+    travel = float(np.ptp(np.asarray(motion.q)[..., :3], axis=0).max())
+    length = max(reach(chain), travel, np.finfo(float).tiny)
+    return (np.concatenate([np.full(3, length), np.ones(4), joints]),
+            np.concatenate([np.full(3, length), np.ones(3), joints]))
 
 
 def reach(chain: Chain) -> float:
@@ -167,9 +186,9 @@ def sample_index(count: int) -> np.ndarray:
 def read_own(sim: JointSimulation, traj: JointTrajectory) -> OwnReading:
     """The engine's own energies and end effector along ``traj`` (:class:`OwnReading`)."""
     index = sample_index(len(traj.times))
-    samples, copies, n = len(index), traj.q.shape[1], traj.q.shape[2]
-    q = np.ascontiguousarray(traj.q[index]).reshape(-1, n)
-    qdot = np.ascontiguousarray(traj.qdot[index]).reshape(-1, n)
+    samples, copies = len(index), traj.q.shape[1]
+    q = np.ascontiguousarray(traj.q[index]).reshape(-1, traj.q.shape[2])
+    qdot = np.ascontiguousarray(traj.qdot[index]).reshape(-1, traj.qdot.shape[2])
     kinetic, potential = sim.energy(q, qdot)
     end_effector = np.asarray(sim.end_effector_world(q), dtype=float)
     return OwnReading(index, np.asarray(kinetic, dtype=float).reshape(samples, copies),
@@ -188,8 +207,9 @@ def _work(scene: JointMotionScene, traj: JointTrajectory) -> tuple[np.ndarray, n
     torque = np.broadcast_to(np.asarray(scene.torque, dtype=float), (len(traj.times), scene.chain.n_joints))
     if scene.timed_torque is not None:  # the references' evaluation at each sample's time (none of core's code)
         torque = torque + np.array([time_loads.at(scene.timed_torque, t) for t in traj.times])
-    drive = np.einsum("tbi,ti->tb", traj.qdot, torque)
-    power = drive - np.einsum("tbi,i,tbi->tb", traj.qdot, damping, traj.qdot)
+    rates = traj.qdot[..., scene.chain.base_dofs:]  # the joints' (a floating base takes no applied force)
+    drive = np.einsum("tbi,ti->tb", rates, torque)
+    power = drive - np.einsum("tbi,i,tbi->tb", rates, damping, rates)
     zero = np.zeros_like(power)
     if len(traj.times) < 3:
         return zero, zero, zero
@@ -307,6 +327,62 @@ def energy_metrics(scene: JointMotionScene, traj: JointTrajectory, own: OwnReadi
     return {ENERGY_DRIFT_MAX: _relative(float(np.abs(energy - energy[0]).max()), scale, "energy drift", floored)}
 
 
+def momentum_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory,
+                     own: OwnReading) -> dict[str, Measured]:
+    """A floating base's momentum from the engine's own model (:meth:`JointSimulation.momentum`) at the samples
+    :func:`read_own` read, against the laws of a robot under joint forces alone (internal: they cancel in its
+    momentum): ``linear_momentum_drift_max`` max_t |P(t) - P(0) - m g t| (the centre of mass falls as a particle, or
+    moves in a straight line without gravity); without gravity ``chain_angular_momentum_drift_max`` max_t |L(t) -
+    L(0)| about the base's initial position (a fixed point: with P conserved, the same as the angular momentum about
+    the centre of mass conserved and the centre of mass moving straight; under gravity it changes, n/a). Relative to
+    the momentum the motion can carry: sqrt(2 m T) (|P| <= sqrt(2 m T) for any motion of kinetic energy T; T the
+    largest over the run and copies) and that times a length, the chain's reach plus the base's travel. At most
+    :data:`ROUNDING_FLOOR_FACTOR` eps x steps: flagged at the rounding floor. Reference-free."""
+    try:
+        momentum = np.asarray(sim.momentum(np.ascontiguousarray(traj.q[own.index]).reshape(-1, traj.q.shape[2]),
+                                           np.ascontiguousarray(traj.qdot[own.index]).reshape(-1, traj.qdot.shape[2])),
+                              dtype=float).reshape(len(own.index), traj.q.shape[1], 6)
+    except NotImplementedError as err:
+        return {m: Measured(math.nan, "1", unmeasurable=str(err)) for m in MOMENTUM_METRICS}
+    chain = scene.chain
+    assert chain.base_inertia is not None  # a floating chain's dynamics_problem() says so
+    mass = chain.base_inertia.mass + sum(j.link.mass for j in chain.joints if j.link is not None)
+    gravity = np.zeros(3) if scene.gravity_world is None else np.asarray(scene.gravity_world, dtype=float)
+    linear = momentum[..., :3]
+    expected = linear[0] + mass * gravity * (traj.times[own.index] - traj.times[0])[:, None, None]
+    point = np.asarray(traj.q[0, :, :3])  # (B, 3): the base's initial position, a fixed point
+    angular = momentum[..., 3:] - np.cross(point, linear)
+    scale = math.sqrt(2.0 * mass * max(float(own.kinetic.max()), 0.0))
+    travel = float(np.linalg.norm(traj.q[own.index, :, :3] - point, axis=-1).max())
+    steps = max(len(traj.times) - 1, 1)
+    floor = ROUNDING_FLOOR_FACTOR * float(np.finfo(float).eps) * steps
+
+    def relative(drift: float, size: float, what: str) -> Measured:
+        if not size > 0:
+            return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=(
+                f"the robot has no kinetic energy: its {what} has no scale"))
+        ratio = drift / size
+        if ratio > SATURATED_DRIFT:
+            return Measured(ratio, "1", flag=SATURATED, unmeasurable=(
+                f"saturated: the {what} drifts {ratio:.3g} x the momentum the motion can carry "
+                f"(> {SATURATED_DRIFT:g})"))
+        if ratio <= floor:
+            return Measured(ratio, "1", flag=ROUNDING_FLOOR, note=(
+                f"at the rounding floor ({floor:.2g}: {ROUNDING_FLOOR_FACTOR:g} eps x {steps} steps): exact up to it"))
+        return Measured(ratio, "1")
+    out = {LINEAR_MOMENTUM_DRIFT_MAX: relative(float(np.linalg.norm(linear - expected, axis=-1).max()), scale,
+                                               "linear momentum")}
+    if np.any(gravity):
+        out[CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX] = Measured(math.nan, "1", unmeasurable=(
+            "under gravity the angular momentum about a fixed point changes (gravity's moment about it); about the "
+            "centre of mass it is conserved, which the engines do not report"))
+    else:
+        out[CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX] = relative(
+            float(np.linalg.norm(angular - angular[0], axis=-1).max()), scale * (reach(chain) + travel),
+            "angular momentum")
+    return out
+
+
 @dataclass(frozen=True)
 class Horizon:
     """Where the reference can be trusted: its samples [0, ``end``) (``end`` = all of them without a chaotic
@@ -323,10 +399,10 @@ def reference_horizon(scene: JointMotionScene, ref: JointTrajectory, coarse: Joi
     values), and the differences over them as the floor of each error."""
     if coarse is None:
         return Horizon(len(ref.times), {})
-    scales = joint_scales(scene.chain, ref)
+    scales, rate_scales = state_scales(scene.chain, ref)
     angle = (np.abs(ref.q - coarse.q) / scales).max(axis=(1, 2))
-    speed = _speed_scale(ref, scales)
-    velocity = (np.abs(ref.qdot - coarse.qdot) / scales).max(axis=(1, 2)) / speed
+    speed = _speed_scale(ref, rate_scales)
+    velocity = (np.abs(ref.qdot - coarse.qdot) / rate_scales).max(axis=(1, 2)) / speed
     beyond = np.flatnonzero(~(angle <= HORIZON_FLOOR))
     end = int(beyond[0]) if beyond.size else len(ref.times)
     floors = {JOINT_ANGLE_ERROR_MAX: float(angle[:end].max(initial=0.0)),
@@ -360,14 +436,14 @@ def reference_errors(scene: JointMotionScene, traj: JointTrajectory, own: OwnRea
                f"than {HORIZON_FLOOR:g} rad at once)")
         return ({m: Measured(math.nan, "1", flag=SATURATED, unmeasurable=why) for m in REFERENCE_ERRORS},
                 {m: math.inf for m in REFERENCE_ERRORS}, {})
-    scales, end = joint_scales(scene.chain, ref), horizon.end
-    speed = _speed_scale(ref, scales)
+    (scales, rate_scales), end = state_scales(scene.chain, ref), horizon.end
+    speed = _speed_scale(ref, rate_scales)
     travel = np.linalg.norm(ref_end_effector - ref_end_effector[:1], axis=-1).max()
     length = max(reach(scene.chain), float(travel))  # a slider's tip may travel farther than the chain is long
     within = own.index < end
     values = {
         JOINT_ANGLE_ERROR_MAX: float((np.abs(traj.q[:end] - ref.q[:end]) / scales).max()),
-        JOINT_VELOCITY_ERROR_MAX: float((np.abs(traj.qdot[:end] - ref.qdot[:end]) / scales).max()) / speed,
+        JOINT_VELOCITY_ERROR_MAX: float((np.abs(traj.qdot[:end] - ref.qdot[:end]) / rate_scales).max()) / speed,
         END_EFFECTOR_ERROR_MAX: float(np.linalg.norm(own.end_effector[within] - ref_end_effector[within],
                                                      axis=-1).max()) / length,
     }
@@ -409,7 +485,7 @@ def parting_times(scene: JointMotionScene, traj: JointTrajectory, perturbed: Joi
     """When ``traj`` parts (a joint more than :data:`PARTING` off, unitless) from the engine's own run from the
     perturbed start, and from the reference's; n/a with the reason where they never part within the run or there is
     nothing to part from."""
-    scales = joint_scales(scene.chain, traj if ref is None else ref)
+    scales = state_scales(scene.chain, traj if ref is None else ref)[0]
 
     def parting(other: JointTrajectory | None, what: str) -> Measured:
         if other is None:

@@ -7,6 +7,7 @@ import numpy as np
 
 from simparity.core.articulated import stepping
 from simparity.core.articulated.chain_arrays import chain_arrays
+from simparity.core.articulated.floating import FloatingRecursiveDynamics
 from simparity.core.articulated.model import RecursiveDynamics
 from simparity.core.articulated.recursive import Recursive
 from simparity.core.articulated.step_jacobian import step_jacobian
@@ -15,6 +16,7 @@ from simparity.core.model.derivatives import StepJacobian
 from simparity.core.model.engine import BatchedRun, JointSimulation
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
+from simparity.core.rotations import quat_wxyz_to_matrix
 
 
 class CoreJointMotion(JointSimulation):
@@ -25,11 +27,15 @@ class CoreJointMotion(JointSimulation):
         self._step = stepping.stepper(scene, scheme, dt)
         gravity = np.zeros(3) if scene.gravity_world is None else scene.gravity_world
         self._gravity = np.asarray(gravity, dtype=float)
-        self._dynamics = Recursive(chain_arrays(scene.chain), self._gravity)
-        self._masses = np.array([j.link.mass if j.link is not None else 0.0 for j in scene.chain.joints])
-        self._coms = np.array([j.link.com_xyz if j.link is not None else np.zeros(3) for j in scene.chain.joints])
+        chain = scene.chain
+        self._floating = FloatingRecursiveDynamics(chain, self._gravity) if chain.floating_base else None
+        self._dynamics = Recursive(chain_arrays(chain), self._gravity)
+        self._masses = np.array([j.link.mass if j.link is not None else 0.0 for j in chain.joints])
+        self._coms = np.array([j.link.com_xyz if j.link is not None else np.zeros(3) for j in chain.joints])
         self.detail = (f"in-house {scheme} on (q, qdot), qddot by ABA (Featherstone), batched over copies"
-                       + ("; damping by ABA with armature + dt D" if scheme == stepping.IMPLICIT_DAMPING else ""))
+                       + ("; damping by ABA with armature + dt D" if scheme == stepping.IMPLICIT_DAMPING else "")
+                       + ("; the floating base's quaternion stepped in R^4 by dq/dt = 1/2 (0, omega) q and "
+                          "normalised after each step" if chain.floating_base else ""))
 
     def run(self, n_steps: int) -> JointTrajectory:
         q, qdot = stepping.run(self._step, np.asarray(self._scene.q0), np.asarray(self._scene.qdot0), n_steps,
@@ -38,8 +44,11 @@ class CoreJointMotion(JointSimulation):
 
     def step_jacobian(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> StepJacobian:
         """Carried analytically through the scheme with core's derivatives (:mod:`core.articulated.step_jacobian`;
-        implicit damping on the chain with armature + dt D, as it steps)."""
+        implicit damping on the chain with armature + dt D, as it steps); not for a floating base yet."""
         chain = self._scene.chain
+        if chain.floating_base:
+            raise NotImplementedError("core's step Jacobian is carried on a fixed base only (a floating base's "
+                                      "quaternion step is not differentiated yet)")
         if self._scheme == stepping.IMPLICIT_DAMPING:
             chain = stepping.damped_armature(chain, self._dt)
         model = RecursiveDynamics(chain, self._gravity)
@@ -52,14 +61,39 @@ class CoreJointMotion(JointSimulation):
         return lambda n_steps: stepping.run(self._step, q0, qdot0, n_steps, self._dt)
 
     def energy(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Kinetic 1/2 qdot^T M qdot (CRBA, armature included); potential -sum m g.c from core's FK."""
-        mass_matrix = self._dynamics.mass_matrix(np.ascontiguousarray(q.T))  # (n, n, B)
-        kinetic = 0.5 * np.einsum("bi,ijb,bj->b", qdot, mass_matrix, qdot)
-        poses = forward_kinematics(self._scene.chain, q)
+        """Kinetic 1/2 qdot^T M qdot (CRBA, armature included; a floating base's with its 6-DOF root); potential
+        -sum m g.c from core's FK (a floating base's own mass included, every frame placed by the base's pose)."""
+        if self._floating is not None:
+            kinetic = 0.5 * np.einsum("bi,bij,bj->b", qdot, self._floating.mass_matrix(q), qdot)
+        else:
+            mass_matrix = self._dynamics.mass_matrix(np.ascontiguousarray(q.T))  # (n, n, B)
+            kinetic = 0.5 * np.einsum("bi,ijb,bj->b", qdot, mass_matrix, qdot)
         n = self._scene.chain.n_joints
+        poses = forward_kinematics(self._scene.chain, q[:, q.shape[1] - n:])
         coms = poses.position_world[:, :n] + np.einsum("bfij,fj->bfi", poses.rotation_world[:, :n], self._coms)
-        potential = -np.einsum("f,bfi,i->b", self._masses, coms, self._gravity)
+        masses = self._masses
+        if self._floating is not None:
+            base = self._scene.chain.base_inertia
+            assert base is not None  # a floating chain's dynamics_problem() says so
+            coms = np.concatenate([np.broadcast_to(base.com_xyz, (len(q), 1, 3)), coms], axis=1)
+            coms = _placed(q, coms)
+            masses = np.concatenate([[base.mass], masses])
+        potential = -np.einsum("f,bfi,i->b", masses, coms, self._gravity)
         return kinetic, potential
 
     def end_effector_world(self, q: np.ndarray) -> np.ndarray:
-        return np.asarray(forward_kinematics(self._scene.chain, q).position_world[:, -1])
+        n = self._scene.chain.n_joints
+        tip = np.asarray(forward_kinematics(self._scene.chain, q[:, q.shape[1] - n:]).position_world[:, -1])
+        return _placed(q, tip[:, None])[:, 0] if self._floating is not None else tip
+
+    def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """Core's floating-base momentum (:meth:`FloatingRecursiveDynamics.momentum`): each body's I v summed."""
+        if self._floating is None:
+            raise NotImplementedError("a fixed base's momentum is not conserved: it is not reported")
+        return self._floating.momentum(q, qdot)
+
+
+def _placed(q: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(B, F, 3) points given in the floating base's frame, placed in the world by the base's pose in q (B, 7 + n)."""
+    rotation = quat_wxyz_to_matrix(q[:, 3:7])
+    return q[:, None, :3] + np.einsum("bij,bfj->bfi", rotation, points)

@@ -14,6 +14,14 @@ free-body family's, on the joints:
   derivatives). ABA solves it: dt D is an armature, so the articulated-body solve of a chain whose armature
   is increased by dt D gives (M + dt D)^-1 (tau - h - D qdot) in O(n).
 
+A floating base (``chain.floating_base``) is stepped in the project's convention: q = (position, quat_wxyz, joints)
+(nq = 7 + n), qdot = (the base origin's velocity and the base's angular velocity in world axes, joint rates)
+(nv = 6 + n), qddot by the floating-base ABA (:mod:`core.articulated.floating`). The schemes above step q by its
+rate dq/dt = (v, 1/2 (0, omega) x quat, joint rates) (:func:`configuration_rate`: the quaternion in R^4, its
+kinematic equation for an angular velocity in world axes) in place of qdot, and normalise the quaternion after each
+step (:func:`normalised`); stages evaluate the dynamics at the stage quaternion normalised. A Runge-Kutta scheme keeps
+its order (the equation is smooth in R^4 and normalising changes a step by the step's own error).
+
 Applied joint forces are the scene's constant ones plus its timed torque (a function of time,
 :mod:`core.model.scenes.time_functions`) evaluated at each stage's own time t + c_i dt, a held one as seen from inside
 the step (:mod:`core.dynamics.time_loads`); the Euler steps take it at the step's start.
@@ -27,6 +35,7 @@ from typing import Callable
 import numpy as np
 
 from simparity.core.articulated.chain_arrays import chain_arrays
+from simparity.core.articulated.floating import FloatingRecursiveDynamics
 from simparity.core.articulated.recursive import Recursive
 from simparity.core.dynamics.time_loads import value_in_step
 from simparity.core.dynamics.tableau import TABLEAUX, Tableau
@@ -46,6 +55,10 @@ ORDER = {scheme: TABLEAUX[scheme].order for scheme in RUNGE_KUTTA} | {scheme: 1 
 STAGES = {scheme: TABLEAUX[scheme].stages for scheme in RUNGE_KUTTA} | {scheme: 1 for scheme in EULER_STEPS}
 """Evaluations of the forward dynamics (ABA) per step: a tableau's stages, one for the Euler steps."""
 
+Rate = Callable[[np.ndarray, np.ndarray], np.ndarray]
+"""dq/dt (nq, B) of (q (nq, B), qdot (nv, B)): qdot itself for a fixed base (:func:`configuration_rate`)."""
+Project = Callable[[np.ndarray], np.ndarray]
+"""q (nq, B) after a step -> the configuration stepped on (its quaternion normalised; q itself for a fixed base)."""
 Acceleration = Callable[[np.ndarray, np.ndarray, float, float], np.ndarray]
 """qddot(q, qdot, t, step_start): the accelerations (n, B) at stage time t [s] of the step starting at step_start."""
 Step = Callable[[float, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
@@ -78,10 +91,39 @@ def _weighted(tableau: Tableau, ks: list[np.ndarray]) -> np.ndarray:
     return total
 
 
-def runge_kutta(tableau: Tableau, qddot: Acceleration, dt: float) -> Step:
-    """One step of the explicit Runge-Kutta scheme ``tableau`` on y = (q, qdot), dy/dt = (qdot, qddot(q, qdot, t)):
-    stage i at (q_i, qdot_i) = y + dt sum_j a_ij k_j with k_j = (qdot_j, qddot(q_j, qdot_j, t + c_j dt)), then
-    y' = y + dt / d sum_i n_i k_i (the weights over their common denominator d, summed by :func:`_weighted`)."""
+def _fixed_rate(q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+    """A fixed base's dq/dt: qdot itself."""
+    return qdot
+
+
+def _unchanged(q: np.ndarray) -> np.ndarray:
+    """A fixed base's configuration after a step: q itself."""
+    return q
+
+
+def configuration_rate(q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+    """A floating base's dq/dt (7 + n, B) of q (7 + n, B) and qdot (6 + n, B): the base origin's velocity, the
+    quaternion's rate 1/2 (0, omega) x quat (omega in world axes: the product on the left), the joint rates."""
+    w, x, y, z = q[3:7]
+    ox, oy, oz = qdot[3:6]
+    quat_rate = 0.5 * np.stack([-ox * x - oy * y - oz * z, ox * w + oy * z - oz * y, oy * w + oz * x - ox * z,
+                                oz * w + ox * y - oy * x])
+    return np.concatenate([qdot[:3], quat_rate, qdot[6:]])
+
+
+def normalised(q: np.ndarray) -> np.ndarray:
+    """q (7 + n, B) with its quaternion rows scaled to unit length."""
+    out = q.copy()
+    out[3:7] /= np.sqrt(np.einsum("ib,ib->b", q[3:7], q[3:7]))
+    return out
+
+
+def runge_kutta(tableau: Tableau, qddot: Acceleration, dt: float, rate: Rate = _fixed_rate,
+                project: Project = _unchanged) -> Step:
+    """One step of the explicit Runge-Kutta scheme ``tableau`` on y = (q, qdot), dy/dt = (rate(q, qdot),
+    qddot(q, qdot, t)): stage i at (q_i, qdot_i) = y + dt sum_j a_ij k_j with k_j = (rate(q_j, qdot_j), qddot(q_j,
+    qdot_j, t + c_j dt)), then y' = y + dt / d sum_i n_i k_i (the weights over their common denominator d, summed by
+    :func:`_weighted`), its q projected (a floating base's quaternion normalised)."""
     scale = dt / tableau.weight_denominator
 
     def step(t: float, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -89,9 +131,9 @@ def runge_kutta(tableau: Tableau, qddot: Acceleration, dt: float) -> Step:
         accelerations: list[np.ndarray] = []
         for row, c in zip(tableau.a, tableau.c):
             q_i, qdot_i = _stage(q, row, velocities, dt), _stage(qdot, row, accelerations, dt)
-            velocities.append(qdot_i)
+            velocities.append(rate(q_i, qdot_i))
             accelerations.append(qddot(q_i, qdot_i, t + c * dt, t))
-        return q + scale * _weighted(tableau, velocities), qdot + scale * _weighted(tableau, accelerations)
+        return project(q + scale * _weighted(tableau, velocities)), qdot + scale * _weighted(tableau, accelerations)
     return step
 
 
@@ -99,41 +141,56 @@ def stepper(scene: JointMotionScene, scheme: str, dt: float) -> Step:
     """One step (q, qdot) -> (q', qdot') of ``scheme`` at ``dt`` [s] for the scene's chain, gravity and torques;
     q and qdot (n, B)."""
     gravity = np.zeros(3) if scene.gravity_world is None else scene.gravity_world
-    dynamics = Recursive(chain_arrays(scene.chain), gravity)
+    floating = scene.chain.floating_base
+    rate, project = (configuration_rate, normalised) if floating else (_fixed_rate, _unchanged)
+    dynamics = _forward_dynamics(scene.chain, gravity)
     constant, timed = scene.torque[:, None], scene.timed_torque
 
-    def torque(q: np.ndarray, t: float, step_start: float) -> np.ndarray:
-        """The joints' applied forces (n, B) at stage time t."""
-        if timed is None:
-            return np.broadcast_to(constant, q.shape)
-        return np.broadcast_to(constant + value_in_step(timed, t, step_start)[:, None], q.shape)
+    def torque(qdot: np.ndarray, t: float, step_start: float) -> np.ndarray:
+        """The applied forces (nv, B) at stage time t: the joints', none on a floating base."""
+        joints = constant if timed is None else constant + value_in_step(timed, t, step_start)[:, None]
+        if floating:
+            joints = np.concatenate([np.zeros((6, 1)), joints])
+        return np.broadcast_to(joints, qdot.shape)
 
     def qddot(q: np.ndarray, qdot: np.ndarray, t: float, step_start: float) -> np.ndarray:
-        return dynamics.forward_dynamics(q, qdot, torque(q, t, step_start))
+        return dynamics(q, qdot, torque(qdot, t, step_start))
 
     if scheme in RUNGE_KUTTA:
-        return runge_kutta(TABLEAUX[scheme], qddot, dt)
+        return runge_kutta(TABLEAUX[scheme], qddot, dt, rate, project)
     if scheme == SEMI_IMPLICIT_EULER:
         def semi_implicit(t: float, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             qdot = qdot + dt * qddot(q, qdot, t, t)
-            return q + dt * qdot, qdot
+            return project(q + dt * rate(q, qdot)), qdot
         return semi_implicit
     if scheme == IMPLICIT_DAMPING:
-        implicit = Recursive(chain_arrays(damped_armature(scene.chain, dt)), gravity)
+        implicit = _forward_dynamics(damped_armature(scene.chain, dt), gravity)
 
         def implicit_damping(t: float, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            qdot = qdot + dt * implicit.forward_dynamics(q, qdot, torque(q, t, t))
-            return q + dt * qdot, qdot
+            qdot = qdot + dt * implicit(q, qdot, torque(qdot, t, t))
+            return project(q + dt * rate(q, qdot)), qdot
         return implicit_damping
     raise ValueError(f"unknown joint-motion integrator {scheme!r} (allowed: {', '.join(SCHEMES)})")
 
 
+def _forward_dynamics(chain: Chain, gravity: np.ndarray) -> Callable[[np.ndarray, np.ndarray, np.ndarray],
+                                                                       np.ndarray]:
+    """qddot (nv, B) of (q (nq, B), qdot (nv, B), tau (nv, B)): ABA, with a floating root where the chain has one
+    (the stage's quaternion normalised)."""
+    if not chain.floating_base:
+        return Recursive(chain_arrays(chain), gravity).forward_dynamics
+    floating = FloatingRecursiveDynamics(chain, gravity)
+
+    def forward(q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        return floating.forward_dynamics(normalised(q).T, qdot.T, tau.T).T
+    return forward
+
+
 def run(step: Step, q0: np.ndarray, qdot0: np.ndarray, n_steps: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
-    """(q, qdot), each (n_steps + 1, B, n), of ``n_steps`` steps of ``dt`` [s] from (q0, qdot0), each (B, n) at
-    t = 0; step k starts at (k - 1) dt."""
-    batch, n = q0.shape
-    q_out = np.empty((n_steps + 1, batch, n))
-    qdot_out = np.empty((n_steps + 1, batch, n))
+    """(q, qdot), (n_steps + 1, B, nq) and (n_steps + 1, B, nv), of ``n_steps`` steps of ``dt`` [s] from (q0, qdot0),
+    (B, nq) and (B, nv) at t = 0; step k starts at (k - 1) dt."""
+    q_out = np.empty((n_steps + 1,) + q0.shape)
+    qdot_out = np.empty((n_steps + 1,) + qdot0.shape)
     q, qdot = np.ascontiguousarray(q0.T), np.ascontiguousarray(qdot0.T)
     q_out[0], qdot_out[0] = q0, qdot0
     for k in range(1, n_steps + 1):

@@ -201,19 +201,25 @@ class JointSimulation(abc.ABC):
 
     @abc.abstractmethod
     def energy(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(kinetic, potential), each (B,) [J], at states q, qdot ((B, n) each), from the engine's own model:
+        """(kinetic, potential), each (B,) [J], at states q, qdot ((B, nq), (B, nv)), from the engine's own model:
         kinetic 1/2 qdot^T M qdot (armature included), potential -sum_i m_i g . c_i(q) (c_i the centre of mass
         of link i in the base frame, 0 without gravity). Not timed."""
 
     @abc.abstractmethod
     def end_effector_world(self, q: np.ndarray) -> np.ndarray:
-        """(B, 3) [m]: the chain's end-effector origin in the base frame at q ((B, n)), by the engine's own
-        forward kinematics. Not timed."""
+        """(B, 3) [m]: the chain's end-effector origin in the base frame (a floating base's: in the world) at q
+        ((B, nq)), by the engine's own forward kinematics. Not timed."""
 
     def batched(self, copies: int) -> BatchedRun:
         """``run(n_steps)`` stepping ``copies`` copies of the scene's first initial state together (as
         :meth:`Simulation.batched`); raises :class:`NotBatchedError` with the reason when the engine cannot."""
         raise NotBatchedError("the engine's joint simulation declares no batched stepping (JointSimulation.batched)")
+
+    def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """(B, 6): a floating-base chain's linear momentum [kg m/s] and its angular momentum about the world's origin
+        [kg m^2/s], both in world axes, at states q (B, 7 + n) and qdot (B, 6 + n), from the engine's own model. Not
+        timed. Optional: the momentum metrics are n/a where an engine does not say."""
+        raise NotImplementedError(f"{type(self).__name__} does not report a floating base's momentum (momentum)")
 
     def step_jacobian(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> StepJacobian:
         """The Jacobian of one step of this simulation's scheme and time step at B states q, qdot ((B, n) each) under

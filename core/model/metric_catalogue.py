@@ -143,6 +143,8 @@ POWER_BALANCE_RESIDUAL_MAX = "power_balance_residual_max"
 ORDER_JOINT_ANGLE = "order_joint_angle"
 ORDER_JOINT_VELOCITY = "order_joint_velocity"
 SEGMENT_REFERENCE_ERROR_MAX = "segment_reference_error_max"
+LINEAR_MOMENTUM_DRIFT_MAX = "linear_momentum_drift_max"
+CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX = "chain_angular_momentum_drift_max"
 SELF_PARTING_TIME = "self_parting_time"
 REFERENCE_PARTING_TIME = "reference_parting_time"
 # Contact: events against the exact bounce sequence, slide and rest.
@@ -278,6 +280,12 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(ORDER_JOINT_VELOCITY, DIMENSIONLESS, ORDER, theory="the scheme's order", source=JOINT_VELOCITY_ERROR_MAX),
     Metric(SEGMENT_REFERENCE_ERROR_MAX, DIMENSIONLESS, ERROR, scale="joint_angle",
            theory="the model against the reference's: the scheme's error at dt / 16 and nothing else"),
+    Metric(LINEAR_MOMENTUM_DRIFT_MAX, DIMENSIONLESS, DRIFT, scale="momentum",
+           theory="a floating base under joint forces only: the robot's momentum P(t) = P(0) + m g t (the centre of "
+                  "mass falls as a particle): 0 up to the scheme's error"),
+    Metric(CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, DIMENSIONLESS, DRIFT, scale="momentum",
+           theory="a floating base under joint forces only, without gravity: the robot's angular momentum about a "
+                  "fixed point conserved: 0 up to the scheme's error"),
     Metric(SELF_PARTING_TIME, "s", PREDICTABILITY,
            theory="when the engine's runs from two starts a perturbation apart part: the chain's own horizon"),
     Metric(REFERENCE_PARTING_TIME, "s", PREDICTABILITY, theory="not before the self-parting time, for a sound engine"),

@@ -98,10 +98,12 @@ class JointTrajectory:
     ----------
     times : (T,) ndarray
         [s], starting at 0.
-    q : (T, B, n) ndarray
-        Joint values [rad or m].
-    qdot : (T, B, n) ndarray
-        Joint velocities [rad/s or m/s].
+    q : (T, B, nq) ndarray
+        Joint values [rad or m] (nq = n); a floating-base chain's configuration (nq = 7 + n: base position [m], base
+        orientation quat_wxyz, joint values; :class:`core.model.scenes.chain.Chain`).
+    qdot : (T, B, nv) ndarray
+        Joint velocities [rad/s or m/s] (nv = n); a floating base's velocity first (nv = 6 + n: base origin linear
+        velocity and base angular velocity in world axes).
     """
 
     times: np.ndarray
@@ -115,8 +117,10 @@ class JointTrajectory:
             if value.ndim != 3 or value.shape[0] != n:
                 raise ValueError(f"JointTrajectory.{name} has shape {value.shape}, expected ({n}, B, n)")
             object.__setattr__(self, name, readonly(value))
-        if self.q.shape != self.qdot.shape:
-            raise ValueError(f"JointTrajectory.qdot has shape {self.qdot.shape}, q has {self.q.shape}")
+        if self.q.shape[:2] != self.qdot.shape[:2] or self.q.shape[2] not in (self.qdot.shape[2],
+                                                                            self.qdot.shape[2] + 1):
+            raise ValueError(f"JointTrajectory.qdot has shape {self.qdot.shape}, q has {self.q.shape} (expected the "
+                             "same samples and copies, and nq = nv, or nq = nv + 1 for a floating base)")
         object.__setattr__(self, "times", readonly(np.asarray(self.times, dtype=float)))
 
     def is_finite(self) -> bool:

@@ -234,6 +234,9 @@ def constant_force_motion(q0: np.ndarray, qdot0: np.ndarray, joint: OneJoint,
 def supports(scene: JointMotionScene) -> Support:
     """Whether the scene has a closed form here (the reason names what does not fit)."""
     chain = scene.chain
+    if chain.floating_base:
+        return Support.no("no closed form for a floating base's motion here: its momentum laws are checked on every "
+                          "engine's own run (linear_momentum_drift_max, chain_angular_momentum_drift_max)")
     if chain.n_joints != 1:
         return Support.no(f"no closed form: the chain has {chain.n_joints} joints (the closed-form joint motion is "
                           "for one joint: a physical pendulum, or a joint under constant forces)")

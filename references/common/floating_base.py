@@ -108,3 +108,20 @@ def project_partials(rotation: np.ndarray, qdot: np.ndarray, qddot: np.ndarray, 
         coupling[:, :3, :3] = -back @ _skew_rows(omega)
         coupling[:, :3, 3:6] = back @ _skew_rows(v)
     return dq, transposed @ (by_v @ turn + mass @ coupling)
+
+
+def configuration_rate(q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+    """dq/dt (B, 7 + n) of project states q (B, 7 + n), qdot (B, 6 + n): the base origin's velocity, the quaternion's
+    rate 1/2 (0, omega) q (omega in world axes, so its product on the left), the joint rates."""
+    w, x, y, z = np.moveaxis(np.asarray(q, dtype=float)[:, 3:7], -1, 0)
+    ox, oy, oz = np.moveaxis(np.asarray(qdot, dtype=float)[:, 3:6], -1, 0)
+    rate = 0.5 * np.stack([-ox * x - oy * y - oz * z, ox * w + oy * z - oz * y, oy * w + oz * x - ox * z,
+                           oz * w + ox * y - oy * x], axis=-1)
+    return np.concatenate([qdot[:, :3], rate, qdot[:, BASE_V:]], axis=1)
+
+
+def unit_quaternions(q: np.ndarray) -> np.ndarray:
+    """Project configurations (B, 7 + n) with their quaternions scaled to unit length."""
+    out = np.array(q, dtype=float)
+    out[:, 3:7] /= np.linalg.norm(out[:, 3:7], axis=1, keepdims=True)
+    return out

@@ -29,6 +29,11 @@ What MuJoCo is given (each pinned by ``tests/references/mujoco/test_joint_motion
   spring energies: there are none). Every body belongs to a chain link or is welded to the base, massless.
 - End effector: MuJoCo's forward kinematics (``mj_kinematics``), the origin ``xpos`` of the body named after the
   chain's end effector (kept as a body: ``fusestatic`` off). The base link is MuJoCo's world frame.
+- A floating base: the builder's free joint on the root body (:mod:`references.mujoco.floating`); its qpos is the
+  project's (position, quat_wxyz), its qvel (v in world axes, R^T omega in the body frame): the angular part is turned
+  in and out (:mod:`references.common.floating_base`). MuJoCo integrates the free joint's quaternion by its own
+  exponential map in the body frame; momentum from ``mj_subtreeVel`` (:class:`MujocoFloatingDynamics`). No step
+  Jacobian yet.
 """
 
 from __future__ import annotations
@@ -44,6 +49,8 @@ from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common.conventions import fmt
 from simparity.references.common import time_loads
+from simparity.references.common.floating_base import base_rotations, turned_base
+from simparity.references.mujoco.floating import MujocoFloatingDynamics
 from simparity.references.mujoco.joint_dynamics import ChainModel
 from simparity.references.mujoco.stage_loads import DETAIL as STAGE_DETAIL
 from simparity.references.mujoco.stage_loads import StepClock, stage_callback
@@ -93,13 +100,16 @@ class MujocoJointMotion(JointSimulation):
         self._scene, self._integrator = scene, integrator
         built = ChainModel(scene.chain, scene.gravity_world)
         self.model, self._dof, self._qpos = built.model, built.dof, built.qpos
+        self._floating = MujocoFloatingDynamics(scene.chain, scene.gravity_world) if scene.chain.floating_base else None
+        if self._floating is not None:
+            self._dof, self._qpos = self._floating.state_dof, self._floating.state_qpos
         kind, disabled = INTEGRATORS[integrator]
         self.model.opt.integrator, self.model.opt.timestep = kind, dt
         self.model.opt.disableflags |= disabled
         self._data = mujoco.MjData(self.model)
         self._end_effector = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, scene.chain.end_effector_name)
         self._control = np.zeros((1, 1, self.model.nv))
-        self._control[0, 0, self._dof] = scene.torque
+        self._control[0, 0, self._dof[len(self._dof) - scene.chain.n_joints:]] = scene.torque
         self._timed = scene.timed_torque
         self._clock = StepClock()
         self._qpos_at = mujoco.mj_stateSize(self.model, mujoco.mjtState.mjSTATE_TIME)
@@ -114,15 +124,22 @@ class MujocoJointMotion(JointSimulation):
                           "stepped by mujoco.rollout" if self._timed is None else
                           f"; qfrc_applied {fmt(scene.torque)} plus the timed torque, {STAGE_DETAIL}; mj_step loop")
                        + "; no velocity clipping; a MuJoCo warning (bad state, reset) raises "
-                       "DivergedError; energy by mj_mulM and -sum m g.xipos; end effector by mj_kinematics")
+                       "DivergedError; energy by mj_mulM and -sum m g.xipos; end effector by mj_kinematics"
+                       + ("; the base a free joint, its body-frame angular velocity turned to world axes; momentum "
+                          "by mj_subtreeVel" if self._floating is not None else ""))
+
+    def _own(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """MuJoCo's qvel rows of the project's (B, nv): a floating base's angular velocity turned into its body frame
+        (qdot itself on a fixed base)."""
+        return qdot if self._floating is None else turned_base(base_rotations(q), qdot, False, True, inverse=True)
 
     def _states(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        """(B, nstate) full-physics states at time 0 with the chain's joints at ``q`` and ``qdot`` ((B, n) each)."""
+        """(B, nstate) full-physics states at time 0 with the chain's joints at ``q`` and ``qdot`` ((B, nq), (B, nv))."""
         template = np.empty(mujoco.mj_stateSize(self.model, _STATE))
         mujoco.mj_getState(self.model, mujoco.MjData(self.model), template, _STATE)
         states = np.repeat(template[None], len(q), axis=0)
         states[:, self._qpos_at + self._qpos] = q
-        states[:, self._qvel_at + self._dof] = qdot
+        states[:, self._qvel_at + self._dof] = self._own(q, qdot)
         return states
 
     def _rollout(self, initial: np.ndarray, n_steps: int) -> np.ndarray:
@@ -139,7 +156,7 @@ class MujocoJointMotion(JointSimulation):
         """MuJoCo's control callback: qfrc_applied = the constant torque plus the timed one at the stage's time."""
         assert self._timed is not None  # installed only with a timed torque
         d.qfrc_applied[:] = self._control[0, 0]
-        d.qfrc_applied[self._dof] += time_loads.at(self._timed, self._clock.stage_time(d.time),
+        d.qfrc_applied[self._dof[len(self._dof) - self._scene.chain.n_joints:]] += time_loads.at(self._timed, self._clock.stage_time(d.time),
                                                    self._clock.step_start)
 
     def _loop(self, initial: np.ndarray, n_steps: int) -> np.ndarray:
@@ -165,8 +182,12 @@ class MujocoJointMotion(JointSimulation):
         if messages:
             raise DivergedError(f"MuJoCo warned while stepping (it resets an unstable simulation): {messages[0]}")
         states = np.concatenate([self._initial[:, None], stepped], axis=1).transpose(1, 0, 2)  # (T, B, nstate)
-        return JointTrajectory(np.arange(n_steps + 1) * self._dt, states[..., self._qpos_at + self._qpos],
-                               states[..., self._qvel_at + self._dof])
+        q, qvel = states[..., self._qpos_at + self._qpos], states[..., self._qvel_at + self._dof]
+        if self._floating is not None:  # the body-frame angular velocity turned to world axes
+            flat_q = q.reshape(-1, q.shape[-1])
+            qvel = turned_base(base_rotations(flat_q), qvel.reshape(-1, qvel.shape[-1]), False, True).reshape(
+                qvel.shape)
+        return JointTrajectory(np.arange(n_steps + 1) * self._dt, q, qvel)
 
     def step_jacobian(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> StepJacobian:
         """``mjd_transitionFD`` (centred differences at :data:`TRANSITION_FD_STEP` of the state and the controls) on
@@ -174,6 +195,9 @@ class MujocoJointMotion(JointSimulation):
         is τ; the stepping model has none), at B states with qfrc_applied 0: A's and B's rows and columns of the
         chain's dofs (MuJoCo's x = (the q tangent, qvel): a hinge's or slide's tangent is its qpos)."""
         kind, disabled = INTEGRATORS[self._integrator]
+        if self._floating is not None:
+            raise NotImplementedError("the step Jacobian of a floating base (its quaternion's tangent) is not "
+                                      "converted yet")
         if kind == mujoco.mjtIntegrator.mjINT_RK4:
             raise NotImplementedError("MuJoCo's mjd_transitionFD does not differentiate its RK4 step (\"RK4 "
                                       "integrator is not supported\")")
@@ -210,7 +234,7 @@ class MujocoJointMotion(JointSimulation):
     def energy(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         kinetic, potential = np.empty(len(q)), np.empty(len(q))
         m_qvel = np.empty(self.model.nv)
-        for k, (row, rates) in enumerate(zip(q, qdot)):
+        for k, (row, rates) in enumerate(zip(q, self._own(q, qdot))):
             d = self._position(row, rates)
             mujoco.mj_mulM(self.model, d, m_qvel, d.qvel)
             kinetic[k] = 0.5 * d.qvel @ m_qvel
@@ -226,3 +250,9 @@ class MujocoJointMotion(JointSimulation):
             mujoco.mj_kinematics(self.model, d)
             out[k] = d.xpos[self._end_effector]
         return out
+
+    def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """A floating base's: :meth:`MujocoFloatingDynamics.momentum` (``mj_subtreeVel``) on the same model."""
+        if self._floating is None:
+            raise NotImplementedError("a fixed base's momentum is not conserved: it is not reported")
+        return self._floating.momentum(q, qdot)

@@ -69,6 +69,7 @@ from simparity.references.pinocchio.joints import configuration
 from simparity.references.common.urdf_export import UrdfChains, chain_export, chain_source, chain_urdf, urdf_support
 from simparity.references.pinocchio import joint_motion
 from simparity.references.pinocchio.floating import PinocchioFloatingDynamics
+from simparity.references.pinocchio.floating_motion import PinocchioFloatingMotion
 from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics, pinocchio_dynamics_problem
 from simparity.references.common.scene_inputs import derives_own_inputs
 
@@ -401,6 +402,8 @@ class PinocchioEngine(UrdfChains, Engine):
         return _dynamics_support(scene.chain) if named.ok else named
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
+        if scene.chain.floating_base:
+            return PinocchioFloatingMotion(scene, integrator, dt)
         return joint_motion.PinocchioJointMotion(scene, integrator, dt)
 
     def ik_solvers(self) -> tuple[str, ...]:

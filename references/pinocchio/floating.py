@@ -37,7 +37,7 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
         self.detail += ("; the free flyer's LOCAL (linear, angular) velocity turned to world axes, its acceleration "
                         "given w_b x v_b")
 
-    def _full(self, q_row: np.ndarray) -> np.ndarray:
+    def configuration(self, q_row: np.ndarray) -> np.ndarray:
         """Pinocchio's configuration (nq,) of a project configuration (7 + n,): quat_xyzw."""
         out = self._configuration(q_row[BASE_Q:])
         out[:3], out[3:7] = q_row[:3], xyzw_from_wxyz(q_row[3:7])
@@ -52,7 +52,7 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         out = np.empty((len(q), len(self._index), len(self._index)))
         for k, row in enumerate(q):
-            upper = np.triu(pin.crba(self.model, self.data, self._full(row)))
+            upper = np.triu(pin.crba(self.model, self.data, self.configuration(row)))
             out[k] = (upper + np.triu(upper, 1).T)[np.ix_(self._index, self._index)]
         return turned_mass(base_rotations(q), out, True, True)
 
@@ -62,7 +62,7 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
         velocity = turned_base(rotation, qdot, True, True, inverse=True)
         acceleration = turned_base(rotation, qddot, True, True, inverse=True)
         acceleration[:, :3] -= local_offset(rotation, qdot)
-        local = np.array([pin.rnea(self.model, self.data, self._full(row), self._vector(rates),
+        local = np.array([pin.rnea(self.model, self.data, self.configuration(row), self._vector(rates),
                                    self._vector(accelerations))[self._index]
                           for row, rates, accelerations in zip(q, velocity, acceleration)])
         return turned_base(rotation, local, True, True)
@@ -81,7 +81,7 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
         damped[:, BASE_V:] -= self.damping * qdot[:, BASE_V:]
         velocity = turned_base(rotation, qdot, True, True, inverse=True)
         force = turned_base(rotation, damped, True, True, inverse=True)
-        local = np.array([pin.aba(self.model, self.data, self._full(row), self._vector(rates),
+        local = np.array([pin.aba(self.model, self.data, self.configuration(row), self._vector(rates),
                                   self._vector(forces))[self._index]
                           for row, rates, forces in zip(q, velocity, force)])
         local[:, :3] += local_offset(rotation, qdot)
@@ -92,7 +92,7 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
         velocity = turned_base(rotation, qdot, True, True, inverse=True)
         out = np.empty(len(q))
         for k, (row, rates) in enumerate(zip(q, velocity)):
-            pin.forwardKinematics(self.model, self.data, self._full(row), self._vector(rates))
+            pin.forwardKinematics(self.model, self.data, self.configuration(row), self._vector(rates))
             out[k] = sum(0.5 * self.model.inertias[i].vtiv(self.data.v[i]) for i in range(1, self.model.njoints))
         return out
 
@@ -102,7 +102,7 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
         velocity = turned_base(base_rotations(q), qdot, True, True, inverse=True)
         out = np.empty((len(q), 6))
         for k, (row, rates) in enumerate(zip(q, velocity)):
-            momentum = pin.computeCentroidalMomentum(self.model, self.data, self._full(row), self._vector(rates))
+            momentum = pin.computeCentroidalMomentum(self.model, self.data, self.configuration(row), self._vector(rates))
             linear = np.array(momentum.linear)
             out[k] = np.r_[linear, np.array(momentum.angular) + np.cross(self.data.com[0], linear)]
         return out
@@ -120,7 +120,7 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
         index = np.ix_(self._index, self._index)
         own = [np.empty((len(q), len(self._index), len(self._index))) for _ in range(3)]
         for k, (row, rates, rate_of_rates) in enumerate(zip(q, velocity, acceleration)):
-            found = pin.computeRNEADerivatives(self.model, self.data, self._full(row), self._vector(rates),
+            found = pin.computeRNEADerivatives(self.model, self.data, self.configuration(row), self._vector(rates),
                                                self._vector(rate_of_rates))
             for out, matrix in zip(own, found):
                 out[k] = np.asarray(matrix)[index]

@@ -712,6 +712,8 @@ class PybulletEngine(UrdfChains, Engine):
 
     def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
         named = super().supports_joint_motion(scene, integrator)
+        if named.ok and scene.chain.floating_base:
+            return Support.no(FLOATING_BASE_WHY)
         return _dynamics_support(scene.chain) if named.ok else named
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:

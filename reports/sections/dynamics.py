@@ -9,7 +9,8 @@ import math
 import pandas as pd
 
 from simparity.core.model.metric_catalogue import (
-    JOINT_ANGLE_ERROR_MAX, REFERENCE_PARTING_TIME, SELF_PARTING_TIME, TIME_PER_STEP,
+    CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, JOINT_ANGLE_ERROR_MAX, LINEAR_MOMENTUM_DRIFT_MAX, REFERENCE_PARTING_TIME,
+    SELF_PARTING_TIME, TIME_PER_STEP,
 )
 from simparity.core.model.results import OK
 from simparity.reports import engine_summary, figures, summary, tables
@@ -60,6 +61,25 @@ def _predictability(rows: pd.DataFrame) -> list[Block]:
                         for e, i in cases))]
 
 
+def _momentum(rows: pd.DataFrame) -> list[Block]:
+    """A floating base's momentum laws at the scene's finest time step (issue #46): each scheme's drift of its linear
+    and angular momentum from its own model; nothing where not measured."""
+    drifts = rows[rows["metric"].isin([LINEAR_MOMENTUM_DRIFT_MAX, CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX])
+                  & rows["dt"].notna()]
+    if drifts.empty:
+        return []
+    finest = drifts[drifts["dt"] == drifts["dt"].min()]
+    cells = {(r["engine"], r["integrator"], r["metric"]): number(r["value"]) if r["status"] == OK else r["status"]
+             for _, r in finest.iterrows()}
+    cases = list(dict.fromkeys(zip(finest["engine"], finest["integrator"])))
+    return [Paragraph(f"Momentum at dt = {finest['dt'].iloc[0]:g} s: joint forces are internal, so each engine's own "
+                      "momentum keeps its law (linear: grows by m g t; angular about a fixed point: conserved "
+                      "without gravity); its drift relative to the momentum the motion can carry."),
+            Table(("engine", "integrator", "linear momentum drift", "angular momentum drift"),
+                  tuple((e, i, cells.get((e, i, LINEAR_MOMENTUM_DRIFT_MAX), "—"),
+                         cells.get((e, i, CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX), "—")) for e, i in cases))]
+
+
 def scheme_row(engine: str, scheme: str, members: list[tuple[str, tuple[str, ...]]]) -> tuple[str, ...]:
     """One compact-table row for the variants of a scheme (core's orientation updates): each cell lists
     the variants' values in the order the integrator cell names them, or one value where they agree."""
@@ -103,7 +123,7 @@ def section(ctx: ReportContext, scene, rows, about, reference, series) -> tuple[
     blocks += touching.figure if touching else []
     blocks += [_per_engine(ctx, scene, cases, fits, unit, touching), _per_scheme(ctx, cases, observed, about, unit)]
     blocks += touching.blocks if touching else []
-    blocks += _predictability(rows)
+    blocks += _predictability(rows) + _momentum(rows)
     columns, order_columns = ((tables.JOINT_MOTION_COLUMNS, tables.JOINT_ORDER_COLUMNS)
                               if metric == JOINT_ANGLE_ERROR_MAX else (tables.DYNAMICS_COLUMNS, tables.ORDER_COLUMNS))
     full: list[Block] = [tables.metric_table(rows[rows["dt"].notna()], columns, ["engine", "integrator", "dt"])]

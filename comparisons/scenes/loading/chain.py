@@ -24,9 +24,8 @@ from simparity.core.urdf import chain_from_urdf
 JOINT_TYPES = ("revolute", "prismatic")
 _CHAIN = ("name", "joint", "end_effector", "end_effector_xyz", "end_effector_rpy", "urdf", "mjcf", "base_link",
           "tip_link", "dh", "floating_base")
-FLOATING_SCENES = "a joint_dynamics scene's URDF or MJCF chain"
-"""What may have a floating base: its state is compared instant by instant, and its base link's mass properties come
-from the file."""
+FLOATING_SCENES = "a joint_dynamics scene's URDF or MJCF chain, or a joint_motion scene's URDF chain"
+"""What may have a floating base: its base link's mass properties come from the file."""
 _DH = ("convention", "a", "alpha", "d", "theta_offset", "lower", "upper")
 PYBULLET_DATA_PREFIX = "pybullet_data:"
 """A ``urdf`` path starting with this is inside the installed pybullet_data package."""
@@ -174,15 +173,16 @@ def _dh_chain(c: TableReader, name: str) -> Chain:
     return replace(chain_from_dh(name, convention=convention, limits=limits, **values), dh=table)
 
 
-def read_chain(top: TableReader, name: str, dynamics: bool = False, floating_allowed: bool = False) -> Chain:
+def read_chain(top: TableReader, name: str, dynamics: bool = False, floating_allowed: bool = False,
+               mjcf_allowed: bool = False) -> Chain:
     """The scene's ``[chain]``; for ``dynamics``, a URDF's inertia tensors must be physical; ``floating_base = true``
-    only where ``floating_allowed`` (:data:`FLOATING_SCENES`)."""
+    only where ``floating_allowed`` (:data:`FLOATING_SCENES`), ``mjcf`` only where ``mjcf_allowed``."""
     c = top.subtable("chain", _CHAIN)
     sources = [key for key in ("joint", "urdf", "mjcf", "dh") if c.has(key)]
     if len(sources) != 1:
         raise c.fail("joint", f"give exactly one chain source, got {sources or 'none'}",
                      "one of [[chain.joint]], urdf, mjcf, [chain.dh]")
-    if sources == ["mjcf"] and not floating_allowed:
+    if sources == ["mjcf"] and not mjcf_allowed:
         raise c.fail("mjcf", f"an MJCF chain is read for joint_dynamics scenes only, not for a "
                      f"{top.table.get('scene', {}).get('kind', 'this')} scene", "urdf, [[chain.joint]] or [chain.dh]")
     floating = c.boolean("floating_base", False)
@@ -211,10 +211,12 @@ def read_chain(top: TableReader, name: str, dynamics: bool = False, floating_all
     )
 
 
-def read_dynamics_chain(top: TableReader, head: dict, floating_allowed: bool = False) -> Chain:
+def read_dynamics_chain(top: TableReader, head: dict, floating_allowed: bool = False,
+                        mjcf_allowed: bool = False) -> Chain:
     """The ``[chain]`` of a joint-dynamics or joint-motion scene: every link with mass properties (a floating base's
     too, where ``floating_allowed``)."""
-    chain = read_chain(top, head["name"], dynamics=True, floating_allowed=floating_allowed)
+    chain = read_chain(top, head["name"], dynamics=True, floating_allowed=floating_allowed,
+                       mjcf_allowed=mjcf_allowed)
     problem = chain.dynamics_problem()
     if problem and chain.floating_base and problem.startswith("the floating"):
         raise top.fail("chain", problem, "a floating base link with a mass and a rotational inertia about every axis "

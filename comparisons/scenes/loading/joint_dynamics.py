@@ -12,7 +12,7 @@ _JOINT_DYNAMICS_SAMPLING = ("states", "seed", "velocity_scale", "acceleration_sc
 
 def read_joint_dynamics(top: TableReader, head: dict) -> JointDynamicsScene:
     """The joint-space dynamics scene of the file's tables ``top``; ``head``: its ``[scene]`` keys."""
-    chain = read_dynamics_chain(top, head, floating_allowed=True)
+    chain = read_dynamics_chain(top, head, floating_allowed=True, mjcf_allowed=True)
     world = top.optional_subtable("world", ("gravity_world",))
     gravity = world.vector("gravity_world", 3, length=1) if world and world.has("gravity_world") else None
     sampling = top.optional_subtable("sampling", _JOINT_DYNAMICS_SAMPLING)

@@ -19,9 +19,13 @@ from simparity.comparisons.scenes.loading.time_functions import FUNCTION_KEYS, r
 from simparity.comparisons.scenes.loading.time_steps import STEP_COUNT_RTOL, time_step_ladder
 from simparity.core.model.errors import echo
 from simparity.core.model.scenes.chain import Chain, sample_configurations
-from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.joint_motion import UNIT_QUATERNION_TOLERANCE, JointMotionScene
 
 _INITIAL = ("q", "qdot", "seed")
+_BASE_INITIAL = ("base_position", "base_quat_wxyz", "base_velocity_world", "base_angular_velocity_world")
+"""A floating base's initial state (``[chain] floating_base = true``): its origin's position [m] and orientation
+(default: the world's origin, unturned), its origin's velocity [m/s] and its angular velocity [rad/s] in world axes
+(default: at rest)."""
 _MOTION_SIMULATION = ("duration", "dt", "integrators", "segments", "perturbation")
 MAX_PERTURBATION = 1e-3
 """[rad] The largest start perturbation for predictability: at the parting threshold itself the runs would part at once."""
@@ -43,6 +47,18 @@ def _initial_q(r: TableReader, chain: Chain) -> np.ndarray:
     return within_limits(r, "q", chain, q)
 
 
+def _with_base(initial: TableReader, q0: np.ndarray, qdot0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """((7 + n,), (6 + n,)): the joints' initial state after the floating base's (:data:`_BASE_INITIAL`)."""
+    quat = initial.vector("base_quat_wxyz", 4, [1.0, 0.0, 0.0, 0.0])
+    if abs(float(np.linalg.norm(quat)) - 1.0) > UNIT_QUATERNION_TOLERANCE:
+        raise initial.fail("base_quat_wxyz", f"length {float(np.linalg.norm(quat)):.17g}",
+                           f"a unit quaternion (w, x, y, z), length 1 within {UNIT_QUATERNION_TOLERANCE:g}")
+    base_q = np.concatenate([initial.vector("base_position", 3, [0.0] * 3, length=1), quat])
+    base_v = np.concatenate([initial.vector("base_velocity_world", 3, [0.0] * 3, length=1),
+                             initial.vector("base_angular_velocity_world", 3, [0.0] * 3)])
+    return np.concatenate([base_q, q0]), np.concatenate([base_v, qdot0])
+
+
 def _with_damping(drive: TableReader, chain: Chain) -> Chain:
     """``chain`` with the joint damping ``[drive] damping`` gives: one number for every joint or one per joint
     [N m s/rad = kg m^2/s, or N s/m = kg/s], >= 0."""
@@ -58,13 +74,16 @@ def _with_damping(drive: TableReader, chain: Chain) -> Chain:
 def read_joint_motion(top: TableReader, head: dict, engines: EngineSet) -> JointMotionScene:
     """The joint-motion scene of the file's tables ``top``; ``head``: its ``[scene]`` keys; ``engines`` offer the
     integrators it may name."""
-    chain = read_dynamics_chain(top, head)
+    chain = read_dynamics_chain(top, head, floating_allowed=True)
     world = top.optional_subtable("world", ("gravity_world",))
     gravity = world.vector("gravity_world", 3, length=1) if world and world.has("gravity_world") else None
-    initial = top.optional_subtable("initial", _INITIAL) or TableReader(top.source, {}, "initial", _INITIAL, top.scale,
+    keys = _INITIAL + (_BASE_INITIAL if chain.floating_base else ())
+    initial = top.optional_subtable("initial", keys) or TableReader(top.source, {}, "initial", keys, top.scale,
                                                                     top.limits)
     q0 = _initial_q(initial, chain)
     qdot0 = joint_values(initial, "qdot", chain, joint_powers(chain, 0, 1))
+    if chain.floating_base:
+        q0, qdot0 = _with_base(initial, q0, qdot0)
     drive = top.optional_subtable("drive", ("torque", "damping", "timed_torque"))
     torque = (joint_values(drive, "torque", chain, joint_powers(chain, 2, 1)) if drive and drive.has("torque")
               else np.zeros(chain.n_joints))  # N m = kg m^2 / s^2 (mass and time fixed) or N = kg m / s^2

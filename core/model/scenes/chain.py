@@ -288,6 +288,13 @@ class Chain:
         base = [1, 1, 1, 0, 0, 0] if self.floating_base else []
         return np.array(base + [1 if j.type == "prismatic" else 0 for j in self.joints], dtype=int)
 
+    @property
+    def configuration_length_powers(self) -> np.ndarray:
+        """(nq,) int: the power of length in each configuration component's unit: a floating base's position 1 and
+        quaternion 0 first, then 1 for a prismatic joint and 0 for a revolute one."""
+        base = [1, 1, 1, 0, 0, 0, 0] if self.floating_base else []
+        return np.array(base + [1 if j.type == "prismatic" else 0 for j in self.joints], dtype=int)
+
     def frame_names(self) -> tuple[str, ...]:
         """Names of the frames FK returns: one per joint (its child link), then the end effector."""
         return tuple(j.name for j in self.joints) + (self.end_effector_name,)

@@ -13,13 +13,20 @@ from simparity.core.model.scenes.suites import SweepPoint
 from simparity.core.model.scenes.time_functions import TimeFunction
 
 
+UNIT_QUATERNION_TOLERANCE = 1e-12
+"""How far from 1 a floating base's initial quaternion may be: rounding of a written unit quaternion (a few eps),
+far below any orientation a scene means; every engine is given it as written."""
+
+
 @dataclass(frozen=True)
 class JointMotionScene:
     """A chain's motion through time: its joints stepped from an initial state under gravity, its joints' damping,
     constant joint forces and a joint force that changes with time, for ``duration`` at each time step of ``dts``.
 
-    The chain's base link is fixed in the world and its frame is the world frame. Every engine is given the same
-    model. The constant joint forces are the same at every stage; the timed one is evaluated at each stage's time
+    The chain's base link is fixed in the world and its frame is the world frame, or it floats free
+    (``chain.floating_base``): the state then starts with the base's pose and velocity, in the project's convention
+    (:class:`core.model.scenes.chain.Chain`), and the applied forces act on the joints only. Every engine is given the
+    same model. The constant joint forces are the same at every stage; the timed one is evaluated at each stage's time
     where the engine can (:mod:`core.model.scenes.time_functions`).
 
     Attributes
@@ -31,8 +38,9 @@ class JointMotionScene:
         ``armature`` are part of the motion.
     gravity_world : (3,) ndarray or None
         [m/s^2] in the base frame; None: no gravity.
-    q0, qdot0 : (B, n) ndarray
-        Initial joint values and velocities of B copies [rad or m, rad/s or m/s] (one copy: B = 1).
+    q0, qdot0 : (B, nq), (B, nv) ndarray
+        Initial joint values and velocities of B copies [rad or m, rad/s or m/s] (one copy: B = 1); with a floating
+        base nq = 7 + n and nv = 6 + n (:attr:`Chain.nq`, :attr:`Chain.nv`), the base's quaternion of unit length.
     torque : (n,) ndarray
         Constant applied joint forces [N m or N].
     timed_torque : TimeFunction or None
@@ -82,13 +90,15 @@ class JointMotionScene:
         n = self.chain.n_joints
         if self.gravity_world is not None:
             object.__setattr__(self, "gravity_world", readonly(self.gravity_world, shape=(3,)))
-        for key in ("q0", "qdot0"):
+        for key, size in (("q0", self.chain.nq), ("qdot0", self.chain.nv)):
             value = np.asarray(getattr(self, key), dtype=float)
-            value = value.reshape(1, n) if value.ndim == 1 else value
-            if value.ndim != 2 or value.shape[1] != n or not np.all(np.isfinite(value)):
-                raise SceneError(self.source, key, f"shape {value.shape}", f"finite numbers, (B, {n}) or ({n},)")
+            value = value.reshape(1, -1) if value.ndim == 1 else value
+            if value.ndim != 2 or value.shape[1] != size or not np.all(np.isfinite(value)):
+                raise SceneError(self.source, key, f"shape {value.shape}", f"finite numbers, (B, {size}) or ({size},)")
             object.__setattr__(self, key, readonly(value))
-        if self.q0.shape != self.qdot0.shape:
+        if self.chain.floating_base:
+            self._floating_checks()
+        if self.q0.shape[0] != self.qdot0.shape[0]:
             raise SceneError(self.source, "qdot0", f"{self.qdot0.shape[0]} copies, q0 has {self.q0.shape[0]}",
                              "as many initial velocities as initial joint values")
         object.__setattr__(self, "torque", readonly(np.asarray(self.torque, dtype=float), shape=(n,)))
@@ -108,6 +118,19 @@ class JointMotionScene:
         if not (np.isfinite(self.perturbation) and self.perturbation >= 0):
             raise SceneError(self.source, "perturbation", f"{self.perturbation}", "a finite number >= 0 (0: none)")
 
+    def _floating_checks(self) -> None:
+        """A floating base's quaternion of unit length (to :data:`UNIT_QUATERNION_TOLERANCE`); no perturbation or
+        segments yet (they move every configuration component alike, a quaternion's too)."""
+        norms = np.linalg.norm(self.q0[:, 3:7], axis=1)
+        bad = np.flatnonzero(~(np.abs(norms - 1.0) <= UNIT_QUATERNION_TOLERANCE))
+        if bad.size:
+            raise SceneError(self.source, "base_quat_wxyz", f"length {norms[bad[0]]:.17g} (copy {bad[0]})",
+                             f"a unit quaternion (w, x, y, z), length 1 within {UNIT_QUATERNION_TOLERANCE:g}")
+        for key, value in (("perturbation", self.perturbation), ("segments", self.segments)):
+            if value:
+                raise SceneError(self.source, f"simulation.{key}", f"{value:g} with a floating base",
+                                 f"0: a floating base's motion is compared against the reference only")
+
     @property
     def copies(self) -> int:
         """B, the copies stepped together."""
@@ -118,5 +141,5 @@ class JointMotionScene:
         return max(1, int(round(self.duration / dt)))
 
     def starting_from(self, q0: np.ndarray, qdot0: np.ndarray, duration: float) -> "JointMotionScene":
-        """The same chain and forces from other initial states ((B, n) each) for ``duration`` [s]."""
+        """The same chain and forces from other initial states ((B, nq) and (B, nv)) for ``duration`` [s]."""
         return replace(self, q0=q0, qdot0=qdot0, duration=duration, dts=tuple(min(dt, duration) for dt in self.dts))

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import pytest
 
-from tests.helpers import assert_caught, run_planted
+from tests.helpers import PLANTED_MOTION_FACTORY, assert_caught, run_planted
 
-PLANTED = '''
+PLANTED = PLANTED_MOTION_FACTORY + '''
 import mujoco
 import numpy as np
 
@@ -20,16 +20,6 @@ from simparity.core.inhouse import InHouseEngine
 from simparity.references.mujoco.adapter import MujocoEngine
 from simparity.references.mujoco.joint_motion import MujocoJointMotion
 
-
-def _engine(base, motion_class, engine_name):
-    """An engine like ``base`` whose joint-motion simulations are ``motion_class`` (a planted copy)."""
-    class Planted(base):
-        name = engine_name
-
-        def build_joint_motion(self, scene, integrator, dt):
-            return motion_class(scene, integrator, dt)
-
-    return Planted
 
 
 class EulerForRk4(CoreJointMotion):

@@ -292,3 +292,40 @@ def test_saturation_is_allowed_only_where_every_engine_saturated(scene, integrat
                     "analytic:closed_form", "n/a", "saturated: on another orbit", "saturated", integrator)
     result = check_table(pd.DataFrame([asdict(row)]), load_tolerances())
     assert (not result.passed) == violated, [str(v) for v in result.violations]
+
+
+FREE_FLIGHT = {
+    "scene": {"name": "ff", "kind": "joint_motion", "reference": "pinocchio"},
+    "chain": {"urdf": "example-robot-data:solo_description/robots/solo12.urdf", "base_link": "base_link",
+              "tip_link": "FL_FOOT", "floating_base": True},
+    "initial": {"q": [0.3, 0.8, -1.6], "base_position": [10.0, 0.0, 0.0], "base_quat_wxyz": [0.0, 1.0, 0.0, 0.0],
+                "base_velocity_world": [1.0, 0.0, 0.0], "base_angular_velocity_world": [0.0, 0.0, 2.0]},
+    "simulation": {"duration": 0.1, "dt": [0.01]},
+}
+
+
+def test_a_floating_base_starts_where_its_file_puts_it_in_si():
+    """Issue #46: the base's pose and velocity before the joints', lengths in the scene's unit."""
+    scene = parse_scene(_with("scene.length_unit", "cm", FREE_FLIGHT))
+    assert scene.chain.floating_base and scene.q0.shape == (1, 10) and scene.qdot0.shape == (1, 9)
+    assert np.array_equal(scene.q0[0, :7], [0.1, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
+    assert np.array_equal(scene.qdot0[0, :6], [0.01, 0.0, 0.0, 0.0, 0.0, 2.0])
+    assert np.array_equal(scene.q0[0, 7:], [0.3, 0.8, -1.6])
+
+
+@pytest.mark.parametrize("path, value, key, words", [
+    ("initial.base_quat_wxyz", [1.0, 0.1, 0.0, 0.0], "initial.base_quat_wxyz", "a unit quaternion"),
+    ("initial.base_position", [1.0, 2.0], "initial.base_position", "a list of 3 numbers"),
+    ("simulation.perturbation", 1e-4, "simulation.perturbation", "compared against the reference only"),
+])
+def test_a_floating_base_s_bad_start_is_refused_in_one_line(path, value, key, words):
+    with pytest.raises(SceneError) as caught:
+        parse_scene(_with(path, value, FREE_FLIGHT))
+    message = str(caught.value)
+    assert key in message and words in message and "\n" not in message, message
+
+
+def test_base_keys_on_a_fixed_base_are_refused():
+    """A fixed base has no pose to give: its [initial] keys are the joints' only."""
+    with pytest.raises(SceneError, match="base_position"):
+        parse_scene(_with("initial.base_position", [0.0, 0.0, 1.0]))
