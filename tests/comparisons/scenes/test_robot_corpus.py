@@ -33,6 +33,7 @@ def _movable_joints(path: str) -> int:
     return sum(joint.get("type") != "fixed" for joint in root.findall("joint"))
 
 
+@pytest.mark.slow  # it loads the 63 scene files and their robots: ~3 s of CPU
 def test_the_corpus_covers_forty_distinct_robots_each_a_file_of_two_or_more_movable_joints():
     scenes = library.load(ROBOT_SCENES)
     assert all(isinstance(s, JointDynamicsScene) and "robots" in s.suites for s in scenes)
