@@ -329,15 +329,16 @@ def energy_metrics(scene: JointMotionScene, traj: JointTrajectory, own: OwnReadi
 
 def momentum_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory,
                      own: OwnReading) -> dict[str, Measured]:
-    """A floating base's momentum from the engine's own model (:meth:`JointSimulation.momentum`) at the samples
-    :func:`read_own` read, against the laws of a robot under joint forces alone (internal: they cancel in its
-    momentum): ``linear_momentum_drift_max`` max_t |P(t) - P(0) - m g t| (the centre of mass falls as a particle, or
-    moves in a straight line without gravity); without gravity ``chain_angular_momentum_drift_max`` max_t |L(t) -
-    L(0)| about the base's initial position (a fixed point: with P conserved, the same as the angular momentum about
-    the centre of mass conserved and the centre of mass moving straight; under gravity it changes, n/a). Relative to
-    the momentum the motion can carry: sqrt(2 m T) (|P| <= sqrt(2 m T) for any motion of kinetic energy T; T the
-    largest over the run and copies) and that times a length, the chain's reach plus the base's travel. At most
-    :data:`ROUNDING_FLOOR_FACTOR` eps x steps: flagged at the rounding floor. Reference-free."""
+    """A floating base's momentum from the engine's own model (:meth:`JointSimulation.momentum`: P and the angular
+    momentum about the robot's centre of mass) at the samples :func:`read_own` read, against the laws of a robot
+    under joint forces alone (internal: they cancel in its momentum, and uniform gravity exerts no moment about the
+    centre of mass): ``linear_momentum_drift_max`` max_t |P(t) - P(0) - m g t| (the centre of mass falls as a
+    particle, or moves in a straight line without gravity) and ``chain_angular_momentum_drift_max`` max_t |L(t) -
+    L(0)|. Relative to the momentum the motion about the centre of mass can carry, sqrt(2 m T_c) (T_c = T - |P|^2 /
+    2m, the kinetic energy relative to the centre of mass, the largest over the run and copies: a fall, a uniform
+    drift or a long run leave it alone), and that times the chain's reach for L. At most :data:`ROUNDING_FLOOR_FACTOR`
+    eps x steps x how far the momentum's size (|P| over that scale) and, for L, the base's distance from the origin
+    (over the reach) carry rounding: flagged at the rounding floor. Reference-free."""
     try:
         momentum = np.asarray(sim.momentum(np.ascontiguousarray(traj.q[own.index]).reshape(-1, traj.q.shape[2]),
                                            np.ascontiguousarray(traj.qdot[own.index]).reshape(-1, traj.qdot.shape[2])),
@@ -348,19 +349,20 @@ def momentum_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointT
     assert chain.base_inertia is not None  # a floating chain's dynamics_problem() says so
     mass = chain.base_inertia.mass + sum(j.link.mass for j in chain.joints if j.link is not None)
     gravity = np.zeros(3) if scene.gravity_world is None else np.asarray(scene.gravity_world, dtype=float)
-    linear = momentum[..., :3]
+    linear, angular = momentum[..., :3], momentum[..., 3:]
     expected = linear[0] + mass * gravity * (traj.times[own.index] - traj.times[0])[:, None, None]
-    point = np.asarray(traj.q[0, :, :3])  # (B, 3): the base's initial position, a fixed point
-    angular = momentum[..., 3:] - np.cross(point, linear)
-    scale = math.sqrt(2.0 * mass * max(float(own.kinetic.max()), 0.0))
-    travel = float(np.linalg.norm(traj.q[own.index, :, :3] - point, axis=-1).max())
-    steps = max(len(traj.times) - 1, 1)
-    floor = ROUNDING_FLOOR_FACTOR * float(np.finfo(float).eps) * steps
+    size = np.linalg.norm(linear, axis=-1)  # (S, B)
+    internal = float(np.max(own.kinetic - size**2 / (2.0 * mass)))
+    scale = math.sqrt(2.0 * mass * max(internal, 0.0))
+    length = reach(chain)
+    if not scale > 0:
+        why = "the robot does not move about its centre of mass: its momentum laws have no scale"
+        return {m: Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=why) for m in MOMENTUM_METRICS}
+    carried = max(1.0, float(size.max()) / scale)
+    distance = float(np.linalg.norm(traj.q[own.index, :, :3], axis=-1).max())
+    unit = ROUNDING_FLOOR_FACTOR * float(np.finfo(float).eps) * max(len(traj.times) - 1, 1)
 
-    def relative(drift: float, size: float, what: str) -> Measured:
-        if not size > 0:
-            return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=(
-                f"the robot has no kinetic energy: its {what} has no scale"))
+    def relative(drift: float, size: float, floor: float, what: str) -> Measured:
         ratio = drift / size
         if ratio > SATURATED_DRIFT:
             return Measured(ratio, "1", flag=SATURATED, unmeasurable=(
@@ -368,19 +370,16 @@ def momentum_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointT
                 f"(> {SATURATED_DRIFT:g})"))
         if ratio <= floor:
             return Measured(ratio, "1", flag=ROUNDING_FLOOR, note=(
-                f"at the rounding floor ({floor:.2g}: {ROUNDING_FLOOR_FACTOR:g} eps x {steps} steps): exact up to it"))
+                f"at the rounding floor ({floor:.2g}: {ROUNDING_FLOOR_FACTOR:g} eps x steps x the momentum's and the "
+                "position's size): exact up to it"))
         return Measured(ratio, "1")
-    out = {LINEAR_MOMENTUM_DRIFT_MAX: relative(float(np.linalg.norm(linear - expected, axis=-1).max()), scale,
-                                               "linear momentum")}
-    if np.any(gravity):
-        out[CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX] = Measured(math.nan, "1", unmeasurable=(
-            "under gravity the angular momentum about a fixed point changes (gravity's moment about it); about the "
-            "centre of mass it is conserved, which the engines do not report"))
-    else:
-        out[CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX] = relative(
-            float(np.linalg.norm(angular - angular[0], axis=-1).max()), scale * (reach(chain) + travel),
-            "angular momentum")
-    return out
+    return {
+        LINEAR_MOMENTUM_DRIFT_MAX: relative(float(np.linalg.norm(linear - expected, axis=-1).max()), scale,
+                                            unit * carried, "linear momentum"),
+        CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX: relative(float(np.linalg.norm(angular - angular[0], axis=-1).max()),
+                                                   scale * length, unit * carried * max(1.0, distance / length),
+                                                   "angular momentum about the centre of mass"),
+    }
 
 
 @dataclass(frozen=True)

@@ -68,18 +68,22 @@ class CoreJointMotion(JointSimulation):
         else:
             mass_matrix = self._dynamics.mass_matrix(np.ascontiguousarray(q.T))  # (n, n, B)
             kinetic = 0.5 * np.einsum("bi,ijb,bj->b", qdot, mass_matrix, qdot)
+        masses, coms = self._mass_centres(q)
+        potential = -np.einsum("f,bfi,i->b", masses, coms, self._gravity)
+        return kinetic, potential
+
+    def _mass_centres(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(masses (F,) [kg], centres of mass (B, F, 3) [m]) of the chain's links from core's FK (a floating base's own
+        first, every frame placed by the base's pose)."""
         n = self._scene.chain.n_joints
         poses = forward_kinematics(self._scene.chain, q[:, q.shape[1] - n:])
         coms = poses.position_world[:, :n] + np.einsum("bfij,fj->bfi", poses.rotation_world[:, :n], self._coms)
-        masses = self._masses
-        if self._floating is not None:
-            base = self._scene.chain.base_inertia
-            assert base is not None  # a floating chain's dynamics_problem() says so
-            coms = np.concatenate([np.broadcast_to(base.com_xyz, (len(q), 1, 3)), coms], axis=1)
-            coms = _placed(q, coms)
-            masses = np.concatenate([[base.mass], masses])
-        potential = -np.einsum("f,bfi,i->b", masses, coms, self._gravity)
-        return kinetic, potential
+        if self._floating is None:
+            return self._masses, coms
+        base = self._scene.chain.base_inertia
+        assert base is not None  # a floating chain's dynamics_problem() says so
+        coms = _placed(q, np.concatenate([np.broadcast_to(base.com_xyz, (len(q), 1, 3)), coms], axis=1))
+        return np.concatenate([[base.mass], self._masses]), coms
 
     def end_effector_world(self, q: np.ndarray) -> np.ndarray:
         n = self._scene.chain.n_joints
@@ -87,10 +91,14 @@ class CoreJointMotion(JointSimulation):
         return _placed(q, tip[:, None])[:, 0] if self._floating is not None else tip
 
     def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        """Core's floating-base momentum (:meth:`FloatingRecursiveDynamics.momentum`): each body's I v summed."""
+        """Core's floating-base momentum (:meth:`FloatingRecursiveDynamics.momentum`: each body's I v summed, about the
+        world origin), the angular part moved to the centre of mass of core's FK (L_c = L_o - c x P)."""
         if self._floating is None:
             raise NotImplementedError("a fixed base's momentum is not conserved: it is not reported")
-        return self._floating.momentum(q, qdot)
+        momentum = self._floating.momentum(q, qdot)
+        masses, coms = self._mass_centres(q)
+        centre = np.einsum("f,bfi->bi", masses, coms) / masses.sum()
+        return np.concatenate([momentum[:, :3], momentum[:, 3:] - np.cross(centre, momentum[:, :3])], axis=1)
 
 
 def _placed(q: np.ndarray, points: np.ndarray) -> np.ndarray:

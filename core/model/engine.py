@@ -216,9 +216,9 @@ class JointSimulation(abc.ABC):
         raise NotBatchedError("the engine's joint simulation declares no batched stepping (JointSimulation.batched)")
 
     def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        """(B, 6): a floating-base chain's linear momentum [kg m/s] and its angular momentum about the world's origin
-        [kg m^2/s], both in world axes, at states q (B, 7 + n) and qdot (B, 6 + n), from the engine's own model. Not
-        timed. Optional: the momentum metrics are n/a where an engine does not say."""
+        """(B, 6): a floating-base chain's linear momentum [kg m/s] and its angular momentum about its own centre of
+        mass [kg m^2/s], both in world axes, at states q (B, 7 + n) and qdot (B, 6 + n), from the engine's own model.
+        Not timed. Optional: the momentum metrics are n/a where an engine does not say."""
         raise NotImplementedError(f"{type(self).__name__} does not report a floating base's momentum (momentum)")
 
     def step_jacobian(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> StepJacobian:

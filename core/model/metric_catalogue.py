@@ -284,8 +284,8 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
            theory="a floating base under joint forces only: the robot's momentum P(t) = P(0) + m g t (the centre of "
                   "mass falls as a particle): 0 up to the scheme's error"),
     Metric(CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, DIMENSIONLESS, DRIFT, scale="momentum",
-           theory="a floating base under joint forces only, without gravity: the robot's angular momentum about a "
-                  "fixed point conserved: 0 up to the scheme's error"),
+           theory="a floating base under joint forces only: the robot's angular momentum about its centre of mass "
+                  "conserved (gravity has no moment about it): 0 up to the scheme's error"),
     Metric(SELF_PARTING_TIME, "s", PREDICTABILITY,
            theory="when the engine's runs from two starts a perturbation apart part: the chain's own horizon"),
     Metric(REFERENCE_PARTING_TIME, "s", PREDICTABILITY, theory="not before the self-parting time, for a sound engine"),

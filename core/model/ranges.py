@@ -59,6 +59,11 @@ RANGES = {
     "velocity_world": Range(0.0, 1e6, "m/s", "slower than 1000 km/s"),
     "air_velocity_world": Range(0.0, 1e6, "m/s", "slower than 1000 km/s"),
     "angular_velocity_world": Range(0.0, 1e6, "rad/s", "below a million rad/s"),
+    "base_position": _LENGTH,
+    "base_velocity_world": Range(0.0, 1e4, "m/s", "orbital speeds included; faster, the base's speed cancels in the "
+                                 "joints' accelerations and float64 keeps too few of their digits (at 1e6 m/s RK4's "
+                                 "joints part from the reference by 2e-5)"),
+    "base_angular_velocity_world": Range(0.0, 1e6, "rad/s", "below a million rad/s"),
     "gravity_world": Range(0.0, 1e4, "m/s^2", "up to 1000 g"),
     "velocity_scale": Range(1e-9, 1e6, "rad/s or m/s", "a joint speed from 1e-9 to a million per second"),
     "acceleration_scale": Range(1e-9, 1e9, "rad/s^2 or m/s^2", "a joint acceleration from 1e-9 to 1e9"),

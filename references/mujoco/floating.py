@@ -69,17 +69,23 @@ class MujocoFloatingDynamics(MujocoJointDynamics):
         return super().link_kinetic_energy(q, turned_base(base_rotations(q), qdot, False, True, inverse=True))
 
     def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        """``mj_subtreeVel`` at the free body after ``mj_forward``: its subtree's mass x ``subtree_linvel`` (the
-        centre of mass's velocity) and ``subtree_angmom`` (about ``subtree_com``), moved to the world origin."""
+        """:meth:`centroidal_momentum`'s angular part moved from the centre of mass to the world origin."""
+        linear, angular, centre = self.centroidal_momentum(q, qdot)
+        return np.concatenate([linear, angular + np.cross(centre, linear)], axis=1)
+
+    def centroidal_momentum(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(linear momentum, angular momentum about the centre of mass, the centre of mass), each (B, 3) in world
+        axes: ``mj_subtreeVel`` at the free body after ``mj_forward``, its subtree's mass x ``subtree_linvel`` (the
+        centre of mass's velocity), ``subtree_angmom`` (about ``subtree_com``) and ``subtree_com``."""
         m, d = self.model, self.data
         body = int(m.jnt_bodyid[[j for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE][0]])
-        out = np.empty((len(q), 6))
+        out = np.empty((3, len(q), 3))
         for k, (row, rates) in enumerate(zip(q, turned_base(base_rotations(q), qdot, False, True, inverse=True))):
             self._set(row, rates)
             mujoco.mj_subtreeVel(m, d)
-            linear = m.body_subtreemass[body] * d.subtree_linvel[body]
-            out[k] = np.r_[linear, d.subtree_angmom[body] + np.cross(d.subtree_com[body], linear)]
-        return out
+            out[:, k] = (m.body_subtreemass[body] * d.subtree_linvel[body], d.subtree_angmom[body],
+                         d.subtree_com[body])
+        return out[0], out[1], out[2]
 
     def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
         """``mjd_inverseFD`` in MuJoCo's own coordinates (its q tangent: position in world axes, the quaternion turned

@@ -252,7 +252,8 @@ class MujocoJointMotion(JointSimulation):
         return out
 
     def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        """A floating base's: :meth:`MujocoFloatingDynamics.momentum` (``mj_subtreeVel``) on the same model."""
+        """A floating base's: :meth:`MujocoFloatingDynamics.centroidal_momentum` (``mj_subtreeVel``)."""
         if self._floating is None:
             raise NotImplementedError("a fixed base's momentum is not conserved: it is not reported")
-        return self._floating.momentum(q, qdot)
+        linear, angular, _ = self._floating.centroidal_momentum(q, qdot)
+        return np.concatenate([linear, angular], axis=1)

@@ -97,15 +97,19 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
         return out
 
     def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        """``computeCentroidalMomentum``: ``hg`` (linear, angular about the centre of mass ``com[0]``, world axes),
-        the angular part moved to the world origin."""
+        """:meth:`centroidal_momentum`'s angular part moved from the centre of mass to the world origin."""
+        linear, angular, centre = self.centroidal_momentum(q, qdot)
+        return np.concatenate([linear, angular + np.cross(centre, linear)], axis=1)
+
+    def centroidal_momentum(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(linear momentum, angular momentum about the centre of mass, the centre of mass), each (B, 3) in world
+        axes: ``computeCentroidalMomentum``'s ``hg`` and ``com[0]``."""
         velocity = turned_base(base_rotations(q), qdot, True, True, inverse=True)
-        out = np.empty((len(q), 6))
+        out = np.empty((3, len(q), 3))
         for k, (row, rates) in enumerate(zip(q, velocity)):
             momentum = pin.computeCentroidalMomentum(self.model, self.data, self.configuration(row), self._vector(rates))
-            linear = np.array(momentum.linear)
-            out[k] = np.r_[linear, np.array(momentum.angular) + np.cross(self.data.com[0], linear)]
-        return out
+            out[:, k] = np.array(momentum.linear), np.array(momentum.angular), self.data.com[0]
+        return out[0], out[1], out[2]
 
     def derivatives(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> DynamicsDerivatives:
         """``computeRNEADerivatives`` in the free flyer's LOCAL coordinates (its tangent R exp(δφ), its velocity and

@@ -11,8 +11,10 @@ combination of stage velocities taken at different configurations would not keep
 - ``explicit_euler``, ``semi_implicit_euler``, ``rk4``: as :mod:`references.pinocchio.joint_motion`'s (the same names,
   orders and stages) on that state.
 - ``dop853`` / ``dop853_coarse``: ``scipy.integrate.solve_ivp(method="DOP853")`` at rtol 1e-13 / 1e-11 on (q, qdot)
-  in R^(13 + 2n), atol the same on q and per the scene's duration on qdot, the quaternion normalised at each sample:
-  the tight reference and its error floor.
+  in R^(13 + 2n), atol the same on q and on qdot that times the larger of 1 / duration and the largest initial speed
+  (a base thrown at 1 km/s carries its velocity through the base-frame terms that cancel in the joints' accelerations:
+  their rounding, eps x that speed, would stall a solve asked for less), the quaternion normalised at each sample: the
+  tight reference and its error floor. A non-finite state (a diverged run) makes every later one NaN.
 - The joints' applied forces: the scene's constant ones (a timed torque at each stage's time); none on the base.
 - Energy: kinetic 1/2 v^T M v (Pinocchio's ``crba`` turned to the project's velocity), potential
   ``computePotentialEnergy``; momentum ``computeCentroidalMomentum``; the end effector's world position by
@@ -60,6 +62,8 @@ class PinocchioFloatingMotion(JointSimulation):
     def _acceleration(self, q: np.ndarray, qdot: np.ndarray, t: float, step_start: float) -> np.ndarray:
         """(1, 6 + n) qddot at stage time t of the step starting at ``step_start``: the joints' applied forces,
         none on the base; the stage's quaternion normalised."""
+        if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qdot))):  # a diverged run: NaN on, never a raise
+            return np.full(np.shape(qdot), np.nan)
         scene = self._scene
         joints = scene.torque if scene.timed_torque is None else (
             scene.torque + time_loads.at(scene.timed_torque, t, step_start))
@@ -114,7 +118,8 @@ class PinocchioFloatingMotion(JointSimulation):
             q, v = y[None, :nq], y[None, nq:]
             return np.concatenate([configuration_rate(q, v)[0], self._acceleration(q, v, t, interval_start)[0]])
 
-        atol = np.concatenate([np.full(nq, tolerance), np.full(len(qdot0), tolerance / end)])
+        speed = max(1.0 / end, float(np.abs(qdot0).max()))
+        atol = np.concatenate([np.full(nq, tolerance), np.full(len(qdot0), tolerance * speed)])
         jumps = time_loads.jump_times([self._scene.timed_torque] if self._scene.timed_torque is not None else [], end)
         starts = np.concatenate([[0.0], jumps])
         y, y0 = np.empty((len(times), nq + len(qdot0))), np.concatenate([q0, qdot0])
@@ -144,4 +149,5 @@ class PinocchioFloatingMotion(JointSimulation):
         return out
 
     def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        return self._dynamics.momentum(q, qdot)
+        linear, angular, _ = self._dynamics.centroidal_momentum(q, qdot)
+        return np.concatenate([linear, angular], axis=1)

@@ -73,8 +73,8 @@ def _momentum(rows: pd.DataFrame) -> list[Block]:
              for _, r in finest.iterrows()}
     cases = list(dict.fromkeys(zip(finest["engine"], finest["integrator"])))
     return [Paragraph(f"Momentum at dt = {finest['dt'].iloc[0]:g} s: joint forces are internal, so each engine's own "
-                      "momentum keeps its law (linear: grows by m g t; angular about a fixed point: conserved "
-                      "without gravity); its drift relative to the momentum the motion can carry."),
+                      "momentum keeps its law (linear: grows by m g t; angular about the centre of mass: "
+                      "conserved); its drift relative to the momentum the motion about the centre of mass carries."),
             Table(("engine", "integrator", "linear momentum drift", "angular momentum drift"),
                   tuple((e, i, cells.get((e, i, LINEAR_MOMENTUM_DRIFT_MAX), "—"),
                          cells.get((e, i, CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX), "—")) for e, i in cases))]

@@ -317,6 +317,10 @@ def test_a_floating_base_starts_where_its_file_puts_it_in_si():
     ("initial.base_quat_wxyz", [1.0, 0.1, 0.0, 0.0], "initial.base_quat_wxyz", "a unit quaternion"),
     ("initial.base_position", [1.0, 2.0], "initial.base_position", "a list of 3 numbers"),
     ("simulation.perturbation", 1e-4, "simulation.perturbation", "compared against the reference only"),
+    ("initial.base_position", [1e9, 0.0, 0.0], "initial.base_position[0]", "a scene within 1000 km"),
+    ("initial.base_velocity_world", [2e4, 0.0, 0.0], "initial.base_velocity_world[0]", "orbital speeds included"),
+    ("initial.base_angular_velocity_world", [0.0, 2e6, 0.0], "initial.base_angular_velocity_world[1]",
+     "below a million rad/s"),
 ])
 def test_a_floating_base_s_bad_start_is_refused_in_one_line(path, value, key, words):
     with pytest.raises(SceneError) as caught:

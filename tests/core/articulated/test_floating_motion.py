@@ -1,6 +1,6 @@
 """Core's floating base stepped through time (core/articulated/stepping.py, core/articulated/motion.py, issue #46)
 against laws that need no engine: joint forces are internal, so a robot in free flight keeps its linear momentum and
-its angular momentum about a fixed point; under gravity it moves as in free flight (the equivalence principle), its
+its angular momentum about its centre of mass; under gravity it moves as in free flight (the equivalence principle), its
 momentum growing by m g t; a robot translating with its joints at rest moves on a straight line at constant speed. Against the other engines: tests/references/
 test_floating_motion_engines.py."""
 
