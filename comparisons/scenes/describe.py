@@ -113,12 +113,19 @@ def _joint_motion_lines(scene: JointMotionScene) -> list[str]:
     accuracy = (f"self-consistency over {scene.segments} segments (each engine against itself at a 16 x smaller step)"
                 if scene.segments else "against the reference")
     timed = scene.timed_torque
-    lines = [f"gravity_world {gravity} (in the base frame); joint torques {_vector(scene.torque)} (constant)"
+    chain, base = scene.chain, scene.chain.base_inertia
+    frame = "world" if chain.floating_base else "base"
+    lines = [f"gravity_world {gravity} (in the {frame} frame); joint torques {_vector(scene.torque)} (constant)"
              + (f" + timed {function_text(timed, 'N m or N')}" if timed is not None else ""),
              f"q0 {_vector(scene.q0[0])}; qdot0 {_vector(scene.qdot0[0])}"
              + (f" ({scene.copies} copies)" if scene.copies > 1 else ""),
              f"duration {scene.duration:.10g} s; dt {', '.join(f'{dt:.10g}' for dt in scene.dts)} s; accuracy {accuracy}"]
-    return lines + _link_lines(scene.chain)
+    if chain.floating_base and base is not None:
+        lines.append(f"floating base {chain.base_link}: q0 starts with its origin [m] and quat_wxyz, qdot0 with its "
+                     f"origin's velocity and its angular velocity in world axes; no force on it; mass "
+                     f"{base.mass:.10g} kg, centre of mass {_vector(base.com_xyz)} m, inertia diagonal "
+                     f"{_vector(np.diag(base.inertia_com))} kg m^2 (everything welded to it and the held branches)")
+    return lines + _link_lines(chain)
 
 
 def _link_lines(chain: Chain) -> list[str]:
