@@ -27,16 +27,15 @@ from collections.abc import Callable
 
 import numpy as np
 import pinocchio as pin
-from scipy.integrate import solve_ivp
 
 from simparity.core.model.engine import BatchedRun, JointSimulation
-from simparity.core.model.errors import DivergedError, NotBatchedError
+from simparity.core.model.errors import NotBatchedError
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common import time_loads
 from simparity.references.common.floating_base import BASE_V, configuration_rate, unit_quaternions
 from simparity.references.pinocchio.floating import PinocchioFloatingDynamics
-from simparity.references.pinocchio.joint_motion import TOLERANCES
+from simparity.references.pinocchio.joint_motion import TOLERANCES, solve_piecewise
 
 Step = Callable[[float, np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
 """(t, q (1, 7 + n), qdot (1, 6 + n)) -> the state after dt."""
@@ -120,19 +119,8 @@ class PinocchioFloatingMotion(JointSimulation):
 
         speed = max(1.0 / end, float(np.abs(qdot0).max()))
         atol = np.concatenate([np.full(nq, tolerance), np.full(len(qdot0), tolerance * speed)])
-        jumps = time_loads.jump_times([self._scene.timed_torque] if self._scene.timed_torque is not None else [], end)
-        starts = np.concatenate([[0.0], jumps])
-        y, y0 = np.empty((len(times), nq + len(qdot0))), np.concatenate([q0, qdot0])
-        for a, b in zip(starts, np.append(jumps, end)):
-            last = b == end
-            inside = (times >= a) & ((times < b) | last)
-            t_eval = times[inside] if last else np.append(times[inside], b)
-            sol = solve_ivp(derivative, (a, b), y0, method="DOP853", t_eval=t_eval, rtol=tolerance, atol=atol,
-                            args=(a,))
-            if not sol.success:
-                raise DivergedError(f"pinocchio {self._integrator}: DOP853 failed: {sol.message}")
-            y[inside] = sol.y.T if last else sol.y[:, :-1].T
-            y0 = sol.y[:, -1]
+        y = solve_piecewise(derivative, np.concatenate([q0, qdot0]), times, self._scene.timed_torque, tolerance, atol,
+                            f"pinocchio {self._integrator}")
         return unit_quaternions(y[:, :nq]), y[:, nq:]
 
     def energy(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -42,6 +42,7 @@ from scipy.integrate import solve_ivp
 from simparity.core.model.engine import BatchedRun, JointSimulation
 from simparity.core.model.errors import DivergedError, NotBatchedError
 from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.scenes.time_functions import TimeFunction
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common import time_loads
 from simparity.references.pinocchio.joint_dynamics import ChainModel, chain_model
@@ -70,6 +71,27 @@ reference, and the coarser solve that measures its error floor."""
 
 State = tuple[np.ndarray, np.ndarray]
 """(Pinocchio configuration (nq,), velocity (nv,))."""
+
+
+def solve_piecewise(derivative: Callable[[float, np.ndarray, float], np.ndarray], y0: np.ndarray, times: np.ndarray,
+                    timed: TimeFunction | None, tolerance: float, atol: np.ndarray, label: str) -> np.ndarray:
+    """(T, len(y0)): y at ``times`` (T,) [s] by DOP853 at rtol ``tolerance`` and ``atol``, one solve per interval
+    between the jumps of a held torque ``timed`` (none: one solve), each from where the one before ended;
+    ``derivative(t, y, interval_start)``. A failed solve raises :class:`DivergedError` naming ``label``."""
+    end = times[-1]
+    jumps = time_loads.jump_times([timed] if timed is not None else [], end)
+    starts = np.concatenate([[0.0], jumps])
+    y = np.empty((len(times), len(y0)))
+    for a, b in zip(starts, np.append(jumps, end)):
+        last = b == end
+        inside = (times >= a) & ((times < b) | last)
+        t_eval = times[inside] if last else np.append(times[inside], b)  # a jump's instant: where the next starts
+        sol = solve_ivp(derivative, (a, b), y0, method="DOP853", t_eval=t_eval, rtol=tolerance, atol=atol, args=(a,))
+        if not sol.success:
+            raise DivergedError(f"{label}: DOP853 failed: {sol.message}")
+        y[inside] = sol.y.T if last else sol.y[:, :-1].T
+        y0 = sol.y[:, -1]
+    return y
 
 
 class PinocchioJointMotion(JointSimulation):
@@ -172,20 +194,9 @@ class PinocchioJointMotion(JointSimulation):
         """One copy by DOP853 from (q0, qdot0) ((n,) each): (q, qdot), (T, n) each at ``times`` (T,) [s]; one solve
         per interval between a held torque's jumps, each from where the one before ended."""
         tolerance = TOLERANCES[self._integrator]
-        n, end = len(q0), times[-1]
-        jumps = time_loads.jump_times([self._timed] if self._timed is not None else [], end)
-        starts = np.concatenate([[0.0], jumps])
-        y, y0 = np.empty((len(times), 2 * n)), np.concatenate([q0, qdot0])
-        for a, b in zip(starts, np.append(jumps, end)):
-            last = b == end
-            inside = (times >= a) & ((times < b) | last)
-            t_eval = times[inside] if last else np.append(times[inside], b)  # a jump's instant: where the next starts
-            sol = solve_ivp(self._derivative, (a, b), y0, method="DOP853", t_eval=t_eval, rtol=tolerance,
-                            atol=self._absolute_tolerance(tolerance, n, end), args=(a,))
-            if not sol.success:
-                raise DivergedError(f"pinocchio {self._integrator}: DOP853 failed: {sol.message}")
-            y[inside] = sol.y.T if last else sol.y[:, :-1].T
-            y0 = sol.y[:, -1]
+        n = len(q0)
+        y = solve_piecewise(self._derivative, np.concatenate([q0, qdot0]), times, self._timed, tolerance,
+                            self._absolute_tolerance(tolerance, n, times[-1]), f"pinocchio {self._integrator}")
         return y[:, :n], y[:, n:]
 
     @staticmethod
