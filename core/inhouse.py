@@ -412,6 +412,10 @@ class InHouseEngine(Engine):
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         return CoreJointMotion(scene, integrator, dt)
 
+    def chain_contact(self, scene: JointMotionScene) -> Support:
+        """The lecture's penalty method at each sphere, through ABA (:mod:`core.articulated.chain_contact`)."""
+        return Support.yes()
+
     def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
         named = super().supports_ik(chain, solver, position_only)
         task = 3 if position_only else 6

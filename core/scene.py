@@ -3,6 +3,7 @@
 
 from simparity.core.model.scenes.bodies import *  # noqa: F401,F403
 from simparity.core.model.scenes.chain import *  # noqa: F401,F403
+from simparity.core.model.scenes.chain_contact import *  # noqa: F401,F403
 from simparity.core.model.scenes.contact import *  # noqa: F401,F403
 from simparity.core.model.scenes.dynamics import *  # noqa: F401,F403
 from simparity.core.model.scenes.ik import *  # noqa: F401,F403

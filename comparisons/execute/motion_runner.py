@@ -28,6 +28,7 @@ from simparity.comparisons.measure.joint_motion_metrics import (
     REFERENCE_ERRORS, Horizon, OwnReading, divergence, energy_metrics, momentum_metrics, motion_metrics, parting_times,
     reach, read_own, reference_errors, reference_horizon, state_scales,
 )
+from simparity.comparisons.measure.chain_contact_metrics import contact_metrics
 from simparity.comparisons.measure.held_forcing import forcing_scheme
 from simparity.comparisons.measure.step_jacobian_metrics import STEP_JACOBIAN_METRICS
 from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
@@ -46,6 +47,9 @@ COARSE_SUFFIX = "_coarse"
 """A reference integrator ``x`` whose engine also offers ``x_coarse`` (the same solve at a looser tolerance) has a
 horizon: where the two part, the reference's own error has grown past use (:func:`reference_horizon`)."""
 
+NO_CONTACT_REFERENCE = ("a scene with contact is run against no reference: each engine's contact is its own (core's "
+                        "penalty springs, MuJoCo's soft constraints), so each is held to truths that need no engine "
+                        "(the contact metrics)")
 REFINEMENT = 16
 """A self-consistency case compares dt with dt / 16: a first-order scheme's error at dt / 16 is 1/16 of its error
 at dt, so the difference measures the coarse run's error within 7 %; a fourth-order one's within 1e-5."""
@@ -96,6 +100,8 @@ def prepare_motion(group: CaseGroup, engine_for: EngineFor, reference_failure: s
     integrator = label.split(":", 1)[1]
     if reference_failure:
         return MotionShared(None, None, None, None, (f"reference {label} failed: {reference_failure}", FAILED))
+    if scene.contact is not None:
+        return MotionShared(None, None, None, None, (NO_CONTACT_REFERENCE, NOT_AVAILABLE))
     reference = engine_for(scene.reference)
     try:
         support = (reference.supports_joint_motion(scene, integrator) if integrator != NO_INTEGRATOR else
@@ -219,9 +225,12 @@ def _measured(scene: JointMotionScene, engine: Engine, sim: JointSimulation, cas
         blown = divergence(scene, traj, own)
     if blown or own is None:
         return CaseOutcome(case.rows(metrics, DIVERGED, f"{blown}; {sim.detail}", values))
-    values.update(energy_metrics(scene, traj, own))
+    if scene.contact is None:
+        values.update(energy_metrics(scene, traj, own))
     if scene.chain.floating_base:
         values.update(momentum_metrics(scene, sim, traj, own))
+    if scene.contact is not None:
+        values.update(contact_metrics(scene, sim, traj, own))
     detail = ("this is the reference; " if is_reference else "") + sim.detail
     if scene.segments and shared.starts is not None:
         errors = _consistency_errors(scene, engine, case, traj, own, shared.ends)

@@ -44,6 +44,10 @@ class EngineConstant:
 
 
 ENGINE_CONSTANTS = (
+    EngineConstant("mujoco", ("joint_motion",), (TIME, LENGTH, MASS), (
+        "a chain's contact in MuJoCo keeps its default soft-contact constants, solref = (0.02, 1) (a time constant "
+        "in the model's unit of time) and solimp's width 0.001 (in its unit of length; references/mujoco/contact.py): "
+        "in other units the contact is softer or stiffer, its penetration and settling differ")),
     EngineConstant("mujoco", DYNAMICS, (TIME, LENGTH), (
         "MuJoCo's constraint solver stops when its improvement (a cost of mass x acceleration^2, x T^-4) or its "
         "gradient (x T^-2), divided by the mean of the inertia matrix's diagonal (kg and kg m^2 mixed) x nv, falls "

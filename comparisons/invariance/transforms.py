@@ -47,6 +47,7 @@ from simparity.core.model.scenes.contact import Contact, Plane, Shape
 from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
+from simparity.core.model.scenes.chain_contact import ChainContact, ContactSphere, frame_index
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.scenes.kinematics import KinematicsScene
 from simparity.core.model.scenes.time_functions import (
@@ -404,11 +405,29 @@ def _joint_motion_scene(scene: JointMotionScene, t: Transform) -> JointMotionSce
     gravity, timed = scene.gravity_world, scene.timed_torque
     torque_scale = t.length_scale ** (2 - variable) * t.factor(mass=1, time=-2)
     return replace(scene, chain=chain, gravity_world=None if gravity is None else t.vector(gravity, length=1, time=-2),
+                   contact=None if scene.contact is None else _chain_contact(scene, scene.contact, t),
                    q0=t.length_scale ** scene.chain.configuration_length_powers * scene.q0,
                    qdot0=t.length_scale ** scene.chain.length_powers / t.time_scale * scene.qdot0,
                    torque=torque_scale * scene.torque,
                    timed_torque=None if timed is None else _time_function(timed, t, torque_scale, turned=False),
                    duration=t.time_scale * scene.duration, dts=tuple(t.time_scale * dt for dt in scene.dts))
+
+
+def _chain_contact(scene: JointMotionScene, contact: ChainContact, t: Transform) -> ChainContact:
+    """The plane moved with the world; each sphere scaled in its link's frame (the frames move with the chain), one on
+    a fixed base's link placed as a world point (that frame is the world's); core's penalty constants in the new
+    units (N/m = kg/s^2, N s/m = kg/s)."""
+    names = tuple(j.name for j in scene.chain.joints)
+    chain = scene.chain
+
+    def centre(sphere: ContactSphere) -> np.ndarray:
+        on_base = frame_index(sphere.frame, names, chain.end_effector_name, chain.base_link) < 0
+        return t.point(sphere.centre_xyz) if on_base and not chain.floating_base else t.length_scale * sphere.centre_xyz
+    return replace(contact, plane=_plane(contact.plane, t),
+                   spheres=tuple(replace(s, centre_xyz=centre(s), radius=t.length_scale * s.radius)
+                                 for s in contact.spheres),
+                   penalty_stiffness=t.factor(mass=1, time=-2) * contact.penalty_stiffness,
+                   penalty_damping=t.factor(mass=1, time=-1) * contact.penalty_damping)
 
 
 FIXED_SEED = 22

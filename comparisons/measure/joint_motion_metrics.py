@@ -27,7 +27,8 @@ from simparity.comparisons.measure.metrics import (
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointSimulation
 from simparity.core.model.metric_catalogue import (
-    CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, END_EFFECTOR_ERROR_MAX, ENERGY_DRIFT_MAX, EVALUATIONS_PER_SECOND,
+    CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, END_EFFECTOR_ERROR_MAX,
+    FRICTION_CONE_VIOLATION_MAX, REST_WEIGHT_ERROR, SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR, ENERGY_DRIFT_MAX, EVALUATIONS_PER_SECOND,
     LINEAR_MOMENTUM_DRIFT_MAX, JOINT_ANGLE_ERROR_MAX, JOINT_VELOCITY_ERROR_MAX,
     ORDER_JOINT_ANGLE, ORDER_JOINT_VELOCITY, POWER_BALANCE_RESIDUAL_MAX, REFERENCE_PARTING_TIME,
     SEGMENT_REFERENCE_ERROR_MAX, SELF_PARTING_TIME,
@@ -52,6 +53,10 @@ JOINT_MOTION_METRICS = units(
 """Every metric a joint-motion case may have; :func:`motion_metrics` those of one scene."""
 MOMENTUM_METRICS = units(LINEAR_MOMENTUM_DRIFT_MAX, CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX)
 """Of a floating base: its momentum against the laws it obeys under joint forces alone (:func:`momentum_metrics`)."""
+CHAIN_CONTACT_METRICS = units(TOUCHDOWN_TIME_ERROR, CONTACT_PENETRATION_MAX, SIGNORINI_VIOLATION_MAX,
+                              FRICTION_CONE_VIOLATION_MAX, CONTACT_ENERGY_GAIN_MAX, REST_WEIGHT_ERROR)
+"""Of a scene with contact (in place of its energy drift or power balance): truths that need no engine
+(:mod:`comparisons.measure.chain_contact_metrics`)."""
 PREDICTABILITY_METRICS = units(SELF_PARTING_TIME, REFERENCE_PARTING_TIME)
 """Of a scene with a perturbation: when each engine's two runs part, and when it parts from the reference."""
 JOINT_MOTION_ORDERS = units(ORDER_JOINT_ANGLE, ORDER_JOINT_VELOCITY)
@@ -89,11 +94,16 @@ def exchanges_energy(scene: JointMotionScene) -> bool:
 
 def motion_metrics(scene: JointMotionScene) -> dict[str, str]:
     """The metrics of a case of ``scene``: its energy balance as a drift where the chain is conservative, as the
-    power balance where it is damped or driven; a floating base's momentum (:func:`momentum_metrics`)."""
-    left_out = ENERGY_DRIFT_MAX if exchanges_energy(scene) else POWER_BALANCE_RESIDUAL_MAX
-    metrics = {m: u for m, u in JOINT_MOTION_METRICS.items() if m != left_out} | STEP_JACOBIAN_METRICS
+    power balance where it is damped or driven, neither with contact (its energy balance is
+    :data:`CHAIN_CONTACT_METRICS`' gain); a floating base's momentum
+    (:func:`momentum_metrics`)."""
+    left_out = ((ENERGY_DRIFT_MAX, POWER_BALANCE_RESIDUAL_MAX) if scene.contact is not None else
+                (ENERGY_DRIFT_MAX,) if exchanges_energy(scene) else (POWER_BALANCE_RESIDUAL_MAX,))
+    metrics = {m: u for m, u in JOINT_MOTION_METRICS.items() if m not in left_out} | STEP_JACOBIAN_METRICS
     if scene.chain.floating_base:
         metrics |= MOMENTUM_METRICS
+    if scene.contact is not None:
+        metrics |= CHAIN_CONTACT_METRICS
     if scene.segments:
         return metrics | units(SEGMENT_REFERENCE_ERROR_MAX)
     return metrics | (PREDICTABILITY_METRICS if scene.perturbation > 0 else {})
@@ -226,6 +236,11 @@ def _work(scene: JointMotionScene, traj: JointTrajectory) -> tuple[np.ndarray, n
     return work, integral(np.maximum(drive, 0.0), traj.times), floor
 
 
+def work_done(scene: JointMotionScene, traj: JointTrajectory) -> np.ndarray:
+    """(T, B) [J] the work done on the chain from t = 0 by the applied forces less the damping (:func:`_work`'s W)."""
+    return _work(scene, traj)[0]
+
+
 def energy_budget(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading) -> np.ndarray:
     """(B,) [J] the most kinetic energy the exact motion can have: its initial kinetic energy, the largest drop of
     its potential energy along the run and the work the applied forces put in (damping only takes energy); at least
@@ -351,6 +366,13 @@ def momentum_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointT
     gravity = np.zeros(3) if scene.gravity_world is None else np.asarray(scene.gravity_world, dtype=float)
     linear, angular = momentum[..., :3], momentum[..., 3:]
     expected = linear[0] + mass * gravity * (traj.times[own.index] - traj.times[0])[:, None, None]
+    linear_drift, angular_drift = linear - expected, angular - angular[0]
+    along = ""
+    if scene.contact is not None:  # a frictionless plane pushes along its normal N: only these components are kept
+        normal = np.asarray(scene.contact.plane.normal_world)
+        linear_drift = linear_drift - (linear_drift @ normal)[..., None] * normal
+        angular_drift = (angular_drift @ normal)[..., None]
+        along = "the components a frictionless plane leaves alone: P along the plane, L along its normal"
     size = np.linalg.norm(linear, axis=-1)  # (S, B)
     internal = float(np.max(own.kinetic - size**2 / (2.0 * mass)))
     scale = math.sqrt(2.0 * mass * max(internal, 0.0))
@@ -364,6 +386,10 @@ def momentum_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointT
 
     def relative(drift: float, size: float, floor: float, what: str) -> Measured:
         ratio = drift / size
+        if along and ratio <= floor:
+            return Measured(ratio, "1", flag=ROUNDING_FLOOR, note=f"{along}; at the rounding floor ({floor:.2g})")
+        if along and ratio <= SATURATED_DRIFT:
+            return Measured(ratio, "1", note=along)
         if ratio > SATURATED_DRIFT:
             return Measured(ratio, "1", flag=SATURATED, unmeasurable=(
                 f"saturated: the {what} drifts {ratio:.3g} x the momentum the motion can carry "
@@ -374,9 +400,9 @@ def momentum_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointT
                 "position's size): exact up to it"))
         return Measured(ratio, "1")
     return {
-        LINEAR_MOMENTUM_DRIFT_MAX: relative(float(np.linalg.norm(linear - expected, axis=-1).max()), scale,
+        LINEAR_MOMENTUM_DRIFT_MAX: relative(float(np.linalg.norm(linear_drift, axis=-1).max()), scale,
                                             unit * carried, "linear momentum"),
-        CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX: relative(float(np.linalg.norm(angular - angular[0], axis=-1).max()),
+        CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX: relative(float(np.linalg.norm(angular_drift, axis=-1).max()),
                                                    scale * length, unit * carried * max(1.0, distance / length),
                                                    "angular momentum about the centre of mass"),
     }

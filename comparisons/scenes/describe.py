@@ -111,7 +111,8 @@ def _joint_dynamics_lines(scene: JointDynamicsScene) -> list[str]:
 def _joint_motion_lines(scene: JointMotionScene) -> list[str]:
     gravity = "none" if scene.gravity_world is None else f"{_vector(scene.gravity_world)} m/s^2"
     accuracy = (f"self-consistency over {scene.segments} segments (each engine against itself at a 16 x smaller step)"
-                if scene.segments else "against the reference")
+                if scene.segments else "truths that need no engine (contact)" if scene.contact is not None
+                else "against the reference")
     timed = scene.timed_torque
     chain, base = scene.chain, scene.chain.base_inertia
     frame = "world" if chain.floating_base else "base"
@@ -125,6 +126,14 @@ def _joint_motion_lines(scene: JointMotionScene) -> list[str]:
                      f"origin's velocity and its angular velocity in world axes; no force on it; mass "
                      f"{base.mass:.10g} kg, centre of mass {_vector(base.com_xyz)} m, inertia diagonal "
                      f"{_vector(np.diag(base.inertia_com))} kg m^2 (everything welded to it and the held branches)")
+    contact = scene.contact
+    if contact is not None:
+        lines.append(f"contact: plane {contact.plane.name} (normal {_vector(contact.plane.normal_world)}, offset "
+                     f"{contact.plane.offset:.10g} m), frictionless; spheres "
+                     + "; ".join(f"{s.frame} at {_vector(s.centre_xyz)} m, radius {s.radius:.10g} m"
+                                 for s in contact.spheres)
+                     + f"; core's penalty k_s {contact.penalty_stiffness:.10g} N/m, k_d {contact.penalty_damping:.10g} "
+                     "N s/m; no reference: each engine against truths that need no engine")
     return lines + _link_lines(chain)
 
 

@@ -7,6 +7,7 @@ import numpy as np
 
 from simparity.core.articulated import stepping
 from simparity.core.articulated.chain_arrays import chain_arrays
+from simparity.core.articulated.chain_contact import ChainContactForces
 from simparity.core.articulated.floating import FloatingRecursiveDynamics
 from simparity.core.articulated.model import RecursiveDynamics
 from simparity.core.articulated.recursive import Recursive
@@ -30,12 +31,16 @@ class CoreJointMotion(JointSimulation):
         chain = scene.chain
         self._floating = FloatingRecursiveDynamics(chain, self._gravity) if chain.floating_base else None
         self._dynamics = Recursive(chain_arrays(chain), self._gravity)
+        self._contact = ChainContactForces(chain, scene.contact) if scene.contact is not None else None
         self._masses = np.array([j.link.mass if j.link is not None else 0.0 for j in chain.joints])
         self._coms = np.array([j.link.com_xyz if j.link is not None else np.zeros(3) for j in chain.joints])
         self.detail = (f"in-house {scheme} on (q, qdot), qddot by ABA (Featherstone), batched over copies"
                        + ("; damping by ABA with armature + dt D" if scheme == stepping.IMPLICIT_DAMPING else "")
                        + ("; the floating base's quaternion stepped in R^4 by dq/dt = 1/2 (0, omega) q and "
-                          "normalised after each step" if chain.floating_base else ""))
+                          "normalised after each step" if chain.floating_base else "")
+                       + (f"; contact by the penalty method at each sphere, k_s = {scene.contact.penalty_stiffness:g} "
+                          f"N/m, k_d = {scene.contact.penalty_damping:g} N s/m, frictionless, through ABA as J^T F"
+                          if scene.contact is not None else ""))
 
     def run(self, n_steps: int) -> JointTrajectory:
         q, qdot = stepping.run(self._step, np.asarray(self._scene.q0), np.asarray(self._scene.qdot0), n_steps,
@@ -46,6 +51,8 @@ class CoreJointMotion(JointSimulation):
         """Carried analytically through the scheme with core's derivatives (:mod:`core.articulated.step_jacobian`;
         implicit damping on the chain with armature + dt D, as it steps); not for a floating base yet."""
         chain = self._scene.chain
+        if self._contact is not None:
+            raise NotImplementedError("core's step Jacobian is not carried through contact forces yet")
         if chain.floating_base:
             raise NotImplementedError("core's step Jacobian is carried on a fixed base only (a floating base's "
                                       "quaternion step is not differentiated yet)")
@@ -89,6 +96,18 @@ class CoreJointMotion(JointSimulation):
         n = self._scene.chain.n_joints
         tip = np.asarray(forward_kinematics(self._scene.chain, q[:, q.shape[1] - n:]).position_world[:, -1])
         return _placed(q, tip[:, None])[:, 0] if self._floating is not None else tip
+
+    def contact_centres(self, q: np.ndarray) -> np.ndarray:
+        """The spheres' centres by core's FK (:class:`ChainContactForces`)."""
+        if self._contact is None:
+            raise NotImplementedError("the scene has no contact")
+        return self._contact.centres_world(np.ascontiguousarray(np.asarray(q, dtype=float).T))
+
+    def contact_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """The penalty force on each sphere at the state (:class:`ChainContactForces`)."""
+        if self._contact is None:
+            raise NotImplementedError("the scene has no contact")
+        return self._contact.forces_world(*(np.ascontiguousarray(np.asarray(x, dtype=float).T) for x in (q, qdot)))
 
     def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         """Core's floating-base momentum (:meth:`FloatingRecursiveDynamics.momentum`: each body's I v summed, about the

@@ -35,6 +35,7 @@ from typing import Callable
 import numpy as np
 
 from simparity.core.articulated.chain_arrays import chain_arrays
+from simparity.core.articulated.chain_contact import ChainContactForces
 from simparity.core.articulated.floating import FloatingRecursiveDynamics
 from simparity.core.articulated.recursive import Recursive
 from simparity.core.dynamics.time_loads import value_in_step
@@ -145,6 +146,7 @@ def stepper(scene: JointMotionScene, scheme: str, dt: float) -> Step:
     rate, project = (configuration_rate, normalised) if floating else (_fixed_rate, _unchanged)
     dynamics = _forward_dynamics(scene.chain, gravity)
     constant, timed = scene.torque[:, None], scene.timed_torque
+    contact = ChainContactForces(scene.chain, scene.contact) if scene.contact is not None else None
 
     def torque(qdot: np.ndarray, t: float, step_start: float) -> np.ndarray:
         """The applied forces (nv, B) at stage time t: the joints', none on a floating base."""
@@ -153,8 +155,13 @@ def stepper(scene: JointMotionScene, scheme: str, dt: float) -> Step:
             joints = np.concatenate([np.zeros((6, 1)), joints])
         return np.broadcast_to(joints, qdot.shape)
 
+    def applied(q: np.ndarray, qdot: np.ndarray, t: float, step_start: float) -> np.ndarray:
+        """The applied forces and, with contact, the plane's generalized force at the state (nv, B)."""
+        tau = torque(qdot, t, step_start)
+        return tau if contact is None else tau + contact.generalized(normalised(q) if floating else q, qdot)
+
     def qddot(q: np.ndarray, qdot: np.ndarray, t: float, step_start: float) -> np.ndarray:
-        return dynamics(q, qdot, torque(qdot, t, step_start))
+        return dynamics(q, qdot, applied(q, qdot, t, step_start))
 
     if scheme in RUNGE_KUTTA:
         return runge_kutta(TABLEAUX[scheme], qddot, dt, rate, project)
@@ -167,7 +174,7 @@ def stepper(scene: JointMotionScene, scheme: str, dt: float) -> Step:
         implicit = _forward_dynamics(damped_armature(scene.chain, dt), gravity)
 
         def implicit_damping(t: float, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            qdot = qdot + dt * implicit(q, qdot, torque(qdot, t, t))
+            qdot = qdot + dt * implicit(q, qdot, applied(q, qdot, t, t))
             return project(q + dt * rate(q, qdot)), qdot
         return implicit_damping
     raise ValueError(f"unknown joint-motion integrator {scheme!r} (allowed: {', '.join(SCHEMES)})")

@@ -221,6 +221,18 @@ class JointSimulation(abc.ABC):
         Not timed. Optional: the momentum metrics are n/a where an engine does not say."""
         raise NotImplementedError(f"{type(self).__name__} does not report a floating base's momentum (momentum)")
 
+    def contact_centres(self, q: np.ndarray) -> np.ndarray:
+        """(B, S, 3) [m]: the centres of the scene's contact spheres (``scene.contact.spheres``) in the world at
+        configurations q (B, nq), by the engine's own forward kinematics. Not timed. A scene with contact needs it:
+        without it every contact metric is n/a."""
+        raise NotImplementedError(f"{type(self).__name__} does not report its contact spheres (contact_centres)")
+
+    def contact_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """(B, S, 3) [N]: the force the plane exerts on each contact sphere, in world axes, at states q (B, nq) and
+        qdot (B, nv) (zero where a sphere does not touch), as the engine's contact model gives it at that state. Not
+        timed. Optional: the contact-force metrics are n/a where an engine does not say."""
+        raise NotImplementedError(f"{type(self).__name__} does not report its contact forces (contact_forces)")
+
     def step_jacobian(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> StepJacobian:
         """The Jacobian of one step of this simulation's scheme and time step at B states q, qdot ((B, n) each) under
         joint forces ``tau`` (B, n) held over the step (the scene's timed torque left out): ∂(q', q̇')/∂(q, q̇) and
@@ -466,9 +478,19 @@ class Engine(abc.ABC):
         return ()
 
     def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
-        """Whether :meth:`build_joint_motion` can step ``scene`` with ``integrator``."""
-        return _offered(self.joint_motion_integrators(), integrator, f"{self.name} steps no chain through time",
-                        f"{self.name} has no joint-motion integrator")
+        """Whether :meth:`build_joint_motion` can step ``scene`` with ``integrator``; a scene with contact only where
+        the engine says :meth:`chain_contact` (its contact reason otherwise)."""
+        offered = _offered(self.joint_motion_integrators(), integrator, f"{self.name} steps no chain through time",
+                           f"{self.name} has no joint-motion integrator")
+        if offered.ok and scene.contact is not None:
+            return self.chain_contact(scene)
+        return offered
+
+    def chain_contact(self, scene: JointMotionScene) -> Support:
+        """Whether the engine puts ``scene.contact``'s spheres and plane into its steps (and reports
+        :meth:`JointSimulation.contact_centres` and, optionally, :meth:`JointSimulation.contact_forces`); no by
+        default: an engine that does overrides this."""
+        return Support.no(f"{self.name} declares no contact of a chain's spheres with a plane (Engine.chain_contact)")
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         """Build ``scene`` for stepping with ``integrator`` at ``dt`` [s] (not timed). Call only when supported."""

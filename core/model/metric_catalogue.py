@@ -168,6 +168,13 @@ REST_TIME_ERROR = "rest_time_error"
 REST_JITTER = "rest_jitter"
 STOPPING_DISTANCE = "stopping_distance"
 STOPPING_DISTANCE_ERROR = "stopping_distance_error"
+# A chain's contact spheres on a plane (issue #46): truths that need no engine.
+TOUCHDOWN_TIME_ERROR = "touchdown_time_error"
+CONTACT_PENETRATION_MAX = "contact_penetration_max"
+SIGNORINI_VIOLATION_MAX = "signorini_violation_max"
+FRICTION_CONE_VIOLATION_MAX = "friction_cone_violation_max"
+CONTACT_ENERGY_GAIN_MAX = "contact_energy_gain_max"
+REST_WEIGHT_ERROR = "rest_weight_error"
 # IK: a solver's outcome on its targets, judged by the harness.
 SOLVE_RATE = "solve_rate"
 SOLVE_RATE_OWN_STOP = "solve_rate_own_stop"
@@ -289,6 +296,17 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(SELF_PARTING_TIME, "s", PREDICTABILITY,
            theory="when the engine's runs from two starts a perturbation apart part: the chain's own horizon"),
     Metric(REFERENCE_PARTING_TIME, "s", PREDICTABILITY, theory="not before the self-parting time, for a sound engine"),
+    Metric(TOUCHDOWN_TIME_ERROR, DIMENSIONLESS, CONTACT,
+           theory="a robot falling at rest as one body touches down at the closed-form time: 0 up to the scheme's "
+                  "error"),
+    Metric(CONTACT_PENETRATION_MAX, DIMENSIONLESS, CONTACT,
+           theory="soft contact penetrates: each engine's own stiffness; past 1 a sphere has sunk through its radius"),
+    Metric(SIGNORINI_VIOLATION_MAX, DIMENSIONLESS, CONTACT,
+           theory="a plane pushes only on a touching sphere and never pulls: 0"),
+    Metric(FRICTION_CONE_VIOLATION_MAX, DIMENSIONLESS, CONTACT, theory="inside the Coulomb cone: 0"),
+    Metric(CONTACT_ENERGY_GAIN_MAX, DIMENSIONLESS, CONTACT,
+           theory="contact and damping only take energy: 0 up to the scheme's error"),
+    Metric(REST_WEIGHT_ERROR, DIMENSIONLESS, CONTACT, theory="at rest the plane carries the weight: 0"),
     Metric(IMPACT_TIME_ERROR, "s", CONTACT),
     Metric(REBOUND_VELOCITY_ERROR, "m/s", CONTACT),
     Metric(APEX_HEIGHT_ERROR, "m", CONTACT),

@@ -454,6 +454,10 @@ class MujocoEngine(Engine):
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         return joint_motion.MujocoJointMotion(scene, integrator, dt)
 
+    def chain_contact(self, scene: JointMotionScene) -> Support:
+        """MuJoCo's soft contact on sphere and plane geoms (:mod:`references.mujoco.contact`)."""
+        return Support.yes()
+
     def ik_solvers(self) -> tuple[str, ...]:
         return mujoco_ik.SOLVERS
 

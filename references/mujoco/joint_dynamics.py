@@ -53,14 +53,17 @@ from simparity.core.model.engine import JointDynamicsModel
 from simparity.core.model.derivatives import DynamicsDerivatives, FiniteDifferences
 from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.chain_contact import ChainContact
 from simparity.references.common.conventions import fmt
 from simparity.references.common.dynamics_mjcf import dynamics_mjcf
 from simparity.references.common.dynamics_urdf import chain_joint_names, dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
 from simparity.references.common.rigid_groups import summed
+from simparity.references.mujoco.contact import add_contact
 
 
-def _compiled(chain: Chain, gravity_world: np.ndarray | None, motors: bool = False) -> mujoco.MjModel:
+def _compiled(chain: Chain, gravity_world: np.ndarray | None, motors: bool = False,
+              contact: ChainContact | None = None) -> mujoco.MjModel:
     """The chain's dynamics model with the compiler options of the module docstring; raises MuJoCo's error. With
     ``motors``, a motor (gear 1, no control limits) on each chain joint in the chain's order: ctrl is τ, for
     ``mjd_transitionFD``'s control block (a URDF declares no actuator)."""
@@ -82,6 +85,8 @@ def _compiled(chain: Chain, gravity_world: np.ndarray | None, motors: bool = Fal
         spec.option.integrator = mujoco.mjtIntegrator.mjINT_EULER  # an MJCF file's RK4: mjd_inverseFD refuses it
         if chain.floating_base:
             spec.worldbody.first_body().add_freejoint()
+        if contact is not None:
+            add_contact(spec, chain, contact)
         for name in chain_joint_names(chain) if motors else ():
             motor = spec.add_actuator()
             motor.name, motor.trntype, motor.target = f"simparity_motor_{name}", mujoco.mjtTrn.mjTRN_JOINT, name
@@ -122,8 +127,9 @@ class ChainModel:
         What MuJoCo was given, for the rows' detail.
     """
 
-    def __init__(self, chain: Chain, gravity_world: np.ndarray | None, motors: bool = False) -> None:
-        model = _compiled(chain, gravity_world, motors)
+    def __init__(self, chain: Chain, gravity_world: np.ndarray | None, motors: bool = False,
+                 contact: ChainContact | None = None) -> None:
+        model = _compiled(chain, gravity_world, motors, contact)
         joints = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name) for name in chain_joint_names(chain)]
         self.dof, self.qpos = model.jnt_dofadr[joints], model.jnt_qposadr[joints]
         model.dof_damping[:] = 0.0

@@ -50,6 +50,8 @@ from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common.conventions import fmt
 from simparity.references.common import time_loads
 from simparity.references.common.floating_base import base_rotations, turned_base
+from simparity.references.mujoco.contact import DETAIL as CONTACT_DETAIL
+from simparity.references.mujoco.contact import ContactReader
 from simparity.references.mujoco.floating import MujocoFloatingDynamics
 from simparity.references.mujoco.joint_dynamics import ChainModel
 from simparity.references.mujoco.stage_loads import DETAIL as STAGE_DETAIL
@@ -98,8 +100,9 @@ class MujocoJointMotion(JointSimulation):
 
     def __init__(self, scene: JointMotionScene, integrator: str, dt: float) -> None:
         self._scene, self._integrator = scene, integrator
-        built = ChainModel(scene.chain, scene.gravity_world)
+        built = ChainModel(scene.chain, scene.gravity_world, contact=scene.contact)
         self.model, self._dof, self._qpos = built.model, built.dof, built.qpos
+        self._contact = ContactReader(self.model, scene.contact) if scene.contact is not None else None
         self._floating = MujocoFloatingDynamics(scene.chain, scene.gravity_world) if scene.chain.floating_base else None
         if self._floating is not None:
             self._dof, self._qpos = self._floating.state_dof, self._floating.state_qpos
@@ -126,7 +129,8 @@ class MujocoJointMotion(JointSimulation):
                        + "; no velocity clipping; a MuJoCo warning (bad state, reset) raises "
                        "DivergedError; energy by mj_mulM and -sum m g.xipos; end effector by mj_kinematics"
                        + ("; the base a free joint, its body-frame angular velocity turned to world axes; momentum "
-                          "by mj_subtreeVel" if self._floating is not None else ""))
+                          "by mj_subtreeVel" if self._floating is not None else "")
+                       + (f"; {CONTACT_DETAIL}" if self._contact is not None else ""))
 
     def _own(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         """MuJoCo's qvel rows of the project's (B, nv): a floating base's angular velocity turned into its body frame
@@ -195,6 +199,9 @@ class MujocoJointMotion(JointSimulation):
         is τ; the stepping model has none), at B states with qfrc_applied 0: A's and B's rows and columns of the
         chain's dofs (MuJoCo's x = (the q tangent, qvel): a hinge's or slide's tangent is its qpos)."""
         kind, disabled = INTEGRATORS[self._integrator]
+        if self._contact is not None:
+            raise NotImplementedError("the step Jacobian with contact is not compared yet (mjd_transitionFD would "
+                                      "differentiate MuJoCo's soft contact, which no other engine shares)")
         if self._floating is not None:
             raise NotImplementedError("the step Jacobian of a floating base (its quaternion's tangent) is not "
                                       "converted yet")
@@ -250,6 +257,19 @@ class MujocoJointMotion(JointSimulation):
             mujoco.mj_kinematics(self.model, d)
             out[k] = d.xpos[self._end_effector]
         return out
+
+    def contact_centres(self, q: np.ndarray) -> np.ndarray:
+        """The sphere geoms' centres (:class:`references.mujoco.contact.ContactReader`)."""
+        if self._contact is None:
+            raise NotImplementedError("the scene has no contact")
+        return self._contact.centres(self._qpos, self._dof, np.asarray(q, dtype=float))
+
+    def contact_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """MuJoCo's contact forces on the spheres at each state (:class:`references.mujoco.contact.ContactReader`)."""
+        if self._contact is None:
+            raise NotImplementedError("the scene has no contact")
+        q = np.asarray(q, dtype=float)
+        return self._contact.forces(self._qpos, self._dof, q, self._own(q, np.asarray(qdot, dtype=float)))
 
     def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         """A floating base's: :meth:`MujocoFloatingDynamics.centroidal_momentum` (``mj_subtreeVel``)."""

@@ -335,6 +335,11 @@ def _dynamics_support(chain: Chain) -> Support:
     return Support.no(refused) if refused else Support.yes()
 
 
+CONTACT_WHY = ("not yet: Pinocchio has no stepper of its own; its point contacts (PointContactConstraintModel, "
+               "constraintDynamics with its ADMM or PGS solvers) need a time-stepping loop the harness writes, with "
+               "the harness's contact detection (issue #46, to come)")
+
+
 @derives_own_inputs
 class PinocchioEngine(UrdfChains, Engine):
     """Pinocchio: kinematics from a chain's URDF; dynamics from aba, stepped by the harness."""
@@ -400,6 +405,9 @@ class PinocchioEngine(UrdfChains, Engine):
         """The chains of :meth:`supports_joint_dynamics`."""
         named = super().supports_joint_motion(scene, integrator)
         return _dynamics_support(scene.chain) if named.ok else named
+
+    def chain_contact(self, scene: JointMotionScene) -> Support:
+        return Support.no(CONTACT_WHY)
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         if scene.chain.floating_base:

@@ -623,6 +623,8 @@ def _armature_support(chain: Chain) -> Support:
     return Support.yes()
 
 
+CONTACT_WHY = ("not yet for a chain: PyBullet's multibody contact of spheres on its links (getContactPoints for the "
+               "forces) is to come (issue #46); its free bodies' contact is compared in the dynamics scenes")
 FLOATING_BASE_WHY = (
     "PyBullet's floating-base dynamics are not comparable at rounding: calculateInverseDynamics of a floating base "
     "(7 + n positions, 6 + n velocities, flags=0) agrees with the other engines with the base unturned and not once it "
@@ -715,6 +717,9 @@ class PybulletEngine(UrdfChains, Engine):
         if named.ok and scene.chain.floating_base:
             return Support.no(FLOATING_BASE_WHY)
         return _dynamics_support(scene.chain) if named.ok else named
+
+    def chain_contact(self, scene: JointMotionScene) -> Support:
+        return Support.no(FLOATING_BASE_WHY if scene.chain.floating_base else CONTACT_WHY)
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         # imported here: joint_motion reuses this module's client, loader and chain kinematics

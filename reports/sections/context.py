@@ -11,7 +11,8 @@ from pathlib import Path
 import pandas as pd
 
 from simparity.core.model.metric_catalogue import (
-    JOINT_ANGLE_ERROR_MAX, MASS_MATRIX_ERROR_MAX, ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, SOLVE_RATE,
+    JOINT_ANGLE_ERROR_MAX, MASS_MATRIX_ERROR_MAX, ORIENTATION_ERROR_MAX, POSITION_ERROR_MAX, REST_WEIGHT_ERROR,
+    SOLVE_RATE,
 )
 from simparity.core.model.run_info import RunInfo
 from simparity.reports import engine_summary, figure_writer, figures, summary, sweep_sections, sweep_summary
@@ -118,5 +119,6 @@ class ReportContext:
                 + (f"Variant {sweep['index'] + 1} of {sweep['count']} of the [sweep of {sweep['base']}]"
                    f"(#{sweep_sections.heading(sweep['base']).anchor}){shown}: "
                    + ", ".join(f"`{key}` = {value}" for key, value in sweep["values"].items()) + ". " if sweep else "")
-                + f"Reference: `{rows['reference'].iloc[0]}`."
+                + ("Reference: none (a scene with contact: each engine against truths that need no engine)."
+                   if rows["metric"].eq(REST_WEIGHT_ERROR).any() else f"Reference: `{rows['reference'].iloc[0]}`.")
                 + (f" Scene file: `{Path(about['source']).name}`." if about.get("source") else ""))

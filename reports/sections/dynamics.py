@@ -9,8 +9,9 @@ import math
 import pandas as pd
 
 from simparity.core.model.metric_catalogue import (
-    CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, JOINT_ANGLE_ERROR_MAX, LINEAR_MOMENTUM_DRIFT_MAX, REFERENCE_PARTING_TIME,
-    SELF_PARTING_TIME, TIME_PER_STEP,
+    CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, JOINT_ANGLE_ERROR_MAX,
+    LINEAR_MOMENTUM_DRIFT_MAX, REFERENCE_PARTING_TIME, REST_WEIGHT_ERROR, SELF_PARTING_TIME, SIGNORINI_VIOLATION_MAX,
+    TIME_PER_STEP, TOUCHDOWN_TIME_ERROR,
 )
 from simparity.core.model.results import OK
 from simparity.reports import engine_summary, figures, summary, tables
@@ -61,23 +62,56 @@ def _predictability(rows: pd.DataFrame) -> list[Block]:
                         for e, i in cases))]
 
 
-def _momentum(rows: pd.DataFrame) -> list[Block]:
-    """A floating base's momentum laws at the scene's finest time step (issue #46): each scheme's drift of its linear
-    and angular momentum from its own model; nothing where not measured."""
-    drifts = rows[rows["metric"].isin([LINEAR_MOMENTUM_DRIFT_MAX, CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX])
-                  & rows["dt"].notna()]
-    if drifts.empty:
+def _finest_table(rows: pd.DataFrame, columns: tuple[tuple[str, str], ...], about: str) -> list[Block]:
+    """A row per engine and integrator of ``columns`` ((metric, heading) pairs) at the scene's finest time step, after
+    the paragraph ``about`` (formatted with ``dt``); nothing where none of the metrics was measured."""
+    names = [m for m, _ in columns]
+    measured = rows[rows["metric"].isin(names) & rows["dt"].notna()]
+    if measured.empty:
         return []
-    finest = drifts[drifts["dt"] == drifts["dt"].min()]
+    finest = measured[measured["dt"] == measured["dt"].min()]
     cells = {(r["engine"], r["integrator"], r["metric"]): number(r["value"]) if r["status"] == OK else r["status"]
              for _, r in finest.iterrows()}
     cases = list(dict.fromkeys(zip(finest["engine"], finest["integrator"])))
-    return [Paragraph(f"Momentum at dt = {finest['dt'].iloc[0]:g} s: joint forces are internal, so each engine's own "
-                      "momentum keeps its law (linear: grows by m g t; angular about the centre of mass: "
-                      "conserved); its drift relative to the momentum the motion about the centre of mass carries."),
-            Table(("engine", "integrator", "linear momentum drift", "angular momentum drift"),
-                  tuple((e, i, cells.get((e, i, LINEAR_MOMENTUM_DRIFT_MAX), "—"),
-                         cells.get((e, i, CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX), "—")) for e, i in cases))]
+    return [Paragraph(about.format(dt=f"{finest['dt'].iloc[0]:g}")),
+            Table(("engine", "integrator") + tuple(head for _, head in columns),
+                  tuple((e, i) + tuple(cells.get((e, i, m), "—") for m in names) for e, i in cases))]
+
+
+def _momentum(rows: pd.DataFrame) -> list[Block]:
+    """A floating base's momentum laws at the scene's finest time step (issue #46): each scheme's drift of its linear
+    and angular momentum from its own model; nothing where not measured."""
+    return _finest_table(rows, ((LINEAR_MOMENTUM_DRIFT_MAX, "linear momentum drift"),
+                                (CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, "angular momentum drift")),
+                         "Momentum at dt = {dt} s: joint forces are internal, so each engine's own momentum keeps its "
+                         "law (linear: grows by m g t; angular about the centre of mass: conserved); its drift relative "
+                         "to the momentum the motion about the centre of mass carries.")
+
+
+CHAIN_CONTACT_COLUMNS = ((TOUCHDOWN_TIME_ERROR, "touchdown error"), (CONTACT_PENETRATION_MAX, "penetration / radius"),
+                         (SIGNORINI_VIOLATION_MAX, "Signorini violation"), (CONTACT_ENERGY_GAIN_MAX, "energy gain"),
+                         (REST_WEIGHT_ERROR, "rest weight error"))
+"""The contact metrics report.md shows for a chain on a plane, each with its column's name."""
+
+
+def _chain_contact(rows: pd.DataFrame) -> list[Block]:
+    """A chain's contact truths at the scene's finest time step (issue #46): each engine and integrator's own run;
+    nothing where the scene has no contact."""
+    return _finest_table(rows, CHAIN_CONTACT_COLUMNS,
+                         "Contact at dt = {dt} s, truths that need no engine: touchdown against the closed-form fall, "
+                         "the deepest penetration, pulls or forces off the plane, energy gained, and at rest the plane "
+                         "carrying the weight (each engine's contact is its own: no reference).")
+
+
+def _contact_verdict(rows: pd.DataFrame) -> str:
+    """A scene with contact in one line: no reference (each engine against truths that need none), the engines that
+    measured them and the cases without a result."""
+    names = [m for m, _ in CHAIN_CONTACT_COLUMNS]
+    measured = rows[rows["metric"].isin(names) & (rows["status"] == OK)]
+    engines = ", ".join(engine_summary.engine_order(measured["engine"])) or "no engine"
+    statuses = rows[rows["metric"] == names[0]]["status"].value_counts()
+    cases = ", ".join(f"{s} {n}" for s, n in statuses.items())
+    return f"contact, no reference: {engines} measured against truths that need no engine; cases {cases}"
 
 
 def scheme_row(engine: str, scheme: str, members: list[tuple[str, tuple[str, ...]]]) -> tuple[str, ...]:
@@ -123,7 +157,7 @@ def section(ctx: ReportContext, scene, rows, about, reference, series) -> tuple[
     blocks += touching.figure if touching else []
     blocks += [_per_engine(ctx, scene, cases, fits, unit, touching), _per_scheme(ctx, cases, observed, about, unit)]
     blocks += touching.blocks if touching else []
-    blocks += _predictability(rows) + _momentum(rows)
+    blocks += _predictability(rows) + _momentum(rows) + _chain_contact(rows)
     columns, order_columns = ((tables.JOINT_MOTION_COLUMNS, tables.JOINT_ORDER_COLUMNS)
                               if metric == JOINT_ANGLE_ERROR_MAX else (tables.DYNAMICS_COLUMNS, tables.ORDER_COLUMNS))
     full: list[Block] = [tables.metric_table(rows[rows["dt"].notna()], columns, ["engine", "integrator", "dt"])]
@@ -136,6 +170,8 @@ def section(ctx: ReportContext, scene, rows, about, reference, series) -> tuple[
         full += explained + _fits(orders)
     verdict = engine_summary.dynamics_verdict(cases, fits, ctx.findings_of(scene), unit,
                                               engine_summary.order_alarms(rows, metric))
+    if rows["metric"].isin([m for m, _ in CHAIN_CONTACT_COLUMNS]).any():
+        verdict = _contact_verdict(rows)
     return verdict, blocks + [Details(f"{scene}: every engine × integrator × dt", tuple(full), markdown=False)]
 
 

@@ -8,6 +8,7 @@ from dataclasses import replace
 import numpy as np
 
 from simparity.comparisons.engines.registry import EngineSet
+from simparity.comparisons.scenes.loading.chain_contact import read_chain_contact
 from simparity.comparisons.scenes.loading.chain import (
     joint_powers,
     joint_values,
@@ -108,6 +109,7 @@ def read_joint_motion(top: TableReader, head: dict, engines: EngineSet) -> Joint
                        f"0 (none) to {MAX_PERTURBATION:g} rad: a small change of the start, for predictability")
     integrators = (sim.strings("integrators", engines.joint_motion_integrators, "no engine steps a chain with {}")
                    if sim.has("integrators") else ())
+    contact = read_chain_contact(top, chain, q0)
     return JointMotionScene(chain=chain, gravity_world=gravity, q0=q0, qdot0=qdot0, torque=torque, timed_torque=timed,
                             duration=duration, dts=dts, integrators=integrators, segments=segments,
-                            perturbation=perturbation, **head)
+                            perturbation=perturbation, contact=contact, **head)

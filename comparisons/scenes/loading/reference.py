@@ -17,7 +17,7 @@ def check_reference(top: TableReader, scene, engines: EngineSet) -> None:
     rows; so is core as the reference of a contact scene that does not run its exact method, backup."""
     contact = getattr(scene, "contact", None)
     if scene.reference == "core":
-        if contact is not None and "backup" not in contact.methods:
+        if isinstance(scene, DynamicsScene) and contact is not None and "backup" not in contact.methods:
             raise top.fail("scene.reference", "core is the reference, but the scene's contact methods leave out "
                            "backup, its exact one", 'contact.methods with "backup", or another reference')
         return
@@ -38,7 +38,9 @@ def check_reference(top: TableReader, scene, engines: EngineSet) -> None:
     else:
         support = engine.supports_kinematics(scene.chain)
     if not support.ok:
-        allowed = ("a reference that can: core (its backup method), mujoco or pybullet for contact" if contact is not None
+        allowed = ("core or mujoco: a scene with a chain's contact runs against no reference, but names an engine that "
+                   "can do it" if isinstance(scene, JointMotionScene) and contact is not None
+                   else "a reference that can: core (its backup method), mujoco or pybullet for contact" if contact is not None
                    else "a reference that computes joint-space dynamics: pinocchio, mujoco, core, or analytic for a "
                         "planar chain of 1 or 2 joints" if isinstance(scene, JointDynamicsScene)
                    else "a reference that steps chains: pinocchio (its DOP853 solve), or analytic for a pendulum or a "

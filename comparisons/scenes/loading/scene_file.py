@@ -30,7 +30,7 @@ KINDS = ("dynamics", "kinematics", "ik", "joint_dynamics", "joint_motion")
 _TOP = ("scene", "world", "body", "simulation", "plane", "contact", "chain", "sampling", "targets", "initial", "drive")
 _PARTS = {"dynamics": ("world", "body", "simulation", "plane", "contact"), "kinematics": ("chain", "sampling"),
           "ik": ("chain", "targets"), "joint_dynamics": ("chain", "world", "sampling"),
-          "joint_motion": ("chain", "world", "initial", "drive", "simulation")}
+          "joint_motion": ("chain", "world", "initial", "drive", "simulation", "plane", "contact")}
 _SCENE = ("name", "description", "kind", "reference", "length_unit", "suites")
 
 

@@ -9,6 +9,7 @@ import numpy as np
 from simparity.core.model.arrays import readonly
 from simparity.core.model.errors import SceneError
 from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.chain_contact import ChainContact, frame_index
 from simparity.core.model.scenes.suites import SweepPoint
 from simparity.core.model.scenes.time_functions import TimeFunction
 
@@ -59,6 +60,10 @@ class JointMotionScene:
         2015): the motion is cut into k segments starting on the reference's trajectory, and each engine's
         state at a segment's end is compared with the same engine and integrator at a much smaller step from
         the same start, averaged over segments, so that a chaotic chain's divergence is not counted as error.
+    contact : ChainContact or None
+        Spheres on the chain's frames against a plane (:mod:`core.model.scenes.chain_contact`); None: nothing touches.
+        A scene with contact is held to truths that need no engine (each engine's contact is its own); it takes no
+        perturbation and no segments.
     source : str
     suites : tuple of str
     sweep : SweepPoint or None
@@ -78,6 +83,7 @@ class JointMotionScene:
     segments: int = 0
     perturbation: float = 0.0
     timed_torque: TimeFunction | None = None
+    contact: ChainContact | None = None
     source: str = field(default="<code>", compare=False)
     suites: tuple[str, ...] = ("default",)
     sweep: SweepPoint | None = None
@@ -98,6 +104,8 @@ class JointMotionScene:
             object.__setattr__(self, key, readonly(value))
         if self.chain.floating_base:
             self._floating_checks()
+        if self.contact is not None:
+            self._contact_checks(self.contact)
         if self.q0.shape[0] != self.qdot0.shape[0]:
             raise SceneError(self.source, "qdot0", f"{self.qdot0.shape[0]} copies, q0 has {self.q0.shape[0]}",
                              "as many initial velocities as initial joint values")
@@ -130,6 +138,23 @@ class JointMotionScene:
             if value:
                 raise SceneError(self.source, f"simulation.{key}", f"{value:g} with a floating base",
                                  f"0: a floating base's motion is compared against the reference only")
+
+    def _contact_checks(self, contact: ChainContact) -> None:
+        """Every sphere on a frame of the chain; no perturbation or segments (a contact scene has no reference run)."""
+        chain = self.chain
+        names = tuple(j.name for j in chain.joints)
+        for k, sphere in enumerate(contact.spheres):
+            try:
+                frame_index(sphere.frame, names, chain.end_effector_name, chain.base_link)
+            except ValueError:
+                frames = ", ".join(names + (chain.end_effector_name,) + ((chain.base_link,) if chain.base_link else ()))
+                raise SceneError(self.source, f"contact.sphere[{k}].frame", f"{sphere.frame!r} is no frame of the chain",
+                                 f"a chain joint's name (the link it moves), the end effector or the base link: {frames}"
+                                 ) from None
+        for key, value in (("perturbation", self.perturbation), ("segments", self.segments)):
+            if value:
+                raise SceneError(self.source, f"simulation.{key}", f"{value:g} with contact",
+                                 "0: a scene with contact is held to truths that need no reference run")
 
     @property
     def copies(self) -> int:

@@ -1,0 +1,213 @@
+"""Metrics of a chain's contact with a plane (a :class:`JointMotionScene` with ``contact``, issue #46): truths that need
+no engine, measured on each engine's own run with its own model. Definitions with their reasons: ``docs/metrics.md``.
+
+Every engine's contact is its own (core's penalty springs, MuJoCo's soft constraints), so no engine is compared with
+another's trajectory; each is held to what any correct contact must give:
+
+- ``touchdown_time_error``: a robot at rest (no joint or base rotation rates, no torque) falls as one rigid body, every
+  sphere's gap closing as h + v t + 1/2 a t^2 (a = g . N, v the base's velocity along N), so the first sphere touches at
+  the closed-form time; the engine's touchdown is where its own sphere centres, extrapolated from its last two samples
+  before any sphere touches by the same law, reach the plane. Relative to the closed-form time.
+- ``contact_penetration_max``: the deepest a sphere sinks into the plane, relative to its radius (soft contact
+  penetrates by its own stiffness; past 1 a sphere has gone through).
+- ``signorini_violation_max``: a plane pushes a touching sphere and nothing else: max of a pull (-f.N)^+ and of a force
+  on a sphere off the plane, |f| gap / radius, relative to the robot's weight m |g|.
+- ``friction_cone_violation_max``: the frictionless plane's tangential force |f - (f.N) N|, relative to the weight.
+- ``contact_energy_gain_max``: contact and damping only take energy (a soft contact stores some while it is
+  compressed, and gives back at most that), so the mechanical energy never exceeds what it was at any earlier instant
+  with no sphere touching (the start counts: a sphere starts at most 1e-9 m inside), less the applied forces' work: max_t (E(t) - W(t) - min over earlier contact-free s of
+  (E(s) - W(s)))^+, relative to the energy the motion can have (:func:`energy_budget`).
+- ``rest_weight_error``: at rest (the centre of mass's acceleration over the last sampled interval below
+  :data:`REST_ACCELERATION` of g, from the engine's own momentum) the plane carries the weight: |sum f + m g| / m |g|
+  at the last sample.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from simparity.comparisons.measure.joint_motion_metrics import (
+    CHAIN_CONTACT_METRICS, OwnReading, energy_budget, work_done,
+)
+from simparity.comparisons.measure.rows import Measured
+from simparity.core.model.engine import JointSimulation
+from simparity.core.model.metric_catalogue import (
+    CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, FRICTION_CONE_VIOLATION_MAX, REST_WEIGHT_ERROR,
+    SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR,
+)
+from simparity.core.model.results import NOTHING_TO_MEASURE
+from simparity.core.model.scenes.chain_contact import ChainContact
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.core.model.trajectory import JointTrajectory
+
+FORCE_METRICS = (SIGNORINI_VIOLATION_MAX, FRICTION_CONE_VIOLATION_MAX, REST_WEIGHT_ERROR)
+"""The metrics that need the engine's contact forces (:meth:`JointSimulation.contact_forces`)."""
+
+REST_ACCELERATION = 1e-3
+"""[1] A robot is at rest when its centre of mass accelerates by at most this fraction of g over the last sampled
+interval (its own momentum's change): the plane then carries its weight to about this fraction, and a contact force
+that is wrong by a factor, a sign or a missing sphere is off by O(1)."""
+TOUCHING = 0.0
+"""[m] A sphere touches the plane when its gap is at most this (the scene's radius; margins are switched off)."""
+
+
+def _states(traj: JointTrajectory, index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(q (S B, nq), qdot (S B, nv)) at the samples ``index``, copies flattened."""
+    return (np.ascontiguousarray(traj.q[index]).reshape(-1, traj.q.shape[2]),
+            np.ascontiguousarray(traj.qdot[index]).reshape(-1, traj.qdot.shape[2]))
+
+
+def _centres(sim: JointSimulation, traj: JointTrajectory, index: np.ndarray, spheres: int) -> np.ndarray:
+    """(S, B, spheres, 3) the engine's sphere centres at the samples ``index``."""
+    q, _ = _states(traj, index)
+    return np.asarray(sim.contact_centres(q), dtype=float).reshape(len(index), traj.q.shape[1], spheres, 3)
+
+
+def total_mass(scene: JointMotionScene) -> float:
+    """[kg] the robot's mass as the file declares it (every importer reads the same: model parity, issue #45)."""
+    chain = scene.chain
+    base = chain.base_inertia.mass if chain.base_inertia is not None else 0.0
+    return base + sum(j.link.mass for j in chain.joints if j.link is not None)
+
+
+def closed_form_touchdown(scene: JointMotionScene, gaps0: np.ndarray) -> tuple[float, str]:
+    """(t [s], "") the first sphere's touchdown in free fall from gaps ``gaps0`` (B, S) [m] (the engine's own at t = 0),
+    or (nan, why) when the scene's start is no rigid fall or nothing reaches the plane within its duration."""
+    contact = scene.contact
+    assert contact is not None
+    chain, normal = scene.chain, np.asarray(contact.plane.normal_world)
+    if not chain.floating_base:
+        return math.nan, "a fixed base does not fall"
+    if scene.gravity_world is None:
+        return math.nan, "no gravity: nothing falls"
+    if (np.any(scene.qdot0[:, 3:] != 0) or np.any(scene.torque != 0) or scene.timed_torque is not None):
+        return math.nan, ("the robot does not start as one rigid body falling (joint or base rotation rates, or "
+                          "applied torques): its touchdown has no closed form")
+    if np.any(gaps0 <= TOUCHING):
+        return math.nan, "a sphere touches the plane at t = 0"
+    a = float(np.asarray(scene.gravity_world) @ normal)
+    v = (np.asarray(scene.qdot0[:, :3]) @ normal)[:, None]  # (B, 1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        roots = np.where(a != 0, (-v - np.sqrt(np.maximum(v**2 - 2 * a * gaps0, 0.0))) / a, -gaps0 / v)
+        reached = (v**2 - 2 * a * gaps0 >= 0) & (roots > 0)
+    times = np.where(reached, roots, np.inf).min(axis=1)
+    if not np.all(times <= scene.duration):
+        return math.nan, f"no sphere reaches the plane within the run's {scene.duration:g} s"
+    return float(times.max()), ""
+
+
+def _engine_touchdown(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, index: np.ndarray,
+                      gaps: np.ndarray) -> float:
+    """The engine's touchdown [s] (the latest over copies): its gaps at its last two samples before any sphere
+    touches, extrapolated by the fall's law (the known acceleration g . N) to zero."""
+    contact = scene.contact
+    assert contact is not None and scene.gravity_world is not None
+    a = float(np.asarray(scene.gravity_world) @ np.asarray(contact.plane.normal_world))
+    touched = np.flatnonzero((gaps <= TOUCHING).any(axis=(1, 2)))
+    first = int(index[touched[0]])
+    start = int(index[max(touched[0] - 1, 0)])
+    window = np.arange(start, first + 1)  # every sample from the last sampled one before the touch
+    fine = contact.gaps(_centres(sim, traj, window, len(contact.spheres)))
+    out = []
+    for b in range(traj.q.shape[1]):
+        free = np.asarray((fine[:, b] > TOUCHING).all(axis=1))
+        last = max(int(np.argmin(free)) - 1, 0) if not free.all() else window.size - 1
+        k = window[last]
+        dt = float(traj.times[k] - traj.times[k - 1]) if k > 0 else 0.0
+        h = fine[last, b]
+        v = ((h - contact.gaps(_centres(sim, traj, np.array([k - 1]), len(contact.spheres)))[0, b]) / dt + 0.5 * a * dt
+             if k > 0 else np.full(h.shape, float(np.asarray(scene.qdot0[b, :3]) @ contact.plane.normal_world)))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            root = np.where(a != 0, (-v - np.sqrt(np.maximum(v**2 - 2 * a * h, 0.0))) / a, -h / v)
+        out.append(float(traj.times[k]) + float(np.min(np.where(root >= 0, root, np.inf))))
+    return max(out)
+
+
+def _touchdown(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, index: np.ndarray,
+               gaps: np.ndarray) -> Measured:
+    exact, why = closed_form_touchdown(scene, gaps[0])
+    if why:
+        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=why)
+    if not (gaps <= TOUCHING).any():
+        return Measured(math.inf, "1", unmeasurable=(
+            f"no sphere of the engine's reached the plane; the closed form touches down at {exact:.6g} s"))
+    measured = _engine_touchdown(scene, sim, traj, index, gaps)
+    return Measured(abs(measured - exact) / exact, "1",
+                    note=f"touchdown at {measured:.9g} s, closed form {exact:.9g} s")
+
+
+def _forces(scene: JointMotionScene, contact: ChainContact, forces: np.ndarray, gaps: np.ndarray,
+            weight: float) -> dict[str, Measured]:
+    """The Signorini and friction-cone violations of forces (S, B, spheres, 3) at gaps (S, B, spheres)."""
+    normal = np.asarray(contact.plane.normal_world)
+    f_n = forces @ normal
+    tangential = np.linalg.norm(forces - f_n[..., None] * normal, axis=-1)
+    at_distance = np.linalg.norm(forces, axis=-1) * np.maximum(gaps, 0.0) / contact.radii
+    signorini = float(np.maximum(np.maximum(-f_n, 0.0), at_distance).max()) / weight
+    return {SIGNORINI_VIOLATION_MAX: Measured(signorini, "1", note="pull or force off the plane, over the weight"),
+            FRICTION_CONE_VIOLATION_MAX: Measured(float(tangential.max()) / weight, "1",
+                                                  note="tangential force on a frictionless plane, over the weight")}
+
+
+def _rest(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, index: np.ndarray,
+          forces: np.ndarray, weight: float, mass: float) -> Measured:
+    if not scene.chain.floating_base:
+        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE,
+                        unmeasurable="a fixed base's mount carries an unknown share of the weight")
+    last = index[-2:]
+    try:
+        momentum = np.asarray(sim.momentum(*_states(traj, last)), dtype=float).reshape(2, traj.q.shape[1], 6)
+    except NotImplementedError as err:
+        return Measured(math.nan, "1", unmeasurable=f"at rest cannot be told: {err}")
+    interval = float(traj.times[last[1]] - traj.times[last[0]])
+    acceleration = float(np.linalg.norm(momentum[1, :, :3] - momentum[0, :, :3], axis=-1).max()) / (mass * interval)
+    g = float(np.linalg.norm(np.asarray(scene.gravity_world)))
+    if acceleration > REST_ACCELERATION * g:
+        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=(
+            f"not at rest at the end: the centre of mass accelerates {acceleration / g:.3g} g over the last sampled "
+            f"interval (rest: at most {REST_ACCELERATION:g} g)"))
+    residual = forces[-1].sum(axis=1) + mass * np.asarray(scene.gravity_world)
+    return Measured(float(np.linalg.norm(residual, axis=-1).max()) / weight, "1",
+                    note=f"at rest (centre of mass accelerating {acceleration / g:.2g} g): |sum f + m g| / m |g|")
+
+
+def _energy_gain(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading, gaps: np.ndarray) -> Measured:
+    energy = own.kinetic + own.potential - work_done(scene, traj)[own.index]
+    free = np.array((gaps > TOUCHING).all(axis=2), dtype=bool)  # (S, B): no sphere touching, no energy stored in a contact
+    free[0] = True  # the start: every sphere outside or touching within the loader's 1e-9 m, nothing stored
+    baseline = np.minimum.accumulate(np.where(free, energy, np.inf), axis=0)
+    gain = float(np.max(np.where(np.isfinite(baseline), energy - baseline, 0.0)))
+    scale = float(energy_budget(scene, traj, own).max())
+    return Measured(max(gain, 0.0) / scale, "1",
+                    note="mechanical energy above its value at an earlier contact-free instant, over the energy budget")
+
+
+def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory,
+                    own: OwnReading) -> dict[str, Measured]:
+    """:data:`CHAIN_CONTACT_METRICS` of the engine's run (see the module docstring), at the samples ``own`` read."""
+    contact = scene.contact
+    assert contact is not None
+    index = own.index
+    try:
+        gaps = contact.gaps(_centres(sim, traj, index, len(contact.spheres)))  # (S, B, spheres)
+    except NotImplementedError as err:
+        return {m: Measured(math.nan, "1", unmeasurable=str(err)) for m in CHAIN_CONTACT_METRICS}
+    out = {
+        TOUCHDOWN_TIME_ERROR: _touchdown(scene, sim, traj, index, gaps),
+        CONTACT_PENETRATION_MAX: Measured(float(np.maximum(-gaps / contact.radii, 0.0).max()), "1",
+                                          note="deepest sinking over the sphere's radius"),
+        CONTACT_ENERGY_GAIN_MAX: _energy_gain(scene, traj, own, gaps),
+    }
+    mass = total_mass(scene)
+    weight = mass * float(np.linalg.norm(scene.gravity_world)) if scene.gravity_world is not None else 0.0
+    if not weight > 0:
+        why = "no weight (no gravity or no mass): the contact forces have no scale"
+        return out | {m: Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=why) for m in FORCE_METRICS}
+    try:
+        forces = np.asarray(sim.contact_forces(*_states(traj, index)), dtype=float).reshape(gaps.shape + (3,))
+    except NotImplementedError as err:
+        return out | {m: Measured(math.nan, "1", unmeasurable=str(err)) for m in FORCE_METRICS}
+    return out | _forces(scene, contact, forces, gaps, weight) | {
+        REST_WEIGHT_ERROR: _rest(scene, sim, traj, index, forces, weight, mass)}

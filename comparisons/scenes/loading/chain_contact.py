@@ -1,0 +1,95 @@
+"""A joint-motion scene's contact: its ``[[plane]]`` (one) and ``[contact]`` with the chain's ``[[contact.sphere]]``."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simparity.comparisons.scenes.loading.contact import START_INSIDE_TOLERANCE
+from simparity.comparisons.scenes.loading.reader import TableReader
+from simparity.core.kinematics import forward_kinematics
+from simparity.core.model.ranges import RANGES, safe_norm
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.chain_contact import ChainContact, ContactSphere, frame_index
+from simparity.core.model.scenes.contact import Plane
+from simparity.core.rotations import quat_wxyz_to_matrix
+
+_PLANE = ("name", "coefficients")
+_CONTACT = ("penalty_stiffness", "penalty_damping", "sphere")
+_SPHERE = ("frame", "centre_xyz", "radius")
+
+
+def _plane(top: TableReader) -> Plane:
+    """The scene's one [[plane]]: ``coefficients`` [a, b, c, d] of a x + b y + c z + d = 0, free side a x + ... > 0."""
+    planes = top.array_of_tables("plane", _PLANE, "max_bodies")
+    if len(planes) != 1:
+        raise top.fail("plane", f"{len(planes)} planes", "one [[plane]]: a robot meets one ground plane (part 1)")
+    p = planes[0]
+    abcd = p.vector("coefficients", 4)
+    length = safe_norm(abcd[:3])
+    if not (length > 0 and np.isfinite(length)):
+        raise p.fail("coefficients", "the normal (a, b, c) is all zeros", "[a, b, c, d] with (a, b, c) != 0")
+    scaled = abcd / np.max(np.abs(abcd[:3]))  # the same plane, its normal's largest entry 1: no overflow
+    offset = scaled[3] / float(np.linalg.norm(scaled[:3])) * p.scale
+    if not RANGES["position_world"].allows(abs(offset)):
+        raise p.fail("coefficients", f"the plane lies {abs(offset):.3g} m from the origin",
+                     RANGES["position_world"].text())
+    return Plane(scaled[:3], scaled[3] * p.scale, p.name("name", "ground"))
+
+
+def _frames(chain: Chain) -> tuple[str, ...]:
+    names = tuple(j.name for j in chain.joints) + (chain.end_effector_name,)
+    return names + ((chain.base_link,) if chain.base_link is not None else ())
+
+
+def read_chain_contact(top: TableReader, chain: Chain, q0: np.ndarray) -> ChainContact | None:
+    """The chain's contact spheres against the scene's plane, or None when the file has no [[plane]]; each sphere must
+    start on the plane's free side (within :data:`START_INSIDE_TOLERANCE`) at ``q0`` (nq,)."""
+    if not top.has("plane"):
+        if top.has("contact"):
+            raise top.fail("contact", "contact settings without a [[plane]]", "a [[plane]] for the spheres to touch")
+        return None
+    if chain.mjcf_path is not None:
+        raise top.fail("plane", "contact for a chain read from an MJCF file",
+                       "a URDF chain or [[chain.joint]] entries: an MJCF importer would weigh the contact spheres")
+    plane = _plane(top)
+    c = top.subtable("contact", _CONTACT)
+    spheres = []
+    for s in c.array_of_tables("sphere", _SPHERE, "max_bodies"):
+        frame = s.string("frame", choices=_frames(chain))
+        spheres.append(ContactSphere(frame, s.vector("centre_xyz", 3, [0.0] * 3, length=1),
+                                     s.number("radius", positive=True, length=1)))
+    if not spheres:
+        raise c.fail("sphere", "no contact sphere", "[[contact.sphere]] entries: frame, centre_xyz, radius")
+    stiffness = c.number("penalty_stiffness", positive=True)  # N/m = kg / s^2: no length
+    masses = [j.link.mass for j in chain.joints if j.link is not None]
+    mass = sum(masses) + (chain.base_inertia.mass if chain.base_inertia is not None else 0.0)
+    damping = (c.number("penalty_damping") if c.has("penalty_damping")
+               else 2.0 * float(np.sqrt(stiffness * mass)))  # critical on the robot's mass, N s/m = kg / s
+    if damping < 0:
+        raise c.fail("penalty_damping", f"{damping:g} is negative", "a number >= 0 [N s/m]")
+    contact = ChainContact(plane, tuple(spheres), stiffness, damping)
+    _check_start_outside(top, chain, contact, q0)
+    return contact
+
+
+def sphere_centres_world(chain: Chain, contact: ChainContact, q: np.ndarray) -> np.ndarray:
+    """(B, S, 3) the spheres' centres [m] at configurations q (B, nq) by core's FK (the loader's check)."""
+    n = chain.n_joints
+    poses = forward_kinematics(chain, q[:, q.shape[1] - n:])
+    names = tuple(j.name for j in chain.joints)
+    out = np.empty((len(q), len(contact.spheres), 3))
+    for k, sphere in enumerate(contact.spheres):
+        i = frame_index(sphere.frame, names, chain.end_effector_name, chain.base_link)
+        out[:, k] = (sphere.centre_xyz if i < 0 else
+                     poses.position_world[:, i] + poses.rotation_world[:, i] @ sphere.centre_xyz)
+    if chain.floating_base:
+        out = q[:, None, :3] + np.einsum("bij,bsj->bsi", quat_wxyz_to_matrix(q[:, 3:7]), out)
+    return out
+
+
+def _check_start_outside(top: TableReader, chain: Chain, contact: ChainContact, q0: np.ndarray) -> None:
+    gaps = contact.gaps(sphere_centres_world(chain, contact, np.atleast_2d(q0)))
+    copy, k = np.unravel_index(int(np.argmin(gaps)), gaps.shape)
+    if -gaps[copy, k] > START_INSIDE_TOLERANCE:
+        raise top.fail(f"contact.sphere[{k}]", f"the sphere on {contact.spheres[k].frame!r} starts "
+                       f"{-gaps[copy, k]:.3g} m inside the plane", "every sphere on the plane's free side at t = 0")

@@ -1,0 +1,109 @@
+"""A robot's contact truths (:mod:`comparisons.measure.chain_contact_metrics`) on each engine's own run of
+``solo12-drop-stand``: the touchdown against the closed-form fall (exact for RK4, dt / (2 t_c) early for semi-implicit
+Euler: theory, not a measurement), no pull, no tangential force, no energy made, the weight carried at rest; and an
+engine that reports its forces wrong is seen."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from simparity.comparisons.api import load_scene
+from simparity.comparisons.measure.chain_contact_metrics import contact_metrics
+from simparity.comparisons.measure.joint_motion_metrics import motion_metrics, read_own
+from simparity.core.articulated.motion import CoreJointMotion
+from simparity.core.model.metric_catalogue import (
+    CONTACT_ENERGY_GAIN_MAX, FRICTION_CONE_VIOLATION_MAX, REST_WEIGHT_ERROR, SIGNORINI_VIOLATION_MAX,
+    TOUCHDOWN_TIME_ERROR,
+)
+from simparity.references.mujoco.joint_motion import MujocoJointMotion
+
+G = 9.81
+DROP = 0.02
+"""[m] The scene's gap: the base at 0.36 m, the feet 0.32 m below it, spheres of 0.02 m."""
+T_CONTACT = math.sqrt(2 * DROP / G)
+"""[s] The closed-form touchdown of a body falling from rest."""
+EXACT = 1e-12
+"""RK4 integrates a constant acceleration exactly: its touchdown is the closed form up to rounding."""
+EULER_SECOND_ORDER = 0.02
+"""Semi-implicit Euler touches down dt / (2 t_c) early to first order; the next term is O(dt / t_c) smaller (1.6 %
+at dt = 1 ms)."""
+REST = 1e-4
+"""The weight carried at rest, measured within 3.6e-5 by every scheme; 1e-4 is far below a force off by a factor."""
+
+
+@pytest.fixture(scope="module")
+def scene():
+    return load_scene("solo12-drop-stand")
+
+
+def _measured(scene, sim_class, integrator, dt, duration):
+    short = replace(scene, duration=duration, dts=(dt,))
+    sim = sim_class(short, integrator, dt)
+    traj = sim.run(short.n_steps(dt))
+    return contact_metrics(short, sim, traj, read_own(sim, traj))
+
+
+def test_the_scene_is_measured_by_its_contact_truths(scene):
+    metrics = motion_metrics(scene)
+    assert TOUCHDOWN_TIME_ERROR in metrics and REST_WEIGHT_ERROR in metrics
+    assert "energy_drift_max" not in metrics and "power_balance_residual_max" not in metrics
+
+
+@pytest.mark.parametrize("sim_class, integrator", [(CoreJointMotion, "rk4"), (MujocoJointMotion, "rk4")])
+def test_rk4_touches_down_at_the_closed_form_time(scene, sim_class, integrator):
+    values = _measured(scene, sim_class, integrator, 0.004, 0.08)
+    assert values[TOUCHDOWN_TIME_ERROR].value < EXACT
+
+
+@pytest.mark.parametrize("sim_class, integrator", [(CoreJointMotion, "semi_implicit_euler"),
+                                                   (MujocoJointMotion, "euler")])
+def test_semi_implicit_euler_touches_down_half_a_step_early(scene, sim_class, integrator):
+    dt = 0.002
+    values = _measured(scene, sim_class, integrator, dt, 0.08)
+    assert values[TOUCHDOWN_TIME_ERROR].value == pytest.approx(dt / (2 * T_CONTACT), rel=EULER_SECOND_ORDER)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sim_class, integrator, dt", [(CoreJointMotion, "rk4", 0.002),
+                                                       (MujocoJointMotion, "euler", 0.001)])
+def test_at_rest_the_plane_carries_the_weight_and_nothing_was_made(scene, sim_class, integrator, dt):
+    values = _measured(scene, sim_class, integrator, dt, scene.duration)
+    assert values[REST_WEIGHT_ERROR].value < REST
+    assert values[SIGNORINI_VIOLATION_MAX].value == 0.0
+    assert values[FRICTION_CONE_VIOLATION_MAX].value == 0.0
+    assert values[CONTACT_ENERGY_GAIN_MAX].value < EXACT
+
+
+class _Reported(MujocoJointMotion):
+    """MuJoCo's run, its forces reported through ``self.report``."""
+
+    report = staticmethod(lambda forces: forces)
+
+    def contact_forces(self, q, qdot):
+        return self.report(super().contact_forces(q, qdot))
+
+
+@pytest.mark.parametrize("report, metric, least", [
+    (lambda f: -f, REST_WEIGHT_ERROR, 1.9),  # the sign flipped: -m g instead of m g
+    (lambda f: -f, SIGNORINI_VIOLATION_MAX, 0.1),  # ... a pull
+    (lambda f: 0.5 * f, REST_WEIGHT_ERROR, 0.49),  # half the force
+    (lambda f: f + np.array([0.1, 0.0, 0.0]) * np.linalg.norm(f, axis=-1, keepdims=True), FRICTION_CONE_VIOLATION_MAX,
+     0.01),  # a tangential part on a frictionless plane
+])
+def test_a_contact_force_reported_wrong_is_seen(scene, report, metric, least):
+    class Wrong(_Reported):
+        pass
+    Wrong.report = staticmethod(report)
+    values = _measured(scene, Wrong, "euler", 0.002, scene.duration)
+    assert values[metric].value > least
+
+
+def test_a_start_that_is_not_a_rigid_fall_has_no_closed_form_touchdown(scene):
+    turning = replace(scene, qdot0=np.concatenate([[0.0, 0.0, 0.0, 0.0, 0.0, 0.5], np.zeros(3)])[None])
+    values = _measured(turning, MujocoJointMotion, "euler", 0.002, 0.08)
+    assert math.isnan(values[TOUCHDOWN_TIME_ERROR].value)
+    assert "no closed form" in values[TOUCHDOWN_TIME_ERROR].unmeasurable

@@ -1,0 +1,71 @@
+"""A joint-motion scene's contact (``[[plane]]``, ``[contact]``, ``[[contact.sphere]]``, issue #46): read as written,
+every meaningless input refused in one line naming its key, and the engines that do not model a chain's contact
+n/a with their reason."""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from simparity.comparisons.scenes.library import resolve
+from simparity.comparisons.scenes.loading.scene_file import parse_scene
+from simparity.core.model.errors import SceneError
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+from simparity.references.pinocchio.adapter import PinocchioEngine
+from simparity.references.pybullet.adapter import PybulletEngine
+
+
+@pytest.fixture(scope="module")
+def data() -> dict:
+    return tomllib.loads(Path(resolve("solo12-drop-stand")).read_text(encoding="utf-8"))
+
+
+def _edited(data: dict, edit) -> dict:
+    out = copy.deepcopy(data)
+    edit(out)
+    return out
+
+
+def test_the_scene_reads_as_written(data):
+    scene = parse_scene(data)
+    contact = scene.contact
+    assert isinstance(scene, JointMotionScene) and contact is not None
+    assert [s.frame for s in contact.spheres] == ["FL_FOOT", "base_link", "base_link", "base_link"]
+    np.testing.assert_array_equal(contact.spheres[1].centre_xyz, [0.1946, -0.14695, -0.32])
+    assert contact.radii.tolist() == [0.02] * 4
+    np.testing.assert_array_equal(contact.plane.normal_world, [0.0, 0.0, 1.0])
+    assert contact.penalty_stiffness == 1e4
+    mass = scene.chain.base_inertia.mass + sum(j.link.mass for j in scene.chain.joints)
+    assert contact.penalty_damping == pytest.approx(2 * np.sqrt(1e4 * mass), rel=1e-15)  # critical on the mass
+
+
+@pytest.mark.parametrize("edit, key, words", [
+    (lambda d: d["plane"].append({"coefficients": [1.0, 0.0, 0.0, 5.0]}), "plane", "one [[plane]]"),
+    (lambda d: d["contact"].update(sphere=[]), "contact.sphere", "one or more tables"),
+    (lambda d: d["contact"]["sphere"][0].update(frame="FR_FOOT"), "contact.sphere[0].frame", "FL_FOOT"),
+    (lambda d: d["contact"]["sphere"][0].update(radius=0.0), "contact.sphere[0].radius", "> 0"),
+    (lambda d: d["contact"]["sphere"][1].update(centre_xyz=[0.0, 0.0]), "contact.sphere[1].centre_xyz", "3 numbers"),
+    (lambda d: d["contact"].update(penalty_stiffness=-1.0), "contact.penalty_stiffness", "> 0"),
+    (lambda d: d["contact"].update(penalty_damping=-1.0), "contact.penalty_damping", ">= 0"),
+    (lambda d: d["contact"].update(friction=0.5), "contact.friction", "allowed"),
+    (lambda d: d["initial"].update(base_position=[0.0, 0.0, 0.33]), "contact.sphere[0]", "inside the plane"),
+    (lambda d: d.pop("plane"), "contact", "without a [[plane]]"),
+    (lambda d: d["plane"][0].update(coefficients=[0.0, 0.0, 0.0, 1.0]), "plane[0].coefficients", "all zeros"),
+    (lambda d: d["simulation"].update(perturbation=1e-6), "simulation.perturbation", "allowed: 0"),
+])
+def test_a_meaningless_contact_is_refused_in_one_line_naming_its_key(data, edit, key, words):
+    with pytest.raises(SceneError) as caught:
+        parse_scene(_edited(data, edit), "drop.toml")
+    message = str(caught.value)
+    assert key in message and words in message and "\n" not in message, message
+
+
+@pytest.mark.parametrize("engine", [PinocchioEngine(), PybulletEngine()])
+def test_engines_without_a_chain_s_contact_say_why(data, engine):
+    scene = parse_scene(data)
+    support = engine.supports_joint_motion(scene, engine.joint_motion_integrators()[0])
+    assert not support.ok and support.reason
