@@ -20,6 +20,11 @@ another's trajectory; each is held to what any correct contact must give:
 - ``rest_weight_error``: at rest (the centre of mass's acceleration over the last sampled interval below
   :data:`REST_ACCELERATION` of g, from the engine's own momentum) the plane carries the weight: |sum f + m g| / m |g|
   at the last sample.
+- ``rest_equilibrium_error``: at rest (also every joint's acceleration below :data:`REST_ACCELERATION` g / reach) the
+  engine's contact forces, gravity, the applied joint forces and the damping balance on every joint and on a floating
+  base, by Pinocchio's model of the file (:class:`references.pinocchio.statics.PinocchioStatics`: an independent
+  model, none of the engine's): |g(q) - sum_s J_s^T f_s - tau + D qdot| row by row, a force over m |g|, a moment over
+  m |g| reach, the largest. The fixed-base arm's closed form f = J^-T (g - tau) is this balance.
 """
 
 from __future__ import annotations
@@ -29,20 +34,20 @@ import math
 import numpy as np
 
 from simparity.comparisons.measure.joint_motion_metrics import (
-    CHAIN_CONTACT_METRICS, OwnReading, energy_budget, work_done,
+    CHAIN_CONTACT_METRICS, OwnReading, energy_budget, reach, work_done,
 )
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointSimulation
 from simparity.core.model.metric_catalogue import (
     CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, FRICTION_CONE_VIOLATION_MAX, REST_WEIGHT_ERROR,
-    SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR,
+    REST_EQUILIBRIUM_ERROR, SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR,
 )
 from simparity.core.model.results import NOTHING_TO_MEASURE
 from simparity.core.model.scenes.chain_contact import ChainContact
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 
-FORCE_METRICS = (SIGNORINI_VIOLATION_MAX, FRICTION_CONE_VIOLATION_MAX, REST_WEIGHT_ERROR)
+FORCE_METRICS = (SIGNORINI_VIOLATION_MAX, FRICTION_CONE_VIOLATION_MAX, REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR)
 """The metrics that need the engine's contact forces (:meth:`JointSimulation.contact_forces`)."""
 
 REST_ACCELERATION = 1e-3
@@ -173,6 +178,50 @@ def _rest(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, 
                     note=f"at rest (centre of mass accelerating {acceleration / g:.2g} g): |sum f + m g| / m |g|")
 
 
+def _joints_at_rest(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray) -> str:
+    """Why the chain's joints are not at rest at the end ("" when they are): a joint's acceleration over the last sampled
+    interval above :data:`REST_ACCELERATION` g / reach (g: 9.81 m/s^2 without gravity), rad/s^2 (a prismatic joint's
+    over g)."""
+    last = index[-2:]
+    interval = float(traj.times[last[1]] - traj.times[last[0]])
+    n = scene.chain.n_joints
+    rates = np.asarray(traj.qdot[last][..., traj.qdot.shape[2] - n:])
+    g = float(np.linalg.norm(scene.gravity_world)) if scene.gravity_world is not None else 9.81
+    scale = np.array([g if j.type == "prismatic" else g / reach(scene.chain) for j in scene.chain.joints])
+    worst = float((np.abs(rates[1] - rates[0]) / interval / scale).max()) if n else 0.0
+    if worst > REST_ACCELERATION:
+        return (f"not at rest at the end: a joint accelerates {worst:.3g} x g / reach over the last sampled interval "
+                f"(rest: at most {REST_ACCELERATION:g})")
+    return ""
+
+
+def _equilibrium(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, forces: np.ndarray,
+                 weight: float, rest: Measured) -> Measured:
+    """``rest_equilibrium_error`` at the last sample (see the module docstring); n/a with why when not at rest."""
+    if scene.chain.floating_base and rest.unmeasurable:
+        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=rest.unmeasurable)
+    moving = _joints_at_rest(scene, traj, index)
+    if moving:
+        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=moving)
+    try:
+        from simparity.references.pinocchio.statics import PinocchioStatics
+    except ImportError as err:
+        return Measured(math.nan, "1", unmeasurable=f"its truth is Pinocchio's model, not installed here: {err}")
+    contact = scene.contact
+    assert contact is not None
+    q = np.asarray(traj.q[index[-1]])
+    qdot = np.asarray(traj.qdot[index[-1]])
+    balance = PinocchioStatics(scene.chain, scene.gravity_world, contact).balance(q, forces[-1])
+    n = scene.chain.n_joints
+    held = np.zeros_like(balance)  # what holds the chain: the applied joint forces less the damping (none on a base)
+    damping = np.array([j.damping for j in scene.chain.joints])
+    held[:, balance.shape[1] - n:] = np.asarray(scene.torque) - damping * qdot[:, qdot.shape[1] - n:]
+    scale = weight * reach(scene.chain) ** (1 - scene.chain.length_powers)
+    worst = float((np.abs(balance - held) / scale).max())
+    return Measured(worst, "1", note=("at rest: |g(q) - sum J^T f - tau + D qdot| by Pinocchio's model, a force over "
+                                      "m |g|, a moment over m |g| reach"))
+
+
 def _energy_gain(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading, gaps: np.ndarray) -> Measured:
     energy = own.kinetic + own.potential - work_done(scene, traj)[own.index]
     free = np.array((gaps > TOUCHING).all(axis=2), dtype=bool)  # (S, B): no sphere touching, no energy stored in a contact
@@ -206,8 +255,10 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
         why = "no weight (no gravity or no mass): the contact forces have no scale"
         return out | {m: Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=why) for m in FORCE_METRICS}
     try:
-        forces = np.asarray(sim.contact_forces(*_states(traj, index)), dtype=float).reshape(gaps.shape + (3,))
+        times = np.repeat(np.asarray(traj.times)[index], traj.q.shape[1])
+        forces = np.asarray(sim.contact_forces(*_states(traj, index), times), dtype=float).reshape(gaps.shape + (3,))
     except NotImplementedError as err:
         return out | {m: Measured(math.nan, "1", unmeasurable=str(err)) for m in FORCE_METRICS}
+    rest = _rest(scene, sim, traj, index, forces, weight, mass)
     return out | _forces(scene, contact, forces, gaps, weight) | {
-        REST_WEIGHT_ERROR: _rest(scene, sim, traj, index, forces, weight, mass)}
+        REST_WEIGHT_ERROR: rest, REST_EQUILIBRIUM_ERROR: _equilibrium(scene, traj, index, forces, weight, rest)}

@@ -103,8 +103,9 @@ class CoreJointMotion(JointSimulation):
             raise NotImplementedError("the scene has no contact")
         return self._contact.centres_world(np.ascontiguousarray(np.asarray(q, dtype=float).T))
 
-    def contact_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        """The penalty force on each sphere at the state (:class:`ChainContactForces`)."""
+    def contact_forces(self, q: np.ndarray, qdot: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """The penalty force on each sphere at the state (:class:`ChainContactForces`: a spring-damper of the state
+        alone, whatever the applied forces)."""
         if self._contact is None:
             raise NotImplementedError("the scene has no contact")
         return self._contact.forces_world(*(np.ascontiguousarray(np.asarray(x, dtype=float).T) for x in (q, qdot)))

@@ -227,10 +227,11 @@ class JointSimulation(abc.ABC):
         without it every contact metric is n/a."""
         raise NotImplementedError(f"{type(self).__name__} does not report its contact spheres (contact_centres)")
 
-    def contact_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+    def contact_forces(self, q: np.ndarray, qdot: np.ndarray, times: np.ndarray) -> np.ndarray:
         """(B, S, 3) [N]: the force the plane exerts on each contact sphere, in world axes, at states q (B, nq) and
-        qdot (B, nv) (zero where a sphere does not touch), as the engine's contact model gives it at that state. Not
-        timed. Optional: the contact-force metrics are n/a where an engine does not say."""
+        qdot (B, nv) reached at ``times`` (B,) [s] (zero where a sphere does not touch), as the engine's contact model
+        gives it at that state under the scene's applied forces at that time (a soft contact's force depends on them).
+        Not timed. Optional: the contact-force metrics are n/a where an engine does not say."""
         raise NotImplementedError(f"{type(self).__name__} does not report its contact forces (contact_forces)")
 
     def step_jacobian(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> StepJacobian:

@@ -175,6 +175,7 @@ SIGNORINI_VIOLATION_MAX = "signorini_violation_max"
 FRICTION_CONE_VIOLATION_MAX = "friction_cone_violation_max"
 CONTACT_ENERGY_GAIN_MAX = "contact_energy_gain_max"
 REST_WEIGHT_ERROR = "rest_weight_error"
+REST_EQUILIBRIUM_ERROR = "rest_equilibrium_error"
 # IK: a solver's outcome on its targets, judged by the harness.
 SOLVE_RATE = "solve_rate"
 SOLVE_RATE_OWN_STOP = "solve_rate_own_stop"
@@ -307,6 +308,8 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(CONTACT_ENERGY_GAIN_MAX, DIMENSIONLESS, CONTACT,
            theory="contact and damping only take energy: 0 up to the scheme's error"),
     Metric(REST_WEIGHT_ERROR, DIMENSIONLESS, CONTACT, theory="at rest the plane carries the weight: 0"),
+    Metric(REST_EQUILIBRIUM_ERROR, DIMENSIONLESS, CONTACT,
+           theory="at rest the contact forces, gravity and the joint forces balance on every joint and the base: 0"),
     Metric(IMPACT_TIME_ERROR, "s", CONTACT),
     Metric(REBOUND_VELOCITY_ERROR, "m/s", CONTACT),
     Metric(APEX_HEIGHT_ERROR, "m", CONTACT),

@@ -11,7 +11,9 @@ What MuJoCo is given (pinned by ``tests/references/test_chain_contact_engines.py
   URDF importer's ``inertiafromgeom`` is false.
 - Constraints on, but only contact: joint limits, equality constraints and frictionloss disabled
   (``mjDSBL_LIMIT``, ``mjDSBL_EQUALITY``, ``mjDSBL_FRICTIONLOSS``), as without contact.
-- Forces: at a state, ``mj_forward`` then ``mj_contactForce`` per contact (the contact frame's first row is the normal,
+- Forces: at a state, with ``qfrc_applied`` as the run had it at that time (the soft contact's force balances the
+  applied forces too: read without them, a pressing arm's force missed its torque's whole share), ``mj_forward`` then
+  ``mj_contactForce`` per contact (the contact frame's first row is the normal,
   from geom 1 to geom 2; the force acts on geom 2 along it), turned to world axes and summed per sphere.
 - Centres: the sphere geoms' ``geom_xpos`` after ``mj_kinematics``.
 """
@@ -93,13 +95,16 @@ class ContactReader:
             out[b] = self._data.geom_xpos[self._geoms]
         return out
 
-    def forces(self, qpos_at: np.ndarray, dof: np.ndarray, q: np.ndarray, qvel: np.ndarray) -> np.ndarray:
-        """(B, S, 3) the plane's force on each sphere in world axes at the states (q (B, nq), MuJoCo's qvel (B, nv))."""
+    def forces(self, qpos_at: np.ndarray, dof: np.ndarray, q: np.ndarray, qvel: np.ndarray,
+               applied: np.ndarray) -> np.ndarray:
+        """(B, S, 3) the plane's force on each sphere in world axes at the states (q (B, nq), MuJoCo's qvel (B, nv))
+        under ``qfrc_applied`` (B, model nv): MuJoCo's soft contact solves for the force with the applied forces in."""
         m, d = self._model, self._data
         out = np.zeros((len(q), len(self._geoms), 3))
         wrench = np.empty(6)
         for b, (row, rates) in enumerate(zip(q, qvel)):
             self._set(qpos_at, dof, row, rates)
+            d.qfrc_applied[:] = applied[b]
             mujoco.mj_forward(m, d)
             for i in range(d.ncon):
                 con = d.contact[i]

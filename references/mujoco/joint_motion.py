@@ -264,12 +264,18 @@ class MujocoJointMotion(JointSimulation):
             raise NotImplementedError("the scene has no contact")
         return self._contact.centres(self._qpos, self._dof, np.asarray(q, dtype=float))
 
-    def contact_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        """MuJoCo's contact forces on the spheres at each state (:class:`references.mujoco.contact.ContactReader`)."""
+    def contact_forces(self, q: np.ndarray, qdot: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """MuJoCo's contact forces on the spheres at each state (:class:`references.mujoco.contact.ContactReader`),
+        under ``qfrc_applied`` as the run had it at each time: its soft contact's force balances the applied forces
+        too."""
         if self._contact is None:
             raise NotImplementedError("the scene has no contact")
         q = np.asarray(q, dtype=float)
-        return self._contact.forces(self._qpos, self._dof, q, self._own(q, np.asarray(qdot, dtype=float)))
+        applied = np.repeat(self._control[0, :1], len(q), axis=0)
+        if self._timed is not None:
+            joints = self._dof[len(self._dof) - self._scene.chain.n_joints:]
+            applied[:, joints] += np.array([time_loads.at(self._timed, float(t)) for t in times])
+        return self._contact.forces(self._qpos, self._dof, q, self._own(q, np.asarray(qdot, dtype=float)), applied)
 
     def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         """A floating base's: :meth:`MujocoFloatingDynamics.centroidal_momentum` (``mj_subtreeVel``)."""

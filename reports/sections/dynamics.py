@@ -10,10 +10,10 @@ import pandas as pd
 
 from simparity.core.model.metric_catalogue import (
     CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, JOINT_ANGLE_ERROR_MAX,
-    LINEAR_MOMENTUM_DRIFT_MAX, REFERENCE_PARTING_TIME, REST_WEIGHT_ERROR, SELF_PARTING_TIME, SIGNORINI_VIOLATION_MAX,
-    TIME_PER_STEP, TOUCHDOWN_TIME_ERROR,
+    LINEAR_MOMENTUM_DRIFT_MAX, REFERENCE_PARTING_TIME, REST_EQUILIBRIUM_ERROR, REST_WEIGHT_ERROR, SELF_PARTING_TIME,
+    SIGNORINI_VIOLATION_MAX, TIME_PER_STEP, TOUCHDOWN_TIME_ERROR,
 )
-from simparity.core.model.results import OK
+from simparity.core.model.results import NOT_AVAILABLE, OK
 from simparity.reports import engine_summary, figures, summary, tables
 from simparity.reports.blocks import SCENE_TABLE_TRIM_ORDER, Block, Bullets, Details, Paragraph, Table, number
 from simparity.reports.sections import contact
@@ -64,7 +64,8 @@ def _predictability(rows: pd.DataFrame) -> list[Block]:
 
 def _finest_table(rows: pd.DataFrame, columns: tuple[tuple[str, str], ...], about: str) -> list[Block]:
     """A row per engine and integrator of ``columns`` ((metric, heading) pairs) at the scene's finest time step, after
-    the paragraph ``about`` (formatted with ``dt``); nothing where none of the metrics was measured."""
+    the paragraph ``about`` (formatted with ``dt``); the cases the engine cannot do left out (the scene's n/a table has
+    them); nothing where none is left."""
     names = [m for m, _ in columns]
     measured = rows[rows["metric"].isin(names) & rows["dt"].notna()]
     if measured.empty:
@@ -72,7 +73,10 @@ def _finest_table(rows: pd.DataFrame, columns: tuple[tuple[str, str], ...], abou
     finest = measured[measured["dt"] == measured["dt"].min()]
     cells = {(r["engine"], r["integrator"], r["metric"]): number(r["value"]) if r["status"] == OK else r["status"]
              for _, r in finest.iterrows()}
-    cases = list(dict.fromkeys(zip(finest["engine"], finest["integrator"])))
+    shown = finest[finest["status"] != NOT_AVAILABLE]  # an engine that cannot do the scene is in the n/a table
+    cases = list(dict.fromkeys(zip(shown["engine"], shown["integrator"])))
+    if not cases:
+        return []
     return [Paragraph(about.format(dt=f"{finest['dt'].iloc[0]:g}")),
             Table(("engine", "integrator") + tuple(head for _, head in columns),
                   tuple((e, i) + tuple(cells.get((e, i, m), "—") for m in names) for e, i in cases))]
@@ -90,7 +94,7 @@ def _momentum(rows: pd.DataFrame) -> list[Block]:
 
 CHAIN_CONTACT_COLUMNS = ((TOUCHDOWN_TIME_ERROR, "touchdown error"), (CONTACT_PENETRATION_MAX, "penetration / radius"),
                          (SIGNORINI_VIOLATION_MAX, "Signorini violation"), (CONTACT_ENERGY_GAIN_MAX, "energy gain"),
-                         (REST_WEIGHT_ERROR, "rest weight error"))
+                         (REST_WEIGHT_ERROR, "rest weight error"), (REST_EQUILIBRIUM_ERROR, "rest equilibrium error"))
 """The contact metrics report.md shows for a chain on a plane, each with its column's name."""
 
 
@@ -100,7 +104,8 @@ def _chain_contact(rows: pd.DataFrame) -> list[Block]:
     return _finest_table(rows, CHAIN_CONTACT_COLUMNS,
                          "Contact at dt = {dt} s, truths that need no engine: touchdown against the closed-form fall, "
                          "the deepest penetration, pulls or forces off the plane, energy gained, and at rest the plane "
-                         "carrying the weight (each engine's contact is its own: no reference).")
+                         "carrying the weight and every joint balanced (by Pinocchio's model; each engine's contact is "
+                         "its own: no reference).")
 
 
 def _contact_verdict(rows: pd.DataFrame) -> str:

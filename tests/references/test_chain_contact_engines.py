@@ -54,5 +54,6 @@ def test_sphere_centres_agree_with_core_s_fk_and_forces_push_along_the_normal(sc
     qdot = rng.uniform(-0.1, 0.1, (5, scene.chain.nv))
     mj, core = MujocoJointMotion(scene, "euler", 0.002), CoreJointMotion(scene, "rk4", 0.002)
     np.testing.assert_allclose(mj.contact_centres(q), core.contact_centres(q), rtol=0, atol=FK_AGREEMENT)
-    for forces in (mj.contact_forces(q, qdot), core.contact_forces(q, qdot)):
+    times = np.zeros(len(q))
+    for forces in (mj.contact_forces(q, qdot, times), core.contact_forces(q, qdot, times)):
         assert np.all(forces[..., :2] == 0.0) and np.all(forces[..., 2] >= 0.0) and np.any(forces[..., 2] > 0.0)

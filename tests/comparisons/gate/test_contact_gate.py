@@ -1,7 +1,8 @@
 """Issue #46's planted contact bugs through the gate: a user's engine that is core or MuJoCo's adapter with one planted
 bug (the plane's normal turned, so that it pulls; the contact forces reported with their sign flipped; MuJoCo's spheres
-twice as large, so that they touch early; one sphere's force left out of what is reported) turns the check of
-``solo12-drop-stand`` red naming it and the metric that sees it; a faithful copy passes. A sweep (a run of the scene
+twice as large, so that they touch early; one sphere's force left out of what is reported; MuJoCo's forces read without
+the applied torque) turns the check of ``solo12-drop-stand`` or ``pendulum-press`` red naming it and the metric that
+sees it; a faithful copy passes on both. A sweep (a run of the scene
 per bug), in ``.ci/run``."""
 
 from __future__ import annotations
@@ -12,6 +13,8 @@ from tests.helpers import PLANTED_MOTION_FACTORY, assert_caught, run_planted
 
 PLANTED = PLANTED_MOTION_FACTORY + '''
 from dataclasses import replace
+
+import numpy as np
 
 from simparity.core.articulated.motion import CoreJointMotion
 from simparity.core.inhouse import InHouseEngine
@@ -36,8 +39,8 @@ class Pulling(CoreJointMotion):
 class FlippedForces(MujocoJointMotion):
     """MuJoCo's forces read as acting on the plane instead of the sphere."""
 
-    def contact_forces(self, q, qdot):
-        return -super().contact_forces(q, qdot)
+    def contact_forces(self, q, qdot, times):
+        return -super().contact_forces(q, qdot, times)
 
 
 class FatSpheres(MujocoJointMotion):
@@ -48,11 +51,20 @@ class FatSpheres(MujocoJointMotion):
         super().__init__(replace(scene, contact=replace(scene.contact, spheres=fat)), integrator, dt)
 
 
+class WithoutTorque(MujocoJointMotion):
+    """MuJoCo's forces read at each state without the applied torque: its soft contact then misses the torque's
+    share."""
+
+    def contact_forces(self, q, qdot, times):
+        return self._contact.forces(self._qpos, self._dof, q, self._own(q, qdot),
+                                    np.zeros((len(q), self.model.nv)))
+
+
 class LostSphere(MujocoJointMotion):
     """One sphere's force left out of what is reported."""
 
-    def contact_forces(self, q, qdot):
-        forces = super().contact_forces(q, qdot)
+    def contact_forces(self, q, qdot, times):
+        forces = super().contact_forces(q, qdot, times)
         forces[:, 0] = 0.0
         return forces
 
@@ -62,28 +74,31 @@ PullingEngine = _engine(InHouseEngine, Pulling, "core-pulling")
 FlippedForcesEngine = _engine(MujocoEngine, FlippedForces, "mujoco-flipped-forces")
 FatSpheresEngine = _engine(MujocoEngine, FatSpheres, "mujoco-fat-spheres")
 LostSphereEngine = _engine(MujocoEngine, LostSphere, "mujoco-lost-sphere")
+WithoutTorqueEngine = _engine(MujocoEngine, WithoutTorque, "mujoco-without-torque")
 '''
 
 
-def _run(tmp_path, monkeypatch, capsys, plugin: str) -> tuple[int, list[str], str]:
-    return run_planted(tmp_path, monkeypatch, capsys, "planted_contact", PLANTED, "solo12-drop-stand", plugin,
-                       engines="mujoco")
+def _run(tmp_path, monkeypatch, capsys, plugin: str, scene: str = "solo12-drop-stand") -> tuple[int, list[str], str]:
+    return run_planted(tmp_path, monkeypatch, capsys, "planted_contact", PLANTED, scene, plugin, engines="mujoco")
 
 
 @pytest.mark.sweep
 @pytest.mark.slow
-@pytest.mark.parametrize("plugin, name, metric", [
-    ("PullingEngine", "core-pulling", "contact_penetration_max"),
-    ("FlippedForcesEngine", "mujoco-flipped-forces", "signorini_violation_max"),
-    ("FatSpheresEngine", "mujoco-fat-spheres", "signorini_violation_max"),
-    ("LostSphereEngine", "mujoco-lost-sphere", "rest_weight_error"),
+@pytest.mark.parametrize("plugin, name, metric, scene", [
+    ("PullingEngine", "core-pulling", "contact_penetration_max", "solo12-drop-stand"),
+    ("FlippedForcesEngine", "mujoco-flipped-forces", "signorini_violation_max", "solo12-drop-stand"),
+    ("FatSpheresEngine", "mujoco-fat-spheres", "signorini_violation_max", "solo12-drop-stand"),
+    ("LostSphereEngine", "mujoco-lost-sphere", "rest_weight_error", "solo12-drop-stand"),
+    ("WithoutTorqueEngine", "mujoco-without-torque", "rest_equilibrium_error", "pendulum-press"),
 ])
-def test_a_planted_contact_bug_is_caught_naming_the_engine(tmp_path, monkeypatch, capsys, plugin, name, metric):
-    assert_caught(_run(tmp_path, monkeypatch, capsys, plugin), name, metric)
+def test_a_planted_contact_bug_is_caught_naming_the_engine(tmp_path, monkeypatch, capsys, plugin, name, metric,
+                                                           scene):
+    assert_caught(_run(tmp_path, monkeypatch, capsys, plugin, scene), name, metric)
 
 
 @pytest.mark.sweep
 @pytest.mark.slow
-def test_a_faithful_copy_of_the_adapter_passes(tmp_path, monkeypatch, capsys):
-    code, violations, out = _run(tmp_path, monkeypatch, capsys, "FaithfulEngine")
+@pytest.mark.parametrize("scene", ["solo12-drop-stand", "pendulum-press"])
+def test_a_faithful_copy_of_the_adapter_passes(tmp_path, monkeypatch, capsys, scene):
+    code, violations, out = _run(tmp_path, monkeypatch, capsys, "FaithfulEngine", scene)
     assert code == 0 and not violations, out[-2000:]

@@ -1,0 +1,67 @@
+"""A chain's static balance under point forces, in Pinocchio: the truth a robot at rest on the ground meets.
+
+``balance(q, forces)`` is the generalized force (the project's convention, B x nv) that holds the chain still at q
+under gravity and the given forces on its contact spheres: ``rnea(q, 0, 0, fext)``, each sphere's force given to
+Pinocchio as an external force on the joint that carries its frame, expressed in that joint's LOCAL frame with its
+moment about the joint's origin (Pinocchio's convention for ``fext``), the sphere's centre placed by Pinocchio's own
+frames (a chain joint's frame is its joint's; the end effector is the URDF link's frame; the base link is the free
+flyer's, or the universe on a fixed base, where a force holds nothing). A floating base's rows are turned to world
+axes (:mod:`references.common.floating_base`). At rest the joints' rows equal the applied joint forces less the
+damping and a floating base's rows are zero: g(q) - sum_s J_s^T f_s = tau.
+
+Nothing of core's: Pinocchio's model of the chain's file, frames and recursion.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.chain_contact import ChainContact, frame_index
+from simparity.references.common.floating_base import base_rotations, turned_base
+from simparity.references.pinocchio.floating import PinocchioFloatingDynamics
+from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics
+
+
+class PinocchioStatics:
+    """The static balance of a chain with its contact spheres (see the module docstring)."""
+
+    def __init__(self, chain: Chain, gravity_world: np.ndarray | None, contact: ChainContact) -> None:
+        self._floating = chain.floating_base
+        dynamics = (PinocchioFloatingDynamics(chain, gravity_world) if chain.floating_base
+                    else PinocchioJointDynamics(chain, gravity_world))
+        self._model, self._data = dynamics.model, dynamics.model.createData()
+        self._configuration = (dynamics.configuration if isinstance(dynamics, PinocchioFloatingDynamics)
+                               else dynamics._configuration)
+        self._index = np.r_[0:6, dynamics.idx_v] if chain.floating_base else np.asarray(dynamics.idx_v)
+        names = tuple(j.name for j in chain.joints)
+        self._joints, self._points = [], []
+        for sphere in contact.spheres:
+            i = frame_index(sphere.frame, names, chain.end_effector_name, chain.base_link)
+            if i == len(names):
+                frame = self._model.frames[self._model.getFrameId(chain.end_effector_name, pin.BODY)]
+                joint, placement = int(frame.parentJoint), frame.placement
+            else:
+                joint = self._model.getJointId(names[i]) if i >= 0 else (1 if chain.floating_base else 0)
+                placement = pin.SE3.Identity()
+            self._joints.append(joint)
+            self._points.append(placement.act(np.asarray(sphere.centre_xyz, dtype=float)))
+
+    def balance(self, q: np.ndarray, forces_world: np.ndarray) -> np.ndarray:
+        """(B, nv): the generalized force that holds the chain still at q (B, nq) under gravity and ``forces_world``
+        (B, S, 3) [N] on its spheres (the project's convention: a floating base's force and moment in world axes)."""
+        m, d = self._model, self._data
+        out = np.empty((len(q), len(self._index)))
+        zero = np.zeros(m.nv)
+        for b, row in enumerate(np.asarray(q, dtype=float)):
+            configuration = self._configuration(row)
+            pin.forwardKinematics(m, d, configuration)
+            external = pin.StdVec_Force()
+            for _ in range(m.njoints):
+                external.append(pin.Force.Zero())
+            for joint, point, force in zip(self._joints, self._points, forces_world[b]):
+                local = d.oMi[joint].rotation.T @ force
+                external[joint] = external[joint] + pin.Force(local, np.cross(point, local))
+            out[b] = pin.rnea(m, d, configuration, zero, zero, external)[self._index]
+        return turned_base(base_rotations(q), out, True, True) if self._floating else out
