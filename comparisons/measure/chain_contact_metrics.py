@@ -36,6 +36,7 @@ import numpy as np
 from simparity.comparisons.measure.joint_motion_metrics import (
     CHAIN_CONTACT_METRICS, OwnReading, energy_budget, reach, work_done,
 )
+from simparity.comparisons.common.error_text import error_text
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointSimulation
 from simparity.core.model.metric_catalogue import (
@@ -211,7 +212,11 @@ def _equilibrium(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarr
     assert contact is not None
     q = np.asarray(traj.q[index[-1]])
     qdot = np.asarray(traj.qdot[index[-1]])
-    balance = PinocchioStatics(scene.chain, scene.gravity_world, contact).balance(q, forces[-1])
+    try:
+        balance = PinocchioStatics(scene.chain, scene.gravity_world, contact).balance(q, forces[-1])
+    except Exception as err:  # noqa: BLE001 - Pinocchio refuses the chain (an unlimited prismatic joint in URDF, ...)
+        return Measured(math.nan, "1", unmeasurable=(
+            f"its truth is Pinocchio's model of the chain, which Pinocchio cannot build: {error_text(err)}"))
     n = scene.chain.n_joints
     held = np.zeros_like(balance)  # what holds the chain: the applied joint forces less the damping (none on a base)
     damping = np.array([j.damping for j in scene.chain.joints])
