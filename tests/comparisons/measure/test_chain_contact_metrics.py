@@ -206,3 +206,14 @@ def test_an_inline_arm_s_balance_is_judged_or_n_a_with_why(limits, balanced):
         assert measured.value < SETTLING
     else:
         assert math.isnan(measured.value) and "Pinocchio cannot build" in measured.unmeasurable
+
+
+def test_an_engine_that_does_not_fall_is_late_not_unmeasured(scene):
+    """A robot held in the air (a plugin that loses gravity) never touches down: its error is at least how far the run
+    ends after the closed-form time, a number the bounds judge, never an n/a."""
+    class Weightless(MujocoJointMotion):
+        def __init__(self, scene, integrator, dt):
+            super().__init__(replace(scene, gravity_world=None), integrator, dt)
+    values = _measured(scene, Weightless, "euler", 0.002, 0.1)
+    assert values[TOUCHDOWN_TIME_ERROR].value == pytest.approx((0.1 - T_CONTACT) / T_CONTACT, rel=1e-9)
+    assert not values[TOUCHDOWN_TIME_ERROR].unmeasurable
