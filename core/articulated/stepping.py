@@ -25,6 +25,10 @@ its order (the equation is smooth in R^4 and normalising changes a step by the s
 Applied joint forces are the scene's constant ones plus its timed torque (a function of time,
 :mod:`core.model.scenes.time_functions`) evaluated at each stage's own time t + c_i dt, a held one as seen from inside
 the step (:mod:`core.dynamics.time_loads`); the Euler steps take it at the step's start.
+
+With contact (``scene.contact``), every evaluation of the accelerations adds the plane's penalty forces on the chain's
+spheres at that stage's state, through the spheres' Jacobians (:mod:`core.articulated.chain_contact`): the contact is a
+force of the state like any other, stepped by the same scheme (the lecture's penalty method, stiff as its spring).
 """
 
 from __future__ import annotations
