@@ -71,13 +71,6 @@ def _centres(sim: JointSimulation, traj: JointTrajectory, index: np.ndarray, sph
     return np.asarray(sim.contact_centres(q), dtype=float).reshape(len(index), traj.q.shape[1], spheres, 3)
 
 
-def total_mass(scene: JointMotionScene) -> float:
-    """[kg] the robot's mass as the file declares it (every importer reads the same: model parity, issue #45)."""
-    chain = scene.chain
-    base = chain.base_inertia.mass if chain.base_inertia is not None else 0.0
-    return base + sum(j.link.mass for j in chain.joints if j.link is not None)
-
-
 def closed_form_touchdown(scene: JointMotionScene, gaps0: np.ndarray) -> tuple[float, str]:
     """(t [s], "") the first sphere's touchdown in free fall from gaps ``gaps0`` (B, S) [m] (the engine's own at t = 0),
     or (nan, why) when the scene's start is no rigid fall or nothing reaches the plane within its duration."""
@@ -256,7 +249,7 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
                                           note="deepest sinking over the sphere's radius"),
         CONTACT_ENERGY_GAIN_MAX: _energy_gain(scene, traj, own, gaps),
     }
-    mass = total_mass(scene)
+    mass = scene.chain.mass  # as the file declares it: every importer reads the same (model parity, issue #45)
     weight = mass * float(np.linalg.norm(scene.gravity_world)) if scene.gravity_world is not None else 0.0
     if not weight > 0:
         why = "no weight (no gravity or no mass): the contact forces have no scale"

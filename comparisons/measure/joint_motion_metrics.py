@@ -363,7 +363,7 @@ def momentum_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointT
         return {m: Measured(math.nan, "1", unmeasurable=str(err)) for m in MOMENTUM_METRICS}
     chain = scene.chain
     assert chain.base_inertia is not None  # a floating chain's dynamics_problem() says so
-    mass = chain.base_inertia.mass + sum(j.link.mass for j in chain.joints if j.link is not None)
+    mass = chain.mass
     gravity = np.zeros(3) if scene.gravity_world is None else np.asarray(scene.gravity_world, dtype=float)
     linear, angular = momentum[..., :3], momentum[..., 3:]
     expected = linear[0] + mass * gravity * (traj.times[own.index] - traj.times[0])[:, None, None]
@@ -387,19 +387,15 @@ def momentum_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointT
 
     def relative(drift: float, size: float, floor: float, what: str) -> Measured:
         ratio = drift / size
-        if along and ratio <= floor:
-            return Measured(ratio, "1", flag=ROUNDING_FLOOR, note=f"{along}; at the rounding floor ({floor:.2g})")
-        if along and ratio <= SATURATED_DRIFT:
-            return Measured(ratio, "1", note=along)
         if ratio > SATURATED_DRIFT:
             return Measured(ratio, "1", flag=SATURATED, unmeasurable=(
                 f"saturated: the {what} drifts {ratio:.3g} x the momentum the motion can carry "
                 f"(> {SATURATED_DRIFT:g})"))
         if ratio <= floor:
-            return Measured(ratio, "1", flag=ROUNDING_FLOOR, note=(
+            return Measured(ratio, "1", flag=ROUNDING_FLOOR, note="; ".join(filter(None, (along, (
                 f"at the rounding floor ({floor:.2g}: {ROUNDING_FLOOR_FACTOR:g} eps x steps x the momentum's and the "
-                "position's size): exact up to it"))
-        return Measured(ratio, "1")
+                "position's size): exact up to it")))))
+        return Measured(ratio, "1", note=along)
     return {
         LINEAR_MOMENTUM_DRIFT_MAX: relative(float(np.linalg.norm(linear_drift, axis=-1).max()), scale,
                                             unit * carried, "linear momentum"),

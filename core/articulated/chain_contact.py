@@ -30,33 +30,51 @@ class ChainContactForces:
     def __init__(self, chain: Chain, contact: ChainContact) -> None:
         self._chain, self._contact = chain, contact
         names = tuple(j.name for j in chain.joints)
-        self._frames = [frame_index(s.frame, names, chain.end_effector_name, chain.base_link)
+        self._frames_of_spheres = [frame_index(s.frame, names, chain.end_effector_name, chain.base_link)
                         for s in contact.spheres]
         self._revolute = np.array([j.type == "revolute" for j in chain.joints])
         self._lowest = -contact.radii[:, None] * contact.plane.normal_world  # (S, 3): centre to contact point
 
-    def _kinematics(self, q: np.ndarray) -> tuple[np.ndarray, list[np.ndarray], np.ndarray | None]:
-        """(centres in the base frame (B, S, 3), per sphere its joint columns (B, k, 3) in the base frame (k joints
-        move it), the base rotation (B, 3, 3) or None on a fixed base)."""
+    def _frames(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+        """(joint positions (B, n + 1, 3), frame rotations (B, n + 1, 3, 3), joint axes (B, n, 3), all in the base
+        frame, and the base rotation (B, 3, 3) or None on a fixed base) at q (nq, B)."""
         n = self._chain.n_joints
         positions, rotations, axes = joint_frames(self._chain, q[q.shape[0] - n:].T)
-        centres, columns = [], []
-        for i, sphere in zip(self._frames, self._contact.spheres):
-            centre = (np.broadcast_to(sphere.centre_xyz, (positions.shape[0], 3)) if i < 0 else
-                      positions[:, i] + rotations[:, i] @ sphere.centre_xyz)
-            moved = n if i == n else i + 1  # joints 0..i move joint i's frame, all move the tip, none the base
-            lever = centre[:, None] - positions[:, :moved]
-            columns.append(np.where(self._revolute[:moved, None], np.cross(axes[:, :moved], lever), axes[:, :moved]))
-            centres.append(centre)
-        rotation = quat_wxyz_to_matrix(q[3:7].T) if self._chain.floating_base else None
-        return np.stack(centres, axis=1), columns, rotation
+        return positions, rotations, axes, quat_wxyz_to_matrix(q[3:7].T) if self._chain.floating_base else None
 
-    def _world(self, q: np.ndarray, qdot: np.ndarray):
-        """(centres (B, S, 3), velocities (B, S, 3), forces (B, S, 3)) in the world, and the kinematics."""
-        centres_base, columns, rotation = self._kinematics(q)
+    def _centres_base(self, positions: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+        """(B, S, 3) the spheres' centres in the base frame."""
+        return np.stack([np.broadcast_to(sphere.centre_xyz, (positions.shape[0], 3)) if i < 0 else
+                         positions[:, i] + rotations[:, i] @ sphere.centre_xyz
+                         for i, sphere in zip(self._frames_of_spheres, self._contact.spheres)], axis=1)
+
+    def _columns(self, positions: np.ndarray, axes: np.ndarray, centres_base: np.ndarray) -> list[np.ndarray]:
+        """Per sphere its Jacobian's joint columns (B, k, 3) in the base frame (the k joints that move it)."""
+        n = self._chain.n_joints
+        columns = []
+        for s, i in enumerate(self._frames_of_spheres):
+            moved = n if i == n else i + 1  # joints 0..i move joint i's frame, all move the tip, none the base
+            lever = centres_base[:, s, None] - positions[:, :moved]
+            columns.append(np.where(self._revolute[:moved, None], np.cross(axes[:, :moved], lever), axes[:, :moved]))
+        return columns
+
+    def centres_world(self, q: np.ndarray) -> np.ndarray:
+        """(B, S, 3) the spheres' centres [m] at q (nq, B)."""
+        positions, rotations, _, rotation = self._frames(q)
+        centres_base = self._centres_base(positions, rotations)
+        return centres_base if rotation is None else q[:3].T[:, None] + np.einsum("bij,bsj->bsi", rotation,
+                                                                                  centres_base)
+
+    def _state(self, q: np.ndarray, qdot: np.ndarray):
+        """(forces (B, S, 3) in the world, the base-to-centre arms in world axes (B, S, 3) or None on a fixed base,
+        the Jacobian columns, the base rotation or None) at the state."""
+        positions, rotations, axes, rotation = self._frames(q)
+        centres_base = self._centres_base(positions, rotations)
+        columns = self._columns(positions, axes, centres_base)
         n = self._chain.n_joints
         rates = qdot[qdot.shape[0] - n:].T  # (B, n)
         relative = np.stack([np.einsum("bkj,bk->bj", cols, rates[:, :cols.shape[1]]) for cols in columns], axis=1)
+        arms = None
         if rotation is None:
             centres, velocities = centres_base, relative
         else:
@@ -66,26 +84,21 @@ class ChainContactForces:
                           + np.einsum("bij,bsj->bsi", rotation, relative))
         c = self._contact
         forces = penalty_force(centres + self._lowest, velocities, c.plane, c.penalty_stiffness, c.penalty_damping)
-        return centres, forces, (centres_base, columns, rotation)
-
-    def centres_world(self, q: np.ndarray) -> np.ndarray:
-        """(B, S, 3) the spheres' centres [m] at q (nq, B)."""
-        return self._world(q, np.zeros((self._chain.nv, q.shape[1])))[0]
+        return forces, arms, columns, rotation
 
     def forces_world(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         """(B, S, 3) the plane's force on each sphere [N] at the state (q (nq, B), qdot (nv, B))."""
-        return self._world(q, qdot)[1]
+        return self._state(q, qdot)[0]
 
     def generalized(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         """(nv, B) the generalized contact force J^T F [N m or N; a floating base's force N and moment N m first]."""
-        _, forces, (centres_base, columns, rotation) = self._world(q, qdot)
+        forces, arms, columns, rotation = self._state(q, qdot)
         n = self._chain.n_joints
         base_forces = forces if rotation is None else np.einsum("bji,bsj->bsi", rotation, forces)  # base axes
         joints = np.zeros((forces.shape[0], n))
         for s, cols in enumerate(columns):
             joints[:, :cols.shape[1]] += np.einsum("bkj,bj->bk", cols, base_forces[:, s])
-        if rotation is None:
+        if arms is None:
             return joints.T
-        arms = np.einsum("bij,bsj->bsi", rotation, centres_base)
         wrench = np.concatenate([forces.sum(axis=1), np.cross(arms, forces).sum(axis=1)], axis=1)
         return np.concatenate([wrench, joints], axis=1).T

@@ -6,12 +6,11 @@ import numpy as np
 
 from simparity.comparisons.scenes.loading.contact import START_INSIDE_TOLERANCE
 from simparity.comparisons.scenes.loading.reader import TableReader
-from simparity.core.kinematics import forward_kinematics
+from simparity.core.articulated.chain_contact import ChainContactForces
 from simparity.core.model.ranges import RANGES, safe_norm
 from simparity.core.model.scenes.chain import Chain
-from simparity.core.model.scenes.chain_contact import ChainContact, ContactSphere, frame_index
+from simparity.core.model.scenes.chain_contact import ChainContact, ContactSphere
 from simparity.core.model.scenes.contact import Plane
-from simparity.core.rotations import quat_wxyz_to_matrix
 
 _PLANE = ("name", "coefficients")
 _CONTACT = ("penalty_stiffness", "penalty_damping", "sphere")
@@ -61,10 +60,8 @@ def read_chain_contact(top: TableReader, chain: Chain, q0: np.ndarray) -> ChainC
     if not spheres:
         raise c.fail("sphere", "no contact sphere", "[[contact.sphere]] entries: frame, centre_xyz, radius")
     stiffness = c.number("penalty_stiffness", positive=True)  # N/m = kg / s^2: no length
-    masses = [j.link.mass for j in chain.joints if j.link is not None]
-    mass = sum(masses) + (chain.base_inertia.mass if chain.base_inertia is not None else 0.0)
     damping = (c.number("penalty_damping") if c.has("penalty_damping")
-               else 2.0 * float(np.sqrt(stiffness * mass)))  # critical on the robot's mass, N s/m = kg / s
+               else 2.0 * float(np.sqrt(stiffness * chain.mass)))  # critical on the robot's mass, N s/m = kg / s
     if damping < 0:
         raise c.fail("penalty_damping", f"{damping:g} is negative", "a number >= 0 [N s/m]")
     contact = ChainContact(plane, tuple(spheres), stiffness, damping)
@@ -72,23 +69,8 @@ def read_chain_contact(top: TableReader, chain: Chain, q0: np.ndarray) -> ChainC
     return contact
 
 
-def sphere_centres_world(chain: Chain, contact: ChainContact, q: np.ndarray) -> np.ndarray:
-    """(B, S, 3) the spheres' centres [m] at configurations q (B, nq) by core's FK (the loader's check)."""
-    n = chain.n_joints
-    poses = forward_kinematics(chain, q[:, q.shape[1] - n:])
-    names = tuple(j.name for j in chain.joints)
-    out = np.empty((len(q), len(contact.spheres), 3))
-    for k, sphere in enumerate(contact.spheres):
-        i = frame_index(sphere.frame, names, chain.end_effector_name, chain.base_link)
-        out[:, k] = (sphere.centre_xyz if i < 0 else
-                     poses.position_world[:, i] + poses.rotation_world[:, i] @ sphere.centre_xyz)
-    if chain.floating_base:
-        out = q[:, None, :3] + np.einsum("bij,bsj->bsi", quat_wxyz_to_matrix(q[:, 3:7]), out)
-    return out
-
-
 def _check_start_outside(top: TableReader, chain: Chain, contact: ChainContact, q0: np.ndarray) -> None:
-    gaps = contact.gaps(sphere_centres_world(chain, contact, np.atleast_2d(q0)))
+    gaps = contact.gaps(ChainContactForces(chain, contact).centres_world(np.atleast_2d(q0).T))
     copy, k = np.unravel_index(int(np.argmin(gaps)), gaps.shape)
     if -gaps[copy, k] > START_INSIDE_TOLERANCE:
         raise top.fail(f"contact.sphere[{k}]", f"the sphere on {contact.spheres[k].frame!r} starts "

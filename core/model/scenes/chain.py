@@ -268,6 +268,13 @@ class Chain:
         return self.n_joints + self.base_dofs
 
     @property
+    def mass(self) -> float:
+        """[kg] the whole robot's mass as declared: a floating base's rigid group (its :attr:`base_inertia`), then every
+        joint's link (0 for a link without mass properties; a fixed base's own mass never matters and is not counted)."""
+        base = self.base_inertia.mass if self.base_inertia is not None else 0.0
+        return base + sum(j.link.mass for j in self.joints if j.link is not None)
+
+    @property
     def lower(self) -> np.ndarray:
         """(n,) lower joint limits, -inf when unlimited."""
         return np.array([j.lower for j in self.joints])

@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.invariance.transforms import FIXED_TRANSFORMS, transform_scene
-from simparity.comparisons.scenes.loading.chain_contact import sphere_centres_world
 from simparity.core.articulated.chain_contact import ChainContactForces
 from simparity.core.model.scenes.chain import Chain, Joint, LinkInertia
 from simparity.core.model.scenes.chain_contact import ChainContact, ContactSphere
@@ -19,6 +18,11 @@ from simparity.core.model.scenes.joint_motion import JointMotionScene
 ROUNDING = 1e-9
 """Relative agreement of gaps and forces across a transform: a 2 km translation rounds positions at ~5e-13 m."""
 
+
+
+def _centres(chain, contact, q: np.ndarray) -> np.ndarray:
+    """(B, S, 3) the spheres' centres by core's FK at configurations q (B, nq)."""
+    return ChainContactForces(chain, contact).centres_world(np.asarray(q).T)
 
 def _scene() -> JointMotionScene:
     link = LinkInertia(1.0, np.array([0.15, 0.0, 0.0]), np.diag([1e-4, 7.5e-3, 7.5e-3]))
@@ -41,8 +45,8 @@ def test_gaps_and_forces_are_the_same_in_every_frame_and_unit(transform):
     powers = scene.chain.length_powers
     q_moved = transform.length_scale ** powers * q
     qdot_moved = transform.length_scale ** powers / transform.time_scale * qdot
-    gaps = scene.contact.gaps(sphere_centres_world(scene.chain, scene.contact, q))
-    gaps_moved = moved.contact.gaps(sphere_centres_world(moved.chain, moved.contact, q_moved))
+    gaps = scene.contact.gaps(_centres(scene.chain, scene.contact, q))
+    gaps_moved = moved.contact.gaps(_centres(moved.chain, moved.contact, q_moved))
     np.testing.assert_allclose(gaps_moved, transform.length_scale * gaps, rtol=ROUNDING, atol=ROUNDING)
     assert np.any(gaps < 0)  # the case presses
     force = ChainContactForces(scene.chain, scene.contact).forces_world(q.T, qdot.T)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from simparity.comparisons.api import load_scene
-from simparity.comparisons.scenes.loading.chain_contact import sphere_centres_world
+from simparity.core.articulated.chain_contact import ChainContactForces
 from simparity.core.articulated.stepping import configuration_rate, normalised
 from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics
 from simparity.references.pinocchio.floating import PinocchioFloatingDynamics
@@ -22,6 +22,11 @@ AGREEMENT = 1e-8
 ROUNDING = 1e-12
 """Two evaluations of one recursion at one state: rounding."""
 
+
+
+def _centres(chain, contact, q: np.ndarray) -> np.ndarray:
+    """(B, S, 3) the spheres' centres by core's FK at configurations q (B, nq)."""
+    return ChainContactForces(chain, contact).centres_world(np.asarray(q).T)
 
 @pytest.mark.parametrize("name, seed", [("solo12-drop-stand", 1), ("pendulum-press", 2)])
 def test_the_balance_is_gravity_less_the_forces_through_the_spheres_jacobians(name, seed):
@@ -47,8 +52,8 @@ def test_the_balance_is_gravity_less_the_forces_through_the_spheres_jacobians(na
             if chain.floating_base:
                 return normalised((q + eps * configuration_rate(q.T, w[:, None]).T).T).T
             return q + eps * w
-        velocities = (sphere_centres_world(chain, contact, moved(FD_STEP))
-                      - sphere_centres_world(chain, contact, moved(-FD_STEP))) / (2 * FD_STEP)
+        velocities = (_centres(chain, contact, moved(FD_STEP))
+                      - _centres(chain, contact, moved(-FD_STEP))) / (2 * FD_STEP)
         virtual = float(np.einsum("bsi,bsi->", forces, velocities))
         scale = float(np.abs(forces).sum() * np.abs(velocities).max())
         assert abs(-float(pushed[0] @ w) - virtual) <= AGREEMENT * scale
