@@ -26,8 +26,10 @@ Conversions (each pinned by a test in ``tests/references/pinocchio/test_adapter.
   ``buildModelFromXML``; fixed base. A ``continuous`` joint has nq = 2 (cos, sin). Joint
   frames are the child links' frames; Jacobians are LOCAL_WORLD_ALIGNED; poses are
   re-expressed in the chain's base link (:mod:`references.common.base_frame`).
-- Contact: a scene with contact is n/a (:data:`NO_CONTACT`). Pinocchio 4.1 has the pieces of ONE
-  contact problem (``PointContactConstraintModel`` with a ``CoulombFrictionCone``, Delassus
+- Contact of free bodies: a dynamics scene with contact is n/a (:data:`NO_CONTACT`): its restitution, friction and
+  rest speed have no piece in Pinocchio. (A chain's frictionless spheres on a plane, in a joint-motion scene, are
+  stepped by the harness's loop on Pinocchio's point contacts and ADMM: :mod:`references.pinocchio.contact`.)
+  Pinocchio 4.1 has the pieces of ONE contact problem (``PointContactConstraintModel`` with a ``CoulombFrictionCone``, Delassus
   operators, ``PGSConstraintSolver`` / ``ADMMConstraintSolver`` for a single conic problem,
   ``constraintDynamics`` for bilateral rigid constraints, ``impulseDynamics`` with a restitution
   coefficient for bilateral impacts) but no time-stepping contact simulation; assembling one
@@ -335,9 +337,10 @@ def _dynamics_support(chain: Chain) -> Support:
     return Support.no(refused) if refused else Support.yes()
 
 
-CONTACT_WHY = ("not yet: Pinocchio has no stepper of its own; its point contacts (PointContactConstraintModel, "
-               "constraintDynamics with its ADMM or PGS solvers) need a time-stepping loop the harness writes, with "
-               "the harness's contact detection (issue #46, to come)")
+CONTACT_SCHEME_WHY = ("Pinocchio's contact is solved at the velocity level once per step (impulses by its ADMM, then q from "
+                      "the new velocity: Moreau-Jean time stepping, references.pinocchio.contact): only semi_implicit_euler "
+                      "steps a scene with contact")
+"""Why Pinocchio's rows with another integrator are n/a on a scene with contact."""
 
 
 @derives_own_inputs
@@ -404,10 +407,13 @@ class PinocchioEngine(UrdfChains, Engine):
     def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
         """The chains of :meth:`supports_joint_dynamics`."""
         named = super().supports_joint_motion(scene, integrator)
+        if named.ok and scene.contact is not None and integrator != "semi_implicit_euler":
+            return Support.no(CONTACT_SCHEME_WHY)
         return _dynamics_support(scene.chain) if named.ok else named
 
     def chain_contact(self, scene: JointMotionScene) -> Support:
-        return Support.no(CONTACT_WHY)
+        """Its point contacts and ADMM in the harness's semi-implicit Euler (:mod:`references.pinocchio.contact`)."""
+        return Support.yes()
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         if scene.chain.floating_base:

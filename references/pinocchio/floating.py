@@ -49,6 +49,16 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
         out[self._index] = local_row
         return out
 
+    def local_velocity(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """Pinocchio's velocity (nv,) (the free flyer's in its LOCAL frame) of a project state q (1, 7 + n),
+        qdot (1, 6 + n) (world axes)."""
+        return self._vector(turned_base(base_rotations(q), qdot, True, True, inverse=True)[0])
+
+    def project_velocity(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """(1, 6 + n): the project's velocity (world axes) of Pinocchio's ``v`` (nv,) at q (1, 7 + n); a velocity
+        change converts the same way (the base's rows turned by R)."""
+        return turned_base(base_rotations(q), v[self._index][None], True, True)
+
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         out = np.empty((len(q), len(self._index), len(self._index)))
         for k, row in enumerate(q):

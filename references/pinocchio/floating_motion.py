@@ -34,6 +34,7 @@ from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common import time_loads
 from simparity.references.common.floating_base import BASE_V, configuration_rate, unit_quaternions
+from simparity.references.pinocchio.contact import PlaneContact
 from simparity.references.pinocchio.floating import PinocchioFloatingDynamics
 from simparity.references.pinocchio.joint_motion import TOLERANCES, solve_piecewise
 
@@ -50,10 +51,12 @@ class PinocchioFloatingMotion(JointSimulation):
         self._dynamics = PinocchioFloatingDynamics(scene.chain, scene.gravity_world)
         self._model, self._data = self._dynamics.model, self._dynamics.data
         self._end_frame = self._model.getFrameId(scene.chain.end_effector_name, pin.BODY)
+        self._contact = None if scene.contact is None else PlaneContact(self._model, scene.chain, scene.contact)
         self.detail = f"{self._dynamics.detail}; harness-stepped on the project's state: " + (
             f"scipy solve_ivp DOP853, rtol = {TOLERANCES[integrator]:g}, on (q, qdot) with the quaternion in R^4"
             if integrator in TOLERANCES else
-            f"{integrator}, q by its rate (the quaternion in R^4, normalised after each step)")
+            f"{integrator}, q by its rate (the quaternion in R^4, normalised after each step)") + (
+            "" if self._contact is None else f"; {self._contact.detail}")
 
     def batched(self, copies: int) -> BatchedRun:
         raise NotBatchedError("the harness steps pinocchio's aba one copy at a time from Python: no batched stepping")
@@ -78,6 +81,8 @@ class PinocchioFloatingMotion(JointSimulation):
 
         def semi_implicit_euler(t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             v = v + dt * acceleration(q, v, t, t)
+            if self._contact is not None:
+                v = v + self._impulse(q, v)[1]
             return unit_quaternions(q + dt * configuration_rate(q, v)), v
 
         def rk4(t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -93,6 +98,34 @@ class PinocchioFloatingMotion(JointSimulation):
 
         return {"explicit_euler": explicit_euler, "semi_implicit_euler": semi_implicit_euler, "rk4": rk4}[
             self._integrator]
+
+    def _impulse(self, q: np.ndarray, v_free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(impulses (S, 3) [N s] in world axes, the project's velocity change (1, 6 + n)) of the contact solve of the
+        step from q (1, 7 + n) with unconstrained velocity ``v_free`` (1, 6 + n) (:class:`PlaneContact`)."""
+        assert self._contact is not None
+        q = unit_quaternions(q)
+        impulses, change = self._contact.solve(self._dynamics.configuration(q[0]),
+                                               self._dynamics.local_velocity(q, v_free))
+        return impulses, self._dynamics.project_velocity(q, change)
+
+    def contact_centres(self, q: np.ndarray) -> np.ndarray:
+        """(B, S, 3) [m]: the spheres' centres by Pinocchio's forward kinematics (:class:`PlaneContact`)."""
+        if self._contact is None:
+            raise NotImplementedError("the scene has no contact")
+        return np.array([self._contact.centres(self._dynamics.configuration(row))
+                         for row in unit_quaternions(np.atleast_2d(q))])
+
+    def contact_forces(self, q: np.ndarray, qdot: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """(B, S, 3) [N]: lambda / dt of the semi-implicit Euler step from each state at its time
+        (:mod:`references.pinocchio.contact`)."""
+        if self._contact is None:
+            raise NotImplementedError("the scene has no contact")
+        out = []
+        for row, rates, t in zip(np.atleast_2d(q), np.atleast_2d(qdot), times):
+            state, v = row[None], rates[None]
+            v_free = v + self._dt * self._acceleration(state, v, float(t), float(t))
+            out.append(self._impulse(state, v_free)[0] / self._dt)
+        return np.array(out)
 
     def run(self, n_steps: int) -> JointTrajectory:
         times = np.arange(n_steps + 1) * self._dt

@@ -45,6 +45,7 @@ from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.scenes.time_functions import TimeFunction
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common import time_loads
+from simparity.references.pinocchio.contact import PlaneContact
 from simparity.references.pinocchio.joint_dynamics import ChainModel, chain_model
 
 SCHEMES = {
@@ -107,6 +108,7 @@ class PinocchioJointMotion(JointSimulation):
         self._timed = scene.timed_torque
         self._damping = self._chain.velocity(self._chain.damping)
         self._end_frame = self._model.getFrameId(scene.chain.end_effector_name, pin.BODY)
+        self._contact = None if scene.contact is None else PlaneContact(self._model, scene.chain, scene.contact)
         continuous = np.array(self._chain.continuous, dtype=bool)
         self._cont_n = np.flatnonzero(continuous)
         self._cont_v = self._chain.idx_v[continuous]
@@ -117,7 +119,8 @@ class PinocchioJointMotion(JointSimulation):
             "on (q, qdot) with qddot = "
             "pin.aba(q, v, tau - D v), sampled at k dt (t_eval)" if integrator in TOLERANCES else
             f"{integrator} on (q, qdot), qddot = pin.aba(q, v, tau - D v), q by pin.integrate "
-            "(continuous joints' angles unwrapped)")
+            "(continuous joints' angles unwrapped)") + (
+            "" if self._contact is None else f"; {self._contact.detail}")
 
     def batched(self, copies: int) -> BatchedRun:
         """The harness calls aba copy by copy from Python: NotBatchedError."""
@@ -166,6 +169,8 @@ class PinocchioJointMotion(JointSimulation):
 
         def semi_implicit_euler(t: float, q: np.ndarray, v: np.ndarray) -> State:
             v = v + dt * acceleration(q, v, t, t)
+            if self._contact is not None:
+                v = v + self._contact.solve(q, v)[1]
             return pin.integrate(model, q, dt * v), v
 
         def rk4(t: float, q: np.ndarray, v: np.ndarray) -> State:
@@ -215,6 +220,24 @@ class PinocchioJointMotion(JointSimulation):
             kinetic[k] = 0.5 * v @ (upper + np.triu(upper, 1).T) @ v
             potential[k] = pin.computePotentialEnergy(self._model, self._data, configuration)
         return kinetic, potential
+
+    def contact_centres(self, q: np.ndarray) -> np.ndarray:
+        """(B, S, 3) [m]: the spheres' centres by Pinocchio's forward kinematics (:class:`PlaneContact`)."""
+        if self._contact is None:
+            raise NotImplementedError("the scene has no contact")
+        return np.array([self._contact.centres(self._chain.configuration(row)) for row in np.atleast_2d(q)])
+
+    def contact_forces(self, q: np.ndarray, qdot: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """(B, S, 3) [N]: lambda / dt of the semi-implicit Euler step from each state at its time (the module
+        docstring of :mod:`references.pinocchio.contact`)."""
+        if self._contact is None:
+            raise NotImplementedError("the scene has no contact")
+        out = []
+        for row, rates, t in zip(np.atleast_2d(q), np.atleast_2d(qdot), times):
+            configuration, v = self._chain.configuration(row), self._chain.velocity(rates)
+            v_free = v + self._dt * self._acceleration(configuration, v, float(t), float(t))
+            out.append(self._contact.solve(configuration, v_free)[0] / self._dt)
+        return np.array(out)
 
     def end_effector_world(self, q: np.ndarray) -> np.ndarray:
         """(B, 3) [m]: Pinocchio's placement of the end-effector link's frame in the model's world, the base frame."""

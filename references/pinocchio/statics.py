@@ -18,8 +18,9 @@ import numpy as np
 import pinocchio as pin
 
 from simparity.core.model.scenes.chain import Chain
-from simparity.core.model.scenes.chain_contact import ChainContact, frame_index
+from simparity.core.model.scenes.chain_contact import ChainContact
 from simparity.references.common.floating_base import base_rotations, turned_base
+from simparity.references.pinocchio.contact import sphere_anchors
 from simparity.references.pinocchio.floating import PinocchioFloatingDynamics
 from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics
 
@@ -35,18 +36,7 @@ class PinocchioStatics:
         self._configuration = (dynamics.configuration if isinstance(dynamics, PinocchioFloatingDynamics)
                                else dynamics._configuration)
         self._index = np.r_[0:6, dynamics.idx_v] if chain.floating_base else np.asarray(dynamics.idx_v)
-        names = tuple(j.name for j in chain.joints)
-        self._joints, self._points = [], []
-        for sphere in contact.spheres:
-            i = frame_index(sphere.frame, names, chain.end_effector_name, chain.base_link)
-            if i == len(names):
-                frame = self._model.frames[self._model.getFrameId(chain.end_effector_name, pin.BODY)]
-                joint, placement = int(frame.parentJoint), frame.placement
-            else:
-                joint = self._model.getJointId(names[i]) if i >= 0 else (1 if chain.floating_base else 0)
-                placement = pin.SE3.Identity()
-            self._joints.append(joint)
-            self._points.append(placement.act(np.asarray(sphere.centre_xyz, dtype=float)))
+        self._joints, self._points = sphere_anchors(self._model, chain, contact)
 
     def balance(self, q: np.ndarray, forces_world: np.ndarray) -> np.ndarray:
         """(B, nv): the generalized force that holds the chain still at q (B, nq) under gravity and ``forces_world``

@@ -1,8 +1,8 @@
 """Issue #46's planted contact bugs through the gate: a user's engine that is core or MuJoCo's adapter with one planted
 bug (the plane's normal turned, so that it pulls; the contact forces reported with their sign flipped; MuJoCo's spheres
 twice as large, so that they touch early; one sphere's force left out of what is reported; MuJoCo's forces read without
-the applied torque) turns the check of ``solo12-drop-stand`` or ``pendulum-press`` red naming it and the metric that
-sees it; a faithful copy passes on both. A sweep (a run of the scene
+the applied torque; Pinocchio's impulses reported as forces) turns the check of ``solo12-drop-stand`` or
+``pendulum-press`` red naming it and the metric that sees it; faithful copies of MuJoCo and Pinocchio pass on both. A sweep (a run of the scene
 per bug), in ``.ci/run``."""
 
 from __future__ import annotations
@@ -21,6 +21,8 @@ from simparity.core.inhouse import InHouseEngine
 from simparity.core.model.scenes.contact import Plane
 from simparity.references.mujoco.adapter import MujocoEngine
 from simparity.references.mujoco.joint_motion import MujocoJointMotion
+from simparity.references.pinocchio.adapter import PinocchioEngine
+from simparity.references.pinocchio.floating_motion import PinocchioFloatingMotion
 
 
 class Faithful(MujocoJointMotion):
@@ -69,7 +71,21 @@ class LostSphere(MujocoJointMotion):
         return forces
 
 
+def PinocchioCopy(scene, integrator, dt):
+    """Pinocchio's own simulation of the scene, as its adapter builds it."""
+    return PinocchioEngine().build_joint_motion(scene, integrator, dt)
+
+
+class ImpulsesAsForces(PinocchioFloatingMotion):
+    """Pinocchio's contact impulses reported as forces: the division by dt forgotten."""
+
+    def contact_forces(self, q, qdot, times):
+        return self._dt * super().contact_forces(q, qdot, times)
+
+
 FaithfulEngine = _engine(MujocoEngine, Faithful, "mujoco-copy")
+PinocchioCopyEngine = _engine(PinocchioEngine, PinocchioCopy, "pinocchio-copy")
+ImpulsesAsForcesEngine = _engine(PinocchioEngine, ImpulsesAsForces, "pinocchio-impulses-as-forces")
 PullingEngine = _engine(InHouseEngine, Pulling, "core-pulling")
 FlippedForcesEngine = _engine(MujocoEngine, FlippedForces, "mujoco-flipped-forces")
 FatSpheresEngine = _engine(MujocoEngine, FatSpheres, "mujoco-fat-spheres")
@@ -90,6 +106,7 @@ def _run(tmp_path, monkeypatch, capsys, plugin: str, scene: str = "solo12-drop-s
     ("FatSpheresEngine", "mujoco-fat-spheres", "signorini_violation_max", "solo12-drop-stand"),
     ("LostSphereEngine", "mujoco-lost-sphere", "rest_weight_error", "solo12-drop-stand"),
     ("WithoutTorqueEngine", "mujoco-without-torque", "rest_equilibrium_error", "pendulum-press"),
+    ("ImpulsesAsForcesEngine", "pinocchio-impulses-as-forces", "rest_weight_error", "solo12-drop-stand"),
 ])
 def test_a_planted_contact_bug_is_caught_naming_the_engine(tmp_path, monkeypatch, capsys, plugin, name, metric,
                                                            scene):
@@ -99,6 +116,7 @@ def test_a_planted_contact_bug_is_caught_naming_the_engine(tmp_path, monkeypatch
 @pytest.mark.sweep
 @pytest.mark.slow
 @pytest.mark.parametrize("scene", ["solo12-drop-stand", "pendulum-press"])
-def test_a_faithful_copy_of_the_adapter_passes(tmp_path, monkeypatch, capsys, scene):
-    code, violations, out = _run(tmp_path, monkeypatch, capsys, "FaithfulEngine", scene)
+@pytest.mark.parametrize("plugin", ["FaithfulEngine", "PinocchioCopyEngine"])
+def test_a_faithful_copy_of_the_adapter_passes(tmp_path, monkeypatch, capsys, scene, plugin):
+    code, violations, out = _run(tmp_path, monkeypatch, capsys, plugin, scene)
     assert code == 0 and not violations, out[-2000:]

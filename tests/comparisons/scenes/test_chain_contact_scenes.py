@@ -1,6 +1,6 @@
 """A joint-motion scene's contact (``[[plane]]``, ``[contact]``, ``[[contact.sphere]]``, issue #46): read as written,
-every meaningless input refused in one line naming its key, and the engines that do not model a chain's contact
-n/a with their reason."""
+every meaningless input refused in one line naming its key, and the engines (or integrators) that do not model a
+chain's contact n/a with their reason."""
 
 from __future__ import annotations
 
@@ -64,8 +64,16 @@ def test_a_meaningless_contact_is_refused_in_one_line_naming_its_key(data, edit,
     assert key in message and words in message and "\n" not in message, message
 
 
-@pytest.mark.parametrize("engine", [PinocchioEngine(), PybulletEngine()])
-def test_engines_without_a_chain_s_contact_say_why(data, engine):
+@pytest.mark.parametrize("engine, integrator", [(PybulletEngine(), "euler"), (PinocchioEngine(), "rk4"),
+                                                (PinocchioEngine(), "dop853")])
+def test_engines_without_a_chain_s_contact_say_why(data, engine, integrator):
+    """PyBullet models no chain's contact; Pinocchio's is velocity-level: only its semi-implicit Euler steps it."""
     scene = parse_scene(data)
-    support = engine.supports_joint_motion(scene, engine.joint_motion_integrators()[0])
+    support = engine.supports_joint_motion(scene, integrator)
     assert not support.ok and support.reason
+
+
+def test_pinocchio_steps_contact_with_semi_implicit_euler_only(data):
+    scene = parse_scene(data)
+    assert PinocchioEngine().supports_joint_motion(scene, "semi_implicit_euler").ok
+    assert "semi_implicit_euler" in PinocchioEngine().supports_joint_motion(scene, "rk4").reason
