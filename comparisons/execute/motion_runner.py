@@ -39,7 +39,7 @@ from simparity.core.model.metric_catalogue import (
     END_EFFECTOR_ERROR_MAX, JOINT_ANGLE_ERROR_MAX, JOINT_VELOCITY_ERROR_MAX, SEGMENT_REFERENCE_ERROR_MAX,
     SELF_PARTING_TIME, TIME_PER_STEP,
 )
-from simparity.core.model.results import DIVERGED, FAILED, NOT_AVAILABLE, OK, SATURATED, ResultRow
+from simparity.core.model.results import DIVERGED, FAILED, NO_REFERENCE, NOT_AVAILABLE, OK, SATURATED, ResultRow
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 
@@ -48,8 +48,8 @@ COARSE_SUFFIX = "_coarse"
 horizon: where the two part, the reference's own error has grown past use (:func:`reference_horizon`)."""
 
 NO_CONTACT_REFERENCE = ("a scene with contact is run against no reference: each engine's contact is its own (core's "
-                        "penalty springs, MuJoCo's soft constraints), so each is held to truths that need no engine "
-                        "(the contact metrics)")
+                        "penalty springs, MuJoCo's soft constraints, Pinocchio's rigid point contacts), so each is "
+                        "held to truths that need no engine (the contact metrics)")
 REFINEMENT = 16
 """A self-consistency case compares dt with dt / 16: a first-order scheme's error at dt / 16 is 1/16 of its error
 at dt, so the difference measures the coarse run's error within 7 %; a fourth-order one's within 1e-5."""
@@ -152,7 +152,8 @@ def motion_case(group: CaseGroup, shared: MotionShared, index: int, engine_for: 
     """The outcome of case ``index`` of a joint-motion group."""
     scene, spec = group.joint_motion_scene, group.cases[index]
     engine = engine_for(spec.engine)
-    case = Case(scene.name, spec.engine, spec.integrator, group.dt, group.reference_label,
+    case = Case(scene.name, spec.engine, spec.integrator, group.dt,
+                group.reference_label if scene.contact is None else NO_REFERENCE,
                 forcing_scheme(declared_scheme(engine, spec.integrator, scene), scene))
     rows: list[ResultRow] = []
     with warnings_into_rows(rows):

@@ -416,7 +416,7 @@ def _joint_motion_scene(scene: JointMotionScene, t: Transform) -> JointMotionSce
 def _chain_contact(scene: JointMotionScene, contact: ChainContact, t: Transform) -> ChainContact:
     """The plane moved with the world; each sphere scaled in its link's frame (the frames move with the chain), one on
     a fixed base's link placed as a world point (that frame is the world's); core's penalty constants in the new
-    units (N/m = kg/s^2, N s/m = kg/s)."""
+    units (N/m = kg/s^2, N s/m = kg/s); the time from which the robot rests in the new unit of time."""
     names = tuple(j.name for j in scene.chain.joints)
     chain = scene.chain
 
@@ -427,7 +427,8 @@ def _chain_contact(scene: JointMotionScene, contact: ChainContact, t: Transform)
                    spheres=tuple(replace(s, centre_xyz=centre(s), radius=t.length_scale * s.radius)
                                  for s in contact.spheres),
                    penalty_stiffness=t.factor(mass=1, time=-2) * contact.penalty_stiffness,
-                   penalty_damping=t.factor(mass=1, time=-1) * contact.penalty_damping)
+                   penalty_damping=t.factor(mass=1, time=-1) * contact.penalty_damping,
+                   rest_after=None if contact.rest_after is None else t.factor(time=1) * contact.rest_after)
 
 
 FIXED_SEED = 22

@@ -25,6 +25,10 @@ another's trajectory; each is held to what any correct contact must give:
   base, by Pinocchio's model of the file (:class:`references.pinocchio.statics.PinocchioStatics`: an independent
   model, none of the engine's): |g(q) - sum_s J_s^T f_s - tau + D qdot| row by row, a force over m |g|, a moment over
   m |g| reach, the largest. The fixed-base arm's closed form f = J^-T (g - tau) is this balance.
+- ``rest_acceleration_max``: where the scene says from when its robot rests (``[contact] rest_after``), the largest
+  acceleration of any joint (over g / reach; a slide's over g) or of a floating base (linear over g, angular over
+  g / reach) over the sampled intervals from then: a run that never settles (a contact that lets a pushed sphere creep,
+  a chattering solve) is a number the bounds judge, where the rest checks above could only be n/a.
 """
 
 from __future__ import annotations
@@ -40,8 +44,8 @@ from simparity.comparisons.common.error_text import error_text
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointSimulation
 from simparity.core.model.metric_catalogue import (
-    CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, FRICTION_CONE_VIOLATION_MAX, REST_WEIGHT_ERROR,
-    REST_EQUILIBRIUM_ERROR, SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR,
+    CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, FRICTION_CONE_VIOLATION_MAX, REST_ACCELERATION_MAX,
+    REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR, SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR,
 )
 from simparity.core.model.results import NOTHING_TO_MEASURE
 from simparity.core.model.scenes.chain_contact import ChainContact
@@ -55,6 +59,8 @@ REST_ACCELERATION = 1e-3
 """[1] A robot is at rest when its centre of mass accelerates by at most this fraction of g over the last sampled
 interval (its own momentum's change): the plane then carries its weight to about this fraction, and a contact force
 that is wrong by a factor, a sign or a missing sphere is off by O(1)."""
+SAMPLE_TIME_RTOL = 1e-9
+"""[1] A sample at k dt is at or after ``rest_after`` when its time is within this of it (k dt rounds)."""
 TOUCHING = 0.0
 """[m] A sphere touches the plane when its gap is at most this (the scene's radius; margins are switched off)."""
 
@@ -174,21 +180,50 @@ def _rest(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, 
                     note=f"at rest (centre of mass accelerating {acceleration / g:.2g} g): |sum f + m g| / m |g|")
 
 
+def _interval_accelerations(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray,
+                            base: bool) -> np.ndarray:
+    """(I,) per sampled interval between the samples ``index``, the largest acceleration (the rates' change over the
+    interval) over every copy: each joint's over g / reach (a prismatic joint's over g; g: 9.81 m/s^2 without gravity),
+    and with ``base`` a floating base's linear rows over g and its angular rows over g / reach."""
+    g = float(np.linalg.norm(scene.gravity_world)) if scene.gravity_world is not None else 9.81
+    scale = [g if j.type == "prismatic" else g / reach(scene.chain) for j in scene.chain.joints]
+    if base and scene.chain.floating_base:
+        scale = [g] * 3 + [g / reach(scene.chain)] * 3 + scale
+    if not scale:
+        return np.zeros(len(index) - 1)
+    rates = np.asarray(traj.qdot[index][..., traj.qdot.shape[2] - len(scale):])
+    intervals = np.diff(np.asarray(traj.times)[index])
+    change = np.abs(rates[1:] - rates[:-1]) / intervals[:, None, None] / np.array(scale)
+    return change.reshape(len(intervals), -1).max(axis=1)
+
+
 def _joints_at_rest(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray) -> str:
     """Why the chain's joints are not at rest at the end ("" when they are): a joint's acceleration over the last sampled
     interval above :data:`REST_ACCELERATION` g / reach (g: 9.81 m/s^2 without gravity), rad/s^2 (a prismatic joint's
     over g)."""
-    last = index[-2:]
-    interval = float(traj.times[last[1]] - traj.times[last[0]])
-    n = scene.chain.n_joints
-    rates = np.asarray(traj.qdot[last][..., traj.qdot.shape[2] - n:])
-    g = float(np.linalg.norm(scene.gravity_world)) if scene.gravity_world is not None else 9.81
-    scale = np.array([g if j.type == "prismatic" else g / reach(scene.chain) for j in scene.chain.joints])
-    worst = float((np.abs(rates[1] - rates[0]) / interval / scale).max()) if n else 0.0
+    worst = float(_interval_accelerations(scene, traj, index[-2:], base=False)[-1])
     if worst > REST_ACCELERATION:
         return (f"not at rest at the end: a joint accelerates {worst:.3g} x g / reach over the last sampled interval "
                 f"(rest: at most {REST_ACCELERATION:g})")
     return ""
+
+
+def _rest_acceleration(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray) -> Measured:
+    """``rest_acceleration_max``: from the scene's ``rest_after`` on, the largest acceleration of any joint or of a
+    floating base over its rest scale (:func:`_interval_accelerations`); n/a where the scene does not say."""
+    contact = scene.contact
+    assert contact is not None
+    if contact.rest_after is None:
+        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=(
+            "the scene does not say when its robot rests ([contact] rest_after)"))
+    starts = np.asarray(traj.times)[index[:-1]]
+    after = starts >= contact.rest_after * (1 - SAMPLE_TIME_RTOL)
+    if not after.any():
+        return Measured(math.nan, "1", unmeasurable=f"no sampled interval starts after rest_after = "
+                                                    f"{contact.rest_after:g} s")
+    worst = float(_interval_accelerations(scene, traj, index, base=True)[after].max())
+    return Measured(worst, "1", note=(f"largest acceleration from t = {contact.rest_after:g} s: a joint's over g / reach "
+                                      "(a slide's over g), a floating base's linear over g and angular over g / reach"))
 
 
 def _equilibrium(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, forces: np.ndarray,
@@ -245,6 +280,7 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
         return {m: Measured(math.nan, "1", unmeasurable=str(err)) for m in CHAIN_CONTACT_METRICS}
     out = {
         TOUCHDOWN_TIME_ERROR: _touchdown(scene, sim, traj, index, gaps),
+        REST_ACCELERATION_MAX: _rest_acceleration(scene, traj, index),
         CONTACT_PENETRATION_MAX: Measured(float(np.maximum(-gaps / contact.radii, 0.0).max()), "1",
                                           note="deepest sinking over the sphere's radius"),
         CONTACT_ENERGY_GAIN_MAX: _energy_gain(scene, traj, own, gaps),

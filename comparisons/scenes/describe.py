@@ -133,7 +133,9 @@ def _joint_motion_lines(scene: JointMotionScene) -> list[str]:
                      + "; ".join(f"{s.frame} at {_vector(s.centre_xyz)} m, radius {s.radius:.10g} m"
                                  for s in contact.spheres)
                      + f"; core's penalty k_s {contact.penalty_stiffness:.10g} N/m, k_d {contact.penalty_damping:.10g} "
-                     "N s/m; no reference: each engine against truths that need no engine")
+                     "N s/m; " + ("" if contact.rest_after is None else
+                                  f"at rest from {contact.rest_after:.10g} s (rest_acceleration_max); ")
+                     + "no reference: each engine against truths that need no engine")
     return lines + _link_lines(chain)
 
 

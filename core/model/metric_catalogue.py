@@ -176,6 +176,7 @@ FRICTION_CONE_VIOLATION_MAX = "friction_cone_violation_max"
 CONTACT_ENERGY_GAIN_MAX = "contact_energy_gain_max"
 REST_WEIGHT_ERROR = "rest_weight_error"
 REST_EQUILIBRIUM_ERROR = "rest_equilibrium_error"
+REST_ACCELERATION_MAX = "rest_acceleration_max"
 # IK: a solver's outcome on its targets, judged by the harness.
 SOLVE_RATE = "solve_rate"
 SOLVE_RATE_OWN_STOP = "solve_rate_own_stop"
@@ -310,6 +311,8 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(REST_WEIGHT_ERROR, DIMENSIONLESS, CONTACT, theory="at rest the plane carries the weight: 0"),
     Metric(REST_EQUILIBRIUM_ERROR, DIMENSIONLESS, CONTACT,
            theory="at rest the contact forces, gravity and the joint forces balance on every joint and the base: 0"),
+    Metric(REST_ACCELERATION_MAX, DIMENSIONLESS, CONTACT,
+           theory="from the time the scene says its robot rests, nothing accelerates: 0"),
     Metric(IMPACT_TIME_ERROR, "s", CONTACT),
     Metric(REBOUND_VELOCITY_ERROR, "m/s", CONTACT),
     Metric(APEX_HEIGHT_ERROR, "m", CONTACT),

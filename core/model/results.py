@@ -114,6 +114,11 @@ class ResultRow:
         return asdict(self)
 
 
+NO_REFERENCE = "none"
+"""The ``reference`` column of the cases of a scene run against no reference (a chain's contact: each engine is held
+to truths that need no engine)."""
+
+
 def reference_label(engine: str, integrator: str) -> str:
     """The ``reference`` column of the cases measured against ``engine`` running ``integrator``
     (``engine:integrator``): a row whose own engine and integrator give its reference is measured against itself."""

@@ -10,7 +10,8 @@ import pandas as pd
 
 from simparity.core.model.metric_catalogue import (
     CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, JOINT_ANGLE_ERROR_MAX,
-    LINEAR_MOMENTUM_DRIFT_MAX, REFERENCE_PARTING_TIME, REST_EQUILIBRIUM_ERROR, REST_WEIGHT_ERROR, SELF_PARTING_TIME,
+    LINEAR_MOMENTUM_DRIFT_MAX, REFERENCE_PARTING_TIME, REST_ACCELERATION_MAX, REST_EQUILIBRIUM_ERROR, REST_WEIGHT_ERROR,
+    SELF_PARTING_TIME,
     SIGNORINI_VIOLATION_MAX, TIME_PER_STEP, TOUCHDOWN_TIME_ERROR,
 )
 from simparity.core.model.results import NOT_AVAILABLE, OK
@@ -94,7 +95,8 @@ def _momentum(rows: pd.DataFrame) -> list[Block]:
 
 CHAIN_CONTACT_COLUMNS = ((TOUCHDOWN_TIME_ERROR, "touchdown error"), (CONTACT_PENETRATION_MAX, "penetration / radius"),
                          (SIGNORINI_VIOLATION_MAX, "Signorini violation"), (CONTACT_ENERGY_GAIN_MAX, "energy gain"),
-                         (REST_WEIGHT_ERROR, "rest weight error"), (REST_EQUILIBRIUM_ERROR, "rest equilibrium error"))
+                         (REST_WEIGHT_ERROR, "rest weight error"), (REST_EQUILIBRIUM_ERROR, "rest equilibrium error"),
+                         (REST_ACCELERATION_MAX, "rest acceleration"))
 """The contact metrics report.md shows for a chain on a plane, each with its column's name."""
 
 
@@ -104,8 +106,8 @@ def _chain_contact(rows: pd.DataFrame) -> list[Block]:
     return _finest_table(rows, CHAIN_CONTACT_COLUMNS,
                          "Contact at dt = {dt} s, truths that need no engine: touchdown against the closed-form fall, "
                          "the deepest penetration, pulls or forces off the plane, energy gained, and at rest the plane "
-                         "carrying the weight and every joint balanced (by Pinocchio's model; each engine's contact is "
-                         "its own: no reference).")
+                         "carrying the weight and every joint balanced (by Pinocchio's model), nothing accelerating from "
+                         "when the scene says its robot rests (each engine's contact is its own: no reference).")
 
 
 def _contact_verdict(rows: pd.DataFrame) -> str:

@@ -13,7 +13,7 @@ from simparity.core.model.scenes.chain_contact import ChainContact, ContactSpher
 from simparity.core.model.scenes.contact import Plane
 
 _PLANE = ("name", "coefficients")
-_CONTACT = ("penalty_stiffness", "penalty_damping", "sphere")
+_CONTACT = ("penalty_stiffness", "penalty_damping", "rest_after", "sphere")
 _SPHERE = ("frame", "centre_xyz", "radius")
 
 
@@ -40,9 +40,10 @@ def _frames(chain: Chain) -> tuple[str, ...]:
     return names + ((chain.base_link,) if chain.base_link is not None else ())
 
 
-def read_chain_contact(top: TableReader, chain: Chain, q0: np.ndarray) -> ChainContact | None:
+def read_chain_contact(top: TableReader, chain: Chain, q0: np.ndarray, duration: float) -> ChainContact | None:
     """The chain's contact spheres against the scene's plane, or None when the file has no [[plane]]; each sphere must
-    start on the plane's free side (within :data:`START_INSIDE_TOLERANCE`) at ``q0`` (nq,)."""
+    start on the plane's free side (within :data:`START_INSIDE_TOLERANCE`) at ``q0`` (nq,); ``rest_after`` inside the
+    scene's ``duration`` [s]."""
     if not top.has("plane"):
         if top.has("contact"):
             raise top.fail("contact", "contact settings without a [[plane]]", "a [[plane]] for the spheres to touch")
@@ -64,7 +65,11 @@ def read_chain_contact(top: TableReader, chain: Chain, q0: np.ndarray) -> ChainC
                else 2.0 * float(np.sqrt(stiffness * chain.mass)))  # critical on the robot's mass, N s/m = kg / s
     if damping < 0:
         raise c.fail("penalty_damping", f"{damping:g} is negative", "a number >= 0 [N s/m]")
-    contact = ChainContact(plane, tuple(spheres), stiffness, damping)
+    rest_after = c.number("rest_after", positive=True) if c.has("rest_after") else None
+    if rest_after is not None and not rest_after < duration:
+        raise c.fail("rest_after", f"{rest_after:g} s is not before the end of the run ({duration:g} s)",
+                     "a time [s] inside the scene's duration, from which its robot is at rest")
+    contact = ChainContact(plane, tuple(spheres), stiffness, damping, rest_after)
     _check_start_outside(top, chain, contact, q0)
     return contact
 

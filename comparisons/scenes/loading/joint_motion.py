@@ -109,7 +109,7 @@ def read_joint_motion(top: TableReader, head: dict, engines: EngineSet) -> Joint
                        f"0 (none) to {MAX_PERTURBATION:g} rad: a small change of the start, for predictability")
     integrators = (sim.strings("integrators", engines.joint_motion_integrators, "no engine steps a chain with {}")
                    if sim.has("integrators") else ())
-    contact = read_chain_contact(top, chain, q0)
+    contact = read_chain_contact(top, chain, q0, duration)
     return JointMotionScene(chain=chain, gravity_world=gravity, q0=q0, qdot0=qdot0, torque=torque, timed_torque=timed,
                             duration=duration, dts=dts, integrators=integrators, segments=segments,
                             perturbation=perturbation, contact=contact, **head)

@@ -59,12 +59,16 @@ class ChainContact:
         k_s [N/m] of core's penalty method, > 0.
     penalty_damping : float
         k_d [N s/m] of core's penalty method, >= 0.
+    rest_after : float or None
+        [s] From this time on the scene's author says the robot is at rest (``rest_acceleration_max`` holds every
+        engine to it); None: the scene does not say, and a run that never settles only leaves the rest checks n/a.
     """
 
     plane: Plane
     spheres: tuple[ContactSphere, ...]
     penalty_stiffness: float
     penalty_damping: float
+    rest_after: float | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "spheres", tuple(self.spheres))
@@ -74,6 +78,8 @@ class ChainContact:
             raise SceneError("<code>", "contact.penalty_stiffness", f"{self.penalty_stiffness}", "a number > 0 [N/m]")
         if not (np.isfinite(self.penalty_damping) and self.penalty_damping >= 0):
             raise SceneError("<code>", "contact.penalty_damping", f"{self.penalty_damping}", "a number >= 0 [N s/m]")
+        if self.rest_after is not None and not (np.isfinite(self.rest_after) and self.rest_after > 0):
+            raise SceneError("<code>", "contact.rest_after", f"{self.rest_after}", "a time > 0 [s]")
 
     @property
     def radii(self) -> np.ndarray:

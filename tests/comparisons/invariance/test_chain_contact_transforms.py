@@ -54,3 +54,14 @@ def test_gaps_and_forces_are_the_same_in_every_frame_and_unit(transform):
     unit = transform.factor(length=1, mass=1, time=-2)
     np.testing.assert_allclose(force_moved, unit * transform.vector(force), rtol=ROUNDING,
                                atol=ROUNDING * float(np.abs(force).max()) * unit)
+
+
+@pytest.mark.parametrize("transform", [t for t in FIXED_TRANSFORMS if t.name != "permute"], ids=lambda t: t.name)
+def test_the_time_the_robot_rests_from_takes_the_new_unit_of_time(transform):
+    from dataclasses import replace
+
+    scene = _scene()
+    scene = replace(scene, contact=replace(scene.contact, rest_after=0.4))
+    moved = transform_scene(scene, transform)
+    assert moved.contact.rest_after == pytest.approx(0.4 * transform.time_scale, rel=1e-15)
+    assert moved.duration == pytest.approx(scene.duration * transform.time_scale, rel=1e-15)

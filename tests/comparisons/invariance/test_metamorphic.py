@@ -182,6 +182,12 @@ KNOWN_METRIC_FINDINGS: tuple[KnownFinding, ...] = ()
 """Absolute choices in simparity's judging code: remove an entry when its choice is made relative."""
 
 KNOWN_ENGINE_FINDINGS: tuple[KnownFinding, ...] = (
+    KnownFinding(("arm-strike-press",), ("mujoco",), ANY, ("rescale", "ms"),
+                 ("contact_penetration_max", "contact_energy_gain_max"), (
+        "MuJoCo's soft contact keeps its default solref = (0.02, 1) (a time constant in the model's unit of time) and "
+        "solimp's width 0.001 (in its unit of length) (references/mujoco/contact.py; comparisons/invariance/"
+        "engine_constants.py): in other units the contact is softer or stiffer (the arm's strike sinks 0.43 of the "
+        "radius, 0.21 rescaled, 0.05 in ms); core's penalty constants and Pinocchio's rigid contact are invariant")),
     KnownFinding(("robot-*",), ("pybullet",), ANY, ("ms",), ("round_trip_residual",), (
         "PyBullet's forward dynamics is one stepSimulation of an absolute step (references/pybullet/joint_dynamics.py "
         "STEP, in seconds): qddot = (qdot' - qdot) / STEP rounds at eps |qdot| / STEP, and in ms |qdot| shrinks a "

@@ -16,8 +16,8 @@ from simparity.comparisons.measure.chain_contact_metrics import contact_metrics
 from simparity.comparisons.measure.joint_motion_metrics import motion_metrics, read_own
 from simparity.core.articulated.motion import CoreJointMotion
 from simparity.core.model.metric_catalogue import (
-    CONTACT_ENERGY_GAIN_MAX, FRICTION_CONE_VIOLATION_MAX, REST_EQUILIBRIUM_ERROR, REST_WEIGHT_ERROR,
-    SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR,
+    CONTACT_ENERGY_GAIN_MAX, FRICTION_CONE_VIOLATION_MAX, REST_ACCELERATION_MAX, REST_EQUILIBRIUM_ERROR,
+    REST_WEIGHT_ERROR, SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR,
 )
 from simparity.references.mujoco.joint_motion import MujocoJointMotion
 
@@ -217,3 +217,24 @@ def test_an_engine_that_does_not_fall_is_late_not_unmeasured(scene):
     values = _measured(scene, Weightless, "euler", 0.002, 0.1)
     assert values[TOUCHDOWN_TIME_ERROR].value == pytest.approx((0.1 - T_CONTACT) / T_CONTACT, rel=1e-9)
     assert not values[TOUCHDOWN_TIME_ERROR].unmeasurable
+
+
+STILL = 1e-6
+"""[1] An arm lying still on the plane: its rates change by rounding and the contact's settling, measured <= 1.1e-7 of
+g / reach after 1 s; REST_ACCELERATION (1e-3) is what the bound allows."""
+
+
+@pytest.mark.parametrize("sim_class, integrator", [
+    pytest.param(CoreJointMotion, "rk4", marks=pytest.mark.slow), (MujocoJointMotion, "euler")])
+def test_a_scene_that_says_when_its_robot_rests_holds_every_engine_to_it(sim_class, integrator):
+    strike = load_scene("arm-strike-press")
+    values = _measured(strike, sim_class, integrator, 0.002, strike.duration)
+    assert values[REST_ACCELERATION_MAX].value < STILL
+    early = replace(strike, contact=replace(strike.contact, rest_after=0.02))  # mid-strike: the arm is flying
+    assert _measured(early, sim_class, integrator, 0.002, strike.duration)[REST_ACCELERATION_MAX].value > 0.1
+
+
+def test_a_scene_that_does_not_say_when_its_robot_rests_leaves_the_check_n_a(scene):
+    values = _measured(scene, MujocoJointMotion, "euler", 0.002, 0.1)
+    assert math.isnan(values[REST_ACCELERATION_MAX].value)
+    assert "rest_after" in values[REST_ACCELERATION_MAX].unmeasurable

@@ -56,6 +56,8 @@ def test_the_scene_reads_as_written(data):
     (lambda d: d.pop("plane"), "contact", "without a [[plane]]"),
     (lambda d: d["plane"][0].update(coefficients=[0.0, 0.0, 0.0, 1.0]), "plane[0].coefficients", "all zeros"),
     (lambda d: d["simulation"].update(perturbation=1e-6), "simulation.perturbation", "allowed: 0"),
+    (lambda d: d["contact"].update(rest_after=0.5), "contact.rest_after", "before the end of the run"),
+    (lambda d: d["contact"].update(rest_after=-0.1), "contact.rest_after", "> 0"),
 ])
 def test_a_meaningless_contact_is_refused_in_one_line_naming_its_key(data, edit, key, words):
     with pytest.raises(SceneError) as caught:
