@@ -623,8 +623,6 @@ def _armature_support(chain: Chain) -> Support:
     return Support.yes()
 
 
-CONTACT_WHY = ("not yet for a chain: PyBullet's multibody contact of spheres on its links (getContactPoints for the "
-               "forces) is to come (issue #46); its free bodies' contact is compared in the dynamics scenes")
 FLOATING_BASE_WHY = (
     "PyBullet's floating-base dynamics are not comparable at rounding: calculateInverseDynamics of a floating base "
     "(7 + n positions, 6 + n velocities, flags=0) agrees with the other engines with the base unturned and not once it "
@@ -719,7 +717,9 @@ class PybulletEngine(UrdfChains, Engine):
         return _dynamics_support(scene.chain) if named.ok else named
 
     def chain_contact(self, scene: JointMotionScene) -> Support:
-        return Support.no(FLOATING_BASE_WHY if scene.chain.floating_base else CONTACT_WHY)
+        """Bullet's multibody contact of sphere shapes on the links (:mod:`references.pybullet.chain_contact`), on a
+        fixed base; a floating base is n/a (:data:`FLOATING_BASE_WHY`)."""
+        return Support.no(FLOATING_BASE_WHY) if scene.chain.floating_base else Support.yes()
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         # imported here: joint_motion reuses this module's client, loader and chain kinematics

@@ -67,11 +67,13 @@ from simparity.core.model.rigid_groups import CompiledJoints, RigidGroups
 from simparity.core.model.engine import JointDynamicsModel
 from simparity.core.model.errors import SimparityError
 from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.chain_contact import ChainContact
 from simparity.references.common.conventions import fmt, quat_wxyz_to_matrix, wxyz_from_xyzw
 from simparity.references.common.rigid_groups import summed
 from simparity.references.common.dynamics_urdf import chain_joint_names, dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
 from simparity.references.pybullet.adapter import _Client, _load_mjcf, _load_urdf, pybullet_mjcf
+from simparity.references.pybullet.chain_contact import with_spheres
 from simparity.references.pybullet.quiet import pybullet
 
 STEP = 1.0  # [s]
@@ -119,7 +121,9 @@ def axes_changed(chain: Chain) -> str:
 class ChainBodies:
     """``copies`` bodies of the chain in a private DIRECT world, every default of the module docstring switched off:
     gravity exactly ``gravity_world`` (None: zero), time step ``time_step`` [s] without sub-steps. The bodies have no
-    collision shapes, so they never touch each other: one ``stepSimulation`` steps each as if it were alone.
+    collision shapes, so they never touch each other: one ``stepSimulation`` steps each as if it were alone. With
+    ``contact`` the URDF's links carry its spheres (:func:`references.pybullet.chain_contact.with_spheres`; the file
+    loaded is ``urdf_text``).
 
     Attributes
     ----------
@@ -137,18 +141,22 @@ class ChainBodies:
     """
 
     def __init__(self, chain: Chain, gravity_world: np.ndarray | None, time_step: float = STEP,
-                 copies: int = 1) -> None:
+                 copies: int = 1, contact: ChainContact | None = None) -> None:
         self._client = _Client()
         c = self.client = self._client.id
         pybullet.setTimeStep(time_step, physicsClientId=c)
         pybullet.setPhysicsEngineParameter(numSubSteps=0, physicsClientId=c)
         pybullet.setGravity(*(np.zeros(3) if gravity_world is None else np.asarray(gravity_world, dtype=float)),
                             physicsClientId=c)
+        self.urdf_text = ""
         if chain.mjcf_path is not None:
             mjcf = pybullet_mjcf(chain)
             self.bodies = [_load_mjcf(c, mjcf) for _ in range(copies)]
         else:
             text = unit_axes(dynamics_urdf(chain))
+            if contact is not None:
+                text = with_spheres(text, chain, contact)
+            self.urdf_text = text
             self.bodies = [_load_urdf(c, text, useFixedBase=True) for _ in range(copies)]
         self.body = b = self.bodies[0]
         info = [pybullet.getJointInfo(b, j, physicsClientId=c)

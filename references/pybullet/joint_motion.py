@@ -5,8 +5,9 @@ The model is part 1's stepped body (:class:`references.pybullet.joint_dynamics.C
 gives every default and why): the chain's dynamics URDF with its axes normalised, ``URDF_USE_INERTIA_FROM_FILE``,
 gravity exactly the scene's (None: zero), link damping 0, braking motors off (VELOCITY_CONTROL, force 0), joint limits
 without force, the velocity cap raised to 1e300, jointDamping the chain's. The world holds nothing else: no ground
-plane, and the bodies have no collision shapes (the dynamics URDF has none), so nothing collides. Each setting is
-pinned by ``tests/references/pybullet/test_joint_motion.py``:
+plane, and the bodies have no collision shapes (the dynamics URDF has none), so nothing collides; a scene with contact
+adds its plane and its spheres and nothing more (:mod:`references.pybullet.chain_contact`). Each setting is pinned by
+``tests/references/pybullet/test_joint_motion.py`` (the contact's by ``tests/references/pybullet/test_chain_contact.py``):
 
 - Time step exactly dt (``setTimeStep``), ``numSubSteps`` 0: one ``stepSimulation`` is one step of dt (read back by
   ``getPhysicsEngineParameters``).
@@ -52,17 +53,31 @@ from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common import time_loads
 from simparity.references.common.dynamics_urdf import dynamics_source
 from simparity.references.pybullet.adapter import PybulletChain
+from simparity.references.pybullet.chain_contact import PlaneContact
 from simparity.references.pybullet.joint_dynamics import CLIPPED, ChainBodies, axes_changed
 from simparity.references.pybullet.quiet import pybullet
 
 
-def _world(scene: JointMotionScene, dt: float, copies: int) -> ChainBodies:
-    """``copies`` bodies of the scene's chain stepping at ``dt`` [s] in one world, out of every collision pair."""
-    world = ChainBodies(scene.chain, scene.gravity_world, time_step=dt, copies=copies)
+def _world(scene: JointMotionScene, dt: float, copies: int) -> tuple[ChainBodies, PlaneContact | None]:
+    """``copies`` bodies of the scene's chain stepping at ``dt`` [s] in one world, out of every collision pair but
+    their contact spheres' with the scene's plane (:mod:`references.pybullet.chain_contact`), and that contact."""
+    world = ChainBodies(scene.chain, scene.gravity_world, time_step=dt, copies=copies, contact=scene.contact)
     for body in world.bodies:
         for link in (-1, *world.links):
             pybullet.setCollisionFilterGroupMask(body, link, 0, 0, physicsClientId=world.client)
-    return world
+    contact = (None if scene.contact is None else
+               PlaneContact(world.client, world.bodies, scene.chain, scene.contact, world.urdf_text))
+    return world, contact
+
+
+def _collisions(scene: JointMotionScene) -> str:
+    """What collides in the world, for the rows' detail."""
+    if scene.contact is None:
+        return "no collision shapes (collision filter group and mask 0), no ground"
+    return ("collision spheres on the contact links against a static GEOM_PLANE, nothing else colliding; frictionless, "
+            "restitution 0, contactERP 0, contactSlop 0, no speculative contact (contactProcessingThreshold 0), "
+            "100 solver iterations to 1e-12; forces by getContactPoints of one step of a scratch world from each "
+            "state")
 
 
 class PybulletJointMotion(JointSimulation):
@@ -70,7 +85,10 @@ class PybulletJointMotion(JointSimulation):
 
     def __init__(self, scene: JointMotionScene, dt: float) -> None:
         self._scene, self._dt = scene, dt
-        self._world = _world(scene, dt, scene.copies)
+        self._world, self._contact = _world(scene, dt, scene.copies)
+        probe: tuple[ChainBodies | None, PlaneContact | None] = (_world(scene, dt, 1) if scene.contact is not None
+                                                                  else (None, None))
+        self._probe, self._probe_contact = probe
         self._model = ChainBodies(scene.chain, scene.gravity_world)
         self._model.build_tree()
         self._kinematics = PybulletChain(scene.chain)
@@ -81,8 +99,7 @@ class PybulletJointMotion(JointSimulation):
         self.detail = (f"stepSimulation of a fixed-base multibody per copy in one world (Featherstone ABA, "
                        f"semi-implicit Euler: q from the new qdot), setTimeStep(dt), numSubSteps 0; "
                        f"loadURDF(URDF_USE_INERTIA_FROM_FILE) of {dynamics_source(scene.chain)}; "
-                       f"{axes_changed(scene.chain)}; no collision shapes (collision filter group and mask 0), no "
-                       f"ground; gravity set; link damping 0, joint limits, velocity cap and braking motors off; joint "
+                       f"{axes_changed(scene.chain)}; {_collisions(scene)}; gravity set; link damping 0, joint limits, velocity cap and braking motors off; joint "
                        f"damping by changeDynamics(jointDamping) (Bullet: -D qdot at the step's start, explicit); torque by "
                        f"TORQUE_CONTROL re-sent before every step (Bullet clears it after each); energy from "
                        f"calculateMassMatrix and getLinkStates; end effector by getLinkState (float32)")
@@ -92,10 +109,40 @@ class PybulletJointMotion(JointSimulation):
 
     def batched(self, copies: int) -> BatchedRun:
         """``copies`` bodies of the first initial state in one world, one ``stepSimulation`` per step."""
-        world = _world(self._scene, self._dt, copies)
+        world, _ = _world(self._scene, self._dt, copies)
         q0 = np.repeat(np.asarray(self._scene.q0)[:1], copies, axis=0)
         qdot0 = np.repeat(np.asarray(self._scene.qdot0)[:1], copies, axis=0)
         return lambda n_steps: self._step(world, q0, qdot0, n_steps)
+
+    def _torque(self, t: float) -> list[float]:
+        """The joints' applied forces at time t [s] (the scene's constant torque and its timed torque)."""
+        constant, timed = np.asarray(self._scene.torque), self._scene.timed_torque
+        return (constant if timed is None else constant + time_loads.at(timed, t)).tolist()
+
+    def contact_centres(self, q: np.ndarray) -> np.ndarray:
+        """(B, S, 3) [m]: the spheres' centres as PyBullet places its links (:class:`PlaneContact`)."""
+        if self._probe is None or self._probe_contact is None:
+            raise NotImplementedError("the scene has no contact")
+        out = []
+        for row in np.atleast_2d(q):
+            self._probe.reset(row, np.zeros_like(row))
+            out.append(self._probe_contact.centres(self._probe.body))
+        return np.array(out)
+
+    def contact_forces(self, q: np.ndarray, qdot: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """(B, S, 3) [N]: the plane's forces in one step of a scratch world from each state under the scene's torque at
+        its time (:mod:`references.pybullet.chain_contact`)."""
+        if self._probe is None or self._probe_contact is None:
+            raise NotImplementedError("the scene has no contact")
+        probe, c = self._probe, self._probe.client
+        out = []
+        for row, rates, t in zip(np.atleast_2d(q), np.atleast_2d(qdot), times):
+            probe.reset(row, rates)
+            pybullet.setJointMotorControlArray(probe.body, probe.joints, pybullet.TORQUE_CONTROL,
+                                               forces=self._torque(float(t)), physicsClientId=c)
+            pybullet.stepSimulation(physicsClientId=c)
+            out.append(self._probe_contact.forces(probe.body))
+        return np.array(out)
 
     def _step(self, world: ChainBodies, q0: np.ndarray, qdot0: np.ndarray, n_steps: int) -> JointTrajectory:
         """Every body of ``world`` from (q0, qdot0) ((B, n) each) for ``n_steps`` steps, sampled after each."""

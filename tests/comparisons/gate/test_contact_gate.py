@@ -2,8 +2,9 @@
 bug (the plane's normal turned, so that it pulls; the contact forces reported with their sign flipped; MuJoCo's spheres
 twice as large, so that they touch early; one sphere's force left out of what is reported; MuJoCo's forces read without
 the applied torque; Pinocchio's impulses reported as forces; a Pinocchio contact that bounces, so that the arm never
-rests) turns the check of ``solo12-drop-stand``, ``pendulum-press`` or ``arm-strike-press`` red naming it and the metric
-that sees it; faithful copies of MuJoCo and Pinocchio pass on all three. A sweep (a run of the scene
+rests; PyBullet's spheres left with Bullet's default friction) turns the check of ``solo12-drop-stand``,
+``pendulum-press`` or ``arm-strike-press`` red naming it and the metric that sees it; faithful copies of MuJoCo and
+Pinocchio pass on all three, PyBullet's on the fixed-base two. A sweep (a run of the scene
 per bug), in ``.ci/run``."""
 
 from __future__ import annotations
@@ -26,6 +27,9 @@ from simparity.references.pinocchio.adapter import PinocchioEngine
 from simparity.references.pinocchio.contact import PlaneContact
 from simparity.references.pinocchio.floating_motion import PinocchioFloatingMotion
 from simparity.references.pinocchio.joint_motion import PinocchioJointMotion
+from simparity.references.pybullet.adapter import PybulletEngine
+from simparity.references.pybullet.joint_motion import PybulletJointMotion
+from simparity.references.pybullet.quiet import pybullet
 
 
 class Faithful(MujocoJointMotion):
@@ -102,7 +106,24 @@ class Bouncing(PinocchioJointMotion):
         self._contact = BouncingContact(self._model, scene.chain, scene.contact)
 
 
+class PybulletCopy(PybulletJointMotion):
+    pass
+
+
+class DefaultFriction(PybulletJointMotion):
+    """PyBullet's spheres left with Bullet's default lateral friction (0.5): the plane holds them sideways."""
+
+    def __init__(self, scene, integrator, dt):
+        super().__init__(scene, dt)
+        for world, contact in ((self._world, self._contact), (self._probe, self._probe_contact)):
+            for body in world.bodies:
+                for link in set(contact.links):
+                    pybullet.changeDynamics(body, link, lateralFriction=0.5, physicsClientId=world.client)
+
+
 FaithfulEngine = _engine(MujocoEngine, Faithful, "mujoco-copy")
+PybulletCopyEngine = _engine(PybulletEngine, lambda scene, integrator, dt: PybulletCopy(scene, dt), "pybullet-copy")
+DefaultFrictionEngine = _engine(PybulletEngine, DefaultFriction, "pybullet-default-friction")
 BouncingEngine = _engine(PinocchioEngine, Bouncing, "pinocchio-bouncing")
 PinocchioCopyEngine = _engine(PinocchioEngine, PinocchioCopy, "pinocchio-copy")
 ImpulsesAsForcesEngine = _engine(PinocchioEngine, ImpulsesAsForces, "pinocchio-impulses-as-forces")
@@ -128,6 +149,7 @@ def _run(tmp_path, monkeypatch, capsys, plugin: str, scene: str = "solo12-drop-s
     ("WithoutTorqueEngine", "mujoco-without-torque", "rest_equilibrium_error", "pendulum-press"),
     ("ImpulsesAsForcesEngine", "pinocchio-impulses-as-forces", "rest_weight_error", "solo12-drop-stand"),
     ("BouncingEngine", "pinocchio-bouncing", "rest_acceleration_max", "arm-strike-press"),
+    ("DefaultFrictionEngine", "pybullet-default-friction", "friction_cone_violation_max", "arm-strike-press"),
 ])
 def test_a_planted_contact_bug_is_caught_naming_the_engine(tmp_path, monkeypatch, capsys, plugin, name, metric,
                                                            scene):
@@ -136,8 +158,10 @@ def test_a_planted_contact_bug_is_caught_naming_the_engine(tmp_path, monkeypatch
 
 @pytest.mark.sweep
 @pytest.mark.slow
-@pytest.mark.parametrize("scene", ["solo12-drop-stand", "pendulum-press", "arm-strike-press"])
-@pytest.mark.parametrize("plugin", ["FaithfulEngine", "PinocchioCopyEngine"])
+@pytest.mark.parametrize("scene, plugin", [
+    *((s, p) for s in ("solo12-drop-stand", "pendulum-press", "arm-strike-press")
+      for p in ("FaithfulEngine", "PinocchioCopyEngine")),
+    *(("pendulum-press", "PybulletCopyEngine"), ("arm-strike-press", "PybulletCopyEngine"))])
 def test_a_faithful_copy_of_the_adapter_passes(tmp_path, monkeypatch, capsys, scene, plugin):
     code, violations, out = _run(tmp_path, monkeypatch, capsys, plugin, scene)
     assert code == 0 and not violations, out[-2000:]
