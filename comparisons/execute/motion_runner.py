@@ -48,8 +48,8 @@ COARSE_SUFFIX = "_coarse"
 horizon: where the two part, the reference's own error has grown past use (:func:`reference_horizon`)."""
 
 NO_CONTACT_REFERENCE = ("a scene with contact is run against no reference: each engine's contact is its own (core's "
-                        "penalty springs, MuJoCo's soft constraints, Pinocchio's rigid point contacts), so each is "
-                        "held to truths that need no engine (the contact metrics)")
+                        "penalty springs, MuJoCo's soft constraints, Pinocchio's and PyBullet's rigid contacts), so each "
+                        "is held to truths that need no engine (the contact metrics)")
 REFINEMENT = 16
 """A self-consistency case compares dt with dt / 16: a first-order scheme's error at dt / 16 is 1/16 of its error
 at dt, so the difference measures the coarse run's error within 7 %; a fourth-order one's within 1e-5."""

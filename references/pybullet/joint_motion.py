@@ -76,7 +76,7 @@ def _collisions(scene: JointMotionScene) -> str:
         return "no collision shapes (collision filter group and mask 0), no ground"
     return ("collision spheres on the contact links against a static GEOM_PLANE, nothing else colliding; frictionless, "
             "restitution 0, contactERP 0, contactSlop 0, no speculative contact (contactProcessingThreshold 0), "
-            "100 solver iterations to 1e-12; forces by getContactPoints of one step of a scratch world from each "
+            "100 solver iterations (all of them: residual threshold 0); forces by getContactPoints of one step of a scratch world from each "
             "state")
 
 
@@ -115,7 +115,7 @@ class PybulletJointMotion(JointSimulation):
         return lambda n_steps: self._step(world, q0, qdot0, n_steps)
 
     def _torque(self, t: float) -> list[float]:
-        """The joints' applied forces at time t [s] (the scene's constant torque and its timed torque)."""
+        """The joints' applied forces at time t [s] (the scene's constant torque and its timed torque), PyBullet's list."""
         constant, timed = np.asarray(self._scene.torque), self._scene.timed_torque
         return (constant if timed is None else constant + time_loads.at(timed, t)).tolist()
 
@@ -152,11 +152,10 @@ class PybulletJointMotion(JointSimulation):
         for k in range(len(world.bodies)):
             world.reset(q0[k], qdot0[k], copy=k)
         q[0], qdot[0] = q0, qdot0
-        constant, timed = np.asarray(self._scene.torque), self._scene.timed_torque
-        torque = constant.tolist()
+        torque = self._torque(0.0)
         for i in range(1, n_steps + 1):
-            if timed is not None:  # at the step's start: stepSimulation evaluates the forces once per step
-                torque = (constant + time_loads.at(timed, (i - 1) * self._dt)).tolist()
+            if self._scene.timed_torque is not None:  # at the step's start: the step evaluates the forces once
+                torque = self._torque((i - 1) * self._dt)
             for body in world.bodies:
                 pybullet.setJointMotorControlArray(body, world.joints, pybullet.TORQUE_CONTROL, forces=torque,
                                                    physicsClientId=c)
