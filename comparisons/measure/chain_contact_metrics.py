@@ -222,8 +222,9 @@ def _rest_acceleration(scene: JointMotionScene, traj: JointTrajectory, index: np
         return Measured(math.nan, "1", unmeasurable=f"no sampled interval starts after rest_after = "
                                                     f"{contact.rest_after:g} s")
     worst = float(_interval_accelerations(scene, traj, index, base=True)[after].max())
-    return Measured(worst, "1", note=(f"largest acceleration from t = {contact.rest_after:g} s: a joint's over g / reach "
-                                      "(a slide's over g), a floating base's linear over g and angular over g / reach"))
+    return Measured(worst, "1", note=(f"largest acceleration from t = {contact.rest_after:g} s: a joint's over "
+                                      "g / reach (a slide's over g), a floating base's linear over g and angular over "
+                                      "g / reach"))
 
 
 def _equilibrium(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, forces: np.ndarray,

@@ -32,6 +32,8 @@ Pinocchio's:
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pinocchio as pin
 
@@ -109,8 +111,9 @@ class PlaneContact:
         s.relative_complementarity_tol = s.relative_feasibility_tol = SOLVER_TOLERANCE
         self.detail = (f"contact: PointContactConstraintModel per sphere at gap <= 0 (harness detection, no margin), "
                        f"friction 0, no Baumgarte, no compliance; impulses by ADMMConstraintSolver on "
-                       f"DelassusOperatorDense(J M^-1 J^T) at {SOLVER_TOLERANCE:g} (polished on its active set, answer checked), v' = v_free + M^-1 J^T lambda "
-                       f"(Moreau-Jean, no restitution, penetration not corrected); force = lambda / dt")
+                       f"DelassusOperatorDense(J M^-1 J^T) at {SOLVER_TOLERANCE:g} (polished on its active set, answer "
+                       f"checked), v' = v_free + M^-1 J^T lambda (Moreau-Jean, no restitution, penetration not "
+                       f"corrected); force = lambda / dt")
 
     def centres(self, configuration: np.ndarray) -> np.ndarray:
         """(S, 3) [m]: the spheres' centres in the world at Pinocchio's ``configuration`` (nq,)."""
@@ -188,10 +191,10 @@ def polished(delassus: np.ndarray, free: np.ndarray, impulses: np.ndarray) -> np
 def ncp_residual(delassus: np.ndarray, free: np.ndarray, impulses: np.ndarray) -> float:
     """[1] How far ``impulses`` (3k,) (t1, t2, n per contact) are from solving the frictionless contact problem of
     Delassus matrix ``delassus`` (3k, 3k) and free velocity ``free`` (3k,) (:data:`NCP_RESIDUAL`'s terms), relative to
-    max |free| (0 when nothing moves)."""
+    max |free|; where nothing moves (free = 0) the answer is no impulse: 0 for it, infinite for any other."""
     scale = float(np.max(np.abs(free)))
     if scale == 0.0:
-        return float(np.max(np.abs(impulses), initial=0.0))
+        return 0.0 if not np.any(impulses) else math.inf
     sigma = (delassus @ impulses + free).reshape(-1, 3)
     lam = impulses.reshape(-1, 3)
     stiffness = float(np.max(np.abs(delassus)))
@@ -205,5 +208,5 @@ def _check_answer(delassus: np.ndarray, free: np.ndarray, impulses: np.ndarray) 
     """Raise :class:`DivergedError` when the solver's ``impulses`` do not solve the problem (:func:`ncp_residual`)."""
     residual = ncp_residual(delassus, free, impulses)
     if not residual <= NCP_RESIDUAL:
-        raise DivergedError(f"Pinocchio's contact solve (ADMM, then polished) leaves a residual of {residual:.3g} of the "
-                            f"free contact velocity (allowed {NCP_RESIDUAL:g}): its impulses do not solve the step")
+        raise DivergedError(f"Pinocchio's contact solve (ADMM, then polished) leaves a residual of {residual:.3g} of "
+                            f"the free contact velocity (allowed {NCP_RESIDUAL:g}): its impulses do not solve the step")

@@ -7,7 +7,8 @@ gravity exactly the scene's (None: zero), link damping 0, braking motors off (VE
 without force, the velocity cap raised to 1e300, jointDamping the chain's. The world holds nothing else: no ground
 plane, and the bodies have no collision shapes (the dynamics URDF has none), so nothing collides; a scene with contact
 adds its plane and its spheres and nothing more (:mod:`references.pybullet.chain_contact`). Each setting is pinned by
-``tests/references/pybullet/test_joint_motion.py`` (the contact's by ``tests/references/pybullet/test_chain_contact.py``):
+``tests/references/pybullet/test_joint_motion.py`` (the contact's by
+``tests/references/pybullet/test_chain_contact.py``):
 
 - Time step exactly dt (``setTimeStep``), ``numSubSteps`` 0: one ``stepSimulation`` is one step of dt (read back by
   ``getPhysicsEngineParameters``).
@@ -76,8 +77,8 @@ def _collisions(scene: JointMotionScene) -> str:
         return "no collision shapes (collision filter group and mask 0), no ground"
     return ("collision spheres on the contact links against a static GEOM_PLANE, nothing else colliding; frictionless, "
             "restitution 0, contactERP 0, contactSlop 0, no speculative contact (contactProcessingThreshold 0), "
-            "100 solver iterations (all of them: residual threshold 0); forces by getContactPoints of one step of a scratch world from each "
-            "state")
+            "100 solver iterations (all of them: residual threshold 0); forces by getContactPoints of one step of a "
+            "scratch world from each state")
 
 
 class PybulletJointMotion(JointSimulation):
@@ -115,7 +116,7 @@ class PybulletJointMotion(JointSimulation):
         return lambda n_steps: self._step(world, q0, qdot0, n_steps)
 
     def _torque(self, t: float) -> list[float]:
-        """The joints' applied forces at time t [s] (the scene's constant torque and its timed torque), PyBullet's list."""
+        """The joints' applied forces at time t [s] (the scene's constant and timed torque), as PyBullet's list."""
         constant, timed = np.asarray(self._scene.torque), self._scene.timed_torque
         return (constant if timed is None else constant + time_loads.at(timed, t)).tolist()
 

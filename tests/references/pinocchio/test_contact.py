@@ -41,8 +41,9 @@ def _moved(model: pin.Model, configuration: np.ndarray, v: np.ndarray, contact: 
 
 
 def _problems(seed: int):
-    """(model, contact, configuration, v_free, the scene's contact) of random pressed states: Solo-12 sunk ~3 mm with a tilted base
-    and a random front-left leg, and the pressed pendulum turned into its plane, each with a random downward v."""
+    """(model, contact, configuration, v_free, the scene's contact) of random pressed states: Solo-12 sunk ~3 mm with a
+    tilted base and a random front-left leg, and the pressed pendulum turned into its plane, each with a random
+    downward v."""
     rng = np.random.default_rng(seed)
     out = []
     for name, floating in (("solo12-drop-stand", True), ("pendulum-press", False)):

@@ -22,7 +22,8 @@ PLACED = 1e-12
 """[m] Two independent forward kinematics of the same file (PyBullet's double link states, Pinocchio's): rounding."""
 SAME_STEP = 1e-8
 """Relative agreement of PyBullet's and Pinocchio's contact force from one state: the same semi-implicit Euler step
-and frictionless velocity-level contact problem, solved by Bullet's PGS (to 1e-12) and by Pinocchio's ADMM, polished: measured 2.4e-16."""
+and frictionless velocity-level contact problem, solved by Bullet's PGS (every sweep) and by Pinocchio's ADMM,
+polished: measured 2.4e-16."""
 DT = 0.002
 
 
