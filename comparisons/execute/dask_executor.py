@@ -21,6 +21,7 @@ import asyncio
 import os
 import pickle
 import socket
+import tempfile
 import threading
 import time
 import uuid
@@ -127,12 +128,20 @@ class DaskExecutor:
                                  "'simparity[dask]', or --executor local)") from None
         self.limits = limits
         self._cluster = None
+        self._scratch: tempfile.TemporaryDirectory | None = None
         self.client: Any = None  # a distributed.Client once connected (Dask is imported only here)
         try:
             if scheduler is None:
-                self._cluster = distributed.LocalCluster(
-                    n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                    dashboard_address=":0", memory_limit=0, silence_logs=50)
+                import dask.config
+
+                # Dask's shared scratch folder (/tmp/dask-scratch-space) is purged of any other cluster's "stale"
+                # lock files when a cluster starts: a second run on the machine killed the first one's workers
+                # (measured: two test runs at once, 0 workers left). Each LocalCluster here has its own.
+                self._scratch = tempfile.TemporaryDirectory(prefix="simparity-dask-")
+                with dask.config.set({"temporary-directory": self._scratch.name}):
+                    self._cluster = distributed.LocalCluster(
+                        n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                        dashboard_address=":0", memory_limit=0, silence_logs=50)
                 self.client = distributed.Client(self._cluster)
             else:
                 _reach(scheduler)
@@ -192,3 +201,6 @@ class DaskExecutor:
         cluster, self._cluster = self._cluster, None
         if cluster is not None:
             cluster.close()
+        scratch, self._scratch = self._scratch, None
+        if scratch is not None:
+            scratch.cleanup()
