@@ -232,6 +232,18 @@ BODY_GROUP, PLANE_GROUP = 1, 2
 """Collision filter groups: a body collides with planes only (group & other mask on both sides)."""
 
 
+def static_plane(client: int, plane) -> int:
+    """A static multibody whose GEOM_PLANE (normal N, through its origin) sits at -d N, with :data:`PLANE_DYNAMICS`;
+    it touches bodies (group :data:`BODY_GROUP`) only. Its unique id."""
+    shape = pybullet.createCollisionShape(pybullet.GEOM_PLANE, planeNormal=plane.normal_world.tolist(),
+                                          physicsClientId=client)
+    uid = pybullet.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=shape,
+                                   basePosition=(-plane.offset * plane.normal_world).tolist(), physicsClientId=client)
+    pybullet.changeDynamics(uid, -1, **PLANE_DYNAMICS, physicsClientId=client)
+    pybullet.setCollisionFilterGroupMask(uid, -1, PLANE_GROUP, BODY_GROUP, physicsClientId=client)
+    return uid
+
+
 def restitution_threshold(contact) -> float:
     """Bullet's restitutionVelocityThreshold [m/s]: the approach speed below which the scene's rule (a rebound
     k |v| below rest_speed ends in resting contact) drops restitution, rest_speed / k; the largest k > 0 of the
@@ -361,15 +373,7 @@ class _Simulation(PieceSimulation):
         )
 
     def _add_plane(self, plane) -> int:
-        """A static multibody whose GEOM_PLANE (normal N, through its origin) sits at -d N; touches bodies only."""
-        c = self._client.id
-        shape = pybullet.createCollisionShape(pybullet.GEOM_PLANE, planeNormal=plane.normal_world.tolist(),
-                                              physicsClientId=c)
-        uid = pybullet.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=shape,
-                                       basePosition=(-plane.offset * plane.normal_world).tolist(), physicsClientId=c)
-        pybullet.changeDynamics(uid, -1, **PLANE_DYNAMICS, physicsClientId=c)
-        pybullet.setCollisionFilterGroupMask(uid, -1, PLANE_GROUP, BODY_GROUP, physicsClientId=c)
-        return uid
+        return static_plane(self._client.id, plane)
 
     def batched(self, copies: int) -> BatchedRun:
         """PyBullet has no batch API: NotBatchedError."""

@@ -5,9 +5,9 @@ What PyBullet is given, beside :mod:`references.pybullet.joint_motion`'s stepped
 - Each sphere is a ``<collision>`` sphere of the scene's radius added to the link of its frame in the chain's dynamics
   URDF (a chain joint's frame is its child link's, the end effector its link, the base link the fixed base), at its
   centre; ``URDF_USE_INERTIA_FROM_FILE`` keeps the file's inertia (the spheres weigh nothing).
-- The plane is a static multibody with a ``GEOM_PLANE`` of the plane's normal placed at -d N. Collision filters: the
-  sphere links collide with the plane only (group 1, mask 2; the plane group 2, mask 1), every other link with
-  nothing; a copy never touches another.
+- The plane is the free bodies' static ``GEOM_PLANE`` multibody (:func:`references.pybullet.adapter.static_plane`).
+  Collision filters: the sphere links collide with the plane only (the adapter's body and plane groups), every other
+  link with nothing; a copy never touches another.
 - Frictionless and without restitution: ``lateralFriction`` 0, ``restitution`` 0, rolling and spinning friction 0 on
   the sphere links (Bullet multiplies the two objects': the plane keeps 1 of each); no speculative contact
   (``contactProcessingThreshold`` 0: a sphere above the plane gets no force).
@@ -36,18 +36,15 @@ import numpy as np
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.chain_contact import ChainContact, frame_index
 from simparity.references.common.conventions import fmt, quat_wxyz_to_matrix, wxyz_from_xyzw
+from simparity.references.pybullet.adapter import BODY_GROUP, PLANE_GROUP, static_plane
 from simparity.references.pybullet.quiet import pybullet
 
-SPHERE_GROUP, PLANE_GROUP = 1, 2
-"""Collision filter groups: a sphere link collides with the plane only."""
 SOLVER = dict(contactERP=0.0, contactSlop=0.0, numSolverIterations=100, solverResidualThreshold=0.0, globalCFM=0.0,
               restitutionVelocityThreshold=0.0, useSplitImpulse=0, deterministicOverlappingPairs=1)
 """setPhysicsEngineParameter of a world with a chain's contact (the module docstring gives each reason)."""
 SPHERE_DYNAMICS = dict(restitution=0.0, lateralFriction=0.0, rollingFriction=0.0, spinningFriction=0.0,
                        contactProcessingThreshold=0.0)
 """changeDynamics of every link that carries a sphere."""
-PLANE_DYNAMICS = dict(restitution=1.0, lateralFriction=1.0, rollingFriction=0.0, spinningFriction=0.0)
-"""changeDynamics of the plane: 1, the neutral factor of Bullet's products."""
 
 
 def sphere_links(chain: Chain, contact: ChainContact, urdf_text: str) -> list[str]:
@@ -94,17 +91,10 @@ class PlaneContact:
         names = sphere_links(chain, contact, urdf_text)
         self.links = [link_index(bodies[0], client, name) for name in names]
         self._points = np.array([s.centre_xyz for s in contact.spheres], dtype=float)
-        plane = contact.plane
-        shape = pybullet.createCollisionShape(pybullet.GEOM_PLANE, planeNormal=plane.normal_world.tolist(),
-                                              physicsClientId=client)
-        self.plane = pybullet.createMultiBody(baseMass=0.0, baseCollisionShapeIndex=shape,
-                                              basePosition=(-plane.offset * plane.normal_world).tolist(),
-                                              physicsClientId=client)
-        pybullet.changeDynamics(self.plane, -1, **PLANE_DYNAMICS, physicsClientId=client)
-        pybullet.setCollisionFilterGroupMask(self.plane, -1, PLANE_GROUP, SPHERE_GROUP, physicsClientId=client)
+        self.plane = static_plane(client, contact.plane)
         for body in bodies:
             for link in set(self.links):
-                pybullet.setCollisionFilterGroupMask(body, link, SPHERE_GROUP, PLANE_GROUP, physicsClientId=client)
+                pybullet.setCollisionFilterGroupMask(body, link, BODY_GROUP, PLANE_GROUP, physicsClientId=client)
                 pybullet.changeDynamics(body, link, **SPHERE_DYNAMICS, physicsClientId=client)
         pybullet.setPhysicsEngineParameter(**SOLVER, physicsClientId=client)
 
