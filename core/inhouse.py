@@ -413,7 +413,11 @@ class InHouseEngine(Engine):
         return CoreJointMotion(scene, integrator, dt)
 
     def chain_contact(self, scene: JointMotionScene) -> Support:
-        """The lecture's penalty method at each sphere, through ABA (:mod:`core.articulated.chain_contact`)."""
+        """Soft: the lecture's penalty method at each sphere, through ABA (:mod:`core.articulated.chain_contact`).
+        Rigid: the lecture's impulses with time backed up, on a fixed base (:mod:`core.articulated.chain_impulse`)."""
+        if scene.contact is not None and scene.contact.rigid and scene.chain.floating_base:
+            return Support.no("core's impulses are carried on a fixed base only (a floating base's contact-space "
+                              "inertia has the base's six rows); its soft contact (penalty_stiffness) runs there")
         return Support.yes()
 
     def supports_ik(self, chain: Chain, solver: str, position_only: bool) -> Support:
@@ -427,9 +431,12 @@ class InHouseEngine(Engine):
         return named
 
     def scheme(self, integrator: str, scene) -> str:
-        """What the engine's default says (core names its methods after what they are), and every in-house IK
-        solver keeps the joints within their limits every iteration: ``+limits``."""
+        """What the engine's default says (core names its methods after what they are); every in-house IK solver
+        keeps the joints within their limits every iteration: ``+limits``; a chain's rigid contact is stepped with
+        time backed up to each impact: ``backup+``."""
         kind = super().scheme(integrator, scene)
+        if kind and isinstance(scene, JointMotionScene) and scene.contact is not None and scene.contact.rigid:
+            return f"backup+{kind}"  # impulses at the backed-up instant: not the plain scheme's discretisation
         return f"{kind}+limits" if kind and isinstance(scene, IKScene) else kind
 
     def build_ik(self, chain: Chain, solver: str, options: IKTolerances) -> IKModel:

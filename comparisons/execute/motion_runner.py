@@ -47,9 +47,16 @@ COARSE_SUFFIX = "_coarse"
 """A reference integrator ``x`` whose engine also offers ``x_coarse`` (the same solve at a looser tolerance) has a
 horizon: where the two part, the reference's own error has grown past use (:func:`reference_horizon`)."""
 
-NO_CONTACT_REFERENCE = ("a scene with contact is run against no reference: each engine's contact is its own (core's "
+NO_CONTACT_REFERENCE = ("a scene with soft contact is run against no reference: each engine's contact is its own (core's "
                         "penalty springs, MuJoCo's soft constraints, Pinocchio's and PyBullet's rigid contacts), so each "
                         "is held to truths that need no engine (the contact metrics)")
+
+
+def against_reference(scene: JointMotionScene) -> bool:
+    """Whether the scene's engines are compared with its reference's run: without contact, or with a rigid contact
+    (one law, Newton's restitution, which a closed form or a rigid engine follows); a soft contact's penetration is
+    each engine's own."""
+    return scene.contact is None or scene.contact.rigid
 REFINEMENT = 16
 """A self-consistency case compares dt with dt / 16: a first-order scheme's error at dt / 16 is 1/16 of its error
 at dt, so the difference measures the coarse run's error within 7 %; a fourth-order one's within 1e-5."""
@@ -100,7 +107,7 @@ def prepare_motion(group: CaseGroup, engine_for: EngineFor, reference_failure: s
     integrator = label.split(":", 1)[1]
     if reference_failure:
         return MotionShared(None, None, None, None, (f"reference {label} failed: {reference_failure}", FAILED))
-    if scene.contact is not None:
+    if not against_reference(scene):
         return MotionShared(None, None, None, None, (NO_CONTACT_REFERENCE, NOT_AVAILABLE))
     reference = engine_for(scene.reference)
     try:
@@ -153,7 +160,7 @@ def motion_case(group: CaseGroup, shared: MotionShared, index: int, engine_for: 
     scene, spec = group.joint_motion_scene, group.cases[index]
     engine = engine_for(spec.engine)
     case = Case(scene.name, spec.engine, spec.integrator, group.dt,
-                group.reference_label if scene.contact is None else NO_REFERENCE,
+                group.reference_label if against_reference(scene) else NO_REFERENCE,
                 forcing_scheme(declared_scheme(engine, spec.integrator, scene), scene))
     rows: list[ResultRow] = []
     with warnings_into_rows(rows):

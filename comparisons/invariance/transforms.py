@@ -416,7 +416,8 @@ def _joint_motion_scene(scene: JointMotionScene, t: Transform) -> JointMotionSce
 def _chain_contact(scene: JointMotionScene, contact: ChainContact, t: Transform) -> ChainContact:
     """The plane moved with the world; each sphere scaled in its link's frame (the frames move with the chain), one on
     a fixed base's link placed as a world point (that frame is the world's); core's penalty constants in the new
-    units (N/m = kg/s^2, N s/m = kg/s); the time from which the robot rests in the new unit of time."""
+    units (N/m = kg/s^2, N s/m = kg/s); the time from which the robot rests in the new unit of time, a rigid contact's
+    rest speed in the new units (its restitution has none)."""
     names = tuple(j.name for j in scene.chain.joints)
     chain = scene.chain
 
@@ -426,9 +427,15 @@ def _chain_contact(scene: JointMotionScene, contact: ChainContact, t: Transform)
     return replace(contact, plane=_plane(contact.plane, t),
                    spheres=tuple(replace(s, centre_xyz=centre(s), radius=t.length_scale * s.radius)
                                  for s in contact.spheres),
-                   penalty_stiffness=t.factor(mass=1, time=-2) * contact.penalty_stiffness,
-                   penalty_damping=t.factor(mass=1, time=-1) * contact.penalty_damping,
-                   rest_after=None if contact.rest_after is None else t.factor(time=1) * contact.rest_after)
+                   penalty_stiffness=_scaled(t.factor(mass=1, time=-2), contact.penalty_stiffness),
+                   penalty_damping=_scaled(t.factor(mass=1, time=-1), contact.penalty_damping),
+                   rest_after=_scaled(t.factor(time=1), contact.rest_after),
+                   rest_speed=t.factor(length=1, time=-1) * contact.rest_speed)
+
+
+def _scaled(factor: float, value: float | None) -> float | None:
+    """``factor`` times ``value``, None for a value the scene does not give."""
+    return None if value is None else factor * value
 
 
 FIXED_SEED = 22

@@ -132,11 +132,19 @@ def _joint_motion_lines(scene: JointMotionScene) -> list[str]:
                      f"{contact.plane.offset:.10g} m), frictionless; spheres "
                      + "; ".join(f"{s.frame} at {_vector(s.centre_xyz)} m, radius {s.radius:.10g} m"
                                  for s in contact.spheres)
-                     + f"; core's penalty k_s {contact.penalty_stiffness:.10g} N/m, k_d {contact.penalty_damping:.10g} "
-                     "N s/m; " + ("" if contact.rest_after is None else
+                     + "; " + _chain_contact_model(contact) + ("" if contact.rest_after is None else
                                   f"at rest from {contact.rest_after:.10g} s (rest_acceleration_max); ")
-                     + "no reference: each engine against truths that need no engine")
+                     + ("against the reference's closed form where it has one" if contact.rigid else
+                        "no reference: each engine against truths that need no engine"))
     return lines + _link_lines(chain)
+
+
+def _chain_contact_model(contact) -> str:
+    """How hard a chain's contact is, as the scene says: core's penalty constants, or rigid with a restitution."""
+    if contact.rigid:
+        return (f"rigid: restitution {contact.restitution:.10g}, plastic below {contact.rest_speed:.10g} m/s "
+                "(core's impulses, time backed up); ")
+    return f"core's penalty k_s {contact.penalty_stiffness:.10g} N/m, k_d {contact.penalty_damping:.10g} N s/m; "
 
 
 def _link_lines(chain: Chain) -> list[str]:

@@ -65,6 +65,46 @@ class ChainContactForces:
         return centres_base if rotation is None else q[:3].T[:, None] + np.einsum("bij,bsj->bsi", rotation,
                                                                                   centres_base)
 
+    def normal_jacobians(self, q: np.ndarray) -> np.ndarray:
+        """(B, S, n) j_s = J_s^T N of a fixed base at q (n, B): the rate of sphere s's normal velocity N . u_s per
+        joint rate (u_s = J_s qdot, J_s the Jacobian of its centre)."""
+        positions, rotations, axes, _ = self._frames(q)
+        return self._normal_rows(axes, self._columns(positions, axes, self._centres_base(positions, rotations)))
+
+    def _normal_rows(self, axes: np.ndarray, columns: list[np.ndarray]) -> np.ndarray:
+        out = np.zeros((axes.shape[0], len(columns), self._chain.n_joints))
+        for s, cols in enumerate(columns):
+            out[:, s, :cols.shape[1]] = cols @ self._contact.plane.normal_world
+        return out
+
+    def normal_kinematics(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(j (B, S, n) as :meth:`normal_jacobians`, N . (dJ_s/dt qdot) (B, S) [m/s^2]) of a fixed base at (q (n, B),
+        qdot (n, B)): each sphere centre's normal acceleration is j_s . qddot + the second. For the joints j that
+        move the centre p (positions P_j, axes a_j, rates w_j): u = sum_j c_j w_j with c_j = a_j x (p - P_j)
+        (revolute) or a_j (prismatic); with qddot = 0, d/dt a_j = Omega_j x a_j (Omega_j = sum_{k<j} a_k w_k over
+        revolute k: the frame before joint j turns), d/dt P_j = sum_{k<j} c_k(P_j) w_k, and d/dt c_j =
+        a_j' x (p - P_j) + a_j x (u - P_j') (revolute) or a_j' (prismatic)."""
+        positions, rotations, axes, _ = self._frames(q)
+        centres = self._centres_base(positions, rotations)
+        columns = self._columns(positions, axes, centres)
+        rates = qdot.T  # (B, n)
+        spins = np.where(self._revolute[None, :, None], axes, 0.0) * rates[:, :, None]  # (B, n, 3): a_k w_k
+        axis_rates = np.cross(np.cumsum(spins, axis=1) - spins, axes)  # (B, n, 3): Omega_j x a_j
+        n = self._chain.n_joints
+        levers = positions[:, None, :n] - positions[:, :n, None]  # (B, k, j, 3): P_j - P_k
+        moves = np.where(self._revolute[None, :, None, None], np.cross(axes[:, :, None], levers),
+                         axes[:, :, None])  # (B, k, j, 3): c_k(P_j)
+        origin_rates = np.einsum("bkjx,bk,kj->bjx", moves, rates, np.triu(np.ones((n, n)), 1))  # k < j
+        bias = np.empty(centres.shape[:2])
+        for s, cols in enumerate(columns):
+            m = cols.shape[1]
+            velocity = np.einsum("bkx,bk->bx", cols, rates[:, :m])
+            revolute_rate = (np.cross(axis_rates[:, :m], centres[:, s, None] - positions[:, :m])
+                             + np.cross(axes[:, :m], velocity[:, None] - origin_rates[:, :m]))
+            column_rates = np.where(self._revolute[:m, None], revolute_rate, axis_rates[:, :m])
+            bias[:, s] = np.einsum("bkx,bk->bx", column_rates, rates[:, :m]) @ self._contact.plane.normal_world
+        return self._normal_rows(axes, columns), bias
+
     def _state(self, q: np.ndarray, qdot: np.ndarray):
         """(forces (B, S, 3) in the world, the base-to-centre arms in world axes (B, S, 3) or None on a fixed base,
         the Jacobian columns, the base rotation or None) at the state."""
@@ -83,6 +123,8 @@ class ChainContactForces:
             velocities = (qdot[:3].T[:, None] + np.cross(qdot[3:6].T[:, None], arms)
                           + np.einsum("bij,bsj->bsi", rotation, relative))
         c = self._contact
+        if c.penalty_stiffness is None or c.penalty_damping is None:
+            raise ValueError("a rigid contact has no penalty forces (core.articulated.chain_impulse steps it)")
         forces = penalty_force(centres + self._lowest, velocities, c.plane, c.penalty_stiffness, c.penalty_damping)
         return forces, arms, columns, rotation
 

@@ -8,6 +8,7 @@ import numpy as np
 from simparity.core.articulated import stepping
 from simparity.core.articulated.chain_arrays import chain_arrays
 from simparity.core.articulated.chain_contact import ChainContactForces
+from simparity.core.articulated.chain_impulse import RigidContact
 from simparity.core.articulated.floating import FloatingRecursiveDynamics
 from simparity.core.articulated.model import RecursiveDynamics
 from simparity.core.articulated.recursive import Recursive
@@ -25,7 +26,11 @@ class CoreJointMotion(JointSimulation):
 
     def __init__(self, scene: JointMotionScene, scheme: str, dt: float) -> None:
         self._scene, self._dt, self._scheme = scene, dt, scheme
-        self._step = stepping.stepper(scene, scheme, dt)
+        rigid = scene.contact is not None and scene.contact.rigid
+        self._rigid = RigidContact(scene, scheme) if rigid else None
+        self._step = (stepping.stepper(scene, scheme, dt) if self._rigid is None else
+                      lambda t, q, qdot: self._rigid_step(t, q, qdot))
+        self._rigid_run: tuple[np.ndarray, np.ndarray] | None = None  # (q, resting) of the last run, rigid contact
         gravity = np.zeros(3) if scene.gravity_world is None else scene.gravity_world
         self._gravity = np.asarray(gravity, dtype=float)
         chain = scene.chain
@@ -38,13 +43,21 @@ class CoreJointMotion(JointSimulation):
                        + ("; damping by ABA with armature + dt D" if scheme == stepping.IMPLICIT_DAMPING else "")
                        + ("; the floating base's quaternion stepped in R^4 by dq/dt = 1/2 (0, omega) q and "
                           "normalised after each step" if chain.floating_base else "")
-                       + (f"; contact by the penalty method at each sphere, k_s = {scene.contact.penalty_stiffness:g} "
-                          f"N/m, k_d = {scene.contact.penalty_damping:g} N s/m, frictionless, through ABA as J^T F"
-                          if scene.contact is not None else ""))
+                       + _contact_detail(scene))
+
+    def _rigid_step(self, t: float, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        assert self._rigid is not None
+        if self._rigid.resting.shape != (q.shape[1],):
+            self._rigid.start(q.shape[1])
+        return self._rigid.step(t, q, qdot, self._dt)
 
     def run(self, n_steps: int) -> JointTrajectory:
-        q, qdot = stepping.run(self._step, np.asarray(self._scene.q0), np.asarray(self._scene.qdot0), n_steps,
-                               self._dt)
+        q0, qdot0 = np.asarray(self._scene.q0), np.asarray(self._scene.qdot0)
+        if self._rigid is not None:
+            q, qdot, resting = self._rigid.run(q0, qdot0, n_steps, self._dt)
+            self._rigid_run = (q, resting)
+        else:
+            q, qdot = stepping.run(self._step, q0, qdot0, n_steps, self._dt)
         return JointTrajectory(np.arange(n_steps + 1) * self._dt, q, qdot)
 
     def step_jacobian(self, q: np.ndarray, qdot: np.ndarray, tau: np.ndarray) -> StepJacobian:
@@ -104,11 +117,31 @@ class CoreJointMotion(JointSimulation):
         return self._contact.centres_world(np.ascontiguousarray(np.asarray(q, dtype=float).T))
 
     def contact_forces(self, q: np.ndarray, qdot: np.ndarray, times: np.ndarray) -> np.ndarray:
-        """The penalty force on each sphere at the state (:class:`ChainContactForces`: a spring-damper of the state
-        alone, whatever the applied forces)."""
+        """Soft contact: the penalty force on each sphere at the state (:class:`ChainContactForces`: a spring-damper
+        of the state alone, whatever the applied forces). Rigid contact: the resting force of the sphere the run
+        rested on at that sample (:meth:`RigidContact.forces_world`), for states of its own last run only."""
         if self._contact is None:
             raise NotImplementedError("the scene has no contact")
-        return self._contact.forces_world(*(np.ascontiguousarray(np.asarray(x, dtype=float).T) for x in (q, qdot)))
+        q, qdot = np.asarray(q, dtype=float), np.asarray(qdot, dtype=float)
+        if self._rigid is None:
+            return self._contact.forces_world(*(np.ascontiguousarray(x.T) for x in (q, qdot)))
+        resting = self._resting_at(q, np.asarray(times, dtype=float))
+        return self._rigid.forces_world(q, qdot, np.asarray(times, dtype=float), resting)
+
+    def _resting_at(self, q: np.ndarray, times: np.ndarray) -> np.ndarray:
+        """(B,) the sphere the last run rested on at each state q (B, n) at ``times`` (B,), found among that
+        sample's copies by its joint values; NotImplementedError for a state off the run."""
+        if self._rigid_run is None:
+            raise NotImplementedError("core reports a rigid contact's forces for states of its own run only")
+        run_q, resting = self._rigid_run
+        samples = np.rint(times / self._dt).astype(int)
+        if np.any((samples < 0) | (samples >= len(run_q))):
+            raise NotImplementedError("core reports a rigid contact's forces for states of its own run only")
+        off = np.abs(run_q[samples] - q[:, None]).max(axis=2)  # (B, copies)
+        copy = np.argmin(off, axis=1)
+        if np.any(off[np.arange(len(q)), copy] > 0):
+            raise NotImplementedError("core reports a rigid contact's forces for states of its own run only")
+        return resting[samples, copy]
 
     def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         """Core's floating-base momentum (:meth:`FloatingRecursiveDynamics.momentum`: each body's I v summed, about the
@@ -119,6 +152,19 @@ class CoreJointMotion(JointSimulation):
         masses, coms = self._mass_centres(q)
         centre = np.einsum("f,bfi->bi", masses, coms) / masses.sum()
         return np.concatenate([momentum[:, :3], momentum[:, 3:] - np.cross(centre, momentum[:, :3])], axis=1)
+
+
+def _contact_detail(scene: JointMotionScene) -> str:
+    """How core's run puts the scene's contact into its steps ("" without contact)."""
+    contact = scene.contact
+    if contact is None:
+        return ""
+    if contact.rigid:
+        return (f"; rigid contact by impulses at each sphere, restitution {contact.restitution:g} (plastic below "
+                f"{contact.rest_speed:g} m/s, then resting), time backed up to each impact, through J M^-1 J^T, "
+                "one contact at a time, frictionless")
+    return (f"; contact by the penalty method at each sphere, k_s = {contact.penalty_stiffness:g} N/m, k_d = "
+            f"{contact.penalty_damping:g} N s/m, frictionless, through ABA as J^T F")
 
 
 def _placed(q: np.ndarray, points: np.ndarray) -> np.ndarray:

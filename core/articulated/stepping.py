@@ -142,15 +142,32 @@ def runge_kutta(tableau: Tableau, qddot: Acceleration, dt: float, rate: Rate = _
     return step
 
 
-def stepper(scene: JointMotionScene, scheme: str, dt: float) -> Step:
+Response = Callable[[np.ndarray, np.ndarray], np.ndarray]
+"""M^-1 f (n, B) of (q (n, B), f (n, B)): the joints' acceleration under the joint forces f alone (no gravity, no
+velocity), with the M the scheme steps with (armature + dt D under implicit damping)."""
+Constraint = Callable[[np.ndarray, np.ndarray, np.ndarray, Response], np.ndarray]
+"""qddot (n, B) of (q, qdot, the unconstrained qddot, the scheme's :data:`Response`): a rigid contact's correction of
+the accelerations (:mod:`core.articulated.chain_impulse`)."""
+
+
+def stepper(scene: JointMotionScene, scheme: str, dt: float, constraint: Constraint | None = None) -> Step:
     """One step (q, qdot) -> (q', qdot') of ``scheme`` at ``dt`` [s] for the scene's chain, gravity and torques;
-    q and qdot (n, B)."""
+    q and qdot (n, B). A ``constraint`` corrects every evaluation of the accelerations (fixed base only)."""
+    return sized_stepper(scene, scheme, constraint)(dt)
+
+
+def sized_stepper(scene: JointMotionScene, scheme: str,
+                  constraint: Constraint | None = None) -> Callable[[float], Step]:
+    """:func:`stepper` of any step size: the dynamics built once, the step for each dt [s] made on demand."""
+    if scheme not in SCHEMES:
+        raise ValueError(f"unknown joint-motion integrator {scheme!r} (allowed: {', '.join(SCHEMES)})")
     gravity = np.zeros(3) if scene.gravity_world is None else scene.gravity_world
     floating = scene.chain.floating_base
     rate, project = (configuration_rate, normalised) if floating else (_fixed_rate, _unchanged)
     dynamics = _forward_dynamics(scene.chain, gravity)
     constant, timed = scene.torque[:, None], scene.timed_torque
-    contact = ChainContactForces(scene.chain, scene.contact) if scene.contact is not None else None
+    contact = (ChainContactForces(scene.chain, scene.contact)
+               if scene.contact is not None and not scene.contact.rigid else None)
 
     def torque(qdot: np.ndarray, t: float, step_start: float) -> np.ndarray:
         """The applied forces (nv, B) at stage time t: the joints', none on a floating base."""
@@ -160,28 +177,46 @@ def stepper(scene: JointMotionScene, scheme: str, dt: float) -> Step:
         return np.broadcast_to(joints, qdot.shape)
 
     def applied(q: np.ndarray, qdot: np.ndarray, t: float, step_start: float) -> np.ndarray:
-        """The applied forces and, with contact, the plane's generalized force at the state (nv, B)."""
+        """The applied forces and, with soft contact, the plane's generalized force at the state (nv, B)."""
         tau = torque(qdot, t, step_start)
         return tau if contact is None else tau + contact.generalized(normalised(q) if floating else q, qdot)
 
-    def qddot(q: np.ndarray, qdot: np.ndarray, t: float, step_start: float) -> np.ndarray:
-        return dynamics(q, qdot, applied(q, qdot, t, step_start))
+    def constrained(forward: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray],
+                    chain: Chain) -> Acceleration:
+        """The accelerations by ``forward`` (of ``chain``), corrected by the constraint where there is one."""
+        if constraint is None:
+            return lambda q, qdot, t, step_start: forward(q, qdot, applied(q, qdot, t, step_start))
+        unforced = _forward_dynamics(chain, np.zeros(3))
+
+        def response(q: np.ndarray, force: np.ndarray) -> np.ndarray:
+            return unforced(q, np.zeros_like(force), force)
+
+        def qddot(q: np.ndarray, qdot: np.ndarray, t: float, step_start: float) -> np.ndarray:
+            return constraint(q, qdot, forward(q, qdot, applied(q, qdot, t, step_start)), response)
+        return qddot
 
     if scheme in RUNGE_KUTTA:
-        return runge_kutta(TABLEAUX[scheme], qddot, dt, rate, project)
+        explicit = constrained(dynamics, scene.chain)
+        return lambda dt: runge_kutta(TABLEAUX[scheme], explicit, dt, rate, project)
     if scheme == SEMI_IMPLICIT_EULER:
-        def semi_implicit(t: float, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            qdot = qdot + dt * qddot(q, qdot, t, t)
-            return project(q + dt * rate(q, qdot)), qdot
-        return semi_implicit
-    if scheme == IMPLICIT_DAMPING:
-        implicit = _forward_dynamics(damped_armature(scene.chain, dt), gravity)
+        accelerations = constrained(dynamics, scene.chain)
+
+        def semi_implicit_step(dt: float) -> Step:
+            def semi_implicit(t: float, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                qdot = qdot + dt * accelerations(q, qdot, t, t)
+                return project(q + dt * rate(q, qdot)), qdot
+            return semi_implicit
+        return semi_implicit_step
+
+    def implicit_damping_step(dt: float) -> Step:
+        damped = damped_armature(scene.chain, dt)
+        implicit = constrained(_forward_dynamics(damped, gravity), damped)
 
         def implicit_damping(t: float, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            qdot = qdot + dt * implicit(q, qdot, applied(q, qdot, t, t))
+            qdot = qdot + dt * implicit(q, qdot, t, t)
             return project(q + dt * rate(q, qdot)), qdot
         return implicit_damping
-    raise ValueError(f"unknown joint-motion integrator {scheme!r} (allowed: {', '.join(SCHEMES)})")
+    return implicit_damping_step
 
 
 def _forward_dynamics(chain: Chain, gravity: np.ndarray) -> Callable[[np.ndarray, np.ndarray, np.ndarray],

@@ -87,6 +87,11 @@ class DivergedError(SimparityError):
     """A simulation became unstable (an engine reported it, or its state left the finite numbers)."""
 
 
+class ContactError(SimparityError):
+    """A contact that core's method cannot resolve (two spheres of a chain touching at once under its one-contact
+    impulses); the message says which and why."""
+
+
 class NotBatchedError(SimparityError):
     """An engine cannot step many copies of a scene in one call (``Simulation.batched``); the message says why, and
     becomes the reason of the case's ``n/a`` batched-timing row."""

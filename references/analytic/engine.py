@@ -59,7 +59,7 @@ from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
 from simparity.references.analytic import contact as analytic_contact
 from simparity.references.analytic import forced
 from simparity.references.analytic import joint_dynamics as planar_dynamics
-from simparity.references.analytic import joint_motion
+from simparity.references.analytic import joint_motion, pendulum_contact
 from simparity.references.analytic import solutions as closed
 from simparity.references.common.conventions import matrix_to_quat_wxyz, principal_axes, quat_wxyz_to_matrix, rotvec_to_matrix
 from simparity.references.common.scene_inputs import derives_own_inputs
@@ -427,6 +427,10 @@ class AnalyticEngine(Engine):
         if not named.ok:
             return named
         return joint_motion.supports(scene)
+
+    def chain_contact(self, scene: JointMotionScene) -> Support:
+        """A pendulum striking a plane with a rigid contact (:mod:`references.analytic.pendulum_contact`)."""
+        return pendulum_contact.supports(scene)
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         return joint_motion.build(scene, dt)

@@ -250,7 +250,8 @@ def supports(scene: JointMotionScene) -> Support:
         why = damped_drive_supported(scene.timed_torque) if joint.damping > 0 else ""
         return Support.no(f"{why} (joint '{name}')") if why else Support.yes()
     if not joint.is_pendulum():
-        return Support.yes()
+        return (Support.no(f"no closed form for contact off a pendulum: joint '{name}' swings under no gravity torque")
+                if scene.contact is not None else Support.yes())
     if joint.damping > 0:
         return Support.no(f"no closed form for a damped pendulum: joint '{name}' has damping {joint.damping:g} "
                           "and gravity exerts a torque about its axis")
@@ -273,9 +274,15 @@ class ClosedFormJointMotion(JointSimulation):
     def __init__(self, scene: JointMotionScene, dt: float) -> None:
         self._scene, self._dt, self._joint = scene, dt, one_joint(scene)
         self._pendulum = pendulum_of(self._joint) if self._joint.is_pendulum() else None
+        # pendulum_contact builds on this module's pendulum: imported here, where a scene has contact
+        from simparity.references.analytic.pendulum_contact import striking_pendulum
+        self._striking = (striking_pendulum(scene, self._joint, self._pendulum)
+                          if self._pendulum is not None and scene.contact is not None else None)
         if self._pendulum is not None:
             self.detail = (f"closed form: physical pendulum (Jacobi elliptic functions), omega0 = "
-                           f"{self._pendulum.omega0:.6g} rad/s; joint limits not enforced")
+                           f"{self._pendulum.omega0:.6g} rad/s; joint limits not enforced"
+                           + ("; impacts on the plane found on the closed form (Brent's method), q' -> -e q' at each"
+                              if self._striking is not None else ""))
         else:
             self.detail = (f"closed form: one joint under a constant force"
                            + (" and a torque that changes with time" if scene.timed_torque is not None else "")
@@ -285,7 +292,11 @@ class ClosedFormJointMotion(JointSimulation):
     def run(self, n_steps: int) -> JointTrajectory:
         times = np.arange(n_steps + 1) * self._dt
         q0, qdot0 = self._scene.q0[:, 0], self._scene.qdot0[:, 0]
-        if self._pendulum is None and self._scene.timed_torque is not None:
+        if self._striking is not None:
+            from simparity.references.analytic.pendulum_contact import striking_motion
+            pairs = [striking_motion(self._striking, a, b, times) for a, b in zip(q0, qdot0)]
+            q, qdot = np.stack([p for p, _ in pairs], axis=1), np.stack([v for _, v in pairs], axis=1)
+        elif self._pendulum is None and self._scene.timed_torque is not None:
             joint = self._joint
             force = joint.torque + (0.0 if joint.revolute else joint.mass * float(joint.gravity @ joint.axis))
             pairs = [driven_joint(a, b, joint.inertia, joint.damping, force, self._scene.timed_torque, times)

@@ -51,6 +51,8 @@ import math
 import numpy as np
 
 from simparity.core.model.scenes.contact import Contact, Plane, Shape
+from simparity.core.model.engine import Support
+from simparity.core.model.scenes.joint_motion import JointMotionScene
 
 POINT_RADIUS = 1e-5  # [m]
 """Radius of the sphere standing for a point (a "point" body, each of "points", each box corner
@@ -188,3 +190,14 @@ def static_friction_note(contact: Contact) -> str:
         return ""
     return (f"mu_s (max {float(np.max(mu_s)):g}) > mu_k: the engine has one friction coefficient and uses "
             "mu_k, so sticking holds only while the tangential force stays within mu_k N")
+
+
+def plastic_only(scene: JointMotionScene, how: str) -> Support:
+    """Whether an engine whose robot contact is plastic (every impulse stops a pushed sphere: restitution 0) can do a
+    joint-motion scene's contact: a soft one (its own stiffness), or a rigid one with restitution 0; ``how`` says what
+    makes it plastic."""
+    contact = scene.contact
+    if contact is not None and contact.rigid and contact.restitution != 0:
+        return Support.no(f"no restitution on a robot's contact: {how}; the scene asks for restitution "
+                          f"{contact.restitution:g}")
+    return Support.yes()

@@ -455,7 +455,10 @@ class MujocoEngine(Engine):
         return joint_motion.MujocoJointMotion(scene, integrator, dt)
 
     def chain_contact(self, scene: JointMotionScene) -> Support:
-        """MuJoCo's soft contact on sphere and plane geoms (:mod:`references.mujoco.contact`)."""
+        """MuJoCo's soft contact on sphere and plane geoms (:mod:`references.mujoco.contact`); not a rigid contact."""
+        if scene.contact is not None and scene.contact.rigid:
+            return Support.no("MuJoCo's contact is soft (solref, solimp): a sphere sinks into the plane and its rebound "
+                              "follows from solref's damping, so it has no rigid contact with a restitution")
         return Support.yes()
 
     def ik_solvers(self) -> tuple[str, ...]:

@@ -62,7 +62,7 @@ from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.scenes.joint_dynamics import JointDynamicsScene
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import FramePoses, Trajectory, piece_bounds
-from simparity.references.common import external_forces, time_loads
+from simparity.references.common import contact_params, external_forces, time_loads
 from simparity.references.pinocchio import ik as pinocchio_ik
 from simparity.references.common.base_frame import BaseFrame
 from simparity.references.common.conventions import matrix_to_quat_wxyz, quat_wxyz_to_matrix
@@ -412,8 +412,9 @@ class PinocchioEngine(UrdfChains, Engine):
         return _dynamics_support(scene.chain) if named.ok else named
 
     def chain_contact(self, scene: JointMotionScene) -> Support:
-        """Its point contacts and ADMM in the harness's semi-implicit Euler (:mod:`references.pinocchio.contact`)."""
-        return Support.yes()
+        """Its point contacts and ADMM in the harness's semi-implicit Euler (:mod:`references.pinocchio.contact`);
+        plastic, so a rigid contact only with restitution 0."""
+        return contact_params.plastic_only(scene, "the harness's Moreau-Jean loop is plastic (an impulse stops a pushed sphere)")
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         if scene.chain.floating_base:

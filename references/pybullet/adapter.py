@@ -723,7 +723,10 @@ class PybulletEngine(UrdfChains, Engine):
     def chain_contact(self, scene: JointMotionScene) -> Support:
         """Bullet's multibody contact of sphere shapes on the links (:mod:`references.pybullet.chain_contact`), on a
         fixed base; a floating base is n/a (:data:`FLOATING_BASE_WHY`)."""
-        return Support.no(FLOATING_BASE_WHY) if scene.chain.floating_base else Support.yes()
+        if scene.chain.floating_base:
+            return Support.no(FLOATING_BASE_WHY)
+        return contact_params.plastic_only(scene, "PyBullet's spheres are set with restitution 0 here (one Moreau-Jean impulse per "
+                                   "step, as the Pinocchio loop)")
 
     def build_joint_motion(self, scene: JointMotionScene, integrator: str, dt: float) -> JointSimulation:
         # imported here: joint_motion reuses this module's client, loader and chain kinematics

@@ -277,10 +277,10 @@ MUTANTS: tuple[Mutation, ...] = (
         JOINT_MOTION, "pendulum-large-amplitude"),
     Mutation(
         "joint_semi_implicit_old_velocity", "integrator stages", "articulated/stepping.py",
-        "            qdot = qdot + dt * qddot(q, qdot, t, t)\n            return project(q + dt * rate(q, qdot)), qdot\n"
-        "        return semi_implicit",
-        "            new = qdot + dt * qddot(q, qdot, t, t)\n            return project(q + dt * rate(q, qdot)), new\n"
-        "        return semi_implicit",
+        "                qdot = qdot + dt * accelerations(q, qdot, t, t)\n"
+        "                return project(q + dt * rate(q, qdot)), qdot\n            return semi_implicit",
+        "                new = qdot + dt * accelerations(q, qdot, t, t)\n"
+        "                return project(q + dt * rate(q, qdot)), new\n            return semi_implicit",
         "semi-implicit Euler moving the joints with the old velocity: explicit Euler under the semi-implicit name",
         JOINT_MOTION, "pendulum-large-amplitude"),
     Mutation(

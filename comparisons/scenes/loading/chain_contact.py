@@ -13,7 +13,7 @@ from simparity.core.model.scenes.chain_contact import ChainContact, ContactSpher
 from simparity.core.model.scenes.contact import Plane
 
 _PLANE = ("name", "coefficients")
-_CONTACT = ("penalty_stiffness", "penalty_damping", "rest_after", "sphere")
+_CONTACT = ("penalty_stiffness", "penalty_damping", "restitution", "rest_speed", "rest_after", "sphere")
 _SPHERE = ("frame", "centre_xyz", "radius")
 
 
@@ -60,18 +60,40 @@ def read_chain_contact(top: TableReader, chain: Chain, q0: np.ndarray, duration:
                                      s.number("radius", positive=True, length=1)))
     if not spheres:
         raise c.fail("sphere", "no contact sphere", "[[contact.sphere]] entries: frame, centre_xyz, radius")
+    rest_after = c.number("rest_after", positive=True) if c.has("rest_after") else None
+    if rest_after is not None and not rest_after < duration:
+        raise c.fail("rest_after", f"{rest_after:g} s is not before the end of the run ({duration:g} s)",
+                     "a time [s] inside the scene's duration, from which its robot is at rest")
+    contact = (_rigid(c, plane, tuple(spheres), rest_after) if c.has("restitution") else
+               _soft(c, chain, plane, tuple(spheres), rest_after))
+    _check_start_outside(top, chain, contact, q0)
+    return contact
+
+
+def _soft(c: TableReader, chain: Chain, plane: Plane, spheres: tuple[ContactSphere, ...],
+          rest_after: float | None) -> ChainContact:
+    """A soft contact: core's penalty spring k_s and damper k_d (critical on the robot's mass by default)."""
+    if c.has("rest_speed"):
+        raise c.fail("rest_speed", "a rest speed on a soft contact", "rest_speed with restitution (a rigid contact)")
     stiffness = c.number("penalty_stiffness", positive=True)  # N/m = kg / s^2: no length
     damping = (c.number("penalty_damping") if c.has("penalty_damping")
                else 2.0 * float(np.sqrt(stiffness * chain.mass)))  # critical on the robot's mass, N s/m = kg / s
     if damping < 0:
         raise c.fail("penalty_damping", f"{damping:g} is negative", "a number >= 0 [N s/m]")
-    rest_after = c.number("rest_after", positive=True) if c.has("rest_after") else None
-    if rest_after is not None and not rest_after < duration:
-        raise c.fail("rest_after", f"{rest_after:g} s is not before the end of the run ({duration:g} s)",
-                     "a time [s] inside the scene's duration, from which its robot is at rest")
-    contact = ChainContact(plane, tuple(spheres), stiffness, damping, rest_after)
-    _check_start_outside(top, chain, contact, q0)
-    return contact
+    return ChainContact(plane, spheres, stiffness, damping, rest_after)
+
+
+def _rigid(c: TableReader, plane: Plane, spheres: tuple[ContactSphere, ...], rest_after: float | None) -> ChainContact:
+    """A rigid contact: Newton's restitution e at each impact, plastic below ``rest_speed`` (m/s, default 1 mm/s)."""
+    for key in ("penalty_stiffness", "penalty_damping"):
+        if c.has(key):
+            raise c.fail(key, "a penalty spring on a rigid contact (restitution is given)",
+                         "either restitution (rigid: impulses) or penalty_stiffness (soft: springs), not both")
+    restitution = c.number("restitution")
+    if not 0 <= restitution <= 1:
+        raise c.fail("restitution", f"{restitution:g} is outside [0, 1]", "a number in [0, 1] (1: elastic)")
+    rest_speed = c.number("rest_speed", 1e-3, positive=True, length=1)
+    return ChainContact(plane, spheres, None, None, rest_after, restitution, rest_speed)
 
 
 def _check_start_outside(top: TableReader, chain: Chain, contact: ChainContact, q0: np.ndarray) -> None:

@@ -38,8 +38,10 @@ def check_reference(top: TableReader, scene, engines: EngineSet) -> None:
     else:
         support = engine.supports_kinematics(scene.chain)
     if not support.ok:
-        allowed = ("core or mujoco: a scene with a chain's contact runs against no reference, but names an engine that "
-                   "can do it" if isinstance(scene, JointMotionScene) and contact is not None
+        allowed = ("analytic for a pendulum striking the plane with one sphere, or core" if isinstance(
+                       scene, JointMotionScene) and contact is not None and contact.rigid
+                   else "core or mujoco: a scene with a chain's soft contact runs against no reference, but names an "
+                   "engine that can do it" if isinstance(scene, JointMotionScene) and contact is not None
                    else "a reference that can: core (its backup method), mujoco or pybullet for contact" if contact is not None
                    else "a reference that computes joint-space dynamics: pinocchio, mujoco, core, or analytic for a "
                         "planar chain of 1 or 2 joints" if isinstance(scene, JointDynamicsScene)

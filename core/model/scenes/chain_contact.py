@@ -46,40 +46,74 @@ class ChainContact:
     normal only, never pulls, and nothing else touches (the spheres do not touch each other, the links have no other
     collision geometry).
 
-    How hard the contact is belongs to each engine: core's penalty method (the lecture's spring-damper at each
-    penetrating sphere, ``penalty_stiffness`` and ``penalty_damping``), MuJoCo's soft constraints (its solref and
-    solimp, reported in each row). The truths a scene is held to need none of them.
+    The contact is soft or rigid, as the scene says:
+
+    - soft (``penalty_stiffness`` given): how hard it is belongs to each engine: core's penalty method (the lecture's
+      spring-damper at each penetrating sphere, ``penalty_stiffness`` and ``penalty_damping``), MuJoCo's soft
+      constraints (its solref and solimp, reported in each row). The truths a scene is held to need none of them.
+    - rigid (``restitution`` given): no sphere enters the plane; at an impact the sphere's normal velocity is reversed
+      and scaled by the restitution e (Newton's law, the lecture's impulse), except that a rebound slower than
+      ``rest_speed`` is plastic (e = 0) and the sphere then rests on the plane while the plane pushes it. A pendulum
+      striking the plane has a closed form (:mod:`references.analytic.joint_motion`).
 
     Attributes
     ----------
     plane : Plane
     spheres : tuple of ContactSphere
         At least one.
-    penalty_stiffness : float
-        k_s [N/m] of core's penalty method, > 0.
-    penalty_damping : float
-        k_d [N s/m] of core's penalty method, >= 0.
+    penalty_stiffness : float or None
+        k_s [N/m] of core's penalty method, > 0; None for a rigid contact.
+    penalty_damping : float or None
+        k_d [N s/m] of core's penalty method, >= 0; None for a rigid contact.
     rest_after : float or None
         [s] From this time on the scene's author says the robot is at rest (``rest_acceleration_max`` holds every
         engine to it); None: the scene does not say, and a run that never settles only leaves the rest checks n/a.
+    restitution : float or None
+        e in [0, 1] of a rigid contact; None for a soft one.
+    rest_speed : float
+        [m/s] of a rigid contact, > 0: a rebound whose normal speed would be below it is plastic (without it a
+        bouncing sphere's impacts accumulate without end, Zeno's bounces).
     """
 
     plane: Plane
     spheres: tuple[ContactSphere, ...]
-    penalty_stiffness: float
-    penalty_damping: float
+    penalty_stiffness: float | None
+    penalty_damping: float | None
     rest_after: float | None = None
+    restitution: float | None = None
+    rest_speed: float = 1e-3
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "spheres", tuple(self.spheres))
         if not self.spheres:
             raise SceneError("<code>", "contact.sphere", "no contact sphere", "at least one [[contact.sphere]]")
-        if not (np.isfinite(self.penalty_stiffness) and self.penalty_stiffness > 0):
-            raise SceneError("<code>", "contact.penalty_stiffness", f"{self.penalty_stiffness}", "a number > 0 [N/m]")
-        if not (np.isfinite(self.penalty_damping) and self.penalty_damping >= 0):
-            raise SceneError("<code>", "contact.penalty_damping", f"{self.penalty_damping}", "a number >= 0 [N s/m]")
+        if self.rigid:
+            self._check_rigid()
+        else:
+            self._check_soft()
         if self.rest_after is not None and not (np.isfinite(self.rest_after) and self.rest_after > 0):
             raise SceneError("<code>", "contact.rest_after", f"{self.rest_after}", "a time > 0 [s]")
+
+    @property
+    def rigid(self) -> bool:
+        """True for a rigid contact (impulses, a restitution), False for a soft one (penalty springs)."""
+        return self.restitution is not None
+
+    def _check_soft(self) -> None:
+        if self.penalty_stiffness is None or not (np.isfinite(self.penalty_stiffness) and self.penalty_stiffness > 0):
+            raise SceneError("<code>", "contact.penalty_stiffness", f"{self.penalty_stiffness}", "a number > 0 [N/m]")
+        if self.penalty_damping is None or not (np.isfinite(self.penalty_damping) and self.penalty_damping >= 0):
+            raise SceneError("<code>", "contact.penalty_damping", f"{self.penalty_damping}", "a number >= 0 [N s/m]")
+
+    def _check_rigid(self) -> None:
+        if self.penalty_stiffness is not None or self.penalty_damping is not None:
+            raise SceneError("<code>", "contact.penalty_stiffness", "a penalty spring on a rigid contact",
+                             "either restitution (rigid) or penalty_stiffness (soft)")
+        e = self.restitution
+        if not (e is not None and np.isfinite(e) and 0 <= e <= 1):
+            raise SceneError("<code>", "contact.restitution", f"{e}", "a number in [0, 1]")
+        if not (np.isfinite(self.rest_speed) and self.rest_speed > 0):
+            raise SceneError("<code>", "contact.rest_speed", f"{self.rest_speed}", "a speed > 0 [m/s]")
 
     @property
     def radii(self) -> np.ndarray:

@@ -79,3 +79,50 @@ def test_pinocchio_steps_contact_with_semi_implicit_euler_only(data):
     scene = parse_scene(data)
     assert PinocchioEngine().supports_joint_motion(scene, "semi_implicit_euler").ok
     assert "semi_implicit_euler" in PinocchioEngine().supports_joint_motion(scene, "rk4").reason
+
+
+@pytest.fixture(scope="module")
+def rigid() -> dict:
+    return tomllib.loads(Path(resolve("pendulum-bounce")).read_text(encoding="utf-8"))
+
+
+def test_a_rigid_contact_reads_as_written(rigid):
+    contact = parse_scene(rigid).contact
+    assert contact.rigid and contact.restitution == 0.5 and contact.rest_speed == 0.01
+    assert contact.penalty_stiffness is None and contact.penalty_damping is None
+    del rigid["contact"]["rest_speed"]
+    assert parse_scene(rigid).contact.rest_speed == 1e-3  # the default, as the free bodies'
+
+
+@pytest.mark.parametrize("edit, key, words", [
+    (lambda d: d["contact"].update(restitution=1.5), "contact.restitution", "outside [0, 1]"),
+    (lambda d: d["contact"].update(restitution=-0.1), "contact.restitution", "outside [0, 1]"),
+    (lambda d: d["contact"].update(restitution="0.5"), "contact.restitution", "a number"),
+    (lambda d: d["contact"].update(rest_speed=0.0), "contact.rest_speed", "> 0"),
+    (lambda d: d["contact"].update(penalty_stiffness=1e4), "contact.penalty_stiffness", "not both"),
+    (lambda d: d["contact"].update(penalty_damping=10.0), "contact.penalty_damping", "not both"),
+])
+def test_a_meaningless_rigid_contact_is_refused_in_one_line_naming_its_key(rigid, edit, key, words):
+    with pytest.raises(SceneError) as caught:
+        parse_scene(_edited(rigid, edit), "bounce.toml")
+    message = str(caught.value)
+    assert key in message and words in message and "\n" not in message, message
+
+
+def test_a_rest_speed_on_a_soft_contact_is_refused(data):
+    with pytest.raises(SceneError, match="contact.rest_speed: a rest speed on a soft contact"):
+        parse_scene(_edited(data, lambda d: d["contact"].update(rest_speed=0.01)), "drop.toml")
+
+
+@pytest.mark.parametrize("restitution, plastic_engines", [(0.5, False), (0.0, True)])
+def test_a_rigid_contact_runs_where_an_engine_has_it(rigid, restitution, plastic_engines):
+    """MuJoCo's contact is soft: never; Pinocchio's loop and PyBullet's step are plastic: restitution 0 only."""
+    from simparity.references.mujoco.adapter import MujocoEngine
+
+    scene = parse_scene(_edited(rigid, lambda d: d["contact"].update(restitution=restitution)))
+    mujoco = MujocoEngine().supports_joint_motion(scene, "rk4")
+    assert not mujoco.ok and "soft" in mujoco.reason
+    for engine, integrator in ((PinocchioEngine(), "semi_implicit_euler"), (PybulletEngine(), "euler")):
+        support = engine.supports_joint_motion(scene, integrator)
+        assert support.ok == plastic_engines, support.reason
+        assert support.ok or "restitution 0.5" in support.reason

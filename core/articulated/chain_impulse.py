@@ -1,0 +1,207 @@
+"""Core's rigid contact of a fixed-base chain's spheres with a plane: the lecture's impulses, time backed up to the
+instant of contact, carried to a chain through the contact-space inverse inertia j^T M^-1 j.
+
+Each step of the scene's scheme is taken from its start (:mod:`core.articulated.stepping`). Where a sphere that was
+off the plane ends the step inside it, time is backed up to the instant it touches (the lecture's "backing up time"):
+the first root of s -> min over those spheres of gap(step of s h from the start), s in [0, 1], each trial the
+scheme's own state at t + s h, found by Brent's method to :data:`TIME_RTOL` of the step; the chain is stepped there,
+responds, and steps the rest of the step (several events in one step in time order, at most
+:data:`MAX_EVENTS_PER_STEP`). A sphere already inside at a step's start and moving in responds at once.
+
+The response is Newton's impulse at the touching sphere: with N the plane's normal, j = J^T N (J the Jacobian of the
+sphere's centre) and v_n = j . qdot its normal velocity (< 0: approaching),
+
+    qdot+ = qdot - (1 + e) v_n M^-1 j / (j^T M^-1 j),
+
+which makes its normal velocity -e v_n, leaves every motion that does not move the sphere along N alone, and takes
+(1 - e^2) v_n^2 / (2 j^T M^-1 j) of kinetic energy (the contact-space mass 1 / (j^T M^-1 j) meeting an immovable
+plane). A rebound slower than the scene's ``rest_speed`` is plastic (e = 0) and the sphere then rests on the plane:
+every evaluation of the accelerations adds the plane's force lambda j with
+
+    lambda = max(0, -(j . a + N . (dJ/dt qdot)) / (j^T M^-1 j))   (a the accelerations without it),
+
+the force that keeps its normal acceleration zero while the plane pushes (the lecture's resting contact force, for
+one contact; M the scheme's own, armature + dt D under implicit damping). The sphere leaves the plane where, at a
+step's last evaluation of the accelerations, the plane would have to pull (lambda's unclipped value <= 0). A resting
+sphere drifts off the plane by the scheme's error only (nothing pulls it back).
+
+One contact at a time: two spheres touching at once couple their impulses through M^-1 and need a complementarity
+solver (PGS or similar), beyond the lecture; core raises :class:`core.model.errors.ContactError` there. A floating
+base is not carried (its Jacobian and M have the base's six rows): the in-house engine declines those scenes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.optimize import brentq
+
+from simparity.core.articulated import stepping
+from simparity.core.articulated.chain_arrays import chain_arrays
+from simparity.core.articulated.chain_contact import ChainContactForces
+from simparity.core.articulated.recursive import Recursive
+from simparity.core.dynamics.time_loads import value_in_step
+from simparity.core.model.errors import ContactError
+from simparity.core.model.scenes.joint_motion import JointMotionScene
+
+TIME_RTOL = 1e-13
+"""[1] The backed-up instant of contact is found to this fraction of the step (Brent's xtol): its error moves the
+impact by |v| dt TIME_RTOL, below the rounding of a 1 m scene for dt <= 1e-2 s."""
+MAX_EVENTS_PER_STEP = 100
+"""Contact events one copy may have in one step; past it the run stops with :class:`ContactError` (a rebound faster
+than ``rest_speed`` takes a finite time to come back: only a scene whose rest speed is far below what one step can
+resolve gets near it)."""
+FREE = -1
+"""The resting sphere of a copy that rests on none."""
+
+
+class RigidContact:
+    """The rigid contact of a fixed-base scene under one scheme: its steps, impacts and resting forces, batched over
+    copies (each copy's events handled in turn). States are the stepping layout: q (n, B), qdot (n, B)."""
+
+    def __init__(self, scene: JointMotionScene, scheme: str) -> None:
+        contact = scene.contact
+        if contact is None or not contact.rigid or scene.chain.floating_base:
+            raise ValueError("RigidContact needs a fixed-base scene with a rigid contact")
+        self._scene, self._contact = scene, contact
+        self._spheres = ChainContactForces(scene.chain, contact)
+        self._sized = stepping.sized_stepper(scene, scheme, self._constraint)
+        gravity = np.zeros(3) if scene.gravity_world is None else np.asarray(scene.gravity_world, dtype=float)
+        self._dynamics = Recursive(chain_arrays(scene.chain), gravity)
+        self._unforced = Recursive(chain_arrays(scene.chain), np.zeros(3))
+        self.resting = np.full(scene.copies, FREE)
+        """(B,) the sphere each copy rests on, :data:`FREE` for none."""
+        self._unclipped = np.zeros(scene.copies)
+        self._active: np.ndarray | slice = slice(None)  # the copies the constraint is evaluated for
+
+    def gaps(self, q: np.ndarray) -> np.ndarray:
+        """(B, S) [m] each sphere's distance from the plane at q (n, B) (negative: inside)."""
+        return self._contact.gaps(self._spheres.centres_world(q))
+
+    def normal_velocities(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """(B, S) [m/s] each sphere's velocity along the plane's normal (negative: approaching)."""
+        return np.einsum("bsn,nb->bs", self._spheres.normal_jacobians(q), qdot)
+
+    def _inverse_mass(self, q: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(M^-1 j (n, B), j^T M^-1 j (B,)) of the true M (armature included) at q for j (n, B)."""
+        response = self._unforced.forward_dynamics(q, np.zeros_like(j), j)
+        return response, np.einsum("ib,ib->b", j, response)
+
+    def _lambda(self, q: np.ndarray, qdot: np.ndarray, a: np.ndarray, response: stepping.Response,
+                resting: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(j (n, B) of each copy's resting sphere, lambda unclipped (B,), 0 where none rests)."""
+        on = resting != FREE
+        sphere, copies = np.where(on, resting, 0), np.arange(q.shape[1])
+        rows, biases = self._spheres.normal_kinematics(q, qdot)
+        j, bias = rows[copies, sphere].T, biases[copies, sphere]
+        unclipped = -(np.einsum("ib,ib->b", j, a) + bias) / np.einsum("ib,ib->b", j, response(q, j))
+        return j, np.where(on, unclipped, 0.0)
+
+    def _constraint(self, q: np.ndarray, qdot: np.ndarray, a: np.ndarray, response: stepping.Response) -> np.ndarray:
+        """The accelerations a (n, B) with each resting sphere's force lambda j added (module docstring)."""
+        resting = self.resting[self._active]
+        if np.all(resting == FREE):
+            self._unclipped[self._active] = 0.0
+            return a
+        j, unclipped = self._lambda(q, qdot, a, response, resting)
+        self._unclipped[self._active] = unclipped
+        return a + response(q, j * np.maximum(unclipped, 0.0))
+
+    def start(self, copies: int) -> None:
+        """Every copy off the plane's hold: a run of ``copies`` copies begins."""
+        self.resting, self._unclipped = np.full(copies, FREE), np.zeros(copies)
+
+    def step(self, t: float, q: np.ndarray, qdot: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """One step of ``dt`` [s] from time t [s] of every copy, impacts and rests included."""
+        self._active = slice(None)
+        q_end, qdot_end = self._sized(dt)(t, q, qdot)
+        events = np.flatnonzero(np.any(self._candidates(q, qdot) & (self.gaps(q_end) < 0), axis=1))
+        for b in events:
+            self._active = np.array([b])
+            q_end[:, [b]], qdot_end[:, [b]] = self._events(t, q[:, [b]], qdot[:, [b]], dt, int(b))
+        self._active = slice(None)
+        self.resting[(self.resting != FREE) & (self._unclipped <= 0)] = FREE
+        return q_end, qdot_end
+
+    def _candidates(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """(B, S) the spheres that may strike within a step from (q, qdot): not resting, and off the plane or moving
+        in (one inside and moving out, by a rebound or the rounding of a touch, is leaving)."""
+        spheres = np.arange(len(self._contact.spheres))
+        resting = self.resting[self._active][:, None] == spheres
+        return ~resting & ((self.gaps(q) >= 0) | (self.normal_velocities(q, qdot) <= 0))
+
+    def _events(self, t: float, q: np.ndarray, qdot: np.ndarray, dt: float, b: int) -> tuple[np.ndarray, np.ndarray]:
+        """Copy b's step of ``dt`` from t with its contact events (module docstring); q (n, 1), qdot (n, 1)."""
+        remaining = dt
+        for _ in range(MAX_EVENTS_PER_STEP):
+            candidates = self._candidates(q, qdot)[0]
+            q_end, qdot_end = self._sized(remaining)(t, q, qdot)
+            if not np.any(candidates & (self.gaps(q_end)[0] < 0)):
+                return q_end, qdot_end
+            s = self._backed_up(t, q, qdot, remaining, candidates)
+            if s > 0:
+                q, qdot = self._sized(s * remaining)(t, q, qdot)
+                t, remaining = t + s * remaining, remaining - s * remaining
+            qdot = self._respond(q, qdot, candidates, b)
+        raise ContactError(f"copy {b} had more than {MAX_EVENTS_PER_STEP} contact events in one step of {dt:g} s at "
+                           f"t = {t:.9g} s (allowed: a rest_speed its steps resolve)")
+
+    def _backed_up(self, t: float, q: np.ndarray, qdot: np.ndarray, h: float, candidates: np.ndarray) -> float:
+        """The fraction s of the step ``h`` at which the first candidate sphere touches (0 when one is inside)."""
+        def lowest(s: float) -> float:
+            return float(np.min(self.gaps(self._sized(s * h)(t, q, qdot)[0])[0][candidates]))
+        start = float(np.min(self.gaps(q)[0][candidates]))
+        return 0.0 if start <= 0 else float(brentq(lowest, 0.0, 1.0, xtol=TIME_RTOL))
+
+    def _respond(self, q: np.ndarray, qdot: np.ndarray, candidates: np.ndarray, b: int) -> np.ndarray:
+        """qdot after the impulse of the touching candidate sphere at (q, qdot) (module docstring)."""
+        gaps = np.where(candidates, self.gaps(q)[0], np.inf)
+        sphere = int(np.argmin(gaps))
+        others = np.flatnonzero((gaps <= 0) & (np.arange(len(gaps)) != sphere))
+        if others.size or self.resting[b] != FREE:
+            second = int(others[0]) if others.size else int(self.resting[b])
+            names = self._contact.spheres
+            raise ContactError(f"spheres on {names[sphere].frame!r} and {names[second].frame!r} touch the plane at "
+                               "once: core's impulses resolve one contact at a time (several need a complementarity "
+                               "solver)")
+        j = self._spheres.normal_jacobians(q)[0, sphere][:, None]
+        normal = float(j[:, 0] @ qdot[:, 0])
+        if normal > 0:
+            return qdot
+        e = self._contact.restitution
+        assert e is not None
+        if -e * normal < self._contact.rest_speed:
+            e, self.resting[b] = 0.0, sphere
+        response, inverse_mass = self._inverse_mass(q, j)
+        return qdot - (1.0 + e) * normal * response / inverse_mass
+
+    def run(self, q0: np.ndarray, qdot0: np.ndarray, n_steps: int, dt: float
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(q (n_steps + 1, B, n), qdot (n_steps + 1, B, n), the resting sphere at each sample (n_steps + 1, B)) of
+        ``n_steps`` steps of ``dt`` [s] from (q0, qdot0), (B, n) each, at t = 0."""
+        self.start(len(q0))
+        log = np.empty((n_steps + 1, len(q0)), dtype=int)
+        log[0] = FREE
+
+        def step(t: float, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            out = self.step(t, q, qdot, dt)
+            log[int(round(t / dt)) + 1] = self.resting
+            return out
+        q, qdot = stepping.run(step, q0, qdot0, n_steps, dt)
+        return q, qdot, log
+
+    def forces_world(self, q: np.ndarray, qdot: np.ndarray, times: np.ndarray, resting: np.ndarray) -> np.ndarray:
+        """(B, S, 3) [N] the plane's force on each sphere at states q (B, n), qdot (B, n) at ``times`` (B,) [s] with
+        the resting spheres ``resting`` (B,): lambda N on a resting sphere (the true M's), 0 on the others (an
+        impact's impulse is no force)."""
+        scene = self._scene
+        q_t, qdot_t = np.ascontiguousarray(q.T), np.ascontiguousarray(qdot.T)
+        tau = np.repeat(scene.torque[:, None], len(times), axis=1)
+        if scene.timed_torque is not None:
+            tau = tau + np.stack([value_in_step(scene.timed_torque, t, t) for t in times], axis=1)
+        a = self._dynamics.forward_dynamics(q_t, qdot_t, tau)
+        _, unclipped = self._lambda(q_t, qdot_t, a, lambda qq, f: self._unforced.forward_dynamics(
+            qq, np.zeros_like(f), f), resting)
+        out = np.zeros((len(times), len(self._contact.spheres), 3))
+        on = np.flatnonzero(resting != FREE)
+        out[on, resting[on]] = np.maximum(unclipped[on], 0.0)[:, None] * self._contact.plane.normal_world
+        return out
