@@ -34,7 +34,7 @@ from simparity.comparisons.measure.step_jacobian_metrics import STEP_JACOBIAN_ME
 from simparity.comparisons.measure.rows import Case, Measured, declared_scheme, warnings_into_rows
 from simparity.comparisons.common.error_text import error_text
 from simparity.core.model.engine import Engine, JointSimulation, Support
-from simparity.core.model.errors import DivergedError
+from simparity.core.model.errors import ContactError, DivergedError
 from simparity.core.model.metric_catalogue import (
     END_EFFECTOR_ERROR_MAX, JOINT_ANGLE_ERROR_MAX, JOINT_VELOCITY_ERROR_MAX, SEGMENT_REFERENCE_ERROR_MAX,
     SELF_PARTING_TIME, TIME_PER_STEP,
@@ -209,6 +209,8 @@ def _motion_case(scene: JointMotionScene, engine: Engine, case: Case, shared: Mo
             timed |= case_cost(engine, sim, case, n, repeats)
     except DivergedError as err:
         return CaseOutcome(case.rows(metrics, DIVERGED, str(err)))
+    except ContactError as err:  # a contact its method does not resolve, found only as it steps: n/a, saying why
+        return CaseOutcome(case.rows(metrics, NOT_AVAILABLE, f"{engine.name} cannot step this contact: {err}"))
     except Exception as err:  # noqa: BLE001 - reported in the rows
         return CaseOutcome(case.rows(metrics, FAILED, error_text(err)))
     problem = sampling_problem(run_scene, traj, n, case.dt)

@@ -11,6 +11,7 @@ import numpy as np
 
 from simparity.comparisons.scenes.sweep import value_text
 from simparity.core.model.scenes.chain import Chain
+from simparity.core.model.scenes.chain_contact import ChainContact
 from simparity.core.model.scenes.dynamics import DynamicsScene
 from simparity.core.model.scenes.ik import IKScene
 from simparity.core.model.scenes.joint_dynamics import BASE_POSITION_RANGE, JointDynamicsScene
@@ -111,8 +112,10 @@ def _joint_dynamics_lines(scene: JointDynamicsScene) -> list[str]:
 def _joint_motion_lines(scene: JointMotionScene) -> list[str]:
     gravity = "none" if scene.gravity_world is None else f"{_vector(scene.gravity_world)} m/s^2"
     accuracy = (f"self-consistency over {scene.segments} segments (each engine against itself at a 16 x smaller step)"
-                if scene.segments else "truths that need no engine (contact)" if scene.contact is not None
-                else "against the reference")
+                if scene.segments else "truths that need no engine (soft contact)"
+                if scene.contact is not None and not scene.contact.rigid
+                else "against the reference" + (" and truths that need no engine (rigid contact)"
+                                                if scene.contact is not None else ""))
     timed = scene.timed_torque
     chain, base = scene.chain, scene.chain.base_inertia
     frame = "world" if chain.floating_base else "base"
@@ -139,7 +142,7 @@ def _joint_motion_lines(scene: JointMotionScene) -> list[str]:
     return lines + _link_lines(chain)
 
 
-def _chain_contact_model(contact) -> str:
+def _chain_contact_model(contact: ChainContact) -> str:
     """How hard a chain's contact is, as the scene says: core's penalty constants, or rigid with a restitution."""
     if contact.rigid:
         return (f"rigid: restitution {contact.restitution:.10g}, plastic below {contact.rest_speed:.10g} m/s "

@@ -3,10 +3,12 @@ instant of contact, carried to a chain through the contact-space inverse inertia
 
 Each step of the scene's scheme is taken from its start (:mod:`core.articulated.stepping`). Where a sphere that was
 off the plane ends the step inside it, time is backed up to the instant it touches (the lecture's "backing up time"):
-the first root of s -> min over those spheres of gap(step of s h from the start), s in [0, 1], each trial the
-scheme's own state at t + s h, found by Brent's method to :data:`TIME_RTOL` of the step; the chain is stepped there,
-responds, and steps the rest of the step (several events in one step in time order, at most
-:data:`MAX_EVENTS_PER_STEP`). A sphere already inside at a step's start and moving in responds at once.
+the first root of s -> min over the spheres of gap(step of s h from the start), s in [0, 1], each trial the scheme's
+own state at t + s h, found by Brent's method to :data:`TIME_RTOL` of the step; the chain is stepped there, responds,
+and steps the rest of the step (several events in one step in time order, at most :data:`MAX_EVENTS_PER_STEP`). A
+sphere on or inside the plane at a step's start and moving in responds at once; one leaving it (just bounced, at a
+gap of rounding) is followed until it clears the plane (:data:`CLEARING`), so that its return within the same step
+is found: on a chain the other joints can bring a bounced sphere straight back.
 
 The response is Newton's impulse at the touching sphere: with N the plane's normal, j = J^T N (J the Jacobian of the
 sphere's centre) and v_n = j . qdot its normal velocity (< 0: approaching),
@@ -21,12 +23,18 @@ every evaluation of the accelerations adds the plane's force lambda j with
     lambda = max(0, -(j . a + N . (dJ/dt qdot)) / (j^T M^-1 j))   (a the accelerations without it),
 
 the force that keeps its normal acceleration zero while the plane pushes (the lecture's resting contact force, for
-one contact; M the scheme's own, armature + dt D under implicit damping). The sphere leaves the plane where, at a
-step's last evaluation of the accelerations, the plane would have to pull (lambda's unclipped value <= 0). A resting
-sphere drifts off the plane by the scheme's error only (nothing pulls it back).
+one contact; M the scheme's own, armature + dt D under implicit damping), and at the end of each step its normal
+velocity is removed by the impulse along M^-1 j (the stages keep the normal acceleration zero, not the velocity at
+the step's end: semi-implicit Euler's drift let a pressed arm's sphere sink 1.5 radii in 2 s). The sphere leaves the
+plane where, at a step's last evaluation of the accelerations, the plane would have to pull (lambda's unclipped value
+<= 0): found at a step's end, not backed up to, so a run where a resting sphere lifts off (a two-link arm whose
+elbow folds on) is first order there whatever the scheme. Its position is not corrected: it stays on the plane to the
+scheme's error in position.
 
-One contact at a time: two spheres touching at once couple their impulses through M^-1 and need a complementarity
-solver (PGS or similar), beyond the lecture; core raises :class:`core.model.errors.ContactError` there. A floating
+One contact at a time: two spheres striking at once, or one striking while another rests, couple their impulses
+through M^-1 and need a complementarity solver (PGS or similar), beyond the lecture; core raises
+:class:`core.model.errors.ContactError` there (its rows n/a, saying so). More than :data:`MAX_EVENTS_PER_STEP` events
+in a step is a failure of the run. A floating
 base is not carried (its Jacobian and M have the base's six rows): the in-house engine declines those scenes.
 """
 
@@ -40,18 +48,21 @@ from simparity.core.articulated.chain_arrays import chain_arrays
 from simparity.core.articulated.chain_contact import ChainContactForces
 from simparity.core.articulated.recursive import Recursive
 from simparity.core.dynamics.time_loads import value_in_step
-from simparity.core.model.errors import ContactError
+from simparity.core.model.errors import ContactError, SimparityError
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 
 TIME_RTOL = 1e-13
 """[1] The backed-up instant of contact is found to this fraction of the step (Brent's xtol): its error moves the
 impact by |v| dt TIME_RTOL, below the rounding of a 1 m scene for dt <= 1e-2 s."""
 MAX_EVENTS_PER_STEP = 100
-"""Contact events one copy may have in one step; past it the run stops with :class:`ContactError` (a rebound faster
+"""Contact events one copy may have in one step; past it the run fails (a rebound faster
 than ``rest_speed`` takes a finite time to come back: only a scene whose rest speed is far below what one step can
 resolve gets near it)."""
 FREE = -1
 """The resting sphere of a copy that rests on none."""
+CLEARING = (1e-12, 1e-9, 1e-6, 1e-3, 0.1, 0.5)
+"""Fractions of a step tried, in turn, for the first at which a sphere leaving the plane (one just bounced, at a gap of
+rounding) is above it: the lower end of the bracket of its return within the step."""
 
 
 class RigidContact:
@@ -88,13 +99,14 @@ class RigidContact:
 
     def _lambda(self, q: np.ndarray, qdot: np.ndarray, a: np.ndarray, response: stepping.Response,
                 resting: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(j (n, B) of each copy's resting sphere, lambda unclipped (B,), 0 where none rests)."""
+        """(M^-1 j (n, B) of each copy's resting sphere, lambda unclipped (B,), 0 where none rests)."""
         on = resting != FREE
         sphere, copies = np.where(on, resting, 0), np.arange(q.shape[1])
         rows, biases = self._spheres.normal_kinematics(q, qdot)
         j, bias = rows[copies, sphere].T, biases[copies, sphere]
-        unclipped = -(np.einsum("ib,ib->b", j, a) + bias) / np.einsum("ib,ib->b", j, response(q, j))
-        return j, np.where(on, unclipped, 0.0)
+        moved = response(q, j)
+        unclipped = -(np.einsum("ib,ib->b", j, a) + bias) / np.einsum("ib,ib->b", j, moved)
+        return moved, np.where(on, unclipped, 0.0)
 
     def _constraint(self, q: np.ndarray, qdot: np.ndarray, a: np.ndarray, response: stepping.Response) -> np.ndarray:
         """The accelerations a (n, B) with each resting sphere's force lambda j added (module docstring)."""
@@ -102,9 +114,9 @@ class RigidContact:
         if np.all(resting == FREE):
             self._unclipped[self._active] = 0.0
             return a
-        j, unclipped = self._lambda(q, qdot, a, response, resting)
+        moved, unclipped = self._lambda(q, qdot, a, response, resting)
         self._unclipped[self._active] = unclipped
-        return a + response(q, j * np.maximum(unclipped, 0.0))
+        return a + moved * np.maximum(unclipped, 0.0)
 
     def start(self, copies: int) -> None:
         """Every copy off the plane's hold: a run of ``copies`` copies begins."""
@@ -114,65 +126,96 @@ class RigidContact:
         """One step of ``dt`` [s] from time t [s] of every copy, impacts and rests included."""
         self._active = slice(None)
         q_end, qdot_end = self._sized(dt)(t, q, qdot)
-        events = np.flatnonzero(np.any(self._candidates(q, qdot) & (self.gaps(q_end) < 0), axis=1))
+        events = np.flatnonzero(np.any(self._free_spheres() & (self.gaps(q_end) < 0), axis=1))
         for b in events:
             self._active = np.array([b])
             q_end[:, [b]], qdot_end[:, [b]] = self._events(t, q[:, [b]], qdot[:, [b]], dt, int(b))
         self._active = slice(None)
         self.resting[(self.resting != FREE) & (self._unclipped <= 0)] = FREE
-        return q_end, qdot_end
+        return q_end, self._held(q_end, qdot_end)
 
-    def _candidates(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
-        """(B, S) the spheres that may strike within a step from (q, qdot): not resting, and off the plane or moving
-        in (one inside and moving out, by a rebound or the rounding of a touch, is leaving)."""
-        spheres = np.arange(len(self._contact.spheres))
-        resting = self.resting[self._active][:, None] == spheres
-        return ~resting & ((self.gaps(q) >= 0) | (self.normal_velocities(q, qdot) <= 0))
+    def _held(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """qdot with each resting sphere's normal velocity removed by the impulse that does it (M^-1 j): the resting
+        force keeps the normal acceleration zero at the scheme's stages, not the normal velocity at the step's end
+        (semi-implicit Euler moves the joints with the new rates at the old Jacobian), so a resting sphere would
+        otherwise sink by a drift that grows with time."""
+        on = np.flatnonzero(self.resting != FREE)
+        if on.size == 0:
+            return qdot
+        j = self._spheres.normal_jacobians(q[:, on])[np.arange(on.size), self.resting[on]].T
+        response, inverse_mass = self._inverse_mass(q[:, on], j)
+        qdot = qdot.copy()
+        qdot[:, on] -= np.einsum("ib,ib->b", j, qdot[:, on]) / inverse_mass * response
+        return qdot
+
+    def _free_spheres(self) -> np.ndarray:
+        """(B, S) the spheres that may strike: every one but the sphere a copy rests on."""
+        return self.resting[self._active][:, None] != np.arange(len(self._contact.spheres))
 
     def _events(self, t: float, q: np.ndarray, qdot: np.ndarray, dt: float, b: int) -> tuple[np.ndarray, np.ndarray]:
         """Copy b's step of ``dt`` from t with its contact events (module docstring); q (n, 1), qdot (n, 1)."""
         remaining = dt
         for _ in range(MAX_EVENTS_PER_STEP):
-            candidates = self._candidates(q, qdot)[0]
+            candidates = self._free_spheres()[0]
             q_end, qdot_end = self._sized(remaining)(t, q, qdot)
             if not np.any(candidates & (self.gaps(q_end)[0] < 0)):
                 return q_end, qdot_end
             s = self._backed_up(t, q, qdot, remaining, candidates)
+            if s is None:  # a sphere leaving the plane is back inside before it clears it: it rests
+                qdot = self._respond(q, qdot, candidates, b, leaving=True)
+                continue
             if s > 0:
                 q, qdot = self._sized(s * remaining)(t, q, qdot)
                 t, remaining = t + s * remaining, remaining - s * remaining
             qdot = self._respond(q, qdot, candidates, b)
-        raise ContactError(f"copy {b} had more than {MAX_EVENTS_PER_STEP} contact events in one step of {dt:g} s at "
-                           f"t = {t:.9g} s (allowed: a rest_speed its steps resolve)")
+        raise SimparityError(f"copy {b} had more than {MAX_EVENTS_PER_STEP} contact events in one step of {dt:g} s "
+                             f"at t = {t:.9g} s (allowed: a rest_speed its steps resolve)")
 
-    def _backed_up(self, t: float, q: np.ndarray, qdot: np.ndarray, h: float, candidates: np.ndarray) -> float:
-        """The fraction s of the step ``h`` at which the first candidate sphere touches (0 when one is inside)."""
+    def _backed_up(self, t: float, q: np.ndarray, qdot: np.ndarray, h: float,
+                   candidates: np.ndarray) -> float | None:
+        """The fraction s of the step ``h`` at which the first candidate sphere strikes: 0 when one is on or inside
+        the plane moving in; else the first root of the lowest gap, bracketed from the first of :data:`CLEARING`
+        at which every sphere leaving the plane (one just bounced) has cleared it; None when one never does (it
+        comes back within the step before it clears the plane by rounding)."""
+        gaps, normal = self.gaps(q)[0][candidates], self.normal_velocities(q, qdot)[0][candidates]
+        if np.any((gaps <= 0) & (normal <= 0)):
+            return 0.0
+
         def lowest(s: float) -> float:
             return float(np.min(self.gaps(self._sized(s * h)(t, q, qdot)[0])[0][candidates]))
-        start = float(np.min(self.gaps(q)[0][candidates]))
-        return 0.0 if start <= 0 else float(brentq(lowest, 0.0, 1.0, xtol=TIME_RTOL))
+        start = 0.0
+        if np.any(gaps <= 0):
+            start = next((s for s in CLEARING if lowest(s) > 0), -1.0)
+            if start < 0:
+                return None
+        return float(brentq(lowest, start, 1.0, xtol=TIME_RTOL))
 
-    def _respond(self, q: np.ndarray, qdot: np.ndarray, candidates: np.ndarray, b: int) -> np.ndarray:
-        """qdot after the impulse of the touching candidate sphere at (q, qdot) (module docstring)."""
-        gaps = np.where(candidates, self.gaps(q)[0], np.inf)
-        sphere = int(np.argmin(gaps))
-        others = np.flatnonzero((gaps <= 0) & (np.arange(len(gaps)) != sphere))
-        if others.size or self.resting[b] != FREE:
-            second = int(others[0]) if others.size else int(self.resting[b])
-            names = self._contact.spheres
-            raise ContactError(f"spheres on {names[sphere].frame!r} and {names[second].frame!r} touch the plane at "
-                               "once: core's impulses resolve one contact at a time (several need a complementarity "
-                               "solver)")
+    def _respond(self, q: np.ndarray, qdot: np.ndarray, candidates: np.ndarray, b: int,
+                 leaving: bool = False) -> np.ndarray:
+        """qdot after the impulse of the striking candidate sphere at (q, qdot) (module docstring): the one on or
+        nearest the plane moving in (or, ``leaving``, the one leaving that comes back at once: put at rest)."""
+        gaps, normal = self.gaps(q)[0], self.normal_velocities(q, qdot)[0]
+        moving = (normal > 0) if leaving else (normal <= 0)
+        sphere = int(np.argmin(np.where(candidates & moving, gaps, np.inf)))
+        others = np.flatnonzero(candidates & (gaps <= 0) & (normal <= 0) & (np.arange(len(gaps)) != sphere))
+        spheres = self._contact.spheres
+        if others.size:
+            raise ContactError(f"spheres {sphere} and {int(others[0])} (on {spheres[sphere].frame!r}, "
+                               f"{spheres[int(others[0])].frame!r}) strike the plane at once: core's impulses resolve "
+                               "one contact at a time (several need a complementarity solver)")
+        if self.resting[b] != FREE:
+            rest = int(self.resting[b])
+            raise ContactError(f"sphere {sphere} (on {spheres[sphere].frame!r}) strikes the plane while sphere {rest} "
+                               f"(on {spheres[rest].frame!r}) rests on it: core's impulses resolve one contact at a "
+                               "time (several need a complementarity solver)")
         j = self._spheres.normal_jacobians(q)[0, sphere][:, None]
-        normal = float(j[:, 0] @ qdot[:, 0])
-        if normal > 0:
-            return qdot
+        speed = float(normal[sphere])
         e = self._contact.restitution
         assert e is not None
-        if -e * normal < self._contact.rest_speed:
+        if leaving or -e * speed < self._contact.rest_speed:
             e, self.resting[b] = 0.0, sphere
         response, inverse_mass = self._inverse_mass(q, j)
-        return qdot - (1.0 + e) * normal * response / inverse_mass
+        return qdot - (1.0 + e) * speed * response / inverse_mass
 
     def run(self, q0: np.ndarray, qdot0: np.ndarray, n_steps: int, dt: float
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
