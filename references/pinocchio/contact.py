@@ -40,6 +40,7 @@ import pinocchio as pin
 from simparity.core.model.errors import DivergedError
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.chain_contact import ChainContact, frame_index
+from simparity.references.pinocchio.mass import mass_matrix
 
 SOLVER_TOLERANCE = 1e-12
 """Pinocchio's ADMM stops when its complementarity and feasibility residuals (absolute and relative) are below this
@@ -145,8 +146,7 @@ class PlaneContact:
             models.append(pin.ConstraintModel(constraint))
             datas.append(pin.ConstraintData(data))
         jacobian = np.concatenate(rows)
-        upper = np.triu(pin.crba(m, d, configuration))
-        mass = upper + np.triu(upper, 1).T
+        mass = mass_matrix(m, d, configuration)
         mobility = np.linalg.solve(mass, jacobian.T)
         delassus, free = jacobian @ mobility, jacobian @ v_free
         posed, posed_free = frictionless(delassus, free)

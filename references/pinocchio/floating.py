@@ -26,6 +26,7 @@ from simparity.references.common.floating_base import (
     turned_mass,
 )
 from simparity.references.pinocchio.joint_dynamics import PinocchioJointDynamics
+from simparity.references.pinocchio.mass import mass_matrix
 
 
 class PinocchioFloatingDynamics(PinocchioJointDynamics):
@@ -62,8 +63,7 @@ class PinocchioFloatingDynamics(PinocchioJointDynamics):
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         out = np.empty((len(q), len(self._index), len(self._index)))
         for k, row in enumerate(q):
-            upper = np.triu(pin.crba(self.model, self.data, self.configuration(row)))
-            out[k] = (upper + np.triu(upper, 1).T)[np.ix_(self._index, self._index)]
+            out[k] = mass_matrix(self.model, self.data, self.configuration(row))[np.ix_(self._index, self._index)]
         return turned_mass(base_rotations(q), out, True, True)
 
     def _rnea(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:

@@ -44,6 +44,7 @@ from simparity.references.common.dynamics_mjcf import dynamics_mjcf
 from simparity.references.common.dynamics_urdf import chain_joint_names, dynamics_source, dynamics_urdf
 from simparity.references.common.quiet import captured_output
 from simparity.references.pinocchio.joints import configuration
+from simparity.references.pinocchio.mass import mass_matrix
 
 
 @dataclass(frozen=True)
@@ -182,8 +183,7 @@ class PinocchioJointDynamics(JointDynamicsModel):
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         out = np.empty((len(q), len(self.idx_v), len(self.idx_v)))
         for k, row in enumerate(q):
-            upper = np.triu(pin.crba(self.model, self.data, self._configuration(row)))
-            out[k] = (upper + np.triu(upper, 1).T)[np.ix_(self.idx_v, self.idx_v)]
+            out[k] = mass_matrix(self.model, self.data, self._configuration(row))[np.ix_(self.idx_v, self.idx_v)]
         return out
 
     def bias_forces(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:

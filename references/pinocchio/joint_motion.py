@@ -47,6 +47,7 @@ from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common import time_loads
 from simparity.references.pinocchio.contact import PlaneContact
 from simparity.references.pinocchio.joint_dynamics import ChainModel, chain_model
+from simparity.references.pinocchio.mass import mass_matrix
 
 SCHEMES = {
     "explicit_euler": "explicit_euler",
@@ -216,8 +217,7 @@ class PinocchioJointMotion(JointSimulation):
         kinetic, potential = np.empty(len(q)), np.empty(len(q))
         for k, (row, rates) in enumerate(zip(q, qdot)):
             configuration, v = self._chain.configuration(row), self._chain.velocity(rates)
-            upper = np.triu(pin.crba(self._model, self._data, configuration))
-            kinetic[k] = 0.5 * v @ (upper + np.triu(upper, 1).T) @ v
+            kinetic[k] = 0.5 * v @ mass_matrix(self._model, self._data, configuration) @ v
             potential[k] = pin.computePotentialEnergy(self._model, self._data, configuration)
         return kinetic, potential
 
