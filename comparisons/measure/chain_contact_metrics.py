@@ -23,7 +23,8 @@ another's trajectory; each is held to what any correct contact must give:
 - ``rest_equilibrium_error``: at rest (also every joint's acceleration below :data:`REST_ACCELERATION` g / reach) the
   engine's contact forces, gravity, the applied joint forces and the damping balance on every joint and on a floating
   base, by Pinocchio's model of the file (:class:`references.pinocchio.statics.PinocchioStatics`: an independent
-  model, none of the engine's): |g(q) - sum_s J_s^T f_s - tau + D qdot| row by row, a force over m |g|, a moment over
+  model, none of the engine's): |g(q) - sum_s J_s^T f_s - tau + D qdot| row by row (tau the constant and the timed
+  torque at that sample's time), a force over m |g|, a moment over
   m |g| reach, the largest. The fixed-base arm's closed form f = J^-T (g - tau) is this balance.
 - ``rest_acceleration_max``: where the scene says from when its robot rests (``[contact] rest_after``), the largest
   acceleration of any joint (over g / reach; a slide's over g) or of a floating base (linear over g, angular over
@@ -38,7 +39,7 @@ import math
 import numpy as np
 
 from simparity.comparisons.measure.joint_motion_metrics import (
-    CHAIN_CONTACT_METRICS, OwnReading, energy_budget, reach, work_done,
+    CHAIN_CONTACT_METRICS, OwnReading, applied_torque, energy_budget, reach, work_done,
 )
 from simparity.comparisons.common.error_text import error_text
 from simparity.comparisons.measure.rows import Measured
@@ -251,7 +252,8 @@ def _equilibrium(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarr
     n = scene.chain.n_joints
     held = np.zeros_like(balance)  # what holds the chain: the applied joint forces less the damping (none on a base)
     damping = np.array([j.damping for j in scene.chain.joints])
-    held[:, balance.shape[1] - n:] = np.asarray(scene.torque) - damping * qdot[:, qdot.shape[1] - n:]
+    torque = applied_torque(scene, np.asarray(traj.times, dtype=float)[index[-1:]])  # the timed one at that time
+    held[:, balance.shape[1] - n:] = torque - damping * qdot[:, qdot.shape[1] - n:]
     scale = weight * reach(scene.chain) ** (1 - scene.chain.length_powers)
     worst = float((np.abs(balance - held) / scale).max())
     return Measured(worst, "1", note=("at rest: |g(q) - sum J^T f - tau + D qdot| by Pinocchio's model, a force over "

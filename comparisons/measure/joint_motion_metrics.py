@@ -208,6 +208,15 @@ def read_own(sim: JointSimulation, traj: JointTrajectory) -> OwnReading:
                       end_effector.reshape(samples, copies, 3))
 
 
+def applied_torque(scene: JointMotionScene, times: np.ndarray) -> np.ndarray:
+    """(T, n) [N m or N] the joints' applied forces at ``times`` (T,) [s]: the constant torque and the timed one at
+    each time, by the references' evaluation (none of core's code)."""
+    torque = np.broadcast_to(np.asarray(scene.torque, dtype=float), (len(times), scene.chain.n_joints))
+    if scene.timed_torque is not None:
+        torque = torque + np.array([time_loads.at(scene.timed_torque, t) for t in times])
+    return torque
+
+
 def _work(scene: JointMotionScene, traj: JointTrajectory) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(W, W_in, W_floor), each (T, B) [J]: the work done on the chain from t = 0 by the applied forces (the constant
     torque and the timed one at each sample's time) less the damping (the power qdot^T tau - qdot^T D qdot integrated by the composite Simpson rule over every step, fourth
@@ -216,9 +225,7 @@ def _work(scene: JointMotionScene, traj: JointTrajectory) -> tuple[np.ndarray, n
     overestimates W's quadrature error some 15 times; 0 between the coarse samples' points, taken as its running
     maximum)."""
     damping = np.array([j.damping for j in scene.chain.joints])
-    torque = np.broadcast_to(np.asarray(scene.torque, dtype=float), (len(traj.times), scene.chain.n_joints))
-    if scene.timed_torque is not None:  # the references' evaluation at each sample's time (none of core's code)
-        torque = torque + np.array([time_loads.at(scene.timed_torque, t) for t in traj.times])
+    torque = applied_torque(scene, np.asarray(traj.times, dtype=float))
     rates = traj.qdot[..., scene.chain.base_dofs:]  # the joints' (a floating base takes no applied force)
     drive = np.einsum("tbi,ti->tb", rates, torque)
     power = drive - np.einsum("tbi,i,tbi->tb", rates, damping, rates)

@@ -130,7 +130,8 @@ class LateImpulses(RigidContact):
     """Impulses without time backed up: applied at the end of the step in which a sphere crossed the plane."""
 
     def _backed_up(self, t, q, qdot, h, candidates):
-        return 1.0
+        s, sphere = super()._backed_up(t, q, qdot, h, candidates)
+        return (1.0 if s > 0 else s), sphere
 
 
 class NoBackup(CoreJointMotion):
@@ -172,8 +173,9 @@ def _run(tmp_path, monkeypatch, capsys, plugin: str, scene: str = "solo12-drop-s
     ("ImpulsesAsForcesEngine", "pinocchio-impulses-as-forces", "rest_weight_error", "solo12-drop-stand"),
     ("BouncingEngine", "pinocchio-bouncing", "rest_acceleration_max", "arm-strike-press"),
     ("DefaultFrictionEngine", "pybullet-default-friction", "friction_cone_violation_max", "arm-strike-press"),
+    # (not on pendulum-strike: a plastic strike ends at rest on the plane, where a late impulse is put back at every
+    # sample, so the missing back-up is not observable there)
     ("NoBackupEngine", "core-no-backup", "joint_angle_error_max", "pendulum-bounce"),
-    ("NoBackupEngine", "core-no-backup", "joint_angle_error_max", "pendulum-strike"),
 ])
 def test_a_planted_contact_bug_is_caught_naming_the_engine(tmp_path, monkeypatch, capsys, plugin, name, metric,
                                                            scene):

@@ -86,7 +86,7 @@ def test_an_impulse_reverses_the_normal_velocity_through_the_inverse_inertia():
     contact.start(1)
     normal_before = contact.normal_velocities(q[:, None], qdot[:, None])[0, 1]
     assert normal_before < -0.1  # the tip approaches
-    after = contact._respond(q[:, None], qdot[:, None], np.array([False, True]), 0)[:, 0]
+    after = contact._respond(q[:, None], qdot[:, None], np.array([False, True]), 1, 0)[:, 0]
     normal_after = contact.normal_velocities(q[:, None], after[:, None])[0, 1]
     assert normal_after == pytest.approx(-RESTITUTION * normal_before, rel=IMPULSE_RTOL)
     mass = Recursive(chain_arrays(scene.chain), np.zeros(3)).mass_matrix(q[:, None])[:, :, 0]  # CRBA, not ABA
@@ -104,7 +104,7 @@ def test_a_slow_rebound_is_plastic_and_the_sphere_rests():
     contact = RigidContact(scene, "rk4")
     contact.start(1)
     slow = 1e-3 * qdot  # a rebound of 0.5 of ~1 mm/s: below the default rest speed (1 mm/s)
-    after = contact._respond(q[:, None], slow[:, None], np.array([False, True]), 0)
+    after = contact._respond(q[:, None], slow[:, None], np.array([False, True]), 1, 0)
     assert contact.normal_velocities(q[:, None], after)[0, 1] == pytest.approx(0.0, abs=1e-16)
     assert contact.resting[0] == 1
 
@@ -190,9 +190,9 @@ def test_a_resting_sphere_does_not_sink_under_semi_implicit_euler():
     dt = 0.004
     traj = CoreJointMotion(scene, "semi_implicit_euler", dt).run(scene.n_steps(dt))
     gaps = RigidContact(scene, "semi_implicit_euler").gaps(np.ascontiguousarray(traj.q[:, 0].T))
-    # Its normal velocity is removed at each step's end: it stays within the step's first-order error in position
-    # (0.045 of the radius measured); without that it sank 1.5 radii in the 2 s
-    assert gaps.min() > -0.1 * scene.contact.spheres[0].radius
+    # Put back on the plane and its normal velocity removed at each step's end: what is left is the stages' drift
+    # within one step (4e-7 of the radius here); without that it sank 1.5 radii in the 2 s
+    assert gaps.min() > -1e-3 * scene.contact.spheres[0].radius
 
 
 @pytest.mark.slow
