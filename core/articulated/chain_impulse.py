@@ -95,9 +95,13 @@ class RigidContact:
         """(B, S) [m/s] each sphere's velocity along the plane's normal (negative: approaching)."""
         return np.einsum("bsn,nb->bs", self._spheres.normal_jacobians(q), qdot)
 
+    def _response(self, q: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """(n, B) M^-1 j of the true M (armature included) at q (n, B) for j (n, B)."""
+        return self._unforced.forward_dynamics(q, np.zeros_like(j), j)
+
     def _inverse_mass(self, q: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(M^-1 j (n, B), j^T M^-1 j (B,)) of the true M (armature included) at q for j (n, B)."""
-        response = self._unforced.forward_dynamics(q, np.zeros_like(j), j)
+        """(M^-1 j (n, B), j^T M^-1 j (B,)) of the true M at q for j (n, B)."""
+        response = self._response(q, j)
         return response, np.einsum("ib,ib->b", j, response)
 
     def _lambda(self, q: np.ndarray, qdot: np.ndarray, a: np.ndarray, response: stepping.Response,
@@ -256,8 +260,7 @@ class RigidContact:
         if scene.timed_torque is not None:
             tau = tau + np.stack([value_in_step(scene.timed_torque, t, t) for t in times], axis=1)
         a = self._dynamics.forward_dynamics(q_t, qdot_t, tau)
-        _, unclipped = self._lambda(q_t, qdot_t, a, lambda qq, f: self._unforced.forward_dynamics(
-            qq, np.zeros_like(f), f), resting)
+        _, unclipped = self._lambda(q_t, qdot_t, a, self._response, resting)
         out = np.zeros((len(times), len(self._contact.spheres), 3))
         on = np.flatnonzero(resting != FREE)
         out[on, resting[on]] = np.maximum(unclipped[on], 0.0)[:, None] * self._contact.plane.normal_world

@@ -20,6 +20,9 @@ from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 from simparity.core.rotations import quat_wxyz_to_matrix
 
+OFF_THE_RUN = "core reports a rigid contact's forces for states of its own run only"
+"""Why a rigid contact's forces are not reported at a state: rest is the run's history, not a function of the state."""
+
 
 class CoreJointMotion(JointSimulation):
     """A chain stepped by one of core's schemes at a fixed step, every copy of the scene in one batch."""
@@ -132,15 +135,15 @@ class CoreJointMotion(JointSimulation):
         """(B,) the sphere the last run rested on at each state q (B, n) at ``times`` (B,), found among that
         sample's copies by its joint values; NotImplementedError for a state off the run."""
         if self._rigid_run is None:
-            raise NotImplementedError("core reports a rigid contact's forces for states of its own run only")
+            raise NotImplementedError(OFF_THE_RUN)
         run_q, resting = self._rigid_run
         samples = np.rint(times / self._dt).astype(int)
         if np.any((samples < 0) | (samples >= len(run_q))):
-            raise NotImplementedError("core reports a rigid contact's forces for states of its own run only")
+            raise NotImplementedError(OFF_THE_RUN)
         off = np.abs(run_q[samples] - q[:, None]).max(axis=2)  # (B, copies)
         copy = np.argmin(off, axis=1)
         if np.any(off[np.arange(len(q)), copy] > 0):
-            raise NotImplementedError("core reports a rigid contact's forces for states of its own run only")
+            raise NotImplementedError(OFF_THE_RUN)
         return resting[samples, copy]
 
     def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:

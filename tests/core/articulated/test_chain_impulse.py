@@ -31,6 +31,19 @@ IMPULSE_RTOL = 1e-12
 """[1] Newton's law and the energy taken, relative: rounding of one ABA, one CRBA and a linear solve (~1e-15) on a
 two-link arm, with margin."""
 RESTITUTION = 0.5
+REMOVED_RATE = 1e-16
+"""[m/s] A plastic rebound's normal velocity after the impulse: rounding of Newton's law on ~1 mm/s."""
+BACKED_UP = 1e-12
+"""[m] The deepest a backed-up sphere ends a step: Brent's xtol 1e-13 of the step at ~1 m/s, where a step past the
+impact would leave it ~v dt ~ 2 mm inside."""
+RESTING_FORCE_RTOL = 1e-12
+"""[1] The resting force against m g l_c / L: rounding of one ABA and one normal Jacobian."""
+RETURN_FOUND = 1e-8
+"""[m] A bounced sphere coming back within a step: nothing deeper than RK4's drift of a resting sphere (~1e-7 of the
+3 cm radius), where a missed return sank it by centimetres."""
+HELD_SHARE = 1e-3
+"""[1 of the radius] Semi-implicit Euler's resting sphere put back on the plane each step: what is left is the
+stages' drift within one step (4e-7 of the radius measured); without it it sank 1.5 radii in 2 s."""
 
 
 def _arm(**contact) -> object:
@@ -105,7 +118,7 @@ def test_a_slow_rebound_is_plastic_and_the_sphere_rests():
     contact.start(1)
     slow = 1e-3 * qdot  # a rebound of 0.5 of ~1 mm/s: below the default rest speed (1 mm/s)
     after = contact._respond(q[:, None], slow[:, None], np.array([False, True]), 1, 0)
-    assert contact.normal_velocities(q[:, None], after)[0, 1] == pytest.approx(0.0, abs=1e-16)
+    assert contact.normal_velocities(q[:, None], after)[0, 1] == pytest.approx(0.0, abs=REMOVED_RATE)
     assert contact.resting[0] == 1
 
 
@@ -120,9 +133,7 @@ def test_time_is_backed_up_so_no_sphere_ends_a_step_inside(scheme):
     traj = sim.run(scene.n_steps(0.002))
     contact = RigidContact(scene, scheme)
     gaps = contact.gaps(np.ascontiguousarray(traj.q[:, 0].T))
-    # Each impact is at the backed-up instant (Brent's xtol 1e-13 of the step at ~1 m/s): the sphere is never found
-    # inside by more than that, where a step past the impact would leave it ~v dt ~ 2 mm inside.
-    assert gaps.min() > -1e-12
+    assert gaps.min() > -BACKED_UP
     assert np.count_nonzero(np.diff(np.sign(traj.qdot[:, 0, 0])) < 0) >= 5  # it bounced
 
 
@@ -133,7 +144,7 @@ def test_a_resting_pendulum_is_held_by_the_force_that_balances_gravity():
     force = sim.contact_forces(traj.q[-1:, 0], traj.qdot[-1:, 0], traj.times[-1:])[0, 0]
     # Moments about the hinge of a link lying at angle theta: m g l_c cos(theta) = f L cos(theta) (a vertical force
     # at the tip, L = 0.5 m, the centre of mass at l_c = 0.25 m, m = 1 kg): f = m g l_c / L.
-    np.testing.assert_allclose(force, [0.0, 0.0, 1.0 * 9.81 * 0.25 / 0.5], rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(force, [0.0, 0.0, 1.0 * 9.81 * 0.25 / 0.5], rtol=RESTING_FORCE_RTOL, atol=RESTING_FORCE_RTOL)
     first = sim.contact_forces(traj.q[:1, 0], traj.qdot[:1, 0], traj.times[:1])
     assert not first.any()  # released in the air: no force
 
@@ -179,9 +190,7 @@ def test_a_sphere_that_bounces_and_comes_back_within_a_step_is_caught():
     sim = CoreJointMotion(scene, "rk4", dt)
     traj = sim.run(scene.n_steps(dt))
     gaps = RigidContact(scene, "rk4").gaps(np.ascontiguousarray(traj.q[:, 0].T))
-    # Every return is found and backed up to: nothing deeper than the resting sphere's drift in position (RK4's
-    # error, ~1e-7 of the 3 cm radius here), where a missed return sank it by centimetres
-    assert gaps.min() > -1e-8
+    assert gaps.min() > -RETURN_FOUND
     assert sim._rigid_run[1][-1, 0] == 0  # it ends resting on its one sphere
 
 
@@ -190,9 +199,7 @@ def test_a_resting_sphere_does_not_sink_under_semi_implicit_euler():
     dt = 0.004
     traj = CoreJointMotion(scene, "semi_implicit_euler", dt).run(scene.n_steps(dt))
     gaps = RigidContact(scene, "semi_implicit_euler").gaps(np.ascontiguousarray(traj.q[:, 0].T))
-    # Put back on the plane and its normal velocity removed at each step's end: what is left is the stages' drift
-    # within one step (4e-7 of the radius here); without that it sank 1.5 radii in the 2 s
-    assert gaps.min() > -1e-3 * scene.contact.spheres[0].radius
+    assert gaps.min() > -HELD_SHARE * scene.contact.spheres[0].radius
 
 
 @pytest.mark.slow
