@@ -14,11 +14,9 @@ another's trajectory; each is held to what any correct contact must give:
   on a sphere off the plane, |f| gap / radius, relative to the robot's weight m |g|.
 - ``friction_cone_violation_max``: the frictionless plane's tangential force |f - (f.N) N|, relative to the weight.
 - ``contact_energy_gain_max``: contact and damping only take energy (a soft contact stores some while it is
-  compressed, and gives back at most that), so what the sampled intervals a contact may act in (:func:`_near_contact`)
-  change of the mechanical energy less the applied forces' work, summed into C(t), never exceeds its value at an
-  earlier instant with no sphere touching (the start counts: a sphere starts at most 1e-9 m inside): max_t (C(t) -
-  min over earlier contact-free s of C(s))^+, relative to the energy the motion can have (:func:`energy_budget`). The
-  intervals far from the plane are left out: the scheme's own energy error in free flight is not the contact's.
+  compressed, and gives back at most that), so the mechanical energy never exceeds what it was at any earlier instant
+  with no sphere touching (the start counts: a sphere starts at most 1e-9 m inside), less the applied forces' work: max_t (E(t) - W(t) - min over earlier contact-free s of
+  (E(s) - W(s)))^+, relative to the energy the motion can have (:func:`energy_budget`).
 - ``rest_weight_error``: at rest (the centre of mass's acceleration over the last sampled interval below
   :data:`REST_ACCELERATION` of g, from the engine's own momentum) the plane carries the weight: |sum f + m g| / m |g|
   at the last sample.
@@ -66,12 +64,6 @@ SAMPLE_TIME_RTOL = 1e-9
 """[1] A sample at k dt is at or after ``rest_after`` when its time is within this of it (k dt rounds)."""
 TOUCHING = 0.0
 """[m] A sphere touches the plane when its gap is at most this (the scene's radius; margins are switched off)."""
-TRAVEL_MARGIN = 2.0
-"""[1] A sampled interval may hold a contact when a sphere's gap at either end is within this many times the largest
-distance a sphere of the copy moves in one interval of the run: reaching the plane from a larger gap within one
-interval would take twice the run's fastest sphere speed, which a resolved run does not reach in one interval (a
-rigid bounce between two samples is inside the margin: its sphere came down from a gap it covered in under one
-interval)."""
 
 
 def _states(traj: JointTrajectory, index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -268,32 +260,15 @@ def _equilibrium(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarr
                                       "m |g|, a moment over m |g| reach"))
 
 
-def _near_contact(centres: np.ndarray, gaps: np.ndarray) -> np.ndarray:
-    """(S - 1, B) bool: a sphere may touch the plane during each sampled interval: its gap at either end is within
-    :data:`TRAVEL_MARGIN` times the farthest any sphere of that copy moves in one interval of the run (a sphere that
-    reaches the plane between two samples moved its gap in under one interval, at a speed the run shows elsewhere).
-
-    ``centres`` (S, B, spheres, 3) [m], ``gaps`` (S, B, spheres) [m]."""
-    travel = np.linalg.norm(np.diff(centres, axis=0), axis=-1).max(axis=(0, 2), initial=0.0)  # (B,)
-    near = gaps <= TRAVEL_MARGIN * travel[None, :, None]
-    return np.asarray((near[:-1] | near[1:]).any(axis=2), dtype=bool)
-
-
-def _energy_gain(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading, centres: np.ndarray,
-                 gaps: np.ndarray) -> Measured:
+def _energy_gain(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading, gaps: np.ndarray) -> Measured:
     energy = own.kinetic + own.potential - work_done(scene, traj)[own.index]
-    # only what changes across an interval a contact may act in counts: the scheme's own energy error in free flight
-    # is not the contact's (semi-implicit Euler's pendulum that never reached its plane gained 0.0189 at 4 ms)
-    step = np.where(_near_contact(centres, gaps), np.diff(energy, axis=0), 0.0)
-    contact_energy = np.concatenate([np.zeros_like(energy[:1]), np.cumsum(step, axis=0)])  # (S, B)
     free = np.array((gaps > TOUCHING).all(axis=2), dtype=bool)  # (S, B): no sphere touching, no energy stored in a contact
     free[0] = True  # the start: every sphere outside or touching within the loader's 1e-9 m, nothing stored
-    baseline = np.minimum.accumulate(np.where(free, contact_energy, np.inf), axis=0)
-    gain = float(np.max(np.where(np.isfinite(baseline), contact_energy - baseline, 0.0)))
+    baseline = np.minimum.accumulate(np.where(free, energy, np.inf), axis=0)
+    gain = float(np.max(np.where(np.isfinite(baseline), energy - baseline, 0.0)))
     scale = float(energy_budget(scene, traj, own).max())
     return Measured(max(gain, 0.0) / scale, "1",
-                    note=("mechanical energy made across the intervals a contact may act in, above its value at an "
-                          "earlier contact-free instant, over the energy budget"))
+                    note="mechanical energy above its value at an earlier contact-free instant, over the energy budget")
 
 
 def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory,
@@ -303,8 +278,7 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
     assert contact is not None
     index = own.index
     try:
-        centres = _centres(sim, traj, index, len(contact.spheres))  # (S, B, spheres, 3)
-        gaps = contact.gaps(centres)  # (S, B, spheres)
+        gaps = contact.gaps(_centres(sim, traj, index, len(contact.spheres)))  # (S, B, spheres)
     except NotImplementedError as err:
         return {m: Measured(math.nan, "1", unmeasurable=str(err)) for m in CHAIN_CONTACT_METRICS}
     out = {
@@ -312,7 +286,7 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
         REST_ACCELERATION_MAX: _rest_acceleration(scene, traj, index),
         CONTACT_PENETRATION_MAX: Measured(float(np.maximum(-gaps / contact.radii, 0.0).max()), "1",
                                           note="deepest sinking over the sphere's radius"),
-        CONTACT_ENERGY_GAIN_MAX: _energy_gain(scene, traj, own, centres, gaps),
+        CONTACT_ENERGY_GAIN_MAX: _energy_gain(scene, traj, own, gaps),
     }
     mass = scene.chain.mass  # as the file declares it: every importer reads the same (model parity, issue #45)
     weight = mass * float(np.linalg.norm(scene.gravity_world)) if scene.gravity_world is not None else 0.0

@@ -635,7 +635,11 @@ FLOATING_BASE_WHY = (
     "with flags=1 it corrupted the process's heap (malloc(): invalid size; NaNs in bullet3 issues 3149 and 4045), "
     "and its forward dynamics is a step of its simulator, which turns the base during the step "
     "(docs/floating-bases.md, PyBullet 3.2.7)")
-"""Why PyBullet's rows are n/a on a floating-base chain (pinned by tests/references/test_floating_base_conventions.py)."""
+"""Why PyBullet's joint-dynamics rows are n/a on a floating-base chain (pinned by
+tests/references/test_floating_base_conventions.py); its motion is stepped (:mod:`references.pybullet.floating_body`)."""
+FLOATING_MJCF_WHY = ("a floating base is stepped from a URDF only: an MJCF chain is loaded as PyBullet's loadMJCF "
+                     "builds it, whose free root this adapter does not convert")
+"""Why PyBullet's motion rows are n/a on a floating-base chain read from an MJCF file."""
 
 
 @derives_own_inputs
@@ -665,7 +669,11 @@ class PybulletEngine(UrdfChains, Engine):
         :mod:`references.pybullet.joint_motion`). Its IK is damped least squares (``-nullspace``: with a null-space
         rest pose)."""
         if isinstance(scene, JointMotionScene):
-            return "semi_implicit_euler" if integrator in self.joint_motion_integrators() else ""
+            if integrator not in self.joint_motion_integrators():
+                return ""
+            # a free multibody's base is its INERTIAL frame, stepped from its centre of mass's new velocity and turned
+            # by the exponential map: another first-order discretisation than the joints' semi-implicit Euler
+            return "engine_euler" if scene.chain.floating_base else "semi_implicit_euler"
         if isinstance(scene, IKScene):
             return ("damped_least_squares+nullspace" if integrator.endswith("nullspace") else
                     "damped_least_squares" if integrator in pybullet_ik.SOLVERS else "")
@@ -715,16 +723,16 @@ class PybulletEngine(UrdfChains, Engine):
         return ("euler",)
 
     def supports_joint_motion(self, scene: JointMotionScene, integrator: str) -> Support:
+        """Bullet's own step; a floating base as a free multibody (:mod:`references.pybullet.floating_body`: its
+        stepping is its simulator's, judged by truths that need no engine, not by the rounding-level dynamics
+        :data:`FLOATING_BASE_WHY` refuses), from a URDF only."""
         named = super().supports_joint_motion(scene, integrator)
-        if named.ok and scene.chain.floating_base:
-            return Support.no(FLOATING_BASE_WHY)
+        if named.ok and scene.chain.floating_base and scene.chain.mjcf_path is not None:
+            return Support.no(FLOATING_MJCF_WHY)
         return _dynamics_support(scene.chain) if named.ok else named
 
     def chain_contact(self, scene: JointMotionScene) -> Support:
-        """Bullet's multibody contact of sphere shapes on the links (:mod:`references.pybullet.chain_contact`), on a
-        fixed base; a floating base is n/a (:data:`FLOATING_BASE_WHY`)."""
-        if scene.chain.floating_base:
-            return Support.no(FLOATING_BASE_WHY)
+        """Bullet's multibody contact of sphere shapes on the links (:mod:`references.pybullet.chain_contact`)."""
         return contact_params.plastic_only(scene, "PyBullet's spheres are set with restitution 0 here (one Moreau-Jean impulse per "
                                    "step, as the Pinocchio loop)")
 

@@ -1,9 +1,9 @@
-"""A fixed-base chain's spheres meeting the scene's plane in PyBullet (issue #46): Bullet's own multibody contact.
+"""A chain's spheres meeting the scene's plane in PyBullet (issue #46): Bullet's own multibody contact.
 
 What PyBullet is given, beside :mod:`references.pybullet.joint_motion`'s stepped body (every default there):
 
 - Each sphere is a ``<collision>`` sphere of the scene's radius added to the link of its frame in the chain's dynamics
-  URDF (a chain joint's frame is its child link's, the end effector its link, the base link the fixed base), at its
+  URDF (a chain joint's frame is its child link's, the end effector its link, the base link the base), at its
   centre; ``URDF_USE_INERTIA_FROM_FILE`` keeps the file's inertia (the spheres weigh nothing).
 - The plane is the free bodies' static ``GEOM_PLANE`` multibody (:func:`references.pybullet.adapter.static_plane`).
   Collision filters: the sphere links collide with the plane only (the adapter's body and plane groups), every other
@@ -24,7 +24,8 @@ What PyBullet is given, beside :mod:`references.pybullet.joint_motion`'s stepped
   forces along their directions (0 here), summed per sphere (a point is
   the sphere's whose centre, placed by PyBullet, is nearest to it). It is the force of the step from that state, as
   Pinocchio's (:mod:`references.pinocchio.contact`).
-- A floating base is n/a (its dynamics are not comparable: :data:`references.pybullet.adapter.FLOATING_BASE_WHY`).
+- On a floating base the body is free (``useFixedBase`` False) and its base's state converted
+  (:mod:`references.pybullet.floating_body`); a sphere on the base link rides on the base link's frame.
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.chain_contact import ChainContact, frame_index
 from simparity.references.common.conventions import fmt, quat_wxyz_to_matrix, wxyz_from_xyzw
 from simparity.references.pybullet.adapter import BODY_GROUP, PLANE_GROUP, static_plane
+from simparity.references.pybullet.floating_body import BaseInertial
 from simparity.references.pybullet.quiet import pybullet
 
 SOLVER = dict(contactERP=0.0, contactSlop=0.0, numSolverIterations=100, solverResidualThreshold=0.0, globalCFM=0.0,
@@ -83,11 +85,32 @@ def link_index(body: int, client: int, name: str) -> int:
     raise KeyError(name)
 
 
+def link_frame(client: int, body: int, link: int, base: BaseInertial | None) -> tuple[np.ndarray, np.ndarray]:
+    """(R (3, 3), origin (3,) [m]) of ``body``'s URDF link frame ``link`` in the world now, in double: a link's from
+    its inertial frame (``getLinkState``'s centre of mass and orientation) moved back by ``getDynamicsInfo``'s local
+    inertial pose (``worldLinkFramePosition`` is float32); the base's (-1) from the floating base's state
+    (:class:`BaseInertial`), or the fixed base's pose (its inertial frame is its link frame: the dynamics URDF gives a
+    fixed base an explicit zero inertial)."""
+    if link < 0:
+        if base is not None:
+            q, _ = base.read(client, body)
+            return quat_wxyz_to_matrix(q[3:7]), q[:3]
+        position, orientation = pybullet.getBasePositionAndOrientation(body, physicsClientId=client)
+        return quat_wxyz_to_matrix(wxyz_from_xyzw(np.array(orientation))), np.asarray(position)
+    state = pybullet.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=client)
+    local = pybullet.getDynamicsInfo(body, link, physicsClientId=client)
+    inertial = quat_wxyz_to_matrix(wxyz_from_xyzw(np.array(state[1])))
+    local_rotation = quat_wxyz_to_matrix(wxyz_from_xyzw(np.array(local[4])))
+    rotation = inertial @ local_rotation.T
+    return rotation, np.asarray(state[0]) - rotation @ np.asarray(local[3])
+
+
 class PlaneContact:
     """The plane and the spheres' links of a world's bodies (the module docstring: shapes, filters, solve)."""
 
-    def __init__(self, client: int, bodies: list[int], chain: Chain, contact: ChainContact, urdf_text: str) -> None:
-        self._client, self._contact = client, contact
+    def __init__(self, client: int, bodies: list[int], chain: Chain, contact: ChainContact, urdf_text: str,
+                 base: BaseInertial | None = None) -> None:
+        self._client, self._contact, self._base = client, contact, base
         names = sphere_links(chain, contact, urdf_text)
         self.links = [link_index(bodies[0], client, name) for name in names]
         self._points = np.array([s.centre_xyz for s in contact.spheres], dtype=float)
@@ -99,23 +122,10 @@ class PlaneContact:
         pybullet.setPhysicsEngineParameter(**SOLVER, physicsClientId=client)
 
     def centres(self, body: int) -> np.ndarray:
-        """(S, 3) [m] the spheres' centres of ``body`` as PyBullet places its links now: each link's frame from its
-        inertial frame (``getLinkState``'s centre of mass and orientation, double) moved back by ``getDynamicsInfo``'s
-        local inertial pose; the fixed base's frame is the world's."""
-        c = self._client
+        """(S, 3) [m] the spheres' centres of ``body`` as PyBullet places its links now (:func:`link_frame`)."""
         out = np.empty((len(self.links), 3))
         for k, (link, point) in enumerate(zip(self.links, self._points)):
-            if link < 0:
-                position, orientation = pybullet.getBasePositionAndOrientation(body, physicsClientId=c)
-                rotation = quat_wxyz_to_matrix(wxyz_from_xyzw(np.array(orientation)))
-                out[k] = np.asarray(position) + rotation @ point
-                continue
-            state = pybullet.getLinkState(body, link, computeForwardKinematics=True, physicsClientId=c)
-            local = pybullet.getDynamicsInfo(body, link, physicsClientId=c)
-            inertial = quat_wxyz_to_matrix(wxyz_from_xyzw(np.array(state[1])))
-            local_rotation = quat_wxyz_to_matrix(wxyz_from_xyzw(np.array(local[4])))
-            rotation = inertial @ local_rotation.T
-            origin = np.asarray(state[0]) - rotation @ np.asarray(local[3])
+            rotation, origin = link_frame(self._client, body, link, self._base)
             out[k] = origin + rotation @ point
         return out
 

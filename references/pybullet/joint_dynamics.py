@@ -74,6 +74,7 @@ from simparity.references.common.dynamics_urdf import chain_joint_names, dynamic
 from simparity.references.common.quiet import captured_output
 from simparity.references.pybullet.adapter import _Client, _load_mjcf, _load_urdf, pybullet_mjcf
 from simparity.references.pybullet.chain_contact import with_spheres
+from simparity.references.pybullet.floating_body import BaseInertial
 from simparity.references.pybullet.quiet import pybullet
 
 STEP = 1.0  # [s]
@@ -157,8 +158,9 @@ class ChainBodies:
             if contact is not None:
                 text = with_spheres(text, chain, contact)
             self.urdf_text = text
-            self.bodies = [_load_urdf(c, text, useFixedBase=True) for _ in range(copies)]
+            self.bodies = [_load_urdf(c, text, useFixedBase=not chain.floating_base) for _ in range(copies)]
         self.body = b = self.bodies[0]
+        self.base = BaseInertial.of(c, b) if chain.floating_base else None
         info = [pybullet.getJointInfo(b, j, physicsClientId=c)
                 for j in range(pybullet.getNumJoints(b, physicsClientId=c))]
         index = {i[1].decode(): i[0] for i in info}
@@ -200,10 +202,23 @@ class ChainBodies:
                          for row in q])
 
     def reset(self, q: np.ndarray, qdot: np.ndarray, copy: int = 0) -> None:
-        """Put the chain's joints of body ``copy`` at ``q``, ``qdot`` (n,)."""
+        """Put body ``copy`` at the state ``q``, ``qdot`` ((n,) each; a floating base's (7 + n,) and (6 + n,), the
+        project's convention: :class:`BaseInertial`)."""
+        if self.base is not None:
+            self.base.put(self.client, self.bodies[copy], np.asarray(q, dtype=float), np.asarray(qdot, dtype=float))
+            q, qdot = q[7:], qdot[6:]
         for j, position, velocity in zip(self.joints, q, qdot):
             pybullet.resetJointState(self.bodies[copy], j, float(position), float(velocity),
                                      physicsClientId=self.client)
+
+    def state(self, copy: int = 0) -> tuple[np.ndarray, np.ndarray]:
+        """(q, qdot) of body ``copy`` now, as :meth:`reset` takes them."""
+        states = pybullet.getJointStates(self.bodies[copy], self.joints, physicsClientId=self.client)
+        q, qdot = np.array([s[0] for s in states]), np.array([s[1] for s in states])
+        if self.base is None:
+            return q, qdot
+        base_q, base_qdot = self.base.read(self.client, self.bodies[copy])
+        return np.concatenate([base_q, q]), np.concatenate([base_qdot, qdot])
 
 
 def _rows(*arrays: np.ndarray) -> list[np.ndarray]:

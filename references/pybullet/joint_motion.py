@@ -54,7 +54,8 @@ from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common import time_loads
 from simparity.references.common.dynamics_urdf import dynamics_source
 from simparity.references.pybullet.adapter import PybulletChain
-from simparity.references.pybullet.chain_contact import PlaneContact
+from simparity.references.pybullet.chain_contact import PlaneContact, link_frame, link_index
+from simparity.references.pybullet.floating_body import MassStates
 from simparity.references.pybullet.joint_dynamics import CLIPPED, ChainBodies, axes_changed
 from simparity.references.pybullet.quiet import pybullet
 
@@ -67,7 +68,7 @@ def _world(scene: JointMotionScene, dt: float, copies: int) -> tuple[ChainBodies
         for link in (-1, *world.links):
             pybullet.setCollisionFilterGroupMask(body, link, 0, 0, physicsClientId=world.client)
     contact = (None if scene.contact is None else
-               PlaneContact(world.client, world.bodies, scene.chain, scene.contact, world.urdf_text))
+               PlaneContact(world.client, world.bodies, scene.chain, scene.contact, world.urdf_text, world.base))
     return world, contact
 
 
@@ -91,13 +92,16 @@ class PybulletJointMotion(JointSimulation):
                                                                   else (None, None))
         self._probe, self._probe_contact = probe
         self._model = ChainBodies(scene.chain, scene.gravity_world)
-        self._model.build_tree()
+        if not scene.chain.floating_base:  # a floating base's energy and momentum are summed from its link states
+            self._model.build_tree()
         self._kinematics = PybulletChain(scene.chain)
         m = self._model
         self._masses = np.array([pybullet.getDynamicsInfo(m.body, link, physicsClientId=m.client)[0]
                                  for link in m.links])
         self._gravity = np.zeros(3) if scene.gravity_world is None else np.asarray(scene.gravity_world, dtype=float)
-        self.detail = (f"stepSimulation of a fixed-base multibody per copy in one world (Featherstone ABA, "
+        base = ("a free multibody (its base's inertial frame converted to the base link's: floating_body)"
+                if scene.chain.floating_base else "a fixed-base multibody")
+        self.detail = (f"stepSimulation of {base} per copy in one world (Featherstone ABA, "
                        f"semi-implicit Euler: q from the new qdot), setTimeStep(dt), numSubSteps 0; "
                        f"loadURDF(URDF_USE_INERTIA_FROM_FILE) of {dynamics_source(scene.chain)}; "
                        f"{axes_changed(scene.chain)}; {_collisions(scene)}; gravity set; link damping 0, joint limits, velocity cap and braking motors off; joint "
@@ -126,7 +130,7 @@ class PybulletJointMotion(JointSimulation):
             raise NotImplementedError("the scene has no contact")
         out = []
         for row in np.atleast_2d(q):
-            self._probe.reset(row, np.zeros_like(row))
+            self._probe.reset(row, np.zeros(self._scene.chain.nv))
             out.append(self._probe_contact.centres(self._probe.body))
         return np.array(out)
 
@@ -148,8 +152,8 @@ class PybulletJointMotion(JointSimulation):
     def _step(self, world: ChainBodies, q0: np.ndarray, qdot0: np.ndarray, n_steps: int) -> JointTrajectory:
         """Every body of ``world`` from (q0, qdot0) ((B, n) each) for ``n_steps`` steps, sampled after each."""
         c = world.client
-        q = np.empty((n_steps + 1, len(world.bodies), len(world.joints)))
-        qdot = np.empty_like(q)
+        q = np.empty((n_steps + 1,) + q0.shape)
+        qdot = np.empty((n_steps + 1,) + qdot0.shape)
         for k in range(len(world.bodies)):
             world.reset(q0[k], qdot0[k], copy=k)
         q[0], qdot[0] = q0, qdot0
@@ -161,18 +165,31 @@ class PybulletJointMotion(JointSimulation):
                 pybullet.setJointMotorControlArray(body, world.joints, pybullet.TORQUE_CONTROL, forces=torque,
                                                    physicsClientId=c)
             pybullet.stepSimulation(physicsClientId=c)
-            for k, body in enumerate(world.bodies):
-                states = pybullet.getJointStates(body, world.joints, physicsClientId=c)
-                q[i, k] = [s[0] for s in states]
-                qdot[i, k] = [s[1] for s in states]
+            for k in range(len(world.bodies)):
+                q[i, k], qdot[i, k] = world.state(k)
         fastest = np.max(np.abs(qdot))
         if fastest >= CLIPPED:
             raise DivergedError(f"PyBullet clamped a joint velocity at {fastest:.3g} (its cap): the run blew up")
         return JointTrajectory(np.arange(n_steps + 1) * self._dt, q, qdot)
 
+    def _mass_states(self, q: np.ndarray, qdot: np.ndarray) -> list[MassStates]:
+        """Each state's links of the model body, its base included (a floating base: :class:`MassStates`)."""
+        m = self._model
+        out = []
+        for row, rates in zip(np.atleast_2d(q), np.atleast_2d(qdot)):
+            m.reset(row, rates)
+            out.append(MassStates.of(m.client, m.body, m.links))
+        return out
+
     def energy(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Kinetic 1/2 qdot^T M qdot (calculateMassMatrix), potential -sum m g.c (getLinkStates), each (B,) [J]."""
+        """Kinetic 1/2 qdot^T M qdot (calculateMassMatrix), potential -sum m g.c (getLinkStates), each (B,) [J]; a
+        floating base's kinetic energy summed over its links (:class:`MassStates`: calculateMassMatrix of a free body
+        is not trusted, ``docs/floating-bases.md``), its base's mass in the potential."""
         q, qdot = np.atleast_2d(q), np.atleast_2d(qdot)
+        if self._scene.chain.floating_base:
+            states = self._mass_states(q, qdot)
+            return (np.array([s.kinetic() for s in states]),
+                    np.array([s.potential(self._gravity) for s in states]))
         m = self._model
         kinetic = 0.5 * np.einsum("bi,bij,bj->b", qdot, m.mass_matrix(q), qdot)
         potential = np.empty(len(q))
@@ -183,5 +200,22 @@ class PybulletJointMotion(JointSimulation):
             potential[k] = -self._masses @ (coms @ self._gravity)
         return kinetic, potential
 
+    def momentum(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """(B, 6) a floating base's P and angular momentum about the centre of mass, summed over the model body's links
+        (:class:`MassStates`)."""
+        if not self._scene.chain.floating_base:
+            raise NotImplementedError("a fixed base's momentum is not conserved: it is not reported")
+        return np.array([s.momentum() for s in self._mass_states(q, qdot)])
+
     def end_effector_world(self, q: np.ndarray) -> np.ndarray:
-        return self._kinematics.end_effector_frames(np.atleast_2d(q))[0]
+        """(B, 3) [m]: a fixed base's by :class:`PybulletChain` (``getLinkState``, float32); a floating base's end
+        effector link frame in the world, in double (:func:`link_frame`)."""
+        if not self._scene.chain.floating_base:
+            return self._kinematics.end_effector_frames(np.atleast_2d(q))[0]
+        m = self._model
+        link = link_index(m.body, m.client, self._scene.chain.end_effector_name)
+        out = []
+        for row in np.atleast_2d(q):
+            m.reset(row, np.zeros(len(row) - 1))
+            out.append(link_frame(m.client, m.body, link, m.base)[1])
+        return np.array(out)

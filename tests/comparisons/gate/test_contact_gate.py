@@ -187,7 +187,8 @@ def test_a_planted_contact_bug_is_caught_naming_the_engine(tmp_path, monkeypatch
 @pytest.mark.parametrize("scene, plugin", [
     *((s, p) for s in ("solo12-drop-stand", "pendulum-press", "arm-strike-press")
       for p in ("FaithfulEngine", "PinocchioCopyEngine")),
-    *(("pendulum-press", "PybulletCopyEngine"), ("arm-strike-press", "PybulletCopyEngine")),
+    *(("pendulum-press", "PybulletCopyEngine"), ("arm-strike-press", "PybulletCopyEngine"),
+      ("solo12-drop-stand", "PybulletCopyEngine")),
     *(("pendulum-bounce", "CoreCopyEngine"), ("pendulum-strike", "CoreCopyEngine"),
       ("pendulum-strike", "PinocchioCopyEngine"), ("pendulum-strike", "PybulletCopyEngine"))])
 def test_a_faithful_copy_of_the_adapter_passes(tmp_path, monkeypatch, capsys, scene, plugin):

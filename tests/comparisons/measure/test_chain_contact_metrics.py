@@ -1,5 +1,5 @@
 """A robot's contact truths (:mod:`comparisons.measure.chain_contact_metrics`) on each engine's own run of
-``solo12-drop-stand``: the touchdown against the closed-form fall (exact for RK4, dt / (2 t_c) early for semi-implicit
+``solo12-drop-stand`` (core, MuJoCo and PyBullet's free multibody): the touchdown against the closed-form fall (exact for RK4, dt / (2 t_c) early for semi-implicit
 Euler: theory, not a measurement), no pull, no tangential force, no energy made, the weight carried at rest; and an
 engine that reports its forces wrong is seen."""
 
@@ -20,6 +20,7 @@ from simparity.core.model.metric_catalogue import (
     REST_WEIGHT_ERROR, SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR,
 )
 from simparity.references.mujoco.joint_motion import MujocoJointMotion
+from simparity.references.pybullet.joint_motion import PybulletJointMotion
 
 G = 9.81
 DROP = 0.02
@@ -38,6 +39,11 @@ REST = 1e-4
 @pytest.fixture(scope="module")
 def scene():
     return load_scene("solo12-drop-stand")
+
+
+def _pybullet(scene, integrator, dt):
+    """PyBullet's free multibody (its one integrator, Bullet's step)."""
+    return PybulletJointMotion(scene, dt)
 
 
 def _measured(scene, sim_class, integrator, dt, duration):
@@ -60,7 +66,7 @@ def test_rk4_touches_down_at_the_closed_form_time(scene, sim_class, integrator):
 
 
 @pytest.mark.parametrize("sim_class, integrator", [(CoreJointMotion, "semi_implicit_euler"),
-                                                   (MujocoJointMotion, "euler")])
+                                                   (MujocoJointMotion, "euler"), (_pybullet, "euler")])
 def test_semi_implicit_euler_touches_down_half_a_step_early(scene, sim_class, integrator):
     dt = 0.002
     values = _measured(scene, sim_class, integrator, dt, 0.08)
@@ -69,7 +75,8 @@ def test_semi_implicit_euler_touches_down_half_a_step_early(scene, sim_class, in
 
 @pytest.mark.slow
 @pytest.mark.parametrize("sim_class, integrator, dt", [(CoreJointMotion, "rk4", 0.002),
-                                                       (MujocoJointMotion, "euler", 0.001)])
+                                                       (MujocoJointMotion, "euler", 0.001),
+                                                       (_pybullet, "euler", 0.001)])
 def test_at_rest_the_plane_carries_the_weight_and_nothing_was_made(scene, sim_class, integrator, dt):
     values = _measured(scene, sim_class, integrator, dt, scene.duration)
     assert values[REST_WEIGHT_ERROR].value < REST
@@ -267,34 +274,31 @@ def _bounce(**keys):
     return parse_scene(data, "pendulum-bounce")
 
 
-def test_the_scheme_s_own_energy_error_far_from_the_plane_is_not_the_contact_s():
-    """Semi-implicit Euler's pendulum swinging above a plane it never reaches gains energy of its own (0.0189 of the
-    budget at 4 ms before the intervals far from the plane were left out, over the 10 dt bound): the contact made
-    none. The scheme's own error is there (its energy rises) and the metric does not count it."""
-    far = _bounce(**{"plane.0.coefficients": [0.0, 0.0, 1.0, 2.0]})  # the tip sweeps down to -0.5 m; the plane at -2 m
-    sim = CoreJointMotion(far, "semi_implicit_euler", 0.004)
-    traj = sim.run(far.n_steps(0.004))
-    own = read_own(sim, traj)
-    energy = own.kinetic + own.potential
-    assert energy.max() - energy[0] > 1e-3 * np.abs(own.potential).max()  # the scheme's own gain is there
-    assert contact_metrics(far, sim, traj, own)[CONTACT_ENERGY_GAIN_MAX].value == 0.0
+MADE_NONE = 1e-4
+"""RK4 at 1 ms with e = 1 makes no energy to its order (measured 1e-7; the bound is 10 dt = 0.01)."""
+MADE_SOME = 0.05
+"""A restitution of 1.05 makes (1.05^2 - 1) of each impact's kinetic energy: ~0.1 of the budget."""
 
 
-@pytest.mark.parametrize("restitution, least", [(1.0, None), (1.05, 0.05)])
-def test_energy_made_at_an_impact_between_two_samples_is_seen(restitution, least):
-    """A rigid bounce happens between two samples; its interval is near the plane, so a restitution above 1 (the
-    loader refuses it: set on the model) is seen. RK4 at 2 ms with e = 1 makes none to its order (measured 1e-6 at
-    2 ms, 10 dt = 0.02 is the bound); 1.05 makes (1.05^2 - 1) of the impact's kinetic energy, ~0.1 of the budget."""
+@pytest.mark.parametrize("restitution, radius_factor, made", [(1.0, 1.0, False), (1.05, 1.0, True),
+                                                                (1.05, 2.0, True)])
+def test_energy_made_at_an_impact_between_two_samples_is_seen(restitution, radius_factor, made):
+    """A rigid bounce happens between two samples, unseen by any sample; a restitution above 1 (the loader refuses
+    it: set on the model) is seen in the energy, also where the engine's sphere is larger than the scene's (a diameter
+    read as a radius: it strikes a radius above the plane the scene measures its gaps to). A held-out trial found a
+    window of intervals "near contact" (a sphere within twice the run's largest one-interval travel) blind to the
+    latter at 1 ms (0 against 0.10 made), and tried on this metric: it is not the metric's."""
     import copy
 
+    from simparity.core.model.scenes.chain_contact import ContactSphere
+
     scene = replace(_bounce(), duration=0.6)
-    sim = CoreJointMotion(scene, "rk4", 0.002)
+    sim = CoreJointMotion(scene, "rk4", 0.001)
     planted = copy.copy(scene.contact)
     object.__setattr__(planted, "restitution", restitution)  # past the loader's check: a planted bug
+    object.__setattr__(planted, "spheres", tuple(ContactSphere(s.frame, s.centre_xyz, radius_factor * s.radius)
+                                                 for s in planted.spheres))
     sim._rigid._contact = planted
-    traj = sim.run(scene.n_steps(0.002))
+    traj = sim.run(scene.n_steps(0.001))
     gain = contact_metrics(scene, sim, traj, read_own(sim, traj))[CONTACT_ENERGY_GAIN_MAX].value
-    if least is None:
-        assert gain < 1e-4
-    else:
-        assert gain > least
+    assert gain > MADE_SOME if made else gain < MADE_NONE

@@ -66,10 +66,9 @@ def test_a_meaningless_contact_is_refused_in_one_line_naming_its_key(data, edit,
     assert key in message and words in message and "\n" not in message, message
 
 
-@pytest.mark.parametrize("engine, integrator", [(PybulletEngine(), "euler"), (PinocchioEngine(), "rk4"),
-                                                (PinocchioEngine(), "dop853")])
+@pytest.mark.parametrize("engine, integrator", [(PinocchioEngine(), "rk4"), (PinocchioEngine(), "dop853")])
 def test_engines_without_a_chain_s_contact_say_why(data, engine, integrator):
-    """PyBullet models no chain's contact; Pinocchio's is velocity-level: only its semi-implicit Euler steps it."""
+    """Pinocchio's contact is velocity-level: only its semi-implicit Euler steps it."""
     scene = parse_scene(data)
     support = engine.supports_joint_motion(scene, integrator)
     assert not support.ok and support.reason

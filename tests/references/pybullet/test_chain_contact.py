@@ -13,7 +13,7 @@ import pytest
 
 from simparity.comparisons.api import load_scene
 from simparity.references.pinocchio.adapter import PinocchioEngine
-from simparity.references.pybullet.adapter import PybulletEngine
+from simparity.references.pybullet.adapter import FLOATING_MJCF_WHY, PybulletEngine
 from simparity.references.pybullet.chain_contact import SOLVER, SPHERE_DYNAMICS
 from simparity.references.pybullet.joint_dynamics import ChainBodies
 from simparity.references.pybullet.joint_motion import PybulletJointMotion, _world
@@ -80,9 +80,13 @@ def test_copies_never_touch_each_other(arm):
     assert np.array_equal(both.q[:, 0], alone.q[:, 0]) and np.array_equal(both.q[:, 1], alone.q[:, 0])
 
 
-def test_a_floating_base_on_the_ground_is_n_a_with_why():
-    support = PybulletEngine().supports_joint_motion(load_scene("solo12-drop-stand"), "euler")
-    assert not support.ok and "floating" in support.reason
+def test_a_floating_base_on_the_ground_is_stepped_and_an_mjcf_one_is_n_a_with_why():
+    scene = load_scene("solo12-drop-stand")
+    assert PybulletEngine().supports_joint_motion(scene, "euler").ok
+    assert PybulletEngine().chain_contact(scene).ok
+    mjcf = replace(scene, chain=replace(scene.chain, urdf_path=None, mjcf_path="robot.xml"))
+    support = PybulletEngine().supports_joint_motion(mjcf, "euler")
+    assert not support.ok and support.reason == FLOATING_MJCF_WHY
 
 
 def test_chain_bodies_without_contact_load_the_file_unchanged(arm):
