@@ -40,6 +40,9 @@ SCHEME_KINDS = {
     "midpoint": "the explicit midpoint rule (RK2): second order",
     "average_velocity": "the lecture's average-velocity rule (Heun's method, RK2): second order",
     "rk4": "classical fourth-order Runge-Kutta",
+    "engine_rk4": "classical fourth-order Runge-Kutta whose stages move a floating base's orientation by the "
+                  "exponential map of their velocity combination, as MuJoCo steps a free joint: fourth order, "
+                  "another discretisation than RK4 on the quaternion in R^4",
     "taylor2": "the lecture's Taylor rule for a point: exact under constant acceleration",
     "constant_velocity": "the lecture's rule for a point no force acts on",
     "closed_form": "a closed-form solution (a truth, not a scheme)",

@@ -302,3 +302,38 @@ def test_energy_made_at_an_impact_between_two_samples_is_seen(restitution, radiu
     traj = sim.run(scene.n_steps(0.001))
     gain = contact_metrics(scene, sim, traj, read_own(sim, traj))[CONTACT_ENERGY_GAIN_MAX].value
     assert gain > MADE_SOME if made else gain < MADE_NONE
+
+
+SLOW_PUSH = 8.0
+"""The planted spring pushes back this many times harder than it was pressed while its sphere leaves slower than
+:data:`SLOW`: the first, fast strike loses energy, every later slow bounce makes some."""
+SLOW = 1.0
+"""[m/s]"""
+
+
+@pytest.mark.parametrize("hub", [False, True])
+def test_a_sphere_touching_with_no_load_does_not_hide_energy_made_by_another(monkeypatch, hub):
+    """A held-out trial: a hub sphere on the hinge's axis touches the plane all the time and carries nothing (the base
+    is fixed); with only gap-free instants as baselines, no sample after the start was one, and the energy the tip's
+    planted spring made on its slow bounces hid under what its first strike lost (0 against 0.12 made). An instant
+    where every touching sphere carries no force stores nothing either: it is a baseline."""
+    import simparity.core.articulated.chain_contact as chain_contact
+    from simparity.core.model.scenes.chain_contact import ContactSphere
+
+    def planted(position, velocity, plane, stiffness, damping):
+        depth = plane.signed_distance(position)
+        leaving = velocity @ plane.normal_world
+        k = np.where((leaving > 0) & (leaving < SLOW), SLOW_PUSH * stiffness, stiffness)
+        push = -k * depth - damping * leaving
+        return np.where(depth < 0.0, np.maximum(push, 0.0), 0.0)[..., None] * plane.normal_world
+
+    monkeypatch.setattr(chain_contact, "penalty_force", planted)
+    scene = _bounce(**{"scene.reference": "core", "contact.restitution": None, "contact.rest_speed": None,
+                       "contact.rest_after": None,
+                       "contact.penalty_stiffness": 2e4, "contact.penalty_damping": 20.0, "simulation.duration": 3.0})
+    if hub:  # radius 0.35 about the axis, which is 0.35 m above the plane: touching at gap 0
+        spheres = scene.contact.spheres + (ContactSphere("hinge", np.array([0.0, 0.25, 0.0]), 0.35),)
+        scene = replace(scene, contact=replace(scene.contact, spheres=spheres))
+    sim = CoreJointMotion(scene, "rk4", 0.001)
+    traj = sim.run(scene.n_steps(0.001))
+    assert contact_metrics(scene, sim, traj, read_own(sim, traj))[CONTACT_ENERGY_GAIN_MAX].value > 0.05
