@@ -26,9 +26,10 @@ the force that keeps its normal acceleration zero while the plane pushes (the le
 one contact; M the scheme's own, armature + dt D under implicit damping). The stages keep its normal acceleration zero,
 not its gap and normal velocity at the step's end: semi-implicit Euler's drift let a pressed arm's sphere sink 1.5
 radii in 2 s, and both are restored at each step's end (below). The sphere leaves the
-plane where, at a step's last evaluation of the accelerations, the plane would have to pull (lambda's unclipped value
-<= 0): found at a step's end, not backed up to, so a run where a resting sphere lifts off (a two-link arm whose
-elbow folds on) is first order there whatever the scheme. At each step's end a resting sphere is put back on the plane
+plane where the plane would have to pull: where, at a step's last evaluation of the accelerations, lambda's unclipped
+value is <= 0, time is backed up to the instant lambda falls to 0 (the first root of s -> lambda at the held step of
+s h, to :data:`TIME_RTOL` of the step), the sphere released there and the rest of the step taken free (a release
+found at the step's end would leave the scheme first order there: the held force switches off inside its stages). At each step's end a resting sphere is put back on the plane
 (Newton steps along M^-1 j remove its gap) and its normal velocity removed (:meth:`RigidContact._held`).
 
 One contact at a time: two spheres striking at once, or one striking while another rests, couple their impulses
@@ -130,16 +131,60 @@ class RigidContact:
         self.resting, self._unclipped = np.full(copies, FREE), np.zeros(copies)
 
     def step(self, t: float, q: np.ndarray, qdot: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:
-        """One step of ``dt`` [s] from time t [s] of every copy, impacts and rests included."""
+        """One step of ``dt`` [s] from time t [s] of every copy, impacts, rests and liftoffs included."""
         self._active = slice(None)
         q_end, qdot_end = self._sized(dt)(t, q, qdot)
+        held = self.resting != FREE  # resting through the step unless an event moves it
         events = np.flatnonzero(np.any(self._free_spheres() & (self.gaps(q_end) < 0), axis=1))
+        held[events] = False
         for b in events:
             self._active = np.array([b])
             q_end[:, [b]], qdot_end[:, [b]] = self._events(t, q[:, [b]], qdot[:, [b]], dt, int(b))
+        lifting = (self.resting != FREE) & (self._unclipped <= 0)
+        for b in np.flatnonzero(lifting & held):
+            self._active = np.array([b])
+            q_end[:, [b]], qdot_end[:, [b]] = self._lifted(t, q[:, [b]], qdot[:, [b]], dt, int(b), q_end[:, [b]],
+                                                            qdot_end[:, [b]])
+        self.resting[lifting & ~held] = FREE  # came to rest in this step's events: released as found
         self._active = slice(None)
-        self.resting[(self.resting != FREE) & (self._unclipped <= 0)] = FREE
         return self._held(q_end, qdot_end)
+
+    def _lifted(self, t: float, q: np.ndarray, qdot: np.ndarray, dt: float, b: int, q_end: np.ndarray,
+                qdot_end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Copy b's step of ``dt`` from t in which its resting sphere lifts off (the plane would pull at the step's
+        last evaluation): backed up to the instant its force lambda falls to 0 (the first root of s -> lambda(state of
+        s dt from the start, held), to :data:`TIME_RTOL` of the step), released there, and stepped free for the rest;
+        where lambda does not change sign over the step (it lifted at its start, or the held end state still presses)
+        released at the step's end, as found. (q_end, qdot_end): the held step's end state."""
+        def pressing(s: float) -> float:
+            q_s, qdot_s = self._sized(s * dt)(t, q, qdot) if s > 0 else (q, qdot)
+            return self._lambda_at(t + s * dt, q_s, qdot_s, b)
+        start, end = pressing(0.0), pressing(1.0)
+        if not (start > 0 >= end):
+            self.resting[b] = FREE
+            return q_end, qdot_end
+        s = float(brentq(pressing, 0.0, 1.0, xtol=TIME_RTOL))
+        q, qdot = self._sized(s * dt)(t, q, qdot)
+        self.resting[b] = FREE
+        rest = (1.0 - s) * dt
+        q_end, qdot_end = self._sized(rest)(t + s * dt, q, qdot)
+        if np.any(self._free_spheres()[0] & (self.gaps(q_end)[0] < 0)):
+            return self._events(t + s * dt, q, qdot, rest, b)
+        return q_end, qdot_end
+
+    def _lambda_at(self, t: float, q: np.ndarray, qdot: np.ndarray, b: int) -> float:
+        """Copy b's resting sphere's unclipped force lambda [N] at the state q, qdot (n, 1) at time t [s], under the
+        scene's torque then (the true M's, as :meth:`forces_world`)."""
+        a = self._dynamics.forward_dynamics(q, qdot, self._applied(np.array([t])))
+        return float(self._lambda(q, qdot, a, self._response, self.resting[[b]])[1][0])
+
+    def _applied(self, times: np.ndarray) -> np.ndarray:
+        """(n, len(times)) the scene's joint torque [N m or N] at ``times`` [s]: the constant and the timed one."""
+        scene = self._scene
+        tau = np.repeat(scene.torque[:, None], len(times), axis=1)
+        if scene.timed_torque is not None:
+            tau = tau + np.stack([value_in_step(scene.timed_torque, t, t) for t in times], axis=1)
+        return tau
 
     def _held(self, q: np.ndarray, qdot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(q, qdot) with each resting sphere put back on the plane: its gap g removed by :data:`PROJECTIONS` Newton
@@ -254,12 +299,8 @@ class RigidContact:
         """(B, S, 3) [N] the plane's force on each sphere at states q (B, n), qdot (B, n) at ``times`` (B,) [s] with
         the resting spheres ``resting`` (B,): lambda N on a resting sphere (the true M's), 0 on the others (an
         impact's impulse is no force)."""
-        scene = self._scene
         q_t, qdot_t = np.ascontiguousarray(q.T), np.ascontiguousarray(qdot.T)
-        tau = np.repeat(scene.torque[:, None], len(times), axis=1)
-        if scene.timed_torque is not None:
-            tau = tau + np.stack([value_in_step(scene.timed_torque, t, t) for t in times], axis=1)
-        a = self._dynamics.forward_dynamics(q_t, qdot_t, tau)
+        a = self._dynamics.forward_dynamics(q_t, qdot_t, self._applied(times))
         _, unclipped = self._lambda(q_t, qdot_t, a, self._response, resting)
         out = np.zeros((len(times), len(self._contact.spheres), 3))
         on = np.flatnonzero(resting != FREE)

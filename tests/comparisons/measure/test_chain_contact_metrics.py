@@ -311,6 +311,7 @@ SLOW = 1.0
 """[m/s]"""
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("hub", [False, True])
 def test_a_sphere_touching_with_no_load_does_not_hide_energy_made_by_another(monkeypatch, hub):
     """A held-out trial: a hub sphere on the hinge's axis touches the plane all the time and carries nothing (the base
