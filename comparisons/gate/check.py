@@ -22,7 +22,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 import pandas as pd
 
-from simparity.comparisons.gate.cross_check import CROSS_CHECK_FACTOR, SOLVE_RATE_FRACTION, cross_check, held_series
+from simparity.comparisons.gate.cross_check import (
+    CROSS_CHECK_FACTOR, JOINT_AGREEMENT_FACTOR, SOLVE_RATE_FRACTION, cross_check, held_series,
+)
 from simparity.comparisons.gate.violation import Violation, row_label
 from simparity.comparisons.engines.registry import ENGINE_NAMES
 from simparity.comparisons.gate.bound_index import unmatched_patterns
@@ -342,8 +344,10 @@ def explain_lines(applied: list[Applied], builtin: bool) -> list[str]:
         lines.append(f"{item.scene}: {where} holds {item.rows} rows ({shown}) to {held} ({item.bound.reason})")
     if not builtin:
         lines.append("and every row to the built-in schemes of its kind in the same run (cross-checks: errors within "
-                     f"{CROSS_CHECK_FACTOR:g} x the largest built-in's, IK solve rates at least "
-                     f"{SOLVE_RATE_FRACTION:.0%} of the best built-in's, null-space terms that help; docs/check.md)")
+                     f"{CROSS_CHECK_FACTOR:g} x the largest built-in's, a chain in motion's within "
+                     f"{JOINT_AGREEMENT_FACTOR:g} x, {CROSS_CHECK_FACTOR:g} x its family's where none of its kind ran "
+                     f"(engine_rk4, engine_euler), IK solve rates at least {SOLVE_RATE_FRACTION:.0%} of the best "
+                     "built-in's, null-space terms that help; docs/check.md)")
     return lines
 
 

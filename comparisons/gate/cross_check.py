@@ -17,6 +17,7 @@ import math
 import pandas as pd
 
 from simparity.comparisons.gate.violation import Violation
+from simparity.core.model.engine import SCHEME_FAMILIES
 from simparity.core.model.results import NOT_AVAILABLE, OK, ROUNDING_FLOOR, SATURATED, UNSOLVED
 from simparity.core.model.metric_catalogue import (
     ANGULAR_MOMENTUM_DRIFT_MAX, ANGULAR_VELOCITY_ERROR_MAX, APEX_HEIGHT_ERROR, CROSS_EVAL_SOLVE_RATE_MIN,
@@ -178,7 +179,9 @@ def held_series(table: pd.DataFrame, builtin: tuple[str, ...]) -> set[tuple[str,
     kinds = set(zip(measured["scene"], measured["scheme"], measured["dt"].map(_dt_key), measured["metric"]))
     users = watched[~watched["engine"].isin(builtin) & (watched["status"] == OK) & (_flags(watched) != ROUNDING_FLOOR)]
     for row in users.to_dict("records"):
-        if (row["scene"], row["scheme"], _dt_key(row["dt"]), row["metric"]) in kinds:
+        scheme = row["scheme"] if (row["scene"], row["scheme"], _dt_key(row["dt"]), row["metric"]) in kinds else (
+            SCHEME_FAMILIES.get(row["scheme"], ""))
+        if (row["scene"], scheme, _dt_key(row["dt"]), row["metric"]) in kinds:
             held.add((row["scene"], row["engine"], row["integrator"]))
     return held
 
@@ -215,30 +218,34 @@ def cross_check(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Violation
         return out
     reference = {key: rows for key, rows in _builtin_rows(watched, builtin).groupby(keys)}
     for row in users.to_dict("records"):
-        rows = reference.get(tuple(row[k] for k in keys))
+        rows, factor = reference.get(tuple(row[k] for k in keys)), None
+        if rows is None and row["scheme"] in SCHEME_FAMILIES:  # no built-in of its kind ran: its family's
+            rows, factor = reference.get((row["scene"], SCHEME_FAMILIES[row["scheme"]], row["dt_key"],
+                                          row["metric"])), CROSS_CHECK_FACTOR
         if rows is None:
             continue
-        found = _judge(row, rows)
+        found = _judge(row, rows, factor)
         if found:
             out.append(Violation(row["scene"], row["engine"], row["integrator"], float(row["dt"]), row["metric"],
                                       *found))
     return out
 
 
-def _judge(row: dict, builtin: pd.DataFrame) -> tuple[str, str, str] | None:
+def _judge(row: dict, builtin: pd.DataFrame, factor: float | None = None) -> tuple[str, str, str] | None:
     """(what was found, the bound, why) when ``row`` breaks the cross-check against ``builtin`` (the built-in rows
-    of its scene, scheme, step and metric), else None."""
+    of its scene, scheme, step and metric, or of its scheme's family: :data:`SCHEME_FAMILIES`, held within
+    ``factor``), else None."""
     measured = builtin[(builtin["status"] == OK)]
+    kind = str(builtin["scheme"].iloc[0])
     if measured.empty or row["flag"] == ROUNDING_FLOOR:
         return None  # nothing to compare with, or exact up to rounding: rounding has no size to hold
     if (measured["flag"] == ROUNDING_FLOOR).any():  # the built-ins are exact up to rounding: hold the user's to more
         largest = float(measured["value"].max())
         if row["status"] == OK and row["metric"] in ERROR_METRICS and float(row["value"]) > FLOOR_FACTOR * largest:
             return (f"{float(row['value']):.4g} {row['unit']}", f"<= {FLOOR_FACTOR:g} x {largest:.4g} {row['unit']}",
-                    f"cross-check: the built-in {row['scheme']} is exact up to rounding here ({largest:.4g}); "
+                    f"cross-check: the built-in {kind} is exact up to rounding here ({largest:.4g}); "
                     f"{FLOOR_FACTOR:g} x that is no rounding of the same arithmetic")
         return None
-    kind = row["scheme"]
     if row["metric"] in WORK_METRICS:
         least = measured.loc[measured["value"].idxmin()]
         if row["status"] == OK and float(row["value"]) < float(least["value"]) * (1 - SAME_WORK_RELATIVE):
@@ -258,7 +265,8 @@ def _judge(row: dict, builtin: pd.DataFrame) -> tuple[str, str, str] | None:
             return "0 (unsolved)", f">= {limit:.3g}", why
         return None
     largest = measured.loc[measured["value"].idxmax()]
-    factor = JOINT_AGREEMENT_FACTOR if row["in_motion"] else CROSS_CHECK_FACTOR
+    if factor is None:
+        factor = JOINT_AGREEMENT_FACTOR if row["in_motion"] else CROSS_CHECK_FACTOR
     limit = factor * float(largest["value"])
     side = f"{largest['engine']} {largest['integrator']} ({float(largest['value']):.4g} {row['unit']})"
     if row["status"] == OK and float(row["value"]) > limit and math.isfinite(limit):

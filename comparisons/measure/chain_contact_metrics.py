@@ -47,7 +47,7 @@ from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointSimulation
 from simparity.core.model.metric_catalogue import (
     CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, FRICTION_CONE_VIOLATION_MAX, REST_ACCELERATION_MAX,
-    REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR, SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR,
+    REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR, SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR, TOUCHDOWN_TIME_STEPS,
 )
 from simparity.core.model.results import NOTHING_TO_MEASURE
 from simparity.core.model.scenes.chain_contact import ChainContact
@@ -84,21 +84,23 @@ def _centres(sim: JointSimulation, traj: JointTrajectory, index: np.ndarray, sph
     return np.asarray(sim.contact_centres(q), dtype=float).reshape(len(index), traj.q.shape[1], spheres, 3)
 
 
-def closed_form_touchdown(scene: JointMotionScene, gaps0: np.ndarray) -> tuple[float, str]:
-    """(t [s], "") the first sphere's touchdown in free fall from gaps ``gaps0`` (B, S) [m] (the engine's own at t = 0),
-    or (nan, why) when the scene's start is no rigid fall or nothing reaches the plane within its duration."""
+def closed_form_touchdown(scene: JointMotionScene, gaps0: np.ndarray) -> tuple[float, float, str]:
+    """(t [s], the first-order shift's factor a t / v at it [1], "") the first sphere's touchdown in free fall from
+    gaps ``gaps0`` (B, S) [m] (the engine's own at t = 0), the latest over copies, with its fall's acceleration a and
+    speed v along the normal there; or (nan, nan, why) when the scene's start is no rigid fall or nothing reaches the
+    plane within its duration."""
     contact = scene.contact
     assert contact is not None
     chain, normal = scene.chain, np.asarray(contact.plane.normal_world)
     if not chain.floating_base:
-        return math.nan, "a fixed base does not fall"
+        return math.nan, math.nan, "a fixed base does not fall"
     if scene.gravity_world is None:
-        return math.nan, "no gravity: nothing falls"
+        return math.nan, math.nan, "no gravity: nothing falls"
     if (np.any(scene.qdot0[:, 3:] != 0) or np.any(scene.torque != 0) or scene.timed_torque is not None):
-        return math.nan, ("the robot does not start as one rigid body falling (joint or base rotation rates, or "
+        return math.nan, math.nan, ("the robot does not start as one rigid body falling (joint or base rotation rates, or "
                           "applied torques): its touchdown has no closed form")
     if np.any(gaps0 <= TOUCHING):
-        return math.nan, "a sphere touches the plane at t = 0"
+        return math.nan, math.nan, "a sphere touches the plane at t = 0"
     a = float(np.asarray(scene.gravity_world) @ normal)
     v = (np.asarray(scene.qdot0[:, :3]) @ normal)[:, None]  # (B, 1)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -106,8 +108,10 @@ def closed_form_touchdown(scene: JointMotionScene, gaps0: np.ndarray) -> tuple[f
         reached = (v**2 - 2 * a * gaps0 >= 0) & (roots > 0)
     times = np.where(reached, roots, np.inf).min(axis=1)
     if not np.all(times <= scene.duration):
-        return math.nan, f"no sphere reaches the plane within the run's {scene.duration:g} s"
-    return float(times.max()), ""
+        return math.nan, math.nan, f"no sphere reaches the plane within the run's {scene.duration:g} s"
+    latest = int(np.argmax(times))
+    speed = abs(float(v[latest, 0]) + a * float(times[latest]))
+    return float(times[latest]), abs(a) * float(times[latest]) / speed if speed > 0 else math.inf, ""
 
 
 def _engine_touchdown(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, index: np.ndarray,
@@ -138,18 +142,27 @@ def _engine_touchdown(scene: JointMotionScene, sim: JointSimulation, traj: Joint
 
 
 def _touchdown(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, index: np.ndarray,
-               gaps: np.ndarray) -> Measured:
-    exact, why = closed_form_touchdown(scene, gaps[0])
+               gaps: np.ndarray) -> dict[str, Measured]:
+    """``touchdown_time_error`` (relative to the closed-form time t_c) and ``touchdown_time_steps`` (in the fall's
+    first-order shift dt a t_c / v_c: a step of the fall's position error a t dt / 2 at speed v_c moves it by half
+    that, early for semi-implicit Euler, late for explicit Euler, whatever the scene)."""
+    exact, factor, why = closed_form_touchdown(scene, gaps[0])
     if why:
-        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=why)
+        return {m: Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=why)
+                for m in (TOUCHDOWN_TIME_ERROR, TOUCHDOWN_TIME_STEPS)}
+    dt = float(traj.times[1] - traj.times[0])
+    shift = dt * factor
     if not (gaps <= TOUCHING).any():
         late = float(traj.times[-1]) - exact  # it touches down after its run ends, if ever: at least this late
-        return Measured(late / exact, "1", note=(
-            f"no sphere of the engine's reached the plane by the run's end {float(traj.times[-1]):.6g} s; the closed "
-            f"form touches down at {exact:.6g} s: at least this late"))
+        note = (f"no sphere of the engine's reached the plane by the run's end {float(traj.times[-1]):.6g} s; the "
+                f"closed form touches down at {exact:.6g} s: at least this late")
+        return {TOUCHDOWN_TIME_ERROR: Measured(late / exact, "1", note=note),
+                TOUCHDOWN_TIME_STEPS: Measured(late / shift, "1", note=note)}
     measured = _engine_touchdown(scene, sim, traj, index, gaps)
-    return Measured(abs(measured - exact) / exact, "1",
-                    note=f"touchdown at {measured:.9g} s, closed form {exact:.9g} s")
+    note = f"touchdown at {measured:.9g} s, closed form {exact:.9g} s"
+    return {TOUCHDOWN_TIME_ERROR: Measured(abs(measured - exact) / exact, "1", note=note),
+            TOUCHDOWN_TIME_STEPS: Measured(abs(measured - exact) / shift, "1",
+                                           note=f"{note}; the fall's first-order shift dt a t_c / v_c {shift:.3g} s")}
 
 
 def _forces(scene: JointMotionScene, contact: ChainContact, forces: np.ndarray, gaps: np.ndarray,
@@ -292,8 +305,7 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
         gaps = contact.gaps(_centres(sim, traj, index, len(contact.spheres)))  # (S, B, spheres)
     except NotImplementedError as err:
         return {m: Measured(math.nan, "1", unmeasurable=str(err)) for m in CHAIN_CONTACT_METRICS}
-    out = {
-        TOUCHDOWN_TIME_ERROR: _touchdown(scene, sim, traj, index, gaps),
+    out = _touchdown(scene, sim, traj, index, gaps) | {
         REST_ACCELERATION_MAX: _rest_acceleration(scene, traj, index),
         CONTACT_PENETRATION_MAX: Measured(float(np.maximum(-gaps / contact.radii, 0.0).max()), "1",
                                           note="deepest sinking over the sphere's radius"),

@@ -83,6 +83,12 @@ TRUTH_SCHEMES = ("closed_form", "adaptive")
 """The kinds of scheme a truth is: a reference runs one where it has one, and no report ranks one beside the schemes
 it judges."""
 
+SCHEME_FAMILIES = {"engine_rk4": "rk4", "engine_euler": "semi_implicit_euler"}
+"""Kinds that are another discretisation of the same order as a kind with more built-in engines: a user's scheme of
+such a kind is cross-checked against its family's built-ins where no built-in of its own kind ran (a looser factor:
+their error constants differ), so that a run without MuJoCo or PyBullet still holds it."""
+
+
 def is_scheme_label(label: str) -> bool:
     """Whether ``label`` is "" or kinds of :data:`SCHEME_KINDS` joined by ``+``."""
     return label == "" or all(part in SCHEME_KINDS for part in label.split("+"))

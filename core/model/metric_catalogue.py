@@ -170,6 +170,7 @@ STOPPING_DISTANCE = "stopping_distance"
 STOPPING_DISTANCE_ERROR = "stopping_distance_error"
 # A chain's contact spheres on a plane (issue #46): truths that need no engine.
 TOUCHDOWN_TIME_ERROR = "touchdown_time_error"
+TOUCHDOWN_TIME_STEPS = "touchdown_time_steps"
 CONTACT_PENETRATION_MAX = "contact_penetration_max"
 SIGNORINI_VIOLATION_MAX = "signorini_violation_max"
 FRICTION_CONE_VIOLATION_MAX = "friction_cone_violation_max"
@@ -301,6 +302,10 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(TOUCHDOWN_TIME_ERROR, DIMENSIONLESS, CONTACT,
            theory="a robot falling at rest as one body touches down at the closed-form time: 0 up to the scheme's "
                   "error"),
+    Metric(TOUCHDOWN_TIME_STEPS, DIMENSIONLESS, CONTACT,
+           theory="the touchdown's error in the fall's first-order shift (dt a t_c / v_c): semi-implicit Euler "
+                  "touches down half of it early and explicit Euler half late in any scene; RK4 and the midpoint "
+                  "rule: 0"),
     Metric(CONTACT_PENETRATION_MAX, DIMENSIONLESS, CONTACT,
            theory="soft contact penetrates: each engine's own stiffness; past 1 a sphere has sunk through its radius"),
     Metric(SIGNORINI_VIOLATION_MAX, DIMENSIONLESS, CONTACT,

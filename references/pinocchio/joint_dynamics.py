@@ -132,8 +132,9 @@ def _mjcf_model(chain: Chain) -> pin.Model:
         path = os.path.join(folder, "model.xml")
         with open(path, "w", encoding="utf-8") as handle:
             handle.write(dynamics_mjcf(chain))
-        return (pin.buildModelFromMJCF(path, pin.JointModelFreeFlyer()) if chain.floating_base
-                else pin.buildModelFromMJCF(path))
+        if chain.floating_base:  # with a root joint it answers (model, constraint models) and needs the joint's name
+            return pin.buildModelFromMJCF(path, pin.JointModelFreeFlyer(), "root_joint")[0]
+        return pin.buildModelFromMJCF(path)
 
 
 COMPOSITE = "JointModelComposite"

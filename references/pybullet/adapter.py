@@ -116,6 +116,7 @@ from simparity.references.common.conventions import (
     wxyz_from_xyzw,
     xyzw_from_wxyz,
 )
+from simparity.references.pybullet.floating_body import massless_base
 from simparity.references.pybullet.quiet import pybullet
 from simparity.references.common.quiet import captured_output
 from simparity.references.common.dynamics_mjcf import WORLD, dynamics_mjcf
@@ -729,7 +730,10 @@ class PybulletEngine(UrdfChains, Engine):
         named = super().supports_joint_motion(scene, integrator)
         if named.ok and scene.chain.floating_base and scene.chain.mjcf_path is not None:
             return Support.no(FLOATING_MJCF_WHY)
-        return _dynamics_support(scene.chain) if named.ok else named
+        support = _dynamics_support(scene.chain) if named.ok else named
+        if support.ok and scene.chain.floating_base and (massless := massless_base(dynamics_urdf(scene.chain))):
+            return Support.no(massless)
+        return support
 
     def chain_contact(self, scene: JointMotionScene) -> Support:
         """Bullet's multibody contact of sphere shapes on the links (:mod:`references.pybullet.chain_contact`)."""

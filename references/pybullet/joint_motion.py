@@ -99,15 +99,19 @@ class PybulletJointMotion(JointSimulation):
         self._masses = np.array([pybullet.getDynamicsInfo(m.body, link, physicsClientId=m.client)[0]
                                  for link in m.links])
         self._gravity = np.zeros(3) if scene.gravity_world is None else np.asarray(scene.gravity_world, dtype=float)
-        base = ("a free multibody (its base's inertial frame converted to the base link's: floating_body)"
-                if scene.chain.floating_base else "a fixed-base multibody")
+        floating = scene.chain.floating_base
+        base = ("a free multibody (its base's inertial frame converted to the base link's: floating_body; its base "
+                "inertial frame stepped by semi-implicit Euler, turned by the exponential map)"
+                if floating else "a fixed-base multibody")
+        own = ("energy and momentum summed over getLinkStates' centre-of-mass and angular velocities; end effector "
+               "from its link's inertial frame (double)" if floating else
+               "energy from calculateMassMatrix and getLinkStates; end effector by getLinkState (float32)")
         self.detail = (f"stepSimulation of {base} per copy in one world (Featherstone ABA, "
                        f"semi-implicit Euler: q from the new qdot), setTimeStep(dt), numSubSteps 0; "
                        f"loadURDF(URDF_USE_INERTIA_FROM_FILE) of {dynamics_source(scene.chain)}; "
                        f"{axes_changed(scene.chain)}; {_collisions(scene)}; gravity set; link damping 0, joint limits, velocity cap and braking motors off; joint "
                        f"damping by changeDynamics(jointDamping) (Bullet: -D qdot at the step's start, explicit); torque by "
-                       f"TORQUE_CONTROL re-sent before every step (Bullet clears it after each); energy from "
-                       f"calculateMassMatrix and getLinkStates; end effector by getLinkState (float32)")
+                       f"TORQUE_CONTROL re-sent before every step (Bullet clears it after each); {own}")
 
     def run(self, n_steps: int) -> JointTrajectory:
         return self._step(self._world, np.asarray(self._scene.q0), np.asarray(self._scene.qdot0), n_steps)

@@ -14,13 +14,15 @@ from simparity.core.model.scenes.joint_motion import JointMotionScene
 
 def check_reference(top: TableReader, scene, engines: EngineSet) -> None:
     """A reference that cannot do the scene (as its engine's ``supports_*`` says) is an error now, not a run of n/a
-    rows; so is core as the reference of a contact scene that does not run its exact method, backup."""
+    rows (core too, on a chain in motion: a floating base's rigid contact it does not step); so is core as the
+    reference of a contact scene that does not run its exact method, backup."""
     contact = getattr(scene, "contact", None)
     if scene.reference == "core":
         if isinstance(scene, DynamicsScene) and contact is not None and "backup" not in contact.methods:
             raise top.fail("scene.reference", "core is the reference, but the scene's contact methods leave out "
                            "backup, its exact one", 'contact.methods with "backup", or another reference')
-        return
+        if not isinstance(scene, JointMotionScene):
+            return
     engine = engines.reference(scene.reference)
     if isinstance(engine, UnavailableEngine):  # its library is missing here: the run's rows say so
         return
@@ -38,7 +40,8 @@ def check_reference(top: TableReader, scene, engines: EngineSet) -> None:
     else:
         support = engine.supports_kinematics(scene.chain)
     if not support.ok:
-        allowed = ("analytic for a pendulum striking the plane with one sphere, or core" if isinstance(
+        allowed = ("analytic for a pendulum striking the plane with one sphere, core on a fixed base, or an engine that "
+                   "steps it (pinocchio, pybullet: restitution 0)" if isinstance(
                        scene, JointMotionScene) and contact is not None and contact.rigid
                    else "core or mujoco: a scene with a chain's soft contact runs against no reference, but names an "
                    "engine that can do it" if isinstance(scene, JointMotionScene) and contact is not None

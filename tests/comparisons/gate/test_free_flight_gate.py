@@ -113,3 +113,23 @@ def test_a_planted_free_flight_bug_is_caught_naming_the_engine(tmp_path, monkeyp
 def test_a_faithful_copy_of_the_adapter_passes(tmp_path, monkeypatch, capsys, plugin, scene):
     code, violations, out = _run(tmp_path, monkeypatch, capsys, plugin, scene)
     assert code == 0 and not violations, out[-2000:]
+
+
+@pytest.mark.sweep
+@pytest.mark.slow
+def test_a_user_s_engine_rk4_is_held_by_rk4_where_mujoco_did_not_run(tmp_path, monkeypatch, capsys):
+    """A user's RK4 that, as MuJoCo's, moves its free joint by the exponential map (scheme engine_rk4) has no built-in
+    of its kind without MuJoCo in the run: it is cross-checked against core's and Pinocchio's RK4 (its family), at
+    twice their error. A held-out trial's MuJoCo copy handing over the angular velocity unturned passed otherwise
+    (0.6 rad against 1.5e-7)."""
+    source = PLANTED + '''
+
+class UnturnedRK4(Unturned):
+    pass
+
+
+UnturnedRK4Engine = _engine(MujocoEngine, UnturnedRK4, "mujoco-unturned-rk4")
+'''
+    result = run_planted(tmp_path, monkeypatch, capsys, "planted_family", source, "go1-free-flight",
+                         "UnturnedRK4Engine", engines="core,pinocchio")
+    assert_caught(result, "mujoco-unturned-rk4", "cross-check: 2 x the largest built-in rk4")

@@ -17,7 +17,7 @@ from simparity.comparisons.measure.joint_motion_metrics import motion_metrics, r
 from simparity.core.articulated.motion import CoreJointMotion
 from simparity.core.model.metric_catalogue import (
     CONTACT_ENERGY_GAIN_MAX, FRICTION_CONE_VIOLATION_MAX, REST_ACCELERATION_MAX, REST_EQUILIBRIUM_ERROR,
-    REST_WEIGHT_ERROR, SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR,
+    REST_WEIGHT_ERROR, SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR, TOUCHDOWN_TIME_STEPS,
 )
 from simparity.references.mujoco.joint_motion import MujocoJointMotion
 from simparity.references.pybullet.joint_motion import PybulletJointMotion
@@ -71,6 +71,23 @@ def test_semi_implicit_euler_touches_down_half_a_step_early(scene, sim_class, in
     dt = 0.002
     values = _measured(scene, sim_class, integrator, dt, 0.08)
     assert values[TOUCHDOWN_TIME_ERROR].value == pytest.approx(dt / (2 * T_CONTACT), rel=EULER_SECOND_ORDER)
+    assert values[TOUCHDOWN_TIME_STEPS].value == pytest.approx(0.5, rel=EULER_SECOND_ORDER)
+
+
+THROWN_UP = 0.6
+"""[m/s] A base thrown upward: it rises 1.8 cm, falls 3.8 cm and touches down at 0.15 s, at 0.86 m/s."""
+
+
+@pytest.mark.parametrize("integrator, early", [("semi_implicit_euler", True), ("explicit_euler", False)])
+def test_a_first_order_touchdown_is_half_its_fall_s_shift_off_in_any_scene(scene, integrator, early):
+    """Thrown upward first, the fall's first-order shift is dt a t_c / v_c (not dt): semi-implicit Euler touches down
+    half of it early, explicit Euler half of it late, as dropped from rest (theory: the step misplaces a uniformly
+    accelerated fall by a t dt / 2)."""
+    thrown = replace(scene, qdot0=np.concatenate([[0.0, 0.0, THROWN_UP, 0.0, 0.0, 0.0], np.zeros(3)])[None])
+    values = _measured(thrown, CoreJointMotion, integrator, 0.002, 0.3)
+    assert values[TOUCHDOWN_TIME_STEPS].value == pytest.approx(0.5, rel=EULER_SECOND_ORDER)
+    t_c = (THROWN_UP + math.sqrt(THROWN_UP**2 + 2 * G * DROP)) / G
+    assert values[TOUCHDOWN_TIME_ERROR].value > 1.5 * 0.002 / (2 * t_c)  # not dt / 2 relative: a t_c / v_c > 1
 
 
 @pytest.mark.slow

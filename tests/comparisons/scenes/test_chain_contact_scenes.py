@@ -125,3 +125,15 @@ def test_a_rigid_contact_runs_where_an_engine_has_it(rigid, restitution, plastic
         support = engine.supports_joint_motion(scene, integrator)
         assert support.ok == plastic_engines, support.reason
         assert support.ok or "restitution 0.5" in support.reason
+
+
+def test_core_as_the_reference_of_a_floating_rigid_contact_is_refused_in_one_line():
+    """Core steps impulses on a fixed base only: a floating base's rigid contact named core its reference and passed
+    with "core measured nothing" (a held-out trial); it is refused at load, saying why."""
+    with open(resolve("solo12-drop-stand"), "rb") as f:
+        data = tomllib.load(f)
+    data["contact"] = {k: v for k, v in data["contact"].items() if not k.startswith("penalty_")} | {"restitution": 0.0}
+    with pytest.raises(SceneError) as caught:
+        parse_scene(data, "drop.toml")
+    message = str(caught.value)
+    assert "scene.reference" in message and "fixed base only" in message and "\n" not in message, message
