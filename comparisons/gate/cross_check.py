@@ -219,9 +219,10 @@ def cross_check(table: pd.DataFrame, builtin: tuple[str, ...]) -> list[Violation
     reference = {key: rows for key, rows in _builtin_rows(watched, builtin).groupby(keys)}
     for row in users.to_dict("records"):
         rows, factor = reference.get(tuple(row[k] for k in keys)), None
-        if rows is None and row["scheme"] in SCHEME_FAMILIES:  # no built-in of its kind ran: its family's
-            rows, factor = reference.get((row["scene"], SCHEME_FAMILIES[row["scheme"]], row["dt_key"],
-                                          row["metric"])), CROSS_CHECK_FACTOR
+        if (rows is None or not (rows["status"] == OK).any()) and row["scheme"] in SCHEME_FAMILIES:
+            family = reference.get((row["scene"], SCHEME_FAMILIES[row["scheme"]], row["dt_key"], row["metric"]))
+            if family is not None:  # no built-in of its kind measured it (none ran, or n/a): its family's did
+                rows, factor = family, CROSS_CHECK_FACTOR
         if rows is None:
             continue
         found = _judge(row, rows, factor)

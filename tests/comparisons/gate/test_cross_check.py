@@ -84,3 +84,21 @@ def test_a_user_scheme_declaring_less_work_than_every_builtin_of_its_kind():
     (violation,) = _check(*builtin, _row("user", 100.0, metric="evaluations_per_second", unit="1/s"))
     assert violation.engine == "user" and violation.metric == "evaluations_per_second"
     assert "core rk4" in violation.reason and "stages()" in violation.reason
+
+
+def test_a_one_engine_kind_is_held_by_its_family_where_its_engine_did_not_measure():
+    """A user's engine_rk4 (MuJoCo's RK4 on a free joint) beside no measured built-in of its kind is held by the RK4
+    built-ins at 2 x, whether MuJoCo did not run or its row is n/a (a review: the n/a row made the user's row skip
+    every cross-check while counting as held); where MuJoCo's measured, by MuJoCo's."""
+    from simparity.comparisons.gate.cross_check import held_series
+
+    core = _row("core", 1e-9, metric="joint_angle_error_max", unit="1")
+    user = _row("user", 5e-3, metric="joint_angle_error_max", scheme="engine_rk4", unit="1")
+    mujoco_na = _row("mujoco", math.nan, metric="joint_angle_error_max", scheme="engine_rk4", status="n/a", unit="1")
+    for rows in ((core, user), (core, mujoco_na, user)):
+        (violation,) = _check(*rows)
+        assert violation.engine == "user" and "built-in rk4" in violation.reason
+        table = pd.DataFrame([r.as_dict() for r in rows], columns=list(COLUMNS))
+        assert ("s", "user", "my-rk4") in held_series(table, BUILTIN)
+    mujoco = _row("mujoco", 4.5e-3, metric="joint_angle_error_max", scheme="engine_rk4", unit="1")
+    assert _check(core, mujoco, user) == []  # within 1.25 x MuJoCo's: its own kind decides

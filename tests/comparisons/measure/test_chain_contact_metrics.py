@@ -355,3 +355,32 @@ def test_a_sphere_touching_with_no_load_does_not_hide_energy_made_by_another(mon
     sim = CoreJointMotion(scene, "rk4", 0.001)
     traj = sim.run(scene.n_steps(0.001))
     assert contact_metrics(scene, sim, traj, read_own(sim, traj))[CONTACT_ENERGY_GAIN_MAX].value > 0.05
+
+
+@pytest.mark.slow
+def test_a_first_contact_between_two_read_samples_is_not_missed(scene, monkeypatch):
+    """A stiff spring's first contact lasts 6 steps; read at 21 samples only (a long run's stride), the touchdown was
+    taken from a later bounce: 309 shifts off for an exact RK4 (a review). Every step up to the first sample that sees
+    a touch is searched."""
+    import simparity.comparisons.measure.joint_motion_metrics as joint_motion_metrics
+
+    stiff = replace(scene, contact=replace(scene.contact, penalty_stiffness=1e6, penalty_damping=0.0),
+                    duration=0.4, dts=(0.0005,))
+    sim = CoreJointMotion(stiff, "rk4", 0.0005)
+    traj = sim.run(stiff.n_steps(0.0005))
+    monkeypatch.setattr(joint_motion_metrics, "MAX_ENERGY_SAMPLES", 21)
+    values = contact_metrics(stiff, sim, traj, read_own(sim, traj))
+    assert values[TOUCHDOWN_TIME_STEPS].value < EXACT and values[TOUCHDOWN_TIME_ERROR].value < EXACT
+
+
+@pytest.mark.parametrize("integrator", ["explicit_euler", "semi_implicit_euler"])
+def test_each_copy_s_touchdown_is_held_to_its_own_fall(scene, integrator):
+    """Two copies: one dropped from rest, one from higher at 3 m/s, touching down 0.2 ms later. Judged against the
+    latest copy's fall only, explicit Euler's first copy read 2.33 shifts (a review); each copy against its own: 0.5."""
+    drop = math.sqrt(2 * DROP / G) + 0.0002
+    q0, qdot0 = np.repeat(scene.q0, 2, axis=0), np.repeat(scene.qdot0, 2, axis=0)
+    q0[1, 2] += 3.0 * drop + G * drop**2 / 2 - DROP
+    qdot0[1, 2] = -3.0
+    two = replace(scene, q0=q0, qdot0=qdot0)
+    values = _measured(two, CoreJointMotion, integrator, 0.002, 0.1)
+    assert values[TOUCHDOWN_TIME_STEPS].value == pytest.approx(0.5, rel=EULER_SECOND_ORDER)
