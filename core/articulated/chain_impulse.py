@@ -159,18 +159,13 @@ class RigidContact:
         def pressing(s: float) -> float:
             q_s, qdot_s = self._sized(s * dt)(t, q, qdot) if s > 0 else (q, qdot)
             return self._lambda_at(t + s * dt, q_s, qdot_s, b)
-        start, end = pressing(0.0), pressing(1.0)
-        if not (start > 0 >= end):
+        if not (pressing(0.0) > 0 >= self._lambda_at(t + dt, q_end, qdot_end, b)):
             self.resting[b] = FREE
             return q_end, qdot_end
         s = float(brentq(pressing, 0.0, 1.0, xtol=TIME_RTOL))
         q, qdot = self._sized(s * dt)(t, q, qdot)
         self.resting[b] = FREE
-        rest = (1.0 - s) * dt
-        q_end, qdot_end = self._sized(rest)(t + s * dt, q, qdot)
-        if np.any(self._free_spheres()[0] & (self.gaps(q_end)[0] < 0)):
-            return self._events(t + s * dt, q, qdot, rest, b)
-        return q_end, qdot_end
+        return self._events(t + s * dt, q, qdot, (1.0 - s) * dt, b)  # free for the rest, any impact in it included
 
     def _lambda_at(self, t: float, q: np.ndarray, qdot: np.ndarray, b: int) -> float:
         """Copy b's resting sphere's unclipped force lambda [N] at the state q, qdot (n, 1) at time t [s], under the

@@ -570,7 +570,8 @@ def _links_support(urdf_text: str) -> Support:
 
 def _dynamics_support(chain: Chain) -> Support:
     """Whether PyBullet can hold the chain's dynamics: a chain URDF can express (a prismatic joint needs limits
-    there), no armature, at most :data:`MAX_LINKS` links."""
+    there), no armature, at most :data:`MAX_LINKS` links, a floating base with a mass of its own
+    (:func:`references.pybullet.floating_body.massless_base`)."""
     expressible = urdf_support(chain) if chain.robot_file is None else Support.yes()
     if not expressible.ok:
         return expressible
@@ -580,6 +581,8 @@ def _dynamics_support(chain: Chain) -> Support:
     if chain.mjcf_path is not None:
         return _mjcf_loader_support(pybullet_mjcf(chain), chain_joint_names(chain))
     text = dynamics_urdf(chain)
+    if chain.floating_base and (massless := massless_base(text)):
+        return Support.no(massless)
     links = _links_support(text)
     return _loader_support(text) if links.ok else links
 
@@ -730,10 +733,7 @@ class PybulletEngine(UrdfChains, Engine):
         named = super().supports_joint_motion(scene, integrator)
         if named.ok and scene.chain.floating_base and scene.chain.mjcf_path is not None:
             return Support.no(FLOATING_MJCF_WHY)
-        support = _dynamics_support(scene.chain) if named.ok else named
-        if support.ok and scene.chain.floating_base and (massless := massless_base(dynamics_urdf(scene.chain))):
-            return Support.no(massless)
-        return support
+        return _dynamics_support(scene.chain) if named.ok else named
 
     def chain_contact(self, scene: JointMotionScene) -> Support:
         """Bullet's multibody contact of sphere shapes on the links (:mod:`references.pybullet.chain_contact`)."""
