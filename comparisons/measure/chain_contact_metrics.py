@@ -12,7 +12,13 @@ another's trajectory; each is held to what any correct contact must give:
   penetrates by its own stiffness; past 1 a sphere has gone through).
 - ``signorini_violation_max``: a plane pushes a touching sphere and nothing else: max of a pull (-f.N)^+ and of a force
   on a sphere off the plane, |f| gap / radius, relative to the robot's weight m |g|.
-- ``friction_cone_violation_max``: the frictionless plane's tangential force |f - (f.N) N|, relative to the weight.
+- ``friction_cone_violation_max``: how far a force leaves the plane's Coulomb cone, (|f - (f.N) N| - mu f.N)^+ (on a
+  frictionless plane, mu = 0, its whole tangential force), relative to the weight.
+- ``sliding_friction_error`` and ``sliding_friction_angle_max``: where a pushed sphere slides (:data:`SLIDING_SPEED`;
+  its contact point's velocity by Pinocchio's model of the file, an independent model), Coulomb's friction is on its
+  cone, |f_t| = mu f_n (the error is ||f_t| - mu f_n| / (mu f_n), the largest), and opposes the slip (the angle between
+  f_t and -u_t, the largest: 0 for Coulomb's maximal dissipation; friction that only takes energy keeps it below
+  pi / 2, a bound any engine meets, while soft and per-direction solvers turn it by their own amounts).
 - ``contact_energy_gain_max``: contact and damping only take energy (a soft contact stores some while it is
   compressed, and gives back at most that), so the mechanical energy never exceeds what it was at any earlier instant
   where no contact stores any (every sphere off the plane, or carrying no force where the engine reports forces:
@@ -47,14 +53,16 @@ from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointSimulation
 from simparity.core.model.metric_catalogue import (
     CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, FRICTION_CONE_VIOLATION_MAX, REST_ACCELERATION_MAX,
-    REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR, SIGNORINI_VIOLATION_MAX, TOUCHDOWN_TIME_ERROR, TOUCHDOWN_TIME_STEPS,
+    REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR, SIGNORINI_VIOLATION_MAX, SLIDING_FRICTION_ANGLE_MAX,
+    SLIDING_FRICTION_ERROR, TOUCHDOWN_TIME_ERROR, TOUCHDOWN_TIME_STEPS,
 )
 from simparity.core.model.results import NOTHING_TO_MEASURE
 from simparity.core.model.scenes.chain_contact import ChainContact
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 
-FORCE_METRICS = (SIGNORINI_VIOLATION_MAX, FRICTION_CONE_VIOLATION_MAX, REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR)
+FORCE_METRICS = (SIGNORINI_VIOLATION_MAX, FRICTION_CONE_VIOLATION_MAX, SLIDING_FRICTION_ERROR, SLIDING_FRICTION_ANGLE_MAX,
+                 REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR)
 """The metrics that need the engine's contact forces (:meth:`JointSimulation.contact_forces`)."""
 
 REST_ACCELERATION = 1e-3
@@ -65,6 +73,17 @@ SAMPLE_TIME_RTOL = 1e-9
 """[1] A sample at k dt is at or after ``rest_after`` when its time is within this of it (k dt rounds)."""
 TOUCHING = 0.0
 """[m] A sphere touches the plane when its gap is at most this (the scene's radius; margins are switched off)."""
+SLIDING_SPEED = 0.1
+"""[1 of sqrt(g reach)] A pushed sphere slides when its contact point slips along the plane at least this fast, at a
+sample and at the next one in nearly the same direction (:data:`SLIDING_TURN`): sqrt(g reach) is the speed of a fall
+by the robot's reach, so a slip of a tenth of it is no creep of a held foot (core's regularised friction creeps below
+1 cm/s; Solo-12's threshold is 0.2 m/s). Slipping at both ends of a sampled interval, it slid through the step
+between them, whose force an engine that steps on impulses reports."""
+FRICTION_ROUNDING = 1e-9
+"""[1 of mu f_n] A sliding contact's friction this small is rounding (a normal force's tangential residue): it has no
+direction for ``sliding_friction_angle_max`` to judge (``sliding_friction_error`` reads its absence, 1)."""
+SLIDING_TURN = 0.1
+"""[rad] The most a sliding sphere's slip may turn between two samples (:data:`SLIDING_SPEED`)."""
 UNLOADED = 1e-12
 """[1 of the weight] A touching sphere whose force is at most this stores no energy in its contact (a spring at
 rounding: f^2 / 2k). Such instants are baselines of ``contact_energy_gain_max`` too: a sphere that touches all the
@@ -177,12 +196,57 @@ def _forces(scene: JointMotionScene, contact: ChainContact, forces: np.ndarray, 
     """The Signorini and friction-cone violations of forces (S, B, spheres, 3) at gaps (S, B, spheres)."""
     normal = np.asarray(contact.plane.normal_world)
     f_n = forces @ normal
-    tangential = np.linalg.norm(forces - f_n[..., None] * normal, axis=-1)
+    outside = np.maximum(np.linalg.norm(forces - f_n[..., None] * normal, axis=-1) - contact.friction * f_n, 0.0)
     at_distance = np.linalg.norm(forces, axis=-1) * np.maximum(gaps, 0.0) / contact.radii
     signorini = float(np.maximum(np.maximum(-f_n, 0.0), at_distance).max()) / weight
     return {SIGNORINI_VIOLATION_MAX: Measured(signorini, "1", note="pull or force off the plane, over the weight"),
-            FRICTION_CONE_VIOLATION_MAX: Measured(float(tangential.max()) / weight, "1",
-                                                  note="tangential force on a frictionless plane, over the weight")}
+            FRICTION_CONE_VIOLATION_MAX: Measured(float(outside.max()) / weight, "1", note=(
+                "tangential force on a frictionless plane, over the weight" if contact.friction == 0 else
+                f"tangential force beyond the Coulomb cone (mu = {contact.friction:g}), over the weight"))}
+
+
+def _sliding(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, forces: np.ndarray,
+             weight: float) -> dict[str, Measured]:
+    """``sliding_friction_error`` and ``sliding_friction_angle_max`` of forces (S, B, spheres, 3) at the samples
+    ``index`` (see the module docstring); n/a with why on a frictionless plane or where nothing slides."""
+    contact = scene.contact
+    assert contact is not None
+    metrics = (SLIDING_FRICTION_ERROR, SLIDING_FRICTION_ANGLE_MAX)
+    if contact.friction == 0:
+        return {m: Measured(math.nan, "1" if m == SLIDING_FRICTION_ERROR else "rad", flag=NOTHING_TO_MEASURE,
+                            unmeasurable=("a frictionless plane: nothing to slide against (friction_cone_violation_max "
+                                          "holds its tangential force to 0)")) for m in metrics}
+    try:
+        from simparity.references.pinocchio.statics import PinocchioStatics
+        velocities = PinocchioStatics(scene.chain, scene.gravity_world, contact).contact_point_velocities(
+            *_states(traj, index)).reshape(forces.shape)
+    except Exception as err:  # noqa: BLE001 - not installed, or Pinocchio refuses the chain
+        return {m: Measured(math.nan, "1" if m == SLIDING_FRICTION_ERROR else "rad", unmeasurable=(
+            f"the slip is read by Pinocchio's model of the chain, which cannot be built here: {error_text(err)}"))
+            for m in metrics}
+    normal = np.asarray(contact.plane.normal_world)
+    slip = velocities - (velocities @ normal)[..., None] * normal
+    speed = np.linalg.norm(slip, axis=-1)
+    threshold = SLIDING_SPEED * math.sqrt(weight / scene.chain.mass * reach(scene.chain))  # weight / m = |g|
+    direction = slip / np.where(speed > 0, speed, 1.0)[..., None]
+    f_n = forces @ normal
+    tangential = forces - f_n[..., None] * normal
+    held = ((speed[:-1] >= threshold) & (speed[1:] >= threshold) & (f_n[:-1] > UNLOADED * weight)
+            & (np.sum(direction[:-1] * direction[1:], axis=-1) >= math.cos(SLIDING_TURN)))
+    if not held.any():
+        why = (f"no pushed sphere slid faster than {threshold:.3g} m/s (0.1 sqrt(g reach)) at two samples in a row")
+        return {m: Measured(math.nan, "1" if m == SLIDING_FRICTION_ERROR else "rad", flag=NOTHING_TO_MEASURE,
+                            unmeasurable=why) for m in metrics}
+    f_t, bound = tangential[:-1][held], contact.friction * f_n[:-1][held]
+    size = np.linalg.norm(f_t, axis=-1)
+    pointing = size > FRICTION_ROUNDING * bound  # a friction at rounding has no direction to judge
+    against = -np.sum(f_t * direction[:-1][held], axis=-1) / np.where(pointing, size, 1.0)
+    angle = np.where(pointing, np.arccos(np.clip(against, -1.0, 1.0)), 0.0)
+    note = f"{int(held.sum())} sliding instants (slip >= {threshold:.3g} m/s)"
+    return {SLIDING_FRICTION_ERROR: Measured(float((np.abs(size - bound) / bound).max()), "1",
+                                             note=f"||f_t| - mu f_n| / (mu f_n) over {note}"),
+            SLIDING_FRICTION_ANGLE_MAX: Measured(float(angle.max()), "rad",
+                                                 note=f"angle between the friction and -slip over {note}")}
 
 
 def _rest(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, index: np.ndarray,
@@ -332,5 +396,5 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
     out[CONTACT_ENERGY_GAIN_MAX] = _energy_gain(scene, traj, own, gaps,
                                                 np.linalg.norm(forces, axis=-1) <= UNLOADED * weight)
     rest = _rest(scene, sim, traj, index, forces, weight, mass)
-    return out | _forces(scene, contact, forces, gaps, weight) | {
+    return out | _forces(scene, contact, forces, gaps, weight) | _sliding(scene, traj, index, forces, weight) | {
         REST_WEIGHT_ERROR: rest, REST_EQUILIBRIUM_ERROR: _equilibrium(scene, traj, index, forces, weight, rest)}

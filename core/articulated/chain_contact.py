@@ -6,15 +6,18 @@ sphere's centre (its normal part is the contact point's). The force acts at the 
 through the contact point: the same moment about every point) and enters the chain's dynamics as the generalized
 force J^T F summed over spheres, with J the Jacobian of the centre: on a joint, (a_j x (p - P_j)) . F for a revolute
 joint, a_j . F for a prismatic one (joints between the base and the sphere's frame); on a floating base, the force
-itself and its moment (p - x_base) x F about the base origin, in world axes. Frictionless: nothing acts along the
-plane.
+itself and its moment (p - x_base) x F about the base origin, in world axes. With the scene's friction mu > 0 the
+plane also resists the slip u_t of the contact point (the sphere's link's point at ``c - r N``, where the engines put
+it too) with the penalty method's regularised Coulomb friction -mu |F_n| u_t / max(|u_t|, v_reg)
+(:func:`core.contact.particle.sliding_friction`, as the free bodies'), and the whole force acts there; without
+friction nothing acts along the plane.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from simparity.core.contact.particle import penalty_force
+from simparity.core.contact.particle import penalty_force, sliding_friction
 from simparity.core.kinematics import joint_frames
 from simparity.core.model.scenes.chain import Chain
 from simparity.core.model.scenes.chain_contact import ChainContact, frame_index
@@ -106,11 +109,18 @@ class ChainContactForces:
         return self._normal_rows(axes, columns), bias
 
     def _state(self, q: np.ndarray, qdot: np.ndarray):
-        """(forces (B, S, 3) in the world, the base-to-centre arms in world axes (B, S, 3) or None on a fixed base,
-        the Jacobian columns, the base rotation or None) at the state."""
+        """(forces (B, S, 3) in the world, the base-to-application-point arms in world axes (B, S, 3) or None on a fixed
+        base, the Jacobian columns, the base rotation or None) at the state. The force acts at the sphere's centre on
+        a frictionless plane (on the normal through the contact point) and at its contact point, the link's point at
+        ``centre - radius N``, with friction (the point whose slip it resists)."""
         positions, rotations, axes, rotation = self._frames(q)
         centres_base = self._centres_base(positions, rotations)
-        columns = self._columns(positions, axes, centres_base)
+        c = self._contact
+        points_base = centres_base
+        if c.friction > 0:
+            points_base = centres_base + (self._lowest if rotation is None
+                                          else np.einsum("bji,sj->bsi", rotation, self._lowest))
+        columns = self._columns(positions, axes, points_base)
         n = self._chain.n_joints
         rates = qdot[qdot.shape[0] - n:].T  # (B, n)
         relative = np.stack([np.einsum("bkj,bk->bj", cols, rates[:, :cols.shape[1]]) for cols in columns], axis=1)
@@ -118,14 +128,15 @@ class ChainContactForces:
         if rotation is None:
             centres, velocities = centres_base, relative
         else:
-            arms = np.einsum("bij,bsj->bsi", rotation, centres_base)
-            centres = q[:3].T[:, None] + arms
+            arms = np.einsum("bij,bsj->bsi", rotation, points_base)
+            centres = q[:3].T[:, None] + np.einsum("bij,bsj->bsi", rotation, centres_base)
             velocities = (qdot[:3].T[:, None] + np.cross(qdot[3:6].T[:, None], arms)
                           + np.einsum("bij,bsj->bsi", rotation, relative))
-        c = self._contact
         if c.penalty_stiffness is None or c.penalty_damping is None:
             raise ValueError("a rigid contact has no penalty forces (core.articulated.chain_impulse steps it)")
         forces = penalty_force(centres + self._lowest, velocities, c.plane, c.penalty_stiffness, c.penalty_damping)
+        if c.friction > 0:
+            forces = forces - sliding_friction(forces, velocities, c.plane.normal_world, c.friction)
         return forces, arms, columns, rotation
 
     def forces_world(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:

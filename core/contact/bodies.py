@@ -24,10 +24,10 @@ from functools import cached_property
 
 import numpy as np
 
-from simparity.core.contact.particle import penalty_force
+from simparity.core.contact.particle import penalty_force, sliding_friction
 from simparity.core.dynamics.forces import make_wrench
 from simparity.core.dynamics.rigid_body import MassProperties, State, Wrench
-from simparity.core.rotations import cross, vector_lengths
+from simparity.core.rotations import cross
 from simparity.core.model.scenes.bodies import AppliedForce, Forces
 from simparity.core.model.scenes.contact import Contact, Plane
 
@@ -45,13 +45,6 @@ step, for a body whose contact was resolved after the fact): a box rocking on a 
 SUPPORT_ANGLE_MARGIN = 1e-6
 """[rad] A COM above the line through two support points (a box balanced on an edge) is not supported: the
 largest angle between support points seen from the COM must be below pi by this much."""
-
-FRICTION_REGULARISATION_SPEED = 1e-2
-"""[m/s] The penalty method's Coulomb friction grows linearly from 0 up to mu_k F_n over this slip speed
-(a discontinuous force would chatter in any explicit scheme). It adds a damping rate mu_k g / v_reg
-(~300 1/s for mu_k = 0.3), comparable to the contact spring's omega = sqrt(k_s / m) ~ 300 rad/s of the
-default stiffness, so it does not make the system stiffer than the spring does; a body held by
-friction creeps at ~v_reg |g_t| / (mu_k |g_n|)."""
 
 FLIGHT_SCHEME = "rk4"
 """The scheme the backup and act_after methods fly bodies by between contacts (quaternion orientation)."""
@@ -367,7 +360,7 @@ def penalty_wrench(model: ContactModel, props: MassProperties, external: Wrench)
 
     At each point with E < 0: F_n = (-k_s E - k_d u.N)^+ N (:func:`core.contact.particle.penalty_force`)
     and regularised Coulomb friction -mu_k |F_n| u_t / max(|u_t|, v_reg)
-    (:data:`FRICTION_REGULARISATION_SPEED`); torque r x F about the COM. Returns
+    (:data:`core.contact.particle.FRICTION_REGULARISATION_SPEED`); torque r x F about the COM. Returns
     f(t, x, R, v, omega, step_start) -> (force (B, 3) [N], torque (B, 3) [N m]).
     """
     # per plane, what its terms read (sliced once, not at every call): the plane, k_d (B, 1), mu_k (B, 1, 1)
@@ -382,10 +375,7 @@ def penalty_wrench(model: ContactModel, props: MassProperties, external: Wrench)
             r = lever[:, p]
             u = v[:, None, :] + cross(omega[:, None, :], r)
             f_n = penalty_force(x[:, None, :] + r, u, plane, model.stiffness, damping)
-            u_t = u - (u @ plane.normal_world)[..., None] * plane.normal_world
-            slip = np.maximum(vector_lengths(u_t), FRICTION_REGULARISATION_SPEED)
-            magnitude = vector_lengths(f_n)
-            f = (f_n - friction * magnitude * u_t / slip) * weights
+            f = (f_n - sliding_friction(f_n, u, plane.normal_world, friction)) * weights
             force = force + f.sum(axis=1)
             torque = torque + cross(r, f).sum(axis=1)
         return force, torque

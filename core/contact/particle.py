@@ -21,6 +21,27 @@ import numpy as np
 
 from simparity.core.dynamics.point_mass import average_velocity_step
 from simparity.core.model.scenes.contact import Plane
+from simparity.core.rotations import vector_lengths
+
+FRICTION_REGULARISATION_SPEED = 1e-2
+"""[m/s] The penalty method's Coulomb friction grows linearly from 0 up to mu_k F_n over this slip speed
+(a discontinuous force would chatter in any explicit scheme). It adds a damping rate mu_k g / v_reg
+(~300 1/s for mu_k = 0.3), comparable to the contact spring's omega = sqrt(k_s / m) ~ 300 rad/s of the
+default stiffness, so it does not make the system stiffer than the spring does; a body held by
+friction creeps at ~v_reg |g_t| / (mu_k |g_n|)."""
+
+
+def sliding_friction(normal_force: np.ndarray, velocity: np.ndarray, normal: np.ndarray,
+                     mu: float | np.ndarray) -> np.ndarray:
+    """The penalty method's regularised Coulomb friction, negated: mu |F_n| u_t / max(|u_t|, v_reg)
+    (:data:`FRICTION_REGULARISATION_SPEED`), u_t the tangential part of ``velocity`` (..., 3) [m/s] along the plane
+    of unit ``normal`` (3,), ``normal_force`` F_n (..., 3) [N], ``mu`` broadcasting against them. The friction force is
+    minus this [N]: opposite the slip, on the cone |f_t| = mu |F_n| once the slip is faster than v_reg, inside it
+    below."""
+    u_t = velocity - (velocity @ normal)[..., None] * normal
+    slip = np.maximum(vector_lengths(u_t), FRICTION_REGULARISATION_SPEED)
+    return mu * vector_lengths(normal_force) * u_t / slip
+
 
 METHODS = ("backup", "detect_and_reflect")
 """Collision handling offered by :func:`step_particles`."""

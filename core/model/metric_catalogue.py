@@ -174,6 +174,8 @@ TOUCHDOWN_TIME_STEPS = "touchdown_time_steps"
 CONTACT_PENETRATION_MAX = "contact_penetration_max"
 SIGNORINI_VIOLATION_MAX = "signorini_violation_max"
 FRICTION_CONE_VIOLATION_MAX = "friction_cone_violation_max"
+SLIDING_FRICTION_ERROR = "sliding_friction_error"
+SLIDING_FRICTION_ANGLE_MAX = "sliding_friction_angle_max"
 CONTACT_ENERGY_GAIN_MAX = "contact_energy_gain_max"
 REST_WEIGHT_ERROR = "rest_weight_error"
 REST_EQUILIBRIUM_ERROR = "rest_equilibrium_error"
@@ -311,6 +313,11 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(SIGNORINI_VIOLATION_MAX, DIMENSIONLESS, CONTACT,
            theory="a plane pushes only on a touching sphere and never pulls: 0"),
     Metric(FRICTION_CONE_VIOLATION_MAX, DIMENSIONLESS, CONTACT, theory="inside the Coulomb cone: 0"),
+    Metric(SLIDING_FRICTION_ERROR, DIMENSIONLESS, CONTACT,
+           theory="a sliding contact's friction is on its cone, |f_t| = mu f_n: 0"),
+    Metric(SLIDING_FRICTION_ANGLE_MAX, "rad", CONTACT,
+           theory="Coulomb's friction opposes the slip (maximal dissipation): 0; friction that only takes energy: "
+                  "below pi / 2"),
     Metric(CONTACT_ENERGY_GAIN_MAX, DIMENSIONLESS, CONTACT,
            theory="contact and damping only take energy: 0 up to the scheme's error"),
     Metric(REST_WEIGHT_ERROR, DIMENSIONLESS, CONTACT, theory="at rest the plane carries the weight: 0"),

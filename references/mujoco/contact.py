@@ -5,7 +5,9 @@ What MuJoCo is given (pinned by ``tests/references/test_chain_contact_engines.py
 - One plane geom on the world body (its normal the plane's, through the point -d N) and a sphere geom per contact
   sphere on the body of its frame: a chain joint's child body (the body the joint moves: its frame is the URDF link's),
   the end effector's body, or the base link's body. Spheres touch the plane only (sphere contype 0, conaffinity 1;
-  plane contype 1, conaffinity 0), ``condim`` 1 (frictionless: the scene's plane pushes along its normal only),
+  plane contype 1, conaffinity 0), ``condim`` 1 on a frictionless plane (it pushes along its normal only), ``condim``
+  3 with the scene's friction (sliding friction mu on both geoms, so that MuJoCo's mix, the larger, is mu; torsional
+  and rolling 0, unused by condim 3) where it has one,
   ``margin`` = ``gap`` = 0 (no force before the sphere touches), MuJoCo's default soft-contact parameters
   (:data:`SOLREF`, :data:`SOLIMP`: reported in each row), elliptic cones (moot with condim 1). Geoms add no mass: the
   URDF importer's ``inertiafromgeom`` is false.
@@ -31,9 +33,15 @@ SOLREF = (0.02, 1.0)
 SOLIMP = (0.9, 0.95, 0.001, 0.5, 2.0)
 """MuJoCo's default solimp (d0, d_width, width [m], midpoint, power), kept."""
 SPHERE_PREFIX = "simparity_contact_sphere_"
-DETAIL = (f"contact: a plane geom and a sphere geom per contact sphere (condim 1, frictionless; margin 0; solref "
-          f"{SOLREF}, solimp {SOLIMP}: MuJoCo's defaults; elliptic cone), joint limits, equality and frictionloss "
-          "disabled; forces by mj_contactForce after mj_forward at each sampled state")
+
+
+def detail(contact: ChainContact) -> str:
+    """What a row says of MuJoCo's contact with ``contact``'s plane."""
+    friction = (f"condim 3, friction {contact.friction:g}, impratio 1" if contact.friction > 0
+                else "condim 1, frictionless")
+    return (f"contact: a plane geom and a sphere geom per contact sphere ({friction}; margin 0; solref {SOLREF}, "
+            f"solimp {SOLIMP}: MuJoCo's defaults; elliptic cone), joint limits, equality and frictionloss disabled; "
+            "forces by mj_contactForce after mj_forward at each sampled state")
 
 
 def _plane_quat_wxyz(normal: np.ndarray) -> np.ndarray:
@@ -53,7 +61,9 @@ def add_contact(spec: mujoco.MjSpec, chain: Chain, contact: ChainContact) -> Non
     plane.type, plane.size = mujoco.mjtGeom.mjGEOM_PLANE, [0.0, 0.0, 1.0]
     plane.pos = -contact.plane.offset * np.asarray(contact.plane.normal_world)
     plane.quat = _plane_quat_wxyz(np.asarray(contact.plane.normal_world))
-    plane.contype, plane.conaffinity, plane.condim = 1, 0, 1
+    condim = 3 if contact.friction > 0 else 1
+    friction = [contact.friction, 0.0, 0.0]
+    plane.contype, plane.conaffinity, plane.condim = 1, 0, condim
     for k, sphere in enumerate(contact.spheres):
         i = frame_index(sphere.frame, names, chain.end_effector_name, chain.base_link)
         body = (spec.worldbody.first_body() if i < 0 else spec.body(chain.end_effector_name) if i == len(names)
@@ -61,10 +71,14 @@ def add_contact(spec: mujoco.MjSpec, chain: Chain, contact: ChainContact) -> Non
         geom = body.add_geom()
         geom.name, geom.type = f"{SPHERE_PREFIX}{k}", mujoco.mjtGeom.mjGEOM_SPHERE
         geom.size, geom.pos = [sphere.radius, 0.0, 0.0], np.asarray(sphere.centre_xyz)
-        geom.contype, geom.conaffinity, geom.condim = 0, 1, 1
+        geom.contype, geom.conaffinity, geom.condim = 0, 1, condim
+        if condim > 1:
+            geom.friction = friction
         geom.margin = geom.gap = 0.0
         geom.solref, geom.solimp = SOLREF, SOLIMP
     plane.solref, plane.solimp, plane.margin, plane.gap = SOLREF, SOLIMP, 0.0, 0.0
+    if condim > 1:
+        plane.friction = friction
     spec.option.disableflags = (mujoco.mjtDisableBit.mjDSBL_LIMIT | mujoco.mjtDisableBit.mjDSBL_EQUALITY
                                 | mujoco.mjtDisableBit.mjDSBL_FRICTIONLOSS)
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC

@@ -50,8 +50,7 @@ from simparity.core.model.trajectory import JointTrajectory
 from simparity.references.common.conventions import fmt
 from simparity.references.common import time_loads
 from simparity.references.common.floating_base import base_rotations, turned_base
-from simparity.references.mujoco.contact import DETAIL as CONTACT_DETAIL
-from simparity.references.mujoco.contact import ContactReader
+from simparity.references.mujoco.contact import ContactReader, detail as contact_detail
 from simparity.references.mujoco.floating import MujocoFloatingDynamics
 from simparity.references.mujoco.joint_dynamics import ChainModel
 from simparity.references.mujoco.stage_loads import DETAIL as STAGE_DETAIL
@@ -130,7 +129,7 @@ class MujocoJointMotion(JointSimulation):
                        "DivergedError; energy by mj_mulM and -sum m g.xipos; end effector by mj_kinematics"
                        + ("; the base a free joint, its body-frame angular velocity turned to world axes; momentum "
                           "by mj_subtreeVel" if self._floating is not None else "")
-                       + (f"; {CONTACT_DETAIL}" if self._contact is not None else ""))
+                       + (f"; {contact_detail(scene.contact)}" if scene.contact is not None else ""))
 
     def _own(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         """MuJoCo's qvel rows of the project's (B, nv): a floating base's angular velocity turned into its body frame

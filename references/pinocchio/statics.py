@@ -5,7 +5,8 @@ under gravity and the given forces on its contact spheres: ``rnea(q, 0, 0, fext)
 Pinocchio as an external force on the joint that carries its frame, expressed in that joint's LOCAL frame with its
 moment about the joint's origin (Pinocchio's convention for ``fext``), the sphere's centre placed by Pinocchio's own
 frames (a chain joint's frame is its joint's; the end effector is the URDF link's frame; the base link is the free
-flyer's, or the universe on a fixed base, where a force holds nothing). A floating base's rows are turned to world
+flyer's, or the universe on a fixed base, where a force holds nothing); with friction at the sphere's contact point
+``centre - radius N`` instead, where a tangential force acts (on a frictionless plane both lie on the force's line). A floating base's rows are turned to world
 axes (:mod:`references.common.floating_base`). At rest the joints' rows equal the applied joint forces less the
 damping and a floating base's rows are zero: g(q) - sum_s J_s^T f_s = tau.
 
@@ -36,7 +37,13 @@ class PinocchioStatics:
         self._configuration = (dynamics.configuration if isinstance(dynamics, PinocchioFloatingDynamics)
                                else dynamics._configuration)
         self._index = np.r_[0:6, dynamics.idx_v] if chain.floating_base else np.asarray(dynamics.idx_v)
+        self._velocity = (dynamics.local_velocity if isinstance(dynamics, PinocchioFloatingDynamics)
+                          else lambda q_row, qdot_row: dynamics._velocity(qdot_row[0]))
+        self._radii = contact.radii
+        self._normal = np.asarray(contact.plane.normal_world, dtype=float)
         self._joints, self._points = sphere_anchors(self._model, chain, contact)
+        self._lowest = (contact.radii[:, None] * np.asarray(contact.plane.normal_world, dtype=float)
+                        if contact.friction > 0 else None)
 
     def balance(self, q: np.ndarray, forces_world: np.ndarray) -> np.ndarray:
         """(B, nv): the generalized force that holds the chain still at q (B, nq) under gravity and ``forces_world``
@@ -50,8 +57,25 @@ class PinocchioStatics:
             external = pin.StdVec_Force()
             for _ in range(m.njoints):
                 external.append(pin.Force.Zero())
-            for joint, point, force in zip(self._joints, self._points, forces_world[b]):
-                local = d.oMi[joint].rotation.T @ force
-                external[joint] = external[joint] + pin.Force(local, np.cross(point, local))
+            for k, (joint, point, force) in enumerate(zip(self._joints, self._points, forces_world[b])):
+                rotation = d.oMi[joint].rotation
+                local = rotation.T @ force
+                at = point if self._lowest is None else point - rotation.T @ self._lowest[k]
+                external[joint] = external[joint] + pin.Force(local, np.cross(at, local))
             out[b] = pin.rnea(m, d, configuration, zero, zero, external)[self._index]
         return turned_base(base_rotations(q), out, True, True) if self._floating else out
+
+    def contact_point_velocities(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """(B, S, 3) [m/s] in world axes: the velocity of each sphere's contact point, the point of its link at
+        ``centre - radius N``, at the states q (B, nq), qdot (B, nv) (the project's convention), by Pinocchio's
+        ``forwardKinematics`` and ``getVelocity`` (the joint's LOCAL spatial velocity moved to the point)."""
+        m, d = self._model, self._data
+        out = np.empty((len(q), len(self._joints), 3))
+        for b, (row, rates) in enumerate(zip(np.asarray(q, dtype=float), np.asarray(qdot, dtype=float))):
+            pin.forwardKinematics(m, d, self._configuration(row), self._velocity(row[None], rates[None]))
+            for k, (joint, point) in enumerate(zip(self._joints, self._points)):
+                rotation = d.oMi[joint].rotation
+                at = point - self._radii[k] * rotation.T @ self._normal
+                motion = pin.getVelocity(m, d, joint, pin.LOCAL)
+                out[b, k] = rotation @ (motion.linear + np.cross(motion.angular, at))
+        return out

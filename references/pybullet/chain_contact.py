@@ -8,8 +8,9 @@ What PyBullet is given, beside :mod:`references.pybullet.joint_motion`'s stepped
 - The plane is the free bodies' static ``GEOM_PLANE`` multibody (:func:`references.pybullet.adapter.static_plane`).
   Collision filters: the sphere links collide with the plane only (the adapter's body and plane groups), every other
   link with nothing; a copy never touches another.
-- Frictionless and without restitution: ``lateralFriction`` 0, ``restitution`` 0, rolling and spinning friction 0 on
-  the sphere links (Bullet multiplies the two objects': the plane keeps 1 of each); no speculative contact
+- Without restitution, and with the scene's Coulomb friction: ``lateralFriction`` mu (0 on a frictionless plane),
+  ``restitution`` 0, rolling and spinning friction 0 on the sphere links (Bullet multiplies the two objects': the plane
+  keeps 1 of each); no speculative contact
   (``contactProcessingThreshold`` 0: a sphere above the plane gets no force).
 - The solve: ``contactERP`` 0 (no position correction by velocity: it adds energy), ``contactSlop`` 0 (the contact
   distance is the spheres' and the plane's exact distance), ``numSolverIterations`` 100, ``solverResidualThreshold`` 0
@@ -17,7 +18,10 @@ What PyBullet is given, beside :mod:`references.pybullet.joint_motion`'s stepped
   another unit; with 1e-12 a held-out three-sphere arm in milliseconds settled to 1e-7 g instead of 8.5e-15 g),
   ``globalCFM`` 0, ``restitutionVelocityThreshold`` 0, split impulse off (not implemented for multibodies):
   Bullet's multibody step is semi-implicit Euler with the contact solved on velocities by its PGS, as the free
-  bodies' (:mod:`references.pybullet.adapter`).
+  bodies' (:mod:`references.pybullet.adapter`). ``enableConeFriction`` 1 (its default, stated): the friction's two
+  rows scaled back into the Coulomb cone; with 0 Bullet clamps each row alone, a box whose diagonal is sqrt(2) mu f_n
+  (measured on ``solo12-incline-slide``: a sliding foot's friction 1.414 mu f_n). Its rows still resist a sideways
+  slip on their own: a sliding foot's friction is on the cone but up to 0.29 rad off the slip's opposite there.
 - The force on a sphere at a state: a scratch copy of the world is put at the state (``resetJointState``, the scene's
   torque at that time) and stepped once; ``getContactPoints`` with the plane gives each point's ``normalForce``
   (Bullet's impulse over dt) along ``contactNormalOnB`` (from the plane to the link) and its two lateral friction
@@ -42,11 +46,11 @@ from simparity.references.pybullet.floating_body import BaseInertial
 from simparity.references.pybullet.quiet import pybullet
 
 SOLVER = dict(contactERP=0.0, contactSlop=0.0, numSolverIterations=100, solverResidualThreshold=0.0, globalCFM=0.0,
-              restitutionVelocityThreshold=0.0, useSplitImpulse=0, deterministicOverlappingPairs=1)
+              restitutionVelocityThreshold=0.0, useSplitImpulse=0, deterministicOverlappingPairs=1,
+              enableConeFriction=1)
 """setPhysicsEngineParameter of a world with a chain's contact (the module docstring gives each reason)."""
-SPHERE_DYNAMICS = dict(restitution=0.0, lateralFriction=0.0, rollingFriction=0.0, spinningFriction=0.0,
-                       contactProcessingThreshold=0.0)
-"""changeDynamics of every link that carries a sphere."""
+SPHERE_DYNAMICS = dict(restitution=0.0, rollingFriction=0.0, spinningFriction=0.0, contactProcessingThreshold=0.0)
+"""changeDynamics of every link that carries a sphere, beside its ``lateralFriction``, the scene's mu."""
 
 
 def sphere_links(chain: Chain, contact: ChainContact, urdf_text: str) -> list[str]:
@@ -118,7 +122,8 @@ class PlaneContact:
         for body in bodies:
             for link in set(self.links):
                 pybullet.setCollisionFilterGroupMask(body, link, BODY_GROUP, PLANE_GROUP, physicsClientId=client)
-                pybullet.changeDynamics(body, link, **SPHERE_DYNAMICS, physicsClientId=client)
+                pybullet.changeDynamics(body, link, **SPHERE_DYNAMICS, lateralFriction=contact.friction,
+                                        physicsClientId=client)
         pybullet.setPhysicsEngineParameter(**SOLVER, physicsClientId=client)
 
     def centres(self, body: int) -> np.ndarray:

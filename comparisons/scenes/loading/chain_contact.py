@@ -13,7 +13,7 @@ from simparity.core.model.scenes.chain_contact import ChainContact, ContactSpher
 from simparity.core.model.scenes.contact import Plane
 
 _PLANE = ("name", "coefficients")
-_CONTACT = ("penalty_stiffness", "penalty_damping", "restitution", "rest_speed", "rest_after", "sphere")
+_CONTACT = ("penalty_stiffness", "penalty_damping", "restitution", "rest_speed", "rest_after", "friction", "sphere")
 _SPHERE = ("frame", "centre_xyz", "radius")
 
 
@@ -75,12 +75,15 @@ def _soft(c: TableReader, chain: Chain, plane: Plane, spheres: tuple[ContactSphe
     """A soft contact: core's penalty spring k_s and damper k_d (critical on the robot's mass by default)."""
     if c.has("rest_speed"):
         raise c.fail("rest_speed", "a rest speed on a soft contact", "rest_speed with restitution (a rigid contact)")
+    friction = c.number("friction", 0.0)
+    if friction < 0:
+        raise c.fail("friction", f"{friction:g} is negative", "a Coulomb coefficient >= 0 (0: a frictionless plane)")
     stiffness = c.number("penalty_stiffness", positive=True)  # N/m = kg / s^2: no length
     damping = (c.number("penalty_damping") if c.has("penalty_damping")
                else 2.0 * float(np.sqrt(stiffness * chain.mass)))  # critical on the robot's mass, N s/m = kg / s
     if damping < 0:
         raise c.fail("penalty_damping", f"{damping:g} is negative", "a number >= 0 [N s/m]")
-    return ChainContact(plane, spheres, stiffness, damping, rest_after)
+    return ChainContact(plane, spheres, stiffness, damping, rest_after, friction=friction)
 
 
 def _rigid(c: TableReader, plane: Plane, spheres: tuple[ContactSphere, ...], rest_after: float | None) -> ChainContact:
@@ -89,6 +92,9 @@ def _rigid(c: TableReader, plane: Plane, spheres: tuple[ContactSphere, ...], res
         if c.has(key):
             raise c.fail(key, "a penalty spring on a rigid contact (restitution is given)",
                          "either restitution (rigid: impulses) or penalty_stiffness (soft: springs), not both")
+    if c.has("friction"):
+        raise c.fail("friction", "friction on a rigid contact (restitution is given)",
+                     "friction on a soft contact (penalty_stiffness): a rigid contact's impacts are frictionless")
     restitution = c.number("restitution")
     if not 0 <= restitution <= 1:
         raise c.fail("restitution", f"{restitution:g} is outside [0, 1]", "a number in [0, 1] (1: elastic)")

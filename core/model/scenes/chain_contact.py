@@ -42,9 +42,10 @@ class ContactSphere:
 
 @dataclass(frozen=True)
 class ChainContact:
-    """A chain's spheres against one plane, frictionless (issue #46, part 1): the plane pushes each sphere along its
-    normal only, never pulls, and nothing else touches (the spheres do not touch each other, the links have no other
-    collision geometry).
+    """A chain's spheres against one plane (issue #46, part 1): the plane pushes each sphere along its normal, never
+    pulls, and with Coulomb friction (``friction`` mu > 0) resists its slip along the plane within the cone
+    |f_t| <= mu f_n; nothing else touches (the spheres do not touch each other, the links have no other collision
+    geometry). Without friction (mu = 0, the default) it pushes along its normal only.
 
     The contact is soft or rigid, as the scene says:
 
@@ -73,6 +74,10 @@ class ChainContact:
     rest_speed : float
         [m/s] of a rigid contact, > 0: a rebound whose normal speed would be below it is plastic (without it a
         bouncing sphere's impacts accumulate without end, Zeno's bounces).
+    friction : float
+        mu >= 0, the Coulomb coefficient of every sphere on the plane (one coefficient: static and kinetic alike);
+        0 is a frictionless plane. A soft contact's only: a rigid one is frictionless (impacts with friction are part
+        2 of the issue).
     """
 
     plane: Plane
@@ -82,6 +87,7 @@ class ChainContact:
     rest_after: float | None = None
     restitution: float | None = None
     rest_speed: float = 1e-3
+    friction: float = 0.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "spheres", tuple(self.spheres))
@@ -91,6 +97,11 @@ class ChainContact:
             self._check_rigid()
         else:
             self._check_soft()
+        if not (np.isfinite(self.friction) and self.friction >= 0):
+            raise SceneError("<code>", "contact.friction", f"{self.friction}", "a Coulomb coefficient >= 0")
+        if self.rigid and self.friction > 0:
+            raise SceneError("<code>", "contact.friction", f"{self.friction} on a rigid contact",
+                             "friction on a soft contact (penalty_stiffness); a rigid contact is frictionless")
         if self.rest_after is not None and not (np.isfinite(self.rest_after) and self.rest_after > 0):
             raise SceneError("<code>", "contact.rest_after", f"{self.rest_after}", "a time > 0 [s]")
 

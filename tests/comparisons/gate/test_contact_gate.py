@@ -2,10 +2,11 @@
 bug (the plane's normal turned, so that it pulls; the contact forces reported with their sign flipped; MuJoCo's spheres
 twice as large, so that they touch early; one sphere's force left out of what is reported; MuJoCo's forces read without
 the applied torque; Pinocchio's impulses reported as forces; a Pinocchio contact that bounces, so that the arm never
-rests; PyBullet's spheres left with Bullet's default friction) turns the check of ``solo12-drop-stand``,
-``pendulum-press`` or ``arm-strike-press`` red naming it and the metric that sees it; faithful copies of MuJoCo and
-Pinocchio pass on all three, PyBullet's on the fixed-base two. A sweep (a run of the scene
-per bug), in ``.ci/run``."""
+rests; PyBullet's spheres left with Bullet's default friction; on a slope with friction: MuJoCo's contact without the
+friction or with its pyramidal cone, its friction reported on the wrong side, PyBullet's spheres given twice the
+friction or its cone friction off (a box), core's friction turned along the slip) turns the check of ``solo12-drop-stand``, ``pendulum-press``, ``arm-strike-press`` or
+``solo12-incline-slide`` red naming it and the metric that sees it; faithful copies of MuJoCo, Pinocchio and PyBullet
+pass on them and on ``solo12-incline-stand``. A sweep (a run of the scene per bug), in ``.ci/run``."""
 
 from __future__ import annotations
 
@@ -16,8 +17,11 @@ from tests.helpers import PLANTED_MOTION_FACTORY, assert_caught, run_planted
 PLANTED = PLANTED_MOTION_FACTORY + '''
 from dataclasses import replace
 
+import mujoco
 import numpy as np
 
+from simparity.core.articulated import stepping
+from simparity.core.articulated.chain_contact import ChainContactForces
 from simparity.core.articulated.chain_impulse import RigidContact
 from simparity.core.articulated.motion import CoreJointMotion
 from simparity.core.inhouse import InHouseEngine
@@ -122,6 +126,75 @@ class DefaultFriction(PybulletJointMotion):
                     pybullet.changeDynamics(body, link, lateralFriction=0.5, physicsClientId=world.client)
 
 
+class DoubleFriction(PybulletJointMotion):
+    """PyBullet's spheres given twice the scene's friction (the plane's own 1 replaced by 2: Bullet multiplies)."""
+
+    def __init__(self, scene, integrator, dt):
+        super().__init__(scene, dt)
+        for world, contact in ((self._world, self._contact), (self._probe, self._probe_contact)):
+            pybullet.changeDynamics(contact.plane, -1, lateralFriction=2.0, physicsClientId=world.client)
+
+
+class BoxFriction(PybulletJointMotion):
+    """PyBullet with its cone friction off (enableConeFriction 0): each friction row clamped alone, a box."""
+
+    def __init__(self, scene, integrator, dt):
+        super().__init__(scene, dt)
+        for world in (self._world, self._probe):
+            pybullet.setPhysicsEngineParameter(enableConeFriction=0, physicsClientId=world.client)
+
+
+class PushingForces(ChainContactForces):
+    """Core's penalty forces with the friction turned along the slip: restitution on the tangential velocity."""
+
+    def _state(self, q, qdot):
+        forces, arms, columns, rotation = super()._state(q, qdot)
+        normal = self._contact.plane.normal_world
+        along = (forces @ normal)[..., None] * normal
+        return along - (forces - along), arms, columns, rotation
+
+
+class PushingFriction(CoreJointMotion):
+    """Core stepping and reporting :class:`PushingForces`."""
+
+    def __init__(self, scene, scheme, dt):
+        original, stepping.ChainContactForces = stepping.ChainContactForces, PushingForces
+        try:
+            super().__init__(scene, scheme, dt)
+        finally:
+            stepping.ChainContactForces = original
+        self._contact = PushingForces(scene.chain, scene.contact)
+
+
+class NoFriction(MujocoJointMotion):
+    """MuJoCo's contact built without the scene's friction (condim 1 on every geom): the feet slide freely."""
+
+    def __init__(self, scene, integrator, dt):
+        super().__init__(scene, integrator, dt)
+        self.model.geom_condim[:] = 1
+
+
+class Pyramid(MujocoJointMotion):
+    """MuJoCo left with its default pyramidal cone: a friction pyramid inside the Coulomb cone, direction-dependent."""
+
+    def __init__(self, scene, integrator, dt):
+        super().__init__(scene, integrator, dt)
+        self.model.opt.cone = mujoco.mjtCone.mjCONE_PYRAMIDAL
+
+
+class WrongSideFriction(MujocoJointMotion):
+    """MuJoCo's friction reported as the force on the plane (its tangential part's sign flipped), the normal right."""
+
+    def __init__(self, scene, integrator, dt):
+        super().__init__(scene, integrator, dt)
+        self._normal = np.asarray(scene.contact.plane.normal_world)
+
+    def contact_forces(self, q, qdot, times):
+        forces = super().contact_forces(q, qdot, times)
+        along = (forces @ self._normal)[..., None] * self._normal
+        return along - (forces - along)
+
+
 class CoreCopy(CoreJointMotion):
     pass
 
@@ -147,6 +220,12 @@ CoreCopyEngine = _engine(InHouseEngine, CoreCopy, "core-copy")
 NoBackupEngine = _engine(InHouseEngine, NoBackup, "core-no-backup")
 PybulletCopyEngine = _engine(PybulletEngine, lambda scene, integrator, dt: PybulletCopy(scene, dt), "pybullet-copy")
 DefaultFrictionEngine = _engine(PybulletEngine, DefaultFriction, "pybullet-default-friction")
+DoubleFrictionEngine = _engine(PybulletEngine, DoubleFriction, "pybullet-double-friction")
+BoxFrictionEngine = _engine(PybulletEngine, BoxFriction, "pybullet-box-friction")
+PushingFrictionEngine = _engine(InHouseEngine, PushingFriction, "core-pushing-friction")
+NoFrictionEngine = _engine(MujocoEngine, NoFriction, "mujoco-no-friction")
+PyramidEngine = _engine(MujocoEngine, Pyramid, "mujoco-pyramid")
+WrongSideFrictionEngine = _engine(MujocoEngine, WrongSideFriction, "mujoco-wrong-side-friction")
 BouncingEngine = _engine(PinocchioEngine, Bouncing, "pinocchio-bouncing")
 PinocchioCopyEngine = _engine(PinocchioEngine, PinocchioCopy, "pinocchio-copy")
 ImpulsesAsForcesEngine = _engine(PinocchioEngine, ImpulsesAsForces, "pinocchio-impulses-as-forces")
@@ -173,6 +252,12 @@ def _run(tmp_path, monkeypatch, capsys, plugin: str, scene: str = "solo12-drop-s
     ("ImpulsesAsForcesEngine", "pinocchio-impulses-as-forces", "rest_weight_error", "solo12-drop-stand"),
     ("BouncingEngine", "pinocchio-bouncing", "rest_acceleration_max", "arm-strike-press"),
     ("DefaultFrictionEngine", "pybullet-default-friction", "friction_cone_violation_max", "arm-strike-press"),
+    ("DoubleFrictionEngine", "pybullet-double-friction", "friction_cone_violation_max", "solo12-incline-slide"),
+    ("BoxFrictionEngine", "pybullet-box-friction", "sliding_friction_error", "solo12-incline-slide"),
+    ("PushingFrictionEngine", "core-pushing-friction", "sliding_friction_angle_max", "solo12-incline-slide"),
+    ("NoFrictionEngine", "mujoco-no-friction", "sliding_friction_error", "solo12-incline-slide"),
+    ("PyramidEngine", "mujoco-pyramid", "sliding_friction_error", "solo12-incline-slide"),
+    ("WrongSideFrictionEngine", "mujoco-wrong-side-friction", "sliding_friction_angle_max", "solo12-incline-slide"),
     # (not on pendulum-strike: a plastic strike ends at rest on the plane, where a late impulse is put back at every
     # sample, so the missing back-up is not observable there)
     ("NoBackupEngine", "core-no-backup", "joint_angle_error_max", "pendulum-bounce"),
@@ -187,6 +272,8 @@ def test_a_planted_contact_bug_is_caught_naming_the_engine(tmp_path, monkeypatch
 @pytest.mark.parametrize("scene, plugin", [
     *((s, p) for s in ("solo12-drop-stand", "pendulum-press", "arm-strike-press")
       for p in ("FaithfulEngine", "PinocchioCopyEngine")),
+    *((s, p) for s in ("solo12-incline-stand", "solo12-incline-slide")
+      for p in ("FaithfulEngine", "PinocchioCopyEngine", "PybulletCopyEngine")),
     *(("pendulum-press", "PybulletCopyEngine"), ("arm-strike-press", "PybulletCopyEngine"),
       ("solo12-drop-stand", "PybulletCopyEngine")),
     *(("pendulum-bounce", "CoreCopyEngine"), ("pendulum-strike", "CoreCopyEngine"),

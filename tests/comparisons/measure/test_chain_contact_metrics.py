@@ -384,3 +384,64 @@ def test_each_copy_s_touchdown_is_held_to_its_own_fall(scene, integrator):
     two = replace(scene, q0=q0, qdot0=qdot0)
     values = _measured(two, CoreJointMotion, integrator, 0.002, 0.1)
     assert values[TOUCHDOWN_TIME_STEPS].value == pytest.approx(0.5, rel=EULER_SECOND_ORDER)
+
+
+SLIDE_SPEED = 0.5
+"""[m/s] The hand-made slide's speed downhill: above the sliding threshold 0.1 sqrt(g reach) (0.18 m/s on Solo-12)."""
+
+
+def _slide_states(slope, samples: int):
+    """A hand-made trajectory of ``slope``'s robot translating downhill at :data:`SLIDE_SPEED` without turning, and
+    each sphere's Coulomb friction for it at a normal force of a quarter of the weight: (traj, forces (S, 1, 4, 3),
+    weight, the downhill unit vector)."""
+    from simparity.core.model.trajectory import JointTrajectory
+
+    normal = np.asarray(slope.contact.plane.normal_world)
+    downhill = np.array([0.0, 0.0, -1.0]) + normal[2] * normal
+    downhill /= np.linalg.norm(downhill)
+    times = np.arange(samples) * 1e-3
+    q = np.tile(slope.q0, (samples, 1, 1))
+    q[:, 0, :3] += SLIDE_SPEED * times[:, None] * downhill
+    qdot = np.zeros((samples, 1, slope.chain.nv))
+    qdot[:, 0, :3] = SLIDE_SPEED * downhill
+    weight = slope.chain.mass * G
+    f_n = weight / 4
+    forces = np.tile(f_n * normal - slope.contact.friction * f_n * downhill, (samples, 1, 4, 1))
+    return JointTrajectory(times, q, qdot), forces, weight, downhill
+
+
+def _turned(forces: np.ndarray, normal: np.ndarray, angle: float) -> np.ndarray:
+    """``forces`` with their tangential part turned by ``angle`` [rad] about the plane's ``normal``."""
+    along = (forces @ normal)[..., None] * normal
+    t = forces - along
+    return along + np.cos(angle) * t + np.sin(angle) * np.cross(normal, t)
+
+
+@pytest.mark.parametrize("change, error, angle", [
+    (lambda f, n: f, 0.0, 0.0),
+    (lambda f, n: _turned(f, n, 0.3), 0.0, 0.3),  # on the cone, 0.3 rad off the slip: a per-direction solver
+    (lambda f, n: _turned(f, n, np.pi), 0.0, np.pi),  # pushing the slip
+    (lambda f, n: (f @ n)[..., None] * n, 1.0, 0.0),  # no friction at all (no angle: nothing to point)
+    (lambda f, n: f - 0.5 * (f - (f @ n)[..., None] * n), 0.5, 0.0),  # half of it
+])
+def test_a_sliding_contact_s_friction_is_read_against_coulomb_s(change, error, angle):
+    """The truth is Coulomb's law at the slip Pinocchio's model gives the state (a pure translation: every contact
+    point slips with the base), so these readings are the planted changes themselves."""
+    from simparity.comparisons.measure.chain_contact_metrics import _sliding
+
+    slope = load_scene("solo12-incline-slide")
+    traj, forces, weight, _ = _slide_states(slope, 3)
+    out = _sliding(slope, traj, np.arange(3), change(forces, np.asarray(slope.contact.plane.normal_world)), weight)
+    assert out["sliding_friction_error"].value == pytest.approx(error, abs=1e-12)
+    assert out["sliding_friction_angle_max"].value == pytest.approx(angle, abs=1e-6)
+
+
+def test_sliding_friction_is_n_a_on_a_frictionless_plane_and_where_nothing_slides(scene):
+    from simparity.comparisons.measure.chain_contact_metrics import _sliding
+
+    slope = load_scene("solo12-incline-slide")
+    traj, forces, weight, _ = _slide_states(slope, 3)
+    frictionless = replace(slope, contact=replace(slope.contact, friction=0.0))
+    assert "frictionless" in _sliding(frictionless, traj, np.arange(3), forces, weight)["sliding_friction_error"].unmeasurable
+    slow = replace(traj, qdot=traj.qdot * 0.1)  # 0.05 m/s: below the threshold
+    assert "slid faster" in _sliding(slope, slow, np.arange(3), forces, weight)["sliding_friction_angle_max"].unmeasurable

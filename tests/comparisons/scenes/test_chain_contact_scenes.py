@@ -51,7 +51,9 @@ def test_the_scene_reads_as_written(data):
     (lambda d: d["contact"]["sphere"][1].update(centre_xyz=[0.0, 0.0]), "contact.sphere[1].centre_xyz", "3 numbers"),
     (lambda d: d["contact"].update(penalty_stiffness=-1.0), "contact.penalty_stiffness", "> 0"),
     (lambda d: d["contact"].update(penalty_damping=-1.0), "contact.penalty_damping", ">= 0"),
-    (lambda d: d["contact"].update(friction=0.5), "contact.friction", "allowed"),
+    (lambda d: d["contact"].update(friction=-0.5), "contact.friction", ">= 0"),
+    (lambda d: d["contact"].update(friction=500.0), "contact.friction", "physical range"),
+    (lambda d: d["contact"].update(friction="0.5"), "contact.friction", "a number"),
     (lambda d: d["initial"].update(base_position=[0.0, 0.0, 0.33]), "contact.sphere[0]", "inside the plane"),
     (lambda d: d.pop("plane"), "contact", "without a [[plane]]"),
     (lambda d: d["plane"][0].update(coefficients=[0.0, 0.0, 0.0, 1.0]), "plane[0].coefficients", "all zeros"),
@@ -100,12 +102,18 @@ def test_a_rigid_contact_reads_as_written(rigid):
     (lambda d: d["contact"].update(rest_speed=0.0), "contact.rest_speed", "> 0"),
     (lambda d: d["contact"].update(penalty_stiffness=1e4), "contact.penalty_stiffness", "not both"),
     (lambda d: d["contact"].update(penalty_damping=10.0), "contact.penalty_damping", "not both"),
+    (lambda d: d["contact"].update(friction=0.5), "contact.friction", "a rigid contact's impacts are frictionless"),
 ])
 def test_a_meaningless_rigid_contact_is_refused_in_one_line_naming_its_key(rigid, edit, key, words):
     with pytest.raises(SceneError) as caught:
         parse_scene(_edited(rigid, edit), "bounce.toml")
     message = str(caught.value)
     assert key in message and words in message and "\n" not in message, message
+
+
+def test_friction_reads_as_written_and_defaults_to_a_frictionless_plane(data):
+    assert parse_scene(data).contact.friction == 0.0
+    assert parse_scene(_edited(data, lambda d: d["contact"].update(friction=0.6))).contact.friction == 0.6
 
 
 def test_a_rest_speed_on_a_soft_contact_is_refused(data):

@@ -109,7 +109,7 @@ def test_a_claimed_convergence_that_is_wrong_is_caught():
     assert ncp_residual(delassus, free, np.array([0.0, 0.0, 0.25])) <= 1e-15
     assert ncp_residual(delassus, free, np.array([0.0, 0.0, -0.1])) > NCP_RESIDUAL  # a pull
     with pytest.raises(DivergedError, match="do not solve the step"):
-        _check_answer(delassus, free, np.zeros(3))
+        _check_answer(delassus, free, np.zeros(3), 0.0)
 
 
 def test_polish_solves_the_pushed_contacts_exactly():
@@ -147,3 +147,21 @@ def test_pinocchio_s_pgs_miss_is_reproduced_standalone():
     assert slowest["PGS, friction 0"] < -0.1
     assert slowest["ADMM, friction 0"] > -STOPPED
     assert abs(slowest["exact (active sets)"]) < STOPPED
+
+
+@pytest.mark.parametrize("impulse, velocity, solves", [
+    ([0.0, 0.0, 0.0], [0.3, -0.2, 0.1], True),  # off and leaving
+    ([0.1, -0.05, 1.0], [0.0, 0.0, 0.0], True),  # sticking inside the cone
+    ([-0.3, -0.4, 1.0], [0.6, 0.8, 0.0], True),  # sliding on the cone (mu 0.5) against its slip
+    ([0.3, 0.4, 1.0], [0.6, 0.8, 0.0], False),  # on the cone along its slip: friction pushing
+    ([-0.6, -0.8, 1.0], [0.6, 0.8, 0.0], False),  # outside the cone (twice mu)
+    ([-0.4, -0.3, 1.0], [0.6, 0.8, 0.0], False),  # on the cone, 16 degrees off its slip
+    ([0.0, 0.0, 1.0], [0.0, 0.0, -0.1], False),  # pushed and still sinking
+])
+def test_the_coulomb_residual_is_zero_exactly_where_coulomb_s_law_holds(impulse, velocity, solves):
+    """The natural map of Coulomb's problem (De Saxce's form) at mu = 0.5, one contact, G = I: g = sigma - lambda."""
+    from simparity.references.pinocchio.contact import ncp_residual
+
+    lam, sigma = np.array(impulse), np.array(velocity)
+    residual = ncp_residual(np.eye(3), sigma - lam, lam, 0.5)
+    assert (residual <= 1e-15) == solves, residual

@@ -42,7 +42,7 @@ def test_the_spheres_weigh_nothing_and_take_every_contact_default(arm):
         assert with_sphere[0] == without[0] and with_sphere[2] == without[2]  # mass, principal moments
     for link in set(contact.links):
         info = pybullet.getDynamicsInfo(world.body, link, physicsClientId=c)
-        assert (info[1], info[5], info[6], info[7]) == (SPHERE_DYNAMICS["lateralFriction"],
+        assert (info[1], info[5], info[6], info[7]) == (arm.contact.friction,
                                                         SPHERE_DYNAMICS["restitution"],
                                                         SPHERE_DYNAMICS["rollingFriction"],
                                                         SPHERE_DYNAMICS["spinningFriction"]) == (0.0, 0.0, 0.0, 0.0)
