@@ -8,6 +8,10 @@ another's trajectory; each is held to what any correct contact must give:
   sphere's gap closing as h + v t + 1/2 a t^2 (a = g . N, v the base's velocity along N), so the first sphere touches at
   the closed-form time; the engine's touchdown is where its own sphere centres, extrapolated from its last two samples
   before any sphere touches by the same law, reach the plane. Relative to the closed-form time.
+- ``contact_centre_error``: the engine's sphere centres (those it measures every gap by) where the robot file puts
+  them, by Pinocchio's forward kinematics of the file at the same configurations (an independent model): the largest
+  distance over the radius. A sphere read off its frame (a link's inertial frame taken for its link frame) is off
+  by O(0.1-1) of its radius while still well inside the penetration bound.
 - ``contact_penetration_max``: the deepest a sphere sinks into the plane, relative to its radius (soft contact
   penetrates by its own stiffness; past 1 a sphere has gone through).
 - ``signorini_violation_max``: a plane pushes a touching sphere and nothing else: max of a pull (-f.N)^+ and of a force
@@ -52,7 +56,8 @@ from simparity.comparisons.common.error_text import error_text
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointSimulation
 from simparity.core.model.metric_catalogue import (
-    CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, FRICTION_CONE_VIOLATION_MAX, REST_ACCELERATION_MAX,
+    CONTACT_CENTRE_ERROR, CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, FRICTION_CONE_VIOLATION_MAX,
+    REST_ACCELERATION_MAX,
     REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR, SIGNORINI_VIOLATION_MAX, SLIDING_FRICTION_ANGLE_MAX,
     SLIDING_FRICTION_ERROR, TOUCHDOWN_TIME_ERROR, TOUCHDOWN_TIME_STEPS,
 )
@@ -203,6 +208,23 @@ def _forces(scene: JointMotionScene, contact: ChainContact, forces: np.ndarray, 
             FRICTION_CONE_VIOLATION_MAX: Measured(float(outside.max()) / weight, "1", note=(
                 "tangential force on a frictionless plane, over the weight" if contact.friction == 0 else
                 f"tangential force beyond the Coulomb cone (mu = {contact.friction:g}), over the weight"))}
+
+
+def _centre_error(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, centres: np.ndarray) -> Measured:
+    """``contact_centre_error``: the engine's sphere centres (S, B, spheres, 3) at the samples ``index`` against
+    Pinocchio's forward kinematics of the file at the same configurations, the largest distance over the radius."""
+    contact = scene.contact
+    assert contact is not None
+    try:
+        from simparity.references.pinocchio.statics import PinocchioStatics
+        truth = PinocchioStatics(scene.chain, scene.gravity_world, contact).centres(_states(traj, index)[0])
+    except Exception as err:  # noqa: BLE001 - not installed, or Pinocchio refuses the chain
+        return Measured(math.nan, "1", unmeasurable=(
+            f"the spheres' places are read by Pinocchio's model of the chain, which cannot be built here: "
+            f"{error_text(err)}"))
+    off = np.linalg.norm(centres - truth.reshape(centres.shape), axis=-1) / contact.radii
+    return Measured(float(off.max()), "1", note="the engine's sphere centres against Pinocchio's kinematics of the "
+                                                "file, over the radius")
 
 
 def _sliding(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, forces: np.ndarray,
@@ -373,10 +395,12 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
     assert contact is not None
     index = own.index
     try:
-        gaps = contact.gaps(_centres(sim, traj, index, len(contact.spheres)))  # (S, B, spheres)
+        centres = _centres(sim, traj, index, len(contact.spheres))  # (S, B, spheres, 3)
     except NotImplementedError as err:
         return {m: Measured(math.nan, "1", unmeasurable=str(err)) for m in CHAIN_CONTACT_METRICS}
+    gaps = contact.gaps(centres)
     out = _touchdown(scene, sim, traj, index, gaps) | {
+        CONTACT_CENTRE_ERROR: _centre_error(scene, traj, index, centres),
         REST_ACCELERATION_MAX: _rest_acceleration(scene, traj, index),
         CONTACT_PENETRATION_MAX: Measured(float(np.maximum(-gaps / contact.radii, 0.0).max()), "1",
                                           note="deepest sinking over the sphere's radius"),

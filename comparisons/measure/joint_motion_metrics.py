@@ -27,7 +27,8 @@ from simparity.comparisons.measure.metrics import (
 from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointSimulation
 from simparity.core.model.metric_catalogue import (
-    CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, END_EFFECTOR_ERROR_MAX,
+    CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX, CONTACT_CENTRE_ERROR, CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX,
+    END_EFFECTOR_ERROR_MAX,
     FRICTION_CONE_VIOLATION_MAX, REST_ACCELERATION_MAX, REST_EQUILIBRIUM_ERROR, REST_WEIGHT_ERROR, SIGNORINI_VIOLATION_MAX,
     SLIDING_FRICTION_ANGLE_MAX, SLIDING_FRICTION_ERROR,
     TOUCHDOWN_TIME_ERROR, TOUCHDOWN_TIME_STEPS, ENERGY_DRIFT_MAX, EVALUATIONS_PER_SECOND,
@@ -55,7 +56,8 @@ JOINT_MOTION_METRICS = units(
 """Every metric a joint-motion case may have; :func:`motion_metrics` those of one scene."""
 MOMENTUM_METRICS = units(LINEAR_MOMENTUM_DRIFT_MAX, CHAIN_ANGULAR_MOMENTUM_DRIFT_MAX)
 """Of a floating base: its momentum against the laws it obeys under joint forces alone (:func:`momentum_metrics`)."""
-CHAIN_CONTACT_METRICS = units(TOUCHDOWN_TIME_ERROR, TOUCHDOWN_TIME_STEPS, CONTACT_PENETRATION_MAX, SIGNORINI_VIOLATION_MAX,
+CHAIN_CONTACT_METRICS = units(TOUCHDOWN_TIME_ERROR, TOUCHDOWN_TIME_STEPS, CONTACT_CENTRE_ERROR, CONTACT_PENETRATION_MAX,
+                              SIGNORINI_VIOLATION_MAX,
                               FRICTION_CONE_VIOLATION_MAX, SLIDING_FRICTION_ERROR, SLIDING_FRICTION_ANGLE_MAX,
                               CONTACT_ENERGY_GAIN_MAX, REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR, REST_ACCELERATION_MAX)
 """Of a scene with contact (in place of its energy drift or power balance): truths that need no engine

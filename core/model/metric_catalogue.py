@@ -175,6 +175,7 @@ CONTACT_PENETRATION_MAX = "contact_penetration_max"
 SIGNORINI_VIOLATION_MAX = "signorini_violation_max"
 FRICTION_CONE_VIOLATION_MAX = "friction_cone_violation_max"
 SLIDING_FRICTION_ERROR = "sliding_friction_error"
+CONTACT_CENTRE_ERROR = "contact_centre_error"
 SLIDING_FRICTION_ANGLE_MAX = "sliding_friction_angle_max"
 CONTACT_ENERGY_GAIN_MAX = "contact_energy_gain_max"
 REST_WEIGHT_ERROR = "rest_weight_error"
@@ -308,6 +309,9 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
            theory="the touchdown's error in the fall's first-order shift (dt a t_c / v_c): semi-implicit Euler "
                   "touches down half of it early and explicit Euler half late in any scene; RK4 and the midpoint "
                   "rule: 0"),
+    Metric(CONTACT_CENTRE_ERROR, DIMENSIONLESS, CONTACT,
+           theory="the engine's spheres where the robot file puts them (an independent model's kinematics): 0 up to "
+                  "rounding"),
     Metric(CONTACT_PENETRATION_MAX, DIMENSIONLESS, CONTACT,
            theory="soft contact penetrates: each engine's own stiffness; past 1 a sphere has sunk through its radius"),
     Metric(SIGNORINI_VIOLATION_MAX, DIMENSIONLESS, CONTACT,

@@ -65,6 +65,15 @@ class PinocchioStatics:
             out[b] = pin.rnea(m, d, configuration, zero, zero, external)[self._index]
         return turned_base(base_rotations(q), out, True, True) if self._floating else out
 
+    def centres(self, q: np.ndarray) -> np.ndarray:
+        """(B, S, 3) [m] the spheres' centres in the world at q (B, nq) by Pinocchio's ``forwardKinematics``."""
+        m, d = self._model, self._data
+        out = np.empty((len(q), len(self._joints), 3))
+        for b, row in enumerate(np.asarray(q, dtype=float)):
+            pin.forwardKinematics(m, d, self._configuration(row))
+            out[b] = [d.oMi[joint].act(point) for joint, point in zip(self._joints, self._points)]
+        return out
+
     def contact_point_velocities(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
         """(B, S, 3) [m/s] in world axes: the velocity of each sphere's contact point, the point of its link at
         ``centre - radius N``, at the states q (B, nq), qdot (B, nv) (the project's convention), by Pinocchio's

@@ -1,6 +1,7 @@
 """Issue #46's planted contact bugs through the gate: a user's engine that is core or MuJoCo's adapter with one planted
 bug (the plane's normal turned, so that it pulls; the contact forces reported with their sign flipped; MuJoCo's spheres
-twice as large, so that they touch early; one sphere's force left out of what is reported; MuJoCo's forces read without
+twice as large, so that they touch early; one sphere's force left out of what is reported; MuJoCo's spheres reported
+from their bodies' centres of mass; MuJoCo's forces read without
 the applied torque; Pinocchio's impulses reported as forces; a Pinocchio contact that bounces, so that the arm never
 rests; PyBullet's spheres left with Bullet's default friction; on a slope with friction: MuJoCo's contact without the
 friction or with its pyramidal cone, its friction reported on the wrong side, PyBullet's spheres given twice the
@@ -72,6 +73,22 @@ class WithoutTorque(MujocoJointMotion):
     def contact_forces(self, q, qdot, times):
         return self._contact.forces(self._qpos, self._dof, q, self._own(q, qdot),
                                     np.zeros((len(q), self.model.nv)))
+
+
+class ComCentres(MujocoJointMotion):
+    """MuJoCo's sphere centres reported from each body's centre of mass instead of its frame (xipos for xpos), its
+    dynamics right."""
+
+    def contact_centres(self, q):
+        reader, m = self._contact, self.model
+        bodies = m.geom_bodyid[reader._geoms]
+        out = np.empty((len(q), len(bodies), 3))
+        for b, row in enumerate(np.asarray(q, dtype=float)):
+            reader._set(self._qpos, self._dof, row, None)
+            mujoco.mj_kinematics(m, reader._data)
+            d = reader._data
+            out[b] = d.geom_xpos[reader._geoms] - d.xpos[bodies] + d.xipos[bodies]
+        return out
 
 
 class LostSphere(MujocoJointMotion):
@@ -233,6 +250,7 @@ PullingEngine = _engine(InHouseEngine, Pulling, "core-pulling")
 FlippedForcesEngine = _engine(MujocoEngine, FlippedForces, "mujoco-flipped-forces")
 FatSpheresEngine = _engine(MujocoEngine, FatSpheres, "mujoco-fat-spheres")
 LostSphereEngine = _engine(MujocoEngine, LostSphere, "mujoco-lost-sphere")
+ComCentresEngine = _engine(MujocoEngine, ComCentres, "mujoco-com-centres")
 WithoutTorqueEngine = _engine(MujocoEngine, WithoutTorque, "mujoco-without-torque")
 '''
 
@@ -248,6 +266,7 @@ def _run(tmp_path, monkeypatch, capsys, plugin: str, scene: str = "solo12-drop-s
     ("FlippedForcesEngine", "mujoco-flipped-forces", "signorini_violation_max", "solo12-drop-stand"),
     ("FatSpheresEngine", "mujoco-fat-spheres", "signorini_violation_max", "solo12-drop-stand"),
     ("LostSphereEngine", "mujoco-lost-sphere", "rest_weight_error", "solo12-drop-stand"),
+    ("ComCentresEngine", "mujoco-com-centres", "contact_centre_error", "pendulum-press"),
     ("WithoutTorqueEngine", "mujoco-without-torque", "rest_equilibrium_error", "pendulum-press"),
     ("ImpulsesAsForcesEngine", "pinocchio-impulses-as-forces", "rest_weight_error", "solo12-drop-stand"),
     ("BouncingEngine", "pinocchio-bouncing", "rest_acceleration_max", "arm-strike-press"),
