@@ -416,8 +416,8 @@ def _joint_motion_scene(scene: JointMotionScene, t: Transform) -> JointMotionSce
 def _chain_contact(scene: JointMotionScene, contact: ChainContact, t: Transform) -> ChainContact:
     """The plane moved with the world; each sphere scaled in its link's frame (the frames move with the chain), one on
     a fixed base's link placed as a world point (that frame is the world's); core's penalty constants in the new
-    units (N/m = kg/s^2, N s/m = kg/s); the time from which the robot rests in the new unit of time, a rigid contact's
-    rest speed in the new units (its restitution has none)."""
+    units (N/m = kg/s^2, N s/m = kg/s) and its friction's regularisation speed; the time from which the robot rests in
+    the new unit of time, a rigid contact's rest speed in the new units (its restitution and the friction have none)."""
     names = tuple(j.name for j in scene.chain.joints)
     chain = scene.chain
 
@@ -430,7 +430,8 @@ def _chain_contact(scene: JointMotionScene, contact: ChainContact, t: Transform)
                    penalty_stiffness=_scaled(t.factor(mass=1, time=-2), contact.penalty_stiffness),
                    penalty_damping=_scaled(t.factor(mass=1, time=-1), contact.penalty_damping),
                    rest_after=_scaled(t.factor(time=1), contact.rest_after),
-                   rest_speed=t.factor(length=1, time=-1) * contact.rest_speed)
+                   rest_speed=t.factor(length=1, time=-1) * contact.rest_speed,
+                   friction_speed=t.factor(length=1, time=-1) * contact.friction_speed)
 
 
 def _scaled(factor: float, value: float | None) -> float | None:

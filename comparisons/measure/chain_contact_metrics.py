@@ -61,7 +61,7 @@ from simparity.core.model.metric_catalogue import (
     REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR, SIGNORINI_VIOLATION_MAX, SLIDING_FRICTION_ANGLE_MAX,
     SLIDING_FRICTION_ERROR, TOUCHDOWN_TIME_ERROR, TOUCHDOWN_TIME_STEPS,
 )
-from simparity.core.model.results import NOTHING_TO_MEASURE
+from simparity.core.model.results import NOT_AT_REST, NOTHING_TO_MEASURE
 from simparity.core.model.scenes.chain_contact import ChainContact
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
@@ -262,8 +262,9 @@ def _sliding(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, 
     f_t, bound = tangential[:-1][held], contact.friction * f_n[:-1][held]
     size = np.linalg.norm(f_t, axis=-1)
     pointing = size > FRICTION_ROUNDING * bound  # a friction at rounding has no direction to judge
-    against = -np.sum(f_t * direction[:-1][held], axis=-1) / np.where(pointing, size, 1.0)
-    angle = np.where(pointing, np.arccos(np.clip(against, -1.0, 1.0)), 0.0)
+    back = -direction[:-1][held]  # atan2 of |f x s| and f . s: exact near 0 and pi, where arccos loses half the digits
+    angle = np.where(pointing, np.arctan2(np.linalg.norm(np.cross(f_t, back), axis=-1),
+                                          np.sum(f_t * back, axis=-1)), 0.0)
     note = f"{int(held.sum())} sliding instants (slip >= {threshold:.3g} m/s)"
     return {SLIDING_FRICTION_ERROR: Measured(float((np.abs(size - bound) / bound).max()), "1",
                                              note=f"||f_t| - mu f_n| / (mu f_n) over {note}"),
@@ -285,7 +286,9 @@ def _rest(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, 
     acceleration = float(np.linalg.norm(momentum[1, :, :3] - momentum[0, :, :3], axis=-1).max()) / (mass * interval)
     g = float(np.linalg.norm(np.asarray(scene.gravity_world)))
     if acceleration > REST_ACCELERATION * g:
-        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=(
+        contact = scene.contact
+        assert contact is not None
+        return Measured(math.nan, "1", flag=NOT_AT_REST if contact.stands else NOTHING_TO_MEASURE, unmeasurable=(
             f"not at rest at the end: the centre of mass accelerates {acceleration / g:.3g} g over the last sampled "
             f"interval (rest: at most {REST_ACCELERATION:g} g)"))
     residual = forces[-1].sum(axis=1) + mass * np.asarray(scene.gravity_world)
@@ -344,7 +347,7 @@ def _equilibrium(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarr
                  weight: float, rest: Measured) -> Measured:
     """``rest_equilibrium_error`` at the last sample (see the module docstring); n/a with why when not at rest."""
     if scene.chain.floating_base and rest.unmeasurable:
-        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=rest.unmeasurable)
+        return Measured(math.nan, "1", flag=rest.flag or NOTHING_TO_MEASURE, unmeasurable=rest.unmeasurable)
     moving = _joints_at_rest(scene, traj, index)
     if moving:
         return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=moving)

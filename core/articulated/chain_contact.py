@@ -8,8 +8,9 @@ force J^T F summed over spheres, with J the Jacobian of the centre: on a joint, 
 joint, a_j . F for a prismatic one (joints between the base and the sphere's frame); on a floating base, the force
 itself and its moment (p - x_base) x F about the base origin, in world axes. With the scene's friction mu > 0 the
 plane also resists the slip u_t of the contact point (the sphere's link's point at ``c - r N``, where the engines put
-it too) with the penalty method's regularised Coulomb friction -mu |F_n| u_t / max(|u_t|, v_reg)
-(:func:`core.contact.particle.sliding_friction`, as the free bodies'), and the whole force acts there; without
+it too) with the penalty method's regularised Coulomb friction -mu |F_n| u_t / max(|u_t|, v_reg), v_reg the scene's
+``friction_speed`` (:func:`core.contact.particle.sliding_friction`, as the free bodies'), and the whole force acts
+there; without
 friction nothing acts along the plane.
 """
 
@@ -136,7 +137,7 @@ class ChainContactForces:
             raise ValueError("a rigid contact has no penalty forces (core.articulated.chain_impulse steps it)")
         forces = penalty_force(centres + self._lowest, velocities, c.plane, c.penalty_stiffness, c.penalty_damping)
         if c.friction > 0:
-            forces = forces - sliding_friction(forces, velocities, c.plane.normal_world, c.friction)
+            forces = forces - sliding_friction(forces, velocities, c.plane.normal_world, c.friction, c.friction_speed)
         return forces, arms, columns, rotation
 
     def forces_world(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:

@@ -13,7 +13,6 @@ from simparity.core.articulated.floating import FloatingRecursiveDynamics
 from simparity.core.articulated.model import RecursiveDynamics
 from simparity.core.articulated.recursive import Recursive
 from simparity.core.articulated.step_jacobian import step_jacobian
-from simparity.core.contact.particle import FRICTION_REGULARISATION_SPEED
 from simparity.core.kinematics import forward_kinematics
 from simparity.core.model.derivatives import StepJacobian
 from simparity.core.model.engine import BatchedRun, JointSimulation
@@ -168,7 +167,7 @@ def _contact_detail(scene: JointMotionScene) -> str:
                 f"{contact.rest_speed:g} m/s, then resting), time backed up to each impact, through J M^-1 J^T, "
                 "one contact at a time, frictionless")
     friction = (f"regularised Coulomb friction mu = {contact.friction:g} (full above a slip of "
-                f"{FRICTION_REGULARISATION_SPEED:g} m/s) at the contact point" if contact.friction > 0 else "frictionless")
+                f"{contact.friction_speed:g} m/s) at the contact point" if contact.friction > 0 else "frictionless")
     return (f"; contact by the penalty method at each sphere, k_s = {contact.penalty_stiffness:g} N/m, k_d = "
             f"{contact.penalty_damping:g} N s/m, {friction}, through ABA as J^T F")
 

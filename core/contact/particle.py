@@ -32,14 +32,15 @@ friction creeps at ~v_reg |g_t| / (mu_k |g_n|)."""
 
 
 def sliding_friction(normal_force: np.ndarray, velocity: np.ndarray, normal: np.ndarray,
-                     mu: float | np.ndarray) -> np.ndarray:
-    """The penalty method's regularised Coulomb friction, negated: mu |F_n| u_t / max(|u_t|, v_reg)
-    (:data:`FRICTION_REGULARISATION_SPEED`), u_t the tangential part of ``velocity`` (..., 3) [m/s] along the plane
+                     mu: float | np.ndarray, speed: float = FRICTION_REGULARISATION_SPEED) -> np.ndarray:
+    """The penalty method's regularised Coulomb friction, negated: mu |F_n| u_t / max(|u_t|, v_reg), v_reg the
+    regularisation ``speed`` [m/s] (:data:`FRICTION_REGULARISATION_SPEED` by default), u_t the tangential part of
+    ``velocity`` (..., 3) [m/s] along the plane
     of unit ``normal`` (3,), ``normal_force`` F_n (..., 3) [N], ``mu`` broadcasting against them. The friction force is
     minus this [N]: opposite the slip, on the cone |f_t| = mu |F_n| once the slip is faster than v_reg, inside it
     below."""
     u_t = velocity - (velocity @ normal)[..., None] * normal
-    slip = np.maximum(vector_lengths(u_t), FRICTION_REGULARISATION_SPEED)
+    slip = np.maximum(vector_lengths(u_t), speed)
     return mu * vector_lengths(normal_force) * u_t / slip
 
 

@@ -97,6 +97,7 @@ RANGES = {
     "friction_static": Range(0.0, 1e2, "1", "a Coulomb coefficient (rubber on rough concrete is ~1)"),
     "friction_kinetic": Range(0.0, 1e2, "1", "a Coulomb coefficient (rubber on rough concrete is ~1)"),
     "friction": Range(0.0, 1e2, "1", "a Coulomb coefficient (rubber on rough concrete is ~1)"),
+    "friction_speed": Range(1e-9, 1e3, "m/s", "a slip speed, from creep to a fast vehicle's"),
     # time functions (core.model.scenes.time_functions): their values are forces [N] or torques [N m]
     "period": Range(1e-9, 1e7, "s", "a control period from a nanosecond to four months, like a scene's duration"),
     "phase": Range(0.0, 1e7, "s", "the first sample instant, within the first control period"),

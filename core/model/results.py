@@ -57,6 +57,7 @@ SATURATED, ROUNDING_FLOOR, PRE_ASYMPTOTIC, SUPERCONVERGENT, BELOW_THEORY, NOT_CO
     "saturated", "rounding-floor", "pre-asymptotic", "superconvergent", "below-theory", "not-converging",
     "nothing-to-measure")
 UNSOLVED = "unsolved"
+NOT_AT_REST = "not-at-rest"
 FLAGS = {
     SATURATED: "n/a: the error is as large as the quantity it measures (the run is on another orbit, or an "
                "orientation is lost): it no longer measures how far; the detail names the scale",
@@ -73,6 +74,9 @@ FLAGS = {
                     "the gate fails it unless a bound names it",
     NOTHING_TO_MEASURE: "n/a: the physics of this run offers nothing to measure (no impact, no motion, a quantity "
                         "that is 0)",
+    NOT_AT_REST: "n/a, and an alarm: a robot whose scene says it stands ([contact] stands) is not at rest at the end "
+                 "(it slides, creeps or chatters), so its rest checks cannot be measured; the gate fails it unless a "
+                 "bound names it",
     UNSOLVED: "n/a: an IK solver that solves none of the scene's reachable targets: a rate of 0 measures a stopping "
               "rule or a cap it does not meet, not how well it solves (the detail gives its median residuals)",
 }
@@ -80,7 +84,7 @@ FLAGS = {
 number would mean nothing, and what an ok order fit shows beside theory. The report's findings and the gate read
 them; nobody parses the detail."""
 
-ALARM_FLAGS = (NOT_CONVERGING,)
+ALARM_FLAGS = (NOT_CONVERGING, NOT_AT_REST)
 """Flags that are a violation of every bound that does not name them (``na_when``): n/a, but not an honest one."""
 
 DIMENSIONLESS = "1"

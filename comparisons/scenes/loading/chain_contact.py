@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from simparity.comparisons.scenes.loading.contact import START_INSIDE_TOLERANCE
@@ -13,7 +15,8 @@ from simparity.core.model.scenes.chain_contact import ChainContact, ContactSpher
 from simparity.core.model.scenes.contact import Plane
 
 _PLANE = ("name", "coefficients")
-_CONTACT = ("penalty_stiffness", "penalty_damping", "restitution", "rest_speed", "rest_after", "friction", "sphere")
+_CONTACT = ("penalty_stiffness", "penalty_damping", "restitution", "rest_speed", "rest_after", "stands", "friction",
+            "friction_speed", "sphere")
 _SPHERE = ("frame", "centre_xyz", "radius")
 
 
@@ -66,6 +69,11 @@ def read_chain_contact(top: TableReader, chain: Chain, q0: np.ndarray, duration:
                      "a time [s] inside the scene's duration, from which its robot is at rest")
     contact = (_rigid(c, plane, tuple(spheres), rest_after) if c.has("restitution") else
                _soft(c, chain, plane, tuple(spheres), rest_after))
+    if c.has("stands"):
+        if not chain.floating_base:
+            raise c.fail("stands", "a fixed base", "stands on a floating base (a fixed base's mount carries an unknown "
+                                                   "share of the weight: its rest checks are the joints')")
+        contact = replace(contact, stands=c.boolean("stands", False))
     _check_start_outside(top, chain, contact, q0)
     return contact
 
@@ -78,12 +86,14 @@ def _soft(c: TableReader, chain: Chain, plane: Plane, spheres: tuple[ContactSphe
     friction = c.number("friction", 0.0)
     if friction < 0:
         raise c.fail("friction", f"{friction:g} is negative", "a Coulomb coefficient >= 0 (0: a frictionless plane)")
+    friction_speed = c.number("friction_speed", 1e-2, positive=True, length=1)  # m/s
     stiffness = c.number("penalty_stiffness", positive=True)  # N/m = kg / s^2: no length
     damping = (c.number("penalty_damping") if c.has("penalty_damping")
                else 2.0 * float(np.sqrt(stiffness * chain.mass)))  # critical on the robot's mass, N s/m = kg / s
     if damping < 0:
         raise c.fail("penalty_damping", f"{damping:g} is negative", "a number >= 0 [N s/m]")
-    return ChainContact(plane, spheres, stiffness, damping, rest_after, friction=friction)
+    return ChainContact(plane, spheres, stiffness, damping, rest_after, friction=friction,
+                        friction_speed=friction_speed)
 
 
 def _rigid(c: TableReader, plane: Plane, spheres: tuple[ContactSphere, ...], rest_after: float | None) -> ChainContact:
@@ -92,9 +102,12 @@ def _rigid(c: TableReader, plane: Plane, spheres: tuple[ContactSphere, ...], res
         if c.has(key):
             raise c.fail(key, "a penalty spring on a rigid contact (restitution is given)",
                          "either restitution (rigid: impulses) or penalty_stiffness (soft: springs), not both")
-    if c.has("friction"):
+    if c.has("friction") and c.number("friction") != 0:
         raise c.fail("friction", "friction on a rigid contact (restitution is given)",
                      "friction on a soft contact (penalty_stiffness): a rigid contact's impacts are frictionless")
+    if c.has("friction_speed"):
+        raise c.fail("friction_speed", "a friction speed on a rigid contact (restitution is given)",
+                     "friction_speed with friction on a soft contact (penalty_stiffness)")
     restitution = c.number("restitution")
     if not 0 <= restitution <= 1:
         raise c.fail("restitution", f"{restitution:g} is outside [0, 1]", "a number in [0, 1] (1: elastic)")

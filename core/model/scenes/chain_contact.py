@@ -78,6 +78,14 @@ class ChainContact:
         mu >= 0, the Coulomb coefficient of every sphere on the plane (one coefficient: static and kinetic alike);
         0 is a frictionless plane. A soft contact's only: a rigid one is frictionless (impacts with friction are part
         2 of the issue).
+    stands : bool
+        The scene's author says the robot comes to rest by the end of the run (on a slope: its friction holds it), so
+        that the rest checks must be measured: a robot not at rest is then an alarm (``not-at-rest``), not n/a. Unlike
+        ``rest_after`` it asks nothing of the joints' motion before the end.
+    friction_speed : float
+        [m/s] > 0, core's penalty friction's regularisation: the slip above which it is the full Coulomb force (below
+        it grows linearly; a held foot creeps at ~friction_speed tan / mu). A constant of core's model like
+        ``penalty_stiffness``, a scene input so that it changes with the scene's units.
     """
 
     plane: Plane
@@ -88,6 +96,8 @@ class ChainContact:
     restitution: float | None = None
     rest_speed: float = 1e-3
     friction: float = 0.0
+    friction_speed: float = 1e-2
+    stands: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "spheres", tuple(self.spheres))
@@ -99,6 +109,8 @@ class ChainContact:
             self._check_soft()
         if not (np.isfinite(self.friction) and self.friction >= 0):
             raise SceneError("<code>", "contact.friction", f"{self.friction}", "a Coulomb coefficient >= 0")
+        if not (np.isfinite(self.friction_speed) and self.friction_speed > 0):
+            raise SceneError("<code>", "contact.friction_speed", f"{self.friction_speed}", "a speed > 0 [m/s]")
         if self.rigid and self.friction > 0:
             raise SceneError("<code>", "contact.friction", f"{self.friction} on a rigid contact",
                              "friction on a soft contact (penalty_stiffness); a rigid contact is frictionless")

@@ -275,6 +275,7 @@ def _run(tmp_path, monkeypatch, capsys, plugin: str, scene: str = "solo12-drop-s
     ("BoxFrictionEngine", "pybullet-box-friction", "sliding_friction_error", "solo12-incline-slide"),
     ("PushingFrictionEngine", "core-pushing-friction", "sliding_friction_angle_max", "solo12-incline-slide"),
     ("NoFrictionEngine", "mujoco-no-friction", "sliding_friction_error", "solo12-incline-slide"),
+    ("NoFrictionEngine", "mujoco-no-friction", "rest_weight_error", "solo12-incline-stand"),  # it slides: not-at-rest
     ("PyramidEngine", "mujoco-pyramid", "sliding_friction_error", "solo12-incline-slide"),
     ("WrongSideFrictionEngine", "mujoco-wrong-side-friction", "sliding_friction_angle_max", "solo12-incline-slide"),
     # (not on pendulum-strike: a plastic strike ends at rest on the plane, where a late impulse is put back at every

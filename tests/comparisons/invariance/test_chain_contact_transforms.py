@@ -24,22 +24,25 @@ def _centres(chain, contact, q: np.ndarray) -> np.ndarray:
     """(B, S, 3) the spheres' centres by core's FK at configurations q (B, nq)."""
     return ChainContactForces(chain, contact).centres_world(np.asarray(q).T)
 
-def _scene() -> JointMotionScene:
+def _scene(friction: float = 0.0) -> JointMotionScene:
     link = LinkInertia(1.0, np.array([0.15, 0.0, 0.0]), np.diag([1e-4, 7.5e-3, 7.5e-3]))
     joints = (Joint("hinge", "revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.eye(3), link=link),
               Joint("slide", "prismatic", np.array([1.0, 0.0, 0.0]), np.array([0.3, 0.0, 0.0]), np.eye(3),
                     lower=-0.1, upper=0.1, link=link))
     spheres = (ContactSphere("tip", np.zeros(3), 0.02), ContactSphere("hinge", np.array([0.2, 0.0, 0.0]), 0.03),
                ContactSphere("base", np.array([0.0, -0.3, 0.0]), 0.05))
-    contact = ChainContact(Plane(np.array([0.0, 1.0, 0.0]), 0.3), spheres, 1e4, 50.0)
+    contact = ChainContact(Plane(np.array([0.0, 1.0, 0.0]), 0.3), spheres, 1e4, 50.0, friction=friction,
+                           friction_speed=1.0)  # faster than the case's slips: core's friction in its linear part
     chain = Chain("arm", joints, "tip", np.array([0.1, 0.0, 0.0]), base_link="base")
     return JointMotionScene("press", "", "core", chain, np.array([0.0, -9.81, 0.0]), np.array([[-0.8, 0.05]]),
                             np.zeros((1, 2)), np.zeros(2), 1.0, (0.01,), contact=contact)
 
 
+@pytest.mark.parametrize("friction", [0.0, 0.5])
 @pytest.mark.parametrize("transform", [t for t in FIXED_TRANSFORMS if t.name != "permute"], ids=lambda t: t.name)
-def test_gaps_and_forces_are_the_same_in_every_frame_and_unit(transform):
-    scene = _scene()
+def test_gaps_and_forces_are_the_same_in_every_frame_and_unit(transform, friction):
+    """With friction too: core's regularisation speed is a scene input, converted with the units."""
+    scene = _scene(friction)
     moved = transform_scene(scene, transform)
     q, qdot = scene.q0, np.array([[0.3, -0.02]])
     powers = scene.chain.length_powers
@@ -49,6 +52,9 @@ def test_gaps_and_forces_are_the_same_in_every_frame_and_unit(transform):
     gaps_moved = moved.contact.gaps(_centres(moved.chain, moved.contact, q_moved))
     np.testing.assert_allclose(gaps_moved, transform.length_scale * gaps, rtol=ROUNDING, atol=ROUNDING)
     assert np.any(gaps < 0)  # the case presses
+    if friction:
+        moved_speed = transform.factor(length=1, time=-1) * scene.contact.friction_speed
+        assert moved.contact.friction_speed == pytest.approx(moved_speed, rel=1e-15)
     force = ChainContactForces(scene.chain, scene.contact).forces_world(q.T, qdot.T)
     force_moved = ChainContactForces(moved.chain, moved.contact).forces_world(q_moved.T, qdot_moved.T)
     unit = transform.factor(length=1, mass=1, time=-2)

@@ -54,6 +54,8 @@ def test_the_scene_reads_as_written(data):
     (lambda d: d["contact"].update(friction=-0.5), "contact.friction", ">= 0"),
     (lambda d: d["contact"].update(friction=500.0), "contact.friction", "physical range"),
     (lambda d: d["contact"].update(friction="0.5"), "contact.friction", "a number"),
+    (lambda d: d["contact"].update(friction=0.5, friction_speed=0.0), "contact.friction_speed", "> 0"),
+    (lambda d: d["contact"].update(stands="yes"), "contact.stands", "true or false"),
     (lambda d: d["initial"].update(base_position=[0.0, 0.0, 0.33]), "contact.sphere[0]", "inside the plane"),
     (lambda d: d.pop("plane"), "contact", "without a [[plane]]"),
     (lambda d: d["plane"][0].update(coefficients=[0.0, 0.0, 0.0, 1.0]), "plane[0].coefficients", "all zeros"),
@@ -103,6 +105,7 @@ def test_a_rigid_contact_reads_as_written(rigid):
     (lambda d: d["contact"].update(penalty_stiffness=1e4), "contact.penalty_stiffness", "not both"),
     (lambda d: d["contact"].update(penalty_damping=10.0), "contact.penalty_damping", "not both"),
     (lambda d: d["contact"].update(friction=0.5), "contact.friction", "a rigid contact's impacts are frictionless"),
+    (lambda d: d["contact"].update(friction_speed=0.1), "contact.friction_speed", "on a soft contact"),
 ])
 def test_a_meaningless_rigid_contact_is_refused_in_one_line_naming_its_key(rigid, edit, key, words):
     with pytest.raises(SceneError) as caught:
@@ -111,9 +114,13 @@ def test_a_meaningless_rigid_contact_is_refused_in_one_line_naming_its_key(rigid
     assert key in message and words in message and "\n" not in message, message
 
 
-def test_friction_reads_as_written_and_defaults_to_a_frictionless_plane(data):
-    assert parse_scene(data).contact.friction == 0.0
-    assert parse_scene(_edited(data, lambda d: d["contact"].update(friction=0.6))).contact.friction == 0.6
+def test_friction_reads_as_written_and_defaults_to_a_frictionless_plane(data, rigid):
+    assert parse_scene(data).contact.friction == 0.0 and parse_scene(data).contact.friction_speed == 1e-2
+    edited = parse_scene(_edited(data, lambda d: d["contact"].update(friction=0.6, friction_speed=0.05))).contact
+    assert (edited.friction, edited.friction_speed) == (0.6, 0.05)
+    assert parse_scene(_edited(rigid, lambda d: d["contact"].update(friction=0.0))).contact.friction == 0.0
+    assert not parse_scene(data).contact.stands
+    assert parse_scene(_edited(data, lambda d: d["contact"].update(stands=True))).contact.stands
 
 
 def test_a_rest_speed_on_a_soft_contact_is_refused(data):
@@ -145,3 +152,11 @@ def test_core_as_the_reference_of_a_floating_rigid_contact_is_refused_in_one_lin
         parse_scene(data, "drop.toml")
     message = str(caught.value)
     assert "scene.reference" in message and "fixed base only" in message and "\n" not in message, message
+
+
+def test_stands_on_a_fixed_base_is_refused_in_one_line():
+    data = tomllib.loads(Path(resolve("pendulum-press")).read_text(encoding="utf-8"))
+    with pytest.raises(SceneError) as caught:
+        parse_scene(_edited(data, lambda d: d["contact"].update(stands=True)), "press.toml")
+    message = str(caught.value)
+    assert "contact.stands" in message and "floating base" in message and "\n" not in message, message
