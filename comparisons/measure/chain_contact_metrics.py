@@ -66,8 +66,8 @@ from simparity.core.model.scenes.chain_contact import ChainContact
 from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 
-FORCE_METRICS = (SIGNORINI_VIOLATION_MAX, FRICTION_CONE_VIOLATION_MAX, SLIDING_FRICTION_ERROR, SLIDING_FRICTION_ANGLE_MAX,
-                 REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR)
+FORCE_METRICS = (SIGNORINI_VIOLATION_MAX, FRICTION_CONE_VIOLATION_MAX, SLIDING_FRICTION_ERROR,
+                 SLIDING_FRICTION_ANGLE_MAX, REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR)
 """The metrics that need the engine's contact forces (:meth:`JointSimulation.contact_forces`)."""
 
 REST_ACCELERATION = 1e-3
@@ -87,6 +87,9 @@ between them, whose force an engine that steps on impulses reports."""
 FRICTION_ROUNDING = 1e-9
 """[1 of mu f_n] A sliding contact's friction this small is rounding (a normal force's tangential residue): it has no
 direction for ``sliding_friction_angle_max`` to judge (``sliding_friction_error`` reads its absence, 1)."""
+REGULARISED_SLIPS = 2.0
+"""A sliding sphere also slips at least this many times the scene's ``friction_speed``, below which core's penalty
+friction is regularised (inside the cone by design): a scene that sets it high is judged on faster slips."""
 SLIDING_TURN = 0.1
 """[rad] The most a sliding sphere's slip may turn between two samples (:data:`SLIDING_SPEED`)."""
 UNLOADED = 1e-12
@@ -210,55 +213,68 @@ def _forces(scene: JointMotionScene, contact: ChainContact, forces: np.ndarray, 
                 f"tangential force beyond the Coulomb cone (mu = {contact.friction:g}), over the weight"))}
 
 
-def _centre_error(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, centres: np.ndarray) -> Measured:
+class _Truth:
+    """Pinocchio's model of the scene's chain and contact (:class:`references.pinocchio.statics.PinocchioStatics`),
+    built once for a case's metrics: the independent model their truths are read by; ``why`` says why not where it
+    cannot be built (not installed, or Pinocchio refuses the chain)."""
+
+    def __init__(self, scene: JointMotionScene) -> None:
+        self.model, self.why = None, ""
+        contact = scene.contact
+        assert contact is not None
+        try:
+            from simparity.references.pinocchio.statics import PinocchioStatics
+            self.model = PinocchioStatics(scene.chain, scene.gravity_world, contact)
+        except Exception as err:  # noqa: BLE001 - not installed, or Pinocchio refuses the chain
+            self.why = f"Pinocchio's model of the chain, which cannot be built here: {error_text(err)}"
+
+
+def _centre_error(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, centres: np.ndarray,
+                  truth: _Truth) -> Measured:
     """``contact_centre_error``: the engine's sphere centres (S, B, spheres, 3) at the samples ``index`` against
     Pinocchio's forward kinematics of the file at the same configurations, the largest distance over the radius."""
     contact = scene.contact
     assert contact is not None
+    if truth.model is None:
+        return Measured(math.nan, "1", unmeasurable=f"the spheres' places are read by {truth.why}")
     try:
-        from simparity.references.pinocchio.statics import PinocchioStatics
-        truth = PinocchioStatics(scene.chain, scene.gravity_world, contact).centres(_states(traj, index)[0])
-    except Exception as err:  # noqa: BLE001 - not installed, or Pinocchio refuses the chain
-        return Measured(math.nan, "1", unmeasurable=(
-            f"the spheres' places are read by Pinocchio's model of the chain, which cannot be built here: "
-            f"{error_text(err)}"))
-    off = np.linalg.norm(centres - truth.reshape(centres.shape), axis=-1) / contact.radii
+        places = truth.model.centres(_states(traj, index)[0])
+    except Exception as err:  # noqa: BLE001 - Pinocchio refuses a configuration
+        return Measured(math.nan, "1", unmeasurable=f"Pinocchio's kinematics failed: {error_text(err)}")
+    off = np.linalg.norm(centres - places.reshape(centres.shape), axis=-1) / contact.radii
     return Measured(float(off.max()), "1", note="the engine's sphere centres against Pinocchio's kinematics of the "
                                                 "file, over the radius")
 
 
 def _sliding(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, forces: np.ndarray,
-             weight: float) -> dict[str, Measured]:
+             weight: float, truth: _Truth) -> dict[str, Measured]:
     """``sliding_friction_error`` and ``sliding_friction_angle_max`` of forces (S, B, spheres, 3) at the samples
     ``index`` (see the module docstring); n/a with why on a frictionless plane or where nothing slides."""
     contact = scene.contact
     assert contact is not None
-    metrics = (SLIDING_FRICTION_ERROR, SLIDING_FRICTION_ANGLE_MAX)
+    units = {SLIDING_FRICTION_ERROR: "1", SLIDING_FRICTION_ANGLE_MAX: "rad"}
     if contact.friction == 0:
-        return {m: Measured(math.nan, "1" if m == SLIDING_FRICTION_ERROR else "rad", flag=NOTHING_TO_MEASURE,
+        return {m: Measured(math.nan, unit, flag=NOTHING_TO_MEASURE,
                             unmeasurable=("a frictionless plane: nothing to slide against (friction_cone_violation_max "
-                                          "holds its tangential force to 0)")) for m in metrics}
-    try:
-        from simparity.references.pinocchio.statics import PinocchioStatics
-        velocities = PinocchioStatics(scene.chain, scene.gravity_world, contact).contact_point_velocities(
-            *_states(traj, index)).reshape(forces.shape)
-    except Exception as err:  # noqa: BLE001 - not installed, or Pinocchio refuses the chain
-        return {m: Measured(math.nan, "1" if m == SLIDING_FRICTION_ERROR else "rad", unmeasurable=(
-            f"the slip is read by Pinocchio's model of the chain, which cannot be built here: {error_text(err)}"))
-            for m in metrics}
+                                          "holds its tangential force to 0)")) for m, unit in units.items()}
+    if truth.model is None:
+        return {m: Measured(math.nan, unit, unmeasurable=f"the slip is read by {truth.why}")
+                for m, unit in units.items()}
+    velocities = truth.model.contact_point_velocities(*_states(traj, index)).reshape(forces.shape)
     normal = np.asarray(contact.plane.normal_world)
     slip = velocities - (velocities @ normal)[..., None] * normal
     speed = np.linalg.norm(slip, axis=-1)
-    threshold = SLIDING_SPEED * math.sqrt(weight / scene.chain.mass * reach(scene.chain))  # weight / m = |g|
+    threshold = max(SLIDING_SPEED * math.sqrt(weight / scene.chain.mass * reach(scene.chain)),  # weight / m = |g|
+                    REGULARISED_SLIPS * contact.friction_speed)
     direction = slip / np.where(speed > 0, speed, 1.0)[..., None]
     f_n = forces @ normal
     tangential = forces - f_n[..., None] * normal
     held = ((speed[:-1] >= threshold) & (speed[1:] >= threshold) & (f_n[:-1] > UNLOADED * weight)
             & (np.sum(direction[:-1] * direction[1:], axis=-1) >= math.cos(SLIDING_TURN)))
     if not held.any():
-        why = (f"no pushed sphere slid faster than {threshold:.3g} m/s (0.1 sqrt(g reach)) at two samples in a row")
-        return {m: Measured(math.nan, "1" if m == SLIDING_FRICTION_ERROR else "rad", flag=NOTHING_TO_MEASURE,
-                            unmeasurable=why) for m in metrics}
+        why = (f"no pushed sphere slid faster than {threshold:.3g} m/s (0.1 sqrt(g reach), at least twice the "
+               f"friction_speed) at two samples in a row")
+        return {m: Measured(math.nan, unit, flag=NOTHING_TO_MEASURE, unmeasurable=why) for m, unit in units.items()}
     f_t, bound = tangential[:-1][held], contact.friction * f_n[:-1][held]
     size = np.linalg.norm(f_t, axis=-1)
     pointing = size > FRICTION_ROUNDING * bound  # a friction at rounding has no direction to judge
@@ -280,8 +296,9 @@ def _rest(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, 
     last = index[-2:]
     try:
         momentum = np.asarray(sim.momentum(*_states(traj, last)), dtype=float).reshape(2, traj.q.shape[1], 6)
-    except NotImplementedError as err:
-        return Measured(math.nan, "1", unmeasurable=f"at rest cannot be told: {err}")
+    except NotImplementedError as err:  # a scene that says its robot stands needs it told: an alarm then
+        return Measured(math.nan, "1", flag=NOT_AT_REST if scene.contact is not None and scene.contact.stands else "",
+                        unmeasurable=f"at rest cannot be told: {err}")
     interval = float(traj.times[last[1]] - traj.times[last[0]])
     acceleration = float(np.linalg.norm(momentum[1, :, :3] - momentum[0, :, :3], axis=-1).max()) / (mass * interval)
     g = float(np.linalg.norm(np.asarray(scene.gravity_world)))
@@ -344,26 +361,22 @@ def _rest_acceleration(scene: JointMotionScene, traj: JointTrajectory, index: np
 
 
 def _equilibrium(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, forces: np.ndarray,
-                 weight: float, rest: Measured) -> Measured:
+                 weight: float, rest: Measured, truth: _Truth) -> Measured:
     """``rest_equilibrium_error`` at the last sample (see the module docstring); n/a with why when not at rest."""
     if scene.chain.floating_base and rest.unmeasurable:
         return Measured(math.nan, "1", flag=rest.flag or NOTHING_TO_MEASURE, unmeasurable=rest.unmeasurable)
     moving = _joints_at_rest(scene, traj, index)
     if moving:
         return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=moving)
-    try:
-        from simparity.references.pinocchio.statics import PinocchioStatics
-    except ImportError as err:
-        return Measured(math.nan, "1", unmeasurable=f"its truth is Pinocchio's model, not installed here: {err}")
-    contact = scene.contact
-    assert contact is not None
+    if truth.model is None:
+        return Measured(math.nan, "1", unmeasurable=f"its truth is {truth.why}")
     q = np.asarray(traj.q[index[-1]])
     qdot = np.asarray(traj.qdot[index[-1]])
     try:
-        balance = PinocchioStatics(scene.chain, scene.gravity_world, contact).balance(q, forces[-1])
-    except Exception as err:  # noqa: BLE001 - Pinocchio refuses the chain (an unlimited prismatic joint in URDF, ...)
-        return Measured(math.nan, "1", unmeasurable=(
-            f"its truth is Pinocchio's model of the chain, which Pinocchio cannot build: {error_text(err)}"))
+        balance = truth.model.balance(q, forces[-1])
+    except Exception as err:  # noqa: BLE001 - Pinocchio refuses a configuration
+        return Measured(math.nan, "1",
+                        unmeasurable=f"its truth, Pinocchio's model of the chain, failed: {error_text(err)}")
     n = scene.chain.n_joints
     held = np.zeros_like(balance)  # what holds the chain: the applied joint forces less the damping (none on a base)
     damping = np.array([j.damping for j in scene.chain.joints])
@@ -402,8 +415,9 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
     except NotImplementedError as err:
         return {m: Measured(math.nan, "1", unmeasurable=str(err)) for m in CHAIN_CONTACT_METRICS}
     gaps = contact.gaps(centres)
+    truth = _Truth(scene)
     out = _touchdown(scene, sim, traj, index, gaps) | {
-        CONTACT_CENTRE_ERROR: _centre_error(scene, traj, index, centres),
+        CONTACT_CENTRE_ERROR: _centre_error(scene, traj, index, centres, truth),
         REST_ACCELERATION_MAX: _rest_acceleration(scene, traj, index),
         CONTACT_PENETRATION_MAX: Measured(float(np.maximum(-gaps / contact.radii, 0.0).max()), "1",
                                           note="deepest sinking over the sphere's radius"),
@@ -423,5 +437,5 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
     out[CONTACT_ENERGY_GAIN_MAX] = _energy_gain(scene, traj, own, gaps,
                                                 np.linalg.norm(forces, axis=-1) <= UNLOADED * weight)
     rest = _rest(scene, sim, traj, index, forces, weight, mass)
-    return out | _forces(scene, contact, forces, gaps, weight) | _sliding(scene, traj, index, forces, weight) | {
-        REST_WEIGHT_ERROR: rest, REST_EQUILIBRIUM_ERROR: _equilibrium(scene, traj, index, forces, weight, rest)}
+    return out | _forces(scene, contact, forces, gaps, weight) | _sliding(scene, traj, index, forces, weight, truth) | {
+        REST_WEIGHT_ERROR: rest, REST_EQUILIBRIUM_ERROR: _equilibrium(scene, traj, index, forces, weight, rest, truth)}

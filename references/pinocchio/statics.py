@@ -6,7 +6,8 @@ Pinocchio as an external force on the joint that carries its frame, expressed in
 moment about the joint's origin (Pinocchio's convention for ``fext``), the sphere's centre placed by Pinocchio's own
 frames (a chain joint's frame is its joint's; the end effector is the URDF link's frame; the base link is the free
 flyer's, or the universe on a fixed base, where a force holds nothing); with friction at the sphere's contact point
-``centre - radius N`` instead, where a tangential force acts (on a frictionless plane both lie on the force's line). A floating base's rows are turned to world
+``centre - radius N`` instead, where a tangential force acts (on a frictionless plane both lie on the force's
+line). A floating base's rows are turned to world
 axes (:mod:`references.common.floating_base`). At rest the joints' rows equal the applied joint forces less the
 damping and a floating base's rows are zero: g(q) - sum_s J_s^T f_s = tau.
 
@@ -42,8 +43,8 @@ class PinocchioStatics:
         self._radii = contact.radii
         self._normal = np.asarray(contact.plane.normal_world, dtype=float)
         self._joints, self._points = sphere_anchors(self._model, chain, contact)
-        self._lowest = (contact.radii[:, None] * np.asarray(contact.plane.normal_world, dtype=float)
-                        if contact.friction > 0 else None)
+        self._centre_to_point = (-contact.radii[:, None] * np.asarray(contact.plane.normal_world, dtype=float)
+                                 if contact.friction > 0 else None)  # (S, 3) world: centre to contact point
 
     def balance(self, q: np.ndarray, forces_world: np.ndarray) -> np.ndarray:
         """(B, nv): the generalized force that holds the chain still at q (B, nq) under gravity and ``forces_world``
@@ -60,7 +61,7 @@ class PinocchioStatics:
             for k, (joint, point, force) in enumerate(zip(self._joints, self._points, forces_world[b])):
                 rotation = d.oMi[joint].rotation
                 local = rotation.T @ force
-                at = point if self._lowest is None else point - rotation.T @ self._lowest[k]
+                at = point if self._centre_to_point is None else point + rotation.T @ self._centre_to_point[k]
                 external[joint] = external[joint] + pin.Force(local, np.cross(at, local))
             out[b] = pin.rnea(m, d, configuration, zero, zero, external)[self._index]
         return turned_base(base_rotations(q), out, True, True) if self._floating else out

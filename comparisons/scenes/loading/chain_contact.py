@@ -86,6 +86,10 @@ def _soft(c: TableReader, chain: Chain, plane: Plane, spheres: tuple[ContactSphe
     friction = c.number("friction", 0.0)
     if friction < 0:
         raise c.fail("friction", f"{friction:g} is negative", "a Coulomb coefficient >= 0 (0: a frictionless plane)")
+    friction += 0.0  # -0.0 is 0
+    if c.has("friction_speed") and friction == 0:
+        raise c.fail("friction_speed", "a friction speed on a frictionless plane",
+                     "friction_speed with friction > 0 (core's regularisation of it)")
     friction_speed = c.number("friction_speed", 1e-2, positive=True, length=1)  # m/s
     stiffness = c.number("penalty_stiffness", positive=True)  # N/m = kg / s^2: no length
     damping = (c.number("penalty_damping") if c.has("penalty_damping")

@@ -56,6 +56,7 @@ def test_the_scene_reads_as_written(data):
     (lambda d: d["contact"].update(friction="0.5"), "contact.friction", "a number"),
     (lambda d: d["contact"].update(friction=0.5, friction_speed=0.0), "contact.friction_speed", "> 0"),
     (lambda d: d["contact"].update(stands="yes"), "contact.stands", "true or false"),
+    (lambda d: d["contact"].update(friction_speed=0.05), "contact.friction_speed", "friction > 0"),
     (lambda d: d["initial"].update(base_position=[0.0, 0.0, 0.33]), "contact.sphere[0]", "inside the plane"),
     (lambda d: d.pop("plane"), "contact", "without a [[plane]]"),
     (lambda d: d["plane"][0].update(coefficients=[0.0, 0.0, 0.0, 1.0]), "plane[0].coefficients", "all zeros"),
@@ -119,6 +120,7 @@ def test_friction_reads_as_written_and_defaults_to_a_frictionless_plane(data, ri
     edited = parse_scene(_edited(data, lambda d: d["contact"].update(friction=0.6, friction_speed=0.05))).contact
     assert (edited.friction, edited.friction_speed) == (0.6, 0.05)
     assert parse_scene(_edited(rigid, lambda d: d["contact"].update(friction=0.0))).contact.friction == 0.0
+    assert str(parse_scene(_edited(data, lambda d: d["contact"].update(friction=-0.0))).contact.friction) == "0.0"
     assert not parse_scene(data).contact.stands
     assert parse_scene(_edited(data, lambda d: d["contact"].update(stands=True))).contact.stands
 
