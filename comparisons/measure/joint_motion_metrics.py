@@ -372,6 +372,10 @@ def momentum_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointT
                               dtype=float).reshape(len(own.index), traj.q.shape[1], 6)
     except NotImplementedError as err:
         return {m: Measured(math.nan, "1", unmeasurable=str(err)) for m in MOMENTUM_METRICS}
+    if scene.contact is not None and scene.contact.friction > 0:
+        why = ("a plane with friction pushes along itself too: no component of the momentum is kept (its forces are "
+               "judged by the friction cone and the sliding friction)")
+        return {m: Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=why) for m in MOMENTUM_METRICS}
     chain = scene.chain
     assert chain.base_inertia is not None  # a floating chain's dynamics_problem() says so
     mass = chain.mass

@@ -80,7 +80,8 @@ def _finest_table(rows: pd.DataFrame, columns: tuple[tuple[str, str], ...], abou
         return []
     return [Paragraph(about.format(dt=f"{finest['dt'].iloc[0]:g}")),
             Table(("engine", "integrator") + tuple(head for _, head in columns),
-                  tuple((e, i) + tuple(cells.get((e, i, m), "—") for m in names) for e, i in cases))]
+                  tuple((e, i) + tuple(cells.get((e, i, m), "—") for m in names) for e, i in cases),
+                  trim_order=SCENE_TABLE_TRIM_ORDER, keep_at_least=0)]  # report.html has every row
 
 
 def _momentum(rows: pd.DataFrame) -> list[Block]:

@@ -448,3 +448,15 @@ def test_sliding_friction_is_n_a_on_a_frictionless_plane_and_where_nothing_slide
     slow = replace(traj, qdot=traj.qdot * 0.1)  # 0.05 m/s: below the threshold
     out = _sliding(slope, slow, np.arange(3), forces, weight, _Truth(slope))
     assert "slid faster" in out["sliding_friction_angle_max"].unmeasurable
+
+
+def test_a_plane_with_friction_keeps_no_momentum_component():
+    """Friction pushes along the plane: the frictionless plane's laws (P along it, L along its normal) do not hold."""
+    from simparity.comparisons.measure.joint_motion_metrics import momentum_metrics
+
+    slope = load_scene("solo12-incline-slide")
+    short = replace(slope, duration=0.01, dts=(1e-3,))
+    sim = CoreJointMotion(short, "rk4", 1e-3)
+    traj = sim.run(10)
+    out = momentum_metrics(short, sim, traj, read_own(sim, traj))
+    assert all(math.isnan(m.value) and "friction" in m.unmeasurable for m in out.values())
