@@ -10,8 +10,7 @@ itself and its moment (p - x_base) x F about the base origin, in world axes. Wit
 plane also resists the slip u_t of the contact point (the sphere's link's point at ``c - r N``, where the engines put
 it too) with the penalty method's regularised Coulomb friction -mu |F_n| u_t / max(|u_t|, v_reg), v_reg the scene's
 ``friction_speed`` (:func:`core.contact.particle.sliding_friction`, as the free bodies'), and the whole force acts
-there; without
-friction nothing acts along the plane.
+there; without friction nothing acts along the plane.
 """
 
 from __future__ import annotations

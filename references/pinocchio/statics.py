@@ -40,11 +40,9 @@ class PinocchioStatics:
         self._index = np.r_[0:6, dynamics.idx_v] if chain.floating_base else np.asarray(dynamics.idx_v)
         self._velocity = (dynamics.local_velocity if isinstance(dynamics, PinocchioFloatingDynamics)
                           else lambda q_row, qdot_row: dynamics._velocity(qdot_row[0]))
-        self._radii = contact.radii
-        self._normal = np.asarray(contact.plane.normal_world, dtype=float)
         self._joints, self._points = sphere_anchors(self._model, chain, contact)
-        self._centre_to_point = (-contact.radii[:, None] * np.asarray(contact.plane.normal_world, dtype=float)
-                                 if contact.friction > 0 else None)  # (S, 3) world: centre to contact point
+        self._centre_to_point = -contact.radii[:, None] * np.asarray(contact.plane.normal_world, dtype=float)  # (S, 3)
+        self._at_contact_point = contact.friction > 0  # where the forces act: the centres on a frictionless plane
 
     def balance(self, q: np.ndarray, forces_world: np.ndarray) -> np.ndarray:
         """(B, nv): the generalized force that holds the chain still at q (B, nq) under gravity and ``forces_world``
@@ -61,7 +59,7 @@ class PinocchioStatics:
             for k, (joint, point, force) in enumerate(zip(self._joints, self._points, forces_world[b])):
                 rotation = d.oMi[joint].rotation
                 local = rotation.T @ force
-                at = point if self._centre_to_point is None else point + rotation.T @ self._centre_to_point[k]
+                at = point + rotation.T @ self._centre_to_point[k] if self._at_contact_point else point
                 external[joint] = external[joint] + pin.Force(local, np.cross(at, local))
             out[b] = pin.rnea(m, d, configuration, zero, zero, external)[self._index]
         return turned_base(base_rotations(q), out, True, True) if self._floating else out
@@ -85,7 +83,7 @@ class PinocchioStatics:
             pin.forwardKinematics(m, d, self._configuration(row), self._velocity(row[None], rates[None]))
             for k, (joint, point) in enumerate(zip(self._joints, self._points)):
                 rotation = d.oMi[joint].rotation
-                at = point - self._radii[k] * rotation.T @ self._normal
+                at = point + rotation.T @ self._centre_to_point[k]
                 motion = pin.getVelocity(m, d, joint, pin.LOCAL)
                 out[b, k] = rotation @ (motion.linear + np.cross(motion.angular, at))
         return out
