@@ -23,6 +23,16 @@ another's trajectory; each is held to what any correct contact must give:
   cone, |f_t| = mu f_n (the error is ||f_t| - mu f_n| / (mu f_n), the largest), and opposes the slip (the angle between
   f_t and -u_t, the largest: 0 for Coulomb's maximal dissipation; friction that only takes energy keeps it below
   pi / 2, a bound any engine meets, while soft and per-direction solvers turn it by their own amounts).
+- ``friction_impulse_error``: the friction an engine reports is the friction that moved it. A floating base meets
+  the plane and gravity only, so its momentum's change along the plane is the impulse of gravity and of the reported
+  contact forces along it (Newton): |t(P(T) - P(0) - int (sum f + m g) dt)| over the friction impulse the plane
+  could give, mu int f_n dt, the largest copy (t the part along the plane). The integral is the closest of the left,
+  right and trapezoid rules over the samples: at every step the left rule is a one-step explicit or semi-implicit
+  scheme's own (its step applies the force at its start: a chattering contact's too), and the trapezoid is within
+  O(dt^2) of a smooth force's. An engine that reports Coulomb's friction but steps without it reads ~1, and so does
+  a scheme that stalls where its forces do not balance (core's RK4 at 1 ms on a stiff regularised friction sits at a
+  spurious fixed point, reporting 0.08 of the weight along the plane). Between samples sparser than the steps it is
+  n/a where the samples do not resolve the friction's impulse (:data:`IMPULSE_RESOLVED`).
 - ``contact_energy_gain_max``: contact and damping only take energy (a soft contact stores some while it is
   compressed, and gives back at most that), so the mechanical energy never exceeds what it was at any earlier instant
   where no contact stores any (every sphere off the plane, or carrying no force where the engine reports forces:
@@ -48,6 +58,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.integrate import trapezoid
 
 from simparity.comparisons.measure.joint_motion_metrics import (
     CHAIN_CONTACT_METRICS, OwnReading, applied_torque, energy_budget, reach, work_done,
@@ -57,7 +68,7 @@ from simparity.comparisons.measure.rows import Measured
 from simparity.core.model.engine import JointSimulation
 from simparity.core.model.metric_catalogue import (
     CONTACT_CENTRE_ERROR, CONTACT_ENERGY_GAIN_MAX, CONTACT_PENETRATION_MAX, FRICTION_CONE_VIOLATION_MAX,
-    REST_ACCELERATION_MAX,
+    FRICTION_IMPULSE_ERROR, REST_ACCELERATION_MAX,
     REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR, SIGNORINI_VIOLATION_MAX, SLIDING_FRICTION_ANGLE_MAX,
     SLIDING_FRICTION_ERROR, TOUCHDOWN_TIME_ERROR, TOUCHDOWN_TIME_STEPS,
 )
@@ -67,7 +78,7 @@ from simparity.core.model.scenes.joint_motion import JointMotionScene
 from simparity.core.model.trajectory import JointTrajectory
 
 FORCE_METRICS = (SIGNORINI_VIOLATION_MAX, FRICTION_CONE_VIOLATION_MAX, SLIDING_FRICTION_ERROR,
-                 SLIDING_FRICTION_ANGLE_MAX, REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR)
+                 SLIDING_FRICTION_ANGLE_MAX, FRICTION_IMPULSE_ERROR, REST_WEIGHT_ERROR, REST_EQUILIBRIUM_ERROR)
 """The metrics that need the engine's contact forces (:meth:`JointSimulation.contact_forces`)."""
 
 REST_ACCELERATION = 1e-3
@@ -90,6 +101,11 @@ direction for ``sliding_friction_angle_max`` to judge (``sliding_friction_error`
 REGULARISED_SLIPS = 2.0
 """A sliding sphere also slips at least this many times the scene's ``friction_speed``, below which core's penalty
 friction is regularised (inside the cone by design): a scene that sets it high is judged on faster slips."""
+IMPULSE_RESOLVED = 0.25
+"""[1 of mu int f_n dt] Where the samples are sparser than the steps, ``friction_impulse_error`` is measured only if they
+resolve the friction's impulse: the trapezoid of the tangential contact force over the samples and over every other
+sample agree within this (a contact that chatters between samples leaves the integral unknown: n/a, not a number).
+Friction reported but not applied reads ~1, so a quadrature that cannot tell a quarter of it cannot judge it."""
 SLIDING_TURN = 0.1
 """[rad] The most a sliding sphere's slip may turn between two samples (:data:`SLIDING_SPEED`)."""
 UNLOADED = 1e-12
@@ -288,6 +304,54 @@ def _sliding(scene: JointMotionScene, traj: JointTrajectory, index: np.ndarray, 
                                                  note=f"angle between the friction and -slip over {note}")}
 
 
+def _along_plane(vectors: np.ndarray, normal: np.ndarray) -> np.ndarray:
+    """(..., 3) the part of ``vectors`` (..., 3) along the plane of unit ``normal`` (3,)."""
+    return vectors - (vectors @ normal)[..., None] * normal
+
+
+def _friction_impulse(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, index: np.ndarray,
+                      forces: np.ndarray, mass: float) -> Measured:
+    """``friction_impulse_error`` of forces (S, B, spheres, 3) at the samples ``index`` (see the module docstring);
+    n/a with why on a frictionless plane, a fixed base, where nothing presses, or where the samples cannot resolve it."""
+    contact = scene.contact
+    assert contact is not None and scene.gravity_world is not None
+    if contact.friction == 0:
+        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=(
+            "a frictionless plane: the momentum along it is held by the momentum laws"))
+    if not scene.chain.floating_base:
+        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE,
+                        unmeasurable="a fixed base's mount pushes it by a force nobody reports")
+    q, qdot = _states(traj, index)
+    try:
+        momentum = np.asarray(sim.momentum(q, qdot), dtype=float).reshape(forces.shape[:2] + (6,))[..., :3]
+    except NotImplementedError as err:
+        return Measured(math.nan, "1", unmeasurable=f"the momentum's change cannot be read: {err}")
+    normal = np.asarray(contact.plane.normal_world)
+    times = np.asarray(traj.times, dtype=float)[index]
+    pressing = contact.friction * trapezoid(np.maximum(forces @ normal, 0.0).sum(axis=2), times, axis=0)  # (B,)
+    if not (pressing > 0).all():
+        return Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable="no sphere pressed on the plane")
+    tangential = _along_plane(forces.sum(axis=2), normal)  # (S, B, 3)
+    if len(index) < len(traj.times):  # between samples: the quadrature must resolve the force
+        odd = len(times) - 1 + len(times) % 2  # every other sample ends on a sample
+        halved = np.linalg.norm(trapezoid(tangential[:odd], times[:odd], axis=0)
+                                - trapezoid(tangential[:odd:2], times[:odd:2], axis=0), axis=-1) / pressing
+        if halved.max() > IMPULSE_RESOLVED:
+            return Measured(math.nan, "1", unmeasurable=(
+                f"the samples (one in {(len(traj.times) - 1) / (len(index) - 1):.3g} steps) do not resolve the "
+                f"friction's impulse: over every other sample it moves by {halved.max():.3g} of mu int f_n dt "
+                f"(resolved: at most {IMPULSE_RESOLVED:g})"))
+    steps = np.diff(times)[:, None, None]
+    change = _along_plane(momentum[-1] - momentum[0] - mass * (times[-1] - times[0]) * np.asarray(
+        scene.gravity_world), normal)
+    rules = (np.sum(steps * tangential[:-1], axis=0), np.sum(steps * tangential[1:], axis=0))  # left, right
+    unexplained = np.min([np.linalg.norm(change - impulse, axis=-1) / pressing
+                          for impulse in (*rules, (rules[0] + rules[1]) / 2)], axis=0)
+    return Measured(float(unexplained.max()), "1", note=(
+        "the momentum's change along the plane less gravity's and the reported forces' impulse (the closest of the "
+        "left, right and trapezoid rules over the samples), over mu int f_n dt"))
+
+
 def _rest(scene: JointMotionScene, sim: JointSimulation, traj: JointTrajectory, index: np.ndarray,
           forces: np.ndarray, weight: float, mass: float) -> Measured:
     if not scene.chain.floating_base:
@@ -438,4 +502,5 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
                                                 np.linalg.norm(forces, axis=-1) <= UNLOADED * weight)
     rest = _rest(scene, sim, traj, index, forces, weight, mass)
     return out | _forces(scene, contact, forces, gaps, weight) | _sliding(scene, traj, index, forces, weight, truth) | {
+        FRICTION_IMPULSE_ERROR: _friction_impulse(scene, sim, traj, index, forces, mass),
         REST_WEIGHT_ERROR: rest, REST_EQUILIBRIUM_ERROR: _equilibrium(scene, traj, index, forces, weight, rest, truth)}

@@ -177,6 +177,7 @@ FRICTION_CONE_VIOLATION_MAX = "friction_cone_violation_max"
 SLIDING_FRICTION_ERROR = "sliding_friction_error"
 CONTACT_CENTRE_ERROR = "contact_centre_error"
 SLIDING_FRICTION_ANGLE_MAX = "sliding_friction_angle_max"
+FRICTION_IMPULSE_ERROR = "friction_impulse_error"
 CONTACT_ENERGY_GAIN_MAX = "contact_energy_gain_max"
 REST_WEIGHT_ERROR = "rest_weight_error"
 REST_EQUILIBRIUM_ERROR = "rest_equilibrium_error"
@@ -322,6 +323,9 @@ CATALOGUE: dict[str, Metric] = {m.name: m for m in (
     Metric(SLIDING_FRICTION_ANGLE_MAX, "rad", CONTACT,
            theory="Coulomb's friction opposes the slip (maximal dissipation): 0; friction that only takes energy: "
                   "below pi / 2"),
+    Metric(FRICTION_IMPULSE_ERROR, DIMENSIONLESS, CONTACT,
+           theory="a floating base's momentum along the plane changes by gravity's and the reported contact forces' "
+                  "impulse: 0 up to the scheme's and the samples' quadrature"),
     Metric(CONTACT_ENERGY_GAIN_MAX, DIMENSIONLESS, CONTACT,
            theory="contact and damping only take energy: 0 up to the scheme's error"),
     Metric(REST_WEIGHT_ERROR, DIMENSIONLESS, CONTACT, theory="at rest the plane carries the weight: 0"),

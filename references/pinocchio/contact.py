@@ -119,11 +119,8 @@ class PlaneContact:
         self._friction = float(contact.friction)
         self._frame = _contact_frame(self._normal)
         self._solver, self._result = pin.ADMMConstraintSolver(), pin.ADMMSolverResult()
-        self._settings = pin.ADMMSolverSettings()
-        s = self._settings
-        s.max_iterations = SOLVER_MAX_ITERATIONS
-        s.absolute_complementarity_tol = s.absolute_feasibility_tol = SOLVER_TOLERANCE
-        s.relative_complementarity_tol = s.relative_feasibility_tol = SOLVER_TOLERANCE
+        self._settings = _limited(pin.ADMMSolverSettings())
+        self._pgs_settings = _limited(pin.PGSSolverSettings())
         self.detail = (f"contact: PointContactConstraintModel per sphere at gap <= 0 (harness detection, no margin), "
                        f"friction {self._friction:g}{' (Coulomb cone)' if self._friction > 0 else ''}, no Baumgarte, "
                        f"no compliance; impulses by "
@@ -206,12 +203,19 @@ class PlaneContact:
 
     def _pgs(self, delassus: np.ndarray, free: np.ndarray, models, datas) -> np.ndarray:
         """(3k,) the impulses of Pinocchio's PGS (:meth:`_admm`'s arguments), at its iteration limit and tolerance."""
-        settings, result = pin.PGSSolverSettings(), pin.PGSSolverResult()
-        settings.max_iterations = SOLVER_MAX_ITERATIONS
-        settings.absolute_complementarity_tol = settings.absolute_feasibility_tol = SOLVER_TOLERANCE
-        settings.relative_complementarity_tol = settings.relative_feasibility_tol = SOLVER_TOLERANCE
-        pin.PGSConstraintSolver().solve(pin.DelassusOperatorDense(delassus), free, models, datas, settings, result)
+        result = pin.PGSSolverResult()  # a fresh solver and result per solve: nothing carried from the last
+        pin.PGSConstraintSolver().solve(pin.DelassusOperatorDense(delassus), free, models, datas, self._pgs_settings,
+                                        result)
         return np.asarray(result.retrieveConstraintImpulses(), dtype=float)
+
+
+def _limited(settings):
+    """Pinocchio's solver ``settings`` (ADMM's or PGS's) at :data:`SOLVER_MAX_ITERATIONS` and every tolerance at
+    :data:`SOLVER_TOLERANCE`: the same stopping rule for each solver the contact tries."""
+    settings.max_iterations = SOLVER_MAX_ITERATIONS
+    settings.absolute_complementarity_tol = settings.absolute_feasibility_tol = SOLVER_TOLERANCE
+    settings.relative_complementarity_tol = settings.relative_feasibility_tol = SOLVER_TOLERANCE
+    return settings
 
 
 def frictionless(delassus: np.ndarray, free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -181,6 +181,14 @@ class PinocchioJointDynamics(JointDynamicsModel):
         self.detail = (f"{self._chain.source}; M = crba, h = nle, tau = rnea + D qdot, qddot = aba(tau - D qdot); "
                        "kinetic energy from forwardKinematics' joint velocities and model.inertias")
 
+    def configuration(self, q_row: np.ndarray) -> np.ndarray:
+        """Pinocchio's configuration (nq,) of a project configuration (n,)."""
+        return self._configuration(q_row)
+
+    def local_velocity(self, q: np.ndarray, qdot: np.ndarray) -> np.ndarray:
+        """Pinocchio's velocity (nv,) of a project state q (1, n), qdot (1, n) (a fixed base's: its joint rates)."""
+        return self._velocity(qdot[0])
+
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         out = np.empty((len(q), len(self.idx_v), len(self.idx_v)))
         for k, row in enumerate(q):

@@ -35,11 +35,8 @@ class PinocchioStatics:
         dynamics = (PinocchioFloatingDynamics(chain, gravity_world) if chain.floating_base
                     else PinocchioJointDynamics(chain, gravity_world))
         self._model, self._data = dynamics.model, dynamics.model.createData()
-        self._configuration = (dynamics.configuration if isinstance(dynamics, PinocchioFloatingDynamics)
-                               else dynamics._configuration)
+        self._configuration, self._velocity = dynamics.configuration, dynamics.local_velocity
         self._index = np.r_[0:6, dynamics.idx_v] if chain.floating_base else np.asarray(dynamics.idx_v)
-        self._velocity = (dynamics.local_velocity if isinstance(dynamics, PinocchioFloatingDynamics)
-                          else lambda q_row, qdot_row: dynamics._velocity(qdot_row[0]))
         self._joints, self._points = sphere_anchors(self._model, chain, contact)
         self._centre_to_point = -contact.radii[:, None] * np.asarray(contact.plane.normal_world, dtype=float)  # (S, 3)
         self._at_contact_point = contact.friction > 0  # where the forces act: the centres on a frictionless plane

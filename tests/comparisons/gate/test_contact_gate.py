@@ -5,7 +5,7 @@ from their bodies' centres of mass; MuJoCo's forces read without
 the applied torque; Pinocchio's impulses reported as forces; a Pinocchio contact that bounces, so that the arm never
 rests; PyBullet's spheres left with Bullet's default friction; on a slope with friction: MuJoCo's contact without the
 friction or with its pyramidal cone, its friction reported on the wrong side, PyBullet's spheres given twice the
-friction or its cone friction off (a box), core's friction turned along the slip) turns the check of ``solo12-drop-stand``, ``pendulum-press``, ``arm-strike-press`` or
+friction or its cone friction off (a box), core's friction turned along the slip or reported but not applied) turns the check of ``solo12-drop-stand``, ``pendulum-press``, ``arm-strike-press`` or
 ``solo12-incline-slide`` red naming it and the metric that sees it; faithful copies of MuJoCo, Pinocchio and PyBullet
 pass on them and on ``solo12-incline-stand``. A sweep (a run of the scene per bug), in ``.ci/run``."""
 
@@ -183,6 +183,14 @@ class PushingFriction(CoreJointMotion):
         self._contact = PushingForces(scene.chain, scene.contact)
 
 
+class UnappliedFriction(CoreJointMotion):
+    """Core stepping on a frictionless plane while reporting the scene's Coulomb friction at each sampled state."""
+
+    def __init__(self, scene, scheme, dt):
+        super().__init__(replace(scene, contact=replace(scene.contact, friction=0.0)), scheme, dt)
+        self._contact = ChainContactForces(scene.chain, scene.contact)
+
+
 class NoFriction(MujocoJointMotion):
     """MuJoCo's contact built without the scene's friction (condim 1 on every geom): the feet slide freely."""
 
@@ -240,6 +248,7 @@ DefaultFrictionEngine = _engine(PybulletEngine, DefaultFriction, "pybullet-defau
 DoubleFrictionEngine = _engine(PybulletEngine, DoubleFriction, "pybullet-double-friction")
 BoxFrictionEngine = _engine(PybulletEngine, BoxFriction, "pybullet-box-friction")
 PushingFrictionEngine = _engine(InHouseEngine, PushingFriction, "core-pushing-friction")
+UnappliedFrictionEngine = _engine(InHouseEngine, UnappliedFriction, "core-unapplied-friction")
 NoFrictionEngine = _engine(MujocoEngine, NoFriction, "mujoco-no-friction")
 PyramidEngine = _engine(MujocoEngine, Pyramid, "mujoco-pyramid")
 WrongSideFrictionEngine = _engine(MujocoEngine, WrongSideFriction, "mujoco-wrong-side-friction")
@@ -275,6 +284,7 @@ def _run(tmp_path, monkeypatch, capsys, plugin: str, scene: str = "solo12-drop-s
     ("BoxFrictionEngine", "pybullet-box-friction", "sliding_friction_error", "solo12-incline-slide"),
     ("PushingFrictionEngine", "core-pushing-friction", "sliding_friction_angle_max", "solo12-incline-slide"),
     ("NoFrictionEngine", "mujoco-no-friction", "sliding_friction_error", "solo12-incline-slide"),
+    ("UnappliedFrictionEngine", "core-unapplied-friction", "friction_impulse_error", "solo12-incline-slide"),
     ("NoFrictionEngine", "mujoco-no-friction", "rest_weight_error", "solo12-incline-stand"),  # it slides: not-at-rest
     ("PyramidEngine", "mujoco-pyramid", "sliding_friction_error", "solo12-incline-slide"),
     ("WrongSideFrictionEngine", "mujoco-wrong-side-friction", "sliding_friction_angle_max", "solo12-incline-slide"),

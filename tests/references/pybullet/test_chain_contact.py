@@ -1,7 +1,8 @@
 """PyBullet's contact of a fixed-base chain's spheres with a plane (``references/pybullet/chain_contact.py``, issue
 #46): every default it sets, pinned; the spheres placed where Pinocchio's independent model places them; the force of
 one step from a pressed state the same as Pinocchio's time-stepping contact gives (both solve the same velocity-level
-problem: two codes, one answer); a sphere above the plane pushed by nothing; copies that never touch each other."""
+problem: two codes, one answer); a sphere above the plane pushed by nothing; copies that never touch each other; a
+sliding foot's friction on the Coulomb cone of the scene's mu."""
 
 from __future__ import annotations
 
@@ -92,3 +93,27 @@ def test_a_floating_base_on_the_ground_is_stepped_and_an_mjcf_one_is_n_a_with_wh
 def test_chain_bodies_without_contact_load_the_file_unchanged(arm):
     assert "<collision" not in ChainBodies(arm.chain, arm.gravity_world).urdf_text
     assert ChainBodies(arm.chain, arm.gravity_world, contact=arm.contact).urdf_text.count("<sphere") == 2
+
+
+ON_THE_CONE = 1e-9
+"""[1 of mu f_n] A sliding sphere's friction on Bullet's Coulomb cone: its rows scaled back onto it (measured 1 to
+rounding); with ``enableConeFriction`` 0 each row is clamped alone, a box whose corner is sqrt(2) mu f_n."""
+
+
+def test_a_sliding_foot_s_friction_is_on_the_cone_of_the_scene_s_mu():
+    """``lateralFriction`` mu on every sphere link and ``enableConeFriction`` 1 (not readable back: pinned by what it
+    does): Solo-12 pressed 0.1 mm into the slope and sliding downhill at 0.5 m/s, 30 degrees off Bullet's axes."""
+    slope = load_scene("solo12-incline-slide")
+    world, contact = _world(slope, DT, 1)
+    assert {pybullet.getDynamicsInfo(world.body, link, physicsClientId=world.client)[1]
+            for link in set(contact.links)} == {slope.contact.friction}
+    normal = np.asarray(slope.contact.plane.normal_world)
+    downhill = np.array([0.0, 0.0, -1.0]) + normal[2] * normal
+    q, qdot = slope.q0.copy(), np.zeros((1, slope.chain.nv))
+    q[0, :3] -= (0.002 + 1e-4) * normal  # the scene starts 2 mm above the plane
+    qdot[0, :3] = 0.5 * downhill / np.linalg.norm(downhill)
+    forces = PybulletJointMotion(slope, DT).contact_forces(q, qdot, np.zeros(1))[0]
+    f_n = forces @ normal
+    f_t = np.linalg.norm(forces - f_n[:, None] * normal, axis=1)
+    assert np.all(f_n > 1.0)  # every foot pressed: newtons
+    assert np.abs(f_t / (slope.contact.friction * f_n) - 1.0).max() < ON_THE_CONE
