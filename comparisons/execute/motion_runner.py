@@ -25,8 +25,8 @@ from simparity.comparisons.execute.derivative_runner import with_derivative_sche
 from simparity.comparisons.execute.step_jacobian_runner import step_jacobian_values
 from simparity.comparisons.execute.timing import best_of
 from simparity.comparisons.measure.joint_motion_metrics import (
-    REFERENCE_ERRORS, Horizon, OwnReading, divergence, energy_metrics, momentum_metrics, motion_metrics, parting_times,
-    reach, read_own, reference_errors, reference_horizon, state_scales,
+    REFERENCE_ERRORS, Horizon, OwnReading, configuration_gap, divergence, energy_metrics, momentum_metrics,
+    motion_metrics, parting_times, reach, read_own, reference_errors, reference_horizon, state_scales,
 )
 from simparity.comparisons.measure.chain_contact_metrics import contact_metrics
 from simparity.comparisons.measure.held_forcing import forcing_scheme
@@ -300,14 +300,14 @@ def _consistency_errors(scene: JointMotionScene, engine: Engine, case: Case, tra
     note = (f"self-consistency: {scene.copies} segments of {scene.duration:.3g} s from the reference's motion, "
             f"each end against the same integrator at dt / {REFINEMENT}, the largest over segments")
     values = {
-        JOINT_ANGLE_ERROR_MAX: float((np.abs(traj.q[-1] - fine.q[-1]) / scales).max()),
+        JOINT_ANGLE_ERROR_MAX: float((configuration_gap(scene.chain, traj.q[-1], fine.q[-1]) / scales).max()),
         JOINT_VELOCITY_ERROR_MAX: float((np.abs(traj.qdot[-1] - fine.qdot[-1]) / rate_scales).max()) / speed,
         END_EFFECTOR_ERROR_MAX: float(np.linalg.norm(own.end_effector[-1] - end_effector, axis=-1).max())
                                 / reach(scene.chain),
     }
     out = {m: Measured(v, "1", note=note) for m, v in values.items()}
     out[SEGMENT_REFERENCE_ERROR_MAX] = (
-        Measured(float((np.abs(fine.q[-1] - ends[0]) / scales).max()), "1", note=(
+        Measured(float((configuration_gap(scene.chain, fine.q[-1], ends[0]) / scales).max()), "1", note=(
             f"each segment's end at dt / {REFINEMENT} against the reference's, the largest over segments"))
         if ends is not None else Measured(math.nan, "1", unmeasurable="the reference gave no segment ends"))
     return out

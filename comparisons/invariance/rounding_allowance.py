@@ -163,11 +163,15 @@ def _joint_dynamics_floors(scene: JointDynamicsScene) -> Floors:
 def _joint_motion_floors(scene: JointMotionScene) -> Floors:
     """A chain's motion: every metric is a ratio; each step rounds the state at eps relative to its size (its joint
     count's operations), and N steps add up (linearly at worst), as for free bodies; with the lever arms' rounding of a
-    chain placed far away (:func:`_joint_dynamics_floors`)."""
+    chain placed far away (:func:`_joint_dynamics_floors`; a floating base's by its initial place, its frames within
+    the chain's reach bound of it)."""
     steps = max(scene.n_steps(dt) for dt in scene.dts)
     unit = ALLOWANCE_FACTOR * float(np.finfo(float).eps) * scene.chain.n_joints * steps
     reach = _reach(scene.chain)
     size = reach - float(np.linalg.norm(scene.chain.joints[0].origin_xyz))
+    if scene.chain.floating_base:  # the chain's frames lie around its base, which the state places in the world
+        size = reach
+        reach += float(np.linalg.norm(np.asarray(scene.q0)[:, :3], axis=1).max())
     ratio = unit * max(1.0, reach / size) if size > 0 else unit
     return Floors(length=unit * reach, speed=0.0, spin=0.0, angle=ratio, time=unit * scene.duration, generic=ratio,
                   length_scale=reach, mass_scale=1.0, time_scale=scene.duration)

@@ -338,12 +338,15 @@ def _joint(joint: Joint, t: Transform, first: bool) -> Joint:
                    armature=t.factor(length=per_rad, mass=1) * joint.armature)
 
 
-def _chain(chain: Chain, t: Transform, source: str) -> Chain:
+def _chain(chain: Chain, t: Transform, source: str, base_in_state: bool = False) -> Chain:
     if chain.robot_file is not None:
+        what = ("which every engine loads itself: the scene cannot scale its lengths (or masses); its floating base "
+                "moves with the state under a rotation or translation" if base_in_state and chain.floating_base else
+                "which every engine loads itself with its base link as the world: the scene cannot move its base or "
+                "scale its lengths (or masses)")
         raise TransformError(source, f"transform {t.name}", f"chain {one_line(chain.name)} is read from the "
                              f"{'URDF' if chain.urdf_path is not None else 'MJCF'} file "
-                             f"{one_line(chain.robot_file)}, which every engine loads itself with its base link as the "
-                             "world: the scene cannot move its base or scale its lengths (or masses)",
+                             f"{one_line(chain.robot_file)}, {what}",
                              "a chain written in the scene file (joints or dh), or the transform applied to the URDF "
                              "file itself")
     free_slides = [j.name for j in chain.joints if j.type == "prismatic" and not j.limited]
@@ -374,12 +377,14 @@ def _chain_scene(scene: KinematicsScene | IKScene, t: Transform):
                    position_tolerance=t.length_scale * scene.position_tolerance)
 
 
-def _timed_chain(chain: Chain, t: Transform, source: str) -> Chain:
+def _timed_chain(chain: Chain, t: Transform, source: str, base_in_state: bool = False) -> Chain:
     """A chain with mass and time: placed and scaled (:func:`_chain`); under a change of the unit of time alone, only
     its joints' damping (N m s/rad: per second) changes, and a URDF chain keeps its file (the engines take damping
-    from the chain, never from the file's ``<dynamics>``)."""
-    if t.moves_frame or t.mass_scale != 1.0:
-        return _chain(chain, t, source)
+    from the chain, never from the file's ``<dynamics>``). With ``base_in_state`` (a floating base, which the scene's
+    state places in the world) a rotation or translation moves the state, not the chain: its file is kept then too."""
+    rigid_move = base_in_state and chain.floating_base and t.length_scale == 1.0
+    if (t.moves_frame and not rigid_move) or t.mass_scale != 1.0:
+        return _chain(chain, t, source, base_in_state)
     return replace(chain, joints=tuple(replace(j, damping=j.damping / t.time_scale) for j in chain.joints))
 
 
@@ -397,17 +402,23 @@ def _joint_dynamics_scene(scene: JointDynamicsScene, t: Transform) -> JointDynam
 
 
 def _joint_motion_scene(scene: JointMotionScene, t: Transform) -> JointMotionScene:
-    """The chain placed, scaled and given mass and time units as a joint-dynamics scene's; gravity turned and scaled;
-    the initial joint values, velocities and torques (the timed one's time too), the duration and the time steps in
-    the new units."""
-    chain = _timed_chain(scene.chain, t, scene.source)
+    """The chain placed, scaled and given mass and time units as a joint-dynamics scene's (a floating base's robot
+    file kept under a rotation or translation: the base is placed by the state); gravity turned and scaled; the
+    initial joint values, velocities and torques (the timed one's time too), a floating base's pose and velocity
+    placed, turned and scaled, the duration and the time steps in the new units."""
+    chain = _timed_chain(scene.chain, t, scene.source, base_in_state=True)
     variable = scene.chain.length_powers[scene.chain.base_dofs:]  # the joints' power of length: m or rad
     gravity, timed = scene.gravity_world, scene.timed_torque
     torque_scale = t.length_scale ** (2 - variable) * t.factor(mass=1, time=-2)
+    q0 = t.length_scale ** scene.chain.configuration_length_powers * scene.q0
+    qdot0 = t.length_scale ** scene.chain.length_powers / t.time_scale * scene.qdot0
+    if scene.chain.floating_base:  # the base's pose and velocity are the world's: placed and turned
+        q0[:, :3], q0[:, 3:7] = t.point(scene.q0[:, :3]), quat_wxyz_multiply(t.quat_wxyz, scene.q0[:, 3:7])
+        qdot0[:, :3] = t.vector(scene.qdot0[:, :3], length=1, time=-1)
+        qdot0[:, 3:6] = t.vector(scene.qdot0[:, 3:6], time=-1)
     return replace(scene, chain=chain, gravity_world=None if gravity is None else t.vector(gravity, length=1, time=-2),
                    contact=None if scene.contact is None else _chain_contact(scene, scene.contact, t),
-                   q0=t.length_scale ** scene.chain.configuration_length_powers * scene.q0,
-                   qdot0=t.length_scale ** scene.chain.length_powers / t.time_scale * scene.qdot0,
+                   q0=q0, qdot0=qdot0,
                    torque=torque_scale * scene.torque,
                    timed_torque=None if timed is None else _time_function(timed, t, torque_scale, turned=False),
                    duration=t.time_scale * scene.duration, dts=tuple(t.time_scale * dt for dt in scene.dts))

@@ -138,6 +138,18 @@ def state_scales(chain: Chain, motion: JointTrajectory) -> tuple[np.ndarray, np.
             np.concatenate([np.full(3, length), np.ones(3), joints]))
 
 
+def configuration_gap(chain: Chain, q: np.ndarray, like: np.ndarray) -> np.ndarray:
+    """(..., nq) |q - like| component by component, of configurations q and ``like`` (..., nq): a floating base's
+    quaternion taken in ``like``'s hemisphere (q and -q are one orientation; an engine that keeps w >= 0 flips the sign
+    wherever w crosses 0, a whole turn's worth of components for an unchanged orientation)."""
+    q, like = np.asarray(q, dtype=float), np.asarray(like, dtype=float)
+    if not chain.floating_base:
+        return np.abs(q - like)
+    turned = np.sum(q[..., 3:7] * like[..., 3:7], axis=-1, keepdims=True) < 0
+    aligned = np.concatenate([q[..., :3], np.where(turned, -q[..., 3:7], q[..., 3:7]), q[..., 7:]], axis=-1)
+    return np.abs(aligned - like)
+
+
 def reach(chain: Chain) -> float:
     """[m] The chain's size: the sum of its joint offsets after the first joint and its end-effector offset; at
     least the largest link's centre-of-mass offset and its radius of gyration sqrt(tr I_c / 2m) (a physical size of
@@ -437,7 +449,7 @@ def reference_horizon(scene: JointMotionScene, ref: JointTrajectory, coarse: Joi
     if coarse is None:
         return Horizon(len(ref.times), {})
     scales, rate_scales = state_scales(scene.chain, ref)
-    angle = (np.abs(ref.q - coarse.q) / scales).max(axis=(1, 2))
+    angle = (configuration_gap(scene.chain, coarse.q, ref.q) / scales).max(axis=(1, 2))
     speed = _speed_scale(ref, rate_scales)
     velocity = (np.abs(ref.qdot - coarse.qdot) / rate_scales).max(axis=(1, 2)) / speed
     beyond = np.flatnonzero(~(angle <= HORIZON_FLOOR))
@@ -479,7 +491,7 @@ def reference_errors(scene: JointMotionScene, traj: JointTrajectory, own: OwnRea
     length = max(reach(scene.chain), float(travel))  # a slider's tip may travel farther than the chain is long
     within = own.index < end
     values = {
-        JOINT_ANGLE_ERROR_MAX: float((np.abs(traj.q[:end] - ref.q[:end]) / scales).max()),
+        JOINT_ANGLE_ERROR_MAX: float((configuration_gap(scene.chain, traj.q[:end], ref.q[:end]) / scales).max()),
         JOINT_VELOCITY_ERROR_MAX: float((np.abs(traj.qdot[:end] - ref.qdot[:end]) / rate_scales).max()) / speed,
         END_EFFECTOR_ERROR_MAX: float(np.linalg.norm(own.end_effector[within] - ref_end_effector[within],
                                                      axis=-1).max()) / length,
@@ -527,7 +539,7 @@ def parting_times(scene: JointMotionScene, traj: JointTrajectory, perturbed: Joi
     def parting(other: JointTrajectory | None, what: str) -> Measured:
         if other is None:
             return Measured(math.nan, "s", unmeasurable=f"no {what} to part from")
-        apart = np.flatnonzero((np.abs(traj.q - other.q) / scales).max(axis=(1, 2)) > PARTING)
+        apart = np.flatnonzero((configuration_gap(scene.chain, other.q, traj.q) / scales).max(axis=(1, 2)) > PARTING)
         if not apart.size:
             return Measured(math.nan, "s", unmeasurable=(
                 f"within {PARTING:g} rad of {what} for the whole run ({float(traj.times[-1]):.3g} s)"))

@@ -84,6 +84,7 @@ def test_known_class_minimal_file_shows_it(known, tmp_path, pybullet_client):
     assert not result.unknown, _verdict([result])
 
 
+@pytest.mark.slow  # over 1.5 s of CPU on a 2-core CI-class machine (tests/conftest.py)
 def test_the_minimiser_shrinks_a_model_to_what_shows_its_class(tmp_path, pybullet_client):
     """The first of the default run's models that shows PyBullet ignoring MJCF armature (a class needing one moving
     joint) minimises to a base and one link, still showing it, in a file less than half the size."""

@@ -37,7 +37,7 @@ def _case(name: str):
     return scene, tree_from_chain(scene.chain, scene.gravity_world), (q, qd, tau)
 
 
-@pytest.fixture(scope="module", params=["driven-arm", "double-pendulum", "chain-20"])
+@pytest.fixture(scope="module", params=["driven-arm", "double-pendulum", pytest.param("chain-20", marks=pytest.mark.slow)])
 def case(request):
     return _case(request.param)
 

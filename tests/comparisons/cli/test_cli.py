@@ -28,6 +28,7 @@ def _run(argv):
     return code, out.getvalue()
 
 
+@pytest.mark.slow  # over 1.5 s of CPU on a 2-core CI-class machine (tests/conftest.py)
 def test_list_names_every_builtin_scene():
     """'simparity list' prints one line per built-in scene, starting with its name; a file with a sweep, one line
     per variant in the sweep's order."""

@@ -76,6 +76,7 @@ def test_processes_forked_one_after_another_share_a_zygote_and_each_sees_its_req
     assert f"-m {zygote.__name__} " in _command(first[2])
 
 
+@pytest.mark.slow  # over 1.5 s of CPU on a 2-core CI-class machine (tests/conftest.py)
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads parents' command lines in Linux's /proc")
 def test_another_folder_gets_a_zygote_of_its_own_and_a_dead_zygote_is_replaced(monkeypatch, tmp_path):
     folder = os.getcwd()

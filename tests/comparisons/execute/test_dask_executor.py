@@ -49,6 +49,11 @@ def _mixed_scenes():
     return [lean(scene) for scene in smoke_scenes()]
 
 
+REGISTERED = 60
+"""[s] The longest a worker may take to register with the scheduler again (a loaded CI machine once showed 0 workers
+registered right after a run whose results were right)."""
+
+
 @pytest.fixture(scope="module")
 def dask():
     """A LocalCluster of :data:`WORKERS` workers shared by the module's tests. Its scheduler allows no retry of a task
@@ -71,6 +76,7 @@ def test_a_local_dask_cluster_gives_the_results_of_this_process(dask):
     got = list(run_scenes(scenes, built_engines(), make_engine, 0, dask))
     assert [s.name for s, _, _ in got] == [s.name for s in scenes]
     assert comparable(got) == comparable(expected)
+    dask.client.wait_for_workers(WORKERS, timeout=REGISTERED)  # a nanny's restart under load re-registers its worker
     assert len(dask.client.scheduler_info()["workers"]) == WORKERS
     assert all(address.startswith("tcp://127.0.0.1:") for address in dask.client.scheduler_info()["workers"])
 

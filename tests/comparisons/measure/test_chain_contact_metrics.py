@@ -498,16 +498,53 @@ def test_the_friction_impulse_is_n_a_with_why_where_it_cannot_be_told(scene):
     traj, forces, _, downhill = _slide_states(slope, 5)
     sim = CoreJointMotion(slope, "semi_implicit_euler", 1e-3)
     frictionless = replace(slope, contact=replace(slope.contact, friction=0.0))
-    assert "frictionless" in _friction_impulse(frictionless, sim, traj, np.arange(5), forces, 1.0).unmeasurable
+    assert "frictionless" in _friction_impulse(frictionless, sim, traj, forces, 1.0).unmeasurable
     arm = load_scene("pendulum-press")
     fixed = replace(arm, contact=replace(arm.contact, friction=0.5))
-    assert "mount" in _friction_impulse(fixed, sim, traj, np.arange(5), forces, 1.0).unmeasurable
+    assert "mount" in _friction_impulse(fixed, sim, traj, forces, 1.0).unmeasurable
     lifted = forces * 0.0
-    assert "pressed" in _friction_impulse(slope, sim, traj, np.arange(5), lifted, 1.0).unmeasurable
-    chattering = forces.copy()  # read at samples 0, 2, 4 of 5 steps: friction flipping at every sample
-    chattering[1::2] = forces[1::2] - 2 * (forces[1::2] - (forces[1::2] @ slope.contact.plane.normal_world)[
-        ..., None] * slope.contact.plane.normal_world)
-    sparse = _friction_impulse(slope, sim, replace(traj, times=np.arange(9) * 5e-4, q=np.repeat(traj.q, 2, axis=0)[:9],
-                                                   qdot=np.repeat(traj.qdot, 2, axis=0)[:9]),
-                               np.arange(0, 9, 2), chattering, 1.0)
-    assert "do not resolve" in sparse.unmeasurable, sparse
+    assert "pressed" in _friction_impulse(slope, sim, traj, lifted, 1.0).unmeasurable
+
+
+class _FlippingFriction:
+    """A robot of 1 kg on the slide's plane, its friction flipping along the plane at every step (+-1 N about 0.5 N
+    downhill), its momentum moved by the left rule, as a first-order scheme's: 9 steps of 1 ms."""
+
+    def __init__(self, slope, downhill):
+        normal = np.asarray(slope.contact.plane.normal_world)
+        self.weight_normal = 9.81 * normal[2]  # the plane carries gravity's normal part
+        self.forces = np.array([(self.weight_normal * normal + (0.5 + (-1.0) ** k) * downhill)
+                                for k in range(9)])[:, None, None, :]  # (9, 1, 1 sphere, 3)
+        gravity = np.asarray(slope.gravity_world)
+        self.momentum_rows = np.concatenate([[np.zeros(3)], np.cumsum(1e-3 * (self.forces[:-1, 0, 0] + gravity),
+                                                                      axis=0)])
+
+    def momentum(self, q, qdot):
+        step = np.rint(q[:, 0] * 1e3).astype(int)  # the hand-made states carry their step in q[0]
+        return np.concatenate([self.momentum_rows[step], np.zeros((len(step), 3))], axis=1)
+
+    def contact_forces(self, q, qdot, times):
+        return self.forces[np.rint(q[:, 0] * 1e3).astype(int), 0]
+
+
+def test_a_friction_that_flips_at_every_step_is_read_at_every_step_not_at_the_samples():
+    """Friction on a floating base is read at every step (``_reads_every_step``): there the left rule explains the
+    momentum exactly; at samples 0, 2, 4, 6 and 8 only, the friction would always be +1.5 N downhill, 2.1 of
+    mu int f_n dt off."""
+    from simparity.comparisons.measure.chain_contact_metrics import _friction_impulse, _reads_every_step
+    from simparity.core.model.trajectory import JointTrajectory
+
+    slope = load_scene("solo12-incline-slide")
+    assert _reads_every_step(slope)
+    assert not _reads_every_step(replace(slope, contact=replace(slope.contact, friction=0.0)))
+    normal = np.asarray(slope.contact.plane.normal_world)
+    downhill = np.array([0.0, 0.0, -1.0]) + normal[2] * normal
+    downhill /= np.linalg.norm(downhill)
+    sim = _FlippingFriction(slope, downhill)
+    q = np.zeros((9, 1, slope.chain.nq))
+    q[:, 0, 0] = np.arange(9) * 1e-3
+    every = JointTrajectory(np.arange(9) * 1e-3, q, np.zeros((9, 1, slope.chain.nv)))
+    assert _friction_impulse(slope, sim, every, sim.forces, 1.0).value <= PLANTED_READING
+    sampled = np.arange(0, 9, 2)
+    samples = JointTrajectory(every.times[sampled], q[sampled], every.qdot[sampled])
+    assert _friction_impulse(slope, sim, samples, sim.forces[sampled], 1.0).value == pytest.approx(2.06, abs=0.01)

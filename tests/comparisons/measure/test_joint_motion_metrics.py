@@ -208,3 +208,21 @@ def test_the_momentum_metrics_see_the_motion_about_the_centre_of_mass_only():
             assert other[metric].value == pytest.approx(measured.value, rel=1e-3), metric
     assert all(m.unmeasurable and "does not move about its centre of mass" in m.unmeasurable
                for m in _free_flight_metrics(still=True).values())
+
+
+def test_a_floating_base_s_quaternion_and_its_negative_are_one_orientation():
+    """An engine that keeps w >= 0 (PyBullet's base) flips its quaternion's sign where w crosses 0: the same
+    orientation, no error; a turned base is still an error, and a fixed base's values are compared as they are."""
+    joint = Joint("j", "revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.eye(3))
+    floating = Chain("c", (joint,), floating_base=True)  # q: position (3), quat_wxyz (4), the joint (1)
+    rng = np.random.default_rng(46)
+    like = rng.normal(size=(4, floating.nq))
+    like[:, 3:7] /= np.linalg.norm(like[:, 3:7], axis=1, keepdims=True)
+    flipped = like.copy()
+    flipped[1::2, 3:7] *= -1.0
+    assert not jm.configuration_gap(floating, flipped, like).any()
+    turned = like.copy()
+    turned[:, 3] += 0.1  # w moved: another orientation
+    assert jm.configuration_gap(floating, turned, like)[:, 3] == pytest.approx(0.1)
+    fixed = dataclasses.replace(floating, floating_base=False)
+    assert np.array_equal(jm.configuration_gap(fixed, flipped, like), np.abs(flipped - like))

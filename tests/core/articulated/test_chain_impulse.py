@@ -126,6 +126,7 @@ def _bounce():
     return builtin("pendulum-bounce")
 
 
+@pytest.mark.slow  # over 1.5 s of CPU on a 2-core CI-class machine (tests/conftest.py)
 @pytest.mark.parametrize("scheme", ["rk4", "semi_implicit_euler"])
 def test_time_is_backed_up_so_no_sphere_ends_a_step_inside(scheme):
     scene = _bounce()
@@ -137,6 +138,7 @@ def test_time_is_backed_up_so_no_sphere_ends_a_step_inside(scheme):
     assert np.count_nonzero(np.diff(np.sign(traj.qdot[:, 0, 0])) < 0) >= 5  # it bounced
 
 
+@pytest.mark.slow  # over 1.5 s of CPU on a 2-core CI-class machine (tests/conftest.py)
 def test_a_resting_pendulum_is_held_by_the_force_that_balances_gravity():
     scene = _bounce()
     sim = CoreJointMotion(scene, "rk4", 0.002)
@@ -194,6 +196,7 @@ def test_a_sphere_that_bounces_and_comes_back_within_a_step_is_caught():
     assert sim._rigid_run[1][-1, 0] == 0  # it ends resting on its one sphere
 
 
+@pytest.mark.slow  # over 1.5 s of CPU on a 2-core CI-class machine (tests/conftest.py)
 def test_a_resting_sphere_does_not_sink_under_semi_implicit_euler():
     scene = _tip_only(0.0)
     dt = 0.004
@@ -232,6 +235,7 @@ def _lifting():
     return parse_scene(data, "pendulum-lift"), rest
 
 
+@pytest.mark.slow  # two RK4 runs of 1.5 s with back-ups: 2.5-4.9 s of CPU on a 2-core CI-class machine
 def test_a_resting_sphere_lifts_off_at_the_instant_its_force_falls_to_zero():
     from scipy.integrate import solve_ivp
 

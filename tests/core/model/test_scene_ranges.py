@@ -27,6 +27,7 @@ def _with_link(scene, **changes):
     return _with_joint(scene, link=link)
 
 
+@pytest.mark.slow  # over 1.5 s of CPU on a 2-core CI-class machine (tests/conftest.py)
 def test_every_builtin_scene_as_loaded_is_within_the_ranges():
     for path in builtin_paths().values():
         for scene in load_scenes(path):
