@@ -26,7 +26,7 @@ from simparity.comparisons.execute.step_jacobian_runner import step_jacobian_val
 from simparity.comparisons.execute.timing import best_of
 from simparity.comparisons.measure.joint_motion_metrics import (
     REFERENCE_ERRORS, Horizon, OwnReading, configuration_gap, divergence, energy_metrics, momentum_metrics,
-    motion_metrics, parting_times, reach, read_own, reference_errors, reference_horizon, state_scales,
+    motion_metrics, parting_times, reach, read_own, reference_errors, reference_horizon, state_scales, velocity_gap,
 )
 from simparity.comparisons.measure.chain_contact_metrics import contact_metrics
 from simparity.comparisons.measure.held_forcing import forcing_scheme
@@ -295,13 +295,14 @@ def _consistency_errors(scene: JointMotionScene, engine: Engine, case: Case, tra
         return {m: Measured(math.nan, "1", unmeasurable=f"its run at dt / {REFINEMENT} failed: {why}")
                 for m in REFERENCE_ERRORS + (SEGMENT_REFERENCE_ERROR_MAX,)}
     scales, rate_scales = state_scales(scene.chain, fine)
-    speed = max(float((np.abs(fine.qdot) / rate_scales).max()), 1.0 / scene.duration)
+    speed = max(float((velocity_gap(scene.chain, fine.qdot, 0.0) / rate_scales).max()), 1.0 / scene.duration)
     end_effector = np.asarray(fine_sim.end_effector_world(np.asarray(fine.q[-1])), dtype=float)
     note = (f"self-consistency: {scene.copies} segments of {scene.duration:.3g} s from the reference's motion, "
             f"each end against the same integrator at dt / {REFINEMENT}, the largest over segments")
     values = {
         JOINT_ANGLE_ERROR_MAX: float((configuration_gap(scene.chain, traj.q[-1], fine.q[-1]) / scales).max()),
-        JOINT_VELOCITY_ERROR_MAX: float((np.abs(traj.qdot[-1] - fine.qdot[-1]) / rate_scales).max()) / speed,
+        JOINT_VELOCITY_ERROR_MAX: float((velocity_gap(scene.chain, traj.qdot[-1], fine.qdot[-1]) / rate_scales).max())
+                                  / speed,
         END_EFFECTOR_ERROR_MAX: float(np.linalg.norm(own.end_effector[-1] - end_effector, axis=-1).max())
                                 / reach(scene.chain),
     }

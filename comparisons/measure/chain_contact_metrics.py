@@ -118,6 +118,16 @@ def _states(traj: JointTrajectory, index: np.ndarray) -> tuple[np.ndarray, np.nd
             np.ascontiguousarray(traj.qdot[index]).reshape(-1, traj.qdot.shape[2]))
 
 
+def _forces_along_each_run(sim: JointSimulation, traj: JointTrajectory, index: np.ndarray) -> np.ndarray:
+    """(S, B, spheres, 3) the engine's contact forces [N] at the samples ``index``, read copy by copy, each copy's in
+    the order of its run (an engine whose reading carries contact history, PyBullet's manifolds, carries its own
+    copy's, not another's: :func:`_reads_every_step`)."""
+    q, qdot = (np.ascontiguousarray(np.swapaxes(x[index], 0, 1)).reshape(-1, x.shape[2]) for x in (traj.q, traj.qdot))
+    times = np.tile(np.asarray(traj.times, dtype=float)[index], traj.q.shape[1])
+    forces = np.asarray(sim.contact_forces(q, qdot, times), dtype=float)
+    return np.swapaxes(forces.reshape((traj.q.shape[1], len(index)) + forces.shape[1:]), 0, 1)
+
+
 def _centres(sim: JointSimulation, traj: JointTrajectory, index: np.ndarray, spheres: int) -> np.ndarray:
     """(S, B, spheres, 3) the engine's sphere centres at the samples ``index``."""
     q, _ = _states(traj, index)
@@ -494,9 +504,7 @@ def contact_metrics(scene: JointMotionScene, sim: JointSimulation, traj: JointTr
             m: Measured(math.nan, "1", flag=NOTHING_TO_MEASURE, unmeasurable=why) for m in FORCE_METRICS}
     read = np.arange(len(traj.times)) if _reads_every_step(scene) else index
     try:
-        times = np.repeat(np.asarray(traj.times)[read], traj.q.shape[1])
-        read_forces = np.asarray(sim.contact_forces(*_states(traj, read), times), dtype=float).reshape(
-            (len(read),) + gaps.shape[1:] + (3,))
+        read_forces = _forces_along_each_run(sim, traj, read)
     except NotImplementedError as err:
         return out | {CONTACT_ENERGY_GAIN_MAX: _energy_gain(scene, traj, own, gaps, None)} | {
             m: Measured(math.nan, "1", unmeasurable=str(err)) for m in FORCE_METRICS}

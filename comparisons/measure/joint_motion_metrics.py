@@ -125,29 +125,44 @@ def joint_scales(chain: Chain, motion: JointTrajectory) -> np.ndarray:
 
 
 def state_scales(chain: Chain, motion: JointTrajectory) -> tuple[np.ndarray, np.ndarray]:
-    """((nq,), (nv,)) what one unit of each configuration and velocity component's error is: the joints'
+    """((k,), (k,)) what one unit of each entry of :func:`configuration_gap` and :func:`velocity_gap` is: the joints'
     (:func:`joint_scales`), after a floating base's: its position and linear velocity the larger of the chain's reach
-    and the base's travel in ``motion`` (as a prismatic joint's), its quaternion's components and angular velocity 1
-    (a quaternion's component error is half the angle it turns by, in radians: unitless as a revolute joint's)."""
+    and the base's travel in ``motion`` (the farthest it gets from where it starts, as a prismatic joint's), its
+    orientation and angular velocity 1 (the quaternions' distance is half the angle between them, in radians:
+    unitless as a revolute joint's)."""
     joints = joint_scales(chain, motion)
     if not chain.floating_base:
         return joints, joints
-    travel = float(np.ptp(np.asarray(motion.q)[..., :3], axis=0).max())
+    position = np.asarray(motion.q)[..., :3]
+    travel = float(np.linalg.norm(position - position[:1], axis=-1).max())
     length = max(reach(chain), travel, np.finfo(float).tiny)
-    return (np.concatenate([np.full(3, length), np.ones(4), joints]),
-            np.concatenate([np.full(3, length), np.ones(3), joints]))
+    return np.concatenate([[length, 1.0], joints]), np.concatenate([[length, 1.0], joints])
 
 
 def configuration_gap(chain: Chain, q: np.ndarray, like: np.ndarray) -> np.ndarray:
-    """(..., nq) |q - like| component by component, of configurations q and ``like`` (..., nq): a floating base's
-    quaternion taken in ``like``'s hemisphere (q and -q are one orientation; an engine that keeps w >= 0 flips the sign
-    wherever w crosses 0, a whole turn's worth of components for an unchanged orientation)."""
+    """(..., k) how far configurations q are from ``like`` (..., nq): |q - like| joint by joint, after a floating
+    base's two entries, each the same in every frame (a world turned or moved turns or moves both alike): the
+    distance between the base positions and between the quaternions, q's taken in ``like``'s hemisphere (q and -q are
+    one orientation; an engine that keeps w >= 0 flips the sign wherever w crosses 0), 2 sin(angle / 4) ~ half the
+    angle between the orientations. k = nq - 5 for a floating base (7 base entries become 2), else nq."""
     q, like = np.asarray(q, dtype=float), np.asarray(like, dtype=float)
     if not chain.floating_base:
         return np.abs(q - like)
     turned = np.sum(q[..., 3:7] * like[..., 3:7], axis=-1, keepdims=True) < 0
-    aligned = np.concatenate([q[..., :3], np.where(turned, -q[..., 3:7], q[..., 3:7]), q[..., 7:]], axis=-1)
-    return np.abs(aligned - like)
+    quat_gap = np.linalg.norm(np.where(turned, -q[..., 3:7], q[..., 3:7]) - like[..., 3:7], axis=-1)
+    return np.concatenate([np.linalg.norm(q[..., :3] - like[..., :3], axis=-1)[..., None], quat_gap[..., None],
+                           np.abs(q[..., 7:] - like[..., 7:])], axis=-1)
+
+
+def velocity_gap(chain: Chain, qdot: np.ndarray, like: np.ndarray | float) -> np.ndarray:
+    """(..., k) how far velocities qdot are from ``like`` (..., nv, or 0 for qdot's sizes): |qdot - like| joint by
+    joint, after a floating base's two entries, the lengths of the linear and of the angular velocity's difference
+    (world axes: the same in every frame). k = nv - 4 for a floating base (6 base entries become 2), else nv."""
+    gap = np.asarray(qdot, dtype=float) - np.asarray(like, dtype=float)
+    if not chain.floating_base:
+        return np.abs(gap)
+    return np.concatenate([np.linalg.norm(gap[..., :3], axis=-1)[..., None],
+                           np.linalg.norm(gap[..., 3:6], axis=-1)[..., None], np.abs(gap[..., 6:])], axis=-1)
 
 
 def reach(chain: Chain) -> float:
@@ -450,8 +465,8 @@ def reference_horizon(scene: JointMotionScene, ref: JointTrajectory, coarse: Joi
         return Horizon(len(ref.times), {})
     scales, rate_scales = state_scales(scene.chain, ref)
     angle = (configuration_gap(scene.chain, coarse.q, ref.q) / scales).max(axis=(1, 2))
-    speed = _speed_scale(ref, rate_scales)
-    velocity = (np.abs(ref.qdot - coarse.qdot) / rate_scales).max(axis=(1, 2)) / speed
+    speed = _speed_scale(scene.chain, ref, rate_scales)
+    velocity = (velocity_gap(scene.chain, ref.qdot, coarse.qdot) / rate_scales).max(axis=(1, 2)) / speed
     beyond = np.flatnonzero(~(angle <= HORIZON_FLOOR))
     end = int(beyond[0]) if beyond.size else len(ref.times)
     floors = {JOINT_ANGLE_ERROR_MAX: float(angle[:end].max(initial=0.0)),
@@ -464,10 +479,11 @@ def reference_horizon(scene: JointMotionScene, ref: JointTrajectory, coarse: Joi
     return Horizon(end, floors, note)
 
 
-def _speed_scale(ref: JointTrajectory, scales: np.ndarray) -> float:
-    """The fastest unitless joint speed of the reference's motion [1/s], at least 1 / its duration."""
+def _speed_scale(chain: Chain, ref: JointTrajectory, scales: np.ndarray) -> float:
+    """The fastest unitless joint speed of the reference's motion [1/s] (a floating base's linear and angular speeds
+    among them), at least 1 / its duration."""
     duration = max(float(ref.times[-1] - ref.times[0]), np.finfo(float).tiny)
-    return max(float((np.abs(ref.qdot) / scales).max()), 1.0 / duration)
+    return max(float((velocity_gap(chain, ref.qdot, 0.0) / scales).max()), 1.0 / duration)
 
 
 def reference_errors(scene: JointMotionScene, traj: JointTrajectory, own: OwnReading, ref: JointTrajectory,
@@ -486,13 +502,14 @@ def reference_errors(scene: JointMotionScene, traj: JointTrajectory, own: OwnRea
         return ({m: Measured(math.nan, "1", flag=SATURATED, unmeasurable=why) for m in REFERENCE_ERRORS},
                 {m: math.inf for m in REFERENCE_ERRORS}, {})
     (scales, rate_scales), end = state_scales(scene.chain, ref), horizon.end
-    speed = _speed_scale(ref, rate_scales)
+    speed = _speed_scale(scene.chain, ref, rate_scales)
     travel = np.linalg.norm(ref_end_effector - ref_end_effector[:1], axis=-1).max()
     length = max(reach(scene.chain), float(travel))  # a slider's tip may travel farther than the chain is long
     within = own.index < end
     values = {
         JOINT_ANGLE_ERROR_MAX: float((configuration_gap(scene.chain, traj.q[:end], ref.q[:end]) / scales).max()),
-        JOINT_VELOCITY_ERROR_MAX: float((np.abs(traj.qdot[:end] - ref.qdot[:end]) / rate_scales).max()) / speed,
+        JOINT_VELOCITY_ERROR_MAX: float((velocity_gap(scene.chain, traj.qdot[:end], ref.qdot[:end]) / rate_scales).max())
+                                  / speed,
         END_EFFECTOR_ERROR_MAX: float(np.linalg.norm(own.end_effector[within] - ref_end_effector[within],
                                                      axis=-1).max()) / length,
     }
@@ -524,7 +541,8 @@ def _rounding_floors(scene: JointMotionScene, ref: JointTrajectory, scales: np.n
     steps = max(end - 1, 1)
     duration = float(ref.times[end - 1] - ref.times[0])
     unit = ROUNDING_FLOOR_FACTOR * np.finfo(float).eps * steps
-    size = float((np.abs(ref.q[:end]) / scales).max()) + duration * speed
+    sizes = configuration_gap(scene.chain, ref.q[:end], np.zeros_like(ref.q[:end]))  # a base's position: |p|
+    size = float((sizes / scales).max()) + duration * speed
     return {JOINT_ANGLE_ERROR_MAX: unit * size, JOINT_VELOCITY_ERROR_MAX: unit,
             END_EFFECTOR_ERROR_MAX: unit * max(size, 1.0)}
 

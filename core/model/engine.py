@@ -240,6 +240,8 @@ class JointSimulation(abc.ABC):
         """(B, S, 3) [N]: the force the plane exerts on each contact sphere, in world axes, at states q (B, nq) and
         qdot (B, nv) reached at ``times`` (B,) [s] (zero where a sphere does not touch), as the engine's contact model
         gives it at that state under the scene's applied forces at that time (a soft contact's force depends on them).
+        The states come copy by copy, each copy's in the order of its run (where friction acts on a floating base, every
+        step of it), so a reading that carries contact history (PyBullet's manifolds) carries its own run's.
         Not timed. Optional: the contact-force metrics are n/a where an engine does not say."""
         raise NotImplementedError(f"{type(self).__name__} does not report its contact forces (contact_forces)")
 

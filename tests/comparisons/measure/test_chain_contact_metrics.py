@@ -548,3 +548,34 @@ def test_a_friction_that_flips_at_every_step_is_read_at_every_step_not_at_the_sa
     sampled = np.arange(0, 9, 2)
     samples = JointTrajectory(every.times[sampled], q[sampled], every.qdot[sampled])
     assert _friction_impulse(slope, sim, samples, sim.forces[sampled], 1.0).value == pytest.approx(2.06, abs=0.01)
+
+
+class _HistoryReader:
+    """An engine whose contact reading carries history (as PyBullet's manifolds do): each force is the number of
+    the state it was asked about, and every call is recorded."""
+
+    def __init__(self):
+        self.calls = []
+
+    def contact_forces(self, q, qdot, times):
+        self.calls.append((q[:, 0].copy(), times.copy()))
+        return np.repeat(q[:, :1, None], 3, axis=2)  # (B, 1 sphere, 3): the state's copy and step
+
+
+def test_contact_forces_are_read_copy_by_copy_each_in_the_order_of_its_run():
+    """With several copies each copy's states reach the engine together and in the order of its run, so a reading
+    that carries history carries the copy's own; the forces come back to their sample and copy."""
+    from simparity.comparisons.measure.chain_contact_metrics import _forces_along_each_run
+    from simparity.core.model.trajectory import JointTrajectory
+
+    steps, copies = 5, 3
+    tag = 10.0 * np.arange(copies)[None, :] + np.arange(steps)[:, None]  # copy b at step k: 10 b + k
+    times = 1e-3 * np.arange(steps)
+    traj = JointTrajectory(times, np.repeat(tag[..., None], 2, axis=2), np.zeros((steps, copies, 2)))
+    sim = _HistoryReader()
+    forces = _forces_along_each_run(sim, traj, np.arange(steps))
+    assert forces.shape == (steps, copies, 1, 3)
+    assert np.array_equal(forces[..., 0, 0], tag)
+    (asked, asked_times), = sim.calls
+    assert np.array_equal(asked, (10.0 * np.arange(copies)[:, None] + np.arange(steps)[None, :]).ravel())
+    assert np.array_equal(asked_times, np.tile(times, copies))

@@ -24,6 +24,8 @@ from simparity.core.model.trajectory import JointTrajectory
 INERTIA = 1.0  # kg m^2 about the axis: a point mass of 1 kg at 1 m
 QUADRATURE_BOUND = 1e-10
 """Simpson's rule on an exponential sampled 2,000 times over 2 s is exact to ~1e-13 relative."""
+FRAME_FREE = 1e-12
+"""A gap computed in a turned and moved frame differs from the unmoved one's by rounding only (O(1) values)."""
 
 
 class _Sim(JointSimulation):
@@ -223,6 +225,40 @@ def test_a_floating_base_s_quaternion_and_its_negative_are_one_orientation():
     assert not jm.configuration_gap(floating, flipped, like).any()
     turned = like.copy()
     turned[:, 3] += 0.1  # w moved: another orientation
-    assert jm.configuration_gap(floating, turned, like)[:, 3] == pytest.approx(0.1)
+    assert jm.configuration_gap(floating, turned, like)[:, 1] == pytest.approx(0.1)  # the base's orientation entry
     fixed = dataclasses.replace(floating, floating_base=False)
     assert np.array_equal(jm.configuration_gap(fixed, flipped, like), np.abs(flipped - like))
+
+
+def test_a_floating_base_s_gaps_are_the_same_in_every_frame():
+    """A world turned and moved turns and moves a floating base's poses and velocities alike: its gaps are lengths
+    and an angle, not components along the world's axes (a base 0.01 m off along each axis is 0.01 sqrt(3) off in
+    every frame; the largest component read 0.0100 or 0.0144 as the world turned)."""
+    from scipy.spatial.transform import Rotation
+
+    joint = Joint("j", "revolute", np.array([0.0, 0.0, 1.0]), np.zeros(3), np.eye(3))
+    floating = Chain("c", (joint,), floating_base=True)
+    rng = np.random.default_rng(4601)
+    like = rng.normal(size=(5, floating.nq))
+    like[:, 3:7] /= np.linalg.norm(like[:, 3:7], axis=1, keepdims=True)
+    q = like + np.concatenate([np.full((5, 3), 0.01), 0.02 * rng.normal(size=(5, 5))], axis=1)
+    q[:, 3:7] /= np.linalg.norm(q[:, 3:7], axis=1, keepdims=True)
+    rates, like_rates = rng.normal(size=(2, 5, floating.nv))
+    turn, shift = Rotation.from_rotvec([0.3, -0.9, 0.5]), np.array([2.0, -1.0, 0.5])
+
+    def moved(config):
+        out = config.copy()
+        out[:, :3] = turn.apply(config[:, :3]) + shift
+        out[:, 3:7] = (turn * Rotation.from_quat(config[:, [4, 5, 6, 3]])).as_quat()[:, [3, 0, 1, 2]]
+        return out
+
+    def turned(velocity):
+        return np.concatenate([turn.apply(velocity[:, :3]), turn.apply(velocity[:, 3:6]), velocity[:, 6:]], axis=1)
+
+    gaps = jm.configuration_gap(floating, q, like)
+    assert gaps[:, 0] == pytest.approx(0.01 * np.sqrt(3.0), rel=1e-12)
+    assert np.allclose(jm.configuration_gap(floating, moved(q), moved(like)), gaps, rtol=0.0, atol=FRAME_FREE)
+    assert np.allclose(jm.velocity_gap(floating, turned(rates), turned(like_rates)),
+                       jm.velocity_gap(floating, rates, like_rates), rtol=0.0, atol=FRAME_FREE)
+    angle = (Rotation.from_quat(q[:, [4, 5, 6, 3]]) * Rotation.from_quat(like[:, [4, 5, 6, 3]]).inv()).magnitude()
+    assert gaps[:, 1] == pytest.approx(2.0 * np.sin(angle / 4.0), rel=1e-9)  # ~ half the angle between them
